@@ -1,0 +1,111 @@
+// The `kairos` command line.
+//
+//   kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE]
+//
+// User errors (config, files, impossible requests) print one line "kairos: error: ..." and exit
+// with status 2; SIGINT/SIGTERM finish the current event, write every output and exit 130/143.
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "io/config.hpp"
+#include "io/progress.hpp"
+#include "run/run.hpp"
+
+namespace {
+
+volatile std::sig_atomic_t g_signal = 0;
+
+extern "C" void on_signal(int sig) {
+  g_signal = sig;
+  kairos::request_stop();
+}
+
+void install_signal_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;  // a second signal kills at once
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+void print_summary(const kairos::RunOutcome& outcome) {
+  const auto& s = outcome.summary;
+  auto num = [&](const char* key) {
+    return s.contains(key) && s[key].is_number() ? s[key].get<double>() : std::nan("");
+  };
+  const auto& z = s["compressibility"];
+  const double zm = z["mean"].is_number() ? z["mean"].get<double>() : std::nan("");
+  const double ze = z["stderr"].is_number() ? z["stderr"].get<double>() : std::nan("");
+  fmt::print("\nKairos run {} ({})\n", outcome.interrupted ? "stopped early" : "finished",
+             s["stop_reason"].get<std::string>());
+  fmt::print("  particles            {} in {}D, packing fraction {:.6g}\n",
+             s["particles"].get<std::uint64_t>(), s["dimension"].get<int>(), num("packing_fraction"));
+  fmt::print("  events               {} ({} collisions) in {} wall\n",
+             s["events"].get<std::uint64_t>(), s["collisions"].get<std::uint64_t>(),
+             kairos::format_duration(num("wall_seconds")));
+  fmt::print("  speed                {:.3g} M events/s, {:.3g} M collisions/s\n",
+             num("events_per_second") / 1e6, num("collisions_per_second") / 1e6);
+  fmt::print("  simulated time       {:.6g}\n", num("sim_time"));
+  fmt::print("  temperature          {:.10g}\n", num("temperature"));
+  fmt::print("  compressibility Z    {:.5f} +- {:.5f}\n", zm, ze);
+  fmt::print("  mean free time       {:.6g}\n", num("mean_free_time"));
+  fmt::print("  energy drift (rel.)  {:.3g}\n", num("energy_drift_relative"));
+  fmt::print("  max overlap          {:.3g}\n", num("max_overlap"));
+  fmt::print("  peak memory          {:.1f} MiB\n", num("peak_rss_bytes") / 1048576.0);
+  fmt::print("  outputs              {}/ (summary.json, thermo.tsv, trajectory.gsd, restart.gsd)\n",
+             outcome.directory.string());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Kairos: event-driven molecular dynamics of hard spheres (3D) and hard disks (2D).\n"
+      "Configuration keys are documented in docs/config.md."};
+  app.set_version_flag("--version", std::string("kairos ") + KAIROS_VERSION);
+  app.require_subcommand(1);
+
+  std::string config_path, outdir, restart;
+  std::vector<std::string> overrides;
+  auto* run = app.add_subcommand("run", "Run a simulation described by a TOML config file.");
+  run->add_option("config", config_path, "TOML configuration file (see docs/config.md)")
+      ->required();
+  run->add_option("-o,--output", outdir,
+                  "Output directory (overrides output.directory; created if missing)");
+  run->add_option("--set", overrides,
+                  "Override a config key, dotted path and TOML value, e.g. "
+                  "--set system.packing_fraction=0.3 --set system.lattice=sc (repeatable)")
+      ->take_all();
+  run->add_option("--restart", restart,
+                  "Continue from a restart file (OUTDIR/restart.gsd); equilibration is skipped and "
+                  "run.collisions_per_particle more collisions per particle are simulated");
+  run->footer(
+      "Outputs in OUTDIR: config.toml, thermo.tsv, trajectory.gsd, restart.gsd, summary.json.\n"
+      "SIGINT/SIGTERM stop after the current event and still write every output.");
+
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    kairos::Config config = kairos::load_config(config_path, overrides);
+    if (!outdir.empty()) config.output.directory = outdir;
+    install_signal_handlers();
+    const std::optional<std::filesystem::path> restart_file =
+        restart.empty() ? std::nullopt : std::optional<std::filesystem::path>(restart);
+    const kairos::RunOutcome outcome = kairos::run_simulation(config, restart_file);
+    print_summary(outcome);
+    if (g_signal != 0) return 128 + g_signal;
+    return 0;
+  } catch (const kairos::InputError& e) {
+    std::fprintf(stderr, "kairos: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "kairos: internal error: %s\n", e.what());
+    return 3;
+  }
+}

@@ -1,0 +1,58 @@
+// Event times of ballistic pairs: the stable, cancellation-free quadratic root.
+//
+// For a pair with relative position r and relative velocity g (both of i minus j) and contact
+// distance sigma, the overlap function is f(t) = |r + g t|^2 - sigma^2 = a + b t + c t^2 with
+// a = r^2 - sigma^2, b = 2 r.g, c = g^2. The event is the earliest t >= 0 with f(t) <= 0 and
+// f'(t) < 0 (Bannerman et al. 2014, formulas.md §3): an overlapping, approaching pair collides
+// now (t = 0), an overlapping, receding pair never does, a tangent pair never does. The root
+// 2a / (-b + sqrt(D)) avoids the cancellation of the textbook (-b - sqrt(D)) / 2c.
+#pragma once
+
+#include <cmath>
+#include <limits>
+
+namespace kairos {
+
+inline constexpr double kNever = std::numeric_limits<double>::infinity();
+
+// Time until two spheres moving ballistically come into contact (a, b, c as above).
+inline double quadratic_contact_time(double a, double b, double c) {
+  if (b >= 0.0) return kNever;  // receding or tangent: no approach
+  if (c <= 0.0) {
+    // c = 0 with b < 0 cannot happen for real vectors (g = 0 gives b = 0); kept for safety.
+    return a <= 0.0 ? 0.0 : kNever;
+  }
+  const double disc = b * b - 4.0 * a * c;
+  if (disc <= 0.0) return kNever;  // near miss (a > 0) or, for a < 0, impossible
+  const double t = 2.0 * a / (-b + std::sqrt(disc));
+  return t > 0.0 ? t : 0.0;  // a <= 0: overlapping and approaching -> now
+}
+
+// Convenience form from the relative state (vectors given as pointers to D components).
+template <int D>
+inline double pair_contact_time(const double* r, const double* g, double sigma) {
+  double r2 = 0.0, rg = 0.0, g2 = 0.0;
+  for (int k = 0; k < D; ++k) {
+    r2 += r[k] * r[k];
+    rg += r[k] * g[k];
+    g2 += g[k] * g[k];
+  }
+  return quadratic_contact_time(r2 - sigma * sigma, 2.0 * rg, g2);
+}
+
+// Time until a point moving at velocity v along one axis leaves the interval [lo, hi].
+// Returns 0 when it already sits outside the interval and moves further out (round-off at a
+// boundary), never a negative time.
+inline double interval_exit_time(double x, double v, double lo, double hi) {
+  if (v > 0.0) {
+    const double t = (hi - x) / v;
+    return t > 0.0 ? t : 0.0;
+  }
+  if (v < 0.0) {
+    const double t = (lo - x) / v;
+    return t > 0.0 ? t : 0.0;
+  }
+  return kNever;
+}
+
+}  // namespace kairos

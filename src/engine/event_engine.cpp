@@ -1,0 +1,328 @@
+#include "engine/event_engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "dynamics/collision_time.hpp"
+#include "interactions/hard_sphere.hpp"
+#include "scheduler/binary_heap_queue.hpp"
+#include "scheduler/calendar_queue.hpp"
+
+namespace kairos {
+
+template <int D, class Queue>
+EventEngine<D, Queue>::EventEngine(ParticleSystem<D> system)
+    : sys_(std::move(system)) {
+  const std::size_t n = sys_.size();
+  if (n < 2) throw InputError("a simulation needs at least 2 particles");
+  double rmax = 0.0;
+  for (const auto& k : sys_.kinematics) rmax = std::max(rmax, k.radius);
+  grid_ = CellGrid<D>(sys_.box, 2.0 * rmax, n);
+  if (sys_.collision_count.size() != n) sys_.collision_count.assign(n, 0);
+  const bool restart = sys_.events.size() == n && sys_.cell.size() == n;
+  if (restart) {
+    for (std::uint32_t i = 0; i < n; ++i) grid_.insert(i, sys_.cell[i]);
+  } else {
+    for (std::uint32_t i = 0; i < n; ++i) {
+      advance_to(i, sys_.time);
+      grid_.insert(i, grid_.locate(sys_.kinematics[i].pos));
+    }
+    predict_all();
+  }
+  std::vector<double> times(n);
+  for (std::uint32_t i = 0; i < n; ++i) times[i] = event_time(i);
+  queue_.reset(times);
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::predict_all() {
+  sys_.events.assign(sys_.size(), EventSlot{});
+  for (std::uint32_t i = 0; i < sys_.size(); ++i) {
+    predict_collision(i, sys_.time);
+    predict_crossing(i);
+  }
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
+  Kinematics<D>& k = sys_.kinematics[i];
+  const double dt = t - k.time;
+  for (int a = 0; a < D; ++a) k.pos[a] += k.vel[a] * dt;
+  k.time = t;
+}
+
+// Tests a particle (state xi, vi at time t) against every particle in one cell. The particle
+// itself may be in the cell: r = g = 0 gives r.g = 0, which the root rejects without a branch.
+template <int D, class Queue>
+void EventEngine<D, Queue>::scan_cell(double t, const Vec<D>& xi,
+                                      const Vec<D>& vi, double ri, std::uint32_t cell,
+                                      const Vec<D>& shift, EventSlot& slot) const {
+  for (std::uint32_t j = grid_.head(cell); j != CellGrid<D>::kNone; j = grid_.next(j)) {
+    const Kinematics<D>& kj = sys_.kinematics[j];
+    const double dtj = t - kj.time;
+    double r[D], g[D];
+    double rg = 0.0;
+    for (int a = 0; a < D; ++a) {
+      r[a] = xi[a] - (kj.pos[a] + kj.vel[a] * dtj + shift[a]);
+      g[a] = vi[a] - kj.vel[a];
+      rg += r[a] * g[a];
+    }
+    double r2 = 0.0, g2 = 0.0;
+    for (int a = 0; a < D; ++a) {
+      r2 += r[a] * r[a];
+      g2 += g[a] * g[a];
+    }
+    const double sigma = ri + kj.radius;
+    // i itself has r = g = 0, so b = 0 rejects it without a branch on j == i.
+    const double dt = HardSphere::contact_time(r2, rg, g2, sigma);
+    if (t + dt < slot.collision_time) {
+      slot.collision_time = t + dt;
+      slot.partner = j;
+      slot.partner_count = sys_.collision_count[j];
+    }
+  }
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::predict_collision(std::uint32_t i, double t) {
+  EventSlot& slot = sys_.events[i];
+  slot.collision_time = kNever;
+  const Kinematics<D>& ki = sys_.kinematics[i];
+  const Vec<D> xi = ki.pos + (t - ki.time) * ki.vel;
+  grid_.for_each_neighbour(grid_.cell_of(i), [&](const typename CellGrid<D>::Neighbour& nb) {
+    scan_cell(t, xi, ki.vel, ki.radius, nb.cell, nb.shift, slot);
+  });
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::predict_crossing(std::uint32_t i) {
+  EventSlot& slot = sys_.events[i];
+  const Kinematics<D>& k = sys_.kinematics[i];
+  const std::uint32_t c = grid_.cell_of(i);
+  slot.crossing_time = kNever;
+  slot.crossing = -1;
+  for (int a = 0; a < D; ++a) {
+    const double dt = interval_exit_time(k.pos[a], k.vel[a], grid_.lower(c, a), grid_.upper(c, a));
+    if (k.time + dt < slot.crossing_time) {
+      slot.crossing_time = k.time + dt;
+      slot.crossing = 2 * a + (k.vel[a] > 0.0 ? 1 : 0);
+    }
+  }
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) {
+  // Canonical order so that which of the pair was popped never changes the arithmetic.
+  if (j < i) std::swap(i, j);
+  advance_to(i, t);
+  advance_to(j, t);
+  Kinematics<D>& ki = sys_.kinematics[i];
+  Kinematics<D>& kj = sys_.kinematics[j];
+  Vec<D> r;
+  double g_dot_r = 0.0, r2 = 0.0;
+  for (int a = 0; a < D; ++a) {
+    double d = ki.pos[a] - kj.pos[a];
+    const double L = sys_.box[a];
+    if (d > 0.5 * L) d -= L;
+    if (d < -0.5 * L) d += L;
+    r[a] = d;
+    r2 += d * d;
+    g_dot_r += (ki.vel[a] - kj.vel[a]) * d;
+  }
+  const double mi = sys_.mass[i], mj = sys_.mass[j];
+  const double s = HardSphere::impulse_factor(g_dot_r, r2, mi * mj / (mi + mj));  // J = s r
+  for (int a = 0; a < D; ++a) {
+    ki.vel[a] += s * r[a] / mi;
+    kj.vel[a] -= s * r[a] / mj;
+  }
+  sys_.counters.virial += s * r2;
+  ++sys_.counters.collisions;
+  ++sys_.collision_count[i];
+  ++sys_.collision_count[j];
+  for (std::uint32_t p : {i, j}) {
+    predict_collision(p, t);
+    predict_crossing(p);
+    queue_.update(p, event_time(p));
+  }
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
+  advance_to(i, t);
+  EventSlot& slot = sys_.events[i];
+  const int axis = slot.crossing / 2;
+  const int sign = (slot.crossing % 2) ? 1 : -1;
+  const std::uint32_t old_cell = grid_.cell_of(i);
+  std::array<int, D> c;
+  for (int a = 0; a < D; ++a) c[a] = grid_.coordinate(old_cell, a);
+  c[axis] += sign;
+  Kinematics<D>& k = sys_.kinematics[i];
+  if (c[axis] < 0) {
+    c[axis] += grid_.cells_along(axis);
+    k.pos[axis] += sys_.box[axis];
+  } else if (c[axis] >= grid_.cells_along(axis)) {
+    c[axis] -= grid_.cells_along(axis);
+    k.pos[axis] -= sys_.box[axis];
+  }
+  const std::uint32_t new_cell = grid_.cell_at(c);
+  grid_.erase(i);
+  grid_.insert(i, new_cell);
+  ++sys_.counters.cell_crossings;
+  grid_.for_each_new_layer(new_cell, axis, sign, [&](const typename CellGrid<D>::Neighbour& nb) {
+    scan_cell(t, k.pos, k.vel, k.radius, nb.cell, nb.shift, slot);
+  });
+  predict_crossing(i);
+  queue_.update(i, event_time(i));
+}
+
+template <int D, class Queue>
+EventKind EventEngine<D, Queue>::step() {
+  const std::uint32_t i = queue_.top();
+  const double t = queue_.top_time();
+  if (!std::isfinite(t)) return EventKind::kNone;
+  sys_.time = t;
+  ++sys_.counters.events;
+  EventSlot& slot = sys_.events[i];
+  if (slot.crossing_time <= slot.collision_time) {
+    cross(i, t);
+    return EventKind::kCellCrossing;
+  }
+  const std::uint32_t j = slot.partner;
+  if (sys_.collision_count[j] != slot.partner_count) {
+    ++sys_.counters.stale_events;
+    predict_collision(i, t);
+    queue_.update(i, event_time(i));
+    return EventKind::kStale;
+  }
+  collide(i, j, t);
+  return EventKind::kCollision;
+}
+
+template <int D, class Queue>
+ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
+  ParticleSystem<D> out = sys_;
+  out.cell.resize(sys_.size());
+  for (std::uint32_t i = 0; i < sys_.size(); ++i) out.cell[i] = grid_.cell_of(i);
+  return out;
+}
+
+template <int D, class Queue>
+double EventEngine<D, Queue>::kinetic_energy() const {
+  double ke = 0.0;
+  for (std::size_t i = 0; i < sys_.size(); ++i) {
+    ke += 0.5 * sys_.mass[i] * norm2(sys_.kinematics[i].vel);
+  }
+  return ke;
+}
+
+template <int D, class Queue>
+Vec<D> EventEngine<D, Queue>::momentum() const {
+  Vec<D> p{};
+  for (std::size_t i = 0; i < sys_.size(); ++i) p = p + sys_.mass[i] * sys_.kinematics[i].vel;
+  return p;
+}
+
+template <int D, class Queue>
+std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
+  std::vector<Vec<D>> out(sys_.size());
+  for (std::size_t i = 0; i < sys_.size(); ++i) {
+    Vec<D> x = sys_.position_at(i, sys_.time);
+    for (int a = 0; a < D; ++a) {
+      x[a] -= sys_.box[a] * std::floor(x[a] / sys_.box[a]);
+      if (x[a] >= sys_.box[a]) x[a] = 0.0;
+    }
+    out[i] = x;
+  }
+  return out;
+}
+
+template <int D, class Queue>
+std::size_t EventEngine<D, Queue>::bytes_per_particle() const {
+  return sizeof(Kinematics<D>) + sizeof(EventSlot) + sizeof(double) /*mass*/ +
+         2 * sizeof(std::uint32_t) /*species, counter*/ + sizeof(std::uint32_t) /*cell*/ +
+         grid_.bytes_per_particle() + queue_.bytes_per_particle() +
+         (grid_.cell_count() * sizeof(std::uint32_t)) / sys_.size();
+}
+
+template <int D, class Queue>
+bool EventEngine<D, Queue>::cells_adjacent(std::uint32_t a, std::uint32_t b) const {
+  for (int k = 0; k < D; ++k) {
+    const int n = grid_.cells_along(k);
+    const int d = std::abs(grid_.coordinate(a, k) - grid_.coordinate(b, k));
+    if (std::min(d, n - d) > 1) return false;
+  }
+  return true;
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::validate() {
+  const double t = sys_.time;
+  const std::size_t n = sys_.size();
+  auto fail = [&](const std::string& what) {
+    std::ostringstream os;
+    os << "engine validation failed at t=" << t << " after " << sys_.counters.events
+       << " events: " << what;
+    throw std::logic_error(os.str());
+  };
+  // Cell membership and the cell lists themselves.
+  std::vector<std::uint32_t> listed(n, 0);
+  for (std::uint32_t c = 0; c < grid_.cell_count(); ++c) {
+    for (std::uint32_t j = grid_.head(c); j != CellGrid<D>::kNone; j = grid_.next(j)) {
+      if (grid_.cell_of(j) != c) fail("particle " + std::to_string(j) + " listed in wrong cell");
+      ++listed[j];
+    }
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (listed[i] != 1) fail("particle " + std::to_string(i) + " listed " +
+                             std::to_string(listed[i]) + " times");
+    const Vec<D> x = sys_.position_at(i, t);
+    const std::uint32_t c = grid_.cell_of(i);
+    for (int a = 0; a < D; ++a) {
+      const double tol = 1e-9 * sys_.box[a];
+      if (x[a] < grid_.lower(c, a) - tol || x[a] > grid_.upper(c, a) + tol)
+        fail("particle " + std::to_string(i) + " outside its cell");
+    }
+  }
+  // Queue order: the top is the soonest stored event; nothing lies in the past.
+  double tmin = kNever;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    tmin = std::min(tmin, event_time(i));
+    if (queue_.time_of(i) != event_time(i)) fail("queue key differs for " + std::to_string(i));
+    if (event_time(i) < t) fail("event of " + std::to_string(i) + " lies in the past");
+  }
+  if (queue_.top_time() != tmin) fail("queue top is not the soonest event");
+  // Prediction invariant and overlaps, brute force over all pairs (minimum image).
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Vec<D> xi = sys_.position_at(i, t);
+    for (std::uint32_t j = i + 1; j < n; ++j) {
+      Vec<D> r = xi - sys_.position_at(j, t);
+      for (int a = 0; a < D; ++a) r[a] -= sys_.box[a] * std::round(r[a] / sys_.box[a]);
+      const Vec<D> g = sys_.kinematics[i].vel - sys_.kinematics[j].vel;
+      const double sigma = sys_.kinematics[i].radius + sys_.kinematics[j].radius;
+      if (norm2(r) < sigma * sigma * (1.0 - 1e-9)) {
+        fail("particles " + std::to_string(i) + " and " + std::to_string(j) + " overlap");
+      }
+      const double tc = pair_contact_time<D>(r.data(), g.data(), sigma);
+      if (!std::isfinite(tc)) continue;
+      const double due = t + tc;
+      // Pairs in neighbouring cells rely on the stored collisions, others on the next crossing.
+      const bool adjacent = cells_adjacent(grid_.cell_of(i), grid_.cell_of(j));
+      const double bound =
+          adjacent ? std::min(sys_.events[i].collision_time, sys_.events[j].collision_time)
+                   : std::min(sys_.events[i].crossing_time, sys_.events[j].crossing_time);
+      if (bound > due * (1.0 + 1e-12) + 1e-12) {
+        fail("pair " + std::to_string(i) + "," + std::to_string(j) + " collides at " +
+             std::to_string(due) + " but no stored event covers it");
+      }
+    }
+  }
+}
+
+template class EventEngine<2, BinaryHeapQueue>;
+template class EventEngine<3, BinaryHeapQueue>;
+template class EventEngine<2, CalendarQueue>;
+template class EventEngine<3, CalendarQueue>;
+
+}  // namespace kairos

@@ -1,0 +1,869 @@
+#include "init/initial_state.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+#include <string_view>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace kairos {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Platform-independent random numbers (the standard distributions are implementation-defined).
+
+// Uniform in [0, 1) with 53 random bits.
+double uniform01(std::mt19937_64& rng) {
+  return static_cast<double>(rng() >> 11) * 0x1.0p-53;
+}
+
+// Uniform integer in [0, n), n >= 1, without modulo bias.
+std::uint64_t uniform_below(std::mt19937_64& rng, std::uint64_t n) {
+  const std::uint64_t max = std::numeric_limits<std::uint64_t>::max();
+  const std::uint64_t limit = max - (max % n + 1) % n;  // accept [0, limit]: a multiple of n
+  std::uint64_t r = rng();
+  while (r > limit) r = rng();
+  return r % n;
+}
+
+template <class T>
+void shuffle(std::vector<T>& v, std::mt19937_64& rng) {
+  for (std::size_t i = v.size(); i > 1; --i) {
+    const std::size_t j = uniform_below(rng, i);
+    std::swap(v[i - 1], v[j]);
+  }
+}
+
+// Standard normal deviates by Box-Muller; the second deviate of each pair is kept for the next
+// call.
+class NormalSource {
+ public:
+  double operator()(std::mt19937_64& rng) {
+    if (has_cached_) {
+      has_cached_ = false;
+      return cached_;
+    }
+    const double u1 = 1.0 - uniform01(rng);  // (0, 1]
+    const double u2 = uniform01(rng);
+    const double r = std::sqrt(-2.0 * std::log(u1));
+    const double theta = 2.0 * std::numbers::pi * u2;
+    cached_ = r * std::sin(theta);
+    has_cached_ = true;
+    return r * std::cos(theta);
+  }
+
+ private:
+  double cached_ = 0.0;
+  bool has_cached_ = false;
+};
+
+// Neumaier's compensated summation: momentum and kinetic energy of many particles accurate to
+// the round-off of the result rather than of the partial sums.
+class CompensatedSum {
+ public:
+  void add(double x) {
+    const double t = sum_ + x;
+    if (std::abs(sum_) >= std::abs(x)) {
+      correction_ += (sum_ - t) + x;
+    } else {
+      correction_ += (x - t) + sum_;
+    }
+    sum_ = t;
+  }
+  double value() const { return sum_ + correction_; }
+
+ private:
+  double sum_ = 0.0;
+  double correction_ = 0.0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Geometry helpers.
+
+// Rounds x > 0 down to 6 significant digits, so that the printed value is itself allowed.
+double round_down_6(double x) {
+  if (!(x > 0.0) || !std::isfinite(x)) return x;
+  const double scale = std::pow(10.0, std::floor(std::log10(x)) - 5.0);
+  const double r = std::floor(x / scale) * scale;
+  return r > x ? std::nextafter(x, 0.0) : r;
+}
+
+// x wrapped into [0, L).
+double wrap(double x, double L) {
+  if (x >= 0.0 && x < L) return x;
+  double y = x - L * std::floor(x / L);
+  if (y >= L) y -= L;
+  if (y < 0.0) y = 0.0;
+  return y;
+}
+
+template <int D>
+double box_volume(const std::array<double, D>& box) {
+  double v = 1.0;
+  for (int k = 0; k < D; ++k) v *= box[k];
+  return v;
+}
+
+// sigma_ij - r_ij under the minimum image convention when positive, else 0. Shared by the cell
+// and the brute-force search so that both give bit-identical values.
+template <int D>
+double pair_overlap(const std::array<double, D>& box, const std::array<double, D>& a,
+                    const std::array<double, D>& b, double da, double db) {
+  double r2 = 0.0;
+  for (int k = 0; k < D; ++k) {
+    double dx = a[k] - b[k];
+    dx -= box[k] * std::round(dx / box[k]);
+    r2 += dx * dx;
+  }
+  const double sigma = 0.5 * (da + db);
+  if (!(r2 < sigma * sigma)) return 0.0;
+  return std::max(0.0, sigma - std::sqrt(r2));
+}
+
+// A periodic grid of cells at least `min_width` wide along every axis (at least one cell per
+// axis), with the total number of cells capped near `max_cells` by widening the cells.
+// Particles are kept in per-cell linked lists.
+template <int D>
+class CellGrid {
+ public:
+  CellGrid(const std::array<double, D>& box, double min_width, std::size_t particles) : box_(box) {
+    const std::size_t max_cells = std::max<std::size_t>(64, 2 * particles);
+    double width = min_width;
+    double total = 1.0;
+    for (int k = 0; k < D; ++k) total *= std::max(1.0, std::floor(box[k] / width));
+    if (total > static_cast<double>(max_cells)) {
+      width = std::max(width, std::pow(box_volume<D>(box) / static_cast<double>(max_cells),
+                                       1.0 / static_cast<double>(D)));
+    }
+    std::size_t cells = 1;
+    for (int k = 0; k < D; ++k) {
+      const double nk =
+          std::min(std::max(1.0, std::floor(box[k] / width)), static_cast<double>(max_cells));
+      n_[k] = static_cast<std::size_t>(nk);
+      cells *= n_[k];
+    }
+    head_.assign(cells, kNoParticle);
+    next_.assign(particles, kNoParticle);
+  }
+
+  std::array<std::size_t, D> coords(const std::array<double, D>& x) const {
+    std::array<std::size_t, D> c{};
+    for (int k = 0; k < D; ++k) {
+      const double u = wrap(x[k], box_[k]) / box_[k] * static_cast<double>(n_[k]);
+      c[k] = std::min(static_cast<std::size_t>(u), n_[k] - 1);
+    }
+    return c;
+  }
+
+  std::size_t index(const std::array<std::size_t, D>& c) const {
+    std::size_t idx = 0;
+    for (int k = D - 1; k >= 0; --k) idx = idx * n_[k] + c[k];
+    return idx;
+  }
+
+  void insert(std::uint32_t particle, const std::array<double, D>& x) {
+    const std::size_t cell = index(coords(x));
+    next_[particle] = head_[cell];
+    head_[cell] = particle;
+  }
+
+  // Calls f(particle) for every particle in the cells adjacent to (and including) the cell at
+  // `c`. Along an axis with fewer than 3 cells every cell is visited exactly once.
+  template <class F>
+  void for_each_neighbour(const std::array<std::size_t, D>& c, F&& f) const {
+    std::array<std::array<std::size_t, 3>, D> axis{};
+    std::array<std::size_t, D> count{};
+    for (int k = 0; k < D; ++k) {
+      if (n_[k] >= 3) {
+        axis[k] = {(c[k] + n_[k] - 1) % n_[k], c[k], (c[k] + 1) % n_[k]};
+        count[k] = 3;
+      } else {
+        for (std::size_t m = 0; m < n_[k]; ++m) axis[k][m] = m;
+        count[k] = n_[k];
+      }
+    }
+    std::array<std::size_t, D> pick{};
+    while (true) {
+      std::array<std::size_t, D> cell{};
+      for (int k = 0; k < D; ++k) cell[k] = axis[k][pick[k]];
+      for (std::uint32_t p = head_[index(cell)]; p != kNoParticle; p = next_[p]) f(p);
+      int k = 0;
+      while (k < D && ++pick[k] == count[k]) pick[k++] = 0;
+      if (k == D) break;
+    }
+  }
+
+ private:
+  std::array<double, D> box_;
+  std::array<std::size_t, D> n_{};
+  std::vector<std::uint32_t> head_;
+  std::vector<std::uint32_t> next_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Lattices.
+
+struct LatticeSpec {
+  std::string_view name;
+  int dimension;
+  std::uint64_t sites_per_cell;
+  std::array<std::array<double, 3>, 4> basis;  // fractional coordinates within the cell
+  std::array<double, 3> cell_shape;            // cell edges in units of the lattice constant
+  double nearest_neighbour;                    // in units of the lattice constant
+  double close_packed;                         // packing fraction at contact, full lattice
+};
+
+constexpr double kPi = std::numbers::pi;
+constexpr LatticeSpec kLattices[] = {
+    {"fcc",
+     3,
+     4,
+     {{{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}}},
+     {1, 1, 1},
+     std::numbers::sqrt2 / 2,
+     kPi / (3 * std::numbers::sqrt2)},
+    {"bcc",
+     3,
+     2,
+     {{{0, 0, 0}, {0.5, 0.5, 0.5}}},
+     {1, 1, 1},
+     std::numbers::sqrt3 / 2,
+     kPi* std::numbers::sqrt3 / 8},
+    {"sc", 3, 1, {{{0, 0, 0}}}, {1, 1, 1}, 1.0, kPi / 6},
+    {"square", 2, 1, {{{0, 0, 0}}}, {1, 1, 1}, 1.0, kPi / 4},
+    {"hex",
+     2,
+     2,
+     {{{0, 0, 0}, {0.5, 0.5, 0}}},
+     {1, std::numbers::sqrt3, 1},
+     1.0,
+     kPi / (2 * std::numbers::sqrt3)},
+};
+
+// Random sequential insertion jams near 0.38 (3D) / 0.547 (2D); beyond these it is refused.
+constexpr double kRandomMaxPacking3 = 0.35;
+constexpr double kRandomMaxPacking2 = 0.50;
+constexpr std::uint64_t kMaxInsertionAttempts = 1'000'000;  // per particle
+
+// "fcc, bcc, sc" / "square, hex", plus ", random" when asked.
+std::string lattice_list(int dimension, bool with_random) {
+  std::string s;
+  for (const auto& l : kLattices) {
+    if (l.dimension != dimension) continue;
+    if (!s.empty()) s += ", ";
+    s += l.name;
+  }
+  return with_random ? s + ", random" : s;
+}
+
+// Smallest n with m n^3 >= N (D = 3) or m n^2 >= N (D = 2).
+std::uint64_t cells_per_axis(std::uint64_t N, std::uint64_t m, int D) {
+  const auto enough = [&](std::uint64_t n) {
+    std::uint64_t sites = m;
+    for (int k = 0; k < D; ++k) sites *= n;
+    return sites >= N;
+  };
+  const double cells = std::ceil(static_cast<double>(N) / static_cast<double>(m));
+  auto n = static_cast<std::uint64_t>(std::pow(cells, 1.0 / D));
+  n = std::max<std::uint64_t>(n, 1);
+  while (!enough(n)) ++n;
+  while (n > 1 && enough(n - 1)) --n;
+  return n;
+}
+
+// Triangular lattice in rectangular cells a x a sqrt(3): for each ny the fewest columns
+// nx = ceil(N / (2 ny)); among these the box closest to square (aspect sqrt(3) ny / nx nearest
+// 1 in log), ties to fewer sites. The aspect grows strictly with ny, so only the two ny around
+// aspect 1 compete. All comparisons are exact integer arithmetic.
+std::array<std::uint64_t, 2> hex_cells(std::uint64_t N) {
+  const auto nx_of = [N](std::uint64_t ny) { return (N + 2 * ny - 1) / (2 * ny); };
+  const auto not_tall = [&](std::uint64_t ny) {  // sqrt(3) ny <= nx
+    const std::uint64_t nx = nx_of(ny);
+    return 3 * ny * ny <= nx * nx;
+  };
+  if (!not_tall(1)) return {nx_of(1), 1};
+  std::uint64_t lo = 1;  // not_tall(lo)
+  std::uint64_t hi = static_cast<std::uint64_t>(std::sqrt(static_cast<double>(N))) + 2;
+  while (not_tall(hi)) hi *= 2;
+  while (hi - lo > 1) {  // not_tall(lo), !not_tall(hi)
+    const std::uint64_t mid = lo + (hi - lo) / 2;
+    (not_tall(mid) ? lo : hi) = mid;
+  }
+  const std::uint64_t ax = nx_of(lo), bx = nx_of(hi);
+  // |ln aspect_a| vs |ln aspect_b| with aspect_a <= 1 < aspect_b: a is closer when
+  // aspect_a * aspect_b > 1, i.e. 3 ny_a ny_b > nx_a nx_b.
+  const std::uint64_t lhs = 3 * lo * hi, rhs = ax * bx;
+  if (lhs > rhs) return {ax, lo};
+  if (lhs < rhs) return {bx, hi};
+  return ax * lo <= bx * hi ? std::array<std::uint64_t, 2>{ax, lo}
+                            : std::array<std::uint64_t, 2>{bx, hi};
+}
+
+// Everything about the box that follows from (N, packing fraction, species, lattice) alone.
+template <int D>
+struct Layout {
+  std::vector<std::uint64_t> counts;  // per species
+  double solid_volume = 0.0;          // sum of the particle volumes
+  std::array<double, D> box{};
+  const LatticeSpec* lattice = nullptr;  // nullptr: random insertion
+  std::array<std::uint64_t, D> cells{};
+  std::uint64_t sites = 0;
+  double lattice_constant = 0.0;
+  double nearest_neighbour = 0.0;
+};
+
+template <int D>
+Layout<D> make_layout(const std::vector<SpeciesConfig>& species, std::uint64_t N, double eta,
+                      const LatticeSpec* lattice) {
+  Layout<D> out;
+  std::vector<double> fractions;
+  for (const auto& s : species) fractions.push_back(s.fraction);
+  out.counts = largest_remainder_counts(fractions, N);
+  for (std::size_t s = 0; s < species.size(); ++s) {
+    out.solid_volume +=
+        static_cast<double>(out.counts[s]) * particle_volume<D>(species[s].diameter);
+  }
+  const double volume = out.solid_volume / eta;
+  out.lattice = lattice;
+  if (lattice == nullptr) {
+    const double L = D == 3 ? std::cbrt(volume) : std::sqrt(volume);
+    out.box.fill(L);
+    return out;
+  }
+  if (lattice->name == "hex") {
+    const auto c = hex_cells(N);
+    out.cells[0] = c[0];
+    out.cells[1] = c[1];
+  } else {
+    out.cells.fill(cells_per_axis(N, lattice->sites_per_cell, D));
+  }
+  out.sites = lattice->sites_per_cell;
+  double unit_volume = 1.0;  // box volume for lattice constant 1
+  for (int k = 0; k < D; ++k) {
+    out.sites *= out.cells[k];
+    unit_volume *= static_cast<double>(out.cells[k]) * lattice->cell_shape[k];
+  }
+  const double ratio = volume / unit_volume;
+  out.lattice_constant = D == 3 ? std::cbrt(ratio) : std::sqrt(ratio);
+  for (int k = 0; k < D; ++k) {
+    out.box[k] = static_cast<double>(out.cells[k]) * lattice->cell_shape[k] * out.lattice_constant;
+  }
+  out.nearest_neighbour = lattice->nearest_neighbour * out.lattice_constant;
+  return out;
+}
+
+template <int D>
+bool fits_lattice(const Layout<D>& layout, double dmax) {
+  return layout.lattice == nullptr || dmax <= layout.nearest_neighbour;
+}
+
+template <int D>
+bool fits_cell_list(const Layout<D>& layout, double dmax) {
+  for (int k = 0; k < D; ++k) {
+    if (layout.box[k] < 3.0 * dmax) return false;
+  }
+  return true;
+}
+
+template <int D>
+std::string cells_text(const Layout<D>& layout) {
+  std::string s = fmt::format("{}", layout.cells[0]);
+  for (int k = 1; k < D; ++k) s += fmt::format("x{}", layout.cells[k]);
+  return s;
+}
+
+std::string lattice_text(const LatticeSpec* lattice) {
+  return lattice == nullptr ? std::string("random insertion")
+                            : fmt::format("a {} lattice", lattice->name);
+}
+
+// The species list of the run, validated.
+std::vector<SpeciesConfig> effective_species(const SystemConfig& system) {
+  if (system.species.empty()) return {SpeciesConfig{}};
+  double total = 0.0;
+  for (std::size_t s = 0; s < system.species.size(); ++s) {
+    const auto& sp = system.species[s];
+    const auto bad = [&](std::string_view key, double v, std::string_view need) {
+      return InputError(
+          fmt::format("system.species[{}].{} = {} is invalid: must be {}", s, key, v, need));
+    };
+    if (!(std::isfinite(sp.diameter) && sp.diameter > 0.0)) {
+      throw bad("diameter", sp.diameter, "finite and > 0");
+    }
+    if (!(std::isfinite(sp.mass) && sp.mass > 0.0)) throw bad("mass", sp.mass, "finite and > 0");
+    if (!(std::isfinite(sp.fraction) && sp.fraction >= 0.0)) {
+      throw bad("fraction", sp.fraction, "finite and >= 0");
+    }
+    total += sp.fraction;
+  }
+  if (!(total > 0.0) || !std::isfinite(total)) {
+    throw InputError("system.species: the fractions must not all be zero");
+  }
+  return system.species;
+}
+
+template <int D>
+void place_on_lattice(const Layout<D>& layout, InitialState<D>& state) {
+  const LatticeSpec& lat = *layout.lattice;
+  const std::uint64_t N = state.position.size();
+  const std::uint64_t whole = layout.sites / N, part = layout.sites % N;
+  for (std::uint64_t i = 0; i < N; ++i) {
+    // Site floor(i * sites / N), without overflow (N < 2^32): occupied sites evenly spread.
+    const std::uint64_t site = i * whole + (i * part) / N;
+    std::uint64_t cell = site / lat.sites_per_cell;
+    const auto& basis = lat.basis[site % lat.sites_per_cell];
+    for (int k = 0; k < D; ++k) {
+      const std::uint64_t ck = cell % layout.cells[k];
+      cell /= layout.cells[k];
+      const double frac = static_cast<double>(ck) + basis[k] + 0.25;  // quarter-cell offset
+      state.position[i][k] = frac * lat.cell_shape[k] * layout.lattice_constant;
+    }
+  }
+}
+
+// The voxels of a periodic grid that may still hold free space for the current insertion
+// diameter. Voxels found to lie entirely inside one exclusion sphere are dropped, so sampling a
+// live voxel uniformly and then a point uniformly inside it is uniform over the free space -
+// exactly random sequential insertion - while wasting far fewer attempts near jamming.
+template <int D>
+class VoxelSampler {
+ public:
+  VoxelSampler(const std::array<double, D>& box, double side, std::size_t max_voxels) : box_(box) {
+    double total = 1.0;
+    for (int k = 0; k < D; ++k) total *= std::max(1.0, std::floor(box[k] / side));
+    if (total > static_cast<double>(max_voxels)) {
+      side = std::pow(box_volume<D>(box) / static_cast<double>(max_voxels),
+                      1.0 / static_cast<double>(D));
+    }
+    std::size_t voxels = 1;
+    for (int k = 0; k < D; ++k) {
+      m_[k] = static_cast<std::size_t>(
+          std::min(std::max(1.0, std::floor(box[k] / side)), static_cast<double>(max_voxels)));
+      h_[k] = box[k] / static_cast<double>(m_[k]);
+      voxels *= m_[k];
+    }
+    live_.resize(voxels);
+    slot_.resize(voxels);
+    for (std::size_t v = 0; v < voxels; ++v) live_[v] = slot_[v] = v;
+  }
+
+  bool empty() const { return live_.empty(); }
+
+  std::size_t pick(std::mt19937_64& rng) const { return live_[uniform_below(rng, live_.size())]; }
+
+  std::array<double, D> point_in(std::size_t voxel, std::mt19937_64& rng) const {
+    std::array<double, D> x{};
+    for (int k = 0; k < D; ++k) {
+      const double c = static_cast<double>(voxel % m_[k]);
+      voxel /= m_[k];
+      x[k] = wrap((c + uniform01(rng)) * h_[k], box_[k]);
+    }
+    return x;
+  }
+
+  // True when every point of the voxel is closer than `radius` to `centre` (minimum image).
+  bool covered(std::size_t voxel, const std::array<double, D>& centre, double radius) const {
+    double far2 = 0.0;
+    for (int k = 0; k < D; ++k) {
+      const double c = (static_cast<double>(voxel % m_[k]) + 0.5) * h_[k];
+      voxel /= m_[k];
+      double dx = centre[k] - c;
+      dx -= box_[k] * std::round(dx / box_[k]);
+      const double far = std::abs(dx) + 0.5 * h_[k];
+      far2 += far * far;
+    }
+    return far2 < radius * radius;
+  }
+
+  void kill(std::size_t voxel) {
+    const std::size_t at = slot_[voxel];
+    const std::size_t last = live_.back();
+    live_[at] = last;
+    slot_[last] = at;
+    live_.pop_back();
+  }
+
+ private:
+  std::array<double, D> box_;
+  std::array<std::size_t, D> m_{};
+  std::array<double, D> h_{};
+  std::vector<std::size_t> live_;  // live voxel ids
+  std::vector<std::size_t> slot_;  // position of a live voxel in live_
+};
+
+// Random sequential insertion in the order of the particles (largest diameters first).
+template <int D>
+void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state,
+                     std::mt19937_64& rng) {
+  const std::size_t N = state.position.size();
+  const double dmax = *std::max_element(state.diameter.begin(), state.diameter.end());
+  CellGrid<D> grid(layout.box, dmax, N);
+  std::optional<VoxelSampler<D>> voxels;
+  const auto fail = [&](std::size_t i, std::string_view why) {
+    return InputError(fmt::format(
+        "system.packing_fraction = {} could not be reached by random insertion: particle {} of "
+        "{} {}; use a lower packing fraction or a lattice ({}) and let the run melt it",
+        eta, i + 1, N, why, lattice_list(D, false)));
+  };
+  for (std::size_t i = 0; i < N; ++i) {
+    const double di = state.diameter[i];
+    if (i == 0 || di != state.diameter[i - 1]) {
+      // Exclusion radii depend on the inserted diameter: start over with all voxels live.
+      voxels.emplace(layout.box, 0.5 * di, std::max<std::size_t>(8 * N, 1024));
+    }
+    bool placed = false;
+    for (std::uint64_t attempt = 0; attempt < kMaxInsertionAttempts && !placed; ++attempt) {
+      if (voxels->empty()) throw fail(i, "found the box jammed");
+      const std::size_t voxel = voxels->pick(rng);
+      const std::array<double, D> x = voxels->point_in(voxel, rng);
+      bool is_free = true;
+      grid.for_each_neighbour(grid.coords(x), [&](std::uint32_t j) {
+        if (is_free &&
+            pair_overlap<D>(layout.box, x, state.position[j], di, state.diameter[j]) > 0) {
+          is_free = false;
+        }
+      });
+      if (is_free) {
+        state.position[i] = x;
+        grid.insert(static_cast<std::uint32_t>(i), x);
+        placed = true;
+        continue;
+      }
+      // Rejected: drop the voxel if a single exclusion sphere covers it.
+      bool dead = false;
+      grid.for_each_neighbour(grid.coords(x), [&](std::uint32_t j) {
+        if (!dead && voxels->covered(voxel, state.position[j], 0.5 * (di + state.diameter[j]))) {
+          dead = true;
+        }
+      });
+      if (dead) voxels->kill(voxel);
+    }
+    if (!placed) {
+      throw fail(i, fmt::format("found no free space in {} attempts", kMaxInsertionAttempts));
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<std::uint64_t> largest_remainder_counts(const std::vector<double>& weights,
+                                                    std::uint64_t total) {
+  double sum = 0.0;
+  for (double w : weights) {
+    if (!(w >= 0.0) || !std::isfinite(w)) {
+      throw std::invalid_argument("largest_remainder_counts: weights must be finite and >= 0");
+    }
+    sum += w;
+  }
+  if (!(sum > 0.0) || !std::isfinite(sum)) {
+    throw std::invalid_argument("largest_remainder_counts: the weights sum to zero");
+  }
+  const std::size_t S = weights.size();
+  std::vector<std::uint64_t> counts(S);
+  std::vector<double> remainder(S);
+  std::uint64_t assigned = 0;
+  for (std::size_t s = 0; s < S; ++s) {
+    const double quota = static_cast<double>(total) * (weights[s] / sum);
+    const double whole = std::min(std::floor(quota), static_cast<double>(total));
+    counts[s] = static_cast<std::uint64_t>(whole);
+    remainder[s] = quota - whole;
+    assigned += counts[s];
+  }
+  std::vector<std::size_t> order(S);
+  for (std::size_t s = 0; s < S; ++s) order[s] = s;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return remainder[a] > remainder[b]; });
+  // Round-off can leave the floors summing to a little more than `total`: take back from the
+  // smallest remainders.
+  for (std::size_t m = S; assigned > total && m-- > 0;) {
+    const std::size_t s = order[m];
+    const std::uint64_t take = std::min(counts[s], assigned - total);
+    counts[s] -= take;
+    assigned -= take;
+  }
+  for (std::size_t m = 0; assigned < total; m = (m + 1) % S) {
+    if (weights[order[m]] > 0.0) {
+      ++counts[order[m]];
+      ++assigned;
+    }
+  }
+  return counts;
+}
+
+template <int D>
+double packing_fraction(const InitialState<D>& state) {
+  double solid = 0.0;
+  for (double d : state.diameter) solid += particle_volume<D>(d);
+  return solid / box_volume<D>(state.box);
+}
+
+template <int D>
+InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& rng) {
+  static_assert(D == 2 || D == 3);
+  if (system.dimension != D) {
+    throw std::invalid_argument(fmt::format(
+        "make_initial_state<{}> called with system.dimension = {}", D, system.dimension));
+  }
+  const std::vector<SpeciesConfig> species = effective_species(system);
+  const std::uint64_t N = system.particles;
+  if (N < 1 || N >= kNoParticle) {
+    throw InputError(
+        fmt::format("system.particles = {} is invalid: must be in [1, {}]", N, kNoParticle - 1));
+  }
+  const double eta = system.packing_fraction;
+  if (!(eta > 0.0 && eta < 1.0)) {
+    throw InputError(
+        fmt::format("system.packing_fraction = {} is invalid: must be in (0, 1)", eta));
+  }
+  if (!(std::isfinite(system.temperature) && system.temperature >= 0.0)) {
+    throw InputError(fmt::format("system.temperature = {} is invalid: must be finite and >= 0",
+                                 system.temperature));
+  }
+
+  const std::string name =
+      system.lattice.empty() ? std::string(D == 3 ? "fcc" : "hex") : system.lattice;
+  const LatticeSpec* lattice = nullptr;
+  if (name != "random") {
+    for (const auto& l : kLattices) {
+      if (l.dimension == D && l.name == name) lattice = &l;
+    }
+    if (lattice == nullptr) {
+      throw InputError(fmt::format("system.lattice = \"{}\" is not a {}D lattice; use one of {}",
+                                   name, D, lattice_list(D, true)));
+    }
+  }
+  double dmax = 0.0;
+  for (const auto& s : species) dmax = std::max(dmax, s.diameter);
+
+  if (lattice == nullptr) {
+    const double limit = D == 3 ? kRandomMaxPacking3 : kRandomMaxPacking2;
+    if (eta > limit) {
+      throw InputError(fmt::format(
+          "system.packing_fraction = {} is too high for random insertion, which jams near {} in "
+          "{}D; use at most {} or a lattice ({}) and let the run melt it",
+          eta, D == 3 ? 0.38 : 0.547, D, limit, lattice_list(D, false)));
+    }
+  }
+
+  const Layout<D> layout = make_layout<D>(species, N, eta, lattice);
+  const bool lattice_fits = fits_lattice(layout, dmax);
+  if (!fits_cell_list(layout, dmax)) {
+    // The smallest larger N whose box is wide enough and whose lattice fits the diameters (a
+    // lattice never fits above its close-packed packing fraction: no search then).
+    constexpr std::uint64_t kScan = 1'000'000;
+    const bool hopeless = lattice != nullptr && eta > lattice->close_packed;
+    std::uint64_t needed = 0;
+    for (std::uint64_t n = N + 1; !hopeless && n <= N + kScan && n < kNoParticle; ++n) {
+      const Layout<D> trial = make_layout<D>(species, n, eta, lattice);
+      if (fits_lattice(trial, dmax) && fits_cell_list(trial, dmax)) {
+        needed = n;
+        break;
+      }
+    }
+    // When the lattice does not fit either and no N helps, the packing fraction is the problem.
+    if (lattice_fits || needed != 0) {
+      const std::string need_text =
+          needed != 0 ? fmt::format("at least {} particles are needed", needed)
+                      : fmt::format("more than {} particles are needed", N + kScan);
+      double shortest = layout.box[0];
+      for (int k = 1; k < D; ++k) shortest = std::min(shortest, layout.box[k]);
+      throw InputError(fmt::format(
+          "system.particles = {} is too few for packing fraction {} on {}: the box edge {:.6g} "
+          "is shorter than 3 x the largest diameter {:.6g} (the cell list needs 3 cells per "
+          "axis); {}",
+          N, eta, lattice_text(lattice), shortest, dmax, need_text));
+    }
+  }
+  if (!lattice_fits) {
+    const double ratio = layout.nearest_neighbour / dmax;
+    const double largest = round_down_6(eta * (D == 3 ? ratio * ratio * ratio : ratio * ratio));
+    std::string filling = fmt::format("{} cells", cells_text(layout));
+    std::string full_hint;
+    if (layout.sites != N) {
+      // Partly filled: the nearest-neighbour distance is that of the full lattice, so point at
+      // the particle number that fills it.
+      filling += fmt::format(", {} sites", layout.sites);
+      const Layout<D> full = make_layout<D>(species, layout.sites, eta, lattice);
+      const double r = full.nearest_neighbour / dmax;
+      full_hint = fmt::format(" ({:.6g} with {} particles, which fill the lattice)",
+                              round_down_6(eta * (D == 3 ? r * r * r : r * r)), layout.sites);
+    }
+    throw InputError(fmt::format(
+        "system.packing_fraction = {} is impossible on a {} lattice with {} particles ({}): the "
+        "nearest-neighbour distance {:.6g} is smaller than the largest diameter {:.6g}; the "
+        "largest possible is {:.6g}{}",
+        eta, lattice->name, N, filling, layout.nearest_neighbour, dmax, largest, full_hint));
+  }
+
+  InitialState<D> state;
+  state.box = layout.box;
+  for (const auto& s : species) state.species_names.push_back(s.name);
+  state.position.resize(N);
+  state.species.reserve(N);
+  if (lattice != nullptr) {
+    // Species spread over the sites at random: a homogeneous mixture.
+    for (std::size_t s = 0; s < species.size(); ++s) {
+      state.species.insert(state.species.end(), layout.counts[s], static_cast<std::uint32_t>(s));
+    }
+    shuffle(state.species, rng);
+  } else {
+    // Largest diameters first (ties: species order).
+    std::vector<std::size_t> order(species.size());
+    for (std::size_t s = 0; s < order.size(); ++s) order[s] = s;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return species[a].diameter > species[b].diameter;
+    });
+    for (std::size_t s : order) {
+      state.species.insert(state.species.end(), layout.counts[s], static_cast<std::uint32_t>(s));
+    }
+  }
+  state.diameter.resize(N);
+  state.mass.resize(N);
+  for (std::size_t i = 0; i < N; ++i) {
+    state.diameter[i] = species[state.species[i]].diameter;
+    state.mass[i] = species[state.species[i]].mass;
+  }
+  if (lattice != nullptr) {
+    place_on_lattice(layout, state);
+  } else {
+    insert_randomly(layout, eta, state, rng);
+  }
+  assign_maxwell_boltzmann_velocities(state, system.temperature, rng);
+  return state;
+}
+
+template <int D>
+void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std::mt19937_64& rng) {
+  if (!(std::isfinite(kT) && kT >= 0.0)) {
+    throw InputError(
+        fmt::format("system.temperature = {} is invalid: must be finite and >= 0", kT));
+  }
+  const std::size_t N = state.mass.size();
+  if (state.position.size() != N) {
+    throw std::invalid_argument("assign_maxwell_boltzmann_velocities: mass and position sizes");
+  }
+  for (double m : state.mass) {
+    if (!(std::isfinite(m) && m > 0.0)) {
+      throw std::invalid_argument("assign_maxwell_boltzmann_velocities: masses must be > 0");
+    }
+  }
+  state.velocity.assign(N, std::array<double, D>{});
+  if (N == 0) return;
+  NormalSource normal;
+  for (std::size_t i = 0; i < N; ++i) {
+    const double sd = std::sqrt(kT / state.mass[i]);
+    for (int k = 0; k < D; ++k) state.velocity[i][k] = sd * normal(rng);
+  }
+  CompensatedSum total_mass;
+  for (double m : state.mass) total_mass.add(m);
+  // Two passes: the second removes the round-off residue of the first.
+  for (int pass = 0; pass < 2; ++pass) {
+    std::array<CompensatedSum, D> momentum{};
+    for (std::size_t i = 0; i < N; ++i) {
+      for (int k = 0; k < D; ++k) momentum[k].add(state.mass[i] * state.velocity[i][k]);
+    }
+    for (int k = 0; k < D; ++k) {
+      const double v_cm = momentum[k].value() / total_mass.value();
+      for (std::size_t i = 0; i < N; ++i) state.velocity[i][k] -= v_cm;
+    }
+  }
+  CompensatedSum ke;
+  for (std::size_t i = 0; i < N; ++i) {
+    for (int k = 0; k < D; ++k) ke.add(state.mass[i] * state.velocity[i][k] * state.velocity[i][k]);
+  }
+  const double twice_ke = ke.value();
+  if (N < 2 || kT == 0.0 || !(twice_ke > 0.0)) {
+    state.velocity.assign(N, std::array<double, D>{});
+    return;
+  }
+  const double scale = std::sqrt(kT * D * static_cast<double>(N - 1) / twice_ke);
+  for (auto& v : state.velocity) {
+    for (int k = 0; k < D; ++k) v[k] *= scale;
+  }
+}
+
+template <int D>
+double max_overlap(const std::array<double, D>& box, const std::vector<std::array<double, D>>& pos,
+                   const std::vector<double>& diameter, std::uint32_t* worst_i,
+                   std::uint32_t* worst_j) {
+  if (worst_i != nullptr) *worst_i = kNoParticle;
+  if (worst_j != nullptr) *worst_j = kNoParticle;
+  if (pos.size() != diameter.size()) {
+    throw std::invalid_argument("max_overlap: positions and diameters differ in size");
+  }
+  if (pos.size() >= kNoParticle) throw std::invalid_argument("max_overlap: too many particles");
+  for (int k = 0; k < D; ++k) {
+    if (!(box[k] > 0.0) || !std::isfinite(box[k])) {
+      throw std::invalid_argument("max_overlap: box edges must be finite and > 0");
+    }
+  }
+  const std::size_t N = pos.size();
+  double dmax = 0.0;
+  for (std::size_t i = 0; i < N; ++i) {
+    for (int k = 0; k < D; ++k) {
+      if (!std::isfinite(pos[i][k]))
+        throw std::invalid_argument("max_overlap: non-finite position");
+    }
+    if (!std::isfinite(diameter[i]))
+      throw std::invalid_argument("max_overlap: non-finite diameter");
+    dmax = std::max(dmax, diameter[i]);
+  }
+  if (N < 2 || !(dmax > 0.0)) return 0.0;
+
+  CellGrid<D> grid(box, dmax, N);
+  for (std::size_t i = 0; i < N; ++i) grid.insert(static_cast<std::uint32_t>(i), pos[i]);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < N; ++i) {
+    grid.for_each_neighbour(grid.coords(pos[i]), [&](std::uint32_t j) {
+      if (j <= i) return;  // each pair once: j's cell is visited once from i's cell
+      const double ov = pair_overlap<D>(box, pos[i], pos[j], diameter[i], diameter[j]);
+      if (ov > worst) {
+        worst = ov;
+        if (worst_i != nullptr) *worst_i = static_cast<std::uint32_t>(i);
+        if (worst_j != nullptr) *worst_j = j;
+      }
+    });
+  }
+  return worst;
+}
+
+template <int D>
+double max_overlap_bruteforce(const std::array<double, D>& box,
+                              const std::vector<std::array<double, D>>& pos,
+                              const std::vector<double>& diameter) {
+  if (pos.size() != diameter.size()) {
+    throw std::invalid_argument("max_overlap_bruteforce: positions and diameters differ in size");
+  }
+  double worst = 0.0;
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    for (std::size_t j = i + 1; j < pos.size(); ++j) {
+      worst = std::max(worst, pair_overlap<D>(box, pos[i], pos[j], diameter[i], diameter[j]));
+    }
+  }
+  return worst;
+}
+
+#define KAIROS_INSTANTIATE(D)                                                                 \
+  template double packing_fraction<D>(const InitialState<D>&);                                \
+  template InitialState<D> make_initial_state<D>(const SystemConfig&, std::mt19937_64&);      \
+  template void assign_maxwell_boltzmann_velocities<D>(InitialState<D>&, double,              \
+                                                       std::mt19937_64&);                     \
+  template double max_overlap<D>(const std::array<double, D>&,                                \
+                                 const std::vector<std::array<double, D>>&,                   \
+                                 const std::vector<double>&, std::uint32_t*, std::uint32_t*); \
+  template double max_overlap_bruteforce<D>(const std::array<double, D>&,                     \
+                                            const std::vector<std::array<double, D>>&,        \
+                                            const std::vector<double>&);
+
+KAIROS_INSTANTIATE(2)
+KAIROS_INSTANTIATE(3)
+#undef KAIROS_INSTANTIATE
+
+}  // namespace kairos

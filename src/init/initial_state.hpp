@@ -1,0 +1,80 @@
+// Initial configurations: lattices scaled to a packing fraction, random insertion, species
+// assignment and Maxwell-Boltzmann velocities.
+//
+// Coordinates live in [0, L_k) along each axis k (the engine's convention; GSD output shifts
+// them to HOOMD's centred box). All functions are deterministic given the RNG state.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "io/config.hpp"
+
+namespace kairos {
+
+// Marks "no particle" in worst-pair outputs.
+inline constexpr std::uint32_t kNoParticle = 0xFFFFFFFFu;
+
+// Volume of a sphere (D = 3, pi d^3 / 6) or area of a disk (D = 2, pi d^2 / 4) of diameter d.
+template <int D>
+constexpr double particle_volume(double diameter) {
+  static_assert(D == 2 || D == 3);
+  constexpr double pi = 3.141592653589793238462643383279502884;
+  if constexpr (D == 3) {
+    return pi * diameter * diameter * diameter / 6.0;
+  } else {
+    return pi * diameter * diameter / 4.0;
+  }
+}
+
+// Splits `total` into counts proportional to the (non-negative, not all zero) weights by
+// largest-remainder rounding: the counts sum to `total` exactly; ties go to the lower index.
+std::vector<std::uint64_t> largest_remainder_counts(const std::vector<double>& weights,
+                                                    std::uint64_t total);
+
+template <int D>
+struct InitialState {
+  std::array<double, D> box{};                  // box edge lengths
+  std::vector<std::array<double, D>> position;  // in [0, box)
+  std::vector<std::array<double, D>> velocity;
+  std::vector<std::uint32_t> species;  // index into species_names
+  std::vector<double> diameter;        // per particle
+  std::vector<double> mass;            // per particle
+  std::vector<std::string> species_names;
+};
+
+// Sum of the particle volumes divided by the box volume.
+template <int D>
+double packing_fraction(const InitialState<D>& state);
+
+// Builds positions, species, diameters and masses from config.system (lattice or random
+// insertion) and Maxwell-Boltzmann velocities at config.system.temperature.
+// Throws InputError naming the key when the request is impossible (packing fraction too high
+// for the lattice or for random insertion, lattice not valid in this dimension, ...).
+template <int D>
+InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& rng);
+
+// Maxwell-Boltzmann velocities: Gaussian components with variance kT/m, zero total momentum,
+// then rescaled so that 2 KE / (D (N - 1)) equals kT exactly.
+template <int D>
+void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std::mt19937_64& rng);
+
+// Largest overlap (sigma_ij - r_ij, > 0 means overlapping) over all pairs under the minimum
+// image convention, found with a cell grid (exact: every pair that can overlap is checked).
+// Returns 0 when no pair overlaps. `worst_i` < `worst_j` (optional) receive the worst pair, or
+// kNoParticle when no pair overlaps. Positions outside [0, box) are wrapped into it.
+template <int D>
+double max_overlap(const std::array<double, D>& box, const std::vector<std::array<double, D>>& pos,
+                   const std::vector<double>& diameter, std::uint32_t* worst_i = nullptr,
+                   std::uint32_t* worst_j = nullptr);
+
+// The same by an O(N^2) loop over all pairs: the reference for tests.
+template <int D>
+double max_overlap_bruteforce(const std::array<double, D>& box,
+                              const std::vector<std::array<double, D>>& pos,
+                              const std::vector<double>& diameter);
+
+}  // namespace kairos

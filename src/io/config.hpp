@@ -1,0 +1,92 @@
+// Run configuration: the TOML schema, its defaults and its validation.
+//
+// Every key is documented in docs/config.md. A config file holding only the keys of
+// `examples/hard_spheres_3d.toml` is complete; everything else has a default here.
+// Reduced units throughout: lengths in units of the first species' diameter is *not* assumed,
+// the user chooses the unit (typically diameter = mass = kT = 1).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace kairos {
+
+struct SpeciesConfig {
+  std::string name = "A";
+  double diameter = 1.0;
+  double mass = 1.0;
+  double fraction = 1.0;  // number fraction; fractions are normalised to sum 1
+
+  bool operator==(const SpeciesConfig&) const = default;
+};
+
+struct SystemConfig {
+  int dimension = 3;                   // 2 or 3
+  std::uint64_t particles = 0;         // required unless initial_state is given
+  double packing_fraction = 0.0;       // required unless initial_state is given
+  std::string lattice;                 // fcc|sc|bcc (3D), hex|square (2D), random; "" -> fcc / hex
+  double temperature = 1.0;            // kT of the initial Maxwell-Boltzmann velocities
+  std::uint64_t seed = 1;              // seeds all randomness of the run
+  std::vector<SpeciesConfig> species;  // empty -> one species "A", diameter 1, mass 1
+  std::string initial_state;           // GSD file to start from (last frame); "" -> generate
+
+  bool operator==(const SystemConfig&) const = default;
+};
+
+struct RunConfig {
+  double equilibration_collisions_per_particle = 20.0;
+  double collisions_per_particle = 100.0;  // production length
+  std::string event_queue = "calendar";    // calendar | heap
+  double max_wall_seconds = 0.0;           // 0 = no limit; stop cleanly when exceeded
+  bool validate = false;  // debug: check neighbour structure and queue against brute force
+
+  bool operator==(const RunConfig&) const = default;
+};
+
+struct OutputConfig {
+  std::string directory = "kairos-output";
+  double thermo_interval = 0.0;      // collisions per particle between thermo rows; 0 = auto
+  double trajectory_interval = 0.0;  // collisions per particle between GSD frames; 0 = auto
+  double restart_interval = 0.0;     // collisions per particle between restart files; 0 = end
+  bool trajectory = true;            // write trajectory.gsd at all
+  std::string progress = "auto";     // auto (when stderr is a terminal) | always | never
+
+  bool operator==(const OutputConfig&) const = default;
+};
+
+struct Config {
+  SystemConfig system;
+  RunConfig run;
+  OutputConfig output;
+
+  bool operator==(const Config&) const = default;  // memberwise (exact doubles)
+};
+
+// Parses TOML text, applies the `key=value` overrides (dotted paths, values in TOML syntax;
+// a bare word is taken as a string), then validates. Throws InputError with a one-line message
+// naming the source and the key on unknown keys, wrong types, NaN/inf, out-of-range values.
+// The result has its defaults resolved: system.lattice is never "" (default_lattice()) and
+// system.species is never empty (one species "A"); species fractions are kept as written.
+// Override paths index species as `system.species.0.diameter` or `system.species[0].diameter`;
+// index N == current count appends a species.
+Config parse_config(std::string_view toml_text, std::string_view source_name,
+                    const std::vector<std::string>& overrides = {});
+
+// Reads the file (InputError if missing/unreadable) and calls parse_config.
+Config load_config(const std::filesystem::path& path,
+                   const std::vector<std::string>& overrides = {});
+
+// The effective configuration (all defaults filled in) as TOML text; parse_config of the result
+// gives back an equal Config (for a Config from parse_config; otherwise its resolved form).
+// Doubles are written in shortest round-trip form. Throws std::out_of_range if particles or seed
+// exceed 2^63 - 1 (not representable in TOML). Written as OUTDIR/config.toml so a run documents
+// itself.
+std::string to_toml(const Config& config);
+
+// Default lattice for a dimension: "fcc" in 3D, "hex" in 2D; std::invalid_argument otherwise.
+std::string default_lattice(int dimension);
+
+}  // namespace kairos

@@ -1,0 +1,500 @@
+// GSD 2.0 file layer; the layout and the commit protocol are described in gsd_file.hpp.
+#include "io/gsd_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "core/error.hpp"
+
+namespace kairos::gsd {
+namespace {
+
+constexpr std::uint64_t kMagic = 0x65DF65DF65DF65DFull;
+constexpr std::uint32_t kGsdVersion = 2u << 16;  // we write file layer 2.0
+constexpr std::uint64_t kInitialIndex = 128;     // entries
+constexpr std::uint64_t kInitialNamelist = 16;   // 64-byte segments
+constexpr std::size_t kBufferBytes = 1u << 22;   // chunk data is written in pieces of ~4 MiB
+
+struct Header {
+  std::uint64_t magic;
+  std::uint64_t index_location;
+  std::uint64_t index_allocated_entries;
+  std::uint64_t namelist_location;
+  std::uint64_t namelist_allocated_entries;  // 64-byte segments
+  std::uint32_t schema_version;
+  std::uint32_t gsd_version;
+  char application[64];
+  char schema[64];
+  char reserved[80];
+};
+
+struct Entry {
+  std::uint64_t frame;
+  std::uint64_t N;
+  std::int64_t location;
+  std::uint32_t M;
+  std::uint16_t id;
+  std::uint8_t type;
+  std::uint8_t flags;
+};
+
+static_assert(sizeof(Header) == 256 && sizeof(Entry) == 32);
+static_assert(std::endian::native == std::endian::little, "GSD files are little-endian");
+
+[[noreturn]] void fail(const std::filesystem::path& path, const std::string& what) {
+  throw InputError("GSD file '" + path.string() + "': " + what);
+}
+
+class Fd {
+ public:
+  explicit Fd(int fd) : fd_(fd) {}
+  Fd(const Fd&) = delete;
+  Fd& operator=(const Fd&) = delete;
+  ~Fd() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  int get() const { return fd_; }
+
+ private:
+  int fd_;
+};
+
+// Reads up to `bytes`; returns the count read (short only at the end of the file).
+std::size_t read_at(int fd, void* dst, std::size_t bytes, std::uint64_t offset,
+                    const std::filesystem::path& path) {
+  std::size_t done = 0;
+  while (done < bytes) {
+    const ssize_t n = ::pread(fd, static_cast<char*>(dst) + done, bytes - done,
+                              static_cast<off_t>(offset + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(path, std::string("read failed: ") + std::strerror(errno));
+    if (n == 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  return done;
+}
+
+void write_at(int fd, const void* src, std::size_t bytes, std::uint64_t offset,
+              const std::filesystem::path& path) {
+  std::size_t done = 0;
+  while (done < bytes) {
+    const ssize_t n = ::pwrite(fd, static_cast<const char*>(src) + done, bytes - done,
+                               static_cast<off_t>(offset + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(path, std::string("write failed: ") + std::strerror(errno));
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+void sync(int fd, const std::filesystem::path& path) {
+  if (::fsync(fd) != 0) fail(path, std::string("fsync failed: ") + std::strerror(errno));
+}
+
+std::string fixed_string(const char (&field)[64]) {
+  return std::string(field, strnlen(field, 64));
+}
+
+std::string version_string(std::uint32_t v) {
+  return std::to_string(v >> 16) + "." + std::to_string(v & 0xFFFFu);
+}
+
+// Header, names and the valid part of the index of an open GSD 2.x file.
+struct Contents {
+  Header header;
+  std::string namelist;  // the names with their terminators, without the final empty name
+  std::vector<std::string> names;
+  std::vector<Entry> index;  // complete frames only
+  std::uint64_t used_slots;  // index slots before the first location 0 (>= index.size())
+  std::uint64_t file_size;
+};
+
+Contents load(int fd, const std::filesystem::path& path) {
+  Contents c{};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) fail(path, std::string("cannot stat: ") + std::strerror(errno));
+  c.file_size = static_cast<std::uint64_t>(st.st_size);
+  Header& h = c.header;
+  if (read_at(fd, &h, sizeof h, 0, path) != sizeof h || h.magic != kMagic)
+    fail(path, "not a GSD file (no GSD header)");
+  if (h.gsd_version >> 16 != 2)
+    fail(path, "unsupported GSD file layer version " + version_string(h.gsd_version) +
+                   " (only 2.x is supported)");
+  if (strnlen(h.application, 64) == 64 || strnlen(h.schema, 64) == 64)
+    fail(path, "corrupt header (unterminated application or schema name)");
+  // A block lies inside the file; checked without overflow.
+  const auto inside = [&](std::uint64_t location, std::uint64_t count, std::uint64_t size) {
+    return location >= sizeof(Header) && location <= c.file_size &&
+           count <= (c.file_size - location) / size;
+  };
+  if (!inside(h.namelist_location, h.namelist_allocated_entries, 64))
+    fail(path, "corrupt header (namelist block outside the file)");
+  if (!inside(h.index_location, h.index_allocated_entries, sizeof(Entry)))
+    fail(path, "corrupt header (index block outside the file)");
+
+  std::string block(h.namelist_allocated_entries * 64, '\0');
+  if (read_at(fd, block.data(), block.size(), h.namelist_location, path) != block.size())
+    fail(path, "namelist is truncated");
+  std::size_t pos = 0;
+  while (pos < block.size() && block[pos] != '\0') {
+    const std::size_t end = block.find('\0', pos);
+    if (end == std::string::npos) fail(path, "corrupt namelist (unterminated name)");
+    c.names.push_back(block.substr(pos, end - pos));
+    pos = end + 1;
+  }
+  block.resize(pos);
+  c.namelist = std::move(block);
+
+  c.index.resize(h.index_allocated_entries);
+  const std::size_t index_bytes = c.index.size() * sizeof(Entry);
+  if (read_at(fd, c.index.data(), index_bytes, h.index_location, path) != index_bytes)
+    fail(path, "index is truncated");
+  std::size_t used = 0;
+  while (used < c.index.size() && c.index[used].location != 0) ++used;
+  c.used_slots = used;
+  std::size_t valid = 0;
+  for (std::uint64_t prev_frame = 0; valid < used; ++valid) {
+    const Entry& e = c.index[valid];
+    const std::uint64_t size = type_size(static_cast<Type>(e.type));
+    const std::uint64_t location = static_cast<std::uint64_t>(e.location);
+    const bool ok = size != 0 && e.flags == 0 && e.id < c.names.size() && e.frame >= prev_frame &&
+                    e.frame < h.index_allocated_entries && e.location > 0 &&
+                    location <= c.file_size &&
+                    (e.N == 0 || e.M == 0 || e.N <= (c.file_size - location) / e.M / size);
+    if (!ok) {
+      // A torn or truncated tail: drop the frame the bad entry belongs to and all later ones.
+      const std::uint64_t cut = std::max(e.frame, prev_frame);
+      while (valid > 0 && c.index[valid - 1].frame >= cut) --valid;
+      break;
+    }
+    prev_frame = e.frame;
+  }
+  c.index.resize(valid);
+  return c;
+}
+
+void copy_name(char (&field)[64], std::string_view value, const char* what) {
+  if (value.size() > 63 || value.find('\0') != std::string_view::npos)
+    throw std::invalid_argument(std::string("GSD ") + what + " name must have at most 63 bytes");
+  std::memset(field, 0, sizeof field);
+  std::memcpy(field, value.data(), value.size());
+}
+
+}  // namespace
+
+std::size_t type_size(Type type) {
+  constexpr std::size_t sizes[] = {0, 1, 2, 4, 8, 1, 2, 4, 8, 4, 8, 1};
+  const auto i = static_cast<std::size_t>(type);
+  return i < std::size(sizes) ? sizes[i] : 0;
+}
+
+std::string_view type_name(Type type) {
+  constexpr std::string_view names[] = {"invalid", "uint8",   "uint16",  "uint32",
+                                        "uint64",  "int8",    "int16",   "int32",
+                                        "int64",   "float32", "float64", "character"};
+  const auto i = static_cast<std::size_t>(type);
+  return names[i < std::size(names) ? i : 0];
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writer
+
+struct Writer::State {
+  std::filesystem::path path;
+  Fd fd;
+  Header header{};
+  std::string namelist;                                // committed names, each 0-terminated
+  std::unordered_map<std::string, std::uint16_t> ids;  // committed and pending names
+  std::string new_names;                               // pending names, each 0-terminated
+  std::uint64_t entries = 0;                           // committed index entries
+  std::uint64_t frames = 0;                            // completed frames
+  std::uint64_t end = 0;      // file size after the last commit; pending data goes after it
+  std::uint64_t flushed = 0;  // pending data bytes already written after `end`
+  std::vector<Entry> pending;
+  std::vector<char> buffer;  // pending data bytes not yet written
+
+  State(std::filesystem::path p, int descriptor) : path(std::move(p)), fd(descriptor) {}
+
+  void flush() {
+    write_at(fd.get(), buffer.data(), buffer.size(), end + flushed, path);
+    flushed += buffer.size();
+    buffer.clear();
+  }
+};
+
+Writer::Writer(std::unique_ptr<State> state) : s_(std::move(state)) {}
+Writer::Writer(Writer&&) noexcept = default;
+Writer& Writer::operator=(Writer&& other) noexcept {
+  if (this != &other) {
+    close();
+    s_ = std::move(other.s_);
+  }
+  return *this;
+}
+Writer::~Writer() {
+  close();
+}
+
+Writer::State& Writer::state(const char* what) const {
+  if (!s_) throw std::logic_error(std::string("gsd::Writer::") + what + " on a closed writer");
+  return *s_;
+}
+
+Writer Writer::create(const std::filesystem::path& path, std::string_view application,
+                      std::string_view schema, std::uint32_t schema_version) {
+  Header h{};
+  copy_name(h.application, application, "application");
+  copy_name(h.schema, schema, "schema");
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) fail(path, std::string("cannot create: ") + std::strerror(errno));
+  auto s = std::make_unique<State>(path, fd);
+  h.magic = kMagic;
+  h.gsd_version = kGsdVersion;
+  h.schema_version = schema_version;
+  h.index_location = sizeof(Header);
+  h.index_allocated_entries = kInitialIndex;
+  h.namelist_location = h.index_location + kInitialIndex * sizeof(Entry);
+  h.namelist_allocated_entries = kInitialNamelist;
+  s->header = h;
+  s->end = h.namelist_location + kInitialNamelist * 64;
+  std::vector<char> image(s->end, '\0');  // header, empty index, empty namelist
+  std::memcpy(image.data(), &h, sizeof h);
+  write_at(fd, image.data(), image.size(), 0, path);
+  sync(fd, path);
+  return Writer(std::move(s));
+}
+
+Writer Writer::open_append(const std::filesystem::path& path) {
+  const int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+  if (fd < 0) fail(path, std::string("cannot open for appending: ") + std::strerror(errno));
+  auto s = std::make_unique<State>(path, fd);
+  Contents c = load(fd, path);
+  if (c.names.size() > 0xFFFF) fail(path, "corrupt namelist (more than 65535 names)");
+  s->header = c.header;
+  s->namelist = std::move(c.namelist);
+  for (std::size_t i = 0; i < c.names.size(); ++i)
+    s->ids.emplace(c.names[i], static_cast<std::uint16_t>(i));
+  s->entries = c.index.size();
+  s->frames = c.index.empty() ? 0 : c.index.back().frame + 1;
+  s->end = c.file_size;
+  if (c.used_slots > s->entries) {  // clear the entries of a dropped (torn) frame
+    const std::vector<Entry> zeros(c.used_slots - s->entries, Entry{});
+    write_at(fd, zeros.data(), zeros.size() * sizeof(Entry),
+             c.header.index_location + s->entries * sizeof(Entry), path);
+    sync(fd, path);
+  }
+  return Writer(std::move(s));
+}
+
+void Writer::write_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M,
+                         const void* data) {
+  State& s = state("write_chunk");
+  const std::size_t size = type_size(type);
+  const std::string chunk(name);
+  const auto refuse = [&](const std::string& why) {
+    throw std::invalid_argument("GSD chunk '" + chunk + "': " + why);
+  };
+  if (size == 0) refuse("invalid type");
+  if (type == Type::character) refuse("type character is not readable by GSD 2.0 readers");
+  if (chunk.empty() || chunk.find('\0') != std::string::npos) refuse("invalid name");
+  if (M != 0 && N > (std::uint64_t{1} << 62) / M / size) refuse("too large");
+  const std::size_t bytes = N * M * size;
+  if (bytes != 0 && data == nullptr) refuse("null data");
+
+  auto it = s.ids.find(chunk);
+  if (it == s.ids.end()) {
+    if (s.ids.size() >= 0xFFFF) refuse("a GSD file holds at most 65535 chunk names");
+    it = s.ids.emplace(chunk, static_cast<std::uint16_t>(s.ids.size())).first;
+    s.new_names += chunk;
+    s.new_names += '\0';
+  }
+  const std::uint16_t id = it->second;
+  if (std::any_of(s.pending.begin(), s.pending.end(), [&](const Entry& e) { return e.id == id; }))
+    refuse("written twice in one frame");
+
+  const std::uint64_t location = s.end + s.flushed + s.buffer.size();
+  s.pending.push_back(Entry{s.frames, N, static_cast<std::int64_t>(location), M, id,
+                            static_cast<std::uint8_t>(type), 0});
+  if (s.buffer.size() + bytes > kBufferBytes) s.flush();
+  if (bytes >= kBufferBytes) {
+    write_at(s.fd.get(), data, bytes, location, s.path);
+    s.flushed += bytes;
+  } else {
+    const char* p = static_cast<const char*>(data);
+    s.buffer.insert(s.buffer.end(), p, p + bytes);
+  }
+}
+
+void Writer::end_frame() {
+  State& s = state("end_frame");
+  try {
+    s.flush();
+    Header& h = s.header;
+    const int fd = s.fd.get();
+    std::uint64_t eof = s.end + s.flushed;
+    std::sort(s.pending.begin(), s.pending.end(),
+              [](const Entry& a, const Entry& b) { return a.id < b.id; });
+
+    // New names: into the namelist's free space (keeping a final empty name), else a copy at
+    // least twice as large at the end of the file.
+    bool new_header = false;
+    if (!s.new_names.empty()) {
+      const std::uint64_t needed = s.namelist.size() + s.new_names.size() + 1;
+      std::uint64_t capacity = h.namelist_allocated_entries * 64;
+      if (needed <= capacity) {
+        const std::string names = s.new_names + '\0';
+        write_at(fd, names.data(), names.size(), h.namelist_location + s.namelist.size(), s.path);
+      } else {
+        capacity = std::max(2 * capacity, (needed + 63) / 64 * 64);
+        std::string block = s.namelist + s.new_names;
+        block.resize(capacity, '\0');
+        write_at(fd, block.data(), block.size(), eof, s.path);
+        h.namelist_location = eof;
+        h.namelist_allocated_entries = capacity / 64;
+        eof += capacity;
+        new_header = true;
+      }
+    }
+
+    // Index: into its free slots, else a doubled copy holding this frame's entries too. GSD
+    // readers also require every frame number to be below the index capacity.
+    const std::uint64_t n = s.pending.size();
+    const std::uint64_t needed = s.entries + n;
+    std::uint64_t capacity = h.index_allocated_entries;
+    const bool relocate = needed > capacity || (n > 0 && s.frames >= capacity);
+    if (relocate) {
+      capacity = std::max<std::uint64_t>(capacity, 1);
+      while (capacity < needed || capacity <= s.frames) capacity *= 2;
+      std::vector<Entry> index(capacity, Entry{});
+      const std::size_t old_bytes = s.entries * sizeof(Entry);
+      if (read_at(fd, index.data(), old_bytes, h.index_location, s.path) != old_bytes)
+        fail(s.path, "index is truncated");
+      std::copy(s.pending.begin(), s.pending.end(), index.begin() + s.entries);
+      write_at(fd, index.data(), index.size() * sizeof(Entry), eof, s.path);
+      h.index_location = eof;
+      h.index_allocated_entries = capacity;
+      eof += capacity * sizeof(Entry);
+      new_header = true;
+    }
+
+    // Everything the frame refers to is durable before the frame becomes visible.
+    sync(fd, s.path);
+    if (new_header) {
+      write_at(fd, &h, sizeof h, 0, s.path);
+      if (!relocate) sync(fd, s.path);  // the new namelist, before entries that use its ids
+    }
+    if (!relocate && n > 0)
+      write_at(fd, s.pending.data(), n * sizeof(Entry),
+               h.index_location + s.entries * sizeof(Entry), s.path);
+    if (new_header || n > 0) sync(fd, s.path);
+
+    s.namelist += s.new_names;
+    s.new_names.clear();
+    s.entries += n;
+    s.pending.clear();
+    s.frames += 1;
+    s.end = eof;
+    s.flushed = 0;
+  } catch (...) {
+    s_.reset();  // the in-memory state no longer matches the file
+    throw;
+  }
+}
+
+std::uint64_t Writer::frame_count() const {
+  return state("frame_count").frames;
+}
+
+void Writer::close() noexcept {
+  if (!s_) return;
+  // Discard an unfinished frame; the file then ends where the last commit left it.
+  if (s_->flushed > 0 && ::ftruncate(s_->fd.get(), static_cast<off_t>(s_->end)) != 0) {
+    // best effort: bytes past the last commit are never referenced
+  }
+  s_.reset();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reader
+
+struct Reader::State {
+  std::filesystem::path path;
+  Fd fd;
+  Contents contents;
+  std::unordered_map<std::string, std::uint16_t> ids;
+
+  State(std::filesystem::path p, int descriptor) : path(std::move(p)), fd(descriptor) {}
+
+  const Entry* find(std::uint64_t frame, std::string_view name) const {
+    const auto id = ids.find(std::string(name));
+    if (id == ids.end()) return nullptr;
+    const auto& index = contents.index;
+    auto it = std::lower_bound(index.begin(), index.end(), frame,
+                               [](const Entry& e, std::uint64_t f) { return e.frame < f; });
+    for (; it != index.end() && it->frame == frame; ++it)
+      if (it->id == id->second) return &*it;
+    return nullptr;
+  }
+};
+
+Reader::Reader(const std::filesystem::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail(path, std::string("cannot open: ") + std::strerror(errno));
+  s_ = std::make_unique<State>(path, fd);
+  s_->contents = load(fd, path);
+  const auto& names = s_->contents.names;
+  for (std::size_t i = 0; i < names.size() && i < 0xFFFF; ++i)
+    s_->ids.emplace(names[i], static_cast<std::uint16_t>(i));
+}
+
+Reader::Reader(Reader&&) noexcept = default;
+Reader& Reader::operator=(Reader&&) noexcept = default;
+Reader::~Reader() = default;
+
+std::uint64_t Reader::frame_count() const {
+  const auto& index = s_->contents.index;
+  return index.empty() ? 0 : index.back().frame + 1;
+}
+std::string Reader::application() const {
+  return fixed_string(s_->contents.header.application);
+}
+std::string Reader::schema() const {
+  return fixed_string(s_->contents.header.schema);
+}
+std::uint32_t Reader::schema_version() const {
+  return s_->contents.header.schema_version;
+}
+std::vector<std::string> Reader::chunk_names() const {
+  return s_->contents.names;
+}
+
+std::optional<Reader::ChunkInfo> Reader::find(std::uint64_t frame, std::string_view name) const {
+  const Entry* e = s_->find(frame, name);
+  if (e == nullptr) return std::nullopt;
+  return ChunkInfo{static_cast<Type>(e->type), e->N, e->M};
+}
+
+Reader::Located Reader::locate(std::uint64_t frame, std::string_view name, Type type) const {
+  const std::string where = "chunk '" + std::string(name) + "' in frame " + std::to_string(frame);
+  const Entry* e = s_->find(frame, name);
+  if (e == nullptr) fail(s_->path, "no " + where);
+  const auto stored = static_cast<Type>(e->type);
+  if (stored != type)
+    fail(s_->path, where + " holds " + std::string(type_name(stored)) + ", not " +
+                       std::string(type_name(type)));
+  return Located{static_cast<std::uint64_t>(e->location), e->N * e->M};
+}
+
+void Reader::read_bytes(std::uint64_t location, void* dst, std::size_t bytes) const {
+  if (read_at(s_->fd.get(), dst, bytes, location, s_->path) != bytes)
+    fail(s_->path, "chunk data is truncated (file changed while open?)");
+}
+
+}  // namespace kairos::gsd

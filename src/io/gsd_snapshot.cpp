@@ -1,0 +1,346 @@
+#include "io/gsd_snapshot.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+
+namespace kairos {
+
+namespace {
+
+constexpr std::uint32_t kRestartFormat = 1;
+
+// HOOMD stores type names as an N_types x M int8 array of 0-padded strings.
+std::vector<std::int8_t> pack_type_names(const std::vector<std::string>& names, std::uint32_t& m) {
+  m = 1;
+  for (const auto& n : names) m = std::max<std::uint32_t>(m, static_cast<std::uint32_t>(n.size() + 1));
+  std::vector<std::int8_t> out(names.size() * m, 0);
+  for (std::size_t t = 0; t < names.size(); ++t) {
+    for (std::size_t c = 0; c < names[t].size(); ++c) out[t * m + c] = static_cast<std::int8_t>(names[t][c]);
+  }
+  return out;
+}
+
+std::vector<std::string> unpack_type_names(const std::vector<std::int8_t>& raw, std::uint32_t m) {
+  std::vector<std::string> names;
+  for (std::size_t t = 0; m > 0 && t < raw.size() / m; ++t) {
+    std::string s;
+    for (std::size_t c = 0; c < m && raw[t * m + c] != 0; ++c) s.push_back(static_cast<char>(raw[t * m + c]));
+    names.push_back(s);
+  }
+  return names;
+}
+
+template <int D>
+void write_standard_chunks(gsd::Writer& w, const ParticleSystem<D>& sys, bool with_static) {
+  const auto n = static_cast<std::uint32_t>(sys.size());
+  const std::uint64_t step = sys.counters.events;
+  const std::uint8_t dims = D;
+  const float box[6] = {static_cast<float>(sys.box[0]), static_cast<float>(sys.box[1]),
+                        D == 3 ? static_cast<float>(sys.box[D - 1]) : 0.0f, 0.0f, 0.0f, 0.0f};
+  w.write_chunk("configuration/step", 1, 1, &step);
+  w.write_chunk("configuration/dimensions", 1, 1, &dims);
+  w.write_chunk("configuration/box", 6, 1, box);
+  w.write_chunk("particles/N", 1, 1, &n);
+  std::vector<float> pos(3 * n, 0.0f), vel(3 * n, 0.0f);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Vec<D> x = sys.position_at(i, sys.time);
+    for (int a = 0; a < D; ++a) {
+      double c = x[a] - sys.box[a] * std::floor(x[a] / sys.box[a]);  // wrap into [0, L)
+      c -= 0.5 * sys.box[a];                                          // HOOMD's centred box
+      pos[3 * i + a] = static_cast<float>(c);
+      vel[3 * i + a] = static_cast<float>(sys.kinematics[i].vel[a]);
+    }
+  }
+  w.write_chunk("particles/position", n, 3, pos.data());
+  w.write_chunk("particles/velocity", n, 3, vel.data());
+  if (with_static) {
+    std::uint32_t m = 0;
+    const auto names = pack_type_names(sys.species_names, m);
+    w.write_chunk("particles/types", sys.species_names.size(), m, names.data());
+    w.write_chunk("particles/typeid", n, 1, sys.species.data());
+    std::vector<float> diameter(n), mass(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      diameter[i] = static_cast<float>(2.0 * sys.kinematics[i].radius);
+      mass[i] = static_cast<float>(sys.mass[i]);
+    }
+    w.write_chunk("particles/diameter", n, 1, diameter.data());
+    w.write_chunk("particles/mass", n, 1, mass.data());
+  }
+  w.write_chunk("log/time", 1, 1, &sys.time);
+  w.write_chunk("log/collisions", 1, 1, &sys.counters.collisions);
+  w.write_chunk("log/events", 1, 1, &sys.counters.events);
+}
+
+template <class T>
+std::optional<std::vector<T>> read_latest(const gsd::Reader& r, std::uint64_t frame,
+                                          std::string_view name) {
+  if (r.find(frame, name)) return r.read<T>(frame, name);
+  if (r.find(0, name)) return r.read<T>(0, name);
+  return std::nullopt;
+}
+
+template <class T>
+std::vector<T> require(const gsd::Reader& r, std::uint64_t frame, std::string_view name,
+                       const std::filesystem::path& path, std::size_t expected) {
+  auto v = read_latest<T>(r, frame, name);
+  if (!v) throw InputError("'" + path.string() + "' has no chunk '" + std::string(name) + "'");
+  if (v->size() != expected) {
+    throw InputError("'" + path.string() + "': chunk '" + std::string(name) + "' holds " +
+                     std::to_string(v->size()) + " values, expected " + std::to_string(expected));
+  }
+  return std::move(*v);
+}
+
+}  // namespace
+
+template <int D>
+void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& system) {
+  write_standard_chunks(writer, system, writer.frame_count() == 0);
+  writer.end_frame();
+}
+
+template <int D>
+void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s,
+                   const std::mt19937_64& rng) {
+  replace_file_atomically(path, [&](const std::filesystem::path& tmp) {
+    auto w = gsd::Writer::create(tmp, "kairos " KAIROS_VERSION);
+    write_standard_chunks(w, s, true);
+    const std::uint64_t n = s.size();
+    std::vector<double> pos(n * D), vel(n * D), local(n), radius(n), now(n * D);
+    std::vector<double> tcoll(n), tcross(n);
+    std::vector<std::uint32_t> partner(n), pcount(n);
+    std::vector<std::int32_t> crossing(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& k = s.kinematics[i];
+      const Vec<D> x = s.position_at(i, s.time);
+      for (int a = 0; a < D; ++a) {
+        pos[i * D + a] = k.pos[a];
+        vel[i * D + a] = k.vel[a];
+        now[i * D + a] = x[a] - s.box[a] * std::floor(x[a] / s.box[a]);
+      }
+      local[i] = k.time;
+      radius[i] = k.radius;
+      tcoll[i] = s.events[i].collision_time;
+      tcross[i] = s.events[i].crossing_time;
+      partner[i] = s.events[i].partner;
+      pcount[i] = s.events[i].partner_count;
+      crossing[i] = s.events[i].crossing;
+    }
+    const std::uint32_t format = kRestartFormat;
+    const std::uint8_t dims = D;
+    const std::uint64_t counters[4] = {s.counters.events, s.counters.collisions,
+                                       s.counters.cell_crossings, s.counters.stale_events};
+    std::ostringstream rng_text;
+    rng_text << rng;
+    const std::string rs = rng_text.str();
+    std::vector<std::int8_t> rng_bytes(rs.begin(), rs.end());
+    w.write_chunk("kairos/format", 1, 1, &format);
+    w.write_chunk("kairos/dimension", 1, 1, &dims);
+    w.write_chunk("kairos/box", D, 1, s.box.data());
+    w.write_chunk("kairos/time", 1, 1, &s.time);
+    w.write_chunk("kairos/position", n, D, now.data());  // at kairos/time, wrapped
+    w.write_chunk("kairos/velocity", n, D, vel.data());
+    w.write_chunk("kairos/mass", n, 1, s.mass.data());
+    w.write_chunk("kairos/radius", n, 1, radius.data());
+    w.write_chunk("kairos/state/position", n, D, pos.data());  // at each local time
+    w.write_chunk("kairos/state/local_time", n, 1, local.data());
+    w.write_chunk("kairos/state/collision_count", n, 1, s.collision_count.data());
+    w.write_chunk("kairos/state/collision_time", n, 1, tcoll.data());
+    w.write_chunk("kairos/state/crossing_time", n, 1, tcross.data());
+    w.write_chunk("kairos/state/partner", n, 1, partner.data());
+    w.write_chunk("kairos/state/partner_count", n, 1, pcount.data());
+    w.write_chunk("kairos/state/crossing", n, 1, crossing.data());
+    w.write_chunk("kairos/state/cell", n, 1, s.cell.data());
+    w.write_chunk("kairos/state/counters", 4, 1, counters);
+    w.write_chunk("kairos/state/virial", 1, 1, &s.counters.virial);
+    w.write_chunk("kairos/state/rng", rng_bytes.size(), 1, rng_bytes.data());
+    w.end_frame();
+    w.close();
+  });
+}
+
+int gsd_dimension(const std::filesystem::path& path) {
+  const gsd::Reader r(path);
+  if (r.frame_count() == 0) throw InputError("'" + path.string() + "' holds no frame");
+  const auto d = read_latest<std::uint8_t>(r, r.frame_count() - 1, "configuration/dimensions");
+  return d && !d->empty() ? (*d)[0] : 3;
+}
+
+template <int D>
+ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_64& rng) {
+  const gsd::Reader r(path);
+  const std::uint64_t f = r.frame_count() == 0 ? 0 : r.frame_count() - 1;
+  if (r.frame_count() == 0 || !r.find(f, "kairos/format")) {
+    throw InputError("'" + path.string() + "' is not a Kairos restart file (no kairos/format)");
+  }
+  if (r.read<std::uint32_t>(f, "kairos/format").at(0) != kRestartFormat) {
+    throw InputError("'" + path.string() + "': unsupported restart format version");
+  }
+  const int dim = r.read<std::uint8_t>(f, "kairos/dimension").at(0);
+  if (dim != D) {
+    throw InputError("'" + path.string() + "' holds a " + std::to_string(dim) +
+                     "D state but system.dimension = " + std::to_string(D));
+  }
+  const std::size_t n = r.read<std::uint32_t>(f, "particles/N").at(0);
+  ParticleSystem<D> s;
+  const auto box = require<double>(r, f, "kairos/box", path, D);
+  for (int a = 0; a < D; ++a) s.box[a] = box[a];
+  s.time = require<double>(r, f, "kairos/time", path, 1)[0];
+  const auto pos = require<double>(r, f, "kairos/state/position", path, n * D);
+  const auto vel = require<double>(r, f, "kairos/velocity", path, n * D);
+  const auto local = require<double>(r, f, "kairos/state/local_time", path, n);
+  const auto radius = require<double>(r, f, "kairos/radius", path, n);
+  s.mass = require<double>(r, f, "kairos/mass", path, n);
+  s.species = require<std::uint32_t>(r, f, "particles/typeid", path, n);
+  const auto types = r.find(f, "particles/types");
+  s.species_names = unpack_type_names(r.read<std::int8_t>(f, "particles/types"), types->M);
+  s.collision_count = require<std::uint32_t>(r, f, "kairos/state/collision_count", path, n);
+  s.cell = require<std::uint32_t>(r, f, "kairos/state/cell", path, n);
+  const auto tcoll = require<double>(r, f, "kairos/state/collision_time", path, n);
+  const auto tcross = require<double>(r, f, "kairos/state/crossing_time", path, n);
+  const auto partner = require<std::uint32_t>(r, f, "kairos/state/partner", path, n);
+  const auto pcount = require<std::uint32_t>(r, f, "kairos/state/partner_count", path, n);
+  const auto crossing = require<std::int32_t>(r, f, "kairos/state/crossing", path, n);
+  const auto counters = require<std::uint64_t>(r, f, "kairos/state/counters", path, 4);
+  s.counters = {counters[0], counters[1], counters[2], counters[3],
+                require<double>(r, f, "kairos/state/virial", path, 1)[0]};
+  s.kinematics.resize(n);
+  s.events.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int a = 0; a < D; ++a) {
+      s.kinematics[i].pos[a] = pos[i * D + a];
+      s.kinematics[i].vel[a] = vel[i * D + a];
+    }
+    s.kinematics[i].time = local[i];
+    s.kinematics[i].radius = radius[i];
+    s.events[i] = {tcoll[i], tcross[i], partner[i], pcount[i], crossing[i]};
+  }
+  const auto rng_bytes = r.read<std::int8_t>(f, "kairos/state/rng");
+  std::istringstream rng_text(std::string(rng_bytes.begin(), rng_bytes.end()));
+  rng_text >> rng;
+  if (!rng_text) throw InputError("'" + path.string() + "': corrupt RNG state");
+  return s;
+}
+
+template <int D>
+InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_velocities) {
+  const gsd::Reader r(path);
+  if (r.frame_count() == 0) throw InputError("'" + path.string() + "' holds no frame");
+  const std::uint64_t f = r.frame_count() - 1;
+  const int dim = gsd_dimension(path);
+  if (dim != D) {
+    throw InputError("system.initial_state '" + path.string() + "' is " + std::to_string(dim) +
+                     "D but system.dimension = " + std::to_string(D));
+  }
+  const auto nv = read_latest<std::uint32_t>(r, f, "particles/N");
+  const std::size_t n = nv && !nv->empty() ? (*nv)[0] : 0;
+  if (n < 2) throw InputError("system.initial_state '" + path.string() + "' holds fewer than 2 particles");
+  InitialState<D> s;
+  const bool exact = r.find(f, "kairos/position").has_value();
+  if (exact) {
+    const auto box = require<double>(r, f, "kairos/box", path, D);
+    for (int a = 0; a < D; ++a) s.box[a] = box[a];
+  } else {
+    const auto box = require<float>(r, f, "configuration/box", path, 6);
+    for (int a = 0; a < D; ++a) s.box[a] = box[a];
+  }
+  for (int a = 0; a < D; ++a) {
+    if (!(s.box[a] > 0.0) || !std::isfinite(s.box[a])) {
+      throw InputError("system.initial_state '" + path.string() + "': box edge " +
+                       std::to_string(a) + " is not a positive number");
+    }
+  }
+  s.position.resize(n);
+  s.velocity.assign(n, Vec<D>{});
+  auto check_finite = [&](double v, const char* what, std::size_t i) {
+    if (!std::isfinite(v)) {
+      throw InputError("system.initial_state '" + path.string() + "': " + what + " of particle " +
+                       std::to_string(i) + " is not finite");
+    }
+  };
+  if (exact) {
+    const auto pos = require<double>(r, f, "kairos/position", path, n * D);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < D; ++a) s.position[i][a] = pos[i * D + a];
+  } else {
+    const auto pos = require<float>(r, f, "particles/position", path, n * 3);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < D; ++a) s.position[i][a] = pos[i * 3 + a] + 0.5 * s.box[a];
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int a = 0; a < D; ++a) {
+      check_finite(s.position[i][a], "position", i);
+      double& x = s.position[i][a];
+      x -= s.box[a] * std::floor(x / s.box[a]);
+      if (x >= s.box[a]) x = 0.0;
+    }
+  }
+  has_velocities = false;
+  if (r.find(f, "kairos/velocity")) {
+    const auto vel = require<double>(r, f, "kairos/velocity", path, n * D);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < D; ++a) s.velocity[i][a] = vel[i * D + a];
+    has_velocities = true;
+  } else if (auto vel = read_latest<float>(r, f, "particles/velocity")) {
+    if (vel->size() != n * 3) throw InputError("'" + path.string() + "': particles/velocity has the wrong size");
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < D; ++a) s.velocity[i][a] = (*vel)[i * 3 + a];
+    has_velocities = true;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (int a = 0; a < D; ++a) check_finite(s.velocity[i][a], "velocity", i);
+  if (auto radius = read_latest<double>(r, f, "kairos/radius"); radius && radius->size() == n) {
+    for (double x : *radius) s.diameter.push_back(2.0 * x);
+  } else if (auto d = read_latest<float>(r, f, "particles/diameter")) {
+    if (d->size() != n) throw InputError("'" + path.string() + "': particles/diameter has the wrong size");
+    s.diameter.assign(d->begin(), d->end());
+  } else {
+    s.diameter.assign(n, 1.0);
+  }
+  if (auto m = read_latest<double>(r, f, "kairos/mass"); m && m->size() == n) {
+    s.mass = *m;
+  } else if (auto mf = read_latest<float>(r, f, "particles/mass")) {
+    if (mf->size() != n) throw InputError("'" + path.string() + "': particles/mass has the wrong size");
+    s.mass.assign(mf->begin(), mf->end());
+  } else {
+    s.mass.assign(n, 1.0);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(s.diameter[i] > 0.0) || !std::isfinite(s.diameter[i]))
+      throw InputError("system.initial_state '" + path.string() + "': diameter of particle " +
+                       std::to_string(i) + " is not a positive number");
+    if (!(s.mass[i] > 0.0) || !std::isfinite(s.mass[i]))
+      throw InputError("system.initial_state '" + path.string() + "': mass of particle " +
+                       std::to_string(i) + " is not a positive number");
+  }
+  if (auto tid = read_latest<std::uint32_t>(r, f, "particles/typeid")) {
+    s.species = *tid;
+  } else {
+    s.species.assign(n, 0);
+  }
+  if (auto info = r.find(f, "particles/types") ? r.find(f, "particles/types") : r.find(0, "particles/types")) {
+    const std::uint64_t frame = r.find(f, "particles/types") ? f : 0;
+    s.species_names = unpack_type_names(r.read<std::int8_t>(frame, "particles/types"), info->M);
+  }
+  if (s.species_names.empty()) s.species_names = {"A"};
+  for (std::size_t i = 0; i < n; ++i) {
+    if (s.species[i] >= s.species_names.size())
+      throw InputError("system.initial_state '" + path.string() + "': typeid of particle " +
+                       std::to_string(i) + " has no entry in particles/types");
+  }
+  return s;
+}
+
+template void append_trajectory_frame<2>(gsd::Writer&, const ParticleSystem<2>&);
+template void append_trajectory_frame<3>(gsd::Writer&, const ParticleSystem<3>&);
+template void write_restart<2>(const std::filesystem::path&, const ParticleSystem<2>&, const std::mt19937_64&);
+template void write_restart<3>(const std::filesystem::path&, const ParticleSystem<3>&, const std::mt19937_64&);
+template ParticleSystem<2> read_restart<2>(const std::filesystem::path&, std::mt19937_64&);
+template ParticleSystem<3> read_restart<3>(const std::filesystem::path&, std::mt19937_64&);
+template InitialState<2> read_initial_state<2>(const std::filesystem::path&, bool&);
+template InitialState<3> read_initial_state<3>(const std::filesystem::path&, bool&);
+
+}  // namespace kairos

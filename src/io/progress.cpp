@@ -1,0 +1,58 @@
+#include "io/progress.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include <fmt/format.h>
+
+namespace kairos {
+
+std::string format_duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
+  const auto s = static_cast<long long>(seconds + 0.5);
+  return s >= 3600 ? fmt::format("{}:{:02}:{:02}", s / 3600, (s / 60) % 60, s % 60)
+                   : fmt::format("{:02}:{:02}", s / 60, s % 60);
+}
+
+ProgressLine::ProgressLine(const std::string& mode) {
+  tty_ = ::isatty(STDERR_FILENO) != 0;
+  enabled_ = mode == "always" || (mode == "auto" && tty_);
+}
+
+void ProgressLine::update(const ProgressInfo& info) {
+  if (!enabled_) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (info.phase != phase_) {
+    if (drawn_ && tty_) std::fputc('\n', stderr);
+    phase_ = info.phase;
+    phase_start_ = now;
+    drawn_ = false;
+  }
+  const double since = std::chrono::duration<double>(now - last_).count();
+  if (drawn_ && since < (tty_ ? 0.25 : 5.0)) return;
+  last_ = now;
+  const double frac = info.total > 0 ? std::min(1.0, info.done / info.total) : 1.0;
+  const double elapsed = std::chrono::duration<double>(now - phase_start_).count();
+  const double eta = frac > 1e-9 ? elapsed * (1.0 - frac) / frac : -1.0;
+  const std::string line = fmt::format(
+      "[{:<13} {:5.1f}%] {:.1f}/{:.0f} coll/particle | t = {:.6g} | {:.3g} M events/s | ETA {}",
+      info.phase, 100.0 * frac, info.done, info.total, info.sim_time,
+      info.events_per_second / 1e6, format_duration(eta));
+  if (tty_) {
+    std::fprintf(stderr, "\r%-100s", line.c_str());
+  } else {
+    std::fprintf(stderr, "%s\n", line.c_str());
+  }
+  std::fflush(stderr);
+  drawn_ = true;
+}
+
+void ProgressLine::finish() {
+  if (enabled_ && drawn_ && tty_) std::fputc('\n', stderr);
+  drawn_ = false;
+  phase_.clear();
+}
+
+}  // namespace kairos

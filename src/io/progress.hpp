@@ -1,0 +1,41 @@
+// The live progress line on stderr: phase, percentage, simulated time, event rate, ETA.
+//
+// On a terminal it redraws one line in place several times a second; otherwise (CI, a pipe)
+// it prints a plain line every few seconds only when asked to (progress = "always").
+#pragma once
+
+#include <chrono>
+#include <string>
+
+namespace kairos {
+
+struct ProgressInfo {
+  std::string phase;     // "equilibration" / "production"
+  double done = 0.0;     // collisions per particle done in this phase
+  double total = 0.0;    // collisions per particle in this phase
+  double sim_time = 0.0;
+  double events_per_second = 0.0;
+};
+
+class ProgressLine {
+ public:
+  // mode: "auto" (only on a terminal), "always" or "never".
+  explicit ProgressLine(const std::string& mode);
+  bool enabled() const { return enabled_; }
+  // Draws if enough wall time has passed since the last draw.
+  void update(const ProgressInfo& info);
+  // Ends the line (a newline on terminals).
+  void finish();
+
+ private:
+  bool enabled_ = false;
+  bool tty_ = false;
+  std::chrono::steady_clock::time_point last_{};
+  std::chrono::steady_clock::time_point phase_start_{};
+  std::string phase_;
+  bool drawn_ = false;
+};
+
+std::string format_duration(double seconds);
+
+}  // namespace kairos

@@ -1,0 +1,391 @@
+#include "run/run.hpp"
+
+#include <sys/resource.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "analysis/block_average.hpp"
+#include "core/error.hpp"
+#include "engine/event_engine.hpp"
+#include "init/initial_state.hpp"
+#include "io/atomic_file.hpp"
+#include "io/gsd_snapshot.hpp"
+#include "io/progress.hpp"
+#include "scheduler/binary_heap_queue.hpp"
+#include "scheduler/calendar_queue.hpp"
+
+namespace kairos {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+template <int D>
+ParticleSystem<D> to_particle_system(const InitialState<D>& init) {
+  ParticleSystem<D> s;
+  s.box = init.box;
+  const std::size_t n = init.position.size();
+  s.kinematics.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    s.kinematics[i] = {init.position[i], init.velocity[i], 0.0, 0.5 * init.diameter[i]};
+  }
+  s.mass = init.mass;
+  s.species = init.species;
+  s.species_names = init.species_names;
+  return s;
+}
+
+template <int D>
+void check_no_overlap(const InitialState<D>& init, const std::string& source) {
+  std::uint32_t i = 0, j = 0;
+  const double worst = max_overlap<D>(init.box, init.position, init.diameter, &i, &j);
+  if (worst > 0.0) {
+    throw InputError(fmt::format("{}: particles {} and {} overlap by {:.6g} (hard particles must "
+                                 "not overlap)",
+                                 source, i, j, worst));
+  }
+}
+
+template <int D>
+ParticleSystem<D> build_start_state(const Config& config,
+                                    const std::optional<fs::path>& restart_file,
+                                    std::mt19937_64& rng) {
+  if (restart_file) {
+    if (!fs::exists(*restart_file)) {
+      throw InputError("restart file '" + restart_file->string() + "' does not exist");
+    }
+    return read_restart<D>(*restart_file, rng);
+  }
+  if (!config.system.initial_state.empty()) {
+    const fs::path path = config.system.initial_state;
+    if (!fs::exists(path)) {
+      throw InputError("system.initial_state: file '" + path.string() + "' does not exist");
+    }
+    bool has_velocities = false;
+    InitialState<D> init = read_initial_state<D>(path, has_velocities);
+    check_no_overlap(init, "system.initial_state '" + path.string() + "'");
+    if (!has_velocities) assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
+    return to_particle_system(init);
+  }
+  InitialState<D> init = make_initial_state<D>(config.system, rng);
+  check_no_overlap(init, "generated initial state");
+  return to_particle_system(init);
+}
+
+std::uint64_t peak_rss_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024u;
+}
+
+// Thermodynamics over one interval, from the collision virial W = sum r_ij . J_i:
+// Z = 1 + W / (D N kT dt), P = Z N kT / V, kT = 2 KE / (D (N - 1)).
+struct ThermoPoint {
+  double time = 0.0, virial = 0.0;
+  std::uint64_t events = 0, collisions = 0;
+};
+
+class ThermoWriter {
+ public:
+  ThermoWriter(const fs::path& path, bool append) {
+    const bool header = !append || !fs::exists(path) || fs::file_size(path) == 0;
+    out_.open(path, append ? std::ios::app : std::ios::trunc);
+    if (!out_) throw InputError("cannot write '" + path.string() + "'");
+    if (header) {
+      write_line(
+          "phase\ttime\tevents\tcollisions\tcollisions_per_particle\ttemperature\tpressure\t"
+          "compressibility\tkinetic_energy\tmean_free_time\n");
+    }
+  }
+  // One row per line, each flushed at once: an interrupted run keeps every earlier row.
+  void write_line(const std::string& line) {
+    out_ << line;
+    out_.flush();
+  }
+
+ private:
+  std::ofstream out_;
+};
+
+template <int D, class Queue>
+class RunDriver {
+ public:
+  RunDriver(const Config& config, const std::optional<fs::path>& restart_file)
+      : config_(config), restart_(restart_file.has_value()), rng_(config.system.seed) {
+    ParticleSystem<D> start = build_start_state<D>(config, restart_file, rng_);
+    n_ = start.size();
+    volume_ = 1.0;
+    for (int a = 0; a < D; ++a) volume_ *= start.box[a];
+    particle_volume_ = 0.0;
+    for (const auto& k : start.kinematics) {
+      particle_volume_ += D == 3 ? 4.0 / 3.0 * std::numbers::pi * k.radius * k.radius * k.radius
+                                 : std::numbers::pi * k.radius * k.radius;
+    }
+    engine_.emplace(std::move(start));
+    dir_ = config.output.directory;
+    std::error_code ec;
+    fs::create_directories(dir_, ec);
+    if (ec || !fs::is_directory(dir_)) {
+      throw InputError("output.directory: cannot create '" + dir_.string() + "': " + ec.message());
+    }
+    write_text_atomically(dir_ / "config.toml", to_toml(config));
+  }
+
+  RunOutcome run() {
+    const auto wall_start = Clock::now();
+    thermo_.emplace(dir_ / "thermo.tsv", restart_);
+    if (config_.output.trajectory) {
+      const fs::path traj = dir_ / "trajectory.gsd";
+      if (restart_ && fs::exists(traj)) {
+        trajectory_.emplace(gsd::Writer::open_append(traj));
+      } else {
+        trajectory_.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
+        append_trajectory_frame(*trajectory_, engine_->system());
+      }
+    }
+    ke_start_ = engine_->kinetic_energy();
+    p_start_ = engine_->momentum();
+    events_start_ = engine_->counters().events;
+    collisions_start_ = engine_->counters().collisions;
+    last_ = point();
+    ProgressLine progress(config_.output.progress);
+
+    const double eq = restart_ ? 0.0 : config_.run.equilibration_collisions_per_particle;
+    bool stopped = false;
+    if (eq > 0.0) stopped = run_phase("equilibration", eq, progress, wall_start);
+    prod_start_ = point();
+    prod_ke_ = engine_->kinetic_energy();
+    if (!stopped) stopped = run_phase("production", config_.run.collisions_per_particle, progress,
+                                      wall_start);
+    progress.finish();
+    if (engine_->counters().collisions > last_.collisions) write_thermo_row(phase_);
+    const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
+
+    if (trajectory_) {
+      if (frame_collisions_ != engine_->counters().collisions)
+        append_trajectory_frame(*trajectory_, engine_->system());
+      trajectory_->close();
+    }
+    write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_);
+    RunOutcome outcome;
+    outcome.directory = dir_;
+    outcome.interrupted = stopped;
+    outcome.summary = summary(wall);
+    write_text_atomically(dir_ / "summary.json", outcome.summary.dump(2) + "\n");
+    return outcome;
+  }
+
+ private:
+  ThermoPoint point() const {
+    const auto& c = engine_->counters();
+    return {engine_->time(), c.virial, c.events, c.collisions};
+  }
+  double temperature(double ke) const { return 2.0 * ke / (D * (static_cast<double>(n_) - 1.0)); }
+  std::uint64_t collisions_for(double per_particle) const {
+    return static_cast<std::uint64_t>(std::llround(per_particle * static_cast<double>(n_) / 2.0));
+  }
+  double per_particle(std::uint64_t collisions) const {
+    return 2.0 * static_cast<double>(collisions) / static_cast<double>(n_);
+  }
+
+  // Runs until `length` more collisions per particle; returns true if stopped early.
+  bool run_phase(const std::string& phase, double length, ProgressLine& progress,
+                 Clock::time_point wall_start) {
+    phase_ = phase;
+    const std::uint64_t begin = engine_->counters().collisions;
+    const std::uint64_t target = begin + collisions_for(length);
+    const double auto_length = config_.run.collisions_per_particle;
+    const double thermo_every =
+        config_.output.thermo_interval > 0 ? config_.output.thermo_interval : auto_length / 100.0;
+    const double traj_every = config_.output.trajectory_interval > 0
+                                  ? config_.output.trajectory_interval
+                                  : auto_length / 10.0;
+    const std::uint64_t thermo_step = std::max<std::uint64_t>(1, collisions_for(thermo_every));
+    const std::uint64_t traj_step = std::max<std::uint64_t>(1, collisions_for(traj_every));
+    const std::uint64_t restart_step = config_.output.restart_interval > 0
+                                           ? std::max<std::uint64_t>(1, collisions_for(config_.output.restart_interval))
+                                           : 0;
+    std::uint64_t next_thermo = begin + thermo_step;
+    std::uint64_t next_traj = begin + traj_step;
+    std::uint64_t next_restart = restart_step ? begin + restart_step : ~0ull;
+    auto rate_clock = Clock::now();
+    std::uint64_t rate_events = engine_->counters().events;
+    double rate = 0.0;
+    while (engine_->counters().collisions < target) {
+      if (engine_->step() == EventKind::kNone) break;
+      if (config_.run.validate) engine_->validate();
+      const std::uint64_t c = engine_->counters().collisions;
+      if (c >= next_thermo) {
+        write_thermo_row(phase);
+        next_thermo += thermo_step;
+      }
+      if (c >= next_traj) {
+        if (trajectory_) {
+          append_trajectory_frame(*trajectory_, engine_->system());
+          frame_collisions_ = c;
+        }
+        next_traj += traj_step;
+      }
+      if (c >= next_restart) {
+        write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_);
+        next_restart += restart_step;
+      }
+      if (g_stop.load(std::memory_order_relaxed)) {
+        stop_reason_ = "signal";
+        return true;
+      }
+      if ((engine_->counters().events & 0x3fffu) == 0) {
+        const auto now = Clock::now();
+        const double dt = std::chrono::duration<double>(now - rate_clock).count();
+        if (dt > 0.2) {
+          rate = static_cast<double>(engine_->counters().events - rate_events) / dt;
+          rate_clock = now;
+          rate_events = engine_->counters().events;
+        }
+        progress.update({phase, per_particle(c - begin), length, engine_->time(), rate});
+        if (config_.run.max_wall_seconds > 0 &&
+            std::chrono::duration<double>(now - wall_start).count() > config_.run.max_wall_seconds) {
+          stop_reason_ = "wall_time_limit";
+          return true;
+        }
+      }
+    }
+    progress.update({phase, length, length, engine_->time(), rate});
+    return false;
+  }
+
+  void write_thermo_row(const std::string& phase) {
+    const ThermoPoint now = point();
+    const double ke = engine_->kinetic_energy();
+    const double kT = temperature(ke);
+    const double dt = now.time - last_.time;
+    const double dc = static_cast<double>(now.collisions - last_.collisions);
+    double z = std::nan(""), mft = std::nan("");
+    if (dt > 0.0 && kT > 0.0) {
+      z = 1.0 + (now.virial - last_.virial) / (D * static_cast<double>(n_) * kT * dt);
+      if (dc > 0) mft = static_cast<double>(n_) * dt / (2.0 * dc);
+    }
+    const double pressure = z * static_cast<double>(n_) * kT / volume_;
+    thermo_->write_line(fmt::format("{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\n",
+                                    phase, now.time, now.events, now.collisions,
+                                    per_particle(now.collisions), kT, pressure, z, ke, mft));
+    if (phase == "production" && std::isfinite(z)) z_samples_.push_back(z);
+    last_ = now;
+  }
+
+  nlohmann::json summary(double wall) const {
+    const auto& c = engine_->counters();
+    const double ke = engine_->kinetic_energy();
+    const double kT = temperature(ke);
+    const Vec<D> p = engine_->momentum();
+    double pscale = 0.0, dp2 = 0.0;
+    for (std::size_t i = 0; i < n_; ++i)
+      pscale += engine_->system().mass[i] * std::sqrt(norm2(engine_->system().kinematics[i].vel));
+    for (int a = 0; a < D; ++a) dp2 += (p[a] - p_start_[a]) * (p[a] - p_start_[a]);
+    const double t_prod = engine_->time() - prod_start_.time;
+    const std::uint64_t coll_prod = c.collisions - prod_start_.collisions;
+    const double kT_prod = temperature(prod_ke_);
+    const BlockAverage z_blocks = block_average(z_samples_);
+    double z_mean = std::nan("");
+    if (t_prod > 0 && kT_prod > 0) {
+      z_mean = 1.0 + (c.virial - prod_start_.virial) / (D * static_cast<double>(n_) * kT_prod * t_prod);
+    }
+    std::vector<double> diameters(n_);
+    for (std::size_t i = 0; i < n_; ++i) diameters[i] = 2.0 * engine_->system().kinematics[i].radius;
+    const double overlap = max_overlap<D>(engine_->system().box, engine_->current_positions(), diameters);
+    const std::uint64_t events = c.events - events_start_;
+    const std::uint64_t collisions = c.collisions - collisions_start_;
+    nlohmann::json j;
+    j["kairos_version"] = KAIROS_VERSION;
+    j["dimension"] = D;
+    j["particles"] = n_;
+    j["packing_fraction"] = particle_volume_ / volume_;
+    j["number_density"] = static_cast<double>(n_) / volume_;
+    j["event_queue"] = engine_->queue_name();
+    j["restarted"] = restart_;
+    j["stop_reason"] = stop_reason_;
+    j["events"] = events;
+    j["collisions"] = collisions;
+    j["event_counts"] = {{"collisions", collisions},
+                         {"cell_crossings", c.cell_crossings},
+                         {"stale", c.stale_events},
+                         {"total_events_since_start", c.events},
+                         {"total_collisions_since_start", c.collisions}};
+    j["sim_time"] = engine_->time();
+    j["production_time"] = t_prod;
+    j["production_collisions_per_particle"] = per_particle(coll_prod);
+    j["wall_seconds"] = wall;
+    j["events_per_second"] = wall > 0 ? static_cast<double>(events) / wall : 0.0;
+    j["collisions_per_second"] = wall > 0 ? static_cast<double>(collisions) / wall : 0.0;
+    j["temperature"] = kT;
+    j["kinetic_energy"] = ke;
+    j["compressibility"] = {{"mean", z_mean},
+                            {"stderr", z_blocks.stderr_},
+                            {"blocks", z_blocks.samples},
+                            {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
+    j["pressure"] = z_mean * static_cast<double>(n_) * kT_prod / volume_;
+    j["mean_free_time"] = coll_prod > 0 ? static_cast<double>(n_) * t_prod / (2.0 * static_cast<double>(coll_prod))
+                                        : std::nan("");
+    j["energy_drift_relative"] = ke_start_ > 0 ? std::abs(ke - ke_start_) / ke_start_ : 0.0;
+    j["momentum_drift"] = pscale > 0 ? std::sqrt(dp2) / pscale : 0.0;
+    j["max_overlap"] = overlap;
+    j["peak_rss_bytes"] = peak_rss_bytes();
+    j["bytes_per_particle"] = engine_->bytes_per_particle();
+    // JSON has no NaN: replace non-finite numbers by null.
+    return j;
+  }
+
+  Config config_;
+  bool restart_;
+  std::mt19937_64 rng_;
+  std::optional<EventEngine<D, Queue>> engine_;
+  std::size_t n_ = 0;
+  double volume_ = 1.0, particle_volume_ = 0.0;
+  fs::path dir_;
+  std::optional<ThermoWriter> thermo_;
+  std::optional<gsd::Writer> trajectory_;
+  std::uint64_t frame_collisions_ = 0;
+  ThermoPoint last_, prod_start_;
+  double ke_start_ = 0.0, prod_ke_ = 0.0;
+  Vec<D> p_start_{};
+  std::uint64_t events_start_ = 0, collisions_start_ = 0;
+  std::vector<double> z_samples_;
+  std::string phase_ = "production";
+  std::string stop_reason_ = "completed";
+};
+
+template <int D>
+RunOutcome run_with_dimension(const Config& config, const std::optional<fs::path>& restart) {
+  if (config.run.event_queue == "heap") return RunDriver<D, BinaryHeapQueue>(config, restart).run();
+  return RunDriver<D, CalendarQueue>(config, restart).run();
+}
+
+}  // namespace
+
+void request_stop() noexcept { g_stop.store(true, std::memory_order_relaxed); }
+void clear_stop_request() noexcept { g_stop.store(false, std::memory_order_relaxed); }
+
+RunOutcome run_simulation(const Config& config, const std::optional<fs::path>& restart_file) {
+  int dimension = config.system.dimension;
+  if (restart_file && fs::exists(*restart_file)) {
+    const int stored = gsd_dimension(*restart_file);
+    if (stored != dimension) {
+      throw InputError(fmt::format("restart file '{}' holds a {}D state but system.dimension = {}",
+                                   restart_file->string(), stored, dimension));
+    }
+  }
+  return dimension == 2 ? run_with_dimension<2>(config, restart_file)
+                        : run_with_dimension<3>(config, restart_file);
+}
+
+}  // namespace kairos

@@ -1,0 +1,31 @@
+// One invocation of `kairos run`: configuration -> initial state -> engine -> outputs.
+//
+// Phases: equilibration (skipped on restart), then production, both measured in collisions per
+// particle c = 2 N_coll / N. Outputs in the output directory: config.toml (the effective
+// configuration), thermo.tsv, trajectory.gsd, restart.gsd, summary.json (see docs/outputs.md).
+#pragma once
+
+#include <filesystem>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "io/config.hpp"
+
+namespace kairos {
+
+struct RunOutcome {
+  nlohmann::json summary;
+  std::filesystem::path directory;
+  bool interrupted = false;  // stopped by a signal or the wall-time limit (outputs still written)
+};
+
+// Runs the whole simulation. Throws InputError for anything the user must fix.
+RunOutcome run_simulation(const Config& config,
+                          const std::optional<std::filesystem::path>& restart_file = {});
+
+// Asks a running simulation to stop after the current event (async-signal-safe).
+void request_stop() noexcept;
+void clear_stop_request() noexcept;
+
+}  // namespace kairos

@@ -1,0 +1,163 @@
+// Cell grid for neighbour finding with cell-crossing events.
+//
+// The periodic box is cut into n_k >= 3 cells per axis, each at least as wide as the largest
+// contact distance, so every pair that can collide before either particle leaves its cell sits in
+// neighbouring cells. Each cell holds an intrusive doubly-linked list of its particles. The image
+// of a neighbouring cell is known from the cell offset (wrapping adds +-L), so pair tests never
+// need a minimum-image rounding.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/vec.hpp"
+
+namespace kairos {
+
+template <int D>
+class CellGrid {
+ public:
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+  static constexpr int kNeighbourCells = D == 3 ? 27 : 9;
+  static constexpr int kLayerCells = D == 3 ? 9 : 3;
+
+  CellGrid() = default;
+  CellGrid(const Vec<D>& box, double min_width, std::size_t particles) : box_(box) {
+    total_ = 1;
+    for (int k = 0; k < D; ++k) {
+      n_[k] = static_cast<int>(std::floor(box[k] / min_width));
+      if (n_[k] < 3) {
+        throw InputError("box edge " + std::to_string(box[k]) +
+                         " is shorter than 3 contact distances (" + std::to_string(min_width) +
+                         "): use more particles");
+      }
+      width_[k] = box[k] / n_[k];
+      stride_[k] = total_;
+      total_ *= static_cast<std::uint32_t>(n_[k]);
+    }
+    head_.assign(total_, kNone);
+    next_.assign(particles, kNone);
+    prev_.assign(particles, kNone);
+    cell_.assign(particles, 0);
+  }
+
+  std::uint32_t cell_count() const { return total_; }
+  int cells_along(int k) const { return n_[k]; }
+  double width(int k) const { return width_[k]; }
+  const Vec<D>& box() const { return box_; }
+  std::uint32_t cell_of(std::uint32_t i) const { return cell_[i]; }
+  std::uint32_t head(std::uint32_t c) const { return head_[c]; }
+  std::uint32_t next(std::uint32_t i) const { return next_[i]; }
+
+  int coordinate(std::uint32_t cell, int k) const {
+    return static_cast<int>((cell / stride_[k]) % static_cast<std::uint32_t>(n_[k]));
+  }
+  std::uint32_t cell_at(const std::array<int, D>& c) const {
+    std::uint32_t idx = 0;
+    for (int k = 0; k < D; ++k) idx += static_cast<std::uint32_t>(c[k]) * stride_[k];
+    return idx;
+  }
+  // Cell containing a position (clamped into the grid: positions may sit a round-off outside).
+  std::uint32_t locate(const Vec<D>& x) const {
+    std::array<int, D> c;
+    for (int k = 0; k < D; ++k) {
+      c[k] = static_cast<int>(std::floor(x[k] / width_[k]));
+      if (c[k] < 0) c[k] = 0;
+      if (c[k] >= n_[k]) c[k] = n_[k] - 1;
+    }
+    return cell_at(c);
+  }
+  double lower(std::uint32_t cell, int k) const { return coordinate(cell, k) * width_[k]; }
+  double upper(std::uint32_t cell, int k) const { return (coordinate(cell, k) + 1) * width_[k]; }
+
+  void insert(std::uint32_t i, std::uint32_t c) {
+    cell_[i] = c;
+    prev_[i] = kNone;
+    next_[i] = head_[c];
+    if (head_[c] != kNone) prev_[head_[c]] = i;
+    head_[c] = i;
+  }
+  void erase(std::uint32_t i) {
+    const std::uint32_t c = cell_[i];
+    if (prev_[i] != kNone) {
+      next_[prev_[i]] = next_[i];
+    } else {
+      head_[c] = next_[i];
+    }
+    if (next_[i] != kNone) prev_[next_[i]] = prev_[i];
+  }
+
+  // A neighbouring cell and the periodic shift to add to positions of particles inside it.
+  struct Neighbour {
+    std::uint32_t cell;
+    Vec<D> shift;
+  };
+
+  // Visits the 3^D cells around `cell` (itself included).
+  template <class F>
+  void for_each_neighbour(std::uint32_t cell, F&& f) const {
+    std::array<int, D> base;
+    for (int k = 0; k < D; ++k) base[k] = coordinate(cell, k);
+    std::array<int, D> off;
+    off.fill(-1);
+    for (int n = 0; n < kNeighbourCells; ++n) {
+      f(offset_cell(base, off));
+      for (int k = 0; k < D; ++k) {
+        if (++off[k] <= 1) break;
+        off[k] = -1;
+      }
+    }
+  }
+
+  // Visits the 3^(D-1) cells that become neighbours when a particle enters `cell` moving in
+  // direction `sign` (+1 or -1) along axis `axis`: the far layer beyond the new cell.
+  template <class F>
+  void for_each_new_layer(std::uint32_t cell, int axis, int sign, F&& f) const {
+    std::array<int, D> base;
+    for (int k = 0; k < D; ++k) base[k] = coordinate(cell, k);
+    std::array<int, D> off;
+    off.fill(-1);
+    off[axis] = sign;
+    for (int n = 0; n < kLayerCells; ++n) {
+      f(offset_cell(base, off));
+      for (int k = 0; k < D; ++k) {
+        if (k == axis) continue;
+        if (++off[k] <= 1) break;
+        off[k] = -1;
+      }
+    }
+  }
+
+  std::size_t bytes_per_particle() const { return 3 * sizeof(std::uint32_t); }
+
+ private:
+  Neighbour offset_cell(const std::array<int, D>& base, const std::array<int, D>& off) const {
+    Neighbour nb;
+    std::array<int, D> c;
+    for (int k = 0; k < D; ++k) {
+      c[k] = base[k] + off[k];
+      nb.shift[k] = 0.0;
+      if (c[k] < 0) {
+        c[k] += n_[k];
+        nb.shift[k] = -box_[k];
+      } else if (c[k] >= n_[k]) {
+        c[k] -= n_[k];
+        nb.shift[k] = box_[k];
+      }
+    }
+    nb.cell = cell_at(c);
+    return nb;
+  }
+
+  Vec<D> box_{};
+  std::array<int, D> n_{};
+  Vec<D> width_{};
+  std::array<std::uint32_t, D> stride_{};
+  std::uint32_t total_ = 0;
+  std::vector<std::uint32_t> head_, next_, prev_, cell_;
+};
+
+}  // namespace kairos

@@ -1,0 +1,58 @@
+// Small hand-built systems for engine tests (independent of the initial-state module).
+#pragma once
+
+#include <cmath>
+#include <random>
+
+#include "core/particle_system.hpp"
+
+namespace kairos::testing {
+
+// N = n^D particles of diameter 1, mass 1 on a simple cubic/square lattice at packing fraction
+// eta, random velocities with zero momentum and 2KE/(D(N-1)) = 1.
+template <int D>
+ParticleSystem<D> lattice_system(int n, double eta, std::uint64_t seed, double mass_ratio = 1.0,
+                                 double diameter_ratio = 1.0) {
+  ParticleSystem<D> s;
+  int count = 1;
+  for (int k = 0; k < D; ++k) count *= n;
+  double vol = 0.0;
+  for (int i = 0; i < count; ++i) {
+    const double d = (i % 2 == 1) ? diameter_ratio : 1.0;
+    vol += D == 3 ? M_PI * d * d * d / 6.0 : M_PI * d * d / 4.0;
+  }
+  const double L = std::pow(vol / eta, 1.0 / D);
+  s.box.fill(L);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Vec<D> p{};
+  double msum = 0.0;
+  for (int i = 0; i < count; ++i) {
+    Kinematics<D> k{};
+    int rem = i;
+    for (int a = 0; a < D; ++a) {
+      k.pos[a] = (rem % n + 0.25) * L / n;
+      rem /= n;
+      k.vel[a] = u(rng);
+    }
+    k.time = 0.0;
+    k.radius = 0.5 * ((i % 2 == 1) ? diameter_ratio : 1.0);
+    const double m = (i % 2 == 1) ? mass_ratio : 1.0;
+    s.kinematics.push_back(k);
+    s.mass.push_back(m);
+    s.species.push_back(static_cast<std::uint32_t>(i % 2));
+    p = p + m * k.vel;
+    msum += m;
+  }
+  double ke = 0.0;
+  for (int i = 0; i < count; ++i) {
+    for (int a = 0; a < D; ++a) s.kinematics[i].vel[a] -= p[a] / msum;
+    ke += 0.5 * s.mass[i] * norm2(s.kinematics[i].vel);
+  }
+  const double scale = std::sqrt(D * (count - 1) / (2.0 * ke));
+  for (auto& k : s.kinematics) k.vel = scale * k.vel;
+  s.species_names = {"A", "B"};
+  return s;
+}
+
+}  // namespace kairos::testing

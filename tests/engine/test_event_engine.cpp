@@ -1,0 +1,116 @@
+// Engine correctness: conservation, no overlap, validated scheduler state, queue equivalence.
+#include <gtest/gtest.h>
+
+#include "engine/event_engine.hpp"
+#include "engine_fixtures.hpp"
+#include "init/initial_state.hpp"
+#include "scheduler/binary_heap_queue.hpp"
+#include "scheduler/calendar_queue.hpp"
+
+namespace kairos {
+namespace {
+
+template <int D, class Q>
+void run_validated(const ParticleSystem<D>& start, int events) {
+  EventEngine<D, Q> engine(start);
+  engine.validate();
+  for (int e = 0; e < events; ++e) {
+    ASSERT_NE(engine.step(), EventKind::kNone);
+    engine.validate();
+  }
+  EXPECT_GT(engine.counters().collisions, 0u);
+}
+
+TEST(EventEngine, ValidatedAgainstBruteForce3D) {
+  run_validated<3, BinaryHeapQueue>(testing::lattice_system<3>(5, 0.4, 1), 3000);
+  run_validated<3, CalendarQueue>(testing::lattice_system<3>(5, 0.4, 2), 3000);
+}
+
+TEST(EventEngine, ValidatedAgainstBruteForce2D) {
+  run_validated<2, BinaryHeapQueue>(testing::lattice_system<2>(8, 0.5, 3), 3000);
+  run_validated<2, CalendarQueue>(testing::lattice_system<2>(8, 0.5, 4), 3000);
+}
+
+TEST(EventEngine, ValidatedBinaryMixtureThreeCellsWide) {
+  // Unequal sizes and masses, and a box only three cells wide (periodic images via shifts).
+  run_validated<3, CalendarQueue>(testing::lattice_system<3>(4, 0.3, 5, 3.0, 1.4), 3000);
+  run_validated<2, CalendarQueue>(testing::lattice_system<2>(6, 0.3, 6, 0.5, 1.4), 3000);
+}
+
+template <int D, class Q>
+void check_conservation(const ParticleSystem<D>& start, std::uint64_t events) {
+  EventEngine<D, Q> engine(start);
+  const double ke0 = engine.kinetic_energy();
+  const Vec<D> p0 = engine.momentum();
+  double pscale = 0.0;
+  for (std::size_t i = 0; i < engine.size(); ++i)
+    pscale += start.mass[i] * std::sqrt(norm2(start.kinematics[i].vel));
+  for (std::uint64_t e = 0; e < events; ++e) ASSERT_NE(engine.step(), EventKind::kNone);
+  EXPECT_GE(engine.counters().events, events);
+  EXPECT_NEAR(engine.kinetic_energy() / ke0, 1.0, 1e-10);
+  const Vec<D> p1 = engine.momentum();
+  for (int a = 0; a < D; ++a) EXPECT_NEAR((p1[a] - p0[a]) / pscale, 0.0, 1e-10);
+  const auto pos = engine.current_positions();
+  std::vector<double> diam;
+  for (const auto& k : engine.system().kinematics) diam.push_back(2.0 * k.radius);
+  EXPECT_LT(max_overlap_bruteforce<D>(engine.system().box, pos, diam), 1e-10);
+}
+
+TEST(EventEngine, ConservesEnergyAndMomentumOverAMillionEvents3D) {
+  check_conservation<3, CalendarQueue>(testing::lattice_system<3>(10, 0.4, 7, 2.0, 1.2), 1000000);
+}
+
+TEST(EventEngine, ConservesEnergyAndMomentumOverAMillionEvents2D) {
+  check_conservation<2, CalendarQueue>(testing::lattice_system<2>(32, 0.6, 8, 2.0, 1.2), 1000000);
+}
+
+TEST(EventEngine, HeapAndCalendarGiveBitIdenticalRuns) {
+  const auto start = testing::lattice_system<3>(8, 0.45, 9);
+  EventEngine<3, BinaryHeapQueue> a(start);
+  EventEngine<3, CalendarQueue> b(start);
+  for (int e = 0; e < 200000; ++e) {
+    a.step();
+    b.step();
+  }
+  ASSERT_EQ(a.time(), b.time());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(a.system().kinematics[i].pos[k], b.system().kinematics[i].pos[k]);
+      ASSERT_EQ(a.system().kinematics[i].vel[k], b.system().kinematics[i].vel[k]);
+    }
+  }
+}
+
+TEST(EventEngine, ContinuingFromExportedStateIsBitIdentical) {
+  const auto start = testing::lattice_system<3>(6, 0.4, 10);
+  EventEngine<3, CalendarQueue> whole(start);
+  for (int e = 0; e < 20000; ++e) whole.step();
+  EventEngine<3, CalendarQueue> first(start);
+  for (int e = 0; e < 10000; ++e) first.step();
+  EventEngine<3, CalendarQueue> second(first.export_state());
+  for (int e = 0; e < 10000; ++e) second.step();
+  ASSERT_EQ(whole.time(), second.time());
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(whole.system().kinematics[i].pos[k], second.system().kinematics[i].pos[k]);
+      ASSERT_EQ(whole.system().kinematics[i].vel[k], second.system().kinematics[i].vel[k]);
+    }
+  }
+}
+
+TEST(EventEngine, TwoParticlesHeadOnSwapVelocities) {
+  ParticleSystem<3> s;
+  s.box = {10, 10, 10};
+  s.kinematics = {{{2, 5, 5}, {1, 0, 0}, 0.0, 0.5}, {{5, 5, 5}, {-1, 0, 0}, 0.0, 0.5}};
+  s.mass = {1, 1};
+  s.species = {0, 0};
+  EventEngine<3, BinaryHeapQueue> engine(s);
+  while (engine.counters().collisions == 0) engine.step();
+  EXPECT_DOUBLE_EQ(engine.time(), 1.0);
+  EXPECT_DOUBLE_EQ(engine.system().kinematics[0].vel[0], -1.0);
+  EXPECT_DOUBLE_EQ(engine.system().kinematics[1].vel[0], 1.0);
+  EXPECT_DOUBLE_EQ(engine.counters().virial, 2.0);  // r.J = sigma * 2 mu |g_n| = 1 * 2 * 0.5 * 2
+}
+
+}  // namespace
+}  // namespace kairos
