@@ -7,6 +7,7 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <string>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -70,6 +71,12 @@ int main(int argc, char** argv) {
       "Configuration keys are documented in docs/config.md."};
   app.set_version_flag("--version", std::string("kairos ") + KAIROS_VERSION);
   app.require_subcommand(1);
+  app.footer(
+      "Usage of run: kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE]\n"
+      "  -o,--output OUTDIR   output directory (overrides output.directory)\n"
+      "  --set key=value      override a config key (repeatable)\n"
+      "  --restart FILE       continue from a restart file (OUTDIR/restart.gsd)\n"
+      "See 'kairos run --help' for details.");
 
   std::string config_path, outdir, restart;
   std::vector<std::string> overrides;
@@ -81,7 +88,8 @@ int main(int argc, char** argv) {
   run->add_option("--set", overrides,
                   "Override a config key, dotted path and TOML value, e.g. "
                   "--set system.packing_fraction=0.3 --set system.lattice=sc (repeatable)")
-      ->take_all();
+      ->take_all()
+      ->allow_extra_args(false);  // one value per --set, so `--set k=v CONFIG` keeps CONFIG
   run->add_option("--restart", restart,
                   "Continue from a restart file (OUTDIR/restart.gsd); equilibration is skipped and "
                   "run.collisions_per_particle more collisions per particle are simulated");
@@ -89,7 +97,20 @@ int main(int argc, char** argv) {
       "Outputs in OUTDIR: config.toml, thermo.tsv, trajectory.gsd, restart.gsd, summary.json.\n"
       "SIGINT/SIGTERM stop after the current event and still write every output.");
 
-  CLI11_PARSE(app, argc, argv);
+  // Usage errors are user errors too: one line "kairos: error: ...", exit status 2 (not CLI11's
+  // own codes and two-line message). --help and --version still print and exit 0.
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::string message = e.what();
+    for (char& c : message) {
+      if (c == '\n' || c == '\r') c = ' ';
+    }
+    std::fprintf(stderr, "kairos: error: %s (see 'kairos --help' and 'kairos run --help')\n",
+                 message.c_str());
+    return 2;
+  }
 
   try {
     kairos::Config config = kairos::load_config(config_path, overrides);

@@ -33,6 +33,22 @@ std::vector<std::string> unpack_type_names(const std::vector<std::int8_t>& raw, 
   return names;
 }
 
+// x wrapped into [0, L). x - L floor(x / L) alone gives exactly L for a tiny negative x.
+double wrap_into_box(double x, double L) {
+  double y = x - L * std::floor(x / L);
+  if (y >= L) y -= L;
+  if (y < 0.0) y = 0.0;
+  return y;
+}
+
+// x as a float32 coordinate in HOOMD's centred box [-L/2, L/2). A coordinate just below L/2
+// can round up to L/2 in float32; that point is the periodic image of -L/2.
+float hoomd_coordinate(double x, double L) {
+  const float half = static_cast<float>(0.5 * L);
+  const float c = static_cast<float>(wrap_into_box(x, L) - 0.5 * L);
+  return c >= half ? -half : c;
+}
+
 template <int D>
 void write_standard_chunks(gsd::Writer& w, const ParticleSystem<D>& sys, bool with_static) {
   const auto n = static_cast<std::uint32_t>(sys.size());
@@ -48,9 +64,7 @@ void write_standard_chunks(gsd::Writer& w, const ParticleSystem<D>& sys, bool wi
   for (std::uint32_t i = 0; i < n; ++i) {
     const Vec<D> x = sys.position_at(i, sys.time);
     for (int a = 0; a < D; ++a) {
-      double c = x[a] - sys.box[a] * std::floor(x[a] / sys.box[a]);  // wrap into [0, L)
-      c -= 0.5 * sys.box[a];                                          // HOOMD's centred box
-      pos[3 * i + a] = static_cast<float>(c);
+      pos[3 * i + a] = hoomd_coordinate(x[a], sys.box[a]);
       vel[3 * i + a] = static_cast<float>(sys.kinematics[i].vel[a]);
     }
   }
@@ -119,7 +133,7 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
       for (int a = 0; a < D; ++a) {
         pos[i * D + a] = k.pos[a];
         vel[i * D + a] = k.vel[a];
-        now[i * D + a] = x[a] - s.box[a] * std::floor(x[a] / s.box[a]);
+        now[i * D + a] = wrap_into_box(x[a], s.box[a]);
       }
       local[i] = k.time;
       radius[i] = k.radius;

@@ -280,6 +280,7 @@ class RunDriver {
                                     phase, now.time, now.events, now.collisions,
                                     per_particle(now.collisions), kT, pressure, z, ke, mft));
     if (phase == "production" && std::isfinite(z)) z_samples_.push_back(z);
+    if (phase == "production" && std::isfinite(mft)) mft_samples_.push_back(mft);
     last_ = now;
   }
 
@@ -336,12 +337,12 @@ class RunDriver {
     j["pressure"] = z_mean * static_cast<double>(n_) * kT_prod / volume_;
     j["mean_free_time"] = coll_prod > 0 ? static_cast<double>(n_) * t_prod / (2.0 * static_cast<double>(coll_prod))
                                         : std::nan("");
+    j["mean_free_time_stderr"] = block_average(mft_samples_).stderr_;
     j["energy_drift_relative"] = ke_start_ > 0 ? std::abs(ke - ke_start_) / ke_start_ : 0.0;
     j["momentum_drift"] = pscale > 0 ? std::sqrt(dp2) / pscale : 0.0;
     j["max_overlap"] = overlap;
     j["peak_rss_bytes"] = peak_rss_bytes();
     j["bytes_per_particle"] = engine_->bytes_per_particle();
-    // JSON has no NaN: replace non-finite numbers by null.
     return j;
   }
 
@@ -359,7 +360,7 @@ class RunDriver {
   double ke_start_ = 0.0, prod_ke_ = 0.0;
   Vec<D> p_start_{};
   std::uint64_t events_start_ = 0, collisions_start_ = 0;
-  std::vector<double> z_samples_;
+  std::vector<double> z_samples_, mft_samples_;
   std::string phase_ = "production";
   std::string stop_reason_ = "completed";
 };

@@ -2,11 +2,14 @@
 //
 // The periodic box is cut into n_k >= 3 cells per axis, each at least as wide as the largest
 // contact distance, so every pair that can collide before either particle leaves its cell sits in
-// neighbouring cells. Each cell holds an intrusive doubly-linked list of its particles. The image
+// neighbouring cells. Each cell stores its particle indices inline in a fixed-stride slot array
+// (count, then indices), so scanning a cell reads one cache line instead of chasing a linked
+// list; the stride doubles (rare, O(N)) when a cell overflows, so there is no hard cap. The image
 // of a neighbouring cell is known from the cell offset (wrapping adds +-L), so pair tests never
 // need a minimum-image rounding.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -38,9 +41,8 @@ class CellGrid {
       stride_[k] = total_;
       total_ *= static_cast<std::uint32_t>(n_[k]);
     }
-    head_.assign(total_, kNone);
-    next_.assign(particles, kNone);
-    prev_.assign(particles, kNone);
+    stride_slots_ = 8;  // count + 7 particles: a 32-byte cell, ample at any hard-sphere density
+    slots_.assign(static_cast<std::size_t>(total_) * stride_slots_, 0);
     cell_.assign(particles, 0);
   }
 
@@ -49,8 +51,11 @@ class CellGrid {
   double width(int k) const { return width_[k]; }
   const Vec<D>& box() const { return box_; }
   std::uint32_t cell_of(std::uint32_t i) const { return cell_[i]; }
-  std::uint32_t head(std::uint32_t c) const { return head_[c]; }
-  std::uint32_t next(std::uint32_t i) const { return next_[i]; }
+  // The particles of cell c: count(c) indices starting at members(c).
+  std::uint32_t count(std::uint32_t c) const { return slots_[std::size_t(c) * stride_slots_]; }
+  const std::uint32_t* members(std::uint32_t c) const {
+    return slots_.data() + std::size_t(c) * stride_slots_ + 1;
+  }
 
   int coordinate(std::uint32_t cell, int k) const {
     return static_cast<int>((cell / stride_[k]) % static_cast<std::uint32_t>(n_[k]));
@@ -74,20 +79,22 @@ class CellGrid {
   double upper(std::uint32_t cell, int k) const { return (coordinate(cell, k) + 1) * width_[k]; }
 
   void insert(std::uint32_t i, std::uint32_t c) {
+    if (count(c) + 1 >= stride_slots_) grow();
+    std::uint32_t* cell = slots_.data() + std::size_t(c) * stride_slots_;
+    cell[1 + cell[0]++] = i;
     cell_[i] = c;
-    prev_[i] = kNone;
-    next_[i] = head_[c];
-    if (head_[c] != kNone) prev_[head_[c]] = i;
-    head_[c] = i;
   }
+  // Removes i from its cell; the last member takes its slot.
   void erase(std::uint32_t i) {
-    const std::uint32_t c = cell_[i];
-    if (prev_[i] != kNone) {
-      next_[prev_[i]] = next_[i];
-    } else {
-      head_[c] = next_[i];
+    std::uint32_t* cell = slots_.data() + std::size_t(cell_[i]) * stride_slots_;
+    const std::uint32_t n = cell[0];
+    for (std::uint32_t k = 1; k <= n; ++k) {
+      if (cell[k] == i) {
+        cell[k] = cell[n];
+        --cell[0];
+        return;
+      }
     }
-    if (next_[i] != kNone) prev_[next_[i]] = prev_[i];
   }
 
   // A neighbouring cell and the periodic shift to add to positions of particles inside it.
@@ -131,9 +138,24 @@ class CellGrid {
     }
   }
 
-  std::size_t bytes_per_particle() const { return 3 * sizeof(std::uint32_t); }
+  // Memory of the grid divided by the number of particles.
+  std::size_t bytes_per_particle() const {
+    return cell_.empty() ? 0
+                         : (slots_.size() + cell_.size()) * sizeof(std::uint32_t) / cell_.size();
+  }
 
  private:
+  // Doubles the per-cell capacity, keeping every cell's members in order.
+  void grow() {
+    const std::uint32_t stride = 2 * stride_slots_;
+    std::vector<std::uint32_t> wider(static_cast<std::size_t>(total_) * stride, 0);
+    for (std::size_t c = 0; c < total_; ++c) {
+      std::copy_n(slots_.data() + c * stride_slots_, stride_slots_, wider.data() + c * stride);
+    }
+    slots_.swap(wider);
+    stride_slots_ = stride;
+  }
+
   Neighbour offset_cell(const std::array<int, D>& base, const std::array<int, D>& off) const {
     Neighbour nb;
     std::array<int, D> c;
@@ -157,7 +179,9 @@ class CellGrid {
   Vec<D> width_{};
   std::array<std::uint32_t, D> stride_{};
   std::uint32_t total_ = 0;
-  std::vector<std::uint32_t> head_, next_, prev_, cell_;
+  std::uint32_t stride_slots_ = 8;
+  std::vector<std::uint32_t> slots_;  // per cell: count, then the member indices
+  std::vector<std::uint32_t> cell_;   // per particle: its cell
 };
 
 }  // namespace kairos

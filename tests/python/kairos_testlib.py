@@ -1,0 +1,281 @@
+"""Shared helpers for the end-to-end tests in tests/python/test_*.py.
+
+Every test file is run by ctest as
+
+    /usr/bin/python3 tests/python/test_X.py <path-to-kairos-binary> <source-dir>
+
+and calls `kairos_testlib.main()`, which takes those two arguments off sys.argv and runs
+unittest (exit status non-zero on failure). /usr/bin/python3 is Debian's interpreter with
+python3-gsd (2.7) and numpy.
+"""
+
+import json
+import math
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+import gsd.fl
+import gsd.hoomd
+
+KAIROS = None      # path of the kairos binary (absolute)
+SOURCE_DIR = None  # project source directory (absolute)
+
+# Per-invocation time limit. Generous: the tests also run under AddressSanitizer (3-5x slower).
+RUN_TIMEOUT = 120
+
+# The float64 chunks that hold the exact state of a restart file.
+EXACT_CHUNKS = ("kairos/state/position", "kairos/velocity", "kairos/time",
+                "kairos/state/local_time")
+
+
+def main():
+    """Parses `<binary> <source-dir>` from sys.argv, then runs the unittest tests of __main__."""
+    global KAIROS, SOURCE_DIR
+    if len(sys.argv) < 3:
+        sys.stderr.write("usage: %s KAIROS_BINARY SOURCE_DIR\n" % sys.argv[0])
+        sys.exit(2)
+    KAIROS = os.path.abspath(sys.argv[1])
+    SOURCE_DIR = os.path.abspath(sys.argv[2])
+    if not os.access(KAIROS, os.X_OK):
+        sys.stderr.write("not an executable: %s\n" % KAIROS)
+        sys.exit(2)
+    unittest.main(argv=[sys.argv[0]], verbosity=2)
+
+
+def example(name):
+    return os.path.join(SOURCE_DIR, "examples", name)
+
+
+# ------------------------------------------------------------------------------------------------
+# TOML
+
+def _toml_value(v):
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)  # a JSON string of ASCII text is a valid TOML basic string
+    raise TypeError("no TOML form for %r" % (v,))
+
+
+def toml_text(config):
+    """{'system': {...}, 'run': {...}, 'output': {...}} -> TOML text. A value in a section may be
+    a list of dicts (an array of tables, e.g. system.species)."""
+    lines = []
+    for section, table in config.items():
+        lines.append("[%s]" % section)
+        arrays = []
+        for key, value in table.items():
+            if isinstance(value, list) and value and isinstance(value[0], dict):
+                arrays.append((key, value))
+            else:
+                lines.append("%s = %s" % (key, _toml_value(value)))
+        for key, elements in arrays:
+            for element in elements:
+                lines.append("[[%s.%s]]" % (section, key))
+                for k, v in element.items():
+                    lines.append("%s = %s" % (k, _toml_value(v)))
+        lines.append("")
+    return "\n".join(lines)
+
+
+def base_config(dimension=3, particles=500, packing_fraction=0.3, lattice=None, seed=7,
+                equilibration=0.0, production=20.0, directory="out", **sections):
+    """A small, quick configuration as a dict. Extra keyword arguments `run={...}`,
+    `output={...}`, `system={...}` are merged into those sections."""
+    config = {
+        "system": {
+            "dimension": dimension,
+            "particles": particles,
+            "packing_fraction": packing_fraction,
+            "lattice": lattice if lattice is not None else ("fcc" if dimension == 3 else "hex"),
+            "temperature": 1.0,
+            "seed": seed,
+        },
+        "run": {
+            "equilibration_collisions_per_particle": float(equilibration),
+            "collisions_per_particle": float(production),
+        },
+        "output": {
+            "directory": directory,
+            "progress": "never",
+        },
+    }
+    for name, extra in sections.items():
+        config.setdefault(name, {}).update(extra)
+    return config
+
+
+# ------------------------------------------------------------------------------------------------
+# Running kairos
+
+def run_kairos(args, cwd, timeout=RUN_TIMEOUT, env=None):
+    """Runs `kairos ARGS` in `cwd`; returns the CompletedProcess (text output)."""
+    return subprocess.run([KAIROS] + list(args), cwd=cwd, capture_output=True, text=True,
+                          timeout=timeout, env=env)
+
+
+def describe(result):
+    """A few lines about a finished process, for assertion messages."""
+    return "command: %s\nexit status: %s\nstdout (tail): %s\nstderr: %s" % (
+        " ".join(result.args), result.returncode, result.stdout[-2000:], result.stderr[-4000:])
+
+
+def signal_name(status):
+    if status < 0:
+        try:
+            return "killed by %s" % signal.Signals(-status).name
+        except ValueError:
+            return "killed by signal %d" % -status
+    return "exit status %d" % status
+
+
+class KairosTestCase(unittest.TestCase):
+    """Each test gets its own temporary directory `self.tmp`, removed afterwards."""
+
+    maxDiff = None
+
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="kairos-%s-" % self._testMethodName)
+        self.addCleanup(shutil.rmtree, self.tmp, ignore_errors=True)
+
+    def path(self, *parts):
+        return os.path.join(self.tmp, *parts)
+
+    def write_config(self, config, name="config.toml"):
+        """Writes a config (dict or TOML text) into the temporary directory; returns its path."""
+        text = config if isinstance(config, str) else toml_text(config)
+        p = self.path(name)
+        with open(p, "w") as f:
+            f.write(text)
+        return p
+
+    def kairos(self, *args, timeout=RUN_TIMEOUT):
+        return run_kairos(args, cwd=self.tmp, timeout=timeout)
+
+    def run_ok(self, *args, timeout=RUN_TIMEOUT):
+        """Runs kairos and asserts exit status 0 and empty stderr (progress is off)."""
+        result = self.kairos(*args, timeout=timeout)
+        self.assertEqual(result.returncode, 0,
+                         "kairos failed (%s)\n%s" % (signal_name(result.returncode),
+                                                     describe(result)))
+        return result
+
+    def assert_user_error(self, result, *needles):
+        """Exit status 2 (not a signal, not 3 = internal error) and exactly one stderr line
+        'kairos: error: ...' containing every needle."""
+        self.assertEqual(result.returncode, 2,
+                         "expected exit status 2 (%s)\n%s" % (signal_name(result.returncode),
+                                                              describe(result)))
+        lines = result.stderr.splitlines()
+        self.assertEqual(len(lines), 1, "expected one line on stderr\n%s" % describe(result))
+        line = lines[0]
+        self.assertTrue(line.startswith("kairos: error: "),
+                        "stderr must start with 'kairos: error: '\n%s" % describe(result))
+        for needle in needles:
+            self.assertIn(needle, line, "the error message should name %r\n%s" %
+                          (needle, describe(result)))
+        return line
+
+    # ----- outputs
+
+    def summary(self, outdir):
+        with open(os.path.join(outdir, "summary.json")) as f:
+            return json.load(f)
+
+    def assert_outputs_exist(self, outdir, trajectory=True):
+        names = ["config.toml", "thermo.tsv", "restart.gsd", "summary.json"]
+        if trajectory:
+            names.append("trajectory.gsd")
+        for name in names:
+            p = os.path.join(outdir, name)
+            self.assertTrue(os.path.isfile(p), "missing output %s" % p)
+            self.assertGreater(os.path.getsize(p), 0, "empty output %s" % p)
+
+
+# ------------------------------------------------------------------------------------------------
+# Files
+
+def read_thermo(path):
+    """thermo.tsv -> (header list, list of row lists). The first column (phase) stays a string,
+    every other column is parsed as a float (raises ValueError if one does not parse)."""
+    with open(path) as f:
+        text = f.read()
+    lines = text.splitlines()
+    header = lines[0].split("\t")
+    rows = []
+    for line in lines[1:]:
+        fields = line.split("\t")
+        rows.append([fields[0]] + [float(x) for x in fields[1:]])
+    return header, rows, text
+
+
+def read_exact_state(path):
+    """The float64 exact-state chunks of the last frame of a restart file, as numpy arrays."""
+    with gsd.fl.open(name=path, mode="rb") as f:
+        frame = f.nframes - 1
+        return {name: f.read_chunk(frame=frame, name=name) for name in EXACT_CHUNKS}
+
+
+def restart_chunk(path, name):
+    with gsd.fl.open(name=path, mode="rb") as f:
+        return f.read_chunk(frame=f.nframes - 1, name=name)
+
+
+def open_trajectory(path):
+    return gsd.hoomd.open(path, "rb")
+
+
+def new_frame():
+    """An empty HOOMD frame (gsd.hoomd.Snapshot in python-gsd 2.x, Frame in 3.x)."""
+    cls = getattr(gsd.hoomd, "Frame", None) or getattr(gsd.hoomd, "Snapshot")
+    return cls()
+
+
+def write_hoomd_file(path, positions, box, dimensions=3, diameter=None, velocity=None,
+                     types=("A",), typeid=None, mass=None):
+    """Writes a one-frame HOOMD GSD file with python-gsd. `positions` in HOOMD's centred box."""
+    positions = np.asarray(positions, dtype=np.float32)
+    frame = new_frame()
+    frame.configuration.box = [float(box[0]), float(box[1]), float(box[2]), 0.0, 0.0, 0.0]
+    frame.configuration.dimensions = dimensions
+    frame.particles.N = len(positions)
+    frame.particles.position = positions
+    frame.particles.types = list(types)
+    if typeid is not None:
+        frame.particles.typeid = np.asarray(typeid, dtype=np.uint32)
+    if diameter is not None:
+        frame.particles.diameter = np.asarray(diameter, dtype=np.float32)
+    if mass is not None:
+        frame.particles.mass = np.asarray(mass, dtype=np.float32)
+    if velocity is not None:
+        frame.particles.velocity = np.asarray(velocity, dtype=np.float32)
+    with gsd.hoomd.open(path, "wb") as f:
+        f.append(frame)
+    return path
+
+
+def cubic_lattice(cells, spacing, dimensions=3):
+    """A simple cubic (square in 2D) lattice of cells^D sites in HOOMD's centred box; returns
+    (positions as N x 3, box edge)."""
+    edge = cells * spacing
+    axis = (np.arange(cells) + 0.5) * spacing - 0.5 * edge
+    if dimensions == 3:
+        grid = np.stack(np.meshgrid(axis, axis, axis, indexing="ij"), axis=-1).reshape(-1, 3)
+    else:
+        xy = np.stack(np.meshgrid(axis, axis, indexing="ij"), axis=-1).reshape(-1, 2)
+        grid = np.concatenate([xy, np.zeros((len(xy), 1))], axis=1)
+    return grid, edge

@@ -1,0 +1,406 @@
+"""Bad input of every kind: exit status 2 and one line 'kairos: error: ...' naming the problem.
+
+Never a crash (a signal), never status 3 (internal error), never a traceback-like multi-line
+message. Also: `kairos --help` and `kairos run --help` document every option.
+"""
+
+import os
+
+import numpy as np
+import gsd.fl
+
+import kairos_testlib as kt
+
+
+class ConfigErrors(kt.KairosTestCase):
+    def setUp(self):
+        super().setUp()
+        self.config = self.write_config(kt.base_config(production=1.0))
+
+    def check(self, config_text, *needles, name="bad.toml", extra=()):
+        path = self.write_config(config_text, name)
+        result = self.kairos("run", path, "-o", self.path("out"), *extra)
+        line = self.assert_user_error(result, *needles)
+        self.assertFalse(os.path.exists(self.path("out", "summary.json")),
+                         "no run may start on bad input: " + line)
+        return line
+
+    def check_set(self, *overrides_and_needles):
+        """check_set(['a=1', ...], needle, ...): the good config plus --set overrides."""
+        overrides, needles = overrides_and_needles[0], overrides_and_needles[1:]
+        args = ["run", self.config, "-o", self.path("out")]
+        for o in overrides:
+            args += ["--set", o]
+        result = self.kairos(*args)
+        line = self.assert_user_error(result, *needles)
+        self.assertFalse(os.path.exists(self.path("out", "summary.json")),
+                         "no run may start on bad input: " + line)
+        return line
+
+    def good_text(self, **sections):
+        return kt.toml_text(kt.base_config(production=1.0, **sections))
+
+    # ----- the good config itself runs (so every failure below is due to the one change)
+
+    def test_good_config_runs(self):
+        self.run_ok("run", self.config, "-o", self.path("out"))
+        self.assert_outputs_exist(self.path("out"))
+
+    # ----- unknown keys
+
+    def test_unknown_top_level_key(self):
+        self.check(self.good_text() + "\nbogus_key = 1\n", "bogus_key")
+
+    def test_unknown_top_level_table(self):
+        self.check(self.good_text() + "\n[simulation]\nsteps = 10\n", "simulation")
+
+    def test_unknown_nested_key(self):
+        line = self.check(self.good_text(system={"particle": 500}), "system.particle")
+        self.assertIn("system.particles", line)  # the suggestion
+
+    def test_unknown_species_key(self):
+        text = self.good_text() + "\n[[system.species]]\nname = \"A\"\ndiamter = 1.0\n"
+        self.check(text, "diamter")
+
+    def test_unknown_key_via_set(self):
+        line = self.check_set(["system.particle=4000"], "system.particle", "override")
+        self.assertIn("system.particles", line)
+
+    def test_unknown_section_via_set(self):
+        self.check_set(["bogus.key=1"], "bogus")
+
+    # ----- wrong types
+
+    def test_string_for_particles(self):
+        self.check(self.good_text(system={"particles": "many"}), "system.particles")
+
+    def test_float_for_particles(self):
+        self.check(self.good_text(system={"particles": 500.5}), "system.particles")
+
+    def test_float_for_particles_via_set(self):
+        self.check_set(["system.particles=1.5"], "system.particles")
+
+    def test_string_for_particles_via_set(self):
+        self.check_set(["system.particles=lots"], "system.particles")
+
+    def test_string_for_packing_fraction(self):
+        self.check(self.good_text(system={"packing_fraction": "0.3"}), "system.packing_fraction")
+
+    def test_boolean_for_collisions(self):
+        self.check(self.good_text(run={"collisions_per_particle": True}),
+                   "run.collisions_per_particle")
+
+    def test_negative_particles(self):
+        self.check(self.good_text(system={"particles": -5}), "system.particles")
+
+    # ----- NaN and infinity
+
+    def test_nan_packing_fraction(self):
+        self.check(self.good_text(system={"packing_fraction": float("nan")}),
+                   "system.packing_fraction", "nan")
+
+    def test_inf_temperature(self):
+        self.check(self.good_text(system={"temperature": float("inf")}),
+                   "system.temperature", "inf")
+
+    def test_nan_run_length(self):
+        self.check(self.good_text(run={"collisions_per_particle": float("nan")}),
+                   "run.collisions_per_particle")
+
+    def test_inf_species_diameter(self):
+        text = self.good_text() + "\n[[system.species]]\nname = \"A\"\ndiameter = inf\n"
+        self.check(text, "diameter", "inf")
+
+    def test_nan_via_set(self):
+        self.check_set(["system.temperature=nan"], "system.temperature", "nan")
+
+    def test_negative_inf_via_set(self):
+        self.check_set(["output.thermo_interval=-inf"], "output.thermo_interval")
+
+    # ----- impossible or out-of-range values
+
+    def test_packing_fraction_too_high_for_fcc(self):
+        self.check(self.good_text(system={"packing_fraction": 0.8, "lattice": "fcc"}),
+                   "packing_fraction", "fcc")
+
+    def test_packing_fraction_too_high_for_sc(self):
+        self.check(self.good_text(system={"packing_fraction": 0.6, "lattice": "sc"}),
+                   "packing_fraction", "sc")
+
+    def test_packing_fraction_too_high_for_hex(self):
+        text = kt.toml_text(kt.base_config(dimension=2, packing_fraction=0.95, production=1.0))
+        self.check(text, "packing_fraction", "hex")
+
+    def test_packing_fraction_one(self):
+        self.check(self.good_text(system={"packing_fraction": 1.0}), "system.packing_fraction")
+
+    def test_packing_fraction_above_one(self):
+        self.check_set(["system.packing_fraction=1.5"], "system.packing_fraction")
+
+    def test_packing_fraction_zero(self):
+        self.check_set(["system.packing_fraction=0"], "system.packing_fraction")
+
+    def test_negative_temperature(self):
+        self.check(self.good_text(system={"temperature": -1.0}), "system.temperature")
+
+    def test_zero_temperature(self):
+        self.check_set(["system.temperature=0"], "system.temperature")
+
+    def test_dimension_4(self):
+        self.check(self.good_text(system={"dimension": 4}), "system.dimension", "4")
+
+    def test_dimension_1_via_set(self):
+        self.check_set(["system.dimension=1"], "system.dimension")
+
+    def test_hex_lattice_in_3d(self):
+        self.check(self.good_text(system={"lattice": "hex"}), "system.lattice", "hex")
+
+    def test_fcc_lattice_in_2d(self):
+        text = kt.toml_text(kt.base_config(dimension=2, lattice="fcc", production=1.0))
+        self.check(text, "system.lattice", "fcc")
+
+    def test_unknown_lattice(self):
+        self.check_set(["system.lattice=diamond"], "system.lattice", "diamond")
+
+    def test_one_particle(self):
+        self.check_set(["system.particles=1"], "system.particles")
+
+    def test_unknown_event_queue(self):
+        self.check_set(["run.event_queue=fibonacci"], "run.event_queue", "fibonacci")
+
+    def test_zero_run_length(self):
+        self.check_set(["run.collisions_per_particle=0"], "run.collisions_per_particle")
+
+    def test_negative_equilibration(self):
+        self.check_set(["run.equilibration_collisions_per_particle=-1"],
+                       "run.equilibration_collisions_per_particle")
+
+    def test_negative_species_mass(self):
+        self.check_set(["system.species.0.mass=-1"], "mass")
+
+    def test_duplicate_species_names(self):
+        text = (self.good_text() + "\n[[system.species]]\nname = \"A\"\n"
+                "\n[[system.species]]\nname = \"A\"\n")
+        self.check(text, "duplicate", "A")
+
+    # ----- files and syntax
+
+    def test_missing_config_file(self):
+        result = self.kairos("run", self.path("no-such-config.toml"))
+        self.assert_user_error(result, "no-such-config.toml")
+
+    def test_config_is_a_directory(self):
+        result = self.kairos("run", self.tmp)
+        self.assert_user_error(result, os.path.basename(self.tmp))
+
+    def test_malformed_toml(self):
+        self.check("[system]\nparticles = \npacking_fraction = 0.3\n", "bad.toml", "syntax")
+
+    def test_malformed_toml_unclosed_table(self):
+        self.check("[system\nparticles = 500\n", "bad.toml")
+
+    def test_malformed_toml_duplicate_key(self):
+        self.check("[system]\nparticles = 500\nparticles = 600\npacking_fraction = 0.3\n",
+                   "bad.toml")
+
+    def test_missing_particles(self):
+        self.check("[system]\npacking_fraction = 0.3\n", "system.particles")
+
+    def test_missing_packing_fraction(self):
+        self.check("[system]\nparticles = 500\n", "system.packing_fraction")
+
+    def test_empty_config(self):
+        self.check("", "system.particles")
+
+    def test_output_directory_is_a_file(self):
+        blocker = self.path("blocker")
+        with open(blocker, "w") as f:
+            f.write("x")
+        result = self.kairos("run", self.config, "-o", blocker)
+        self.assert_user_error(result, "blocker")
+
+    # ----- --set syntax
+
+    def test_set_without_equals(self):
+        self.check_set(["system.particles"], "system.particles")
+
+    def test_set_without_key(self):
+        self.check_set(["=5"], "=5")
+
+    def test_set_species_index_out_of_range(self):
+        self.check_set(["system.species.5.diameter=1.2"], "system.species")
+
+
+class InitialStateErrors(kt.KairosTestCase):
+    def run_from(self, gsd_path, dimension=3, *needles):
+        config = kt.base_config(dimension=dimension, production=1.0)
+        config["system"] = {"dimension": dimension, "initial_state": gsd_path}
+        path = self.write_config(config)
+        result = self.kairos("run", path, "-o", self.path("out"))
+        return self.assert_user_error(result, *needles)
+
+    def test_missing_initial_state(self):
+        self.run_from(self.path("nothing-here.gsd"), 3, "system.initial_state", "nothing-here.gsd")
+
+    def test_initial_state_not_gsd(self):
+        p = self.path("text.gsd")
+        with open(p, "w") as f:
+            f.write("this is not a GSD file\n" * 20)
+        self.run_from(p, 3, "text.gsd")
+
+    def test_overlapping_particles(self):
+        p = kt.write_hoomd_file(self.path("overlap.gsd"), [[0, 0, 0], [0.5, 0, 0]],
+                                [10, 10, 10], diameter=[1, 1])
+        line = self.run_from(p, 3, "overlap.gsd", "overlap")
+        self.assertIn("0", line)
+        self.assertIn("1", line)
+
+    def test_overlap_across_periodic_boundary(self):
+        p = kt.write_hoomd_file(self.path("wrap.gsd"), [[-4.8, 0, 0], [4.8, 0, 0]],
+                                [10, 10, 10], diameter=[1, 1])
+        self.run_from(p, 3, "wrap.gsd", "overlap")
+
+    def test_overlapping_disks_2d(self):
+        p = kt.write_hoomd_file(self.path("disks.gsd"), [[0, 0, 0], [0, 0.9, 0]],
+                                [10, 10, 0], dimensions=2, diameter=[1, 1])
+        self.run_from(p, 2, "disks.gsd", "overlap")
+
+    def test_nan_position(self):
+        p = kt.write_hoomd_file(self.path("nanpos.gsd"), [[0, 0, 0], [np.nan, 1, 1]],
+                                [10, 10, 10])
+        line = self.run_from(p, 3, "nanpos.gsd")
+        self.assertIn("position", line)
+
+    def test_inf_position(self):
+        p = kt.write_hoomd_file(self.path("infpos.gsd"), [[0, 0, 0], [2, np.inf, 1]],
+                                [10, 10, 10])
+        self.run_from(p, 3, "infpos.gsd", "position")
+
+    def test_nan_velocity(self):
+        p = kt.write_hoomd_file(self.path("nanvel.gsd"), [[0, 0, 0], [2, 2, 2]], [10, 10, 10],
+                                velocity=[[0, 0, 0], [0, np.nan, 0]])
+        self.run_from(p, 3, "nanvel.gsd", "velocity")
+
+    def test_zero_box(self):
+        p = kt.write_hoomd_file(self.path("flat.gsd"), [[0, 0, 0], [2, 2, 2]], [10, 0, 10])
+        self.run_from(p, 3, "flat.gsd", "box")
+
+    def test_one_particle(self):
+        p = kt.write_hoomd_file(self.path("single.gsd"), [[0, 0, 0]], [10, 10, 10])
+        self.run_from(p, 3, "single.gsd")
+
+    def test_dimension_mismatch(self):
+        p = kt.write_hoomd_file(self.path("flat2d.gsd"), [[0, 0, 0], [2, 2, 0]], [10, 10, 0],
+                                dimensions=2)
+        self.run_from(p, 3, "flat2d.gsd", "2D")
+
+    def test_no_frames(self):
+        p = self.path("empty.gsd")
+        with gsd.fl.open(name=p, mode="wb", application="test", schema="hoomd",
+                         schema_version=[1, 4]):
+            pass
+        self.run_from(p, 3, "empty.gsd")
+
+    def test_truncated_gsd(self):
+        good = kt.write_hoomd_file(self.path("good.gsd"), [[0, 0, 0], [2, 2, 2]], [10, 10, 10])
+        with open(good, "rb") as f:
+            data = f.read()
+        p = self.path("truncated.gsd")
+        with open(p, "wb") as f:
+            f.write(data[:100])
+        self.run_from(p, 3, "truncated.gsd")
+
+
+class RestartErrors(kt.KairosTestCase):
+    def setUp(self):
+        super().setUp()
+        self.config = self.write_config(kt.base_config(production=1.0))
+
+    def test_missing_restart_file(self):
+        result = self.kairos("run", self.config, "-o", self.path("out"),
+                             "--restart", self.path("gone", "restart.gsd"))
+        self.assert_user_error(result, "restart.gsd")
+
+    def test_restart_from_trajectory(self):
+        self.run_ok("run", self.config, "-o", self.path("first"))
+        traj = self.path("first", "trajectory.gsd")
+        result = self.kairos("run", self.config, "-o", self.path("second"), "--restart", traj)
+        self.assert_user_error(result, "trajectory.gsd", "restart")
+
+    def test_restart_from_text_file(self):
+        result = self.kairos("run", self.config, "-o", self.path("out"), "--restart", self.config)
+        self.assert_user_error(result, "config.toml")
+
+    def test_restart_from_directory(self):
+        os.mkdir(self.path("adir"))
+        result = self.kairos("run", self.config, "-o", self.path("out"),
+                             "--restart", self.path("adir"))
+        self.assert_user_error(result, "adir")
+
+    def test_restart_from_python_gsd_file(self):
+        p = kt.write_hoomd_file(self.path("plain.gsd"), [[0, 0, 0], [2, 2, 2]], [10, 10, 10])
+        result = self.kairos("run", self.config, "-o", self.path("out"), "--restart", p)
+        self.assert_user_error(result, "plain.gsd", "restart")
+
+    def test_restart_dimension_mismatch(self):
+        self.run_ok("run", self.config, "-o", self.path("first"))
+        result = self.kairos("run", self.config, "-o", self.path("second"),
+                             "--set", "system.dimension=2", "--set", "system.lattice=hex",
+                             "--restart", self.path("first", "restart.gsd"))
+        self.assert_user_error(result, "restart.gsd", "system.dimension")
+
+
+class CommandLine(kt.KairosTestCase):
+    OPTIONS = ("--set", "--restart", "-o")
+
+    def test_top_level_help(self):
+        result = self.kairos("--help")
+        self.assertEqual(result.returncode, 0, kt.describe(result))
+        self.assertIn("run", result.stdout)
+        for option in self.OPTIONS:
+            self.assertIn(option, result.stdout, "kairos --help should mention " + option)
+
+    def test_run_help(self):
+        result = self.kairos("run", "--help")
+        self.assertEqual(result.returncode, 0, kt.describe(result))
+        for option in self.OPTIONS:
+            self.assertIn(option, result.stdout, "kairos run --help should mention " + option)
+        self.assertIn("--output", result.stdout)
+
+    def test_version(self):
+        result = self.kairos("--version")
+        self.assertEqual(result.returncode, 0, kt.describe(result))
+        self.assertIn("kairos", result.stdout)
+
+    def test_no_subcommand(self):
+        self.assert_user_error(self.kairos())
+
+    def test_unknown_subcommand(self):
+        self.assert_user_error(self.kairos("simulate", "x.toml"))
+
+    def test_run_without_config(self):
+        self.assert_user_error(self.kairos("run"), "config")
+
+    def test_unknown_option(self):
+        config = self.write_config(kt.base_config(production=1.0))
+        self.assert_user_error(self.kairos("run", config, "--frobnicate"), "--frobnicate")
+
+    def test_option_without_value(self):
+        config = self.write_config(kt.base_config(production=1.0))
+        self.assert_user_error(self.kairos("run", config, "--restart"), "--restart")
+
+    def test_set_before_config(self):
+        # `--set` takes one value per use: the config file after it is still the config.
+        config = self.write_config(kt.base_config(production=1.0))
+        self.run_ok("run", "--set", "system.particles=256", config, "-o", self.path("out"))
+        self.assertEqual(self.summary(self.path("out"))["particles"], 256)
+
+    def test_two_values_after_one_set(self):
+        config = self.write_config(kt.base_config(production=1.0))
+        result = self.kairos("run", config, "--set", "system.particles=256",
+                             "run.collisions_per_particle=2")
+        self.assert_user_error(result, "run.collisions_per_particle=2")
+
+
+if __name__ == "__main__":
+    kt.main()
