@@ -175,9 +175,10 @@ class CellGrid {
   }
 
   // Calls f(particle) for every particle in the cells adjacent to (and including) the cell at
-  // `c`. Along an axis with fewer than 3 cells every cell is visited exactly once.
+  // `c`, until f returns true. Along an axis with fewer than 3 cells every cell is visited
+  // exactly once. Returns whether f stopped the iteration.
   template <class F>
-  void for_each_neighbour(const std::array<std::size_t, D>& c, F&& f) const {
+  bool for_each_neighbour(const std::array<std::size_t, D>& c, F&& f) const {
     std::array<std::array<std::size_t, 3>, D> axis{};
     std::array<std::size_t, D> count{};
     for (int k = 0; k < D; ++k) {
@@ -193,10 +194,12 @@ class CellGrid {
     while (true) {
       std::array<std::size_t, D> cell{};
       for (int k = 0; k < D; ++k) cell[k] = axis[k][pick[k]];
-      for (std::uint32_t p = head_[index(cell)]; p != kNoParticle; p = next_[p]) f(p);
+      for (std::uint32_t p = head_[index(cell)]; p != kNoParticle; p = next_[p]) {
+        if (f(p)) return true;
+      }
       int k = 0;
       while (k < D && ++pick[k] == count[k]) pick[k++] = 0;
-      if (k == D) break;
+      if (k == D) return false;
     }
   }
 
@@ -439,6 +442,7 @@ class VoxelSampler {
  public:
   static constexpr int kMaxLevel = 12;
 
+  // Voxels of edge >= side, at most max_voxels of them (wider voxels if needed).
   VoxelSampler(const std::array<double, D>& box, double side, std::size_t max_voxels) : box_(box) {
     double total = 1.0;
     for (int k = 0; k < D; ++k) total *= std::max(1.0, std::floor(box[k] / side));
@@ -499,17 +503,21 @@ class VoxelSampler {
     return far2 < radius * radius;
   }
 
-  bool can_refine(std::size_t max_voxels) const {
-    return level_ < kMaxLevel && live_.size() <= (max_voxels >> D);
-  }
+  // Whether a refinement may be tried: below the deepest level, and the live voxels have
+  // halved since the last refinement that had to be abandoned.
+  bool can_refine() const { return level_ < kMaxLevel && live_.size() <= retry_below_; }
 
-  // Splits every live voxel into 2^D and keeps the children for which is_covered is false.
+  // Splits every live voxel into 2^D and keeps the children for which
+  // is_covered(sampler, child) is false. Abandoned (nothing changes) when more than max_live
+  // children survive.
   template <class Covered>
-  void refine(Covered&& is_covered) {
-    std::array<std::uint64_t, D> m2{};
-    for (int k = 0; k < D; ++k) m2[k] = 2 * m_[k];
-    std::vector<std::uint64_t> next;
-    next.reserve(live_.size() << D);
+  void refine(Covered&& is_covered, std::size_t max_live) {
+    VoxelSampler finer(box_);
+    for (int k = 0; k < D; ++k) {
+      finer.m_[k] = 2 * m_[k];
+      finer.h_[k] = 0.5 * h_[k];
+    }
+    finer.level_ = level_ + 1;
     for (std::uint64_t v : live_) {
       std::array<std::uint64_t, D> c{};
       for (int k = 0; k < D; ++k) {
@@ -518,25 +526,27 @@ class VoxelSampler {
       }
       for (std::uint64_t child = 0; child < (std::uint64_t{1} << D); ++child) {
         std::uint64_t id = 0;
-        for (int k = D - 1; k >= 0; --k) id = id * m2[k] + c[k] + ((child >> k) & 1);
-        next.push_back(id);
+        for (int k = D - 1; k >= 0; --k) id = id * finer.m_[k] + c[k] + ((child >> k) & 1);
+        if (is_covered(finer, id)) continue;
+        if (finer.live_.size() >= max_live) {
+          retry_below_ = live_.size() / 2;
+          return;
+        }
+        finer.live_.push_back(id);
       }
     }
-    m_ = m2;
-    for (int k = 0; k < D; ++k) h_[k] *= 0.5;
-    ++level_;
-    live_.clear();
-    for (std::uint64_t id : next) {
-      if (!is_covered(id)) live_.push_back(id);
-    }
+    *this = std::move(finer);
   }
 
  private:
+  explicit VoxelSampler(const std::array<double, D>& box) : box_(box) {}
+
   std::array<double, D> box_;
-  std::array<std::uint64_t, D> m_{};
-  std::array<double, D> h_{};
+  std::array<std::uint64_t, D> m_{};  // voxels per axis at the current level
+  std::array<double, D> h_{};         // voxel edges
   int level_ = 0;
-  std::vector<std::uint64_t> live_;  // live voxel ids at the current level
+  std::size_t retry_below_ = std::numeric_limits<std::size_t>::max();
+  std::vector<std::uint64_t> live_;  // live voxel ids (x fastest) at the current level
 };
 
 // Random sequential insertion in the order of the particles (largest diameters first).
@@ -546,26 +556,23 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
   const std::size_t N = state.position.size();
   const double dmax = *std::max_element(state.diameter.begin(), state.diameter.end());
   CellGrid<D> grid(layout.box, dmax, N);
+  // Memory: at most 8 N voxel ids at the start of a diameter class, 16 N after refinements.
+  const std::size_t max_voxels = std::max<std::size_t>(8 * N, 1024);
   std::optional<VoxelSampler<D>> voxels;
+  std::uint64_t tries = 0, hits = 0;  // since the last (re)start or refinement of the voxels
   const auto fail = [&](std::size_t i, std::string_view why) {
     return InputError(fmt::format(
         "system.packing_fraction = {} could not be reached by random insertion: particle {} of "
         "{} {}; use a lower packing fraction or a lattice ({}) and let the run melt it",
         eta, i + 1, N, why, lattice_list(D, false)));
   };
-  const std::size_t max_voxels = std::max<std::size_t>(8 * N, 1024);
-  std::uint64_t tries = 0, hits = 0;  // since the last (re)start or refinement of the voxels
   for (std::size_t i = 0; i < N; ++i) {
     const double di = state.diameter[i];
-    // Whether some placed sphere's exclusion zone for diameter di covers the voxel.
-    const auto covered = [&](std::uint64_t voxel) {
-      bool dead = false;
-      grid.for_each_neighbour(grid.coords(voxels->centre(voxel)), [&](std::uint32_t j) {
-        if (!dead && voxels->covered(voxel, state.position[j], 0.5 * (di + state.diameter[j]))) {
-          dead = true;
-        }
+    // Whether the exclusion zone (for diameter di) of one placed particle covers the voxel.
+    const auto covered = [&](const VoxelSampler<D>& sampler, std::uint64_t voxel) {
+      return grid.for_each_neighbour(grid.coords(sampler.centre(voxel)), [&](std::uint32_t j) {
+        return sampler.covered(voxel, state.position[j], 0.5 * (di + state.diameter[j]));
       });
-      return dead;
     };
     if (i == 0 || di != state.diameter[i - 1]) {
       // Exclusion radii depend on the inserted diameter: start over with all voxels live.
@@ -579,12 +586,8 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
       const std::uint64_t voxel = voxels->voxel(slot);
       const std::array<double, D> x = voxels->point_in(voxel, rng);
       ++tries;
-      bool is_free = true;
-      grid.for_each_neighbour(grid.coords(x), [&](std::uint32_t j) {
-        if (is_free &&
-            pair_overlap<D>(layout.box, x, state.position[j], di, state.diameter[j]) > 0) {
-          is_free = false;
-        }
+      const bool is_free = !grid.for_each_neighbour(grid.coords(x), [&](std::uint32_t j) {
+        return pair_overlap<D>(layout.box, x, state.position[j], di, state.diameter[j]) > 0;
       });
       if (is_free) {
         state.position[i] = x;
@@ -593,10 +596,10 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
         ++hits;
         continue;
       }
-      if (covered(voxel)) voxels->kill(slot);
-      // Acceptance below 1/8 over a good sample: split the live voxels.
-      if (tries >= 2 * voxels->size() + 64 && 8 * hits < tries && voxels->can_refine(max_voxels)) {
-        voxels->refine(covered);
+      if (covered(*voxels, voxel)) voxels->kill(slot);
+      // Acceptance below 1/8 over a fair sample: split the live voxels.
+      if (tries >= voxels->size() + 256 && 8 * hits < tries && voxels->can_refine()) {
+        voxels->refine(covered, 2 * max_voxels);
         tries = hits = 0;
       }
     }
@@ -877,13 +880,14 @@ double max_overlap(const std::array<double, D>& box, const std::vector<std::arra
   double worst = 0.0;
   for (std::size_t i = 0; i < N; ++i) {
     grid.for_each_neighbour(grid.coords(pos[i]), [&](std::uint32_t j) {
-      if (j <= i) return;  // each pair once: j's cell is visited once from i's cell
+      if (j <= i) return false;  // each pair once: j's cell is visited once from i's cell
       const double ov = pair_overlap<D>(box, pos[i], pos[j], diameter[i], diameter[j]);
       if (ov > worst) {
         worst = ov;
         if (worst_i != nullptr) *worst_i = static_cast<std::uint32_t>(i);
         if (worst_j != nullptr) *worst_j = j;
       }
+      return false;
     });
   }
   return worst;

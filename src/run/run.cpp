@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -56,6 +57,43 @@ void check_no_overlap(const InitialState<D>& init, const std::string& source) {
   }
 }
 
+// A HOOMD file stores float32 positions. A frame written at a collision (Kairos writes its
+// trajectory frames right after one) holds a pair in exact contact, which the rounding to float32
+// turns into an overlap of ~1e-7 about half of the time. Overlaps within that round-off are
+// removed by expanding the box and all positions uniformly by the smallest factor that clears
+// them: every distance grows by that factor, the packing fraction shrinks by ~1e-7 relative, less
+// than the file's precision. Larger overlaps are left for check_no_overlap to report.
+template <int D>
+void expand_away_rounding_overlaps(InitialState<D>& init) {
+  double edge = 0.0;
+  for (int a = 0; a < D; ++a) edge = std::max(edge, init.box[a]);
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const double d : init.diameter) smallest = std::min(smallest, d);
+  const double tolerance =
+      std::min(8.0 * std::numeric_limits<float>::epsilon() * edge, 1e-3 * smallest);
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    const double worst = max_overlap<D>(init.box, init.position, init.diameter);
+    if (worst == 0.0 || worst > tolerance) return;
+    // Every overlapping pair has r >= sigma - worst with sigma >= smallest.
+    const double factor =
+        (1.0 + 8.0 * std::numeric_limits<double>::epsilon()) / (1.0 - worst / smallest);
+    for (int a = 0; a < D; ++a) init.box[a] *= factor;
+    for (auto& x : init.position) {
+      for (int a = 0; a < D; ++a) {
+        x[a] *= factor;
+        if (x[a] >= init.box[a]) x[a] -= init.box[a];
+        if (x[a] < 0.0) x[a] = 0.0;
+      }
+    }
+  }
+}
+
+// True when the last frame of a GSD file holds Kairos' float64 positions (a restart file).
+bool holds_exact_positions(const fs::path& path) {
+  const gsd::Reader r(path);
+  return r.frame_count() > 0 && r.find(r.frame_count() - 1, "kairos/position").has_value();
+}
+
 template <int D>
 ParticleSystem<D> build_start_state(const Config& config,
                                     const std::optional<fs::path>& restart_file,
@@ -73,6 +111,7 @@ ParticleSystem<D> build_start_state(const Config& config,
     }
     bool has_velocities = false;
     InitialState<D> init = read_initial_state<D>(path, has_velocities);
+    if (!holds_exact_positions(path)) expand_away_rounding_overlaps(init);
     check_no_overlap(init, "system.initial_state '" + path.string() + "'");
     if (!has_velocities) assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
     return to_particle_system(init);

@@ -14,10 +14,17 @@
 #include <limits>
 #include <vector>
 
+#include "scheduler/indexed_min_heap.hpp"
+
 namespace kairos {
 
 class CalendarQueue {
  public:
+  // The heap points into this object's key array: not copyable.
+  CalendarQueue() = default;
+  CalendarQueue(const CalendarQueue&) = delete;
+  CalendarQueue& operator=(const CalendarQueue&) = delete;
+
   static constexpr const char* name() { return "calendar"; }
 
   void reset(const std::vector<double>& times) {
@@ -26,7 +33,7 @@ class CalendarQueue {
     next_.assign(n, kNone);
     prev_.assign(n, kNone);
     where_.assign(n, kOverflow);
-    heap_pos_.assign(n, 0);
+    heap_.bind(&key_);
     nb_ = 1;
     while (nb_ < n) nb_ <<= 1;
     mask_ = nb_ - 1;
@@ -35,11 +42,11 @@ class CalendarQueue {
 
   std::uint32_t top() {
     if (heap_.empty()) advance();
-    return heap_.empty() ? 0 : heap_[0];
+    return heap_.empty() ? 0 : heap_.top();
   }
   double top_time() {
     if (heap_.empty()) advance();
-    return heap_.empty() ? std::numeric_limits<double>::infinity() : key_[heap_[0]];
+    return heap_.empty() ? std::numeric_limits<double>::infinity() : key_[heap_.top()];
   }
   double time_of(std::uint32_t i) const { return key_[i]; }
   std::size_t size() const { return key_.size(); }
@@ -183,60 +190,19 @@ class CalendarQueue {
     return false;
   }
 
-  bool less(std::uint32_t a, std::uint32_t b) const {
-    return key_[a] < key_[b] || (key_[a] == key_[b] && a < b);
-  }
-  void heap_place(std::uint32_t pos, std::uint32_t p) {
-    heap_[pos] = p;
-    heap_pos_[p] = pos;
-  }
   void heap_push(std::uint32_t p) {
     where_[p] = kInHeap;
-    heap_.push_back(p);
-    sift_up(static_cast<std::uint32_t>(heap_.size() - 1));
+    heap_.push(p);
   }
   void heap_erase(std::uint32_t p) {
-    const std::uint32_t pos = heap_pos_[p];
-    const std::uint32_t last = heap_.back();
-    heap_.pop_back();
-    if (pos == heap_.size()) {
-      ++pops_this_turn_;
-      return;
-    }
-    heap_place(pos, last);
-    sift_down(pos);
-    sift_up(heap_pos_[last]);
+    heap_.erase(p);
     ++pops_this_turn_;
-  }
-  void sift_up(std::uint32_t pos) {
-    const std::uint32_t p = heap_[pos];
-    while (pos > 0) {
-      const std::uint32_t parent = (pos - 1) / 2;
-      if (!less(p, heap_[parent])) break;
-      heap_place(pos, heap_[parent]);
-      pos = parent;
-    }
-    heap_place(pos, p);
-  }
-  void sift_down(std::uint32_t pos) {
-    const auto n = static_cast<std::uint32_t>(heap_.size());
-    const std::uint32_t p = heap_[pos];
-    while (true) {
-      std::uint32_t child = 2 * pos + 1;
-      if (child >= n) break;
-      if (child + 1 < n && less(heap_[child + 1], heap_[child])) ++child;
-      if (!less(heap_[child], p)) break;
-      heap_place(pos, heap_[child]);
-      pos = child;
-    }
-    heap_place(pos, p);
   }
 
   std::vector<double> key_;
   std::vector<std::uint32_t> next_, prev_;  // intrusive bucket / overflow lists
   std::vector<std::int32_t> where_;         // bucket index, kInHeap or kOverflow
-  std::vector<std::uint32_t> heap_pos_;
-  std::vector<std::uint32_t> heap_;         // the current bucket, sorted
+  IndexedMinHeap heap_;                     // the current bucket, sorted
   std::vector<std::uint32_t> bucket_head_;
   std::uint32_t overflow_head_ = kNone;
   std::uint32_t nb_ = 1, mask_ = 0;

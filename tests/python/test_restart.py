@@ -1,0 +1,181 @@
+"""The exact-restart contract and restart bookkeeping.
+
+50 + 50 collisions per particle through --restart must end bit-identical to one run of 100
+(float64 positions, velocities, time and local times of the final restart.gsd), in 3D and 2D,
+with both event queues. A restart skips equilibration, appends to the trajectory and thermo
+file of the same output directory, and periodic restart files are valid restart files.
+"""
+
+import os
+
+import numpy as np
+
+import kairos_testlib as kt
+
+
+def config(dimension, queue, production, equilibration=0.0, **output):
+    particles = 500 if dimension == 3 else 400
+    packing = 0.4 if dimension == 3 else 0.5
+    return kt.base_config(dimension=dimension, particles=particles, packing_fraction=packing,
+                          seed=20 + dimension, equilibration=equilibration,
+                          production=production, run={"event_queue": queue}, output=output)
+
+
+class ExactRestart(kt.KairosTestCase):
+    def check_exact(self, dimension, queue):
+        half = self.write_config(config(dimension, queue, 50.0), "half.toml")
+        full = self.write_config(config(dimension, queue, 100.0), "full.toml")
+        self.run_ok("run", half, "-o", self.path("first"))
+        self.run_ok("run", half, "--restart", self.path("first", "restart.gsd"),
+                    "-o", self.path("second"))
+        self.run_ok("run", full, "-o", self.path("whole"))
+
+        split = kt.read_exact_state(self.path("second", "restart.gsd"))
+        whole = kt.read_exact_state(self.path("whole", "restart.gsd"))
+        first = kt.read_exact_state(self.path("first", "restart.gsd"))
+        for name in kt.EXACT_CHUNKS:
+            self.assertEqual(split[name].dtype, np.float64, name)
+            self.assertTrue(np.array_equal(split[name], whole[name]),
+                            "%s differs between 50+50 (restart) and 100 collisions per particle "
+                            "(%dD, %s queue); max |diff| = %g" %
+                            (name, dimension, queue,
+                             np.max(np.abs(split[name] - whole[name]))))
+        # The restart continued (it did not just copy the first half).
+        self.assertGreater(split["kairos/time"][0], first["kairos/time"][0])
+
+        # The bookkeeping agrees too: same total number of collisions and events.
+        s2 = self.summary(self.path("second"))
+        sw = self.summary(self.path("whole"))
+        self.assertTrue(s2["restarted"])
+        self.assertFalse(sw["restarted"])
+        self.assertEqual(s2["event_queue"], queue)
+        self.assertEqual(s2["event_counts"]["total_collisions_since_start"],
+                         sw["event_counts"]["total_collisions_since_start"])
+        self.assertEqual(s2["event_counts"]["total_events_since_start"],
+                         sw["event_counts"]["total_events_since_start"])
+        self.assertEqual(s2["sim_time"], sw["sim_time"])
+        counters2 = kt.restart_chunk(self.path("second", "restart.gsd"), "kairos/state/counters")
+        counters_w = kt.restart_chunk(self.path("whole", "restart.gsd"), "kairos/state/counters")
+        self.assertTrue(np.array_equal(counters2, counters_w))
+
+    def test_3d_calendar(self):
+        self.check_exact(3, "calendar")
+
+    def test_3d_heap(self):
+        self.check_exact(3, "heap")
+
+    def test_2d_calendar(self):
+        self.check_exact(2, "calendar")
+
+    def test_2d_heap(self):
+        self.check_exact(2, "heap")
+
+    def test_restart_twice(self):
+        # 30 + 30 + 40 == 100, through two restarts.
+        cfg = self.write_config(config(3, "calendar", 30.0), "a.toml")
+        self.run_ok("run", cfg, "-o", self.path("a"))
+        self.run_ok("run", cfg, "--restart", self.path("a", "restart.gsd"), "-o", self.path("b"))
+        self.run_ok("run", cfg, "--restart", self.path("b", "restart.gsd"), "-o", self.path("c"),
+                    "--set", "run.collisions_per_particle=40")
+        full = self.write_config(config(3, "calendar", 100.0), "full.toml")
+        self.run_ok("run", full, "-o", self.path("whole"))
+        c = kt.read_exact_state(self.path("c", "restart.gsd"))
+        whole = kt.read_exact_state(self.path("whole", "restart.gsd"))
+        for name in kt.EXACT_CHUNKS:
+            self.assertTrue(np.array_equal(c[name], whole[name]), name)
+
+
+class RestartBookkeeping(kt.KairosTestCase):
+    def test_restart_skips_equilibration(self):
+        n = 500
+        cfg = self.write_config(config(3, "calendar", 10.0, equilibration=30.0))
+        self.run_ok("run", cfg, "-o", self.path("first"))
+        first = self.summary(self.path("first"))
+        self.assertEqual(first["collisions"], (30 + 10) * n // 2)
+
+        self.run_ok("run", cfg, "--restart", self.path("first", "restart.gsd"),
+                    "-o", self.path("second"))
+        second = self.summary(self.path("second"))
+        self.assertTrue(second["restarted"])
+        # Only production: 10 collisions per particle, no 30 of equilibration.
+        self.assertEqual(second["collisions"], 10 * n // 2)
+        self.assertEqual(second["production_collisions_per_particle"], 10.0)
+        self.assertEqual(second["event_counts"]["total_collisions_since_start"],
+                         (30 + 10 + 10) * n // 2)
+        header, rows, _ = kt.read_thermo(self.path("second", "thermo.tsv"))
+        phases = {row[0] for row in rows}
+        self.assertEqual(phases, {"production"}, "a restart must not equilibrate again")
+
+    def test_restart_into_same_directory_appends(self):
+        out = self.path("out")
+        cfg = self.write_config(config(3, "calendar", 20.0, trajectory_interval=5.0))
+        self.run_ok("run", cfg, "-o", out)
+        traj = kt.open_trajectory(os.path.join(out, "trajectory.gsd"))
+        frames_before = len(traj)
+        times_before = [float(f.log["time"][0]) for f in traj]
+        self.assertEqual(frames_before, 1 + 20 // 5)
+        _, rows_before, text_before = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+
+        self.run_ok("run", cfg, "--restart", os.path.join(out, "restart.gsd"), "-o", out)
+
+        traj = kt.open_trajectory(os.path.join(out, "trajectory.gsd"))
+        self.assertEqual(len(traj), frames_before + 20 // 5,
+                         "the restart should append one frame per trajectory_interval "
+                         "(and not repeat the restart frame)")
+        times = [float(f.log["time"][0]) for f in traj]
+        self.assertEqual(times[:frames_before], times_before, "earlier frames must be kept")
+        self.assertTrue(all(b > a for a, b in zip(times, times[1:])),
+                        "log/time must increase across the restart: %s" % times)
+        last = traj[len(traj) - 1]
+        self.assertEqual(last.particles.N, 500)
+        self.assertEqual(len(last.particles.position), 500)
+        self.assertEqual(list(last.particles.types), ["A"])  # static data from frame 0
+        final_time = kt.restart_chunk(os.path.join(out, "restart.gsd"), "kairos/time")[0]
+        self.assertEqual(times[-1], final_time)
+
+        header, rows, text = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        self.assertTrue(text.startswith(text_before), "the earlier thermo rows must be kept")
+        self.assertEqual(text.count("phase\t"), 1, "one header only")
+        self.assertGreater(len(rows), len(rows_before))
+        t = header.index("time")
+        c = header.index("collisions")
+        self.assertTrue(all(b[t] > a[t] for a, b in zip(rows, rows[1:])))
+        self.assertTrue(all(b[c] > a[c] for a, b in zip(rows, rows[1:])))
+        self.assertEqual(rows[-1][c], 40 * 500 // 2)
+
+    def test_restart_into_new_directory_starts_new_files(self):
+        cfg = self.write_config(config(2, "heap", 10.0, trajectory_interval=5.0))
+        self.run_ok("run", cfg, "-o", self.path("a"))
+        self.run_ok("run", cfg, "--restart", self.path("a", "restart.gsd"), "-o", self.path("b"))
+        traj = kt.open_trajectory(self.path("b", "trajectory.gsd"))
+        self.assertEqual(len(traj), 1 + 10 // 5)  # the restart state, then one per interval
+        start_time = kt.restart_chunk(self.path("a", "restart.gsd"), "kairos/time")[0]
+        self.assertEqual(float(traj[0].log["time"][0]), start_time)
+        self.assertEqual(traj[0].configuration.dimensions, 2)
+        header, rows, text = kt.read_thermo(self.path("b", "thermo.tsv"))
+        self.assertEqual(header[0], "phase")
+        self.assertGreater(len(rows), 0)
+
+    def test_periodic_restart_files(self):
+        cfg = self.write_config(config(3, "calendar", 20.0, restart_interval=5.0))
+        self.run_ok("run", cfg, "-o", self.path("out"))
+        restart = self.path("out", "restart.gsd")
+        self.assertTrue(os.path.isfile(restart))
+        self.assertFalse(os.path.exists(restart + ".tmp"), "temporary file left behind")
+        state = kt.read_exact_state(restart)
+        self.assertEqual(state["kairos/state/position"].shape, (500, 3))
+        self.assertTrue(np.all(np.isfinite(state["kairos/state/position"])))
+        # It is the final state and restarts exactly like a run without restart_interval.
+        self.assertEqual(state["kairos/time"][0], self.summary(self.path("out"))["sim_time"])
+        plain = self.write_config(config(3, "calendar", 20.0), "plain.toml")
+        self.run_ok("run", plain, "-o", self.path("plain"))
+        other = kt.read_exact_state(self.path("plain", "restart.gsd"))
+        for name in kt.EXACT_CHUNKS:
+            self.assertTrue(np.array_equal(state[name], other[name]),
+                            "writing periodic restart files must not change the run: " + name)
+        self.run_ok("run", cfg, "--restart", restart, "-o", self.path("again"),
+                    "--set", "run.collisions_per_particle=2")
+
+
+if __name__ == "__main__":
+    kt.main()
