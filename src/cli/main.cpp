@@ -83,16 +83,17 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "Run a simulation described by a TOML config file.");
   run->add_option("config", config_path, "TOML configuration file (see docs/config.md)")
       ->required();
-  run->add_option("-o,--output", outdir,
-                  "Output directory (overrides output.directory; created if missing)");
+  auto* output_option = run->add_option(
+      "-o,--output", outdir, "Output directory (overrides output.directory; created if missing)");
   run->add_option("--set", overrides,
                   "Override a config key, dotted path and TOML value, e.g. "
                   "--set system.packing_fraction=0.3 --set system.lattice=sc (repeatable)")
       ->take_all()
       ->allow_extra_args(false);  // one value per --set, so `--set k=v CONFIG` keeps CONFIG
-  run->add_option("--restart", restart,
-                  "Continue from a restart file (OUTDIR/restart.gsd); equilibration is skipped and "
-                  "run.collisions_per_particle more collisions per particle are simulated");
+  auto* restart_option = run->add_option(
+      "--restart", restart,
+      "Continue from a restart file (OUTDIR/restart.gsd); equilibration is skipped and "
+      "run.collisions_per_particle more collisions per particle are simulated");
   run->footer(
       "Outputs in OUTDIR: config.toml, thermo.tsv, trajectory.gsd, restart.gsd, summary.json.\n"
       "SIGINT/SIGTERM stop after the current event and still write every output.");
@@ -113,6 +114,14 @@ int main(int argc, char** argv) {
   }
 
   try {
+    // An empty value (e.g. from an unset shell variable) is an error, not "option absent": a
+    // silently fresh run would overwrite the outputs it was meant to continue.
+    if (output_option->count() > 0 && outdir.empty()) {
+      throw kairos::InputError("-o/--output: the output directory must not be empty");
+    }
+    if (restart_option->count() > 0 && restart.empty()) {
+      throw kairos::InputError("--restart: the restart file name must not be empty");
+    }
     kairos::Config config = kairos::load_config(config_path, overrides);
     if (!outdir.empty()) config.output.directory = outdir;
     install_signal_handlers();

@@ -23,7 +23,10 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> system)
   if (sys_.collision_count.size() != n) sys_.collision_count.assign(n, 0);
   const bool restart = sys_.events.size() == n && sys_.cell.size() == n;
   if (restart) {
-    for (std::uint32_t i = 0; i < n; ++i) grid_.insert(i, sys_.cell[i]);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      check_restored_cell(i);
+      grid_.insert(i, sys_.cell[i]);
+    }
   } else {
     for (std::uint32_t i = 0; i < n; ++i) {
       advance_to(i, sys_.time);
@@ -34,6 +37,23 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> system)
   std::vector<double> times(n);
   for (std::uint32_t i = 0; i < n; ++i) times[i] = event_time(i);
   queue_.reset(times);
+}
+
+// A restored cell must exist and contain the particle's position (up to round-off): a damaged
+// file, or one from a build with another grid sizing, must not silently mean other cells.
+template <int D, class Queue>
+void EventEngine<D, Queue>::check_restored_cell(std::uint32_t i) const {
+  const std::uint32_t c = sys_.cell[i];
+  bool ok = c < grid_.cell_count();
+  for (int a = 0; ok && a < D; ++a) {
+    const double x = sys_.kinematics[i].pos[a];
+    const double tol = 1e-9 * sys_.box[a];
+    ok = x >= grid_.lower(c, a) - tol && x <= grid_.upper(c, a) + tol;
+  }
+  if (!ok) {
+    throw InputError("restart state is inconsistent: particle " + std::to_string(i) +
+                     " is not inside its stored cell " + std::to_string(c));
+  }
 }
 
 template <int D, class Queue>

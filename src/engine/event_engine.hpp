@@ -69,6 +69,7 @@ class EventEngine {
   void cross(std::uint32_t i, double t);
   void predict_all();
   bool cells_adjacent(std::uint32_t a, std::uint32_t b) const;
+  void check_restored_cell(std::uint32_t i) const;
 
   ParticleSystem<D> sys_;
   CellGrid<D> grid_;

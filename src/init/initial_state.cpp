@@ -119,7 +119,7 @@ double pair_overlap(const std::array<double, D>& box, const std::array<double, D
   double r2 = 0.0;
   for (int k = 0; k < D; ++k) {
     double dx = a[k] - b[k];
-    dx -= box[k] * std::round(dx / box[k]);
+    if (std::abs(dx) > 0.5 * box[k]) dx -= box[k] * std::round(dx / box[k]);
     r2 += dx * dx;
   }
   const double sigma = 0.5 * (da + db);
@@ -496,7 +496,7 @@ class VoxelSampler {
     double far2 = 0.0;
     for (int k = 0; k < D; ++k) {
       double dx = point[k] - c[k];
-      dx -= box_[k] * std::round(dx / box_[k]);
+      if (std::abs(dx) > 0.5 * box_[k]) dx -= box_[k] * std::round(dx / box_[k]);
       const double far = std::abs(dx) + 0.5 * h_[k];
       far2 += far * far;
     }
@@ -507,18 +507,28 @@ class VoxelSampler {
   // halved since the last refinement that had to be abandoned.
   bool can_refine() const { return level_ < kMaxLevel && live_.size() <= retry_below_; }
 
-  // Splits every live voxel into 2^D and keeps the children for which
-  // is_covered(sampler, child) is false. Abandoned (nothing changes) when more than max_live
-  // children survive.
-  template <class Covered>
-  void refine(Covered&& is_covered, std::size_t max_live) {
+  struct Sphere {
+    std::array<double, D> centre;
+    double radius;
+  };
+
+  // Splits every live voxel into 2^D and keeps the children not covered by a single exclusion
+  // sphere; gather(point, spheres) must append every sphere that reaches within one
+  // particle diameter of `point` (the cell-grid neighbourhood). Abandoned (nothing changes)
+  // when more than max_live children would survive: skipped at once when a sample says so,
+  // otherwise after the full pass, and then not tried again before the live voxels have halved.
+  template <class Gather>
+  void refine(Gather&& gather, std::size_t max_live) {
     VoxelSampler finer(box_);
     for (int k = 0; k < D; ++k) {
       finer.m_[k] = 2 * m_[k];
       finer.h_[k] = 0.5 * h_[k];
     }
     finer.level_ = level_ + 1;
-    for (std::uint64_t v : live_) {
+    std::vector<Sphere> near;
+    const auto children = [&](std::uint64_t v, auto&& visit) {
+      near.clear();
+      gather(centre(v), near);  // the children lie inside v: one neighbourhood serves them all
       std::array<std::uint64_t, D> c{};
       for (int k = 0; k < D; ++k) {
         c[k] = 2 * (v % m_[k]);
@@ -527,13 +537,37 @@ class VoxelSampler {
       for (std::uint64_t child = 0; child < (std::uint64_t{1} << D); ++child) {
         std::uint64_t id = 0;
         for (int k = D - 1; k >= 0; --k) id = id * finer.m_[k] + c[k] + ((child >> k) & 1);
-        if (is_covered(finer, id)) continue;
-        if (finer.live_.size() >= max_live) {
-          retry_below_ = live_.size() / 2;
-          return;
-        }
-        finer.live_.push_back(id);
+        const bool dead = std::any_of(near.begin(), near.end(), [&](const Sphere& sphere) {
+          return finer.covered(id, sphere.centre, sphere.radius);
+        });
+        if (!dead) visit(id);
       }
+    };
+    // Estimate the survivors from an evenly spread sample before doing all the work.
+    constexpr std::size_t kSample = 256;
+    if (live_.size() > 4 * kSample) {
+      std::size_t survivors = 0;
+      for (std::size_t s = 0; s < kSample; ++s) {
+        children(live_[s * (live_.size() / kSample)], [&](std::uint64_t) { ++survivors; });
+      }
+      if (static_cast<double>(survivors) * static_cast<double>(live_.size() / kSample) >
+          static_cast<double>(max_live)) {
+        return;  // cheap to try again later, when more particles cover more voxels
+      }
+    }
+    bool too_many = false;
+    for (std::size_t s = 0; s < live_.size() && !too_many; ++s) {
+      children(live_[s], [&](std::uint64_t id) {
+        if (finer.live_.size() >= max_live) {
+          too_many = true;
+        } else {
+          finer.live_.push_back(id);
+        }
+      });
+    }
+    if (too_many) {
+      retry_below_ = live_.size() / 2;
+      return;
     }
     *this = std::move(finer);
   }
@@ -569,9 +603,17 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
   for (std::size_t i = 0; i < N; ++i) {
     const double di = state.diameter[i];
     // Whether the exclusion zone (for diameter di) of one placed particle covers the voxel.
-    const auto covered = [&](const VoxelSampler<D>& sampler, std::uint64_t voxel) {
-      return grid.for_each_neighbour(grid.coords(sampler.centre(voxel)), [&](std::uint32_t j) {
-        return sampler.covered(voxel, state.position[j], 0.5 * (di + state.diameter[j]));
+    const auto covered = [&](std::uint64_t voxel) {
+      return grid.for_each_neighbour(grid.coords(voxels->centre(voxel)), [&](std::uint32_t j) {
+        return voxels->covered(voxel, state.position[j], 0.5 * (di + state.diameter[j]));
+      });
+    };
+    // The exclusion spheres (for diameter di) of the placed particles near a point.
+    const auto gather = [&](const std::array<double, D>& point,
+                            std::vector<typename VoxelSampler<D>::Sphere>& out) {
+      grid.for_each_neighbour(grid.coords(point), [&](std::uint32_t j) {
+        out.push_back({state.position[j], 0.5 * (di + state.diameter[j])});
+        return false;
       });
     };
     if (i == 0 || di != state.diameter[i - 1]) {
@@ -596,10 +638,10 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
         ++hits;
         continue;
       }
-      if (covered(*voxels, voxel)) voxels->kill(slot);
+      if (covered(voxel)) voxels->kill(slot);
       // Acceptance below 1/8 over a fair sample: split the live voxels.
       if (tries >= voxels->size() + 256 && 8 * hits < tries && voxels->can_refine()) {
-        voxels->refine(covered, 2 * max_voxels);
+        voxels->refine(gather, 2 * max_voxels);
         tries = hits = 0;
       }
     }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <string>
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
@@ -108,6 +109,43 @@ std::vector<T> require(const gsd::Reader& r, std::uint64_t frame, std::string_vi
   return std::move(*v);
 }
 
+// A restart file is trusted to index arrays (partners, types); reject a damaged one with an
+// InputError instead of crashing. Cell indices are left to the engine: their meaning depends on
+// the grid it builds.
+template <int D>
+void validate_restart(const ParticleSystem<D>& s, const std::filesystem::path& path) {
+  const auto bad = [&](const std::string& what) {
+    return InputError("'" + path.string() + "' is not a valid restart file: " + what);
+  };
+  const std::size_t n = s.size();
+  if (n < 2) throw bad("fewer than 2 particles");
+  for (int a = 0; a < D; ++a) {
+    if (!(s.box[a] > 0.0) || !std::isfinite(s.box[a]))
+      throw bad("box edge is not a positive number");
+  }
+  if (!std::isfinite(s.time)) throw bad("kairos/time is not finite");
+  if (s.species_names.empty()) throw bad("no particle types");
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& k = s.kinematics[i];
+    const auto& e = s.events[i];
+    const std::string who = " of particle " + std::to_string(i);
+    for (int a = 0; a < D; ++a) {
+      if (!std::isfinite(k.pos[a]) || !std::isfinite(k.vel[a]))
+        throw bad("position or velocity" + who + " is not finite");
+    }
+    if (!std::isfinite(k.time)) throw bad("local time" + who + " is not finite");
+    if (!(k.radius > 0.0) || !std::isfinite(k.radius))
+      throw bad("radius" + who + " is not positive");
+    if (!(s.mass[i] > 0.0) || !std::isfinite(s.mass[i]))
+      throw bad("mass" + who + " is not positive");
+    if (s.species[i] >= s.species_names.size()) throw bad("typeid" + who + " out of range");
+    if (std::isnan(e.collision_time) || std::isnan(e.crossing_time))
+      throw bad("pending event time" + who + " is NaN");
+    if (e.partner >= n) throw bad("collision partner" + who + " out of range");
+    if (e.crossing < -1 || e.crossing >= 2 * D) throw bad("cell crossing" + who + " out of range");
+  }
+}
+
 }  // namespace
 
 template <int D>
@@ -190,15 +228,15 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   if (r.frame_count() == 0 || !r.find(f, "kairos/format")) {
     throw InputError("'" + path.string() + "' is not a Kairos restart file (no kairos/format)");
   }
-  if (r.read<std::uint32_t>(f, "kairos/format").at(0) != kRestartFormat) {
+  if (require<std::uint32_t>(r, f, "kairos/format", path, 1)[0] != kRestartFormat) {
     throw InputError("'" + path.string() + "': unsupported restart format version");
   }
-  const int dim = r.read<std::uint8_t>(f, "kairos/dimension").at(0);
+  const int dim = require<std::uint8_t>(r, f, "kairos/dimension", path, 1)[0];
   if (dim != D) {
     throw InputError("'" + path.string() + "' holds a " + std::to_string(dim) +
                      "D state but system.dimension = " + std::to_string(D));
   }
-  const std::size_t n = r.read<std::uint32_t>(f, "particles/N").at(0);
+  const std::size_t n = require<std::uint32_t>(r, f, "particles/N", path, 1)[0];
   ParticleSystem<D> s;
   const auto box = require<double>(r, f, "kairos/box", path, D);
   for (int a = 0; a < D; ++a) s.box[a] = box[a];
@@ -210,6 +248,7 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   s.mass = require<double>(r, f, "kairos/mass", path, n);
   s.species = require<std::uint32_t>(r, f, "particles/typeid", path, n);
   const auto types = r.find(f, "particles/types");
+  if (!types) throw InputError("'" + path.string() + "' has no chunk 'particles/types'");
   s.species_names = unpack_type_names(r.read<std::int8_t>(f, "particles/types"), types->M);
   s.collision_count = require<std::uint32_t>(r, f, "kairos/state/collision_count", path, n);
   s.cell = require<std::uint32_t>(r, f, "kairos/state/cell", path, n);
@@ -232,6 +271,7 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
     s.kinematics[i].radius = radius[i];
     s.events[i] = {tcoll[i], tcross[i], partner[i], pcount[i], crossing[i]};
   }
+  validate_restart(s, path);
   const auto rng_bytes = r.read<std::int8_t>(f, "kairos/state/rng");
   std::istringstream rng_text(std::string(rng_bytes.begin(), rng_bytes.end()));
   rng_text >> rng;

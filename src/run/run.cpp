@@ -48,6 +48,13 @@ ParticleSystem<D> to_particle_system(const InitialState<D>& init) {
 
 template <int D>
 void check_no_overlap(const InitialState<D>& init, const std::string& source) {
+  for (int a = 0; a < D; ++a) {
+    if (!std::isfinite(init.box[a]) || !(init.box[a] > 0.0)) {
+      throw InputError(fmt::format("{}: the box edge {} is {}: check system.particles, "
+                                   "system.packing_fraction and the species diameters",
+                                   source, a, init.box[a]));
+    }
+  }
   std::uint32_t i = 0, j = 0;
   const double worst = max_overlap<D>(init.box, init.position, init.diameter, &i, &j);
   if (worst > 0.0) {
@@ -94,6 +101,16 @@ bool holds_exact_positions(const fs::path& path) {
   return r.frame_count() > 0 && r.find(r.frame_count() - 1, "kairos/position").has_value();
 }
 
+// When the state comes from a file, the generating keys do not apply; say so if they disagree.
+void note_ignored_system_keys(const Config& config, std::size_t n, const std::string& source) {
+  if (config.system.particles != 0 && config.system.particles != n) {
+    fmt::print(stderr,
+               "kairos: note: {} holds {} particles; system.particles = {} and the other "
+               "generating keys (packing_fraction, lattice, species) are not used\n",
+               source, n, config.system.particles);
+  }
+}
+
 template <int D>
 ParticleSystem<D> build_start_state(const Config& config,
                                     const std::optional<fs::path>& restart_file,
@@ -102,7 +119,9 @@ ParticleSystem<D> build_start_state(const Config& config,
     if (!fs::exists(*restart_file)) {
       throw InputError("restart file '" + restart_file->string() + "' does not exist");
     }
-    return read_restart<D>(*restart_file, rng);
+    ParticleSystem<D> s = read_restart<D>(*restart_file, rng);
+    note_ignored_system_keys(config, s.size(), "the restart file");
+    return s;
   }
   if (!config.system.initial_state.empty()) {
     const fs::path path = config.system.initial_state;
@@ -113,6 +132,7 @@ ParticleSystem<D> build_start_state(const Config& config,
     InitialState<D> init = read_initial_state<D>(path, has_velocities);
     if (!holds_exact_positions(path)) expand_away_rounding_overlaps(init);
     check_no_overlap(init, "system.initial_state '" + path.string() + "'");
+    note_ignored_system_keys(config, init.position.size(), "system.initial_state");
     if (!has_velocities) assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
     return to_particle_system(init);
   }
@@ -170,7 +190,12 @@ class RunDriver {
       particle_volume_ += D == 3 ? 4.0 / 3.0 * std::numbers::pi * k.radius * k.radius * k.radius
                                  : std::numbers::pi * k.radius * k.radius;
     }
-    engine_.emplace(std::move(start));
+    try {
+      engine_.emplace(std::move(start));
+    } catch (const InputError& e) {
+      if (!restart_file) throw;
+      throw InputError("restart file '" + restart_file->string() + "': " + e.what());
+    }
     dir_ = config.output.directory;
     std::error_code ec;
     fs::create_directories(dir_, ec);

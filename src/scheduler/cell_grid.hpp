@@ -28,15 +28,28 @@ class CellGrid {
   static constexpr int kLayerCells = D == 3 ? 9 : 3;
 
   CellGrid() = default;
+  // Cells at least `min_width` wide, at least 3 per axis, and at most ~4 per particle (dilute
+  // systems get wider cells instead of an unbounded, mostly empty grid).
   CellGrid(const Vec<D>& box, double min_width, std::size_t particles) : box_(box) {
-    total_ = 1;
+    double wanted[D];
+    double product = 1.0;
     for (int k = 0; k < D; ++k) {
-      n_[k] = static_cast<int>(std::floor(box[k] / min_width));
-      if (n_[k] < 3) {
+      if (!(box[k] > 0.0) || !std::isfinite(box[k])) {
+        throw InputError("box edge " + std::to_string(box[k]) + " is not a finite positive length");
+      }
+      wanted[k] = std::min(std::floor(box[k] / min_width), 1e6);
+      if (wanted[k] < 3.0) {
         throw InputError("box edge " + std::to_string(box[k]) +
                          " is shorter than 3 contact distances (" + std::to_string(min_width) +
-                         "): use more particles");
+                         "): use more particles or a lower packing fraction");
       }
+      product *= wanted[k];
+    }
+    const double max_cells = std::max(27.0, 4.0 * static_cast<double>(particles));
+    const double shrink = product > max_cells ? std::pow(max_cells / product, 1.0 / D) : 1.0;
+    total_ = 1;
+    for (int k = 0; k < D; ++k) {
+      n_[k] = static_cast<int>(std::max(3.0, std::floor(wanted[k] * shrink)));
       width_[k] = box[k] / n_[k];
       stride_[k] = total_;
       total_ *= static_cast<std::uint32_t>(n_[k]);

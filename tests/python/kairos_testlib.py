@@ -172,7 +172,13 @@ class KairosTestCase(unittest.TestCase):
         self.assertEqual(result.returncode, 0,
                          "kairos failed (%s)\n%s" % (signal_name(result.returncode),
                                                      describe(result)))
+        self.assert_no_sanitizer_report(result)
         return result
+
+    def assert_no_sanitizer_report(self, result):
+        """Under -fsanitize=undefined a report does not change the exit status: look for it."""
+        for marker in ("runtime error:", "Sanitizer", "kairos: error", "internal error"):
+            self.assertNotIn(marker, result.stderr, describe(result))
 
     def assert_user_error(self, result, *needles):
         """Exit status 2 (not a signal, not 3 = internal error) and exactly one stderr line
@@ -180,6 +186,8 @@ class KairosTestCase(unittest.TestCase):
         self.assertEqual(result.returncode, 2,
                          "expected exit status 2 (%s)\n%s" % (signal_name(result.returncode),
                                                               describe(result)))
+        for marker in ("runtime error:", "Sanitizer"):
+            self.assertNotIn(marker, result.stderr, describe(result))
         lines = result.stderr.splitlines()
         self.assertEqual(len(lines), 1, "expected one line on stderr\n%s" % describe(result))
         line = lines[0]

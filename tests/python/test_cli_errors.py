@@ -5,6 +5,7 @@ message. Also: `kairos --help` and `kairos run --help` document every option.
 """
 
 import os
+import unittest
 
 import numpy as np
 import gsd.fl
@@ -350,6 +351,70 @@ class RestartErrors(kt.KairosTestCase):
         self.assert_user_error(result, "restart.gsd", "system.dimension")
 
 
+class DamagedRestartFiles(kt.KairosTestCase):
+    """A restart file with one chunk missing or damaged: a user error, never a crash."""
+
+    def setUp(self):
+        super().setUp()
+        self.config = self.write_config(kt.base_config(particles=256, production=1.0))
+        self.run_ok("run", self.config, "-o", self.path("first"))
+        self.source = self.path("first", "restart.gsd")
+
+    def damaged(self, drop=(), **replace):
+        """A copy of the restart file without the chunks in `drop` and with chunks replaced
+        (keyword names use '__' for '/')."""
+        replace = {k.replace("__", "/"): v for k, v in replace.items()}
+        with gsd.fl.open(name=self.source, mode="rb") as f:
+            names = [n for n in f.find_matching_chunk_names("") if f.chunk_exists(frame=0, name=n)]
+            data = {n: f.read_chunk(frame=0, name=n) for n in names}
+        path = self.path("damaged.gsd")
+        with gsd.fl.open(name=path, mode="wb", application="test", schema="hoomd",
+                         schema_version=[1, 4]) as g:
+            for n in names:
+                if n not in drop:
+                    g.write_chunk(n, replace.get(n, data[n]))
+            g.end_frame()
+        return path
+
+    def check(self, path, *needles):
+        result = self.kairos("run", self.config, "-o", self.path("second"), "--restart", path)
+        self.assert_user_error(result, "damaged.gsd", *needles)
+
+    def test_missing_types(self):
+        self.check(self.damaged(drop=["particles/types"]), "particles/types")
+
+    def test_missing_n(self):
+        self.check(self.damaged(drop=["particles/N"]), "particles/N")
+
+    def test_missing_position(self):
+        self.check(self.damaged(drop=["kairos/state/position"]), "kairos/state/position")
+
+    def test_empty_format(self):
+        self.check(self.damaged(kairos__format=np.zeros(0, np.uint32)), "kairos/format")
+
+    def test_wrong_format_version(self):
+        self.check(self.damaged(kairos__format=np.array([99], np.uint32)), "format")
+
+    def test_n_disagrees_with_arrays(self):
+        self.check(self.damaged(particles__N=np.array([300], np.uint32)))
+
+    def test_partner_out_of_range(self):
+        self.check(self.damaged(kairos__state__partner=np.full(256, 10 ** 6, np.uint32)),
+                   "partner")
+
+    def test_typeid_out_of_range(self):
+        self.check(self.damaged(particles__typeid=np.full(256, 5, np.uint32)), "typeid")
+
+    def test_nan_velocity(self):
+        self.check(self.damaged(kairos__velocity=np.full((256, 3), np.nan)), "velocity")
+
+    def test_corrupt_rng(self):
+        self.check(self.damaged(kairos__state__rng=np.frombuffer(b"garbage", np.int8)), "RNG")
+
+    def test_cell_out_of_range(self):
+        self.check(self.damaged(kairos__state__cell=np.full(256, 10 ** 8, np.uint32)), "cell")
+
+
 class CommandLine(kt.KairosTestCase):
     OPTIONS = ("--set", "--restart", "-o")
 
@@ -388,6 +453,17 @@ class CommandLine(kt.KairosTestCase):
     def test_option_without_value(self):
         config = self.write_config(kt.base_config(production=1.0))
         self.assert_user_error(self.kairos("run", config, "--restart"), "--restart")
+
+    def test_empty_output_option(self):
+        config = self.write_config(kt.base_config(production=1.0))
+        self.assert_user_error(self.kairos("run", config, "-o", ""), "output")
+
+    def test_empty_restart_option(self):
+        # e.g. --restart "$UNSET": must not silently start afresh and overwrite the outputs.
+        config = self.write_config(kt.base_config(production=1.0))
+        self.assert_user_error(self.kairos("run", config, "-o", self.path("out"), "--restart", ""),
+                               "--restart")
+        self.assertFalse(os.path.exists(self.path("out")))
 
     def test_set_before_config(self):
         # `--set` takes one value per use: the config file after it is still the config.

@@ -10,12 +10,14 @@ import math
 import os
 
 import numpy as np
+import gsd.fl
 
 import kairos_testlib as kt
 
 
 SUMMARY_KEYS = ("events", "collisions", "sim_time", "wall_seconds", "events_per_second",
                 "collisions_per_second", "temperature", "compressibility", "mean_free_time",
+                "mean_free_time_stderr",
                 "energy_drift_relative", "momentum_drift", "max_overlap", "peak_rss_bytes")
 THERMO_COLUMNS = ("time", "events", "collisions", "temperature", "pressure", "compressibility",
                   "kinetic_energy")
@@ -97,7 +99,7 @@ class OutputChecks(kt.KairosTestCase):
             self.assertAlmostEqual(ke, 0.5 * dimension * (n - 1), delta=1e-9 * ke)
         return header, rows
 
-    def check_summary(self, outdir, n, dimension):
+    def check_summary(self, outdir, n, dimension, temperature_tolerance=1e-9):
         s = self.summary(outdir)
         for key in SUMMARY_KEYS:
             self.assertIn(key, s)
@@ -116,7 +118,7 @@ class OutputChecks(kt.KairosTestCase):
         self.assertGreaterEqual(s["wall_seconds"], 0)
         self.assertGreater(s["events_per_second"], 0)
         self.assertGreater(s["collisions_per_second"], 0)
-        self.assertAlmostEqual(s["temperature"], 1.0, places=9)
+        self.assertAlmostEqual(s["temperature"], 1.0, delta=temperature_tolerance)
         self.assertGreater(s["mean_free_time"], 0)
         self.assertLess(s["energy_drift_relative"], 1e-9)
         self.assertLess(s["momentum_drift"], 1e-9)
@@ -343,6 +345,36 @@ class InitialStateFromGsd(OutputChecks):
         self.assertEqual(s["particles"], 2)
         self.assertLess(s["max_overlap"], 1e-12)
 
+    def test_position_just_below_box_edge(self):
+        # x = L - 1e-12 rounds to L/2 in float32 HOOMD coordinates; it must be written as -L/2
+        # (HOOMD's box is [-L/2, L/2)), and kairos/position must stay in [0, L).
+        path = self.path("edge.gsd")
+        with gsd.fl.open(name=path, mode="wb", application="test", schema="hoomd",
+                         schema_version=[1, 4]) as f:
+            f.write_chunk("configuration/dimensions", np.array([3], np.uint8))
+            f.write_chunk("configuration/box", np.array([10, 10, 10, 0, 0, 0], np.float32))
+            f.write_chunk("particles/N", np.array([3], np.uint32))
+            f.write_chunk("particles/position", np.zeros((3, 3), np.float32))
+            f.write_chunk("kairos/box", np.array([10.0, 10.0, 10.0]))
+            f.write_chunk("kairos/position",
+                          np.array([[10 - 1e-12, 1, 1], [5.0, 5.0, 5.0], [2.0, 8.0, 5.0]]))
+            f.write_chunk("kairos/velocity",
+                          np.array([[0.0, 0, 0], [0.0, 0, 0], [0.0, 0, 1e-3]]))
+            f.end_frame()
+        start = kt.base_config(production=1.0)
+        start["system"] = {"initial_state": path}
+        start["run"]["max_wall_seconds"] = 0.5
+        self.run_ok("run", self.write_config(start), "-o", self.path("out"))
+        traj = kt.open_trajectory(self.path("out", "trajectory.gsd"))
+        x = np.asarray(traj[0].particles.position)
+        self.assertTrue(np.all(x >= -5.0) and np.all(x < 5.0), x)
+        self.assertEqual(x[0, 0], -5.0)
+        with gsd.fl.open(name=self.path("out", "restart.gsd"), mode="rb") as f:
+            kx = f.read_chunk(frame=0, name="kairos/position")
+            hx = f.read_chunk(frame=0, name="particles/position")
+        self.assertTrue(np.all(kx >= 0.0) and np.all(kx < 10.0), kx)
+        self.assertTrue(np.all(hx >= -5.0) and np.all(hx < 5.0), hx)
+
     def test_from_kairos_trajectory_2d(self):
         n = 400
         cfg = self.write_config(kt.base_config(dimension=2, particles=n, packing_fraction=0.5,
@@ -351,7 +383,8 @@ class InitialStateFromGsd(OutputChecks):
         start = kt.base_config(dimension=2, production=5.0)
         start["system"] = {"dimension": 2, "initial_state": self.path("first", "trajectory.gsd")}
         self.run_ok("run", self.write_config(start, "b.toml"), "-o", self.path("second"))
-        self.check_summary(self.path("second"), n, 2)
+        # float32 velocities from the file: kT = 1 up to their round-off
+        self.check_summary(self.path("second"), n, 2, temperature_tolerance=1e-6)
 
     def test_from_restart_file_as_initial_state(self):
         # A restart file is a GSD file too; as an initial state its float64 chunks are used.

@@ -1,0 +1,200 @@
+"""SIGINT / SIGTERM: the run stops after the current event, writes every output and exits with
+128 + signal number; the restart file it leaves continues the run. Also the wall-time limit
+(status 0, stop_reason "wall_time_limit") and a hard kill (SIGKILL) between periodic restart
+files, which must leave the last restart file and the trajectory readable.
+"""
+
+import math
+import os
+import signal
+import subprocess
+import time
+
+import numpy as np
+
+import kairos_testlib as kt
+
+
+# Long enough never to finish on its own within the test (~10^8 collisions).
+def long_config(**output):
+    return kt.base_config(particles=4000, packing_fraction=0.4, seed=3, production=50000.0,
+                          output=dict({"thermo_interval": 1.0, "trajectory_interval": 2.0},
+                                      **output))
+
+
+class Interrupt(kt.KairosTestCase):
+    def start(self, config, outdir, *extra):
+        """Starts kairos in the background; returns the Popen once the run has begun (its
+        config.toml exists, which is written after the signal handlers are installed)."""
+        cfg = self.write_config(config)
+        proc = subprocess.Popen([kt.KAIROS, "run", cfg, "-o", outdir] + list(extra),
+                                cwd=self.tmp, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True)
+        self.addCleanup(self.reap, proc)
+        deadline = time.monotonic() + 60
+        while not os.path.exists(os.path.join(outdir, "config.toml")):
+            if proc.poll() is not None:
+                out, err = proc.communicate()
+                self.fail("kairos exited early with %s\nstdout: %s\nstderr: %s" %
+                          (kt.signal_name(proc.returncode), out, err))
+            if time.monotonic() > deadline:
+                self.fail("kairos did not start within 60 s")
+            time.sleep(0.02)
+        return proc
+
+    @staticmethod
+    def reap(proc):
+        if proc.poll() is None:
+            proc.kill()
+        proc.communicate()
+
+    def interrupt(self, sig, expected_status):
+        out = self.path("out")
+        proc = self.start(long_config(), out)
+        time.sleep(1.5)
+        self.assertIsNone(proc.poll(), "the run ended before it was interrupted")
+        sent = time.monotonic()
+        proc.send_signal(sig)
+        try:
+            stdout, stderr = proc.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate()
+            self.fail("kairos did not stop within 20 s of %s" % sig.name)
+        elapsed = time.monotonic() - sent
+        self.assertEqual(proc.returncode, expected_status,
+                         "exit %s after %s\nstdout: %s\nstderr: %s" %
+                         (kt.signal_name(proc.returncode), sig.name, stdout[-2000:], stderr))
+        self.assertLess(elapsed, 10.0, "stopping took %.1f s" % elapsed)
+        self.assertNotIn("error", stderr)
+        self.assertNotIn("Sanitizer", stderr)
+        self.assertIn("stopped early", stdout)
+        self.check_outputs(out)
+
+        # The restart file continues the run.
+        self.run_ok("run", self.path("config.toml"), "--restart",
+                    os.path.join(out, "restart.gsd"), "-o", self.path("continued"),
+                    "--set", "run.collisions_per_particle=2")
+        before = self.summary(out)
+        after = self.summary(self.path("continued"))
+        self.assertTrue(after["restarted"])
+        self.assertEqual(after["stop_reason"], "completed")
+        self.assertEqual(after["event_counts"]["total_collisions_since_start"],
+                         before["event_counts"]["total_collisions_since_start"] + 2 * 4000 // 2)
+        self.assertGreater(after["sim_time"], before["sim_time"])
+        self.assertLess(after["max_overlap"], 1e-12)
+        self.assertLess(after["energy_drift_relative"], 1e-9)
+
+    def check_outputs(self, out):
+        self.assert_outputs_exist(out)
+        for name in os.listdir(out):
+            self.assertFalse(name.endswith(".tmp"), "temporary file left behind: " + name)
+        s = self.summary(out)
+        self.assertEqual(s["stop_reason"], "signal")
+        self.assertGreater(s["collisions"], 0)
+        self.assertLess(s["collisions"], 50000 * 4000 // 2)
+        self.assertLess(s["max_overlap"], 1e-12)
+        self.assertLess(s["energy_drift_relative"], 1e-9)
+        for key in ("sim_time", "temperature", "events_per_second"):
+            self.assertTrue(math.isfinite(s[key]), key)
+
+        # restart.gsd holds the final state.
+        restart = os.path.join(out, "restart.gsd")
+        state = kt.read_exact_state(restart)
+        self.assertEqual(state["kairos/state/position"].shape, (4000, 3))
+        self.assertEqual(state["kairos/time"][0], s["sim_time"])
+        counters = kt.restart_chunk(restart, "kairos/state/counters")
+        self.assertEqual(int(counters[1]), s["event_counts"]["total_collisions_since_start"])
+
+        # thermo.tsv: complete lines, the last one at the final state.
+        header, rows, text = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        self.assertTrue(text.endswith("\n"), "the last thermo row is incomplete")
+        self.assertGreater(len(rows), 0)
+        for row in rows:
+            self.assertEqual(len(row), len(header))
+        col = {name: i for i, name in enumerate(header)}
+        self.assertEqual(rows[-1][col["collisions"]], s["collisions"])
+        self.assertEqual(rows[-1][col["time"]], s["sim_time"])
+
+        # trajectory.gsd readable, its last frame the final state.
+        traj = kt.open_trajectory(os.path.join(out, "trajectory.gsd"))
+        self.assertGreaterEqual(len(traj), 1)
+        last = traj[len(traj) - 1]
+        self.assertEqual(last.particles.N, 4000)
+        self.assertEqual(float(last.log["time"][0]), s["sim_time"])
+
+    def test_sigint(self):
+        self.interrupt(signal.SIGINT, 130)
+
+    def test_sigterm(self):
+        self.interrupt(signal.SIGTERM, 143)
+
+    def test_sigint_during_equilibration(self):
+        out = self.path("out")
+        config = long_config()
+        config["run"]["equilibration_collisions_per_particle"] = 50000.0
+        proc = self.start(config, out)
+        time.sleep(1.0)
+        proc.send_signal(signal.SIGINT)
+        stdout, stderr = proc.communicate(timeout=20)
+        self.assertEqual(proc.returncode, 130, stderr)
+        s = self.summary(out)
+        self.assertEqual(s["stop_reason"], "signal")
+        header, rows, _ = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        self.assertEqual({row[0] for row in rows}, {"equilibration"},
+                         "no production after the signal")
+        self.assertEqual(s["production_collisions_per_particle"], 0.0)
+
+    def test_wall_time_limit(self):
+        out = self.path("out")
+        config = long_config()
+        config["run"]["max_wall_seconds"] = 1.0
+        cfg = self.write_config(config)
+        started = time.monotonic()
+        result = self.run_ok("run", cfg, "-o", out)
+        self.assertLess(time.monotonic() - started, 30.0)
+        self.assertIn("stopped early", result.stdout)
+        s = self.summary(out)
+        self.assertEqual(s["stop_reason"], "wall_time_limit")
+        self.assertGreaterEqual(s["wall_seconds"], 1.0)
+        self.assert_outputs_exist(out)
+
+    def test_sigkill_keeps_last_restart_file(self):
+        # No clean shutdown at all: the periodic restart file and every committed trajectory
+        # frame must still be valid, and the restart file continues the run.
+        out = self.path("out")
+        proc = self.start(long_config(restart_interval=1.0), out)
+        restart = os.path.join(out, "restart.gsd")
+        deadline = time.monotonic() + 60
+        while not os.path.exists(restart):
+            self.assertIsNone(proc.poll(), "kairos ended early")
+            self.assertLess(time.monotonic(), deadline, "no periodic restart file after 60 s")
+            time.sleep(0.05)
+        time.sleep(0.5)
+        proc.send_signal(signal.SIGKILL)
+        proc.communicate(timeout=20)
+        self.assertEqual(proc.returncode, -signal.SIGKILL)
+        self.assertFalse(os.path.exists(os.path.join(out, "summary.json")))
+
+        state = kt.read_exact_state(restart)
+        self.assertEqual(state["kairos/state/position"].shape, (4000, 3))
+        traj = kt.open_trajectory(os.path.join(out, "trajectory.gsd"))
+        self.assertGreaterEqual(len(traj), 1)
+        for i in range(len(traj)):
+            self.assertEqual(np.asarray(traj[i].particles.position).shape, (4000, 3))
+        header, rows, text = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        self.assertGreater(len(rows), 0)
+
+        self.run_ok("run", self.path("config.toml"), "--restart", restart, "-o", out,
+                    "--set", "run.collisions_per_particle=1")
+        s = self.summary(out)
+        self.assertTrue(s["restarted"])
+        self.assertEqual(s["stop_reason"], "completed")
+        self.assertLess(s["max_overlap"], 1e-12)
+        traj = kt.open_trajectory(os.path.join(out, "trajectory.gsd"))
+        times = [float(f.log["time"][0]) for f in traj]
+        self.assertEqual(times[-1], s["sim_time"])
+
+
+if __name__ == "__main__":
+    kt.main()
