@@ -73,33 +73,52 @@ void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
   k.time = t;
 }
 
-// Tests a particle (state xi, vi at time t) against every particle in one cell. The particle
-// itself may be in the cell: r = g = 0 gives r.g = 0, which the root rejects without a branch.
+// Collects the members of one neighbour cell as candidates, prefetching their records so the
+// cache misses of a whole prediction overlap instead of queueing one after another.
 template <int D, class Queue>
-void EventEngine<D, Queue>::scan_cell(double t, const Vec<D>& xi,
-                                      const Vec<D>& vi, double ri, std::uint32_t cell,
-                                      const Vec<D>& shift, EventSlot& slot) const {
-  const std::uint32_t* members = grid_.members(cell);
-  const std::uint32_t count = grid_.count(cell);
+void EventEngine<D, Queue>::gather(const typename CellGrid<D>::Neighbour& nb) {
+  const std::uint32_t count = grid_.count(nb.cell);
+  if (count == 0) return;
+  const std::uint32_t* members = grid_.members(nb.cell);
   for (std::uint32_t m = 0; m < count; ++m) {
-    const std::uint32_t j = members[m];
+    __builtin_prefetch(&sys_.kinematics[members[m]]);
+    candidates_[n_candidates_] = members[m];
+    candidate_shift_[n_candidates_++] = static_cast<std::uint8_t>(nb.shifted ? n_shifts_ : 0);
+  }
+  if (nb.shifted) shifts_[n_shifts_++] = nb.shift;
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::reset_candidates() {
+  n_candidates_ = 0;
+  n_shifts_ = 1;  // shifts_[0] is the zero shift shared by all unshifted cells
+  const std::size_t need = CellGrid<D>::kNeighbourCells * grid_.capacity();
+  if (candidates_.size() < need) {
+    candidates_.resize(need);
+    candidate_shift_.resize(need);
+  }
+}
+
+// Tests a particle (state xi, vi at time t) against the gathered candidates in one flat loop.
+// The particle itself may be among them: r = g = 0 gives r.g = 0, which the root rejects
+// without a branch.
+template <int D, class Queue>
+void EventEngine<D, Queue>::test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi,
+                                            double ri, EventSlot& slot) const {
+  for (std::uint32_t k = 0; k < n_candidates_; ++k) {
+    const std::uint32_t j = candidates_[k];
+    const Vec<D>& shift = shifts_[candidate_shift_[k]];
     const Kinematics<D>& kj = sys_.kinematics[j];
     const double dtj = t - kj.time;
-    double r[D], g[D];
-    double rg = 0.0;
+    double r2 = 0.0, rg = 0.0, g2 = 0.0;
     for (int a = 0; a < D; ++a) {
-      r[a] = xi[a] - (kj.pos[a] + kj.vel[a] * dtj + shift[a]);
-      g[a] = vi[a] - kj.vel[a];
-      rg += r[a] * g[a];
+      const double r = xi[a] - (kj.pos[a] + kj.vel[a] * dtj + shift[a]);
+      const double g = vi[a] - kj.vel[a];
+      r2 += r * r;
+      rg += r * g;
+      g2 += g * g;
     }
-    double r2 = 0.0, g2 = 0.0;
-    for (int a = 0; a < D; ++a) {
-      r2 += r[a] * r[a];
-      g2 += g[a] * g[a];
-    }
-    const double sigma = ri + kj.radius;
-    // i itself has r = g = 0, so b = 0 rejects it without a branch on j == i.
-    const double dt = HardSphere::contact_time(r2, rg, g2, sigma);
+    const double dt = HardSphere::contact_time(r2, rg, g2, ri + kj.radius);
     if (t + dt < slot.collision_time) {
       slot.collision_time = t + dt;
       slot.partner = j;
@@ -114,18 +133,10 @@ void EventEngine<D, Queue>::predict_collision(std::uint32_t i, double t) {
   slot.collision_time = kNever;
   const Kinematics<D>& ki = sys_.kinematics[i];
   const Vec<D> xi = ki.pos + (t - ki.time) * ki.vel;
-  // Two passes: first touch every neighbour cell and prefetch its members' records, so the
-  // ~25 cache misses of a prediction overlap instead of queueing one after another.
-  typename CellGrid<D>::Neighbour cells[CellGrid<D>::kNeighbourCells];
-  int n = 0;
-  grid_.for_each_neighbour(grid_.cell_of(i), [&](const typename CellGrid<D>::Neighbour& nb) {
-    const std::uint32_t* members = grid_.members(nb.cell);
-    for (std::uint32_t m = 0, c = grid_.count(nb.cell); m < c; ++m) {
-      __builtin_prefetch(&sys_.kinematics[members[m]]);
-    }
-    cells[n++] = nb;
-  });
-  for (int k = 0; k < n; ++k) scan_cell(t, xi, ki.vel, ki.radius, cells[k].cell, cells[k].shift, slot);
+  reset_candidates();
+  grid_.for_each_neighbour(grid_.cell_of(i),
+                           [&](const typename CellGrid<D>::Neighbour& nb) { gather(nb); });
+  test_candidates(t, xi, ki.vel, ki.radius, slot);
 }
 
 template <int D, class Queue>
@@ -202,9 +213,10 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   grid_.erase(i);
   grid_.insert(i, new_cell);
   ++sys_.counters.cell_crossings;
-  grid_.for_each_new_layer(new_cell, axis, sign, [&](const typename CellGrid<D>::Neighbour& nb) {
-    scan_cell(t, k.pos, k.vel, k.radius, nb.cell, nb.shift, slot);
-  });
+  reset_candidates();
+  grid_.for_each_new_layer(new_cell, axis, sign,
+                           [&](const typename CellGrid<D>::Neighbour& nb) { gather(nb); });
+  test_candidates(t, k.pos, k.vel, k.radius, slot);
   predict_crossing(i);
   queue_.update(i, event_time(i));
 }

@@ -62,8 +62,10 @@ class EventEngine {
     return s.collision_time < s.crossing_time ? s.collision_time : s.crossing_time;
   }
   void predict_collision(std::uint32_t i, double t);
-  void scan_cell(double t, const Vec<D>& xi, const Vec<D>& vi, double ri,
-                 std::uint32_t cell, const Vec<D>& shift, EventSlot& slot) const;
+  void reset_candidates();
+  void gather(const typename CellGrid<D>::Neighbour& nb);
+  void test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi, double ri,
+                       EventSlot& slot) const;
   void predict_crossing(std::uint32_t i);
   void collide(std::uint32_t i, std::uint32_t j, double t);
   void cross(std::uint32_t i, double t);
@@ -74,6 +76,11 @@ class EventEngine {
   ParticleSystem<D> sys_;
   CellGrid<D> grid_;
   Queue queue_;
+  // Scratch of one prediction: candidate partners and the periodic shift of each one's cell.
+  std::vector<std::uint32_t> candidates_;
+  std::vector<std::uint8_t> candidate_shift_;
+  Vec<D> shifts_[CellGrid<D>::kNeighbourCells + 1] = {};
+  std::uint32_t n_candidates_ = 0, n_shifts_ = 0;
 };
 
 }  // namespace kairos

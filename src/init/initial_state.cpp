@@ -224,31 +224,19 @@ struct LatticeSpec {
 };
 
 constexpr double kPi = std::numbers::pi;
+constexpr double kSqrt2 = std::numbers::sqrt2;
+constexpr double kSqrt3 = std::numbers::sqrt3;
+// clang-format off
 constexpr LatticeSpec kLattices[] = {
-    {"fcc",
-     3,
-     4,
-     {{{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}}},
-     {1, 1, 1},
-     std::numbers::sqrt2 / 2,
-     kPi / (3 * std::numbers::sqrt2)},
-    {"bcc",
-     3,
-     2,
-     {{{0, 0, 0}, {0.5, 0.5, 0.5}}},
-     {1, 1, 1},
-     std::numbers::sqrt3 / 2,
-     kPi* std::numbers::sqrt3 / 8},
+    {"fcc", 3, 4, {{{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}}}, {1, 1, 1},
+     kSqrt2 / 2, kPi / (3 * kSqrt2)},
+    {"bcc", 3, 2, {{{0, 0, 0}, {0.5, 0.5, 0.5}}}, {1, 1, 1}, kSqrt3 / 2, kSqrt3 * kPi / 8},
     {"sc", 3, 1, {{{0, 0, 0}}}, {1, 1, 1}, 1.0, kPi / 6},
     {"square", 2, 1, {{{0, 0, 0}}}, {1, 1, 1}, 1.0, kPi / 4},
-    {"hex",
-     2,
-     2,
-     {{{0, 0, 0}, {0.5, 0.5, 0}}},
-     {1, std::numbers::sqrt3, 1},
-     1.0,
-     kPi / (2 * std::numbers::sqrt3)},
+    // triangular: rectangular cells a x a sqrt(3) holding two sites
+    {"hex", 2, 2, {{{0, 0, 0}, {0.5, 0.5, 0}}}, {1, kSqrt3, 1}, 1.0, kPi / (2 * kSqrt3)},
 };
+// clang-format on
 
 // Random sequential insertion jams near 0.38 (3D) / 0.547 (2D); beyond these it is refused.
 constexpr double kRandomMaxPacking3 = 0.35;
@@ -490,9 +478,10 @@ class VoxelSampler {
     return x;
   }
 
-  // True when every point of the voxel is closer than `radius` to `point` (minimum image).
-  bool covered(std::uint64_t voxel, const std::array<double, D>& point, double radius) const {
-    const std::array<double, D> c = centre(voxel);
+  // True when every point of the voxel centred at `c` is closer than `radius` to `point`
+  // (minimum image).
+  bool covered(const std::array<double, D>& c, const std::array<double, D>& point,
+               double radius) const {
     double far2 = 0.0;
     for (int k = 0; k < D; ++k) {
       double dx = point[k] - c[k];
@@ -503,9 +492,14 @@ class VoxelSampler {
     return far2 < radius * radius;
   }
 
-  // Whether a refinement may be tried: below the deepest level, and the live voxels have
-  // halved since the last refinement that had to be abandoned.
-  bool can_refine() const { return level_ < kMaxLevel && live_.size() <= retry_below_; }
+  // Whether a refinement may be tried: below the deepest level, ids still fit, and the live
+  // voxels have halved since the last refinement that had to be abandoned.
+  bool can_refine() const {
+    std::uint64_t total = 1;  // voxel ids of the next level must fit in 64 bits
+    for (int k = 0; k < D; ++k) total *= m_[k];
+    return level_ < kMaxLevel && live_.size() <= retry_below_ &&
+           total <= (std::numeric_limits<std::uint64_t>::max() >> (D + 1));
+  }
 
   struct Sphere {
     std::array<double, D> centre;
@@ -513,8 +507,8 @@ class VoxelSampler {
   };
 
   // Splits every live voxel into 2^D and keeps the children not covered by a single exclusion
-  // sphere; gather(point, spheres) must append every sphere that reaches within one
-  // particle diameter of `point` (the cell-grid neighbourhood). Abandoned (nothing changes)
+  // sphere; gather(point, spheres) appends the exclusion spheres that may contain `point` (those
+  // of the particles in the cell-grid neighbourhood). Abandoned (nothing changes)
   // when more than max_live children would survive: skipped at once when a sample says so,
   // otherwise after the full pass, and then not tried again before the live voxels have halved.
   template <class Gather>
@@ -528,7 +522,9 @@ class VoxelSampler {
     std::vector<Sphere> near;
     const auto children = [&](std::uint64_t v, auto&& visit) {
       near.clear();
-      gather(centre(v), near);  // the children lie inside v: one neighbourhood serves them all
+      // The centre of v is a corner of every child, so a sphere covering a child contains it:
+      // the spheres near that one point are all the candidates.
+      gather(centre(v), near);
       std::array<std::uint64_t, D> c{};
       for (int k = 0; k < D; ++k) {
         c[k] = 2 * (v % m_[k]);
@@ -536,9 +532,14 @@ class VoxelSampler {
       }
       for (std::uint64_t child = 0; child < (std::uint64_t{1} << D); ++child) {
         std::uint64_t id = 0;
-        for (int k = D - 1; k >= 0; --k) id = id * finer.m_[k] + c[k] + ((child >> k) & 1);
+        std::array<double, D> child_centre{};
+        for (int k = D - 1; k >= 0; --k) {
+          const std::uint64_t ck = c[k] + ((child >> k) & 1);
+          id = id * finer.m_[k] + ck;
+          child_centre[k] = (static_cast<double>(ck) + 0.5) * finer.h_[k];
+        }
         const bool dead = std::any_of(near.begin(), near.end(), [&](const Sphere& sphere) {
-          return finer.covered(id, sphere.centre, sphere.radius);
+          return finer.covered(child_centre, sphere.centre, sphere.radius);
         });
         if (!dead) visit(id);
       }
@@ -604,8 +605,9 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
     const double di = state.diameter[i];
     // Whether the exclusion zone (for diameter di) of one placed particle covers the voxel.
     const auto covered = [&](std::uint64_t voxel) {
-      return grid.for_each_neighbour(grid.coords(voxels->centre(voxel)), [&](std::uint32_t j) {
-        return voxels->covered(voxel, state.position[j], 0.5 * (di + state.diameter[j]));
+      const std::array<double, D> c = voxels->centre(voxel);
+      return grid.for_each_neighbour(grid.coords(c), [&](std::uint32_t j) {
+        return voxels->covered(c, state.position[j], 0.5 * (di + state.diameter[j]));
       });
     };
     // The exclusion spheres (for diameter di) of the placed particles near a point.

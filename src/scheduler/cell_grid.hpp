@@ -54,12 +54,24 @@ class CellGrid {
       stride_[k] = total_;
       total_ *= static_cast<std::uint32_t>(n_[k]);
     }
+    std::array<int, D> off;
+    off.fill(-1);
+    for (int n = 0; n < kNeighbourCells; ++n) {
+      std::int64_t delta = 0;
+      for (int k = 0; k < D; ++k) delta += static_cast<std::int64_t>(off[k]) * stride_[k];
+      neighbour_delta_[n] = static_cast<std::int32_t>(delta);
+      for (int k = 0; k < D; ++k) {
+        if (++off[k] <= 1) break;
+        off[k] = -1;
+      }
+    }
     stride_slots_ = 8;  // count + 7 particles: a 32-byte cell, ample at any hard-sphere density
     slots_.assign(static_cast<std::size_t>(total_) * stride_slots_, 0);
     cell_.assign(particles, 0);
   }
 
   std::uint32_t cell_count() const { return total_; }
+  std::uint32_t capacity() const { return stride_slots_ - 1; }  // members a cell can hold now
   int cells_along(int k) const { return n_[k]; }
   double width(int k) const { return width_[k]; }
   const Vec<D>& box() const { return box_; }
@@ -110,17 +122,32 @@ class CellGrid {
     }
   }
 
-  // A neighbouring cell and the periodic shift to add to positions of particles inside it.
+  // A neighbouring cell and the periodic shift to add to positions of particles inside it;
+  // `shifted` is false when the shift is zero (most cells: the caller can skip the copy).
   struct Neighbour {
     std::uint32_t cell;
+    bool shifted;
     Vec<D> shift;
   };
 
-  // Visits the 3^D cells around `cell` (itself included).
+  // Visits the 3^D cells around `cell` (itself included). Cells away from the box faces take a
+  // fast path: fixed index offsets, no wrapping, no shift.
   template <class F>
   void for_each_neighbour(std::uint32_t cell, F&& f) const {
     std::array<int, D> base;
-    for (int k = 0; k < D; ++k) base[k] = coordinate(cell, k);
+    bool interior = true;
+    for (int k = 0; k < D; ++k) {
+      base[k] = coordinate(cell, k);
+      interior = interior && base[k] > 0 && base[k] < n_[k] - 1;
+    }
+    if (interior) {
+      Neighbour nb{0, false, {}};
+      for (int n = 0; n < kNeighbourCells; ++n) {
+        nb.cell = cell + neighbour_delta_[n];
+        f(nb);
+      }
+      return;
+    }
     std::array<int, D> off;
     off.fill(-1);
     for (int n = 0; n < kNeighbourCells; ++n) {
@@ -171,6 +198,7 @@ class CellGrid {
 
   Neighbour offset_cell(const std::array<int, D>& base, const std::array<int, D>& off) const {
     Neighbour nb;
+    nb.shifted = false;
     std::array<int, D> c;
     for (int k = 0; k < D; ++k) {
       c[k] = base[k] + off[k];
@@ -178,9 +206,11 @@ class CellGrid {
       if (c[k] < 0) {
         c[k] += n_[k];
         nb.shift[k] = -box_[k];
+        nb.shifted = true;
       } else if (c[k] >= n_[k]) {
         c[k] -= n_[k];
         nb.shift[k] = box_[k];
+        nb.shifted = true;
       }
     }
     nb.cell = cell_at(c);
@@ -193,6 +223,7 @@ class CellGrid {
   std::array<std::uint32_t, D> stride_{};
   std::uint32_t total_ = 0;
   std::uint32_t stride_slots_ = 8;
+  std::int32_t neighbour_delta_[kNeighbourCells] = {};  // index offsets of an interior cell
   std::vector<std::uint32_t> slots_;  // per cell: count, then the member indices
   std::vector<std::uint32_t> cell_;   // per particle: its cell
 };

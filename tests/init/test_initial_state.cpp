@@ -64,7 +64,7 @@ void expect_valid(const InitialState<D>& st, std::uint64_t n, double eta) {
 
 // ---------------------------------------------------------------------------------------------
 
-TEST(LargestRemainder, SumsExactlyAndRoundsByRemainder) {
+TEST(InitLargestRemainder, SumsExactlyAndRoundsByRemainder) {
   EXPECT_EQ(largest_remainder_counts({1, 1, 1}, 10), (std::vector<std::uint64_t>{4, 3, 3}));
   EXPECT_EQ(largest_remainder_counts({0.5, 0.5}, 1001), (std::vector<std::uint64_t>{501, 500}));
   EXPECT_EQ(largest_remainder_counts({0.2, 0.3, 0.5}, 7), (std::vector<std::uint64_t>{1, 2, 4}));
@@ -76,7 +76,7 @@ TEST(LargestRemainder, SumsExactlyAndRoundsByRemainder) {
   }
 }
 
-TEST(ParticleVolume, SpheresAndDisks) {
+TEST(InitParticleVolume, SpheresAndDisks) {
   EXPECT_DOUBLE_EQ(particle_volume<3>(2.0), 4.0 / 3.0 * std::numbers::pi);
   EXPECT_DOUBLE_EQ(particle_volume<2>(2.0), std::numbers::pi);
 }
@@ -86,10 +86,10 @@ struct LatticeCase {
   std::uint64_t n;
 };
 
-class Lattice3D : public ::testing::TestWithParam<LatticeCase> {};
-class Lattice2D : public ::testing::TestWithParam<LatticeCase> {};
+class InitLattice3D : public ::testing::TestWithParam<LatticeCase> {};
+class InitLattice2D : public ::testing::TestWithParam<LatticeCase> {};
 
-TEST_P(Lattice3D, RightCountInsideBoxNoOverlapExactPacking) {
+TEST_P(InitLattice3D, RightCountInsideBoxNoOverlapExactPacking) {
   const auto& c = GetParam();
   const double eta = 0.35;
   std::mt19937_64 rng(7);
@@ -100,7 +100,7 @@ TEST_P(Lattice3D, RightCountInsideBoxNoOverlapExactPacking) {
   ASSERT_EQ(st.species_names, std::vector<std::string>{"A"});
 }
 
-TEST_P(Lattice2D, RightCountInsideBoxNoOverlapExactPacking) {
+TEST_P(InitLattice2D, RightCountInsideBoxNoOverlapExactPacking) {
   const auto& c = GetParam();
   const double eta = 0.5;
   std::mt19937_64 rng(7);
@@ -112,7 +112,7 @@ TEST_P(Lattice2D, RightCountInsideBoxNoOverlapExactPacking) {
   EXPECT_GT(aspect, 1.0 / 1.2);
 }
 
-INSTANTIATE_TEST_SUITE_P(All, Lattice3D,
+INSTANTIATE_TEST_SUITE_P(All, InitLattice3D,
                          ::testing::Values(LatticeCase{"fcc", 500}, LatticeCase{"fcc", 1000},
                                            LatticeCase{"fcc", 1001}, LatticeCase{"fcc", 97},
                                            LatticeCase{"bcc", 432}, LatticeCase{"bcc", 1000},
@@ -125,7 +125,7 @@ INSTANTIATE_TEST_SUITE_P(All, Lattice3D,
                                   std::to_string(param_info.param.n);
                          });
 
-INSTANTIATE_TEST_SUITE_P(All, Lattice2D,
+INSTANTIATE_TEST_SUITE_P(All, InitLattice2D,
                          ::testing::Values(LatticeCase{"square", 1024}, LatticeCase{"square", 1000},
                                            LatticeCase{"square", 1001}, LatticeCase{"hex", 1000},
                                            LatticeCase{"hex", 1001}, LatticeCase{"hex", 780},
@@ -136,7 +136,7 @@ INSTANTIATE_TEST_SUITE_P(All, Lattice2D,
                                   std::to_string(param_info.param.n);
                          });
 
-TEST(Lattice, PartialFillingIsUniform) {
+TEST(InitLattice, PartialFillingIsUniform) {
   // 1000 particles on the 1372 sites of 7x7x7 fcc cells: every octant holds about 1/8.
   std::mt19937_64 rng(3);
   const auto st = make_initial_state<3>(make_system(3, 1000, 0.4, "fcc"), rng);
@@ -152,7 +152,7 @@ TEST(Lattice, PartialFillingIsUniform) {
   }
 }
 
-TEST(Lattice, HexPerfectLatticeHasUnitNearestNeighbourRatio) {
+TEST(InitLattice, HexPerfectLatticeHasUnitNearestNeighbourRatio) {
   // 780 = 2 x 26 x 15 sites in a nearly square box (aspect 15 sqrt(3) / 26 = 0.999): fully
   // filled; at the close-packing limit pi / (2 sqrt 3) the disks touch.
   std::mt19937_64 rng(3);
@@ -164,7 +164,7 @@ TEST(Lattice, HexPerfectLatticeHasUnitNearestNeighbourRatio) {
   EXPECT_GT(max_overlap_bruteforce<2>(st.box, st.position, touching), 0.0);
 }
 
-TEST(Lattice, MixtureIsSpreadOverTheSites) {
+TEST(InitLattice, MixtureIsSpreadOverTheSites) {
   std::mt19937_64 rng(11);
   const auto st = make_initial_state<3>(make_system(3, 2000, 0.3, "fcc", binary_mixture()), rng);
   ASSERT_EQ(st.species_names, (std::vector<std::string>{"S", "L"}));
@@ -182,7 +182,7 @@ TEST(Lattice, MixtureIsSpreadOverTheSites) {
   EXPECT_EQ(max_overlap_bruteforce<3>(st.box, st.position, st.diameter), 0.0);
 }
 
-TEST(Lattice, ImpossiblePackingFractionExactMessage) {
+TEST(InitLattice, ImpossiblePackingFractionExactMessage) {
   EXPECT_EQ(error_of<3>(make_system(3, 1000, 0.6, "sc")),
             "system.packing_fraction = 0.6 is impossible on a sc lattice with 1000 particles "
             "(10x10x10 cells): the nearest-neighbour distance 0.955614 is smaller than the "
@@ -194,7 +194,7 @@ TEST(Lattice, ImpossiblePackingFractionExactMessage) {
             "particles, which fill the lattice)");
 }
 
-TEST(Lattice, FccCloseToClosePacking) {
+TEST(InitLattice, FccCloseToClosePacking) {
   EXPECT_EQ(error_of<3>(make_system(3, 500, 0.74, "fcc")), "");
   EXPECT_EQ(error_of<3>(make_system(3, 500, 0.74048, "fcc")), "");  // the printed limit works
   const std::string e = error_of<3>(make_system(3, 500, 0.75, "fcc"));
@@ -207,7 +207,7 @@ TEST(Lattice, FccCloseToClosePacking) {
   expect_valid(st, 864, 0.74);
 }
 
-TEST(Lattice, ImpossibleForEveryLattice) {
+TEST(InitLattice, ImpossibleForEveryLattice) {
   EXPECT_NE(error_of<3>(make_system(3, 432, 0.69, "bcc")).find("system.packing_fraction"),
             std::string::npos);
   EXPECT_EQ(error_of<3>(make_system(3, 432, 0.68, "bcc")), "");
@@ -222,7 +222,7 @@ TEST(Lattice, ImpossibleForEveryLattice) {
             std::string::npos);
 }
 
-TEST(Lattice, TooFewParticlesNamesTheMinimum) {
+TEST(InitLattice, TooFewParticlesNamesTheMinimum) {
   const std::string e = error_of<3>(make_system(3, 10, 0.3, "sc"));
   ASSERT_NE(e.find("system.particles = 10"), std::string::npos) << e;
   const auto at = e.find("at least ");
@@ -241,7 +241,7 @@ TEST(Lattice, TooFewParticlesNamesTheMinimum) {
             std::string::npos);
 }
 
-TEST(Lattice, InvalidRequests) {
+TEST(InitLattice, InvalidRequests) {
   EXPECT_NE(error_of<3>(make_system(3, 100, 0.3, "hex")).find("system.lattice"), std::string::npos);
   EXPECT_NE(error_of<2>(make_system(2, 100, 0.3, "fcc")).find("system.lattice"), std::string::npos);
   EXPECT_NE(error_of<3>(make_system(3, 0, 0.3, "fcc")).find("system.particles"), std::string::npos);
@@ -254,7 +254,7 @@ TEST(Lattice, InvalidRequests) {
   EXPECT_THROW((void)make_initial_state<2>(make_system(3, 100, 0.3, "fcc"), rng), std::logic_error);
 }
 
-TEST(Random, BinaryMixture3D) {
+TEST(InitRandom, BinaryMixture3D) {
   std::mt19937_64 rng(21);
   const auto st = make_initial_state<3>(make_system(3, 2000, 0.3, "random", binary_mixture()), rng);
   expect_valid(st, 2000, 0.3);
@@ -265,7 +265,7 @@ TEST(Random, BinaryMixture3D) {
   EXPECT_EQ(max_overlap<3>(st.box, st.position, st.diameter), 0.0);
 }
 
-TEST(Random, BinaryMixture2D) {
+TEST(InitRandom, BinaryMixture2D) {
   std::mt19937_64 rng(22);
   const auto st = make_initial_state<2>(make_system(2, 2000, 0.4, "random", binary_mixture()), rng);
   expect_valid(st, 2000, 0.4);
@@ -274,13 +274,34 @@ TEST(Random, BinaryMixture2D) {
   EXPECT_EQ(st.box[0], st.box[1]);
 }
 
-TEST(Random, NearTheAllowedLimit) {
+TEST(InitRandom, NearTheAllowedLimit) {
   std::mt19937_64 rng(23);
   expect_valid(make_initial_state<3>(make_system(3, 1000, 0.35, "random"), rng), 1000, 0.35);
   expect_valid(make_initial_state<2>(make_system(2, 1000, 0.5, "random"), rng), 1000, 0.5);
 }
 
-TEST(Random, RefusedAboveTheJammingMargin) {
+// The voxel-accelerated insertion must stay uniform: coordinate histograms along every axis
+// are flat within a generous statistical margin (expected 250 per bin, sd ~ 15).
+template <int D>
+void expect_uniform(const InitialState<D>& st) {
+  constexpr int kBins = 8;
+  for (int k = 0; k < D; ++k) {
+    std::vector<int> hist(kBins, 0);
+    for (const auto& x : st.position) {
+      ++hist[static_cast<std::size_t>(x[k] / st.box[k] * kBins)];
+    }
+    const double expected = static_cast<double>(st.position.size()) / kBins;
+    for (int h : hist) EXPECT_NEAR(h, expected, 0.25 * expected) << "axis " << k;
+  }
+}
+
+TEST(InitRandom, UniformNearTheLimit) {
+  std::mt19937_64 rng(24);
+  expect_uniform(make_initial_state<3>(make_system(3, 2000, 0.35, "random"), rng));
+  expect_uniform(make_initial_state<2>(make_system(2, 2000, 0.5, "random"), rng));
+}
+
+TEST(InitRandom, RefusedAboveTheJammingMargin) {
   const std::string e3 = error_of<3>(make_system(3, 1000, 0.36, "random"));
   EXPECT_NE(e3.find("system.packing_fraction = 0.36"), std::string::npos) << e3;
   EXPECT_NE(e3.find("lattice"), std::string::npos) << e3;
@@ -339,14 +360,14 @@ void check_velocities(std::size_t n, double kT, std::uint64_t seed) {
   EXPECT_NEAR(heavy / static_cast<double>(n - n_light), kT, 0.1 * kT);
 }
 
-TEST(Velocities, ZeroMomentumExactTemperature) {
+TEST(InitVelocities, ZeroMomentumExactTemperature) {
   check_velocities<3>(3000, 1.0, 1);
   check_velocities<3>(10000, 2.5, 2);
   check_velocities<2>(3000, 0.7, 3);
   check_velocities<2>(10000, 1.0, 4);
 }
 
-TEST(Velocities, DegenerateCases) {
+TEST(InitVelocities, DegenerateCases) {
   InitialState<3> one;
   one.position.resize(1);
   one.mass = {1.0};
@@ -362,7 +383,7 @@ TEST(Velocities, DegenerateCases) {
   EXPECT_THROW(assign_maxwell_boltzmann_velocities(cold, -1.0, rng), InputError);
 }
 
-TEST(Velocities, MakeInitialStateUsesTheTemperature) {
+TEST(InitVelocities, MakeInitialStateUsesTheTemperature) {
   auto sys = make_system(3, 500, 0.3, "fcc", binary_mixture());
   sys.temperature = 1.7;
   std::mt19937_64 rng(8);
@@ -400,7 +421,7 @@ void compare_overlaps(std::mt19937_64& rng, const std::array<double, D>& box, st
   }
 }
 
-TEST(MaxOverlap, AgreesWithBruteForce3D) {
+TEST(InitMaxOverlap, AgreesWithBruteForce3D) {
   std::mt19937_64 rng(31);
   const std::vector<std::array<double, 3>> boxes = {
       {10.0, 10.0, 10.0}, {12.0, 7.3, 5.1},     {4.0, 4.0, 4.0}, {3.2, 3.2, 3.2},
@@ -411,7 +432,7 @@ TEST(MaxOverlap, AgreesWithBruteForce3D) {
   }
 }
 
-TEST(MaxOverlap, AgreesWithBruteForce2D) {
+TEST(InitMaxOverlap, AgreesWithBruteForce2D) {
   std::mt19937_64 rng(32);
   const std::vector<std::array<double, 2>> boxes = {
       {20.0, 20.0}, {13.0, 4.2}, {3.1, 3.1}, {2.2, 2.2}, {1.5, 30.0}, {0.8, 0.8}, {400.0, 400.0}};
@@ -420,7 +441,7 @@ TEST(MaxOverlap, AgreesWithBruteForce2D) {
   }
 }
 
-TEST(MaxOverlap, KnownPairAcrossTheBoundary) {
+TEST(InitMaxOverlap, KnownPairAcrossTheBoundary) {
   const std::array<double, 3> box = {10.0, 10.0, 10.0};
   std::vector<std::array<double, 3>> pos = {{5, 5, 5}, {0.2, 3, 3}, {9.5, 3, 3}, {5, 6.2, 5}};
   std::vector<double> diameter = {1.0, 1.0, 1.0, 1.0};
