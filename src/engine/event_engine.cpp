@@ -76,7 +76,7 @@ void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
 // Collects the members of one neighbour cell as candidates, prefetching their records so the
 // cache misses of a whole prediction overlap instead of queueing one after another.
 template <int D, class Queue>
-void EventEngine<D, Queue>::gather(const typename CellGrid<D>::Neighbour& nb) {
+[[gnu::always_inline]] inline void EventEngine<D, Queue>::gather(const typename CellGrid<D>::Neighbour& nb) {
   const std::uint32_t count = grid_.count(nb.cell);
   if (count == 0) return;
   const std::uint32_t* members = grid_.members(nb.cell);
@@ -291,16 +291,6 @@ std::size_t EventEngine<D, Queue>::bytes_per_particle() const {
 }
 
 template <int D, class Queue>
-bool EventEngine<D, Queue>::cells_adjacent(std::uint32_t a, std::uint32_t b) const {
-  for (int k = 0; k < D; ++k) {
-    const int n = grid_.cells_along(k);
-    const int d = std::abs(grid_.coordinate(a, k) - grid_.coordinate(b, k));
-    if (std::min(d, n - d) > 1) return false;
-  }
-  return true;
-}
-
-template <int D, class Queue>
 void EventEngine<D, Queue>::validate() {
   const double t = sys_.time;
   const std::size_t n = sys_.size();
@@ -338,29 +328,46 @@ void EventEngine<D, Queue>::validate() {
     if (event_time(i) < t) fail("event of " + std::to_string(i) + " lies in the past");
   }
   if (queue_.top_time() != tmin) fail("queue top is not the soonest event");
-  // Prediction invariant and overlaps, brute force over all pairs (minimum image).
+  // Prediction invariant and overlaps, brute force over all pairs.
+  auto check_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, double bound,
+                           const char* which) {
+    const Vec<D> g = sys_.kinematics[i].vel - sys_.kinematics[j].vel;
+    const double sigma = sys_.kinematics[i].radius + sys_.kinematics[j].radius;
+    const double due = t + pair_contact_time<D>(r.data(), g.data(), sigma);
+    if (std::isfinite(due) && bound > due * (1.0 + 1e-12) + 1e-12) {
+      fail("pair " + std::to_string(i) + "," + std::to_string(j) + " (" + which +
+           ") collides at " + std::to_string(due) + " but no stored event covers it");
+    }
+  };
   for (std::uint32_t i = 0; i < n; ++i) {
     const Vec<D> xi = sys_.position_at(i, t);
+    const std::uint32_t ci = grid_.cell_of(i);
     for (std::uint32_t j = i + 1; j < n; ++j) {
-      Vec<D> r = xi - sys_.position_at(j, t);
+      const EventSlot& si = sys_.events[i];
+      const EventSlot& sj = sys_.events[j];
+      const double collisions = std::min(si.collision_time, sj.collision_time);
+      const double any = std::min({collisions, si.crossing_time, sj.crossing_time});
+      const Vec<D> raw = xi - sys_.position_at(j, t);
+      // The image the engine tests (neighbouring cells): the stored collisions must cover it.
+      std::array<int, D> d;
+      if (grid_.neighbour_offset(ci, grid_.cell_of(j), d)) {
+        Vec<D> r = raw;
+        for (int a = 0; a < D; ++a) {
+          const int c = grid_.coordinate(ci, a) + d[a];
+          if (c < 0) r[a] += sys_.box[a];
+          if (c >= grid_.cells_along(a)) r[a] -= sys_.box[a];
+        }
+        check_covered(i, j, r, collisions, "neighbour-cell image");
+      }
+      // The nearest image: some stored event (a collision, or a crossing that changes which
+      // cells the pair occupies) must come first.
+      Vec<D> r = raw;
       for (int a = 0; a < D; ++a) r[a] -= sys_.box[a] * std::round(r[a] / sys_.box[a]);
-      const Vec<D> g = sys_.kinematics[i].vel - sys_.kinematics[j].vel;
       const double sigma = sys_.kinematics[i].radius + sys_.kinematics[j].radius;
       if (norm2(r) < sigma * sigma * (1.0 - 1e-9)) {
         fail("particles " + std::to_string(i) + " and " + std::to_string(j) + " overlap");
       }
-      const double tc = pair_contact_time<D>(r.data(), g.data(), sigma);
-      if (!std::isfinite(tc)) continue;
-      const double due = t + tc;
-      // Pairs in neighbouring cells rely on the stored collisions, others on the next crossing.
-      const bool adjacent = cells_adjacent(grid_.cell_of(i), grid_.cell_of(j));
-      const double bound =
-          adjacent ? std::min(sys_.events[i].collision_time, sys_.events[j].collision_time)
-                   : std::min(sys_.events[i].crossing_time, sys_.events[j].crossing_time);
-      if (bound > due * (1.0 + 1e-12) + 1e-12) {
-        fail("pair " + std::to_string(i) + "," + std::to_string(j) + " collides at " +
-             std::to_string(due) + " but no stored event covers it");
-      }
+      check_covered(i, j, r, any, "nearest image");
     }
   }
 }

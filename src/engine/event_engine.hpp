@@ -35,7 +35,6 @@ class EventEngine {
   EventKind step();
 
   double time() const { return sys_.time; }
-  double next_event_time() { return queue_.top_time(); }
   const EventCounters& counters() const { return sys_.counters; }
   const ParticleSystem<D>& system() const { return sys_; }
   // The complete state including the scheduler's, for restarts: an engine built from it
@@ -54,6 +53,7 @@ class EventEngine {
 
   std::size_t bytes_per_particle() const;
   const char* queue_name() const { return Queue::name(); }
+  const CellGrid<D>& grid() const { return grid_; }
 
  private:
   void advance_to(std::uint32_t i, double t);
@@ -70,7 +70,6 @@ class EventEngine {
   void collide(std::uint32_t i, std::uint32_t j, double t);
   void cross(std::uint32_t i, double t);
   void predict_all();
-  bool cells_adjacent(std::uint32_t a, std::uint32_t b) const;
   void check_restored_cell(std::uint32_t i) const;
 
   ParticleSystem<D> sys_;

@@ -836,10 +836,43 @@ InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& 
     place_on_lattice(layout, state);
   } else {
     insert_randomly(layout, eta, state, rng);
+    sort_spatially(state);  // neighbours close in memory: fewer cache misses in the engine
   }
   assign_maxwell_boltzmann_velocities(state, system.temperature, rng);
   return state;
 }
+
+template <int D>
+void sort_spatially(InitialState<D>& state) {
+  const std::size_t n = state.position.size();
+  if (n == 0) return;
+  // Cells as wide as the largest diameter: the engine's own neighbour cells.
+  const double width = *std::max_element(state.diameter.begin(), state.diameter.end());
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keys(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t key = 0;
+    for (int k = D - 1; k >= 0; --k) {
+      const auto along = static_cast<std::uint64_t>(std::max(1.0, std::floor(state.box[k] / width)));
+      const auto c = static_cast<std::uint64_t>(std::max(0.0, state.position[i][k] / width));
+      key = key * along + std::min(c, along - 1);
+    }
+    keys[i] = {key, static_cast<std::uint32_t>(i)};
+  }
+  std::sort(keys.begin(), keys.end());
+  InitialState<D> sorted = state;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t from = keys[i].second;
+    sorted.position[i] = state.position[from];
+    sorted.species[i] = state.species[from];
+    sorted.diameter[i] = state.diameter[from];
+    sorted.mass[i] = state.mass[from];
+    if (!state.velocity.empty()) sorted.velocity[i] = state.velocity[from];
+  }
+  state = std::move(sorted);
+}
+
+template void sort_spatially<2>(InitialState<2>&);
+template void sort_spatially<3>(InitialState<3>&);
 
 template <int D>
 void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std::mt19937_64& rng) {

@@ -74,6 +74,12 @@ double packing_fraction(const InitialState<D>& state);
 template <int D>
 InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& rng);
 
+// Renumbers the particles in row-major order of cells as wide as the largest diameter, so
+// particles close in space are close in memory (random insertion otherwise leaves them in
+// insertion order). Applied to generated random states; files keep their particle order.
+template <int D>
+void sort_spatially(InitialState<D>& state);
+
 // Maxwell-Boltzmann velocities: Gaussian components with variance kT/m (Box-Muller on 53-bit
 // uniforms: the same numbers on every platform), zero total momentum, then rescaled so that
 // 2 KE / (D (N - 1)) equals kT exactly. All zero when N < 2 or kT == 0. Throws InputError

@@ -6,7 +6,8 @@
 //   - a future bucket inside the window, an unsorted intrusive doubly-linked list;
 //   - the overflow list (beyond the window, or never), rescanned once per turn of the window.
 // Pop order is exactly (time, particle index), the same total order as BinaryHeapQueue, so
-// both queues give bit-identical runs. dt adapts when the pops per bucket drift too far.
+// both queues give bit-identical runs. dt adapts, after a full turn of the window, when the
+// number of entries per bucket drifts outside [0.25, 8].
 #pragma once
 
 #include <cmath>
@@ -41,10 +42,12 @@ class CalendarQueue {
   }
 
   std::uint32_t top() {
+    if (heap_.size() > heap_limit_) rebuild(estimate_dt());
     if (heap_.empty()) advance();
     return heap_.empty() ? 0 : heap_.top();
   }
   double top_time() {
+    if (heap_.size() > heap_limit_) rebuild(estimate_dt());
     if (heap_.empty()) advance();
     return heap_.empty() ? std::numeric_limits<double>::infinity() : key_[heap_.top()];
   }
@@ -61,6 +64,7 @@ class CalendarQueue {
     return sizeof(double) + 4 * sizeof(std::uint32_t) + sizeof(std::int32_t);
   }
   double bucket_width() const { return dt_; }
+  std::size_t sorted_size() const { return heap_.size(); }  // entries in the current bucket
 
  private:
   static constexpr std::uint32_t kNone = 0xffffffffu;
@@ -98,8 +102,11 @@ class CalendarQueue {
     double tmin = std::numeric_limits<double>::infinity();
     for (double t : key_) tmin = std::min(tmin, t);
     current_ = std::isfinite(tmin) ? bucket_number(tmin) : 0;
-    pops_this_turn_ = 0;
+    loaded_this_turn_ = buckets_this_turn_ = 0;
     for (std::uint32_t i = 0; i < key_.size(); ++i) insert(i);
+    // Too many entries in the sorted bucket means dt is too coarse (the time scale shrank):
+    // rebuild then. The limit grows with what a rebuild itself leaves there (equal times).
+    heap_limit_ = std::max<std::size_t>(256, 4 * heap_.size());
   }
 
   void insert(std::uint32_t i) {
@@ -145,9 +152,11 @@ class CalendarQueue {
       if ((current_ & mask_) == 0 && turn_complete()) return;  // rebuilt or nothing left
       std::uint32_t p = bucket_head_[current_ & mask_];
       bucket_head_[current_ & mask_] = kNone;
+      ++buckets_this_turn_;
       while (p != kNone) {
         const std::uint32_t nxt = next_[p];
         heap_push(p);
+        ++loaded_this_turn_;
         p = nxt;
       }
       if (scanned > 4 * static_cast<std::uint64_t>(nb_) + 4) return;  // only infinite times left
@@ -157,9 +166,12 @@ class CalendarQueue {
   // Start of a new turn of the window: adapt dt if needed, pull due entries from overflow.
   // Returns true when the caller must stop advancing (the queue was rebuilt or is empty).
   bool turn_complete() {
-    const double per_bucket = static_cast<double>(pops_this_turn_) / static_cast<double>(nb_);
-    pops_this_turn_ = 0;
-    if (per_bucket > 8.0 || (per_bucket > 0.0 && per_bucket < 0.25)) {
+    // Adapt only on a full turn's statistics (a rebuild starts mid-turn).
+    const double per_bucket =
+        static_cast<double>(loaded_this_turn_) / static_cast<double>(std::max<std::uint64_t>(1, buckets_this_turn_));
+    const bool full_turn = buckets_this_turn_ >= nb_ / 2;
+    loaded_this_turn_ = buckets_this_turn_ = 0;
+    if (full_turn && (per_bucket > 8.0 || (per_bucket > 0.0 && per_bucket < 0.25))) {
       rebuild(dt_ * 2.0 / per_bucket);
       return true;
     }
@@ -194,10 +206,7 @@ class CalendarQueue {
     where_[p] = kInHeap;
     heap_.push(p);
   }
-  void heap_erase(std::uint32_t p) {
-    heap_.erase(p);
-    ++pops_this_turn_;
-  }
+  void heap_erase(std::uint32_t p) { heap_.erase(p); }
 
   std::vector<double> key_;
   std::vector<std::uint32_t> next_, prev_;  // intrusive bucket / overflow lists
@@ -208,7 +217,9 @@ class CalendarQueue {
   std::uint32_t nb_ = 1, mask_ = 0;
   double dt_ = 1.0, inv_dt_ = 1.0;
   std::uint64_t current_ = 0;  // absolute number of the current bucket
-  std::uint64_t pops_this_turn_ = 0;
+  std::size_t heap_limit_ = 256;
+  std::uint64_t loaded_this_turn_ = 0;   // entries moved from buckets into the heap this turn
+  std::uint64_t buckets_this_turn_ = 0;  // buckets advanced this turn
 };
 
 }  // namespace kairos

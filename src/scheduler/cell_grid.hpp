@@ -179,6 +179,19 @@ class CellGrid {
   }
 
   // Memory of the grid divided by the number of particles.
+  // Offset of cell b from cell a, each component wrapped into {-1, 0, 1}; false if the cells
+  // are not neighbours.
+  bool neighbour_offset(std::uint32_t a, std::uint32_t b, std::array<int, D>& d) const {
+    for (int k = 0; k < D; ++k) {
+      int diff = coordinate(b, k) - coordinate(a, k);
+      if (diff > 1) diff -= n_[k];
+      if (diff < -1) diff += n_[k];
+      if (diff < -1 || diff > 1) return false;
+      d[k] = diff;
+    }
+    return true;
+  }
+
   std::size_t bytes_per_particle() const {
     return cell_.empty() ? 0
                          : (slots_.size() + cell_.size()) * sizeof(std::uint32_t) / cell_.size();

@@ -11,8 +11,11 @@ namespace kairos {
 namespace {
 
 template <int D, class Q>
-void run_validated(const ParticleSystem<D>& start, int events) {
+void run_validated(const ParticleSystem<D>& start, int events, int expect_cells = 0) {
   EventEngine<D, Q> engine(start);
+  if (expect_cells > 0) {
+    for (int k = 0; k < D; ++k) ASSERT_EQ(engine.grid().cells_along(k), expect_cells);
+  }
   engine.validate();
   for (int e = 0; e < events; ++e) {
     ASSERT_NE(engine.step(), EventKind::kNone);
@@ -31,10 +34,18 @@ TEST(EventEngine, ValidatedAgainstBruteForce2D) {
   run_validated<2, CalendarQueue>(testing::lattice_system<2>(8, 0.5, 4), 3000);
 }
 
-TEST(EventEngine, ValidatedBinaryMixtureThreeCellsWide) {
-  // Unequal sizes and masses, and a box only three cells wide (periodic images via shifts).
-  run_validated<3, CalendarQueue>(testing::lattice_system<3>(4, 0.3, 5, 3.0, 1.4), 3000);
-  run_validated<2, CalendarQueue>(testing::lattice_system<2>(6, 0.3, 6, 0.5, 1.4), 3000);
+TEST(EventEngine, ValidatedBinaryMixture) {
+  // Unequal sizes and masses (4 and 8 cells wide).
+  run_validated<3, CalendarQueue>(testing::lattice_system<3>(4, 0.3, 5, 3.0, 1.4), 3000, 4);
+  run_validated<2, CalendarQueue>(testing::lattice_system<2>(6, 0.3, 6, 0.5, 1.4), 3000, 8);
+}
+
+TEST(EventEngine, ValidatedInABoxThreeCellsWide) {
+  // The smallest grid: the far layer of a neighbourhood is the near layer's other image, so
+  // every pair test relies on the cell-offset image shifts. Unequal masses, equal sizes.
+  run_validated<3, CalendarQueue>(testing::lattice_system<3>(3, 0.3, 11, 2.0), 5000, 3);
+  run_validated<3, BinaryHeapQueue>(testing::lattice_system<3>(3, 0.45, 12), 5000, 3);
+  run_validated<2, CalendarQueue>(testing::lattice_system<2>(3, 0.5, 13, 0.5), 5000, 3);
 }
 
 template <int D, class Q>
