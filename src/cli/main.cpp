@@ -129,7 +129,7 @@ int main(int argc, char** argv) {
         restart.empty() ? std::nullopt : std::optional<std::filesystem::path>(restart);
     const kairos::RunOutcome outcome = kairos::run_simulation(config, restart_file);
     print_summary(outcome);
-    if (g_signal != 0) return 128 + g_signal;
+    if (outcome.interrupted && g_signal != 0) return 128 + g_signal;
     return 0;
   } catch (const kairos::InputError& e) {
     std::fprintf(stderr, "kairos: error: %s\n", e.what());

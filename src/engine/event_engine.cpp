@@ -284,10 +284,11 @@ std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
 
 template <int D, class Queue>
 std::size_t EventEngine<D, Queue>::bytes_per_particle() const {
+  // Per-particle arrays of the state, plus the grid's and the queue's own (cells and buckets
+  // included, divided by N).
   return sizeof(Kinematics<D>) + sizeof(EventSlot) + sizeof(double) /*mass*/ +
-         2 * sizeof(std::uint32_t) /*species, counter*/ + sizeof(std::uint32_t) /*cell*/ +
-         grid_.bytes_per_particle() + queue_.bytes_per_particle() +
-         (grid_.cell_count() * sizeof(std::uint32_t)) / sys_.size();
+         2 * sizeof(std::uint32_t) /*species, collision counter*/ + grid_.bytes_per_particle() +
+         queue_.bytes_per_particle();
 }
 
 template <int D, class Queue>

@@ -25,7 +25,13 @@ void replace_file_atomically(const std::filesystem::path& target,
                              const std::function<void(const std::filesystem::path&)>& write) {
   std::filesystem::path tmp = target;
   tmp += ".tmp";
-  write(tmp);
+  try {
+    write(tmp);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw;
+  }
   fsync_path(tmp, O_RDONLY);
   std::error_code ec;
   std::filesystem::rename(tmp, target, ec);

@@ -226,7 +226,11 @@ class RunDriver {
 
     const double eq = restart_ ? 0.0 : config_.run.equilibration_collisions_per_particle;
     bool stopped = false;
-    if (eq > 0.0) stopped = run_phase("equilibration", eq, progress, wall_start);
+    if (eq > 0.0) {
+      stopped = run_phase("equilibration", eq, progress, wall_start);
+      // Close the equilibration rows so no production row spans both phases.
+      if (engine_->counters().collisions > last_.collisions) write_thermo_row("equilibration");
+    }
     prod_start_ = point();
     prod_ke_ = engine_->kinetic_energy();
     if (!stopped) stopped = run_phase("production", config_.run.collisions_per_particle, progress,
@@ -240,11 +244,11 @@ class RunDriver {
         append_trajectory_frame(*trajectory_, engine_->system());
       trajectory_->close();
     }
-    write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_);
     RunOutcome outcome;
     outcome.directory = dir_;
     outcome.interrupted = stopped;
-    outcome.summary = summary(wall);
+    outcome.summary = summary(wall);  // before the restart copy inflates the peak memory
+    write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_);
     write_text_atomically(dir_ / "summary.json", outcome.summary.dump(2) + "\n");
     return outcome;
   }
@@ -286,7 +290,10 @@ class RunDriver {
     std::uint64_t rate_events = engine_->counters().events;
     double rate = 0.0;
     while (engine_->counters().collisions < target) {
-      if (engine_->step() == EventKind::kNone) break;
+      if (engine_->step() == EventKind::kNone) {
+        stop_reason_ = "no_more_events";  // every particle at rest, or alone
+        break;
+      }
       if (config_.run.validate) engine_->validate();
       const std::uint64_t c = engine_->counters().collisions;
       if (c >= next_thermo) {

@@ -27,7 +27,6 @@ class BinaryHeapQueue {
   std::uint32_t top() const { return heap_.top(); }
   double top_time() const { return key_[heap_.top()]; }
   double time_of(std::uint32_t i) const { return key_[i]; }
-  std::size_t size() const { return key_.size(); }
 
   void update(std::uint32_t i, double t) {
     key_[i] = t;

@@ -52,7 +52,6 @@ class CalendarQueue {
     return heap_.empty() ? std::numeric_limits<double>::infinity() : key_[heap_.top()];
   }
   double time_of(std::uint32_t i) const { return key_[i]; }
-  std::size_t size() const { return key_.size(); }
 
   void update(std::uint32_t i, double t) {
     remove(i);
@@ -60,10 +59,11 @@ class CalendarQueue {
     insert(i);
   }
 
+  // key, list links, location, heap position, plus the bucket heads divided by N.
   std::size_t bytes_per_particle() const {
-    return sizeof(double) + 4 * sizeof(std::uint32_t) + sizeof(std::int32_t);
+    return sizeof(double) + 4 * sizeof(std::uint32_t) +
+           (key_.empty() ? 0 : bucket_head_.size() * sizeof(std::uint32_t) / key_.size());
   }
-  double bucket_width() const { return dt_; }
   std::size_t sorted_size() const { return heap_.size(); }  // entries in the current bucket
 
  private:

@@ -23,7 +23,6 @@ namespace kairos {
 template <int D>
 class CellGrid {
  public:
-  static constexpr std::uint32_t kNone = 0xffffffffu;
   static constexpr int kNeighbourCells = D == 3 ? 27 : 9;
   static constexpr int kLayerCells = D == 3 ? 9 : 3;
 
@@ -73,8 +72,6 @@ class CellGrid {
   std::uint32_t cell_count() const { return total_; }
   std::uint32_t capacity() const { return stride_slots_ - 1; }  // members a cell can hold now
   int cells_along(int k) const { return n_[k]; }
-  double width(int k) const { return width_[k]; }
-  const Vec<D>& box() const { return box_; }
   std::uint32_t cell_of(std::uint32_t i) const { return cell_[i]; }
   // The particles of cell c: count(c) indices starting at members(c).
   std::uint32_t count(std::uint32_t c) const { return slots_[std::size_t(c) * stride_slots_]; }
