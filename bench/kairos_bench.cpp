@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
@@ -28,7 +28,7 @@ struct Case {
   int dimension = 3;
   std::uint64_t particles = 32000;
   double eta = 0.45;
-  std::string lattice;  // default: fcc / hex
+  std::string lattice;      // default: fcc / hex
   double size_ratio = 1.0;  // > 1: 50:50 bidisperse mixture (random insertion)
 };
 
@@ -86,7 +86,8 @@ Result measure(const ParticleSystem<D>& start, double equilibrate, double timed)
 }
 
 template <int D>
-Result measure_queue(const std::string& queue, const ParticleSystem<D>& s, double eq, double timed) {
+Result measure_queue(const std::string& queue, const ParticleSystem<D>& s, double eq,
+                     double timed) {
   if (queue == "heap") return measure<D, BinaryHeapQueue>(s, eq, timed);
   return measure<D, CalendarQueue>(s, eq, timed);
 }
@@ -110,11 +111,13 @@ void run_case(const Case& c, const std::vector<std::string>& queues, int repeat,
     });
     const Result& best = rs.front();
     const double worst = rs.back().collisions_per_second;
-    fmt::print("| {}D | {} | {:.2f} | {} | {} | {:.3f} M | {:.3f} M | {:.0f} % | {:.3f} | {:.3f} | {} |\n",
-               c.dimension, c.particles, c.eta, c.size_ratio > 1 ? fmt::format("1:{}", c.size_ratio) : "mono",
-               queues[q], best.collisions_per_second / 1e6, best.events_per_second / 1e6,
-               100.0 * (best.collisions_per_second - worst) / best.collisions_per_second,
-               best.crossings_per_collision, best.stale_per_collision, best.bytes_per_particle);
+    fmt::print(
+        "| {}D | {} | {:.2f} | {} | {} | {:.3f} M | {:.3f} M | {:.0f} % | {:.3f} | {:.3f} | {} |\n",
+        c.dimension, c.particles, c.eta,
+        c.size_ratio > 1 ? fmt::format("1:{}", c.size_ratio) : "mono", queues[q],
+        best.collisions_per_second / 1e6, best.events_per_second / 1e6,
+        100.0 * (best.collisions_per_second - worst) / best.collisions_per_second,
+        best.crossings_per_collision, best.stale_per_collision, best.bytes_per_particle);
     std::fflush(stdout);
   }
 }
@@ -142,7 +145,9 @@ int main(int argc, char** argv) {
   if (etas.empty()) etas = {0.45};
   if (dims.empty()) dims = {3};
 
-  fmt::print("| dim | N | eta | sizes | queue | collisions/s | events/s | spread | crossings/coll | stale/coll | bytes/particle |\n");
+  fmt::print(
+      "| dim | N | eta | sizes | queue | collisions/s | events/s | spread | crossings/coll | "
+      "stale/coll | bytes/particle |\n");
   fmt::print("|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int d : dims)
     for (double eta : etas)

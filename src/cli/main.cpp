@@ -9,8 +9,8 @@
 #include <iostream>
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "core/error.hpp"
 #include "io/config.hpp"
@@ -46,7 +46,8 @@ void print_summary(const kairos::RunOutcome& outcome) {
   fmt::print("\nKairos run {} ({})\n", outcome.interrupted ? "stopped early" : "finished",
              s["stop_reason"].get<std::string>());
   fmt::print("  particles            {} in {}D, packing fraction {:.6g}\n",
-             s["particles"].get<std::uint64_t>(), s["dimension"].get<int>(), num("packing_fraction"));
+             s["particles"].get<std::uint64_t>(), s["dimension"].get<int>(),
+             num("packing_fraction"));
   fmt::print("  events               {} ({} collisions) in {} wall\n",
              s["events"].get<std::uint64_t>(), s["collisions"].get<std::uint64_t>(),
              kairos::format_duration(num("wall_seconds")));

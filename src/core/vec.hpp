@@ -13,13 +13,15 @@ template <int D>
 using Vec = std::array<double, static_cast<std::size_t>(D)>;
 
 template <std::size_t D>
-inline std::array<double, D> operator+(const std::array<double, D>& a, const std::array<double, D>& b) {
+inline std::array<double, D> operator+(const std::array<double, D>& a,
+                                       const std::array<double, D>& b) {
   std::array<double, D> r;
   for (std::size_t k = 0; k < D; ++k) r[k] = a[k] + b[k];
   return r;
 }
 template <std::size_t D>
-inline std::array<double, D> operator-(const std::array<double, D>& a, const std::array<double, D>& b) {
+inline std::array<double, D> operator-(const std::array<double, D>& a,
+                                       const std::array<double, D>& b) {
   std::array<double, D> r;
   for (std::size_t k = 0; k < D; ++k) r[k] = a[k] - b[k];
   return r;

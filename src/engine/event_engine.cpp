@@ -13,8 +13,7 @@
 namespace kairos {
 
 template <int D, class Queue>
-EventEngine<D, Queue>::EventEngine(ParticleSystem<D> system)
-    : sys_(std::move(system)) {
+EventEngine<D, Queue>::EventEngine(ParticleSystem<D> system) : sys_(std::move(system)) {
   const std::size_t n = sys_.size();
   if (n < 2) throw InputError("a simulation needs at least 2 particles");
   double rmax = 0.0;
@@ -76,7 +75,8 @@ void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
 // Collects the members of one neighbour cell as candidates, prefetching their records so the
 // cache misses of a whole prediction overlap instead of queueing one after another.
 template <int D, class Queue>
-[[gnu::always_inline]] inline void EventEngine<D, Queue>::gather(const typename CellGrid<D>::Neighbour& nb) {
+[[gnu::always_inline]] inline void EventEngine<D, Queue>::gather(
+    const typename CellGrid<D>::Neighbour& nb) {
   const std::uint32_t count = grid_.count(nb.cell);
   if (count == 0) return;
   const std::uint32_t* members = grid_.members(nb.cell);
@@ -103,8 +103,8 @@ void EventEngine<D, Queue>::reset_candidates() {
 // The particle itself may be among them: r = g = 0 gives r.g = 0, which the root rejects
 // without a branch.
 template <int D, class Queue>
-void EventEngine<D, Queue>::test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi,
-                                            double ri, EventSlot& slot) const {
+void EventEngine<D, Queue>::test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi, double ri,
+                                            EventSlot& slot) const {
   for (std::uint32_t k = 0; k < n_candidates_; ++k) {
     const std::uint32_t j = candidates_[k];
     const Vec<D>& shift = shifts_[candidate_shift_[k]];
@@ -311,8 +311,8 @@ void EventEngine<D, Queue>::validate() {
     }
   }
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (listed[i] != 1) fail("particle " + std::to_string(i) + " listed " +
-                             std::to_string(listed[i]) + " times");
+    if (listed[i] != 1)
+      fail("particle " + std::to_string(i) + " listed " + std::to_string(listed[i]) + " times");
     const Vec<D> x = sys_.position_at(i, t);
     const std::uint32_t c = grid_.cell_of(i);
     for (int a = 0; a < D; ++a) {
@@ -336,8 +336,8 @@ void EventEngine<D, Queue>::validate() {
     const double sigma = sys_.kinematics[i].radius + sys_.kinematics[j].radius;
     const double due = t + pair_contact_time<D>(r.data(), g.data(), sigma);
     if (std::isfinite(due) && bound > due * (1.0 + 1e-12) + 1e-12) {
-      fail("pair " + std::to_string(i) + "," + std::to_string(j) + " (" + which +
-           ") collides at " + std::to_string(due) + " but no stored event covers it");
+      fail("pair " + std::to_string(i) + "," + std::to_string(j) + " (" + which + ") collides at " +
+           std::to_string(due) + " but no stored event covers it");
     }
   };
   for (std::uint32_t i = 0; i < n; ++i) {

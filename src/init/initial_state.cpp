@@ -852,7 +852,8 @@ void sort_spatially(InitialState<D>& state) {
   for (std::size_t i = 0; i < n; ++i) {
     std::uint64_t key = 0;
     for (int k = D - 1; k >= 0; --k) {
-      const auto along = static_cast<std::uint64_t>(std::max(1.0, std::floor(state.box[k] / width)));
+      const auto along =
+          static_cast<std::uint64_t>(std::max(1.0, std::floor(state.box[k] / width)));
       const auto c = static_cast<std::uint64_t>(std::max(0.0, state.position[i][k] / width));
       key = key * along + std::min(c, along - 1);
     }

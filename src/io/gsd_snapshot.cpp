@@ -16,10 +16,12 @@ constexpr std::uint32_t kRestartFormat = 1;
 // HOOMD stores type names as an N_types x M int8 array of 0-padded strings.
 std::vector<std::int8_t> pack_type_names(const std::vector<std::string>& names, std::uint32_t& m) {
   m = 1;
-  for (const auto& n : names) m = std::max<std::uint32_t>(m, static_cast<std::uint32_t>(n.size() + 1));
+  for (const auto& n : names)
+    m = std::max<std::uint32_t>(m, static_cast<std::uint32_t>(n.size() + 1));
   std::vector<std::int8_t> out(names.size() * m, 0);
   for (std::size_t t = 0; t < names.size(); ++t) {
-    for (std::size_t c = 0; c < names[t].size(); ++c) out[t * m + c] = static_cast<std::int8_t>(names[t][c]);
+    for (std::size_t c = 0; c < names[t].size(); ++c)
+      out[t * m + c] = static_cast<std::int8_t>(names[t][c]);
   }
   return out;
 }
@@ -28,7 +30,8 @@ std::vector<std::string> unpack_type_names(const std::vector<std::int8_t>& raw, 
   std::vector<std::string> names;
   for (std::size_t t = 0; m > 0 && t < raw.size() / m; ++t) {
     std::string s;
-    for (std::size_t c = 0; c < m && raw[t * m + c] != 0; ++c) s.push_back(static_cast<char>(raw[t * m + c]));
+    for (std::size_t c = 0; c < m && raw[t * m + c] != 0; ++c)
+      s.push_back(static_cast<char>(raw[t * m + c]));
     names.push_back(s);
   }
   return names;
@@ -55,8 +58,12 @@ void write_standard_chunks(gsd::Writer& w, const ParticleSystem<D>& sys, bool wi
   const auto n = static_cast<std::uint32_t>(sys.size());
   const std::uint64_t step = sys.counters.events;
   const std::uint8_t dims = D;
-  const float box[6] = {static_cast<float>(sys.box[0]), static_cast<float>(sys.box[1]),
-                        D == 3 ? static_cast<float>(sys.box[D - 1]) : 0.0f, 0.0f, 0.0f, 0.0f};
+  const float box[6] = {static_cast<float>(sys.box[0]),
+                        static_cast<float>(sys.box[1]),
+                        D == 3 ? static_cast<float>(sys.box[D - 1]) : 0.0f,
+                        0.0f,
+                        0.0f,
+                        0.0f};
   w.write_chunk("configuration/step", 1, 1, &step);
   w.write_chunk("configuration/dimensions", 1, 1, &dims);
   w.write_chunk("configuration/box", 6, 1, box);
@@ -291,7 +298,8 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   }
   const auto nv = read_latest<std::uint32_t>(r, f, "particles/N");
   const std::size_t n = nv && !nv->empty() ? (*nv)[0] : 0;
-  if (n < 2) throw InputError("system.initial_state '" + path.string() + "' holds fewer than 2 particles");
+  if (n < 2)
+    throw InputError("system.initial_state '" + path.string() + "' holds fewer than 2 particles");
   InitialState<D> s;
   const bool exact = r.find(f, "kairos/position").has_value();
   if (exact) {
@@ -339,7 +347,8 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
       for (int a = 0; a < D; ++a) s.velocity[i][a] = vel[i * D + a];
     has_velocities = true;
   } else if (auto vel = read_latest<float>(r, f, "particles/velocity")) {
-    if (vel->size() != n * 3) throw InputError("'" + path.string() + "': particles/velocity has the wrong size");
+    if (vel->size() != n * 3)
+      throw InputError("'" + path.string() + "': particles/velocity has the wrong size");
     for (std::size_t i = 0; i < n; ++i)
       for (int a = 0; a < D; ++a) s.velocity[i][a] = (*vel)[i * 3 + a];
     has_velocities = true;
@@ -349,7 +358,8 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   if (auto radius = read_latest<double>(r, f, "kairos/radius"); radius && radius->size() == n) {
     for (double x : *radius) s.diameter.push_back(2.0 * x);
   } else if (auto d = read_latest<float>(r, f, "particles/diameter")) {
-    if (d->size() != n) throw InputError("'" + path.string() + "': particles/diameter has the wrong size");
+    if (d->size() != n)
+      throw InputError("'" + path.string() + "': particles/diameter has the wrong size");
     s.diameter.assign(d->begin(), d->end());
   } else {
     s.diameter.assign(n, 1.0);
@@ -357,7 +367,8 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   if (auto m = read_latest<double>(r, f, "kairos/mass"); m && m->size() == n) {
     s.mass = *m;
   } else if (auto mf = read_latest<float>(r, f, "particles/mass")) {
-    if (mf->size() != n) throw InputError("'" + path.string() + "': particles/mass has the wrong size");
+    if (mf->size() != n)
+      throw InputError("'" + path.string() + "': particles/mass has the wrong size");
     s.mass.assign(mf->begin(), mf->end());
   } else {
     s.mass.assign(n, 1.0);
@@ -375,7 +386,8 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   } else {
     s.species.assign(n, 0);
   }
-  if (auto info = r.find(f, "particles/types") ? r.find(f, "particles/types") : r.find(0, "particles/types")) {
+  if (auto info = r.find(f, "particles/types") ? r.find(f, "particles/types")
+                                               : r.find(0, "particles/types")) {
     const std::uint64_t frame = r.find(f, "particles/types") ? f : 0;
     s.species_names = unpack_type_names(r.read<std::int8_t>(frame, "particles/types"), info->M);
   }
@@ -390,8 +402,10 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
 
 template void append_trajectory_frame<2>(gsd::Writer&, const ParticleSystem<2>&);
 template void append_trajectory_frame<3>(gsd::Writer&, const ParticleSystem<3>&);
-template void write_restart<2>(const std::filesystem::path&, const ParticleSystem<2>&, const std::mt19937_64&);
-template void write_restart<3>(const std::filesystem::path&, const ParticleSystem<3>&, const std::mt19937_64&);
+template void write_restart<2>(const std::filesystem::path&, const ParticleSystem<2>&,
+                               const std::mt19937_64&);
+template void write_restart<3>(const std::filesystem::path&, const ParticleSystem<3>&,
+                               const std::mt19937_64&);
 template ParticleSystem<2> read_restart<2>(const std::filesystem::path&, std::mt19937_64&);
 template ParticleSystem<3> read_restart<3>(const std::filesystem::path&, std::mt19937_64&);
 template InitialState<2> read_initial_state<2>(const std::filesystem::path&, bool&);

@@ -38,8 +38,8 @@ void ProgressLine::update(const ProgressInfo& info) {
   const double eta = frac > 1e-9 ? elapsed * (1.0 - frac) / frac : -1.0;
   const std::string line = fmt::format(
       "[{:<13} {:5.1f}%] {:.1f}/{:.0f} coll/particle | t = {:.6g} | {:.3g} M events/s | ETA {}",
-      info.phase, 100.0 * frac, info.done, info.total, info.sim_time,
-      info.events_per_second / 1e6, format_duration(eta));
+      info.phase, 100.0 * frac, info.done, info.total, info.sim_time, info.events_per_second / 1e6,
+      format_duration(eta));
   if (tty_) {
     std::fprintf(stderr, "\r%-100s", line.c_str());
   } else {

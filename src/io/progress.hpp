@@ -10,9 +10,9 @@
 namespace kairos {
 
 struct ProgressInfo {
-  std::string phase;     // "equilibration" / "production"
-  double done = 0.0;     // collisions per particle done in this phase
-  double total = 0.0;    // collisions per particle in this phase
+  std::string phase;   // "equilibration" / "production"
+  double done = 0.0;   // collisions per particle done in this phase
+  double total = 0.0;  // collisions per particle in this phase
   double sim_time = 0.0;
   double events_per_second = 0.0;
 };

@@ -50,17 +50,19 @@ template <int D>
 void check_no_overlap(const InitialState<D>& init, const std::string& source) {
   for (int a = 0; a < D; ++a) {
     if (!std::isfinite(init.box[a]) || !(init.box[a] > 0.0)) {
-      throw InputError(fmt::format("{}: the box edge {} is {}: check system.particles, "
-                                   "system.packing_fraction and the species diameters",
-                                   source, a, init.box[a]));
+      throw InputError(
+          fmt::format("{}: the box edge {} is {}: check system.particles, "
+                      "system.packing_fraction and the species diameters",
+                      source, a, init.box[a]));
     }
   }
   std::uint32_t i = 0, j = 0;
   const double worst = max_overlap<D>(init.box, init.position, init.diameter, &i, &j);
   if (worst > 0.0) {
-    throw InputError(fmt::format("{}: particles {} and {} overlap by {:.6g} (hard particles must "
-                                 "not overlap)",
-                                 source, i, j, worst));
+    throw InputError(
+        fmt::format("{}: particles {} and {} overlap by {:.6g} (hard particles must "
+                    "not overlap)",
+                    source, i, j, worst));
   }
 }
 
@@ -211,6 +213,7 @@ class RunDriver {
     if (config_.output.trajectory) {
       const fs::path traj = dir_ / "trajectory.gsd";
       if (restart_ && fs::exists(traj)) {
+        check_same_system(traj);
         trajectory_.emplace(gsd::Writer::open_append(traj));
       } else {
         trajectory_.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
@@ -233,8 +236,8 @@ class RunDriver {
     }
     prod_start_ = point();
     prod_ke_ = engine_->kinetic_energy();
-    if (!stopped) stopped = run_phase("production", config_.run.collisions_per_particle, progress,
-                                      wall_start);
+    if (!stopped)
+      stopped = run_phase("production", config_.run.collisions_per_particle, progress, wall_start);
     progress.finish();
     if (engine_->counters().collisions > last_.collisions) write_thermo_row(phase_);
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
@@ -254,6 +257,22 @@ class RunDriver {
   }
 
  private:
+  // Appending to another system's trajectory would corrupt it for every reader.
+  void check_same_system(const fs::path& traj) const {
+    const gsd::Reader r(traj);
+    const auto n = r.find(0, "particles/N") ? r.read<std::uint32_t>(0, "particles/N")
+                                            : std::vector<std::uint32_t>{};
+    const auto dims = r.find(0, "configuration/dimensions")
+                          ? r.read<std::uint8_t>(0, "configuration/dimensions")
+                          : std::vector<std::uint8_t>{3};
+    if (n.empty() || n[0] != n_ || dims.empty() || dims[0] != D) {
+      throw InputError(fmt::format(
+          "output.directory '{}' holds a trajectory.gsd of another system ({} particles in {}D, "
+          "this run has {} in {}D): write the continued run to another directory (-o)",
+          dir_.string(), n.empty() ? 0u : n[0], dims.empty() ? 0 : dims[0], n_, D));
+    }
+  }
+
   ThermoPoint point() const {
     const auto& c = engine_->counters();
     return {engine_->time(), c.virial, c.events, c.collisions};
@@ -280,9 +299,10 @@ class RunDriver {
                                   : auto_length / 10.0;
     const std::uint64_t thermo_step = std::max<std::uint64_t>(1, collisions_for(thermo_every));
     const std::uint64_t traj_step = std::max<std::uint64_t>(1, collisions_for(traj_every));
-    const std::uint64_t restart_step = config_.output.restart_interval > 0
-                                           ? std::max<std::uint64_t>(1, collisions_for(config_.output.restart_interval))
-                                           : 0;
+    const std::uint64_t restart_step =
+        config_.output.restart_interval > 0
+            ? std::max<std::uint64_t>(1, collisions_for(config_.output.restart_interval))
+            : 0;
     std::uint64_t next_thermo = begin + thermo_step;
     std::uint64_t next_traj = begin + traj_step;
     std::uint64_t next_restart = restart_step ? begin + restart_step : ~0ull;
@@ -325,7 +345,8 @@ class RunDriver {
         }
         progress.update({phase, per_particle(c - begin), length, engine_->time(), rate});
         if (config_.run.max_wall_seconds > 0 &&
-            std::chrono::duration<double>(now - wall_start).count() > config_.run.max_wall_seconds) {
+            std::chrono::duration<double>(now - wall_start).count() >
+                config_.run.max_wall_seconds) {
           stop_reason_ = "wall_time_limit";
           return true;
         }
@@ -347,9 +368,10 @@ class RunDriver {
       if (dc > 0) mft = static_cast<double>(n_) * dt / (2.0 * dc);
     }
     const double pressure = z * static_cast<double>(n_) * kT / volume_;
-    thermo_->write_line(fmt::format("{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\n",
-                                    phase, now.time, now.events, now.collisions,
-                                    per_particle(now.collisions), kT, pressure, z, ke, mft));
+    thermo_->write_line(
+        fmt::format("{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\n",
+                    phase, now.time, now.events, now.collisions, per_particle(now.collisions), kT,
+                    pressure, z, ke, mft));
     if (phase == "production" && std::isfinite(z)) z_samples_.push_back(z);
     if (phase == "production" && std::isfinite(mft)) mft_samples_.push_back(mft);
     last_ = now;
@@ -370,11 +392,14 @@ class RunDriver {
     const BlockAverage z_blocks = block_average(z_samples_);
     double z_mean = std::nan("");
     if (t_prod > 0 && kT_prod > 0) {
-      z_mean = 1.0 + (c.virial - prod_start_.virial) / (D * static_cast<double>(n_) * kT_prod * t_prod);
+      z_mean =
+          1.0 + (c.virial - prod_start_.virial) / (D * static_cast<double>(n_) * kT_prod * t_prod);
     }
     std::vector<double> diameters(n_);
-    for (std::size_t i = 0; i < n_; ++i) diameters[i] = 2.0 * engine_->system().kinematics[i].radius;
-    const double overlap = max_overlap<D>(engine_->system().box, engine_->current_positions(), diameters);
+    for (std::size_t i = 0; i < n_; ++i)
+      diameters[i] = 2.0 * engine_->system().kinematics[i].radius;
+    const double overlap =
+        max_overlap<D>(engine_->system().box, engine_->current_positions(), diameters);
     const std::uint64_t events = c.events - events_start_;
     const std::uint64_t collisions = c.collisions - collisions_start_;
     nlohmann::json j;
@@ -406,8 +431,9 @@ class RunDriver {
                             {"blocks", z_blocks.samples},
                             {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
     j["pressure"] = z_mean * static_cast<double>(n_) * kT_prod / volume_;
-    j["mean_free_time"] = coll_prod > 0 ? static_cast<double>(n_) * t_prod / (2.0 * static_cast<double>(coll_prod))
-                                        : std::nan("");
+    j["mean_free_time"] =
+        coll_prod > 0 ? static_cast<double>(n_) * t_prod / (2.0 * static_cast<double>(coll_prod))
+                      : std::nan("");
     j["mean_free_time_stderr"] = block_average(mft_samples_).stderr_;
     j["energy_drift_relative"] = ke_start_ > 0 ? std::abs(ke - ke_start_) / ke_start_ : 0.0;
     j["momentum_drift"] = pscale > 0 ? std::sqrt(dp2) / pscale : 0.0;
@@ -444,8 +470,12 @@ RunOutcome run_with_dimension(const Config& config, const std::optional<fs::path
 
 }  // namespace
 
-void request_stop() noexcept { g_stop.store(true, std::memory_order_relaxed); }
-void clear_stop_request() noexcept { g_stop.store(false, std::memory_order_relaxed); }
+void request_stop() noexcept {
+  g_stop.store(true, std::memory_order_relaxed);
+}
+void clear_stop_request() noexcept {
+  g_stop.store(false, std::memory_order_relaxed);
+}
 
 RunOutcome run_simulation(const Config& config, const std::optional<fs::path>& restart_file) {
   int dimension = config.system.dimension;

@@ -167,8 +167,8 @@ class CalendarQueue {
   // Returns true when the caller must stop advancing (the queue was rebuilt or is empty).
   bool turn_complete() {
     // Adapt only on a full turn's statistics (a rebuild starts mid-turn).
-    const double per_bucket =
-        static_cast<double>(loaded_this_turn_) / static_cast<double>(std::max<std::uint64_t>(1, buckets_this_turn_));
+    const double per_bucket = static_cast<double>(loaded_this_turn_) /
+                              static_cast<double>(std::max<std::uint64_t>(1, buckets_this_turn_));
     const bool full_turn = buckets_this_turn_ >= nb_ / 2;
     loaded_this_turn_ = buckets_this_turn_ = 0;
     if (full_turn && (per_bucket > 8.0 || (per_bucket > 0.0 && per_bucket < 0.25))) {

@@ -234,8 +234,8 @@ class CellGrid {
   std::uint32_t total_ = 0;
   std::uint32_t stride_slots_ = 8;
   std::int32_t neighbour_delta_[kNeighbourCells] = {};  // index offsets of an interior cell
-  std::vector<std::uint32_t> slots_;  // per cell: count, then the member indices
-  std::vector<std::uint32_t> cell_;   // per particle: its cell
+  std::vector<std::uint32_t> slots_;                    // per cell: count, then the member indices
+  std::vector<std::uint32_t> cell_;                     // per particle: its cell
 };
 
 }  // namespace kairos

@@ -12,7 +12,9 @@ double contact(std::array<double, 3> r, std::array<double, 3> v) {
   return pair_contact_time<3>(r.data(), v.data(), 1.0);
 }
 
-TEST(CollisionTime, HeadOnApproach) { EXPECT_DOUBLE_EQ(contact({3, 0, 0}, {-1, 0, 0}), 2.0); }
+TEST(CollisionTime, HeadOnApproach) {
+  EXPECT_DOUBLE_EQ(contact({3, 0, 0}, {-1, 0, 0}), 2.0);
+}
 
 TEST(CollisionTime, OverlappingApproachingCollidesNow) {
   // The textbook formula returns -0.001 here; the stable rule says "now".
@@ -23,7 +25,9 @@ TEST(CollisionTime, OverlappingRecedingNeverCollides) {
   EXPECT_EQ(contact({0.999, 0, 0}, {1, 0, 0}), kNever);
 }
 
-TEST(CollisionTime, NearMissNeverCollides) { EXPECT_EQ(contact({3, 1.5, 0}, {-1, 0, 0}), kNever); }
+TEST(CollisionTime, NearMissNeverCollides) {
+  EXPECT_EQ(contact({3, 1.5, 0}, {-1, 0, 0}), kNever);
+}
 
 TEST(CollisionTime, GrazingOffsetMatchesGeometry) {
   EXPECT_NEAR(contact({3, 0.5, 0}, {-1, 0, 0}), 2.1339745962155614, 1e-15);
@@ -36,12 +40,14 @@ TEST(CollisionTime, TinyGapIsTheExactRootOfTheRoundedInput) {
 }
 
 TEST(CollisionTime, TouchingPairs) {
-  EXPECT_EQ(contact({1, 0, 0}, {-1, 0, 0}), 0.0);   // touching, approaching: now
+  EXPECT_EQ(contact({1, 0, 0}, {-1, 0, 0}), 0.0);    // touching, approaching: now
   EXPECT_EQ(contact({1, 0, 0}, {1, 0, 0}), kNever);  // touching, receding
   EXPECT_EQ(contact({1, 0, 0}, {0, 1, 0}), kNever);  // touching, tangential (f' = 0)
 }
 
-TEST(CollisionTime, AtRestNeverCollides) { EXPECT_EQ(contact({0.5, 0, 0}, {0, 0, 0}), kNever); }
+TEST(CollisionTime, AtRestNeverCollides) {
+  EXPECT_EQ(contact({0.5, 0, 0}, {0, 0, 0}), kNever);
+}
 
 TEST(CollisionTime, NeverNegativeOverRandomStates) {
   // Sweep gaps from -1e-3 to 1e-3 around contact, all approach angles: t is >= 0 or never.

@@ -39,8 +39,8 @@ double z_hard_spheres(double eta) {
   const double x = eta / (1.0 - eta);
   return 1 + 4 * x + 6 * x * x + 2.3647684 * std::pow(x, 3) - 0.8698551 * std::pow(x, 4) +
          1.1062803 * std::pow(x, 5) - 1.1014221 * std::pow(x, 6) + 0.66605866 * std::pow(x, 7) -
-         0.03633431 * std::pow(x, 8) - 0.20965164 * std::pow(x, 10) +
-         0.10555569 * std::pow(x, 14) - 0.00872380 * std::pow(x, 22);
+         0.03633431 * std::pow(x, 8) - 0.20965164 * std::pow(x, 10) + 0.10555569 * std::pow(x, 14) -
+         0.00872380 * std::pow(x, 22);
 }
 
 TEST(Physics, ReferenceSeriesReproducesTabulatedValues) {

@@ -156,6 +156,19 @@ class RestartBookkeeping(kt.KairosTestCase):
         self.assertEqual(header[0], "phase")
         self.assertGreater(len(rows), 0)
 
+    def test_restart_into_directory_of_another_system_is_refused(self):
+        cfg3 = self.write_config(config(3, "calendar", 5.0), "three.toml")
+        cfg2 = self.write_config(config(2, "calendar", 5.0), "two.toml")
+        self.run_ok("run", cfg3, "-o", self.path("a"))
+        self.run_ok("run", cfg2, "-o", self.path("b"))
+        frames = len(kt.open_trajectory(self.path("a", "trajectory.gsd")))
+        # Continuing the 2D state into the 3D run's directory would append 400-particle 2D
+        # frames to a 500-particle 3D trajectory.
+        result = self.kairos("run", cfg2, "--restart", self.path("b", "restart.gsd"),
+                             "-o", self.path("a"))
+        self.assert_user_error(result, "trajectory.gsd", "another system")
+        self.assertEqual(len(kt.open_trajectory(self.path("a", "trajectory.gsd"))), frames)
+
     def test_periodic_restart_files(self):
         cfg = self.write_config(config(3, "calendar", 20.0, restart_interval=5.0))
         self.run_ok("run", cfg, "-o", self.path("out"))

@@ -69,7 +69,7 @@ TEST(EventQueues, EngineLikeSequencesMatchReference) {
   engine_like_sequence<BinaryHeapQueue>(1000, 0.0, 1.0, 50000, 1);
   engine_like_sequence<CalendarQueue>(1000, 0.0, 1.0, 50000, 1);
   engine_like_sequence<CalendarQueue>(1, 0.0, 1.0, 1000, 2);
-  engine_like_sequence<CalendarQueue>(3000, 1e4, 0.01, 50000, 3);  // late start, fine scale
+  engine_like_sequence<CalendarQueue>(3000, 1e4, 0.01, 50000, 3);     // late start, fine scale
   engine_like_sequence<CalendarQueue>(500, 0.0, 1.0, 20000, 4, 0.2);  // some never happen
 }
 
