@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/periodic.hpp"
 #include "dynamics/collision_time.hpp"
 #include "interactions/hard_sphere.hpp"
 #include "scheduler/binary_heap_queue.hpp"
@@ -13,23 +14,28 @@
 namespace kairos {
 
 template <int D, class Queue>
-EventEngine<D, Queue>::EventEngine(ParticleSystem<D> system) : sys_(std::move(system)) {
+EventEngine<D, Queue>::EventEngine(ParticleSystem<D> system, StartMode mode) : sys_(std::move(system)) {
   const std::size_t n = sys_.size();
   if (n < 2) throw InputError("a simulation needs at least 2 particles");
   double rmax = 0.0;
   for (const auto& k : sys_.kinematics) rmax = std::max(rmax, k.radius);
   grid_ = CellGrid<D>(sys_.box, 2.0 * rmax, n);
   if (sys_.collision_count.size() != n) sys_.collision_count.assign(n, 0);
-  const bool restart = sys_.events.size() == n && sys_.cell.size() == n;
-  if (restart) {
+  if (mode == StartMode::kResume) {
+    if (sys_.events.size() != n || sys_.cell.size() != n) {
+      throw InputError("cannot resume: the state carries no scheduler state (events, cells)");
+    }
     for (std::uint32_t i = 0; i < n; ++i) {
       check_restored_cell(i);
       grid_.insert(i, sys_.cell[i]);
     }
+    sys_.cell = {};  // the grid owns cell membership from here; export_state() writes it back
   } else {
     for (std::uint32_t i = 0; i < n; ++i) {
       advance_to(i, sys_.time);
-      grid_.insert(i, grid_.locate(sys_.kinematics[i].pos));
+      Vec<D>& x = sys_.kinematics[i].pos;
+      for (int a = 0; a < D; ++a) x[a] = wrap_into_box(x[a], sys_.box[a]);
+      grid_.insert(i, grid_.locate(x));
     }
     predict_all();
   }
@@ -273,10 +279,7 @@ std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
   std::vector<Vec<D>> out(sys_.size());
   for (std::size_t i = 0; i < sys_.size(); ++i) {
     Vec<D> x = sys_.position_at(i, sys_.time);
-    for (int a = 0; a < D; ++a) {
-      x[a] -= sys_.box[a] * std::floor(x[a] / sys_.box[a]);
-      if (x[a] >= sys_.box[a]) x[a] = 0.0;
-    }
+    for (int a = 0; a < D; ++a) x[a] = wrap_into_box(x[a], sys_.box[a]);
     out[i] = x;
   }
   return out;

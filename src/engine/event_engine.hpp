@@ -24,12 +24,16 @@ namespace kairos {
 
 enum class EventKind { kNone, kCollision, kCellCrossing, kStale };
 
+// How an engine starts: predict every event from the state, or resume the scheduler state the
+// ParticleSystem carries (from export_state() or a restart file) to continue bit-identically.
+enum class StartMode { kPredict, kResume };
+
 template <int D, class Queue>
 class EventEngine {
  public:
-  // Takes the state; predicts every event unless the state carries the scheduler's own
-  // (a restart), in which case it continues exactly where that run stopped.
-  explicit EventEngine(ParticleSystem<D> system);
+  // Takes the state. kResume requires the scheduler state (events and cells) and throws
+  // InputError if it is missing or inconsistent with the positions.
+  explicit EventEngine(ParticleSystem<D> system, StartMode mode = StartMode::kPredict);
 
   // Processes the next event. Returns kNone when nothing can ever happen again.
   EventKind step();

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/periodic.hpp"
 
 namespace kairos {
 namespace {
@@ -95,15 +96,6 @@ double round_down_6(double x) {
   return r > x ? std::nextafter(x, 0.0) : r;
 }
 
-// x wrapped into [0, L).
-double wrap(double x, double L) {
-  if (x >= 0.0 && x < L) return x;
-  double y = x - L * std::floor(x / L);
-  if (y >= L) y -= L;
-  if (y < 0.0) y = 0.0;
-  return y;
-}
-
 template <int D>
 double box_volume(const std::array<double, D>& box) {
   double v = 1.0;
@@ -156,7 +148,7 @@ class CellGrid {
   std::array<std::size_t, D> coords(const std::array<double, D>& x) const {
     std::array<std::size_t, D> c{};
     for (int k = 0; k < D; ++k) {
-      const double u = wrap(x[k], box_[k]) / box_[k] * static_cast<double>(n_[k]);
+      const double u = wrap_into_box(x[k], box_[k]) / box_[k] * static_cast<double>(n_[k]);
       c[k] = std::min(static_cast<std::size_t>(u), n_[k] - 1);
     }
     return c;
@@ -464,7 +456,7 @@ class VoxelSampler {
     for (int k = 0; k < D; ++k) {
       const double c = static_cast<double>(voxel % m_[k]);
       voxel /= m_[k];
-      x[k] = wrap((c + uniform01(rng)) * h_[k], box_[k]);
+      x[k] = wrap_into_box((c + uniform01(rng)) * h_[k], box_[k]);
     }
     return x;
   }

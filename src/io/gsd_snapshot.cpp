@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/periodic.hpp"
 #include "io/atomic_file.hpp"
 
 namespace kairos {
@@ -35,14 +36,6 @@ std::vector<std::string> unpack_type_names(const std::vector<std::int8_t>& raw, 
     names.push_back(s);
   }
   return names;
-}
-
-// x wrapped into [0, L). x - L floor(x / L) alone gives exactly L for a tiny negative x.
-double wrap_into_box(double x, double L) {
-  double y = x - L * std::floor(x / L);
-  if (y >= L) y -= L;
-  if (y < 0.0) y = 0.0;
-  return y;
 }
 
 // x as a float32 coordinate in HOOMD's centred box [-L/2, L/2). A coordinate just below L/2

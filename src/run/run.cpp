@@ -193,7 +193,7 @@ class RunDriver {
                                  : std::numbers::pi * k.radius * k.radius;
     }
     try {
-      engine_.emplace(std::move(start));
+      engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict);
     } catch (const InputError& e) {
       if (!restart_file) throw;
       throw InputError("restart file '" + restart_file->string() + "': " + e.what());

@@ -1,6 +1,7 @@
 // Engine correctness: conservation, no overlap, validated scheduler state, queue equivalence.
 #include <gtest/gtest.h>
 
+#include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "engine_fixtures.hpp"
 #include "init/initial_state.hpp"
@@ -98,7 +99,7 @@ TEST(EventEngine, ContinuingFromExportedStateIsBitIdentical) {
   for (int e = 0; e < 20000; ++e) whole.step();
   EventEngine<3, CalendarQueue> first(start);
   for (int e = 0; e < 10000; ++e) first.step();
-  EventEngine<3, CalendarQueue> second(first.export_state());
+  EventEngine<3, CalendarQueue> second(first.export_state(), StartMode::kResume);
   for (int e = 0; e < 10000; ++e) second.step();
   ASSERT_EQ(whole.time(), second.time());
   for (std::size_t i = 0; i < whole.size(); ++i) {
@@ -106,6 +107,30 @@ TEST(EventEngine, ContinuingFromExportedStateIsBitIdentical) {
       ASSERT_EQ(whole.system().kinematics[i].pos[k], second.system().kinematics[i].pos[k]);
       ASSERT_EQ(whole.system().kinematics[i].vel[k], second.system().kinematics[i].vel[k]);
     }
+  }
+}
+
+TEST(EventEngine, ResumeNeedsSchedulerState) {
+  const auto fresh = testing::lattice_system<3>(4, 0.3, 14);
+  EXPECT_THROW((EventEngine<3, CalendarQueue>(fresh, StartMode::kResume)), InputError);
+  // A stored cell that does not contain the particle is refused, not trusted.
+  EventEngine<3, CalendarQueue> engine(fresh);
+  ParticleSystem<3> state = engine.export_state();
+  state.cell[0] = (state.cell[0] + 1) % engine.grid().cell_count();
+  EXPECT_THROW((EventEngine<3, CalendarQueue>(state, StartMode::kResume)), InputError);
+}
+
+TEST(EventEngine, PositionsOutsideTheBoxAreWrappedIn) {
+  auto s = testing::lattice_system<3>(5, 0.3, 15);
+  for (auto& k : s.kinematics) k.pos[0] += 3.0 * s.box[0];  // three images away
+  EventEngine<3, CalendarQueue> engine(s);
+  for (std::size_t i = 0; i < engine.size(); ++i) {
+    EXPECT_GE(engine.system().kinematics[i].pos[0], 0.0);
+    EXPECT_LT(engine.system().kinematics[i].pos[0], s.box[0]);
+  }
+  for (int e = 0; e < 500; ++e) {
+    engine.step();
+    engine.validate();
   }
 }
 
