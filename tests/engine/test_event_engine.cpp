@@ -76,6 +76,17 @@ TEST(EventEngine, ConservesEnergyAndMomentumOverAMillionEvents2D) {
   check_conservation<2, CalendarQueue>(testing::lattice_system<2>(32, 0.6, 8, 2.0, 1.2), 1000000);
 }
 
+template <int D>
+void expect_bit_identical(const ParticleSystem<D>& a, const ParticleSystem<D>& b) {
+  ASSERT_EQ(a.time, b.time);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (int k = 0; k < D; ++k) {
+      ASSERT_EQ(a.kinematics[i].pos[k], b.kinematics[i].pos[k]) << "particle " << i;
+      ASSERT_EQ(a.kinematics[i].vel[k], b.kinematics[i].vel[k]) << "particle " << i;
+    }
+  }
+}
+
 TEST(EventEngine, HeapAndCalendarGiveBitIdenticalRuns) {
   const auto start = testing::lattice_system<3>(8, 0.45, 9);
   EventEngine<3, BinaryHeapQueue> a(start);
@@ -84,13 +95,7 @@ TEST(EventEngine, HeapAndCalendarGiveBitIdenticalRuns) {
     a.step();
     b.step();
   }
-  ASSERT_EQ(a.time(), b.time());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    for (int k = 0; k < 3; ++k) {
-      ASSERT_EQ(a.system().kinematics[i].pos[k], b.system().kinematics[i].pos[k]);
-      ASSERT_EQ(a.system().kinematics[i].vel[k], b.system().kinematics[i].vel[k]);
-    }
-  }
+  expect_bit_identical(a.system(), b.system());
 }
 
 TEST(EventEngine, ContinuingFromExportedStateIsBitIdentical) {
@@ -101,13 +106,7 @@ TEST(EventEngine, ContinuingFromExportedStateIsBitIdentical) {
   for (int e = 0; e < 10000; ++e) first.step();
   EventEngine<3, CalendarQueue> second(first.export_state(), StartMode::kResume);
   for (int e = 0; e < 10000; ++e) second.step();
-  ASSERT_EQ(whole.time(), second.time());
-  for (std::size_t i = 0; i < whole.size(); ++i) {
-    for (int k = 0; k < 3; ++k) {
-      ASSERT_EQ(whole.system().kinematics[i].pos[k], second.system().kinematics[i].pos[k]);
-      ASSERT_EQ(whole.system().kinematics[i].vel[k], second.system().kinematics[i].vel[k]);
-    }
-  }
+  expect_bit_identical(whole.system(), second.system());
 }
 
 TEST(EventEngine, ResumeNeedsSchedulerState) {
