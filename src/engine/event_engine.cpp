@@ -14,7 +14,8 @@
 namespace kairos {
 
 template <int D, class Queue>
-EventEngine<D, Queue>::EventEngine(ParticleSystem<D> system, StartMode mode) : sys_(std::move(system)) {
+EventEngine<D, Queue>::EventEngine(ParticleSystem<D> system, StartMode mode)
+    : sys_(std::move(system)) {
   const std::size_t n = sys_.size();
   if (n < 2) throw InputError("a simulation needs at least 2 particles");
   double rmax = 0.0;

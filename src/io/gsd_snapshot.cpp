@@ -156,7 +156,7 @@ void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& syste
 
 template <int D>
 void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s,
-                   const std::mt19937_64& rng) {
+                   const std::mt19937_64& rng, const RunProgress& progress) {
   replace_file_atomically(path, [&](const std::filesystem::path& tmp) {
     auto w = gsd::Writer::create(tmp, "kairos " KAIROS_VERSION);
     write_standard_chunks(w, s, true);
@@ -209,6 +209,7 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     w.write_chunk("kairos/state/counters", 4, 1, counters);
     w.write_chunk("kairos/state/virial", 1, 1, &s.counters.virial);
     w.write_chunk("kairos/state/rng", rng_bytes.size(), 1, rng_bytes.data());
+    w.write_chunk("kairos/run/equilibration_remaining", 1, 1, &progress.equilibration_remaining);
     w.end_frame();
     w.close();
   });
@@ -222,7 +223,8 @@ int gsd_dimension(const std::filesystem::path& path) {
 }
 
 template <int D>
-ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_64& rng) {
+ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_64& rng,
+                               RunProgress* progress) {
   const gsd::Reader r(path);
   const std::uint64_t f = r.frame_count() == 0 ? 0 : r.frame_count() - 1;
   if (r.frame_count() == 0 || !r.find(f, "kairos/format")) {
@@ -276,6 +278,17 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   std::istringstream rng_text(std::string(rng_bytes.begin(), rng_bytes.end()));
   rng_text >> rng;
   if (!rng_text) throw InputError("'" + path.string() + "': corrupt RNG state");
+  if (progress != nullptr) {
+    *progress = {};
+    if (r.find(f, "kairos/run/equilibration_remaining")) {
+      const double left = require<double>(r, f, "kairos/run/equilibration_remaining", path, 1)[0];
+      if (!std::isfinite(left) || left < 0.0) {
+        throw InputError("'" + path.string() + "': kairos/run/equilibration_remaining is " +
+                         std::to_string(left));
+      }
+      progress->equilibration_remaining = left;
+    }
+  }
   return s;
 }
 
@@ -396,11 +409,13 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
 template void append_trajectory_frame<2>(gsd::Writer&, const ParticleSystem<2>&);
 template void append_trajectory_frame<3>(gsd::Writer&, const ParticleSystem<3>&);
 template void write_restart<2>(const std::filesystem::path&, const ParticleSystem<2>&,
-                               const std::mt19937_64&);
+                               const std::mt19937_64&, const RunProgress&);
 template void write_restart<3>(const std::filesystem::path&, const ParticleSystem<3>&,
-                               const std::mt19937_64&);
-template ParticleSystem<2> read_restart<2>(const std::filesystem::path&, std::mt19937_64&);
-template ParticleSystem<3> read_restart<3>(const std::filesystem::path&, std::mt19937_64&);
+                               const std::mt19937_64&, const RunProgress&);
+template ParticleSystem<2> read_restart<2>(const std::filesystem::path&, std::mt19937_64&,
+                                           RunProgress*);
+template ParticleSystem<3> read_restart<3>(const std::filesystem::path&, std::mt19937_64&,
+                                           RunProgress*);
 template InitialState<2> read_initial_state<2>(const std::filesystem::path&, bool&);
 template InitialState<3> read_initial_state<3>(const std::filesystem::path&, bool&);
 

@@ -24,15 +24,21 @@ namespace kairos {
 template <int D>
 void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& system);
 
+// Where the run that wrote a restart file stood, beyond the physical state.
+struct RunProgress {
+  double equilibration_remaining = 0.0;  // collisions per particle still to equilibrate
+};
+
 // Writes the restart file atomically (temporary file + rename).
 template <int D>
 void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& full_state,
-                   const std::mt19937_64& rng);
+                   const std::mt19937_64& rng, const RunProgress& progress = {});
 
 // Reads a restart file written by write_restart; InputError if it is not one or if its
-// dimension differs from D.
+// dimension differs from D. `progress` (optional) receives the run's progress.
 template <int D>
-ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_64& rng);
+ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_64& rng,
+                               RunProgress* progress = nullptr);
 
 // The spatial dimension stored in a GSD file's last frame (configuration/dimensions).
 int gsd_dimension(const std::filesystem::path& path);

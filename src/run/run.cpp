@@ -116,12 +116,12 @@ void note_ignored_system_keys(const Config& config, std::size_t n, const std::st
 template <int D>
 ParticleSystem<D> build_start_state(const Config& config,
                                     const std::optional<fs::path>& restart_file,
-                                    std::mt19937_64& rng) {
+                                    std::mt19937_64& rng, RunProgress& progress) {
   if (restart_file) {
     if (!fs::exists(*restart_file)) {
       throw InputError("restart file '" + restart_file->string() + "' does not exist");
     }
-    ParticleSystem<D> s = read_restart<D>(*restart_file, rng);
+    ParticleSystem<D> s = read_restart<D>(*restart_file, rng, &progress);
     note_ignored_system_keys(config, s.size(), "the restart file");
     return s;
   }
@@ -183,7 +183,7 @@ class RunDriver {
  public:
   RunDriver(const Config& config, const std::optional<fs::path>& restart_file)
       : config_(config), restart_(restart_file.has_value()), rng_(config.system.seed) {
-    ParticleSystem<D> start = build_start_state<D>(config, restart_file, rng_);
+    ParticleSystem<D> start = build_start_state<D>(config, restart_file, rng_, resumed_);
     n_ = start.size();
     volume_ = 1.0;
     for (int a = 0; a < D; ++a) volume_ *= start.box[a];
@@ -227,7 +227,9 @@ class RunDriver {
     last_ = point();
     ProgressLine progress(config_.output.progress);
 
-    const double eq = restart_ ? 0.0 : config_.run.equilibration_collisions_per_particle;
+    // A restart continues an interrupted equilibration, otherwise goes straight to production.
+    const double eq = restart_ ? resumed_.equilibration_remaining
+                               : config_.run.equilibration_collisions_per_particle;
     bool stopped = false;
     if (eq > 0.0) {
       stopped = run_phase("equilibration", eq, progress, wall_start);
@@ -251,7 +253,7 @@ class RunDriver {
     outcome.directory = dir_;
     outcome.interrupted = stopped;
     outcome.summary = summary(wall);  // before the restart copy inflates the peak memory
-    write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_);
+    write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
     write_text_atomically(dir_ / "summary.json", outcome.summary.dump(2) + "\n");
     return outcome;
   }
@@ -273,6 +275,16 @@ class RunDriver {
     }
   }
 
+  // Equilibration still owed if the run stops now (a restart file records it).
+  RunProgress progress_now() const {
+    RunProgress p;
+    const std::uint64_t c = engine_->counters().collisions;
+    if (phase_ == "equilibration" && c < equilibration_target_) {
+      p.equilibration_remaining = per_particle(equilibration_target_ - c);
+    }
+    return p;
+  }
+
   ThermoPoint point() const {
     const auto& c = engine_->counters();
     return {engine_->time(), c.virial, c.events, c.collisions};
@@ -291,6 +303,7 @@ class RunDriver {
     phase_ = phase;
     const std::uint64_t begin = engine_->counters().collisions;
     const std::uint64_t target = begin + collisions_for(length);
+    if (phase == "equilibration") equilibration_target_ = target;
     const double auto_length = config_.run.collisions_per_particle;
     const double thermo_every =
         config_.output.thermo_interval > 0 ? config_.output.thermo_interval : auto_length / 100.0;
@@ -328,7 +341,7 @@ class RunDriver {
         next_traj += traj_step;
       }
       if (c >= next_restart) {
-        write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_);
+        write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
         next_restart += restart_step;
       }
       if (g_stop.load(std::memory_order_relaxed)) {
@@ -459,6 +472,8 @@ class RunDriver {
   std::uint64_t events_start_ = 0, collisions_start_ = 0;
   std::vector<double> z_samples_, mft_samples_;
   std::string phase_ = "production";
+  std::uint64_t equilibration_target_ = 0;
+  RunProgress resumed_;  // progress recorded in the restart file this run continues
   std::string stop_reason_ = "completed";
 };
 

@@ -106,6 +106,32 @@ class RestartBookkeeping(kt.KairosTestCase):
         phases = {row[0] for row in rows}
         self.assertEqual(phases, {"production"}, "a restart must not equilibrate again")
 
+    def test_interrupted_equilibration_is_resumed(self):
+        # The wall-time limit is checked every 16384 events: with a limit of 0.1 ms the run
+        # stops at event 16384, deep inside 200 collisions per particle of equilibration.
+        cfg = kt.base_config(particles=500, packing_fraction=0.4, equilibration=200.0,
+                             production=5.0, run={"max_wall_seconds": 0.0001})
+        first = self.write_config(cfg, "first.toml")
+        self.run_ok("run", first, "-o", self.path("a"))
+        stopped = self.summary(self.path("a"))
+        self.assertEqual(stopped["stop_reason"], "wall_time_limit")
+        left = kt.restart_chunk(self.path("a", "restart.gsd"),
+                                "kairos/run/equilibration_remaining")[0]
+        self.assertGreater(left, 0.0)
+        cfg["run"]["max_wall_seconds"] = 0.0
+        second = self.write_config(cfg, "second.toml")
+        self.run_ok("run", second, "--restart", self.path("a", "restart.gsd"),
+                    "-o", self.path("b"))
+        done = self.summary(self.path("b"))
+        # The rest of the equilibration, then the whole production.
+        self.assertEqual(done["event_counts"]["total_collisions_since_start"], (200 + 5) * 250)
+        self.assertEqual(done["production_collisions_per_particle"], 5.0)
+        _, rows, _ = kt.read_thermo(self.path("b", "thermo.tsv"))
+        self.assertEqual(rows[0][0], "equilibration")
+        self.assertEqual(rows[-1][0], "production")
+        self.assertEqual(kt.restart_chunk(self.path("b", "restart.gsd"),
+                                          "kairos/run/equilibration_remaining")[0], 0.0)
+
     def test_restart_into_same_directory_appends(self):
         out = self.path("out")
         cfg = self.write_config(config(3, "calendar", 20.0, trajectory_interval=5.0))
