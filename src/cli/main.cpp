@@ -93,7 +93,8 @@ int main(int argc, char** argv) {
       ->allow_extra_args(false);  // one value per --set, so `--set k=v CONFIG` keeps CONFIG
   auto* restart_option = run->add_option(
       "--restart", restart,
-      "Continue from a restart file (OUTDIR/restart.gsd); equilibration is skipped and "
+      "Continue from a restart file (OUTDIR/restart.gsd) bit-identically: a finished "
+      "equilibration is not repeated (an interrupted one is completed), then "
       "run.collisions_per_particle more collisions per particle are simulated");
   run->footer(
       "Outputs in OUTDIR: config.toml, thermo.tsv, trajectory.gsd, restart.gsd, summary.json.\n"
