@@ -11,7 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "analysis/block_average.hpp"
+#include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
@@ -149,13 +149,6 @@ std::uint64_t peak_rss_bytes() {
   return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024u;
 }
 
-// Thermodynamics over one interval, from the collision virial W = sum r_ij . J_i:
-// Z = 1 + W / (D N kT dt), P = Z N kT / V, kT = 2 KE / (D (N - 1)).
-struct ThermoPoint {
-  double time = 0.0, virial = 0.0;
-  std::uint64_t events = 0, collisions = 0;
-};
-
 class ThermoWriter {
  public:
   ThermoWriter(const fs::path& path, bool append) {
@@ -169,12 +162,19 @@ class ThermoWriter {
     }
   }
   // One row per line, each flushed at once: an interrupted run keeps every earlier row.
+  void write(const std::string& phase, const ThermoRow& r) {
+    write_line(fmt::format(
+        "{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\n", phase,
+        r.at.time, r.at.events, r.at.collisions, r.collisions_per_particle, r.temperature,
+        r.pressure, r.compressibility, r.kinetic_energy, r.mean_free_time));
+  }
+
+ private:
   void write_line(const std::string& line) {
     out_ << line;
     out_.flush();
   }
 
- private:
   std::ofstream out_;
 };
 
@@ -192,6 +192,7 @@ class RunDriver {
       particle_volume_ += D == 3 ? 4.0 / 3.0 * std::numbers::pi * k.radius * k.radius * k.radius
                                  : std::numbers::pi * k.radius * k.radius;
     }
+    thermo_stats_.emplace(D, n_, volume_);
     try {
       engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict);
     } catch (const InputError& e) {
@@ -224,7 +225,7 @@ class RunDriver {
     p_start_ = engine_->momentum();
     events_start_ = engine_->counters().events;
     collisions_start_ = engine_->counters().collisions;
-    last_ = point();
+    thermo_stats_->mark(point());
     ProgressLine progress(config_.output.progress);
 
     // A restart continues an interrupted equilibration, otherwise goes straight to production.
@@ -234,14 +235,16 @@ class RunDriver {
     if (eq > 0.0) {
       stopped = run_phase("equilibration", eq, progress, wall_start);
       // Close the equilibration rows so no production row spans both phases.
-      if (engine_->counters().collisions > last_.collisions) write_thermo_row("equilibration");
+      if (engine_->counters().collisions > thermo_stats_->last().collisions) {
+        write_thermo_row("equilibration");
+      }
     }
     prod_start_ = point();
     prod_ke_ = engine_->kinetic_energy();
     if (!stopped)
       stopped = run_phase("production", config_.run.collisions_per_particle, progress, wall_start);
     progress.finish();
-    if (engine_->counters().collisions > last_.collisions) write_thermo_row(phase_);
+    if (engine_->counters().collisions > thermo_stats_->last().collisions) write_thermo_row(phase_);
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
 
     if (trajectory_) {
@@ -289,12 +292,11 @@ class RunDriver {
     const auto& c = engine_->counters();
     return {engine_->time(), c.virial, c.events, c.collisions};
   }
-  double temperature(double ke) const { return 2.0 * ke / (D * (static_cast<double>(n_) - 1.0)); }
   std::uint64_t collisions_for(double per_particle) const {
     return static_cast<std::uint64_t>(std::llround(per_particle * static_cast<double>(n_) / 2.0));
   }
   double per_particle(std::uint64_t collisions) const {
-    return 2.0 * static_cast<double>(collisions) / static_cast<double>(n_);
+    return thermo_stats_->per_particle(collisions);
   }
 
   // Runs until `length` more collisions per particle; returns true if stopped early.
@@ -370,30 +372,15 @@ class RunDriver {
   }
 
   void write_thermo_row(const std::string& phase) {
-    const ThermoPoint now = point();
-    const double ke = engine_->kinetic_energy();
-    const double kT = temperature(ke);
-    const double dt = now.time - last_.time;
-    const double dc = static_cast<double>(now.collisions - last_.collisions);
-    double z = std::nan(""), mft = std::nan("");
-    if (dt > 0.0 && kT > 0.0) {
-      z = 1.0 + (now.virial - last_.virial) / (D * static_cast<double>(n_) * kT * dt);
-      if (dc > 0) mft = static_cast<double>(n_) * dt / (2.0 * dc);
-    }
-    const double pressure = z * static_cast<double>(n_) * kT / volume_;
-    thermo_->write_line(
-        fmt::format("{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\n",
-                    phase, now.time, now.events, now.collisions, per_particle(now.collisions), kT,
-                    pressure, z, ke, mft));
-    if (phase == "production" && std::isfinite(z)) z_samples_.push_back(z);
-    if (phase == "production" && std::isfinite(mft)) mft_samples_.push_back(mft);
-    last_ = now;
+    thermo_->write(phase,
+                   thermo_stats_->row(point(), engine_->kinetic_energy(), phase == "production"));
   }
 
   nlohmann::json summary(double wall) const {
     const auto& c = engine_->counters();
     const double ke = engine_->kinetic_energy();
-    const double kT = temperature(ke);
+    const Thermodynamics& th = *thermo_stats_;
+    const double kT = th.temperature(ke);
     const Vec<D> p = engine_->momentum();
     double pscale = 0.0, dp2 = 0.0;
     for (std::size_t i = 0; i < n_; ++i)
@@ -401,13 +388,9 @@ class RunDriver {
     for (int a = 0; a < D; ++a) dp2 += (p[a] - p_start_[a]) * (p[a] - p_start_[a]);
     const double t_prod = engine_->time() - prod_start_.time;
     const std::uint64_t coll_prod = c.collisions - prod_start_.collisions;
-    const double kT_prod = temperature(prod_ke_);
-    const BlockAverage z_blocks = block_average(z_samples_);
-    double z_mean = std::nan("");
-    if (t_prod > 0 && kT_prod > 0) {
-      z_mean =
-          1.0 + (c.virial - prod_start_.virial) / (D * static_cast<double>(n_) * kT_prod * t_prod);
-    }
+    const double kT_prod = th.temperature(prod_ke_);
+    const BlockAverage z_blocks = th.compressibility_blocks();
+    const double z_mean = th.compressibility(c.virial - prod_start_.virial, kT_prod, t_prod);
     std::vector<double> diameters(n_);
     for (std::size_t i = 0; i < n_; ++i)
       diameters[i] = 2.0 * engine_->system().kinematics[i].radius;
@@ -443,11 +426,9 @@ class RunDriver {
                             {"stderr", z_blocks.stderr_},
                             {"blocks", z_blocks.samples},
                             {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
-    j["pressure"] = z_mean * static_cast<double>(n_) * kT_prod / volume_;
-    j["mean_free_time"] =
-        coll_prod > 0 ? static_cast<double>(n_) * t_prod / (2.0 * static_cast<double>(coll_prod))
-                      : std::nan("");
-    j["mean_free_time_stderr"] = block_average(mft_samples_).stderr_;
+    j["pressure"] = th.pressure(z_mean, kT_prod);
+    j["mean_free_time"] = th.mean_free_time(t_prod, coll_prod);
+    j["mean_free_time_stderr"] = th.mean_free_time_blocks().stderr_;
     j["energy_drift_relative"] = ke_start_ > 0 ? std::abs(ke - ke_start_) / ke_start_ : 0.0;
     j["momentum_drift"] = pscale > 0 ? std::sqrt(dp2) / pscale : 0.0;
     j["max_overlap"] = overlap;
@@ -466,11 +447,11 @@ class RunDriver {
   std::optional<ThermoWriter> thermo_;
   std::optional<gsd::Writer> trajectory_;
   std::uint64_t frame_collisions_ = 0;
-  ThermoPoint last_, prod_start_;
+  std::optional<Thermodynamics> thermo_stats_;
+  ThermoPoint prod_start_;
   double ke_start_ = 0.0, prod_ke_ = 0.0;
   Vec<D> p_start_{};
   std::uint64_t events_start_ = 0, collisions_start_ = 0;
-  std::vector<double> z_samples_, mft_samples_;
   std::string phase_ = "production";
   std::uint64_t equilibration_target_ = 0;
   RunProgress resumed_;  // progress recorded in the restart file this run continues

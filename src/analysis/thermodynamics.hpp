@@ -1,0 +1,61 @@
+// Thermodynamics of a hard-particle run from its event counters (docs/outputs.md):
+//   kT = 2 K / (D (N - 1))                 (total momentum fixed: D (N - 1) degrees of freedom)
+//   Z  = 1 + W / (D N kT t)                W = sum over collisions of r_ij . J_i
+//   P  = Z N kT / V,  mean free time = N t / (2 N_coll),  c = 2 N_coll / N.
+// Rows cover the interval since the previous row; production rows feed the block averages.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "analysis/block_average.hpp"
+
+namespace kairos {
+
+// Cumulative counters at one instant.
+struct ThermoPoint {
+  double time = 0.0;
+  double virial = 0.0;
+  std::uint64_t events = 0;
+  std::uint64_t collisions = 0;
+};
+
+struct ThermoRow {
+  ThermoPoint at;
+  double collisions_per_particle = 0.0;  // cumulative
+  double temperature = 0.0;
+  double pressure = 0.0;         // over the interval
+  double compressibility = 0.0;  // over the interval (NaN for an empty interval)
+  double kinetic_energy = 0.0;
+  double mean_free_time = 0.0;  // over the interval (NaN without collisions)
+};
+
+class Thermodynamics {
+ public:
+  Thermodynamics(int dimension, std::size_t particles, double volume);
+
+  double temperature(double kinetic_energy) const;
+  double compressibility(double virial, double kT, double duration) const;
+  double pressure(double compressibility, double kT) const;
+  double mean_free_time(double duration, std::uint64_t collisions) const;
+  double per_particle(std::uint64_t collisions) const;
+
+  // Starts the next interval at `p` without a row (e.g. at the start of a run).
+  void mark(const ThermoPoint& p) { last_ = p; }
+  const ThermoPoint& last() const { return last_; }
+  // The row for the interval from the last mark to `now`; starts the next interval at `now`.
+  ThermoRow row(const ThermoPoint& now, double kinetic_energy, bool production);
+
+  BlockAverage compressibility_blocks() const { return block_average(z_samples_); }
+  BlockAverage mean_free_time_blocks() const { return block_average(mft_samples_); }
+
+ private:
+  double dimension_;
+  double n_;
+  double volume_;
+  ThermoPoint last_;
+  std::vector<double> z_samples_, mft_samples_;
+};
+
+}  // namespace kairos
