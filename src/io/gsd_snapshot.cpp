@@ -146,6 +146,26 @@ void validate_restart(const ParticleSystem<D>& s, const std::filesystem::path& p
   }
 }
 
+// A per-particle property from the exact float64 chunk (times `scale`) when present, else from
+// the HOOMD float32 chunk, else HOOMD's default of 1.
+std::vector<double> per_particle_property(const gsd::Reader& r, std::uint64_t f,
+                                          const std::filesystem::path& path, std::size_t n,
+                                          std::string_view exact, double scale,
+                                          std::string_view hoomd) {
+  std::vector<double> out;
+  if (auto v = read_latest<double>(r, f, exact); v && v->size() == n) {
+    for (double x : *v) out.push_back(scale * x);
+  } else if (auto w = read_latest<float>(r, f, hoomd)) {
+    if (w->size() != n) {
+      throw InputError("'" + path.string() + "': " + std::string(hoomd) + " has the wrong size");
+    }
+    out.assign(w->begin(), w->end());
+  } else {
+    out.assign(n, 1.0);
+  }
+  return out;
+}
+
 }  // namespace
 
 template <int D>
@@ -361,24 +381,8 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   }
   for (std::size_t i = 0; i < n; ++i)
     for (int a = 0; a < D; ++a) check_finite(s.velocity[i][a], "velocity", i);
-  if (auto radius = read_latest<double>(r, f, "kairos/radius"); radius && radius->size() == n) {
-    for (double x : *radius) s.diameter.push_back(2.0 * x);
-  } else if (auto d = read_latest<float>(r, f, "particles/diameter")) {
-    if (d->size() != n)
-      throw InputError("'" + path.string() + "': particles/diameter has the wrong size");
-    s.diameter.assign(d->begin(), d->end());
-  } else {
-    s.diameter.assign(n, 1.0);
-  }
-  if (auto m = read_latest<double>(r, f, "kairos/mass"); m && m->size() == n) {
-    s.mass = *m;
-  } else if (auto mf = read_latest<float>(r, f, "particles/mass")) {
-    if (mf->size() != n)
-      throw InputError("'" + path.string() + "': particles/mass has the wrong size");
-    s.mass.assign(mf->begin(), mf->end());
-  } else {
-    s.mass.assign(n, 1.0);
-  }
+  s.diameter = per_particle_property(r, f, path, n, "kairos/radius", 2.0, "particles/diameter");
+  s.mass = per_particle_property(r, f, path, n, "kairos/mass", 1.0, "particles/mass");
   for (std::size_t i = 0; i < n; ++i) {
     if (!(s.diameter[i] > 0.0) || !std::isfinite(s.diameter[i]))
       throw InputError("system.initial_state '" + path.string() + "': diameter of particle " +
