@@ -21,24 +21,28 @@ ProgressLine::ProgressLine(const std::string& mode) {
   enabled_ = mode == "always" || (mode == "auto" && tty_);
 }
 
-void ProgressLine::update(const ProgressInfo& info) {
+void ProgressLine::update(const ProgressInfo& info, bool force) {
   if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();
   if (info.phase != phase_) {
     if (drawn_ && tty_) std::fputc('\n', stderr);
     phase_ = info.phase;
-    phase_start_ = now;
+    phase_start_ = last_ = now;
+    last_events_ = info.events;
     drawn_ = false;
+    return;  // nothing to show yet: the rate needs an interval
   }
   const double since = std::chrono::duration<double>(now - last_).count();
-  if (drawn_ && since < (tty_ ? 0.25 : 5.0)) return;
+  if (!force && since < (drawn_ ? (tty_ ? 0.25 : 5.0) : 0.25)) return;
+  if (since > 0.0) rate_ = static_cast<double>(info.events - last_events_) / since;
   last_ = now;
+  last_events_ = info.events;
   const double frac = info.total > 0 ? std::min(1.0, info.done / info.total) : 1.0;
   const double elapsed = std::chrono::duration<double>(now - phase_start_).count();
   const double eta = frac > 1e-9 ? elapsed * (1.0 - frac) / frac : -1.0;
   const std::string line = fmt::format(
       "[{:<13} {:5.1f}%] {:.1f}/{:.0f} coll/particle | t = {:.6g} | {:.3g} M events/s | ETA {}",
-      info.phase, 100.0 * frac, info.done, info.total, info.sim_time, info.events_per_second / 1e6,
+      info.phase, 100.0 * frac, info.done, info.total, info.sim_time, rate_ / 1e6,
       format_duration(eta));
   if (tty_) {
     std::fprintf(stderr, "\r%-100s", line.c_str());

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <string>
 
 namespace kairos {
@@ -14,7 +15,7 @@ struct ProgressInfo {
   double done = 0.0;   // collisions per particle done in this phase
   double total = 0.0;  // collisions per particle in this phase
   double sim_time = 0.0;
-  double events_per_second = 0.0;
+  std::uint64_t events = 0;  // cumulative; the line shows the rate since the previous draw
 };
 
 class ProgressLine {
@@ -22,8 +23,9 @@ class ProgressLine {
   // mode: "auto" (only on a terminal), "always" or "never".
   explicit ProgressLine(const std::string& mode);
   bool enabled() const { return enabled_; }
-  // Draws if enough wall time has passed since the last draw.
-  void update(const ProgressInfo& info);
+  // Draws if enough wall time has passed since the last draw, or always when `force` is set
+  // (the end of a phase).
+  void update(const ProgressInfo& info, bool force = false);
   // Ends the line (a newline on terminals).
   void finish();
 
@@ -34,6 +36,8 @@ class ProgressLine {
   std::chrono::steady_clock::time_point phase_start_{};
   std::string phase_;
   bool drawn_ = false;
+  std::uint64_t last_events_ = 0;
+  double rate_ = 0.0;
 };
 
 std::string format_duration(double seconds);

@@ -321,9 +321,7 @@ class RunDriver {
     std::uint64_t next_thermo = begin + thermo_step;
     std::uint64_t next_traj = begin + traj_step;
     std::uint64_t next_restart = restart_step ? begin + restart_step : ~0ull;
-    auto rate_clock = Clock::now();
-    std::uint64_t rate_events = engine_->counters().events;
-    double rate = 0.0;
+    progress.update({phase, 0.0, length, engine_->time(), engine_->counters().events});
     while (engine_->counters().collisions < target) {
       if (engine_->step() == EventKind::kNone) {
         stop_reason_ = "no_more_events";  // every particle at rest, or alone
@@ -352,13 +350,8 @@ class RunDriver {
       }
       if ((engine_->counters().events & 0x3fffu) == 0) {
         const auto now = Clock::now();
-        const double dt = std::chrono::duration<double>(now - rate_clock).count();
-        if (dt > 0.2) {
-          rate = static_cast<double>(engine_->counters().events - rate_events) / dt;
-          rate_clock = now;
-          rate_events = engine_->counters().events;
-        }
-        progress.update({phase, per_particle(c - begin), length, engine_->time(), rate});
+        progress.update(
+            {phase, per_particle(c - begin), length, engine_->time(), engine_->counters().events});
         if (config_.run.max_wall_seconds > 0 &&
             std::chrono::duration<double>(now - wall_start).count() >
                 config_.run.max_wall_seconds) {
@@ -367,7 +360,7 @@ class RunDriver {
         }
       }
     }
-    progress.update({phase, length, length, engine_->time(), rate});
+    progress.update({phase, length, length, engine_->time(), engine_->counters().events}, true);
     return false;
   }
 

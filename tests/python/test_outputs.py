@@ -286,6 +286,21 @@ class RunOutputs(OutputChecks):
                     'event_queue = "calendar"', "[[system.species]]", 'name = "A"'):
             self.assertIn(key, text)
 
+    def test_progress_line_and_final_summary(self):
+        # progress = "always" prints plain lines when stderr is not a terminal (as here).
+        cfg = self.write_config(kt.base_config(particles=2000, packing_fraction=0.3,
+                                               equilibration=5.0, production=60.0,
+                                               output={"progress": "always"}))
+        result = self.kairos("run", cfg, "-o", self.path("out"))
+        self.assertEqual(result.returncode, 0, kt.describe(result))
+        lines = [l for l in result.stderr.splitlines() if l.startswith("[")]
+        self.assertTrue(any(l.startswith("[equilibration") for l in lines), result.stderr)
+        last = [l for l in lines if l.startswith("[production")][-1]
+        for field in ("100.0%", "coll/particle", "t = ", "M events/s", "ETA"):
+            self.assertIn(field, last)
+        for field in ("compressibility Z", "mean free time", "energy drift", "max overlap"):
+            self.assertIn(field, result.stdout)
+
 
 class InitialStateFromGsd(OutputChecks):
     def test_from_kairos_trajectory(self):
