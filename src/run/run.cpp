@@ -178,6 +178,38 @@ class ThermoWriter {
   std::ofstream out_;
 };
 
+// When the periodic outputs of a phase are due, in collisions (not time: the same schedule at
+// any density). Intervals of 0 in the config mean: thermo 100 rows and trajectory 10 frames per
+// production length; restart files only at the end.
+struct OutputSchedule {
+  struct Every {
+    std::uint64_t step = 0, next = ~0ull;  // step 0: never
+    // True (once) when `collisions` has reached the next multiple.
+    bool due(std::uint64_t collisions) {
+      if (collisions < next) return false;
+      next += step;
+      return true;
+    }
+  };
+  Every thermo, trajectory, restart;
+
+  template <class ToCollisions>
+  OutputSchedule(const OutputConfig& out, double production, std::uint64_t begin,
+                 ToCollisions&& collisions_for) {
+    auto every = [&](double per_particle) {
+      Every e;
+      if (per_particle > 0.0) {
+        e.step = std::max<std::uint64_t>(1, collisions_for(per_particle));
+        e.next = begin + e.step;
+      }
+      return e;
+    };
+    thermo = every(out.thermo_interval > 0 ? out.thermo_interval : production / 100.0);
+    trajectory = every(out.trajectory_interval > 0 ? out.trajectory_interval : production / 10.0);
+    restart = every(out.restart_interval);
+  }
+};
+
 template <int D, class Queue>
 class RunDriver {
  public:
@@ -306,21 +338,8 @@ class RunDriver {
     const std::uint64_t begin = engine_->counters().collisions;
     const std::uint64_t target = begin + collisions_for(length);
     if (phase == "equilibration") equilibration_target_ = target;
-    const double auto_length = config_.run.collisions_per_particle;
-    const double thermo_every =
-        config_.output.thermo_interval > 0 ? config_.output.thermo_interval : auto_length / 100.0;
-    const double traj_every = config_.output.trajectory_interval > 0
-                                  ? config_.output.trajectory_interval
-                                  : auto_length / 10.0;
-    const std::uint64_t thermo_step = std::max<std::uint64_t>(1, collisions_for(thermo_every));
-    const std::uint64_t traj_step = std::max<std::uint64_t>(1, collisions_for(traj_every));
-    const std::uint64_t restart_step =
-        config_.output.restart_interval > 0
-            ? std::max<std::uint64_t>(1, collisions_for(config_.output.restart_interval))
-            : 0;
-    std::uint64_t next_thermo = begin + thermo_step;
-    std::uint64_t next_traj = begin + traj_step;
-    std::uint64_t next_restart = restart_step ? begin + restart_step : ~0ull;
+    OutputSchedule schedule(config_.output, config_.run.collisions_per_particle, begin,
+                            [&](double c) { return collisions_for(c); });
     progress.update({phase, 0.0, length, engine_->time(), engine_->counters().events});
     while (engine_->counters().collisions < target) {
       if (engine_->step() == EventKind::kNone) {
@@ -329,20 +348,13 @@ class RunDriver {
       }
       if (config_.run.validate) engine_->validate();
       const std::uint64_t c = engine_->counters().collisions;
-      if (c >= next_thermo) {
-        write_thermo_row(phase);
-        next_thermo += thermo_step;
+      if (schedule.thermo.due(c)) write_thermo_row(phase);
+      if (schedule.trajectory.due(c) && trajectory_) {
+        append_trajectory_frame(*trajectory_, engine_->system());
+        frame_collisions_ = c;
       }
-      if (c >= next_traj) {
-        if (trajectory_) {
-          append_trajectory_frame(*trajectory_, engine_->system());
-          frame_collisions_ = c;
-        }
-        next_traj += traj_step;
-      }
-      if (c >= next_restart) {
+      if (schedule.restart.due(c)) {
         write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
-        next_restart += restart_step;
       }
       if (g_stop.load(std::memory_order_relaxed)) {
         stop_reason_ = "signal";
