@@ -112,6 +112,7 @@ void EventEngine<D, Queue>::reset_candidates() {
 template <int D, class Queue>
 void EventEngine<D, Queue>::test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi, double ri,
                                             EventSlot& slot) const {
+  double best = slot.collision_time - t;  // soonest contact found so far, relative to t
   for (std::uint32_t k = 0; k < n_candidates_; ++k) {
     const std::uint32_t j = candidates_[k];
     const Vec<D>& shift = shifts_[candidate_shift_[k]];
@@ -125,8 +126,15 @@ void EventEngine<D, Queue>::test_candidates(double t, const Vec<D>& xi, const Ve
       rg += r * g;
       g2 += g * g;
     }
-    const double dt = HardSphere::contact_time(r2, rg, g2, ri + kj.radius);
-    if (t + dt < slot.collision_time) {
+    const double sigma = ri + kj.radius;
+    // Cheap rejection before the square root: the contact time 2a/(-b + sqrt(D)) is at least
+    // a/(-b) (b = 2 r.g < 0 when approaching), so a pair that cannot beat `best` is skipped.
+    // Receding pairs (r.g >= 0, the particle itself included) fail the same test.
+    const double gap = r2 - sigma * sigma;
+    if (!(rg < 0.0) || gap > -2.0 * rg * best) continue;
+    const double dt = HardSphere::contact_time(r2, rg, g2, sigma);
+    if (dt < best) {
+      best = dt;
       slot.collision_time = t + dt;
       slot.partner = j;
       slot.partner_count = sys_.collision_count[j];
