@@ -1,4 +1,5 @@
-// Periodic boundaries: the one definition of wrapping a coordinate into the box.
+// Periodic boundaries: the one definition of wrapping a coordinate into the box and of the
+// minimum image.
 #pragma once
 
 #include <cmath>
@@ -13,6 +14,12 @@ inline double wrap_into_box(double x, double L) {
   if (y >= L) y -= L;
   if (y < 0.0) y = 0.0;
   return y;
+}
+
+// The minimum-image component of a separation d in a periodic box of length L.
+inline double minimum_image(double d, double L) {
+  if (std::abs(d) > 0.5 * L) d -= L * std::round(d / L);
+  return d;
 }
 
 }  // namespace kairos

@@ -181,10 +181,7 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
   Vec<D> r;
   double g_dot_r = 0.0, r2 = 0.0;
   for (int a = 0; a < D; ++a) {
-    double d = ki.pos[a] - kj.pos[a];
-    const double L = sys_.box[a];
-    if (d > 0.5 * L) d -= L;
-    if (d < -0.5 * L) d += L;
+    const double d = minimum_image(ki.pos[a] - kj.pos[a], sys_.box[a]);
     r[a] = d;
     r2 += d * d;
     g_dot_r += (ki.vel[a] - kj.vel[a]) * d;
@@ -375,7 +372,7 @@ void EventEngine<D, Queue>::validate() {
       // The nearest image: some stored event (a collision, or a crossing that changes which
       // cells the pair occupies) must come first.
       Vec<D> r = raw;
-      for (int a = 0; a < D; ++a) r[a] -= sys_.box[a] * std::round(r[a] / sys_.box[a]);
+      for (int a = 0; a < D; ++a) r[a] = minimum_image(r[a], sys_.box[a]);
       const double sigma = sys_.kinematics[i].radius + sys_.kinematics[j].radius;
       if (norm2(r) < sigma * sigma * (1.0 - 1e-9)) {
         fail("particles " + std::to_string(i) + " and " + std::to_string(j) + " overlap");

@@ -111,7 +111,7 @@ double pair_overlap(const std::array<double, D>& box, const std::array<double, D
   double r2 = 0.0;
   for (int k = 0; k < D; ++k) {
     double dx = a[k] - b[k];
-    if (std::abs(dx) > 0.5 * box[k]) dx -= box[k] * std::round(dx / box[k]);
+    dx = minimum_image(dx, box[k]);
     r2 += dx * dx;
   }
   const double sigma = 0.5 * (da + db);
@@ -477,7 +477,7 @@ class VoxelSampler {
     double far2 = 0.0;
     for (int k = 0; k < D; ++k) {
       double dx = point[k] - c[k];
-      if (std::abs(dx) > 0.5 * box_[k]) dx -= box_[k] * std::round(dx / box_[k]);
+      dx = minimum_image(dx, box_[k]);
       const double far = std::abs(dx) + 0.5 * h_[k];
       far2 += far * far;
     }
