@@ -51,16 +51,7 @@ ParticleSystem<D> make_system(const Case& c, std::uint64_t seed) {
     sys.species = {{"A", 1.0, 1.0, 0.5}, {"B", c.size_ratio, 1.0, 0.5}};
   }
   std::mt19937_64 rng(seed);
-  const InitialState<D> init = make_initial_state<D>(sys, rng);
-  ParticleSystem<D> s;
-  s.box = init.box;
-  for (std::size_t i = 0; i < init.position.size(); ++i) {
-    s.kinematics.push_back({init.position[i], init.velocity[i], 0.0, 0.5 * init.diameter[i]});
-  }
-  s.mass = init.mass;
-  s.species = init.species;
-  s.species_names = init.species_names;
-  return s;
+  return to_particle_system<D>(make_initial_state<D>(sys, rng));
 }
 
 template <int D, class Queue>

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/particle_system.hpp"
 #include "io/config.hpp"
 
 namespace kairos {
@@ -73,6 +74,22 @@ double packing_fraction(const InitialState<D>& state);
 // std::invalid_argument when system.dimension != D.
 template <int D>
 InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& rng);
+
+// The engine's starting state: every particle at time 0 with radius = diameter / 2, no
+// scheduler state (the engine predicts every event).
+template <int D>
+ParticleSystem<D> to_particle_system(const InitialState<D>& init) {
+  ParticleSystem<D> s;
+  s.box = init.box;
+  s.kinematics.resize(init.position.size());
+  for (std::size_t i = 0; i < init.position.size(); ++i) {
+    s.kinematics[i] = {init.position[i], init.velocity[i], 0.0, 0.5 * init.diameter[i]};
+  }
+  s.mass = init.mass;
+  s.species = init.species;
+  s.species_names = init.species_names;
+  return s;
+}
 
 // Renumbers the particles in row-major order of cells as wide as the largest diameter, so
 // particles close in space are close in memory (random insertion otherwise leaves them in

@@ -536,17 +536,24 @@ class Reader {
     return node;
   }
 
-  const toml::node* get_integer(const toml::table& t, std::string_view prefix, std::string_view key,
-                                std::int64_t& out) const {
+  // A value of exactly TOML type T (std::int64_t, std::string or bool), named `what` in errors.
+  template <class T>
+  const toml::node* get_exact(const toml::table& t, std::string_view prefix, std::string_view key,
+                              T& out, std::string_view what) const {
     const toml::node* node = t.get(key);
     if (node == nullptr) return nullptr;
-    const auto* i = node->as_integer();
-    if (i == nullptr) {
+    const auto* v = node->as<T>();
+    if (v == nullptr) {
       const std::string path = join_key(prefix, key);
-      fail(node, path, fmt::format("{}: expected an integer, found {}", path, describe(*node)));
+      fail(node, path, fmt::format("{}: expected {}, found {}", path, what, describe(*node)));
     }
-    out = i->get();
+    out = v->get();
     return node;
+  }
+
+  const toml::node* get_integer(const toml::table& t, std::string_view prefix, std::string_view key,
+                                std::int64_t& out) const {
+    return get_exact(t, prefix, key, out, "an integer");
   }
 
   const toml::node* get_unsigned(const toml::table& t, std::string_view prefix,
@@ -564,29 +571,12 @@ class Reader {
 
   const toml::node* get_string(const toml::table& t, std::string_view prefix, std::string_view key,
                                std::string& out) const {
-    const toml::node* node = t.get(key);
-    if (node == nullptr) return nullptr;
-    const auto* s = node->as_string();
-    if (s == nullptr) {
-      const std::string path = join_key(prefix, key);
-      fail(node, path, fmt::format("{}: expected a string, found {}", path, describe(*node)));
-    }
-    out = s->get();
-    return node;
+    return get_exact(t, prefix, key, out, "a string");
   }
 
   const toml::node* get_bool(const toml::table& t, std::string_view prefix, std::string_view key,
                              bool& out) const {
-    const toml::node* node = t.get(key);
-    if (node == nullptr) return nullptr;
-    const auto* b = node->as_boolean();
-    if (b == nullptr) {
-      const std::string path = join_key(prefix, key);
-      fail(node, path,
-           fmt::format("{}: expected a boolean (true or false), found {}", path, describe(*node)));
-    }
-    out = b->get();
-    return node;
+    return get_exact(t, prefix, key, out, "a boolean (true or false)");
   }
 
   // ----- range checks

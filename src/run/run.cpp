@@ -32,21 +32,6 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 template <int D>
-ParticleSystem<D> to_particle_system(const InitialState<D>& init) {
-  ParticleSystem<D> s;
-  s.box = init.box;
-  const std::size_t n = init.position.size();
-  s.kinematics.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    s.kinematics[i] = {init.position[i], init.velocity[i], 0.0, 0.5 * init.diameter[i]};
-  }
-  s.mass = init.mass;
-  s.species = init.species;
-  s.species_names = init.species_names;
-  return s;
-}
-
-template <int D>
 void check_no_overlap(const InitialState<D>& init, const std::string& source) {
   for (int a = 0; a < D; ++a) {
     if (!std::isfinite(init.box[a]) || !(init.box[a] > 0.0)) {
@@ -136,11 +121,11 @@ ParticleSystem<D> build_start_state(const Config& config,
     check_no_overlap(init, "system.initial_state '" + path.string() + "'");
     note_ignored_system_keys(config, init.position.size(), "system.initial_state");
     if (!has_velocities) assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
-    return to_particle_system(init);
+    return to_particle_system<D>(init);
   }
   InitialState<D> init = make_initial_state<D>(config.system, rng);
   check_no_overlap(init, "generated initial state");
-  return to_particle_system(init);
+  return to_particle_system<D>(init);
 }
 
 std::uint64_t peak_rss_bytes() {
