@@ -3,8 +3,8 @@
 // Conventions (reduced units chosen by the user, typically diameter = mass = kT = 1):
 //   - positions live in the periodic box [0, L_k) and are stored at each particle's own local
 //     time ("delayed states"): the position at time t is pos + vel * (t - time);
-//   - the hot record a pair prediction reads (position, velocity, local time, radius) is one
-//     64-byte line in 3D; everything else lives in separate arrays.
+//   - this is the exchange form of the state (what outputs, restarts and tests read); the engine
+//     keeps its own compact layout (engine/event_engine.hpp) and converts on entry and export.
 #pragma once
 
 #include <cstdint>
@@ -17,23 +17,22 @@
 namespace kairos {
 
 template <int D>
-struct alignas(D == 3 ? 64 : 16) Kinematics {
+struct Kinematics {
   Vec<D> pos;     // position at local time `time`
   Vec<D> vel;     // velocity (constant between events)
   double time;    // local time of the stored position
   double radius;  // contact distance of a pair is r_i + r_j
 };
-static_assert(sizeof(Kinematics<3>) == 64, "3D hot record must fill one cache line");
 
-// The one pending event a particle keeps (Lubachevsky): its soonest predicted collision and its
-// next cell crossing. A collision is valid only if the partner's collision counter still equals
-// the snapshot taken at prediction time (lazy invalidation).
+// The one pending event a particle keeps (Lubachevsky): the soonest of its predicted collision
+// and its next cell crossing. `partner == kNoPartner` marks a cell crossing (or nothing, when
+// `time` is infinite). A collision is valid only if the partner's collision counter still
+// equals the snapshot taken at prediction time (lazy invalidation).
 struct EventSlot {
-  double collision_time = std::numeric_limits<double>::infinity();
-  double crossing_time = std::numeric_limits<double>::infinity();
-  std::uint32_t partner = 0;
+  static constexpr std::uint32_t kNoPartner = 0xffffffffu;
+  double time = std::numeric_limits<double>::infinity();
+  std::uint32_t partner = kNoPartner;
   std::uint32_t partner_count = 0;
-  std::int32_t crossing = -1;  // 2 * axis + (moving up ? 1 : 0); -1: none
 };
 
 struct EventCounters {
@@ -53,9 +52,12 @@ struct ParticleSystem {
   std::vector<std::uint32_t> species;
   std::vector<std::string> species_names;
   std::vector<std::uint32_t> collision_count;  // per particle: invalidates partners' predictions
-  // Scheduler state, kept for exact restarts; empty means "predict afresh".
+  // Scheduler state, kept for exact restarts; empty means "predict afresh". `order` is the
+  // engine's internal numbering (order[k] = the particle stored at position k), which decides
+  // ties between equal event times; empty means the identity.
   std::vector<EventSlot> events;
   std::vector<std::uint32_t> cell;
+  std::vector<std::uint32_t> order;
   EventCounters counters;
 
   std::size_t size() const { return kinematics.size(); }

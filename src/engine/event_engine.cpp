@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
+#include "core/error.hpp"
 #include "core/periodic.hpp"
 #include "dynamics/collision_time.hpp"
 #include "interactions/hard_sphere.hpp"
@@ -13,120 +17,272 @@
 
 namespace kairos {
 
+namespace {
+constexpr std::uint32_t kNoPartner = EventSlot::kNoPartner;
+}
+
 template <int D, class Queue>
-EventEngine<D, Queue>::EventEngine(ParticleSystem<D> system, StartMode mode)
-    : sys_(std::move(system)) {
-  const std::size_t n = sys_.size();
+EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
+                                   EngineOptions options)
+    : box_(s.box),
+      time_(s.time),
+      counters_(s.counters),
+      species_names_(s.species_names),
+      options_(options) {
+  const std::size_t n = s.size();
   if (n < 2) throw InputError("a simulation needs at least 2 particles");
+  if (n >= 0xffffffffu) throw InputError("too many particles (at most 2^32 - 2)");
+  if (s.mass.size() != n || s.species.size() != n) {
+    throw InputError("the state needs a mass and a species for every particle");
+  }
+  build_shapes(s);
   double rmax = 0.0;
-  for (const auto& k : sys_.kinematics) rmax = std::max(rmax, k.radius);
-  grid_ = CellGrid<D>(sys_.box, 2.0 * rmax, n);
-  if (sys_.collision_count.size() != n) sys_.collision_count.assign(n, 0);
-  if (mode == StartMode::kResume) {
-    if (sys_.events.size() != n || sys_.cell.size() != n) {
-      throw InputError("cannot resume: the state carries no scheduler state (events, cells)");
+  for (const Shape& sh : shapes_) rmax = std::max(rmax, sh.radius);
+  grid_ = CellGrid<D>(box_, 2.0 * rmax, n, options_.max_cells_per_particle);
+  candidates_.resize(256);
+  candidate_shift_.resize(256);
+
+  // Internal numbering: the stored one when resuming, else the caller's (renumbered below).
+  id_.resize(n);
+  std::iota(id_.begin(), id_.end(), 0u);
+  if (mode == StartMode::kResume && !s.order.empty()) {
+    std::vector<char> seen(n, 0);
+    bool ok = s.order.size() == n;
+    for (std::size_t k = 0; ok && k < n; ++k) {
+      ok = s.order[k] < n && !seen[s.order[k]];
+      if (ok) seen[s.order[k]] = 1;
     }
-    for (std::uint32_t i = 0; i < n; ++i) {
-      check_restored_cell(i);
-      grid_.insert(i, sys_.cell[i]);
-    }
-    sys_.cell = {};  // the grid owns cell membership from here; export_state() writes it back
-  } else {
-    for (std::uint32_t i = 0; i < n; ++i) {
-      advance_to(i, sys_.time);
-      Vec<D>& x = sys_.kinematics[i].pos;
-      for (int a = 0; a < D; ++a) x[a] = wrap_into_box(x[a], sys_.box[a]);
-      grid_.insert(i, grid_.locate(x));
-    }
-    predict_all();
+    if (!ok) throw InputError("cannot resume: the stored particle order is not a permutation");
+    id_ = s.order;
+  }
+  std::vector<std::uint16_t> shape_by_id = std::move(shape_);
+  if (!shape_by_id.empty()) {
+    shape_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) shape_[k] = shape_by_id[id_[k]];
+  }
+  const bool has_counts = s.collision_count.size() == n;
+  hot_.resize(n);
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const Kinematics<D>& kin = s.kinematics[id_[k]];
+    hot_[k] = {kin.pos, kin.vel, kin.time, has_counts ? s.collision_count[id_[k]] : 0u, 0u};
   }
   std::vector<double> times(n);
-  for (std::uint32_t i = 0; i < n; ++i) times[i] = event_time(i);
+  pending_.assign(n, {kNoPartner, 0});
+  if (mode == StartMode::kResume) {
+    if (s.events.size() != n || s.cell.size() != n || !has_counts) {
+      throw InputError("cannot resume: the state carries no scheduler state (events, cells)");
+    }
+    std::vector<std::uint32_t> internal(n);
+    for (std::uint32_t k = 0; k < n; ++k) internal[id_[k]] = k;
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const EventSlot& e = s.events[id_[k]];
+      if (e.partner != kNoPartner && e.partner >= n) {
+        throw InputError("cannot resume: particle " + std::to_string(id_[k]) +
+                         " has a collision partner out of range");
+      }
+      if (std::isnan(e.time) || e.time < time_) {
+        throw InputError("cannot resume: the pending event of particle " + std::to_string(id_[k]) +
+                         " is not at or after the state's time");
+      }
+      pending_[k] = {e.partner == kNoPartner ? kNoPartner : internal[e.partner], e.partner_count};
+      times[k] = e.time;
+      hot_[k].cell = s.cell[id_[k]];
+      check_restored_cell(k);
+    }
+    insert_all_into_grid();
+  } else {
+    for (std::uint32_t k = 0; k < n; ++k) {
+      advance_to(k, time_);
+      for (int a = 0; a < D; ++a) hot_[k].pos[a] = wrap_into_box(hot_[k].pos[a], box_[a]);
+      hot_[k].cell = grid_.locate(hot_[k].pos);
+    }
+    renumber(/*queue_filled=*/false);
+    for (std::uint32_t k = 0; k < n; ++k) times[k] = predict(k, time_);
+  }
   queue_.reset(times);
+  renumber_period_ =
+      options_.renumber_interval > 0.0
+          ? std::max<std::uint64_t>(1, static_cast<std::uint64_t>(options_.renumber_interval *
+                                                                  static_cast<double>(n) / 2.0))
+          : 0;
+  next_renumber_ = next_renumber_after(counters_.collisions);
+}
+
+// Distinct (radius, mass, species) triples; particles store a 2-byte index into them.
+template <int D, class Queue>
+void EventEngine<D, Queue>::build_shapes(const ParticleSystem<D>& s) {
+  std::map<std::tuple<double, double, std::uint32_t>, std::uint16_t> index;
+  std::vector<std::uint16_t> shape(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double r = s.kinematics[i].radius, m = s.mass[i];
+    if (!(r > 0.0) || !std::isfinite(r) || !(m > 0.0) || !std::isfinite(m)) {
+      throw InputError("particle " + std::to_string(i) +
+                       " needs a finite positive radius and mass");
+    }
+    const auto key = std::make_tuple(r, m, s.species[i]);
+    auto it = index.find(key);
+    if (it == index.end()) {
+      if (shapes_.size() == 0x10000) {
+        throw InputError(
+            "more than 65536 distinct (diameter, mass, species) combinations: Kairos keeps a "
+            "2-byte shape index per particle; round the diameters to fewer distinct values");
+      }
+      it = index.emplace(key, static_cast<std::uint16_t>(shapes_.size())).first;
+      shapes_.push_back({r, m, s.species[i]});
+    }
+    shape[i] = it->second;
+  }
+  uniform_radius_ = std::all_of(shapes_.begin(), shapes_.end(),
+                                [&](const Shape& sh) { return sh.radius == shapes_[0].radius; });
+  if (shapes_.size() > 1) shape_ = std::move(shape);  // caller's numbering; permuted by caller
 }
 
 // A restored cell must exist and contain the particle's position (up to round-off): a damaged
 // file, or one from a build with another grid sizing, must not silently mean other cells.
 template <int D, class Queue>
 void EventEngine<D, Queue>::check_restored_cell(std::uint32_t i) const {
-  const std::uint32_t c = sys_.cell[i];
-  bool ok = c < grid_.cell_count();
+  const CellCode c = hot_[i].cell;
+  bool ok = grid_.valid(c);
   for (int a = 0; ok && a < D; ++a) {
-    const double x = sys_.kinematics[i].pos[a];
-    const double tol = 1e-9 * sys_.box[a];
+    const double x = hot_[i].pos[a];
+    const double tol = 1e-9 * box_[a];
     ok = x >= grid_.lower(c, a) - tol && x <= grid_.upper(c, a) + tol;
   }
   if (!ok) {
-    throw InputError("restart state is inconsistent: particle " + std::to_string(i) +
+    throw InputError("restart state is inconsistent: particle " + std::to_string(id_[i]) +
                      " is not inside its stored cell " + std::to_string(c));
   }
 }
 
 template <int D, class Queue>
-void EventEngine<D, Queue>::predict_all() {
-  sys_.events.assign(sys_.size(), EventSlot{});
-  for (std::uint32_t i = 0; i < sys_.size(); ++i) {
-    predict_collision(i, sys_.time);
-    predict_crossing(i);
+void EventEngine<D, Queue>::insert_all_into_grid() {
+  grid_.clear();
+  // Inserting from the back leaves every cell's list in increasing index order.
+  for (auto k = static_cast<std::uint32_t>(size()); k-- > 0;) grid_.insert(k, hot_[k].cell);
+}
+
+template <int D, class Queue>
+std::uint64_t EventEngine<D, Queue>::next_renumber_after(std::uint64_t collisions) const {
+  if (renumber_period_ == 0) return ~std::uint64_t{0};
+  return (collisions / renumber_period_ + 1) * renumber_period_;
+}
+
+// Renumbers particles along the Morton order of their cells, so that the members of
+// neighbouring cells sit close together in memory. Partners, ids, shapes and queue keys follow;
+// the caller's numbering stays available through id_.
+template <int D, class Queue>
+void EventEngine<D, Queue>::renumber(bool queue_filled) {
+  const auto n = static_cast<std::uint32_t>(size());
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> rank(n);
+  for (std::uint32_t k = 0; k < n; ++k) rank[k] = {grid_.morton_rank(hot_[k].cell), k};
+  std::sort(rank.begin(), rank.end());
+  std::vector<std::uint32_t> new_index(n);
+  for (std::uint32_t k = 0; k < n; ++k) new_index[rank[k].second] = k;
+  std::vector<double> times(queue_filled ? n : 0);
+  {
+    std::vector<HotRecord<D>> hot(n);
+    std::vector<PendingEvent> pending(n);
+    std::vector<std::uint32_t> id(n);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::uint32_t old = rank[k].second;
+      hot[k] = hot_[old];
+      pending[k] = pending_[old];
+      if (pending[k].partner != kNoPartner) pending[k].partner = new_index[pending[k].partner];
+      id[k] = id_[old];
+      if (queue_filled) times[k] = queue_.time_of(old);
+    }
+    hot_.swap(hot);
+    pending_.swap(pending);
+    id_.swap(id);
   }
+  if (!shape_.empty()) {
+    std::vector<std::uint16_t> shape(n);
+    for (std::uint32_t k = 0; k < n; ++k) shape[k] = shape_[rank[k].second];
+    shape_.swap(shape);
+  }
+  insert_all_into_grid();
+  if (queue_filled) queue_.reset(times);
 }
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
-  Kinematics<D>& k = sys_.kinematics[i];
-  const double dt = t - k.time;
-  for (int a = 0; a < D; ++a) k.pos[a] += k.vel[a] * dt;
-  k.time = t;
+  HotRecord<D>& h = hot_[i];
+  const double dt = t - h.time;
+  for (int a = 0; a < D; ++a) h.pos[a] += h.vel[a] * dt;
+  h.time = t;
 }
 
-// Collects the members of one neighbour cell as candidates, prefetching their records so the
-// cache misses of a whole prediction overlap instead of queueing one after another.
+// When the particle leaves its cell, through which face. Always computed from the unchanged
+// record, so the time a crossing was scheduled at and the face it is processed with agree.
 template <int D, class Queue>
-[[gnu::always_inline]] inline void EventEngine<D, Queue>::gather(
-    const typename CellGrid<D>::Neighbour& nb) {
-  const std::uint32_t count = grid_.count(nb.cell);
-  if (count == 0) return;
-  const std::uint32_t* members = grid_.members(nb.cell);
-  for (std::uint32_t m = 0; m < count; ++m) {
-    __builtin_prefetch(&sys_.kinematics[members[m]]);
-    candidates_[n_candidates_] = members[m];
-    candidate_shift_[n_candidates_++] = static_cast<std::uint8_t>(nb.shifted ? n_shifts_ : 0);
+typename EventEngine<D, Queue>::Crossing EventEngine<D, Queue>::next_crossing(
+    const HotRecord<D>& h) const {
+  Crossing x{kNever, -1, 0};
+  for (int a = 0; a < D; ++a) {
+    const double dt =
+        interval_exit_time(h.pos[a], h.vel[a], grid_.lower(h.cell, a), grid_.upper(h.cell, a));
+    if (h.time + dt < x.time) x = {h.time + dt, a, h.vel[a] > 0.0 ? 1 : -1};
   }
-  if (nb.shifted) shifts_[n_shifts_++] = nb.shift;
+  return x;
 }
 
+// Collects the members of the 3^D cells around `cell` as candidates, prefetching their records
+// so that the cache misses of a whole prediction overlap instead of queueing one after another.
+// Locals instead of members in the loop: the compiler need not reload them after every store.
 template <int D, class Queue>
-void EventEngine<D, Queue>::reset_candidates() {
-  n_candidates_ = 0;
-  n_shifts_ = 1;  // shifts_[0] is the zero shift shared by all unshifted cells
-  const std::size_t need = CellGrid<D>::kNeighbourCells * grid_.capacity();
-  if (candidates_.size() < need) {
-    candidates_.resize(need);
-    candidate_shift_.resize(need);
-  }
+void EventEngine<D, Queue>::gather(CellCode cell) {
+  std::uint32_t n = 0, n_shifts = 1;  // shifts_[0] is the zero shift of all unshifted cells
+  auto cap = static_cast<std::uint32_t>(candidates_.size());
+  std::uint32_t* cand = candidates_.data();
+  std::uint16_t* shift_of = candidate_shift_.data();
+  const std::uint32_t* heads = grid_.heads();
+  const std::uint32_t* next = grid_.links();
+  const HotRecord<D>* hot = hot_.data();
+  grid_.for_each_neighbour(cell, [&](const typename CellGrid<D>::Neighbour& nb) {
+    const auto shift = static_cast<std::uint16_t>(nb.shifted ? n_shifts : 0);
+    for (std::uint32_t p = heads[nb.cell]; p != CellGrid<D>::kEnd; p = next[p]) {
+      __builtin_prefetch(hot + p);
+      if (n == cap) [[unlikely]] {
+        candidates_.resize(2 * candidates_.size());
+        candidate_shift_.resize(candidates_.size());
+        cap = static_cast<std::uint32_t>(candidates_.size());
+        cand = candidates_.data();
+        shift_of = candidate_shift_.data();
+      }
+      cand[n] = p;
+      shift_of[n] = shift;
+      ++n;
+    }
+    if (nb.shifted) shifts_[n_shifts++] = nb.shift;
+  });
+  n_candidates_ = n;
+  n_shifts_ = n_shifts;
 }
 
-// Tests a particle (state xi, vi at time t) against the gathered candidates in one flat loop.
-// The particle itself may be among them: r = g = 0 gives r.g = 0, which the root rejects
-// without a branch.
+// Tests a particle (state xi, vi at time t) against the gathered candidates in one flat loop;
+// returns the partner of the soonest contact earlier than t + best (kNoPartner if none) and
+// lowers `best` to it. The particle itself may be among the candidates: r = g = 0 gives
+// r.g = 0, which the first test rejects without a branch of its own.
 template <int D, class Queue>
-void EventEngine<D, Queue>::test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi, double ri,
-                                            EventSlot& slot) const {
-  double best = slot.collision_time - t;  // soonest contact found so far, relative to t
+template <bool kUniformRadius>
+std::uint32_t EventEngine<D, Queue>::test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi,
+                                                     double ri, double& best) const {
+  std::uint32_t partner = kNoPartner;
+  const double sigma0 = 2.0 * ri;
   for (std::uint32_t k = 0; k < n_candidates_; ++k) {
     const std::uint32_t j = candidates_[k];
     const Vec<D>& shift = shifts_[candidate_shift_[k]];
-    const Kinematics<D>& kj = sys_.kinematics[j];
-    const double dtj = t - kj.time;
+    const HotRecord<D>& hj = hot_[j];
+    const double dtj = t - hj.time;
     double r2 = 0.0, rg = 0.0, g2 = 0.0;
     for (int a = 0; a < D; ++a) {
-      const double r = xi[a] - (kj.pos[a] + kj.vel[a] * dtj + shift[a]);
-      const double g = vi[a] - kj.vel[a];
+      const double r = xi[a] - (hj.pos[a] + hj.vel[a] * dtj + shift[a]);
+      const double g = vi[a] - hj.vel[a];
       r2 += r * r;
       rg += r * g;
       g2 += g * g;
     }
-    const double sigma = ri + kj.radius;
+    const double sigma = kUniformRadius ? sigma0 : ri + shapes_[shape_[j]].radius;
     // Cheap rejection before the square root: the contact time 2a/(-b + sqrt(D)) is at least
     // a/(-b) (b = 2 r.g < 0 when approaching), so a pair that cannot beat `best` is skipped.
     // Receding pairs (r.g >= 0, the particle itself included) fail the same test.
@@ -135,39 +291,32 @@ void EventEngine<D, Queue>::test_candidates(double t, const Vec<D>& xi, const Ve
     const double dt = HardSphere::contact_time(r2, rg, g2, sigma);
     if (dt < best) {
       best = dt;
-      slot.collision_time = t + dt;
-      slot.partner = j;
-      slot.partner_count = sys_.collision_count[j];
+      partner = j;
     }
   }
+  return partner;
 }
 
+// Finds the particle's next event from time t: the soonest collision with a neighbour, if it
+// comes before the particle leaves its cell, else the crossing. Stores it; returns its time.
 template <int D, class Queue>
-void EventEngine<D, Queue>::predict_collision(std::uint32_t i, double t) {
-  EventSlot& slot = sys_.events[i];
-  slot.collision_time = kNever;
-  const Kinematics<D>& ki = sys_.kinematics[i];
-  const Vec<D> xi = ki.pos + (t - ki.time) * ki.vel;
-  reset_candidates();
-  grid_.for_each_neighbour(grid_.cell_of(i),
-                           [&](const typename CellGrid<D>::Neighbour& nb) { gather(nb); });
-  test_candidates(t, xi, ki.vel, ki.radius, slot);
-}
-
-template <int D, class Queue>
-void EventEngine<D, Queue>::predict_crossing(std::uint32_t i) {
-  EventSlot& slot = sys_.events[i];
-  const Kinematics<D>& k = sys_.kinematics[i];
-  const std::uint32_t c = grid_.cell_of(i);
-  slot.crossing_time = kNever;
-  slot.crossing = -1;
-  for (int a = 0; a < D; ++a) {
-    const double dt = interval_exit_time(k.pos[a], k.vel[a], grid_.lower(c, a), grid_.upper(c, a));
-    if (k.time + dt < slot.crossing_time) {
-      slot.crossing_time = k.time + dt;
-      slot.crossing = 2 * a + (k.vel[a] > 0.0 ? 1 : 0);
-    }
+double EventEngine<D, Queue>::predict(std::uint32_t i, double t) {
+  const HotRecord<D>& h = hot_[i];
+  const Crossing crossing = next_crossing(h);
+  double best = crossing.time - t;
+  const Vec<D> xi = h.pos + (t - h.time) * h.vel;
+  gather(h.cell);
+  const std::uint32_t partner = uniform_radius_
+                                    ? test_candidates<true>(t, xi, h.vel, radius_of(i), best)
+                                    : test_candidates<false>(t, xi, h.vel, radius_of(i), best);
+  double when = crossing.time;
+  if (partner != kNoPartner) {
+    pending_[i] = {partner, hot_[partner].collisions};
+    when = t + best;
+  } else {
+    pending_[i] = {kNoPartner, 0};
   }
+  return when > t ? when : t;  // never in the past, whatever the round-off
 }
 
 template <int D, class Queue>
@@ -176,61 +325,50 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
   if (j < i) std::swap(i, j);
   advance_to(i, t);
   advance_to(j, t);
-  Kinematics<D>& ki = sys_.kinematics[i];
-  Kinematics<D>& kj = sys_.kinematics[j];
+  HotRecord<D>& hi = hot_[i];
+  HotRecord<D>& hj = hot_[j];
   Vec<D> r;
   double g_dot_r = 0.0, r2 = 0.0;
   for (int a = 0; a < D; ++a) {
-    const double d = minimum_image(ki.pos[a] - kj.pos[a], sys_.box[a]);
+    const double d = minimum_image(hi.pos[a] - hj.pos[a], box_[a]);
     r[a] = d;
     r2 += d * d;
-    g_dot_r += (ki.vel[a] - kj.vel[a]) * d;
+    g_dot_r += (hi.vel[a] - hj.vel[a]) * d;
   }
-  const double mi = sys_.mass[i], mj = sys_.mass[j];
+  const double mi = mass_of(i), mj = mass_of(j);
   const double s = HardSphere::impulse_factor(g_dot_r, r2, mi * mj / (mi + mj));  // J = s r
   for (int a = 0; a < D; ++a) {
-    ki.vel[a] += s * r[a] / mi;
-    kj.vel[a] -= s * r[a] / mj;
+    hi.vel[a] += s * r[a] / mi;
+    hj.vel[a] -= s * r[a] / mj;
   }
-  sys_.counters.virial += s * r2;
-  ++sys_.counters.collisions;
-  ++sys_.collision_count[i];
-  ++sys_.collision_count[j];
-  for (std::uint32_t p : {i, j}) {
-    predict_collision(p, t);
-    predict_crossing(p);
-    queue_.update(p, event_time(p));
-  }
+  counters_.virial += s * r2;
+  ++counters_.collisions;
+  ++hi.collisions;
+  ++hj.collisions;
+  queue_.update(i, predict(i, t));
+  queue_.update(j, predict(j, t));
 }
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
+  HotRecord<D>& h = hot_[i];
+  const Crossing x = next_crossing(h);
   advance_to(i, t);
-  EventSlot& slot = sys_.events[i];
-  const int axis = slot.crossing / 2;
-  const int sign = (slot.crossing % 2) ? 1 : -1;
-  const std::uint32_t old_cell = grid_.cell_of(i);
   std::array<int, D> c;
-  for (int a = 0; a < D; ++a) c[a] = grid_.coordinate(old_cell, a);
-  c[axis] += sign;
-  Kinematics<D>& k = sys_.kinematics[i];
-  if (c[axis] < 0) {
-    c[axis] += grid_.cells_along(axis);
-    k.pos[axis] += sys_.box[axis];
-  } else if (c[axis] >= grid_.cells_along(axis)) {
-    c[axis] -= grid_.cells_along(axis);
-    k.pos[axis] -= sys_.box[axis];
+  for (int a = 0; a < D; ++a) c[a] = grid_.coordinate(h.cell, a);
+  c[x.axis] += x.sign;
+  if (c[x.axis] < 0) {
+    c[x.axis] += grid_.cells_along(x.axis);
+    h.pos[x.axis] += box_[x.axis];
+  } else if (c[x.axis] >= grid_.cells_along(x.axis)) {
+    c[x.axis] -= grid_.cells_along(x.axis);
+    h.pos[x.axis] -= box_[x.axis];
   }
-  const std::uint32_t new_cell = grid_.cell_at(c);
-  grid_.erase(i);
-  grid_.insert(i, new_cell);
-  ++sys_.counters.cell_crossings;
-  reset_candidates();
-  grid_.for_each_new_layer(new_cell, axis, sign,
-                           [&](const typename CellGrid<D>::Neighbour& nb) { gather(nb); });
-  test_candidates(t, k.pos, k.vel, k.radius, slot);
-  predict_crossing(i);
-  queue_.update(i, event_time(i));
+  grid_.erase(i, h.cell);
+  h.cell = grid_.code_at(c);
+  grid_.insert(i, h.cell);
+  ++counters_.cell_crossings;
+  queue_.update(i, predict(i, t));
 }
 
 template <int D, class Queue>
@@ -238,146 +376,171 @@ EventKind EventEngine<D, Queue>::step() {
   const std::uint32_t i = queue_.top();
   const double t = queue_.top_time();
   if (!std::isfinite(t)) return EventKind::kNone;
-  sys_.time = t;
-  ++sys_.counters.events;
-  EventSlot& slot = sys_.events[i];
-  if (slot.crossing_time <= slot.collision_time) {
+  time_ = t;
+  ++counters_.events;
+  const PendingEvent e = pending_[i];
+  if (e.partner == kNoPartner) {
     cross(i, t);
     return EventKind::kCellCrossing;
   }
-  const std::uint32_t j = slot.partner;
-  if (sys_.collision_count[j] != slot.partner_count) {
-    ++sys_.counters.stale_events;
-    predict_collision(i, t);
-    queue_.update(i, event_time(i));
+  if (hot_[e.partner].collisions != e.partner_count) {
+    ++counters_.stale_events;
+    queue_.update(i, predict(i, t));
     return EventKind::kStale;
   }
-  collide(i, j, t);
+  collide(i, e.partner, t);
+  if (counters_.collisions >= next_renumber_) {
+    renumber(/*queue_filled=*/true);
+    next_renumber_ = next_renumber_after(counters_.collisions);
+  }
   return EventKind::kCollision;
 }
 
 template <int D, class Queue>
 ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
-  ParticleSystem<D> out = sys_;
-  out.cell.resize(sys_.size());
-  for (std::uint32_t i = 0; i < sys_.size(); ++i) out.cell[i] = grid_.cell_of(i);
+  const std::size_t n = size();
+  ParticleSystem<D> out;
+  out.box = box_;
+  out.time = time_;
+  out.counters = counters_;
+  out.species_names = species_names_;
+  out.kinematics.resize(n);
+  out.mass.resize(n);
+  out.species.resize(n);
+  out.collision_count.resize(n);
+  out.events.resize(n);
+  out.cell.resize(n);
+  out.order = id_;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const std::uint32_t c = id_[k];
+    const HotRecord<D>& h = hot_[k];
+    const Shape& sh = shapes_[shape_.empty() ? 0 : shape_[k]];
+    out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};
+    out.mass[c] = sh.mass;
+    out.species[c] = sh.species;
+    out.collision_count[c] = h.collisions;
+    out.cell[c] = h.cell;
+    const PendingEvent& e = pending_[k];
+    out.events[c] = {queue_.time_of(k), e.partner == kNoPartner ? kNoPartner : id_[e.partner],
+                     e.partner_count};
+  }
   return out;
 }
 
 template <int D, class Queue>
 double EventEngine<D, Queue>::kinetic_energy() const {
   double ke = 0.0;
-  for (std::size_t i = 0; i < sys_.size(); ++i) {
-    ke += 0.5 * sys_.mass[i] * norm2(sys_.kinematics[i].vel);
-  }
+  for (std::uint32_t i = 0; i < size(); ++i) ke += 0.5 * mass_of(i) * norm2(hot_[i].vel);
   return ke;
 }
 
 template <int D, class Queue>
 Vec<D> EventEngine<D, Queue>::momentum() const {
   Vec<D> p{};
-  for (std::size_t i = 0; i < sys_.size(); ++i) p = p + sys_.mass[i] * sys_.kinematics[i].vel;
+  for (std::uint32_t i = 0; i < size(); ++i) p = p + mass_of(i) * hot_[i].vel;
   return p;
 }
 
 template <int D, class Queue>
 std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
-  std::vector<Vec<D>> out(sys_.size());
-  for (std::size_t i = 0; i < sys_.size(); ++i) {
-    Vec<D> x = sys_.position_at(i, sys_.time);
-    for (int a = 0; a < D; ++a) x[a] = wrap_into_box(x[a], sys_.box[a]);
-    out[i] = x;
+  std::vector<Vec<D>> out(size());
+  for (std::uint32_t i = 0; i < size(); ++i) {
+    const HotRecord<D>& h = hot_[i];
+    Vec<D> x = h.pos + (time_ - h.time) * h.vel;
+    for (int a = 0; a < D; ++a) x[a] = wrap_into_box(x[a], box_[a]);
+    out[id_[i]] = x;
   }
   return out;
 }
 
 template <int D, class Queue>
-std::size_t EventEngine<D, Queue>::bytes_per_particle() const {
-  // Per-particle arrays of the state, plus the grid's and the queue's own (cells and buckets
-  // included, divided by N).
-  return sizeof(Kinematics<D>) + sizeof(EventSlot) + sizeof(double) /*mass*/ +
-         2 * sizeof(std::uint32_t) /*species, collision counter*/ + grid_.bytes_per_particle() +
-         queue_.bytes_per_particle();
+double EventEngine<D, Queue>::bytes_per_particle() const {
+  // Per-particle arrays plus the grid's and the queue's own (cells and buckets included,
+  // divided by N); the shape table is a few bytes in all.
+  const double shapes =
+      static_cast<double>(shapes_.size() * sizeof(Shape)) / static_cast<double>(size());
+  return static_cast<double>(sizeof(HotRecord<D>) + sizeof(PendingEvent) + sizeof(std::uint32_t) +
+                             (shape_.empty() ? 0 : sizeof(std::uint16_t))) +
+         shapes + grid_.bytes_per_particle() + static_cast<double>(queue_.bytes_per_particle());
 }
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::validate() {
-  const double t = sys_.time;
-  const std::size_t n = sys_.size();
+  const double t = time_;
+  const auto n = static_cast<std::uint32_t>(size());
   auto fail = [&](const std::string& what) {
     std::ostringstream os;
-    os << "engine validation failed at t=" << t << " after " << sys_.counters.events
+    os << "engine validation failed at t=" << t << " after " << counters_.events
        << " events: " << what;
     throw std::logic_error(os.str());
   };
+  auto name = [&](std::uint32_t i) { return std::to_string(id_[i]); };
   // Cell membership and the cell lists themselves.
   std::vector<std::uint32_t> listed(n, 0);
   for (std::uint32_t c = 0; c < grid_.cell_count(); ++c) {
-    for (std::uint32_t m = 0; m < grid_.count(c); ++m) {
-      const std::uint32_t j = grid_.members(c)[m];
-      if (grid_.cell_of(j) != c) fail("particle " + std::to_string(j) + " listed in wrong cell");
-      ++listed[j];
+    std::uint32_t steps = 0;
+    for (std::uint32_t p = grid_.first(c); p != CellGrid<D>::kEnd; p = grid_.next(p)) {
+      if (p >= n || ++steps > n) fail("cell " + std::to_string(c) + " has a broken list");
+      if (grid_.index(hot_[p].cell) != c)
+        fail("particle " + name(p) + " listed in a cell it is not in");
+      ++listed[p];
     }
   }
   for (std::uint32_t i = 0; i < n; ++i) {
     if (listed[i] != 1)
-      fail("particle " + std::to_string(i) + " listed " + std::to_string(listed[i]) + " times");
-    const Vec<D> x = sys_.position_at(i, t);
-    const std::uint32_t c = grid_.cell_of(i);
+      fail("particle " + name(i) + " listed " + std::to_string(listed[i]) + " times");
+    const HotRecord<D>& h = hot_[i];
+    const Vec<D> x = h.pos + (t - h.time) * h.vel;
     for (int a = 0; a < D; ++a) {
-      const double tol = 1e-9 * sys_.box[a];
-      if (x[a] < grid_.lower(c, a) - tol || x[a] > grid_.upper(c, a) + tol)
-        fail("particle " + std::to_string(i) + " outside its cell");
+      const double tol = 1e-9 * box_[a];
+      if (x[a] < grid_.lower(h.cell, a) - tol || x[a] > grid_.upper(h.cell, a) + tol)
+        fail("particle " + name(i) + " outside its cell");
     }
+    if (pending_[i].partner != kNoPartner && pending_[i].partner >= n)
+      fail("particle " + name(i) + " has a partner out of range");
   }
   // Queue order: the top is the soonest stored event; nothing lies in the past.
   double tmin = kNever;
   for (std::uint32_t i = 0; i < n; ++i) {
-    tmin = std::min(tmin, event_time(i));
-    if (queue_.time_of(i) != event_time(i)) fail("queue key differs for " + std::to_string(i));
-    if (event_time(i) < t) fail("event of " + std::to_string(i) + " lies in the past");
+    tmin = std::min(tmin, queue_.time_of(i));
+    if (queue_.time_of(i) < t) fail("event of " + name(i) + " lies in the past");
   }
   if (queue_.top_time() != tmin) fail("queue top is not the soonest event");
-  // Prediction invariant and overlaps, brute force over all pairs.
-  auto check_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, double bound,
-                           const char* which) {
-    const Vec<D> g = sys_.kinematics[i].vel - sys_.kinematics[j].vel;
-    const double sigma = sys_.kinematics[i].radius + sys_.kinematics[j].radius;
+  // Prediction invariant and overlaps, brute force over all pairs: some pending event of the
+  // pair (a collision, or a crossing that triggers a new scan) comes no later than its contact.
+  auto check_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, const char* which) {
+    const Vec<D> g = hot_[i].vel - hot_[j].vel;
+    const double sigma = radius_of(i) + radius_of(j);
     const double due = t + pair_contact_time<D>(r.data(), g.data(), sigma);
+    const double bound = std::min(queue_.time_of(i), queue_.time_of(j));
     if (std::isfinite(due) && bound > due * (1.0 + 1e-12) + 1e-12) {
-      fail("pair " + std::to_string(i) + "," + std::to_string(j) + " (" + which + ") collides at " +
-           std::to_string(due) + " but no stored event covers it");
+      fail("pair " + name(i) + "," + name(j) + " (" + which + ") collides at " +
+           std::to_string(due) + " but no pending event comes first");
     }
   };
   for (std::uint32_t i = 0; i < n; ++i) {
-    const Vec<D> xi = sys_.position_at(i, t);
-    const std::uint32_t ci = grid_.cell_of(i);
+    const Vec<D> xi = hot_[i].pos + (t - hot_[i].time) * hot_[i].vel;
+    const std::uint32_t ci = hot_[i].cell;
     for (std::uint32_t j = i + 1; j < n; ++j) {
-      const EventSlot& si = sys_.events[i];
-      const EventSlot& sj = sys_.events[j];
-      const double collisions = std::min(si.collision_time, sj.collision_time);
-      const double any = std::min({collisions, si.crossing_time, sj.crossing_time});
-      const Vec<D> raw = xi - sys_.position_at(j, t);
-      // The image the engine tests (neighbouring cells): the stored collisions must cover it.
+      const Vec<D> raw = xi - (hot_[j].pos + (t - hot_[j].time) * hot_[j].vel);
+      // The image the engine tests (neighbouring cells).
       std::array<int, D> d;
-      if (grid_.neighbour_offset(ci, grid_.cell_of(j), d)) {
+      if (grid_.neighbour_offset(ci, hot_[j].cell, d)) {
         Vec<D> r = raw;
         for (int a = 0; a < D; ++a) {
           const int c = grid_.coordinate(ci, a) + d[a];
-          if (c < 0) r[a] += sys_.box[a];
-          if (c >= grid_.cells_along(a)) r[a] -= sys_.box[a];
+          if (c < 0) r[a] += box_[a];
+          if (c >= grid_.cells_along(a)) r[a] -= box_[a];
         }
-        check_covered(i, j, r, collisions, "neighbour-cell image");
+        check_covered(i, j, r, "neighbour-cell image");
       }
-      // The nearest image: some stored event (a collision, or a crossing that changes which
-      // cells the pair occupies) must come first.
       Vec<D> r = raw;
-      for (int a = 0; a < D; ++a) r[a] = minimum_image(r[a], sys_.box[a]);
-      const double sigma = sys_.kinematics[i].radius + sys_.kinematics[j].radius;
+      for (int a = 0; a < D; ++a) r[a] = minimum_image(r[a], box_[a]);
+      const double sigma = radius_of(i) + radius_of(j);
       if (norm2(r) < sigma * sigma * (1.0 - 1e-9)) {
-        fail("particles " + std::to_string(i) + " and " + std::to_string(j) + " overlap");
+        fail("particles " + name(i) + " and " + name(j) + " overlap");
       }
-      check_covered(i, j, r, any, "nearest image");
+      check_covered(i, j, r, "nearest image");
     }
   }
 }

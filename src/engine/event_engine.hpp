@@ -1,16 +1,26 @@
 // The event-driven engine for hard spheres (D = 3) and hard disks (D = 2).
 //
-// One event's path: the queue yields the particle with the soonest pending event; its EventSlot
-// says whether that is a cell crossing or a collision. A collision whose partner has collided
-// since the prediction is stale: the particle is re-predicted and nothing else happens. A valid
-// collision advances both particles to the event time (their local clocks), applies the elastic
-// impulse, bumps both collision counters and re-predicts both. A crossing moves the particle to
-// the next cell and tests it only against the newly adjacent layer of cells: its stored
-// collision stays a lower bound for the old neighbours.
+// One event's path: the queue yields the particle with the soonest pending event. The particle's
+// PendingEvent says whether that is a collision (with a partner) or a cell crossing. A collision
+// whose partner has collided since the prediction is stale: the particle is re-predicted and
+// nothing else happens. A valid collision advances both particles to the event time (their
+// local clocks), applies the elastic impulse, bumps both collision counters and re-predicts
+// both. A crossing moves the particle to the next cell and re-predicts it.
 //
-// Invariant (checked by validate()): for every pair in neighbouring cells, the smaller of the
-// two stored collision times is no later than the pair's true next contact; so the queue never
-// passes over a collision.
+// Every prediction scans the particle's 3^D neighbouring cells, bounded by its next cell
+// crossing: a collision later than the crossing is found again by the full scan the crossing
+// triggers, so only the soonest of the two is stored (no second time per particle).
+//
+// Invariant (checked by validate()): for every pair in neighbouring cells, the sooner of the
+// two particles' pending events is no later than the pair's true next contact; so the queue
+// never passes over a collision.
+//
+// Memory layout (what bytes_per_particle() counts): the hot record a pair test reads (position,
+// velocity, local time, collision counter, cell) is one 64-byte line in 3D; the pending event
+// (partner and its counter snapshot) is 8 bytes; the queue keeps the event time; the cell grid
+// a link per particle; the particle's id (outputs keep the caller's numbering while the engine
+// renumbers particles along a space-filling curve) 4 bytes; radius, mass and species live in a
+// small table of shapes indexed by a 2-byte shape number (absent for a single shape).
 #pragma once
 
 #include <cstdint>
@@ -28,60 +38,109 @@ enum class EventKind { kNone, kCollision, kCellCrossing, kStale };
 // ParticleSystem carries (from export_state() or a restart file) to continue bit-identically.
 enum class StartMode { kPredict, kResume };
 
+// What a pair test reads of a particle, in one cache line (3D).
+template <int D>
+struct alignas(D == 3 ? 64 : 16) HotRecord {
+  Vec<D> pos;                // position at local time `time`
+  Vec<D> vel;                // velocity
+  double time;               // local time of `pos`
+  std::uint32_t collisions;  // collision counter: invalidates partners' predictions
+  CellCode cell;             // the cell the particle is in
+};
+static_assert(sizeof(HotRecord<3>) == 64, "3D hot record must fill one cache line");
+
+// Radius, mass and species shared by many particles.
+struct Shape {
+  double radius;
+  double mass;
+  std::uint32_t species;
+};
+
+struct EngineOptions {
+  // Renumber particles along a Morton curve every this many collisions per particle (0: never).
+  double renumber_interval = 32.0;
+  double max_cells_per_particle = CellGrid<3>::kDefaultCellsPerParticle;
+};
+
 template <int D, class Queue>
 class EventEngine {
  public:
   // Takes the state. kResume requires the scheduler state (events and cells) and throws
   // InputError if it is missing or inconsistent with the positions.
-  explicit EventEngine(ParticleSystem<D> system, StartMode mode = StartMode::kPredict);
+  explicit EventEngine(const ParticleSystem<D>& system, StartMode mode = StartMode::kPredict,
+                       EngineOptions options = {});
 
   // Processes the next event. Returns kNone when nothing can ever happen again.
   EventKind step();
 
-  double time() const { return sys_.time; }
-  const EventCounters& counters() const { return sys_.counters; }
-  const ParticleSystem<D>& system() const { return sys_; }
-  // The complete state including the scheduler's, for restarts: an engine built from it
-  // continues bit-identically.
+  double time() const { return time_; }
+  const EventCounters& counters() const { return counters_; }
+  const Vec<D>& box() const { return box_; }
+  // The complete state in the caller's particle numbering, scheduler state included: an engine
+  // resumed from it continues bit-identically.
   ParticleSystem<D> export_state() const;
-  std::size_t size() const { return sys_.size(); }
+  std::size_t size() const { return hot_.size(); }
 
   double kinetic_energy() const;
   Vec<D> momentum() const;
-  // Positions at the current time, wrapped into the box.
+  // Positions at the current time, wrapped into the box, in the caller's numbering.
   std::vector<Vec<D>> current_positions() const;
 
   // Debug: checks cell membership, queue order and the prediction invariant against brute
   // force; throws std::logic_error describing the first violation. O(N^2).
   void validate();
 
-  std::size_t bytes_per_particle() const;
+  double bytes_per_particle() const;
   const char* queue_name() const { return Queue::name(); }
   const CellGrid<D>& grid() const { return grid_; }
 
  private:
+  struct PendingEvent {
+    std::uint32_t partner;        // EventSlot::kNoPartner: the event is a cell crossing
+    std::uint32_t partner_count;  // the partner's collision counter when predicted
+  };
+  struct Crossing {
+    double time;  // absolute
+    int axis;     // -1: never
+    int sign;     // +1 up, -1 down
+  };
+
+  void build_shapes(const ParticleSystem<D>& s);
+  double radius_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].radius; }
+  double mass_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].mass; }
   void advance_to(std::uint32_t i, double t);
-  double event_time(std::uint32_t i) const {
-    const EventSlot& s = sys_.events[i];
-    return s.collision_time < s.crossing_time ? s.collision_time : s.crossing_time;
-  }
-  void predict_collision(std::uint32_t i, double t);
-  void reset_candidates();
-  void gather(const typename CellGrid<D>::Neighbour& nb);
-  void test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi, double ri,
-                       EventSlot& slot) const;
-  void predict_crossing(std::uint32_t i);
+  Crossing next_crossing(const HotRecord<D>& h) const;
+  double predict(std::uint32_t i, double t);
+  void gather(CellCode cell);
+  template <bool kUniformRadius>
+  std::uint32_t test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi, double ri,
+                                double& best) const;
   void collide(std::uint32_t i, std::uint32_t j, double t);
   void cross(std::uint32_t i, double t);
-  void predict_all();
+  void renumber(bool queue_filled);
+  void insert_all_into_grid();
   void check_restored_cell(std::uint32_t i) const;
+  std::uint64_t next_renumber_after(std::uint64_t collisions) const;
 
-  ParticleSystem<D> sys_;
+  Vec<D> box_{};
+  double time_ = 0.0;
+  EventCounters counters_;
+  std::vector<std::string> species_names_;
+  EngineOptions options_;
+
+  std::vector<HotRecord<D>> hot_;
+  std::vector<PendingEvent> pending_;
+  std::vector<std::uint16_t> shape_;  // per particle; empty when there is a single shape
+  std::vector<Shape> shapes_;
+  bool uniform_radius_ = true;
+  std::vector<std::uint32_t> id_;  // internal index -> the caller's particle number
   CellGrid<D> grid_;
   Queue queue_;
+  std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions
+
   // Scratch of one prediction: candidate partners and the periodic shift of each one's cell.
   std::vector<std::uint32_t> candidates_;
-  std::vector<std::uint8_t> candidate_shift_;
+  std::vector<std::uint16_t> candidate_shift_;
   Vec<D> shifts_[CellGrid<D>::kNeighbourCells + 1] = {};
   std::uint32_t n_candidates_ = 0, n_shifts_ = 0;
 };

@@ -12,7 +12,7 @@ namespace kairos {
 
 namespace {
 
-constexpr std::uint32_t kRestartFormat = 1;
+constexpr std::uint32_t kRestartFormat = 2;  // 2: one event time per particle, order
 
 // HOOMD stores type names as an N_types x M int8 array of 0-padded strings.
 std::vector<std::int8_t> pack_type_names(const std::vector<std::string>& names, std::uint32_t& m) {
@@ -139,10 +139,14 @@ void validate_restart(const ParticleSystem<D>& s, const std::filesystem::path& p
     if (!(s.mass[i] > 0.0) || !std::isfinite(s.mass[i]))
       throw bad("mass" + who + " is not positive");
     if (s.species[i] >= s.species_names.size()) throw bad("typeid" + who + " out of range");
-    if (std::isnan(e.collision_time) || std::isnan(e.crossing_time))
-      throw bad("pending event time" + who + " is NaN");
-    if (e.partner >= n) throw bad("collision partner" + who + " out of range");
-    if (e.crossing < -1 || e.crossing >= 2 * D) throw bad("cell crossing" + who + " out of range");
+    if (std::isnan(e.time)) throw bad("pending event time" + who + " is NaN");
+    if (e.partner != EventSlot::kNoPartner && e.partner >= n)
+      throw bad("collision partner" + who + " out of range");
+  }
+  std::vector<char> seen(n, 0);
+  for (std::uint32_t k : s.order) {
+    if (k >= n || seen[k]) throw bad("kairos/state/order is not a permutation");
+    seen[k] = 1;
   }
 }
 
@@ -182,9 +186,8 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     write_standard_chunks(w, s, true);
     const std::uint64_t n = s.size();
     std::vector<double> pos(n * D), vel(n * D), local(n), radius(n), now(n * D);
-    std::vector<double> tcoll(n), tcross(n);
+    std::vector<double> tevent(n);
     std::vector<std::uint32_t> partner(n), pcount(n);
-    std::vector<std::int32_t> crossing(n);
     for (std::size_t i = 0; i < n; ++i) {
       const auto& k = s.kinematics[i];
       const Vec<D> x = s.position_at(i, s.time);
@@ -195,11 +198,9 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
       }
       local[i] = k.time;
       radius[i] = k.radius;
-      tcoll[i] = s.events[i].collision_time;
-      tcross[i] = s.events[i].crossing_time;
+      tevent[i] = s.events[i].time;
       partner[i] = s.events[i].partner;
       pcount[i] = s.events[i].partner_count;
-      crossing[i] = s.events[i].crossing;
     }
     const std::uint32_t format = kRestartFormat;
     const std::uint8_t dims = D;
@@ -220,12 +221,11 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     w.write_chunk("kairos/state/position", n, D, pos.data());  // at each local time
     w.write_chunk("kairos/state/local_time", n, 1, local.data());
     w.write_chunk("kairos/state/collision_count", n, 1, s.collision_count.data());
-    w.write_chunk("kairos/state/collision_time", n, 1, tcoll.data());
-    w.write_chunk("kairos/state/crossing_time", n, 1, tcross.data());
+    w.write_chunk("kairos/state/event_time", n, 1, tevent.data());
     w.write_chunk("kairos/state/partner", n, 1, partner.data());
     w.write_chunk("kairos/state/partner_count", n, 1, pcount.data());
-    w.write_chunk("kairos/state/crossing", n, 1, crossing.data());
     w.write_chunk("kairos/state/cell", n, 1, s.cell.data());
+    if (!s.order.empty()) w.write_chunk("kairos/state/order", n, 1, s.order.data());
     w.write_chunk("kairos/state/counters", 4, 1, counters);
     w.write_chunk("kairos/state/virial", 1, 1, &s.counters.virial);
     w.write_chunk("kairos/state/rng", rng_bytes.size(), 1, rng_bytes.data());
@@ -250,8 +250,11 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   if (r.frame_count() == 0 || !r.find(f, "kairos/format")) {
     throw InputError("'" + path.string() + "' is not a Kairos restart file (no kairos/format)");
   }
-  if (require<std::uint32_t>(r, f, "kairos/format", path, 1)[0] != kRestartFormat) {
-    throw InputError("'" + path.string() + "': unsupported restart format version");
+  if (const auto v = require<std::uint32_t>(r, f, "kairos/format", path, 1)[0];
+      v != kRestartFormat) {
+    throw InputError("'" + path.string() + "': restart format version " + std::to_string(v) +
+                     ", this Kairos reads version " + std::to_string(kRestartFormat) +
+                     " (restart files are not portable across these versions)");
   }
   const int dim = require<std::uint8_t>(r, f, "kairos/dimension", path, 1)[0];
   if (dim != D) {
@@ -274,11 +277,11 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   s.species_names = unpack_type_names(r.read<std::int8_t>(f, "particles/types"), types->M);
   s.collision_count = require<std::uint32_t>(r, f, "kairos/state/collision_count", path, n);
   s.cell = require<std::uint32_t>(r, f, "kairos/state/cell", path, n);
-  const auto tcoll = require<double>(r, f, "kairos/state/collision_time", path, n);
-  const auto tcross = require<double>(r, f, "kairos/state/crossing_time", path, n);
+  const auto tevent = require<double>(r, f, "kairos/state/event_time", path, n);
   const auto partner = require<std::uint32_t>(r, f, "kairos/state/partner", path, n);
   const auto pcount = require<std::uint32_t>(r, f, "kairos/state/partner_count", path, n);
-  const auto crossing = require<std::int32_t>(r, f, "kairos/state/crossing", path, n);
+  if (r.find(f, "kairos/state/order"))
+    s.order = require<std::uint32_t>(r, f, "kairos/state/order", path, n);
   const auto counters = require<std::uint64_t>(r, f, "kairos/state/counters", path, 4);
   s.counters = {counters[0], counters[1], counters[2], counters[3],
                 require<double>(r, f, "kairos/state/virial", path, 1)[0]};
@@ -291,7 +294,7 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
     }
     s.kinematics[i].time = local[i];
     s.kinematics[i].radius = radius[i];
-    s.events[i] = {tcoll[i], tcross[i], partner[i], pcount[i], crossing[i]};
+    s.events[i] = {tevent[i], partner[i], pcount[i]};
   }
   validate_restart(s, path);
   const auto rng_bytes = r.read<std::int8_t>(f, "kairos/state/rng");

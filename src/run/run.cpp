@@ -235,7 +235,7 @@ class RunDriver {
         trajectory_.emplace(gsd::Writer::open_append(traj));
       } else {
         trajectory_.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
-        append_trajectory_frame(*trajectory_, engine_->system());
+        append_trajectory_frame(*trajectory_, engine_->export_state());
       }
     }
     ke_start_ = engine_->kinetic_energy();
@@ -266,7 +266,7 @@ class RunDriver {
 
     if (trajectory_) {
       if (frame_collisions_ != engine_->counters().collisions)
-        append_trajectory_frame(*trajectory_, engine_->system());
+        append_trajectory_frame(*trajectory_, engine_->export_state());
       trajectory_->close();
     }
     RunOutcome outcome;
@@ -335,7 +335,7 @@ class RunDriver {
       const std::uint64_t c = engine_->counters().collisions;
       if (schedule.thermo.due(c)) write_thermo_row(phase);
       if (schedule.trajectory.due(c) && trajectory_) {
-        append_trajectory_frame(*trajectory_, engine_->system());
+        append_trajectory_frame(*trajectory_, engine_->export_state());
         frame_collisions_ = c;
       }
       if (schedule.restart.due(c)) {
@@ -372,9 +372,10 @@ class RunDriver {
     const Thermodynamics& th = *thermo_stats_;
     const double kT = th.temperature(ke);
     const Vec<D> p = engine_->momentum();
+    const ParticleSystem<D> state = engine_->export_state();
     double pscale = 0.0, dp2 = 0.0;
     for (std::size_t i = 0; i < n_; ++i)
-      pscale += engine_->system().mass[i] * std::sqrt(norm2(engine_->system().kinematics[i].vel));
+      pscale += state.mass[i] * std::sqrt(norm2(state.kinematics[i].vel));
     for (int a = 0; a < D; ++a) dp2 += (p[a] - p_start_[a]) * (p[a] - p_start_[a]);
     const double t_prod = engine_->time() - prod_start_.time;
     const std::uint64_t coll_prod = c.collisions - prod_start_.collisions;
@@ -382,10 +383,8 @@ class RunDriver {
     const BlockAverage z_blocks = th.compressibility_blocks();
     const double z_mean = th.compressibility(c.virial - prod_start_.virial, kT_prod, t_prod);
     std::vector<double> diameters(n_);
-    for (std::size_t i = 0; i < n_; ++i)
-      diameters[i] = 2.0 * engine_->system().kinematics[i].radius;
-    const double overlap =
-        max_overlap<D>(engine_->system().box, engine_->current_positions(), diameters);
+    for (std::size_t i = 0; i < n_; ++i) diameters[i] = 2.0 * state.kinematics[i].radius;
+    const double overlap = max_overlap<D>(state.box, engine_->current_positions(), diameters);
     const std::uint64_t events = c.events - events_start_;
     const std::uint64_t collisions = c.collisions - collisions_start_;
     nlohmann::json j;

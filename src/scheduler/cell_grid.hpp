@@ -2,11 +2,16 @@
 //
 // The periodic box is cut into n_k >= 3 cells per axis, each at least as wide as the largest
 // contact distance, so every pair that can collide before either particle leaves its cell sits in
-// neighbouring cells. Each cell stores its particle indices inline in a fixed-stride slot array
-// (count, then indices), so scanning a cell reads one cache line instead of chasing a linked
-// list; the stride doubles (rare, O(N)) when a cell overflows, so there is no hard cap. The image
-// of a neighbouring cell is known from the cell offset (wrapping adds +-L), so pair tests never
-// need a minimum-image rounding.
+// neighbouring cells.
+//
+// A particle's cell is named by a CellCode, its integer coordinates packed into 32 bits (10 bits
+// per axis in 3D, 16 in 2D): bounds, neighbours and crossings then need no division. Cells are
+// singly linked lists (a head per cell, a `next` per particle): 4 bytes per particle plus 4 per
+// cell, the smallest structure with no capacity limit. The caller keeps each particle's code
+// (the engine stores it in its hot record). With particles renumbered along morton_rank(), a
+// cell's members and its neighbours' sit close together in memory. The image of a neighbouring
+// cell is known from the cell offset (wrapping adds +-L), so pair tests never need a
+// minimum-image rounding.
 #pragma once
 
 #include <algorithm>
@@ -20,23 +25,32 @@
 
 namespace kairos {
 
+using CellCode = std::uint32_t;
+
 template <int D>
 class CellGrid {
  public:
   static constexpr int kNeighbourCells = D == 3 ? 27 : 9;
-  static constexpr int kLayerCells = D == 3 ? 9 : 3;
+  static constexpr std::uint32_t kEnd = 0xffffffffu;  // end of a cell's list
+  static constexpr int kBits = D == 3 ? 10 : 16;      // bits per coordinate in a CellCode
+  static constexpr int kMaxCellsAlong = 1 << kBits;
+  // Bounds the grid's memory (4 bytes per cell) at 6 bytes per particle.
+  static constexpr double kDefaultCellsPerParticle = 1.5;
 
   CellGrid() = default;
-  // Cells at least `min_width` wide, at least 3 per axis, and at most ~4 per particle (dilute
-  // systems get wider cells instead of an unbounded, mostly empty grid).
-  CellGrid(const Vec<D>& box, double min_width, std::size_t particles) : box_(box) {
+  // Cells at least `min_width` wide, at least 3 per axis, at most `max_cells_per_particle` per
+  // particle (dilute systems get wider cells instead of a large, mostly empty grid) and at most
+  // kMaxCellsAlong per axis.
+  CellGrid(const Vec<D>& box, double min_width, std::size_t particles,
+           double max_cells_per_particle = kDefaultCellsPerParticle)
+      : box_(box) {
     double wanted[D];
     double product = 1.0;
     for (int k = 0; k < D; ++k) {
       if (!(box[k] > 0.0) || !std::isfinite(box[k])) {
         throw InputError("box edge " + std::to_string(box[k]) + " is not a finite positive length");
       }
-      wanted[k] = std::min(std::floor(box[k] / min_width), 1e6);
+      wanted[k] = std::min(std::floor(box[k] / min_width), double{kMaxCellsAlong});
       if (wanted[k] < 3.0) {
         throw InputError("box edge " + std::to_string(box[k]) +
                          " is shorter than 3 contact distances (" + std::to_string(min_width) +
@@ -44,7 +58,8 @@ class CellGrid {
       }
       product *= wanted[k];
     }
-    const double max_cells = std::max(27.0, 4.0 * static_cast<double>(particles));
+    const double max_cells =
+        std::max(27.0, max_cells_per_particle * static_cast<double>(particles));
     const double shrink = product > max_cells ? std::pow(max_cells / product, 1.0 / D) : 1.0;
     total_ = 1;
     for (int k = 0; k < D; ++k) {
@@ -64,83 +79,94 @@ class CellGrid {
         off[k] = -1;
       }
     }
-    stride_slots_ = 8;  // count + 7 particles: a 32-byte cell, ample at any hard-sphere density
-    slots_.assign(static_cast<std::size_t>(total_) * stride_slots_, 0);
-    cell_.assign(particles, 0);
+    head_.assign(total_, kEnd);
+    next_.assign(particles, kEnd);
   }
 
   std::uint32_t cell_count() const { return total_; }
-  std::uint32_t capacity() const { return stride_slots_ - 1; }  // members a cell can hold now
   int cells_along(int k) const { return n_[k]; }
-  std::uint32_t cell_of(std::uint32_t i) const { return cell_[i]; }
-  // The particles of cell c: count(c) indices starting at members(c).
-  std::uint32_t count(std::uint32_t c) const { return slots_[std::size_t(c) * stride_slots_]; }
-  const std::uint32_t* members(std::uint32_t c) const {
-    return slots_.data() + std::size_t(c) * stride_slots_ + 1;
-  }
+  double width(int k) const { return width_[k]; }
 
-  int coordinate(std::uint32_t cell, int k) const {
-    return static_cast<int>((cell / stride_[k]) % static_cast<std::uint32_t>(n_[k]));
+  // Codes and linear indices (the position of a cell's list head).
+  int coordinate(CellCode c, int k) const {
+    return static_cast<int>((c >> (kBits * k)) & (kMaxCellsAlong - 1));
   }
-  std::uint32_t cell_at(const std::array<int, D>& c) const {
+  CellCode code_at(const std::array<int, D>& c) const {
+    CellCode code = 0;
+    for (int k = 0; k < D; ++k) code |= static_cast<CellCode>(c[k]) << (kBits * k);
+    return code;
+  }
+  std::uint32_t index(CellCode c) const {
     std::uint32_t idx = 0;
-    for (int k = 0; k < D; ++k) idx += static_cast<std::uint32_t>(c[k]) * stride_[k];
+    for (int k = 0; k < D; ++k) idx += static_cast<std::uint32_t>(coordinate(c, k)) * stride_[k];
     return idx;
   }
+  // Whether a code names a cell of this grid (restart files are checked with it).
+  bool valid(CellCode c) const {
+    if (D == 3 && (c >> (3 * kBits)) != 0) return false;
+    for (int k = 0; k < D; ++k)
+      if (coordinate(c, k) >= n_[k]) return false;
+    return true;
+  }
   // Cell containing a position (clamped into the grid: positions may sit a round-off outside).
-  std::uint32_t locate(const Vec<D>& x) const {
+  CellCode locate(const Vec<D>& x) const {
     std::array<int, D> c;
     for (int k = 0; k < D; ++k) {
       c[k] = static_cast<int>(std::floor(x[k] / width_[k]));
       if (c[k] < 0) c[k] = 0;
       if (c[k] >= n_[k]) c[k] = n_[k] - 1;
     }
-    return cell_at(c);
+    return code_at(c);
   }
-  double lower(std::uint32_t cell, int k) const { return coordinate(cell, k) * width_[k]; }
-  double upper(std::uint32_t cell, int k) const { return (coordinate(cell, k) + 1) * width_[k]; }
+  double lower(CellCode c, int k) const { return coordinate(c, k) * width_[k]; }
+  double upper(CellCode c, int k) const { return (coordinate(c, k) + 1) * width_[k]; }
 
-  void insert(std::uint32_t i, std::uint32_t c) {
-    if (count(c) + 1 >= stride_slots_) grow();
-    std::uint32_t* cell = slots_.data() + std::size_t(c) * stride_slots_;
-    cell[1 + cell[0]++] = i;
-    cell_[i] = c;
+  // The particles of a cell (by linear index): first(), then next(i) until kEnd.
+  std::uint32_t first(std::uint32_t cell_index) const { return head_[cell_index]; }
+  std::uint32_t next(std::uint32_t i) const { return next_[i]; }
+  const std::uint32_t* heads() const { return head_.data(); }
+  const std::uint32_t* links() const { return next_.data(); }
+
+  void insert(std::uint32_t i, CellCode c) {
+    const std::uint32_t h = index(c);
+    next_[i] = head_[h];
+    head_[h] = i;
   }
-  // Removes i from its cell; the last member takes its slot.
-  void erase(std::uint32_t i) {
-    std::uint32_t* cell = slots_.data() + std::size_t(cell_[i]) * stride_slots_;
-    const std::uint32_t n = cell[0];
-    for (std::uint32_t k = 1; k <= n; ++k) {
-      if (cell[k] == i) {
-        cell[k] = cell[n];
-        --cell[0];
-        return;
-      }
-    }
+  // Removes i from cell c (where the caller says it is): a walk along a list of ~1 member.
+  void erase(std::uint32_t i, CellCode c) {
+    std::uint32_t* link = &head_[index(c)];
+    while (*link != i) link = &next_[*link];
+    *link = next_[i];
+  }
+  // Empties every cell (before particles are inserted again in a new numbering).
+  void clear() {
+    std::fill(head_.begin(), head_.end(), kEnd);
+    std::fill(next_.begin(), next_.end(), kEnd);
   }
 
-  // A neighbouring cell and the periodic shift to add to positions of particles inside it;
-  // `shifted` is false when the shift is zero (most cells: the caller can skip the copy).
+  // A neighbouring cell (linear index) and the periodic shift to add to positions of particles
+  // inside it; `shifted` is false when the shift is zero (most cells).
   struct Neighbour {
     std::uint32_t cell;
     bool shifted;
     Vec<D> shift;
   };
 
-  // Visits the 3^D cells around `cell` (itself included). Cells away from the box faces take a
+  // Visits the 3^D cells around `c` (itself included). Cells away from the box faces take a
   // fast path: fixed index offsets, no wrapping, no shift.
   template <class F>
-  void for_each_neighbour(std::uint32_t cell, F&& f) const {
+  void for_each_neighbour(CellCode c, F&& f) const {
     std::array<int, D> base;
     bool interior = true;
     for (int k = 0; k < D; ++k) {
-      base[k] = coordinate(cell, k);
+      base[k] = coordinate(c, k);
       interior = interior && base[k] > 0 && base[k] < n_[k] - 1;
     }
     if (interior) {
+      const std::uint32_t centre = index(c);
       Neighbour nb{0, false, {}};
       for (int n = 0; n < kNeighbourCells; ++n) {
-        nb.cell = cell + neighbour_delta_[n];
+        nb.cell = centre + static_cast<std::uint32_t>(neighbour_delta_[n]);
         f(nb);
       }
       return;
@@ -156,29 +182,9 @@ class CellGrid {
     }
   }
 
-  // Visits the 3^(D-1) cells that become neighbours when a particle enters `cell` moving in
-  // direction `sign` (+1 or -1) along axis `axis`: the far layer beyond the new cell.
-  template <class F>
-  void for_each_new_layer(std::uint32_t cell, int axis, int sign, F&& f) const {
-    std::array<int, D> base;
-    for (int k = 0; k < D; ++k) base[k] = coordinate(cell, k);
-    std::array<int, D> off;
-    off.fill(-1);
-    off[axis] = sign;
-    for (int n = 0; n < kLayerCells; ++n) {
-      f(offset_cell(base, off));
-      for (int k = 0; k < D; ++k) {
-        if (k == axis) continue;
-        if (++off[k] <= 1) break;
-        off[k] = -1;
-      }
-    }
-  }
-
-  // Memory of the grid divided by the number of particles.
   // Offset of cell b from cell a, each component wrapped into {-1, 0, 1}; false if the cells
   // are not neighbours.
-  bool neighbour_offset(std::uint32_t a, std::uint32_t b, std::array<int, D>& d) const {
+  bool neighbour_offset(CellCode a, CellCode b, std::array<int, D>& d) const {
     for (int k = 0; k < D; ++k) {
       int diff = coordinate(b, k) - coordinate(a, k);
       if (diff > 1) diff -= n_[k];
@@ -189,41 +195,47 @@ class CellGrid {
     return true;
   }
 
-  std::size_t bytes_per_particle() const {
-    return cell_.empty() ? 0
-                         : (slots_.size() + cell_.size()) * sizeof(std::uint32_t) / cell_.size();
+  // The grid's memory (cell heads and particle links) divided by the number of particles.
+  double bytes_per_particle() const {
+    return next_.empty()
+               ? 0.0
+               : static_cast<double>((head_.size() + next_.size()) * sizeof(std::uint32_t)) /
+                     static_cast<double>(next_.size());
+  }
+
+  // Rank of a cell along a Morton (Z-order) curve through the grid: numbering particles by it
+  // keeps the members of neighbouring cells close in memory in every direction.
+  std::uint64_t morton_rank(CellCode c) const {
+    std::uint64_t code = 0;
+    for (int bit = 0; bit < kBits; ++bit) {
+      for (int k = 0; k < D; ++k) {
+        const auto x = static_cast<std::uint64_t>(coordinate(c, k));
+        code |= ((x >> bit) & 1u) << (D * bit + k);
+      }
+    }
+    return code;
   }
 
  private:
-  // Doubles the per-cell capacity, keeping every cell's members in order.
-  void grow() {
-    const std::uint32_t stride = 2 * stride_slots_;
-    std::vector<std::uint32_t> wider(static_cast<std::size_t>(total_) * stride, 0);
-    for (std::size_t c = 0; c < total_; ++c) {
-      std::copy_n(slots_.data() + c * stride_slots_, stride_slots_, wider.data() + c * stride);
-    }
-    slots_.swap(wider);
-    stride_slots_ = stride;
-  }
-
   Neighbour offset_cell(const std::array<int, D>& base, const std::array<int, D>& off) const {
     Neighbour nb;
     nb.shifted = false;
-    std::array<int, D> c;
+    std::uint32_t idx = 0;
     for (int k = 0; k < D; ++k) {
-      c[k] = base[k] + off[k];
+      int c = base[k] + off[k];
       nb.shift[k] = 0.0;
-      if (c[k] < 0) {
-        c[k] += n_[k];
+      if (c < 0) {
+        c += n_[k];
         nb.shift[k] = -box_[k];
         nb.shifted = true;
-      } else if (c[k] >= n_[k]) {
-        c[k] -= n_[k];
+      } else if (c >= n_[k]) {
+        c -= n_[k];
         nb.shift[k] = box_[k];
         nb.shifted = true;
       }
+      idx += static_cast<std::uint32_t>(c) * stride_[k];
     }
-    nb.cell = cell_at(c);
+    nb.cell = idx;
     return nb;
   }
 
@@ -232,10 +244,9 @@ class CellGrid {
   Vec<D> width_{};
   std::array<std::uint32_t, D> stride_{};
   std::uint32_t total_ = 0;
-  std::uint32_t stride_slots_ = 8;
   std::int32_t neighbour_delta_[kNeighbourCells] = {};  // index offsets of an interior cell
-  std::vector<std::uint32_t> slots_;                    // per cell: count, then the member indices
-  std::vector<std::uint32_t> cell_;                     // per particle: its cell
+  std::vector<std::uint32_t> head_;                     // per cell: first member or kEnd
+  std::vector<std::uint32_t> next_;                     // per particle: next member or kEnd
 };
 
 }  // namespace kairos

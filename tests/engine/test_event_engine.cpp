@@ -12,8 +12,9 @@ namespace kairos {
 namespace {
 
 template <int D, class Q>
-void run_validated(const ParticleSystem<D>& start, int events, int expect_cells = 0) {
-  EventEngine<D, Q> engine(start);
+void run_validated(const ParticleSystem<D>& start, int events, int expect_cells = 0,
+                   EngineOptions options = {}) {
+  EventEngine<D, Q> engine(start, StartMode::kPredict, options);
   if (expect_cells > 0) {
     for (int k = 0; k < D; ++k) ASSERT_EQ(engine.grid().cells_along(k), expect_cells);
   }
@@ -36,9 +37,9 @@ TEST(EventEngine, ValidatedAgainstBruteForce2D) {
 }
 
 TEST(EventEngine, ValidatedBinaryMixture) {
-  // Unequal sizes and masses (4 and 8 cells wide).
+  // Unequal sizes and masses (4 and 7 cells wide).
   run_validated<3, CalendarQueue>(testing::lattice_system<3>(4, 0.3, 5, 3.0, 1.4), 3000, 4);
-  run_validated<2, CalendarQueue>(testing::lattice_system<2>(6, 0.3, 6, 0.5, 1.4), 3000, 8);
+  run_validated<2, CalendarQueue>(testing::lattice_system<2>(6, 0.3, 6, 0.5, 1.4), 3000, 7);
 }
 
 TEST(EventEngine, ValidatedInABoxThreeCellsWide) {
@@ -47,6 +48,64 @@ TEST(EventEngine, ValidatedInABoxThreeCellsWide) {
   run_validated<3, CalendarQueue>(testing::lattice_system<3>(3, 0.3, 11, 2.0), 5000, 3);
   run_validated<3, BinaryHeapQueue>(testing::lattice_system<3>(3, 0.45, 12), 5000, 3);
   run_validated<2, CalendarQueue>(testing::lattice_system<2>(3, 0.5, 13, 0.5), 5000, 3);
+}
+
+template <int D>
+void expect_bit_identical(const ParticleSystem<D>& a, const ParticleSystem<D>& b) {
+  ASSERT_EQ(a.time, b.time);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (int k = 0; k < D; ++k) {
+      ASSERT_EQ(a.kinematics[i].pos[k], b.kinematics[i].pos[k]) << "particle " << i;
+      ASSERT_EQ(a.kinematics[i].vel[k], b.kinematics[i].vel[k]) << "particle " << i;
+    }
+  }
+}
+
+TEST(EventEngine, ValidatedWhileRenumberingEveryFewCollisions) {
+  // Renumbering every 0.2 collisions per particle: partners, cells and queue keys must follow.
+  EngineOptions often;
+  often.renumber_interval = 0.2;
+  run_validated<3, CalendarQueue>(testing::lattice_system<3>(4, 0.3, 16, 2.0, 1.3), 3000, 0, often);
+  run_validated<2, BinaryHeapQueue>(testing::lattice_system<2>(7, 0.5, 17, 0.5), 3000, 0, often);
+}
+
+TEST(EventEngine, RenumberingKeepsTheCallersParticleNumbering) {
+  auto s = testing::lattice_system<3>(5, 0.3, 18, 2.0, 1.4);
+  EngineOptions often;
+  often.renumber_interval = 0.5;
+  EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, often);
+  for (int e = 0; e < 5000; ++e) engine.step();
+  const auto state = engine.export_state();
+  ASSERT_EQ(state.size(), s.size());
+  bool permuted = false;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    // Species, radius and mass are properties of the particle, whatever its internal slot.
+    EXPECT_EQ(state.species[i], s.species[i]);
+    EXPECT_EQ(state.kinematics[i].radius, s.kinematics[i].radius);
+    EXPECT_EQ(state.mass[i], s.mass[i]);
+    permuted = permuted || state.order[i] != i;
+  }
+  EXPECT_TRUE(permuted) << "the test should exercise a non-trivial internal order";
+  // The collision counters of all particles add up to twice the collisions.
+  std::uint64_t sum = 0;
+  for (auto c : state.collision_count) sum += c;
+  EXPECT_EQ(sum, 2 * engine.counters().collisions);
+}
+
+TEST(EventEngine, ResumingAcrossRenumberingIsBitIdentical) {
+  const auto start = testing::lattice_system<3>(6, 0.45, 19, 1.0, 1.2);
+  EngineOptions often;
+  often.renumber_interval = 1.0;
+  EventEngine<3, CalendarQueue> whole(start, StartMode::kPredict, often);
+  for (int e = 0; e < 30000; ++e) whole.step();
+  EventEngine<3, CalendarQueue> first(start, StartMode::kPredict, often);
+  for (int e = 0; e < 12345; ++e) first.step();
+  EventEngine<3, CalendarQueue> second(first.export_state(), StartMode::kResume, often);
+  for (int e = 0; e < 30000 - 12345; ++e) second.step();
+  const auto a = whole.export_state(), b = second.export_state();
+  expect_bit_identical(a, b);
+  EXPECT_EQ(a.order, b.order);
+  EXPECT_EQ(a.counters.stale_events, b.counters.stale_events);
 }
 
 template <int D, class Q>
@@ -64,8 +123,8 @@ void check_conservation(const ParticleSystem<D>& start, std::uint64_t events) {
   for (int a = 0; a < D; ++a) EXPECT_NEAR((p1[a] - p0[a]) / pscale, 0.0, 1e-10);
   const auto pos = engine.current_positions();
   std::vector<double> diam;
-  for (const auto& k : engine.system().kinematics) diam.push_back(2.0 * k.radius);
-  EXPECT_LT(max_overlap_bruteforce<D>(engine.system().box, pos, diam), 1e-10);
+  for (const auto& k : start.kinematics) diam.push_back(2.0 * k.radius);
+  EXPECT_LT(max_overlap_bruteforce<D>(engine.box(), pos, diam), 1e-10);
 }
 
 TEST(EventEngine, ConservesEnergyAndMomentumOverAMillionEvents3D) {
@@ -76,17 +135,6 @@ TEST(EventEngine, ConservesEnergyAndMomentumOverAMillionEvents2D) {
   check_conservation<2, CalendarQueue>(testing::lattice_system<2>(32, 0.6, 8, 2.0, 1.2), 1000000);
 }
 
-template <int D>
-void expect_bit_identical(const ParticleSystem<D>& a, const ParticleSystem<D>& b) {
-  ASSERT_EQ(a.time, b.time);
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    for (int k = 0; k < D; ++k) {
-      ASSERT_EQ(a.kinematics[i].pos[k], b.kinematics[i].pos[k]) << "particle " << i;
-      ASSERT_EQ(a.kinematics[i].vel[k], b.kinematics[i].vel[k]) << "particle " << i;
-    }
-  }
-}
-
 TEST(EventEngine, HeapAndCalendarGiveBitIdenticalRuns) {
   const auto start = testing::lattice_system<3>(8, 0.45, 9);
   EventEngine<3, BinaryHeapQueue> a(start);
@@ -95,7 +143,7 @@ TEST(EventEngine, HeapAndCalendarGiveBitIdenticalRuns) {
     a.step();
     b.step();
   }
-  expect_bit_identical(a.system(), b.system());
+  expect_bit_identical(a.export_state(), b.export_state());
 }
 
 TEST(EventEngine, ContinuingFromExportedStateIsBitIdentical) {
@@ -106,7 +154,7 @@ TEST(EventEngine, ContinuingFromExportedStateIsBitIdentical) {
   for (int e = 0; e < 10000; ++e) first.step();
   EventEngine<3, CalendarQueue> second(first.export_state(), StartMode::kResume);
   for (int e = 0; e < 10000; ++e) second.step();
-  expect_bit_identical(whole.system(), second.system());
+  expect_bit_identical(whole.export_state(), second.export_state());
 }
 
 TEST(EventEngine, ResumeNeedsSchedulerState) {
@@ -123,9 +171,10 @@ TEST(EventEngine, PositionsOutsideTheBoxAreWrappedIn) {
   auto s = testing::lattice_system<3>(5, 0.3, 15);
   for (auto& k : s.kinematics) k.pos[0] += 3.0 * s.box[0];  // three images away
   EventEngine<3, CalendarQueue> engine(s);
+  const auto state = engine.export_state();
   for (std::size_t i = 0; i < engine.size(); ++i) {
-    EXPECT_GE(engine.system().kinematics[i].pos[0], 0.0);
-    EXPECT_LT(engine.system().kinematics[i].pos[0], s.box[0]);
+    EXPECT_GE(state.kinematics[i].pos[0], 0.0);
+    EXPECT_LT(state.kinematics[i].pos[0], s.box[0]);
   }
   for (int e = 0; e < 500; ++e) {
     engine.step();
@@ -142,8 +191,9 @@ TEST(EventEngine, TwoParticlesHeadOnSwapVelocities) {
   EventEngine<3, BinaryHeapQueue> engine(s);
   while (engine.counters().collisions == 0) engine.step();
   EXPECT_DOUBLE_EQ(engine.time(), 1.0);
-  EXPECT_DOUBLE_EQ(engine.system().kinematics[0].vel[0], -1.0);
-  EXPECT_DOUBLE_EQ(engine.system().kinematics[1].vel[0], 1.0);
+  const auto state = engine.export_state();
+  EXPECT_DOUBLE_EQ(state.kinematics[0].vel[0], -1.0);
+  EXPECT_DOUBLE_EQ(state.kinematics[1].vel[0], 1.0);
   EXPECT_DOUBLE_EQ(engine.counters().virial, 2.0);  // r.J = sigma * 2 mu |g_n| = 1 * 2 * 0.5 * 2
 }
 
