@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "core/periodic.hpp"
 #include "dynamics/collision_time.hpp"
+#include "engine/candidate_scan.hpp"
 #include "interactions/hard_sphere.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -39,8 +40,10 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
   double rmax = 0.0;
   for (const Shape& sh : shapes_) rmax = std::max(rmax, sh.radius);
   grid_ = CellGrid<D>(box_, 2.0 * rmax, n, options_.max_cells_per_particle);
-  candidates_.resize(256);
-  candidate_shift_.resize(256);
+  for (CandidateList& list : lists_) {
+    list.ids.resize(256);
+    list.shift.resize(256);
+  }
 
   // Internal numbering: the stored one when resuming, else the caller's (renumbered below).
   id_.resize(n);
@@ -57,9 +60,13 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
   }
   std::vector<std::uint16_t> shape_by_id = std::move(shape_);
   if (!shape_by_id.empty()) {
-    shape_.resize(n);
+    shape_.resize(n + 1);  // one spare entry: the vector loop reads shapes 4 bytes at a time
     for (std::size_t k = 0; k < n; ++k) shape_[k] = shape_by_id[id_[k]];
   }
+  for (const Shape& sh : shapes_) shape_radius_.push_back(sh.radius);
+  // The vector loop indexes records with 32-bit offsets.
+  vector_scan_ = options_.vector_scan && cpu_has_avx512() &&
+                 static_cast<double>(n) * sizeof(HotRecord<D>) < 2e9;
   const bool has_counts = s.collision_count.size() == n;
   hot_.resize(n);
   for (std::uint32_t k = 0; k < n; ++k) {
@@ -196,7 +203,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
     id_.swap(id);
   }
   if (!shape_.empty()) {
-    std::vector<std::uint16_t> shape(n);
+    std::vector<std::uint16_t> shape(n + 1);
     for (std::uint32_t k = 0; k < n; ++k) shape[k] = shape_[rank[k].second];
     shape_.swap(shape);
   }
@@ -214,101 +221,191 @@ void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
 
 // When the particle leaves its cell, through which face. Always computed from the unchanged
 // record, so the time a crossing was scheduled at and the face it is processed with agree.
+// Branch-free (the signs of velocity components are random): the same arithmetic as
+// interval_exit_time(), the first axis winning ties.
 template <int D, class Queue>
 typename EventEngine<D, Queue>::Crossing EventEngine<D, Queue>::next_crossing(
     const HotRecord<D>& h) const {
   Crossing x{kNever, -1, 0};
   for (int a = 0; a < D; ++a) {
-    const double dt =
-        interval_exit_time(h.pos[a], h.vel[a], grid_.lower(h.cell, a), grid_.upper(h.cell, a));
-    if (h.time + dt < x.time) x = {h.time + dt, a, h.vel[a] > 0.0 ? 1 : -1};
+    const double v = h.vel[a];
+    const double face = v > 0.0 ? grid_.upper(h.cell, a) : grid_.lower(h.cell, a);
+    double dt = (face - h.pos[a]) / v;
+    dt = dt > 0.0 ? dt : 0.0;  // already past the face (round-off): now
+    dt = v != 0.0 ? dt : kNever;
+    const double when = h.time + dt;
+    const bool sooner = when < x.time;
+    x.time = sooner ? when : x.time;
+    x.axis = sooner ? a : x.axis;
+    x.sign = sooner ? (v > 0.0 ? 1 : -1) : x.sign;
   }
   return x;
 }
 
-// Collects the members of the 3^D cells around `cell` as candidates, prefetching their records
-// so that the cache misses of a whole prediction overlap instead of queueing one after another.
-// Locals instead of members in the loop: the compiler need not reload them after every store.
+// Doubles a candidate list's storage (rare: a crowded neighbourhood); returns the new storage.
 template <int D, class Queue>
-void EventEngine<D, Queue>::gather(CellCode cell) {
-  std::uint32_t n = 0, n_shifts = 1;  // shifts_[0] is the zero shift of all unshifted cells
-  auto cap = static_cast<std::uint32_t>(candidates_.size());
-  std::uint32_t* cand = candidates_.data();
-  std::uint16_t* shift_of = candidate_shift_.data();
-  const std::uint32_t* heads = grid_.heads();
-  const std::uint32_t* next = grid_.links();
-  const HotRecord<D>* hot = hot_.data();
-  grid_.for_each_neighbour(cell, [&](const typename CellGrid<D>::Neighbour& nb) {
-    const auto shift = static_cast<std::uint16_t>(nb.shifted ? n_shifts : 0);
-    for (std::uint32_t p = heads[nb.cell]; p != CellGrid<D>::kEnd; p = next[p]) {
-      __builtin_prefetch(hot + p);
-      if (n == cap) [[unlikely]] {
-        candidates_.resize(2 * candidates_.size());
-        candidate_shift_.resize(candidates_.size());
-        cap = static_cast<std::uint32_t>(candidates_.size());
-        cand = candidates_.data();
-        shift_of = candidate_shift_.data();
-      }
-      cand[n] = p;
-      shift_of[n] = shift;
-      ++n;
-    }
-    if (nb.shifted) shifts_[n_shifts++] = nb.shift;
-  });
-  n_candidates_ = n;
-  n_shifts_ = n_shifts;
+std::uint32_t* EventEngine<D, Queue>::grow(CandidateList& list) {
+  list.ids.resize(2 * list.ids.size());
+  list.shift.resize(list.ids.size());
+  return list.ids.data();
 }
 
-// Tests a particle (state xi, vi at time t) against the gathered candidates in one flat loop;
-// returns the partner of the soonest contact earlier than t + best (kNoPartner if none) and
-// lowers `best` to it. The particle itself may be among the candidates: r = g = 0 gives
-// r.g = 0, which the first test rejects without a branch of its own.
+// Appends the members of the list starting at p to cand[n...]. Cells hold about one particle,
+// so the first two links are followed without a branch (an empty slot is written but not
+// counted); only a third member takes the loop. Records are prefetched so that the cache
+// misses of a whole prediction overlap instead of queueing one after another.
 template <int D, class Queue>
-template <bool kUniformRadius>
-std::uint32_t EventEngine<D, Queue>::test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi,
-                                                     double ri, double& best) const {
-  std::uint32_t partner = kNoPartner;
-  const double sigma0 = 2.0 * ri;
-  for (std::uint32_t k = 0; k < n_candidates_; ++k) {
-    const std::uint32_t j = candidates_[k];
-    const Vec<D>& shift = shifts_[candidate_shift_[k]];
-    const HotRecord<D>& hj = hot_[j];
-    const double dtj = t - hj.time;
-    double r2 = 0.0, rg = 0.0, g2 = 0.0;
-    for (int a = 0; a < D; ++a) {
-      const double r = xi[a] - (hj.pos[a] + hj.vel[a] * dtj + shift[a]);
-      const double g = vi[a] - hj.vel[a];
-      r2 += r * r;
-      rg += r * g;
-      g2 += g * g;
+[[gnu::always_inline]] inline void EventEngine<D, Queue>::append_members(
+    std::uint32_t p, const Links& links, CandidateList& list, std::uint32_t& n,
+    std::uint32_t*& cand, std::uint32_t& cap) {
+  const std::uint32_t* next = links.next;
+  const std::uint32_t end = links.end;
+  const HotRecord<D>* hot = links.hot;
+  for (int unrolled = 0; unrolled < 2; ++unrolled) {
+    __builtin_prefetch(hot + p);
+    cand[n] = p;
+    n += p != end ? 1u : 0u;
+    p = next[p];
+  }
+  for (; p != end; p = next[p]) {
+    if (cap - n < kCandidateSlack) [[unlikely]] {
+      cand = grow(list);
+      cap = static_cast<std::uint32_t>(list.ids.size());
     }
-    const double sigma = kUniformRadius ? sigma0 : ri + shapes_[shape_[j]].radius;
-    // Cheap rejection before the square root: the contact time 2a/(-b + sqrt(D)) is at least
-    // a/(-b) (b = 2 r.g < 0 when approaching), so a pair that cannot beat `best` is skipped.
-    // Receding pairs (r.g >= 0, the particle itself included) fail the same test.
-    const double gap = r2 - sigma * sigma;
-    if (!(rg < 0.0) || gap > -2.0 * rg * best) continue;
-    const double dt = HardSphere::contact_time(r2, rg, g2, sigma);
-    if (dt < best) {
-      best = dt;
-      partner = j;
+    __builtin_prefetch(hot + p);
+    cand[n++] = p;
+  }
+}
+
+// Collects the members of the 3^D cells around `cell` as candidates. Cells away from the box
+// faces (most) need no periodic shifts and take a loop over fixed index offsets.
+template <int D, class Queue>
+void EventEngine<D, Queue>::gather(CellCode cell, CandidateList& list) {
+  constexpr auto kCells = static_cast<std::uint32_t>(CellGrid<D>::kNeighbourCells);
+  std::uint32_t n = 0;
+  auto cap = static_cast<std::uint32_t>(list.ids.size());
+  std::uint32_t* cand = list.ids.data();
+  const std::uint32_t* heads = grid_.heads();
+  // Read once: the stores into the candidate list could alias them for the compiler.
+  const Links links{grid_.links(), grid_.end(), hot_.data()};
+  if (vector_scan_) {
+    gather_vector(cell, list);
+    return;
+  }
+  if (grid_.interior(cell)) {
+    const std::uint32_t centre = grid_.index(cell);
+    const std::int32_t* delta = grid_.neighbour_deltas();
+    for (std::uint32_t c = 0; c < kCells; ++c) {
+      if (cap - n < kCandidateSlack) [[unlikely]] {
+        cand = grow(list);
+        cap = static_cast<std::uint32_t>(list.ids.size());
+      }
+      append_members(heads[centre + static_cast<std::uint32_t>(delta[c])], links, list, n, cand,
+                     cap);
+    }
+    list.n_shifts = 1;
+  } else {
+    std::uint32_t n_shifts = 1;  // shifts[0] is the zero shift
+    grid_.for_each_neighbour(cell, [&](const typename CellGrid<D>::Neighbour& nb) {
+      if (cap - n < kCandidateSlack) [[unlikely]] {
+        cand = grow(list);
+        cap = static_cast<std::uint32_t>(list.ids.size());
+      }
+      const std::uint32_t from = n;
+      append_members(heads[nb.cell], links, list, n, cand, cap);
+      const std::uint32_t shift = nb.shifted ? n_shifts : 0;
+      for (std::uint32_t k = from; k < n; ++k) list.shift[k] = shift;
+      if (nb.shifted) list.shifts[n_shifts++] = nb.shift;
+    });
+    list.n_shifts = n_shifts;
+  }
+  list.count = n;
+}
+
+// gather() with AVX-512: the neighbourhood's list heads and their successors are fetched and
+// compressed sixteen lists at a time; the rare third and later members follow by links.
+template <int D, class Queue>
+void EventEngine<D, Queue>::gather_vector(CellCode cell, CandidateList& list) {
+  constexpr auto kCells = static_cast<std::uint32_t>(CellGrid<D>::kNeighbourCells);
+  while (list.ids.size() < 2 * kCells + kCandidateSlack) grow(list);
+  std::uint32_t cells[kCells], tags[kCells];
+  const bool interior = grid_.interior(cell);
+  std::uint32_t n_shifts = 1;  // shifts[0] is the zero shift
+  if (interior) {
+    const std::uint32_t centre = grid_.index(cell);
+    const std::int32_t* delta = grid_.neighbour_deltas();
+    for (std::uint32_t c = 0; c < kCells; ++c)
+      cells[c] = centre + static_cast<std::uint32_t>(delta[c]);
+  } else {
+    std::uint32_t c = 0;
+    grid_.for_each_neighbour(cell, [&](const typename CellGrid<D>::Neighbour& nb) {
+      cells[c] = nb.cell;
+      tags[c++] = nb.shifted ? n_shifts : 0;
+      if (nb.shifted) list.shifts[n_shifts++] = nb.shift;
+    });
+  }
+  const Neighbourhood nb{
+      grid_.heads(),           grid_.links(), grid_.end(), cells, interior ? nullptr : tags,
+      static_cast<int>(kCells)};
+  std::uint32_t third[kCells], third_tag[kCells];
+  std::uint32_t n_third = 0;
+  std::uint32_t n =
+      gather_lists_avx512(nb, list.ids.data(), list.shift.data(), third, third_tag, n_third);
+  for (std::uint32_t k = 0; k < n_third; ++k) {
+    for (std::uint32_t p = third[k]; p != grid_.end(); p = grid_.next(p)) {
+      if (list.ids.size() - n < kCandidateSlack) [[unlikely]]
+        grow(list);
+      list.ids[n] = p;
+      list.shift[n++] = third_tag[k];
     }
   }
-  return partner;
+  const HotRecord<D>* hot = hot_.data();
+  const std::uint32_t* ids = list.ids.data();
+  for (std::uint32_t k = 0; k < n; ++k) __builtin_prefetch(hot + ids[k]);
+  list.count = n;
+  list.n_shifts = n_shifts;
+}
+
+// Tests particle i (at xi, time t) against a gathered candidate list; returns the partner of
+// the soonest contact earlier than t + best (kNoPartner if none) and lowers `best` to it.
+template <int D, class Queue>
+std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, std::uint32_t i,
+                                                     double t, const Vec<D>& xi,
+                                                     double& best) const {
+  CandidateScan<D> scan;
+  scan.records = reinterpret_cast<const double*>(hot_.data());
+  scan.stride = static_cast<int>(sizeof(HotRecord<D>) / sizeof(double));
+  scan.candidates = list.ids.data();
+  scan.shift_index = list.shift.data();
+  scan.shifts = list.shifts;
+  scan.any_shift = list.n_shifts > 1;  // else list.shift is stale and must not be read
+  scan.count = list.count;
+  scan.uniform = uniform_radius_;
+  scan.sigma = 2.0 * radius_of(i);
+  scan.radius_i = radius_of(i);
+  scan.shape = shape_.data();
+  scan.shape_radius = shape_radius_.data();
+  const std::uint32_t k = vector_scan_ ? scan_candidates_avx512<D>(scan, t, xi, hot_[i].vel, best)
+                                       : scan_candidates_scalar<D>(scan, t, xi, hot_[i].vel, best);
+  return k == kNoCandidate ? kNoPartner : list.ids[k];
 }
 
 // Finds the particle's next event from time t: the soonest collision with a neighbour, if it
 // comes before the particle leaves its cell, else the crossing. Stores it; returns its time.
 template <int D, class Queue>
 double EventEngine<D, Queue>::predict(std::uint32_t i, double t) {
+  gather(hot_[i].cell, lists_[0]);
+  return predict_from(lists_[0], i, t);
+}
+
+// predict() with the candidates already gathered (from the particle's own cell).
+template <int D, class Queue>
+double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint32_t i, double t) {
   const HotRecord<D>& h = hot_[i];
   const Crossing crossing = next_crossing(h);
   double best = crossing.time - t;
   const Vec<D> xi = h.pos + (t - h.time) * h.vel;
-  gather(h.cell);
-  const std::uint32_t partner = uniform_radius_
-                                    ? test_candidates<true>(t, xi, h.vel, radius_of(i), best)
-                                    : test_candidates<false>(t, xi, h.vel, radius_of(i), best);
+  const std::uint32_t partner = test_candidates(list, i, t, xi, best);
   double when = crossing.time;
   if (partner != kNoPartner) {
     pending_[i] = {partner, hot_[partner].collisions};
@@ -345,8 +442,13 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
   ++counters_.collisions;
   ++hi.collisions;
   ++hj.collisions;
-  queue_.update(i, predict(i, t));
-  queue_.update(j, predict(j, t));
+  // Both neighbourhoods are gathered (and their records prefetched) before either is tested;
+  // partners in one cell share one list.
+  gather(hi.cell, lists_[0]);
+  const bool shared = hj.cell == hi.cell;
+  if (!shared) gather(hj.cell, lists_[1]);
+  queue_.update(i, predict_from(lists_[0], i, t));
+  queue_.update(j, predict_from(lists_[shared ? 0 : 1], j, t));
 }
 
 template <int D, class Queue>
@@ -479,7 +581,7 @@ void EventEngine<D, Queue>::validate() {
   std::vector<std::uint32_t> listed(n, 0);
   for (std::uint32_t c = 0; c < grid_.cell_count(); ++c) {
     std::uint32_t steps = 0;
-    for (std::uint32_t p = grid_.first(c); p != CellGrid<D>::kEnd; p = grid_.next(p)) {
+    for (std::uint32_t p = grid_.first(c); p != grid_.end(); p = grid_.next(p)) {
       if (p >= n || ++steps > n) fail("cell " + std::to_string(c) + " has a broken list");
       if (grid_.index(hot_[p].cell) != c)
         fail("particle " + name(p) + " listed in a cell it is not in");

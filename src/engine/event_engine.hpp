@@ -60,6 +60,8 @@ struct EngineOptions {
   // Renumber particles along a Morton curve every this many collisions per particle (0: never).
   double renumber_interval = 32.0;
   double max_cells_per_particle = CellGrid<3>::kDefaultCellsPerParticle;
+  // Test candidates eight at a time with AVX-512 when the CPU has it (same results either way).
+  bool vector_scan = true;
 };
 
 template <int D, class Queue>
@@ -99,6 +101,14 @@ class EventEngine {
     std::uint32_t partner;        // EventSlot::kNoPartner: the event is a cell crossing
     std::uint32_t partner_count;  // the partner's collision counter when predicted
   };
+  // Scratch of a prediction: candidate partners and the periodic shift of each one's cell. Two,
+  // so that both partners of a collision gather (and prefetch) before either is tested.
+  struct CandidateList {
+    std::vector<std::uint32_t> ids;
+    std::vector<std::uint32_t> shift;  // per candidate, into shifts; read only if n_shifts > 1
+    Vec<D> shifts[CellGrid<D>::kNeighbourCells + 1] = {};
+    std::uint32_t count = 0, n_shifts = 1;
+  };
   struct Crossing {
     double time;  // absolute
     int axis;     // -1: never
@@ -111,10 +121,21 @@ class EventEngine {
   void advance_to(std::uint32_t i, double t);
   Crossing next_crossing(const HotRecord<D>& h) const;
   double predict(std::uint32_t i, double t);
-  void gather(CellCode cell);
-  template <bool kUniformRadius>
-  std::uint32_t test_candidates(double t, const Vec<D>& xi, const Vec<D>& vi, double ri,
-                                double& best) const;
+  double predict_from(const CandidateList& list, std::uint32_t i, double t);
+  void gather(CellCode cell, CandidateList& list);
+  void gather_vector(CellCode cell, CandidateList& list);
+  struct Links {
+    const std::uint32_t* next;
+    std::uint32_t end;
+    const HotRecord<D>* hot;
+  };
+  void append_members(std::uint32_t p, const Links& links, CandidateList& list, std::uint32_t& n,
+                      std::uint32_t*& cand, std::uint32_t& cap);
+  static std::uint32_t* grow(CandidateList& list);
+  // Free candidate slots kept before each list is appended (its unconditional writes).
+  static constexpr std::uint32_t kCandidateSlack = 4;
+  std::uint32_t test_candidates(const CandidateList& list, std::uint32_t i, double t,
+                                const Vec<D>& xi, double& best) const;
   void collide(std::uint32_t i, std::uint32_t j, double t);
   void cross(std::uint32_t i, double t);
   void renumber(bool queue_filled);
@@ -133,16 +154,14 @@ class EventEngine {
   std::vector<std::uint16_t> shape_;  // per particle; empty when there is a single shape
   std::vector<Shape> shapes_;
   bool uniform_radius_ = true;
+  std::vector<double> shape_radius_;  // radius per shape, for the candidate loops
+  bool vector_scan_ = false;
   std::vector<std::uint32_t> id_;  // internal index -> the caller's particle number
   CellGrid<D> grid_;
   Queue queue_;
   std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions
 
-  // Scratch of one prediction: candidate partners and the periodic shift of each one's cell.
-  std::vector<std::uint32_t> candidates_;
-  std::vector<std::uint16_t> candidate_shift_;
-  Vec<D> shifts_[CellGrid<D>::kNeighbourCells + 1] = {};
-  std::uint32_t n_candidates_ = 0, n_shifts_ = 0;
+  CandidateList lists_[2];
 };
 
 }  // namespace kairos

@@ -31,8 +31,7 @@ template <int D>
 class CellGrid {
  public:
   static constexpr int kNeighbourCells = D == 3 ? 27 : 9;
-  static constexpr std::uint32_t kEnd = 0xffffffffu;  // end of a cell's list
-  static constexpr int kBits = D == 3 ? 10 : 16;      // bits per coordinate in a CellCode
+  static constexpr int kBits = D == 3 ? 10 : 16;  // bits per coordinate in a CellCode
   static constexpr int kMaxCellsAlong = 1 << kBits;
   // Bounds the grid's memory (4 bytes per cell) at 6 bytes per particle.
   static constexpr double kDefaultCellsPerParticle = 1.5;
@@ -79,8 +78,9 @@ class CellGrid {
         off[k] = -1;
       }
     }
-    head_.assign(total_, kEnd);
-    next_.assign(particles, kEnd);
+    end_ = static_cast<std::uint32_t>(particles);
+    head_.assign(total_, end_);
+    next_.assign(particles + 1, end_);
   }
 
   std::uint32_t cell_count() const { return total_; }
@@ -103,7 +103,9 @@ class CellGrid {
   }
   // Whether a code names a cell of this grid (restart files are checked with it).
   bool valid(CellCode c) const {
-    if (D == 3 && (c >> (3 * kBits)) != 0) return false;
+    if constexpr (D == 3) {
+      if ((c >> (3 * kBits)) != 0) return false;
+    }
     for (int k = 0; k < D; ++k)
       if (coordinate(c, k) >= n_[k]) return false;
     return true;
@@ -121,7 +123,10 @@ class CellGrid {
   double lower(CellCode c, int k) const { return coordinate(c, k) * width_[k]; }
   double upper(CellCode c, int k) const { return (coordinate(c, k) + 1) * width_[k]; }
 
-  // The particles of a cell (by linear index): first(), then next(i) until kEnd.
+  // The particles of a cell (by linear index): first(), then next(i) until end(). The end
+  // marker is the particle count, and next(end()) is end() again, so a loop may follow links
+  // past the end without a branch.
+  std::uint32_t end() const { return end_; }
   std::uint32_t first(std::uint32_t cell_index) const { return head_[cell_index]; }
   std::uint32_t next(std::uint32_t i) const { return next_[i]; }
   const std::uint32_t* heads() const { return head_.data(); }
@@ -140,8 +145,8 @@ class CellGrid {
   }
   // Empties every cell (before particles are inserted again in a new numbering).
   void clear() {
-    std::fill(head_.begin(), head_.end(), kEnd);
-    std::fill(next_.begin(), next_.end(), kEnd);
+    std::fill(head_.begin(), head_.end(), end_);
+    std::fill(next_.begin(), next_.end(), end_);
   }
 
   // A neighbouring cell (linear index) and the periodic shift to add to positions of particles
@@ -151,6 +156,15 @@ class CellGrid {
     bool shifted;
     Vec<D> shift;
   };
+
+  // Whether all 3^D cells around `c` lie inside the grid without wrapping: then they sit at
+  // index(c) + neighbour_deltas()[n], and none needs a periodic shift.
+  bool interior(CellCode c) const {
+    bool in = true;
+    for (int k = 0; k < D; ++k) in = in && coordinate(c, k) > 0 && coordinate(c, k) < n_[k] - 1;
+    return in;
+  }
+  const std::int32_t* neighbour_deltas() const { return neighbour_delta_; }
 
   // Visits the 3^D cells around `c` (itself included). Cells away from the box faces take a
   // fast path: fixed index offsets, no wrapping, no shift.
@@ -244,9 +258,10 @@ class CellGrid {
   Vec<D> width_{};
   std::array<std::uint32_t, D> stride_{};
   std::uint32_t total_ = 0;
+  std::uint32_t end_ = 0;  // the list end marker: the number of particles
   std::int32_t neighbour_delta_[kNeighbourCells] = {};  // index offsets of an interior cell
-  std::vector<std::uint32_t> head_;                     // per cell: first member or kEnd
-  std::vector<std::uint32_t> next_;                     // per particle: next member or kEnd
+  std::vector<std::uint32_t> head_;                     // per cell: first member or end_
+  std::vector<std::uint32_t> next_;                     // per particle (+ end_): next or end_
 };
 
 }  // namespace kairos

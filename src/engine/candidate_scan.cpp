@@ -1,0 +1,188 @@
+#include "engine/candidate_scan.hpp"
+
+#include <immintrin.h>
+
+#include <limits>
+
+namespace kairos {
+
+bool cpu_has_avx512() {
+#if defined(__x86_64__) && defined(__GNUC__)
+  static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512bw");
+  return has;
+#else
+  return false;
+#endif
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+
+// Everything up to the matching pop_options is compiled for AVX-512 (and only ever called
+// after cpu_has_avx512()).
+#pragma GCC push_options
+#pragma GCC target("avx512f,avx512vl,avx512bw")
+// GCC 12 flags its own _mm512_undefined_pd() inside the intrinsics headers (a known false
+// positive of -Wmaybe-uninitialized); nothing in this file reads an uninitialised value.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+
+namespace {
+
+// Field f of the eight records whose first doubles sit at offsets `base` (masked lanes: 0).
+inline __m512d gather_field(const double* records, __m256i base, __mmask8 live, int f) {
+  return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live,
+                                  _mm256_add_epi32(base, _mm256_set1_epi32(f)), records, 8);
+}
+
+}  // namespace
+
+// Eight candidates per iteration. Record fields come in by gathers (the records were prefetched
+// while the candidate list was built); lanes past the end read record 0 and are masked out.
+// Every lane computes the full contact time; invalid lanes (receding, near miss, beaten by the
+// cheap bound) become +inf, and the lowest lane holding the minimum wins, as in list order.
+template <int D>
+std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
+                                     const Vec<D>& vi, double& best) {
+  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512d vt = _mm512_set1_pd(t);
+  const __m512d minus_two = _mm512_set1_pd(-2.0);
+  __m512d vxi[D], vvi[D];
+  for (int a = 0; a < D; ++a) {
+    vxi[a] = _mm512_set1_pd(xi[a]);
+    vvi[a] = _mm512_set1_pd(vi[a]);
+  }
+  const __m512d vsigma2 = _mm512_set1_pd(s.sigma * s.sigma);
+  const __m512d vradius_i = _mm512_set1_pd(s.radius_i);
+  const __m256i vstride = _mm256_set1_epi32(s.stride);
+  std::uint32_t found = kNoCandidate;
+  for (std::uint32_t k = 0; k < s.count; k += 8) {
+    const std::uint32_t left = s.count - k;
+    const __mmask8 live = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
+    const __m256i ids = _mm256_maskz_loadu_epi32(live, s.candidates + k);
+    const __m256i base = _mm256_mullo_epi32(ids, vstride);
+    const __m512d dtj = _mm512_sub_pd(vt, gather_field(s.records, base, live, 2 * D));
+    __m512d r2 = zero, rg = zero, g2 = zero;
+    __m256i shift_base = _mm256_setzero_si256();
+    if (s.any_shift) {
+      const __m256i sidx = _mm256_maskz_loadu_epi32(live, s.shift_index + k);
+      shift_base = _mm256_mullo_epi32(sidx, _mm256_set1_epi32(D));
+    }
+    for (int a = 0; a < D; ++a) {
+      const __m512d vel = gather_field(s.records, base, live, D + a);
+      __m512d xj = _mm512_add_pd(gather_field(s.records, base, live, a), _mm512_mul_pd(vel, dtj));
+      if (s.any_shift) {
+        const __m512d sh =
+            _mm512_mask_i32gather_pd(zero, live, _mm256_add_epi32(shift_base, _mm256_set1_epi32(a)),
+                                     reinterpret_cast<const double*>(s.shifts), 8);
+        xj = _mm512_add_pd(xj, sh);
+      }
+      const __m512d r = _mm512_sub_pd(vxi[a], xj);
+      const __m512d g = _mm512_sub_pd(vvi[a], vel);
+      r2 = _mm512_add_pd(r2, _mm512_mul_pd(r, r));
+      rg = _mm512_add_pd(rg, _mm512_mul_pd(r, g));
+      g2 = _mm512_add_pd(g2, _mm512_mul_pd(g, g));
+    }
+    __m512d sigma2 = vsigma2;
+    if (!s.uniform) {
+      // Shape numbers are 16-bit: gather 32 bits at each and keep the low half (the array is
+      // padded by the engine so the last read stays inside it).
+      const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(live),
+                                                      _mm512_castsi256_si512(ids), s.shape, 2);
+      const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
+      const __m512d rj = _mm512_mask_i32gather_pd(zero, live, shp, s.shape_radius, 8);
+      const __m512d sigma = _mm512_add_pd(vradius_i, rj);
+      sigma2 = _mm512_mul_pd(sigma, sigma);
+    }
+    const __m512d gap = _mm512_sub_pd(r2, sigma2);
+    const __m512d bound = _mm512_mul_pd(_mm512_mul_pd(minus_two, rg), _mm512_set1_pd(best));
+    __mmask8 ok = _mm512_mask_cmp_pd_mask(live, rg, zero, _CMP_LT_OQ);
+    ok = _mm512_mask_cmp_pd_mask(ok, gap, bound, _CMP_LE_OQ);
+    if (ok == 0) continue;
+    const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(rg, rg), _mm512_mul_pd(g2, gap));
+    ok = _mm512_mask_cmp_pd_mask(ok, disc, zero, _CMP_GT_OQ);
+    if (ok == 0) continue;
+    const __m512d root = _mm512_sqrt_pd(disc);
+    __m512d dt = _mm512_div_pd(gap, _mm512_sub_pd(root, rg));
+    dt = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(dt, zero, _CMP_GT_OQ), zero, dt);
+    dt = _mm512_mask_blend_pd(ok, inf, dt);
+    const double m = _mm512_reduce_min_pd(dt);
+    if (m < best) {
+      const __mmask8 at = _mm512_mask_cmp_pd_mask(ok, dt, _mm512_set1_pd(m), _CMP_EQ_OQ);
+      best = m;
+      found = k + static_cast<std::uint32_t>(__builtin_ctz(at));
+    }
+  }
+  return found;
+}
+
+template std::uint32_t scan_candidates_avx512<2>(const CandidateScan<2>&, double, const Vec<2>&,
+                                                 const Vec<2>&, double&);
+template std::uint32_t scan_candidates_avx512<3>(const CandidateScan<3>&, double, const Vec<3>&,
+                                                 const Vec<3>&, double&);
+
+// Up to 16 lists per register (two registers for the 27 cells of 3D): gather the heads,
+// compress the non-empty ones out, gather their successors, compress again.
+std::uint32_t gather_lists_avx512(const Neighbourhood& nb, std::uint32_t* out,
+                                  std::uint32_t* out_shift, std::uint32_t* third,
+                                  std::uint32_t* third_shift, std::uint32_t& n_third) {
+  const __m512i end = _mm512_set1_epi32(static_cast<int>(nb.end));
+  __m512i member[2], tag[2];
+  __mmask16 has[2];
+  const int blocks = nb.cells > 16 ? 2 : 1;
+  std::uint32_t n = 0;
+  for (int b = 0; b < blocks; ++b) {
+    const int lanes = nb.cells - 16 * b < 16 ? nb.cells - 16 * b : 16;
+    const auto live = static_cast<__mmask16>((1u << lanes) - 1u);
+    const __m512i cell = _mm512_maskz_loadu_epi32(live, nb.cell + 16 * b);
+    tag[b] = nb.shift ? _mm512_maskz_loadu_epi32(live, nb.shift + 16 * b) : _mm512_setzero_si512();
+    member[b] = _mm512_mask_i32gather_epi32(end, live, cell, nb.heads, 4);
+    has[b] = _mm512_mask_cmpneq_epu32_mask(live, member[b], end);
+    _mm512_mask_compressstoreu_epi32(out + n, has[b], member[b]);
+    if (nb.shift) _mm512_mask_compressstoreu_epi32(out_shift + n, has[b], tag[b]);
+    n += static_cast<std::uint32_t>(__builtin_popcount(has[b]));
+  }
+  for (int b = 0; b < blocks; ++b) {
+    member[b] = _mm512_mask_i32gather_epi32(end, has[b], member[b], nb.next, 4);
+    has[b] = _mm512_mask_cmpneq_epu32_mask(has[b], member[b], end);
+    _mm512_mask_compressstoreu_epi32(out + n, has[b], member[b]);
+    if (nb.shift) _mm512_mask_compressstoreu_epi32(out_shift + n, has[b], tag[b]);
+    n += static_cast<std::uint32_t>(__builtin_popcount(has[b]));
+  }
+  n_third = 0;
+  for (int b = 0; b < blocks; ++b) {
+    member[b] = _mm512_mask_i32gather_epi32(end, has[b], member[b], nb.next, 4);
+    has[b] = _mm512_mask_cmpneq_epu32_mask(has[b], member[b], end);
+    _mm512_mask_compressstoreu_epi32(third + n_third, has[b], member[b]);
+    _mm512_mask_compressstoreu_epi32(third_shift + n_third, has[b], tag[b]);
+    n_third += static_cast<std::uint32_t>(__builtin_popcount(has[b]));
+  }
+  return n;
+}
+
+#pragma GCC diagnostic pop
+#pragma GCC pop_options
+
+#else
+
+template <int D>
+std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
+                                     const Vec<D>& vi, double& best) {
+  return scan_candidates_scalar<D>(s, t, xi, vi, best);
+}
+
+template std::uint32_t scan_candidates_avx512<2>(const CandidateScan<2>&, double, const Vec<2>&,
+                                                 const Vec<2>&, double&);
+template std::uint32_t scan_candidates_avx512<3>(const CandidateScan<3>&, double, const Vec<3>&,
+                                                 const Vec<3>&, double&);
+
+std::uint32_t gather_lists_avx512(const Neighbourhood&, std::uint32_t*, std::uint32_t*,
+                                  std::uint32_t*, std::uint32_t*, std::uint32_t& n_third) {
+  n_third = 0;
+  return 0;  // never called: cpu_has_avx512() is false on this platform
+}
+
+#endif
+
+}  // namespace kairos
