@@ -15,6 +15,7 @@
 #include "interactions/hard_sphere.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
+#include "scheduler/tournament_tree_queue.hpp"
 
 namespace kairos {
 
@@ -103,7 +104,11 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
       for (int a = 0; a < D; ++a) hot_[k].pos[a] = wrap_into_box(hot_[k].pos[a], box_[a]);
       hot_[k].cell = grid_.locate(hot_[k].pos);
     }
-    renumber(/*queue_filled=*/false);
+    if (options_.renumber_interval > 0.0) {
+      renumber(/*queue_filled=*/false);  // fills the grid in the new numbering
+    } else {
+      insert_all_into_grid();
+    }
     for (std::uint32_t k = 0; k < n; ++k) times[k] = predict(k, time_);
   }
   queue_.reset(times);
@@ -651,5 +656,7 @@ template class EventEngine<2, BinaryHeapQueue>;
 template class EventEngine<3, BinaryHeapQueue>;
 template class EventEngine<2, CalendarQueue>;
 template class EventEngine<3, CalendarQueue>;
+template class EventEngine<2, TournamentTreeQueue>;
+template class EventEngine<3, TournamentTreeQueue>;
 
 }  // namespace kairos

@@ -57,7 +57,8 @@ struct Shape {
 };
 
 struct EngineOptions {
-  // Renumber particles along a Morton curve every this many collisions per particle (0: never).
+  // Renumber particles along a Morton curve at the start and every this many collisions per
+  // particle (0: never, the caller's order is kept).
   double renumber_interval = 32.0;
   double max_cells_per_particle = CellGrid<3>::kDefaultCellsPerParticle;
   // Test candidates eight at a time with AVX-512 when the CPU has it (same results either way).

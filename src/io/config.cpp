@@ -75,7 +75,7 @@ constexpr KeySpec kSchema[] = {
 
 constexpr std::string_view kLattices3D[] = {"fcc", "sc", "bcc", "random"};
 constexpr std::string_view kLattices2D[] = {"hex", "square", "random"};
-constexpr std::string_view kEventQueues[] = {"calendar", "heap"};
+constexpr std::string_view kEventQueues[] = {"calendar", "heap", "tree"};
 constexpr std::string_view kProgressModes[] = {"auto", "always", "never"};
 
 std::string join_key(std::string_view prefix, std::string_view key) {

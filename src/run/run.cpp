@@ -20,6 +20,7 @@
 #include "io/progress.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
+#include "scheduler/tournament_tree_queue.hpp"
 
 namespace kairos {
 
@@ -450,6 +451,9 @@ class RunDriver {
 template <int D>
 RunOutcome run_with_dimension(const Config& config, const std::optional<fs::path>& restart) {
   if (config.run.event_queue == "heap") return RunDriver<D, BinaryHeapQueue>(config, restart).run();
+  if (config.run.event_queue == "tree") {
+    return RunDriver<D, TournamentTreeQueue>(config, restart).run();
+  }
   return RunDriver<D, CalendarQueue>(config, restart).run();
 }
 

@@ -8,6 +8,7 @@
 #include "init/initial_state.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
+#include "scheduler/tournament_tree_queue.hpp"
 
 namespace kairos {
 namespace {
@@ -95,6 +96,19 @@ TEST(EventEngine, ValidatedWhileRenumberingEveryFewCollisions) {
   run_validated<2, BinaryHeapQueue>(testing::lattice_system<2>(7, 0.5, 17, 0.5), 3000, 0, often);
 }
 
+TEST(EventEngine, ValidatedWithoutRenumbering) {
+  EngineOptions never;
+  never.renumber_interval = 0.0;
+  run_validated<3, CalendarQueue>(testing::lattice_system<3>(4, 0.4, 24), 3000, 0, never);
+  run_validated<2, TournamentTreeQueue>(testing::lattice_system<2>(7, 0.5, 25), 3000, 0, never);
+  // The caller's numbering is kept.
+  const auto s = testing::lattice_system<3>(4, 0.3, 26);
+  EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, never);
+  for (int e = 0; e < 1000; ++e) engine.step();
+  const auto state = engine.export_state();
+  for (std::uint32_t i = 0; i < state.size(); ++i) ASSERT_EQ(state.order[i], i);
+}
+
 TEST(EventEngine, RenumberingKeepsTheCallersParticleNumbering) {
   auto s = testing::lattice_system<3>(5, 0.3, 18, 2.0, 1.4);
   EngineOptions often;
@@ -161,15 +175,19 @@ TEST(EventEngine, ConservesEnergyAndMomentumOverAMillionEvents2D) {
   check_conservation<2, CalendarQueue>(testing::lattice_system<2>(32, 0.6, 8, 2.0, 1.2), 1000000);
 }
 
-TEST(EventEngine, HeapAndCalendarGiveBitIdenticalRuns) {
+TEST(EventEngine, HeapCalendarAndTreeQueuesGiveBitIdenticalRuns) {
   const auto start = testing::lattice_system<3>(8, 0.45, 9);
   EventEngine<3, BinaryHeapQueue> a(start);
   EventEngine<3, CalendarQueue> b(start);
+  EventEngine<3, TournamentTreeQueue> c(start);
   for (int e = 0; e < 200000; ++e) {
     a.step();
     b.step();
+    c.step();
   }
   expect_bit_identical(a.export_state(), b.export_state());
+  expect_bit_identical(a.export_state(), c.export_state());
+  EXPECT_EQ(a.counters().stale_events, c.counters().stale_events);
 }
 
 TEST(EventEngine, ContinuingFromExportedStateIsBitIdentical) {
