@@ -33,8 +33,9 @@ class CellGrid {
   static constexpr int kNeighbourCells = D == 3 ? 27 : 9;
   static constexpr int kBits = D == 3 ? 10 : 16;  // bits per coordinate in a CellCode
   static constexpr int kMaxCellsAlong = 1 << kBits;
-  // Bounds the grid's memory (4 bytes per cell) at 6 bytes per particle.
-  static constexpr double kDefaultCellsPerParticle = 1.5;
+  // Bounds the grid's memory (4 bytes per cell) at 5 bytes per particle; speed is flat between
+  // 1 and 3 cells per particle (docs/performance.md).
+  static constexpr double kDefaultCellsPerParticle = 1.25;
 
   CellGrid() = default;
   // Cells at least `min_width` wide, at least 3 per axis, at most `max_cells_per_particle` per
