@@ -57,9 +57,9 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
       if (ok) seen[s.order[k]] = 1;
     }
     if (!ok) throw InputError("cannot resume: the stored particle order is not a permutation");
-    id_ = s.order;
+    id_.assign(s.order.begin(), s.order.end());
   }
-  std::vector<std::uint16_t> shape_by_id = std::move(shape_);
+  HugeVector<std::uint16_t> shape_by_id = std::move(shape_);
   if (!shape_by_id.empty()) {
     shape_.resize(n + 1);  // one spare entry: the vector loop reads shapes 4 bytes at a time
     for (std::size_t k = 0; k < n; ++k) shape_[k] = shape_by_id[id_[k]];
@@ -124,7 +124,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
 template <int D, class Queue>
 void EventEngine<D, Queue>::build_shapes(const ParticleSystem<D>& s) {
   std::map<std::tuple<double, double, std::uint32_t>, std::uint16_t> index;
-  std::vector<std::uint16_t> shape(s.size());
+  HugeVector<std::uint16_t> shape(s.size());
   for (std::size_t i = 0; i < s.size(); ++i) {
     const double r = s.kinematics[i].radius, m = s.mass[i];
     if (!(r > 0.0) || !std::isfinite(r) || !(m > 0.0) || !std::isfinite(m)) {
@@ -192,9 +192,9 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   for (std::uint32_t k = 0; k < n; ++k) new_index[rank[k].second] = k;
   std::vector<double> times(queue_filled ? n : 0);
   {
-    std::vector<HotRecord<D>> hot(n);
-    std::vector<PendingEvent> pending(n);
-    std::vector<std::uint32_t> id(n);
+    HugeVector<HotRecord<D>> hot(n);
+    HugeVector<PendingEvent> pending(n);
+    HugeVector<std::uint32_t> id(n);
     for (std::uint32_t k = 0; k < n; ++k) {
       const std::uint32_t old = rank[k].second;
       hot[k] = hot_[old];
@@ -208,7 +208,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
     id_.swap(id);
   }
   if (!shape_.empty()) {
-    std::vector<std::uint16_t> shape(n + 1);
+    HugeVector<std::uint16_t> shape(n + 1);
     for (std::uint32_t k = 0; k < n; ++k) shape[k] = shape_[rank[k].second];
     shape_.swap(shape);
   }
@@ -485,6 +485,12 @@ EventKind EventEngine<D, Queue>::step() {
   if (!std::isfinite(t)) return EventKind::kNone;
   time_ = t;
   ++counters_.events;
+  if constexpr (requires { queue_.likely_next(); }) {
+    // Start the next event's memory accesses now, so they overlap with this one's work.
+    const std::uint32_t k = queue_.likely_next();
+    __builtin_prefetch(&hot_[k]);
+    __builtin_prefetch(&pending_[k]);
+  }
   const PendingEvent e = pending_[i];
   if (e.partner == kNoPartner) {
     cross(i, t);
@@ -517,7 +523,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
   out.collision_count.resize(n);
   out.events.resize(n);
   out.cell.resize(n);
-  out.order = id_;
+  out.order.assign(id_.begin(), id_.end());
   for (std::uint32_t k = 0; k < n; ++k) {
     const std::uint32_t c = id_[k];
     const HotRecord<D>& h = hot_[k];

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
 #include "scheduler/cell_grid.hpp"
 
@@ -150,14 +151,14 @@ class EventEngine {
   std::vector<std::string> species_names_;
   EngineOptions options_;
 
-  std::vector<HotRecord<D>> hot_;
-  std::vector<PendingEvent> pending_;
-  std::vector<std::uint16_t> shape_;  // per particle; empty when there is a single shape
+  HugeVector<HotRecord<D>> hot_;
+  HugeVector<PendingEvent> pending_;
+  HugeVector<std::uint16_t> shape_;  // per particle; empty when there is a single shape
   std::vector<Shape> shapes_;
   bool uniform_radius_ = true;
   std::vector<double> shape_radius_;  // radius per shape, for the candidate loops
   bool vector_scan_ = false;
-  std::vector<std::uint32_t> id_;  // internal index -> the caller's particle number
+  HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
   CellGrid<D> grid_;
   Queue queue_;
   std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions

@@ -33,6 +33,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/huge_page_allocator.hpp"
+
 namespace kairos {
 
 class CalendarQueue {
@@ -48,10 +50,10 @@ class CalendarQueue {
       throw std::length_error("CalendarQueue: at most 2^30 - 2 particles");
     }
     const auto n = static_cast<std::uint32_t>(times.size());
-    key_ = std::vector<double>(times);  // fresh vectors: capacity == size
-    next_ = std::vector<std::uint32_t>(n, kBeyond);
+    key_ = HugeVector<double>(times.begin(), times.end());  // fresh vectors: capacity == size
+    next_ = HugeVector<std::uint32_t>(n, kBeyond);
     nb_ = std::bit_ceil(std::max<std::uint32_t>(1, n / kParticlesPerBucket));
-    head_ = std::vector<std::uint32_t>(nb_, kEnd);
+    head_ = HugeVector<std::uint32_t>(nb_, kEnd);
     heap_ = std::vector<std::uint32_t>(16);
     heap_n_ = 0;
     double tmin = kInf, sum = 0.0, count = 0.0;
@@ -79,6 +81,13 @@ class CalendarQueue {
     return heap_n_ > 0 ? key_[heap_[0]] : kInf;
   }
   double time_of(std::uint32_t i) const { return key_[i]; }
+  // The entry most likely to be popped after the top (the smaller child of the heap's root),
+  // for prefetching its data; the top itself when there is no other.
+  std::uint32_t likely_next() const {
+    if (heap_n_ < 2) return heap_n_ > 0 ? heap_[0] : 0;
+    if (heap_n_ < 3) return heap_[1];
+    return key_[heap_[2]] < key_[heap_[1]] ? heap_[2] : heap_[1];
+  }
 
   void update(std::uint32_t i, double t) {
     const double x = slot(t);
@@ -334,9 +343,9 @@ class CalendarQueue {
     heap_[at] = p;
   }
 
-  std::vector<double> key_;
-  std::vector<std::uint32_t> next_;  // state (top 2 bits) | bucket-list successor
-  std::vector<std::uint32_t> head_;  // first entry of each bucket of the window, or kEnd
+  HugeVector<double> key_;
+  HugeVector<std::uint32_t> next_;   // state (top 2 bits) | bucket-list successor
+  HugeVector<std::uint32_t> head_;   // first entry of each bucket of the window, or kEnd
   std::vector<std::uint32_t> heap_;  // the current bucket, sorted; heap_n_ used of its size
   std::uint32_t heap_n_ = 0;
   std::uint32_t heap_limit_ = kMinLimit;

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/huge_page_allocator.hpp"
 #include "core/vec.hpp"
 
 namespace kairos {
@@ -261,8 +262,8 @@ class CellGrid {
   std::uint32_t total_ = 0;
   std::uint32_t end_ = 0;  // the list end marker: the number of particles
   std::int32_t neighbour_delta_[kNeighbourCells] = {};  // index offsets of an interior cell
-  std::vector<std::uint32_t> head_;                     // per cell: first member or end_
-  std::vector<std::uint32_t> next_;                     // per particle (+ end_): next or end_
+  HugeVector<std::uint32_t> head_;                      // per cell: first member or end_
+  HugeVector<std::uint32_t> next_;                      // per particle (+ end_): next or end_
 };
 
 }  // namespace kairos
