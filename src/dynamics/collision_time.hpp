@@ -42,17 +42,12 @@ inline double pair_contact_time(const double* r, const double* g, double sigma) 
 
 // Time until a point moving at velocity v along one axis leaves the interval [lo, hi].
 // Returns 0 when it already sits outside the interval and moves further out (round-off at a
-// boundary), never a negative time.
+// boundary), never a negative time. Written with selects, not branches: the sign of v is
+// random, so branches would mispredict half the time in the engine's crossing predictions.
 inline double interval_exit_time(double x, double v, double lo, double hi) {
-  if (v > 0.0) {
-    const double t = (hi - x) / v;
-    return t > 0.0 ? t : 0.0;
-  }
-  if (v < 0.0) {
-    const double t = (lo - x) / v;
-    return t > 0.0 ? t : 0.0;
-  }
-  return kNever;
+  const double face = v > 0.0 ? hi : lo;
+  const double t = (face - x) / v;  // +-inf or NaN for v = 0: replaced below
+  return v != 0.0 ? (t > 0.0 ? t : 0.0) : kNever;
 }
 
 }  // namespace kairos

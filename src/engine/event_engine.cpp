@@ -226,18 +226,15 @@ void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
 
 // When the particle leaves its cell, through which face. Always computed from the unchanged
 // record, so the time a crossing was scheduled at and the face it is processed with agree.
-// Branch-free (the signs of velocity components are random): the same arithmetic as
-// interval_exit_time(), the first axis winning ties.
+// Branch-free (the signs of velocity components are random); the first axis wins ties.
 template <int D, class Queue>
 typename EventEngine<D, Queue>::Crossing EventEngine<D, Queue>::next_crossing(
     const HotRecord<D>& h) const {
   Crossing x{kNever, -1, 0};
   for (int a = 0; a < D; ++a) {
     const double v = h.vel[a];
-    const double face = v > 0.0 ? grid_.upper(h.cell, a) : grid_.lower(h.cell, a);
-    double dt = (face - h.pos[a]) / v;
-    dt = dt > 0.0 ? dt : 0.0;  // already past the face (round-off): now
-    dt = v != 0.0 ? dt : kNever;
+    const double dt =
+        interval_exit_time(h.pos[a], v, grid_.lower(h.cell, a), grid_.upper(h.cell, a));
     const double when = h.time + dt;
     const bool sooner = when < x.time;
     x.time = sooner ? when : x.time;

@@ -87,7 +87,6 @@ class CellGrid {
 
   std::uint32_t cell_count() const { return total_; }
   int cells_along(int k) const { return n_[k]; }
-  double width(int k) const { return width_[k]; }
 
   // Codes and linear indices (the position of a cell's list head).
   int coordinate(CellCode c, int k) const {
