@@ -283,6 +283,10 @@ template <int D, class Queue>
 // faces (most) need no periodic shifts and take a loop over fixed index offsets.
 template <int D, class Queue>
 void EventEngine<D, Queue>::gather(CellCode cell, CandidateList& list) {
+  if (vector_scan_) {
+    gather_vector(cell, list);
+    return;
+  }
   constexpr auto kCells = static_cast<std::uint32_t>(CellGrid<D>::kNeighbourCells);
   std::uint32_t n = 0;
   auto cap = static_cast<std::uint32_t>(list.ids.size());
@@ -290,10 +294,6 @@ void EventEngine<D, Queue>::gather(CellCode cell, CandidateList& list) {
   const std::uint32_t* heads = grid_.heads();
   // Read once: the stores into the candidate list could alias them for the compiler.
   const Links links{grid_.links(), grid_.end(), hot_.data()};
-  if (vector_scan_) {
-    gather_vector(cell, list);
-    return;
-  }
   if (grid_.interior(cell)) {
     const std::uint32_t centre = grid_.index(cell);
     const std::int32_t* delta = grid_.neighbour_deltas();
