@@ -37,11 +37,24 @@ struct EventSlot {
 
 struct EventCounters {
   std::uint64_t events = 0;
-  std::uint64_t collisions = 0;
+  std::uint64_t collisions = 0;  // particle-particle
   std::uint64_t cell_crossings = 0;
   std::uint64_t stale_events = 0;  // popped events invalidated by a partner's collision
   double virial = 0.0;             // sum over collisions of r_ij . J_i (J_i: impulse on i)
+  // Granular bookkeeping (zero for elastic hard spheres in a periodic box).
+  std::uint64_t wall_collisions = 0;
+  std::uint64_t elastic_by_rule = 0;     // made elastic by the TC model or elastic_below_speed
+  std::uint64_t sliding_collisions = 0;  // Coulomb-limited (Walton) contacts that slid
+  // Kinetic energy (translational + rotational) dissipated in particle-particle and in
+  // particle-wall collisions, and the work moving walls did on the particles.
+  double dissipated_in_collisions = 0.0;
+  double dissipated_at_walls = 0.0;
+  double work_by_walls = 0.0;
 };
+
+// Angular velocity: a vector in 3D, the z component alone in 2D.
+template <int D>
+using AngularVelocity = Vec<D == 3 ? 3 : 1>;
 
 template <int D>
 struct ParticleSystem {
@@ -52,6 +65,10 @@ struct ParticleSystem {
   std::vector<std::uint32_t> species;
   std::vector<std::string> species_names;
   std::vector<std::uint32_t> collision_count;  // per particle: invalidates partners' predictions
+  // Rough particles only (empty otherwise): angular velocity per particle.
+  std::vector<AngularVelocity<D>> angular_velocity;
+  // TC model only (empty otherwise): time of each particle's last collision.
+  std::vector<double> last_collision_time;
   // Scheduler state, kept for exact restarts; empty means "predict afresh". `order` is the
   // engine's internal numbering (order[k] = the particle stored at position k), which decides
   // ties between equal event times; empty means the identity.

@@ -70,8 +70,13 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
       shift_base = _mm256_mullo_epi32(sidx, _mm256_set1_epi32(D));
     }
     for (int a = 0; a < D; ++a) {
-      const __m512d vel = gather_field(s.records, base, live, D + a);
+      __m512d vel = gather_field(s.records, base, live, D + a);
       __m512d xj = _mm512_add_pd(gather_field(s.records, base, live, a), _mm512_mul_pd(vel, dtj));
+      if (s.accelerated) {
+        xj = _mm512_add_pd(xj,
+                           _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(s.half_accel[a]), dtj), dtj));
+        vel = _mm512_add_pd(vel, _mm512_mul_pd(_mm512_set1_pd(s.accel[a]), dtj));
+      }
       if (s.any_shift) {
         const __m512d sh =
             _mm512_mask_i32gather_pd(zero, live, _mm256_add_epi32(shift_base, _mm256_set1_epi32(a)),

@@ -35,6 +35,11 @@ struct CandidateScan {
   double radius_i = 0.0;                 // non-uniform: this particle's radius
   const std::uint16_t* shape = nullptr;  // non-uniform: per particle
   const double* shape_radius = nullptr;  // non-uniform: per shape
+  // Uniform acceleration (gravity) felt by every candidate: their positions and velocities at
+  // time t gain g dt^2/2 and g dt. The pair's relative motion stays a straight line.
+  bool accelerated = false;
+  Vec<D> accel{};       // g
+  Vec<D> half_accel{};  // g / 2
 };
 
 inline constexpr std::uint32_t kNoCandidate = 0xffffffffu;
@@ -54,8 +59,14 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
     const double dtj = t - rec[2 * D];
     double r2 = 0.0, rg = 0.0, g2 = 0.0;
     for (int a = 0; a < D; ++a) {
-      const double r = xi[a] - ((rec[a] + rec[D + a] * dtj) + shift[a]);
-      const double g = vi[a] - rec[D + a];
+      double xj = rec[a] + rec[D + a] * dtj;
+      double vj = rec[D + a];
+      if (s.accelerated) {
+        xj = xj + (s.half_accel[a] * dtj) * dtj;
+        vj = vj + s.accel[a] * dtj;
+      }
+      const double r = xi[a] - (xj + shift[a]);
+      const double g = vi[a] - vj;
       r2 = r2 + r * r;
       rg = rg + r * g;
       g2 = g2 + g * g;

@@ -11,7 +11,9 @@
 #include "core/error.hpp"
 #include "core/periodic.hpp"
 #include "dynamics/collision_time.hpp"
+#include "dynamics/trajectory_events.hpp"
 #include "engine/candidate_scan.hpp"
+#include "interactions/granular_contact.hpp"
 #include "interactions/hard_sphere.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -21,26 +23,43 @@ namespace kairos {
 
 namespace {
 constexpr std::uint32_t kNoPartner = EventSlot::kNoPartner;
+
+// The engine stores 2D spins as one-component vectors; the contact laws take a scalar.
+template <int D>
+Spin<D> to_spin(const AngularVelocity<D>& w) {
+  if constexpr (D == 3) {
+    return w;
+  } else {
+    return w[0];
+  }
 }
+template <int D>
+AngularVelocity<D> from_spin(const Spin<D>& w) {
+  if constexpr (D == 3) {
+    return w;
+  } else {
+    return {w};
+  }
+}
+}  // namespace
 
 template <int D, class Queue>
 EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
-                                   EngineOptions options)
+                                   EngineOptions options, const Environment<D>& environment)
     : box_(s.box),
       time_(s.time),
       counters_(s.counters),
       species_names_(s.species_names),
-      options_(options) {
+      options_(options),
+      env_(environment) {
   const std::size_t n = s.size();
   if (n < 2) throw InputError("a simulation needs at least 2 particles");
-  if (n >= 0xffffffffu) throw InputError("too many particles (at most 2^32 - 2)");
+  if (n >= kFirstWall) throw InputError("too many particles (at most 2^32 - 16)");
   if (s.mass.size() != n || s.species.size() != n) {
     throw InputError("the state needs a mass and a species for every particle");
   }
   build_shapes(s);
-  double rmax = 0.0;
-  for (const Shape& sh : shapes_) rmax = std::max(rmax, sh.radius);
-  grid_ = CellGrid<D>(box_, 2.0 * rmax, n, options_.max_cells_per_particle);
+  setup_environment(s);
   for (CandidateList& list : lists_) {
     list.ids.resize(256);
     list.shift.resize(256);
@@ -74,6 +93,20 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
     const Kinematics<D>& kin = s.kinematics[id_[k]];
     hot_[k] = {kin.pos, kin.vel, kin.time, has_counts ? s.collision_count[id_[k]] : 0u, 0u};
   }
+  // Spins are tracked when contacts can change them, or when the state carries them.
+  if (env_.rotates() || !s.angular_velocity.empty()) {
+    if (!s.angular_velocity.empty() && s.angular_velocity.size() != n) {
+      throw InputError("the state has angular velocities for some particles but not all");
+    }
+    spin_.assign(n, AngularVelocity<D>{});
+    if (!s.angular_velocity.empty())
+      for (std::uint32_t k = 0; k < n; ++k) spin_[k] = s.angular_velocity[id_[k]];
+  }
+  if (env_.tc > 0.0) {
+    last_collision_.assign(n, -kNever);
+    if (s.last_collision_time.size() == n)
+      for (std::uint32_t k = 0; k < n; ++k) last_collision_[k] = s.last_collision_time[id_[k]];
+  }
   std::vector<double> times(n);
   pending_.assign(n, {kNoPartner, 0});
   if (mode == StartMode::kResume) {
@@ -84,15 +117,16 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
     for (std::uint32_t k = 0; k < n; ++k) internal[id_[k]] = k;
     for (std::uint32_t k = 0; k < n; ++k) {
       const EventSlot& e = s.events[id_[k]];
-      if (e.partner != kNoPartner && e.partner >= n) {
-        throw InputError("cannot resume: particle " + std::to_string(id_[k]) +
-                         " has a collision partner out of range");
-      }
       if (std::isnan(e.time) || e.time < time_) {
         throw InputError("cannot resume: the pending event of particle " + std::to_string(id_[k]) +
                          " is not at or after the state's time");
       }
-      pending_[k] = {e.partner == kNoPartner ? kNoPartner : internal[e.partner], e.partner_count};
+      const bool particle = e.partner < n;
+      if (!particle && e.partner < kFirstWall) {
+        throw InputError("cannot resume: particle " + std::to_string(id_[k]) +
+                         " has an event partner code out of range");
+      }
+      pending_[k] = {particle ? internal[e.partner] : e.partner, e.partner_count};
       times[k] = e.time;
       hot_[k].cell = s.cell[id_[k]];
       check_restored_cell(k);
@@ -101,8 +135,21 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
   } else {
     for (std::uint32_t k = 0; k < n; ++k) {
       advance_to(k, time_);
-      for (int a = 0; a < D; ++a) hot_[k].pos[a] = wrap_into_box(hot_[k].pos[a], box_[a]);
+      for (int a = 0; a < D; ++a)
+        if (grid_.periodic(a)) hot_[k].pos[a] = wrap_into_box(hot_[k].pos[a], box_[a]);
       hot_[k].cell = grid_.locate(hot_[k].pos);
+      for (int f = 0; f < 2 * D; ++f) {
+        if (env_.faces[f].kind != FaceKind::kWall) continue;
+        const int a = f / 2;
+        const double gap = f % 2 == 0 ? hot_[k].pos[a] - wall_offset(f, time_)
+                                      : wall_offset(f, time_) - hot_[k].pos[a];
+        if (gap < radius_of(k) * (1.0 - 1e-12)) {
+          throw InputError("particle " + std::to_string(id_[k]) + " overlaps the wall at the " +
+                           (f % 2 == 0 ? "low" : "high") + " face of axis " +
+                           std::string(1, "xyz"[a]) + " (centre " + std::to_string(gap) +
+                           " from the wall, radius " + std::to_string(radius_of(k)) + ")");
+        }
+      }
     }
     if (options_.renumber_interval > 0.0) {
       renumber(/*queue_filled=*/false);  // fills the grid in the new numbering
@@ -147,6 +194,50 @@ void EventEngine<D, Queue>::build_shapes(const ParticleSystem<D>& s) {
   uniform_radius_ = std::all_of(shapes_.begin(), shapes_.end(),
                                 [&](const Shape& sh) { return sh.radius == shapes_[0].radius; });
   if (shapes_.size() > 1) shape_ = std::move(shape);  // caller's numbering; permuted by caller
+}
+
+// Checks the environment against the particles and sizes the cell grid for it: periodic axes
+// need 3 cells; along a wall axis, only the outer layer may touch a wall (cells at least a
+// diameter plus the vibration amplitude wide).
+template <int D, class Queue>
+void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
+  env_.check();
+  std::uint32_t species = 1;
+  for (const Shape& sh : shapes_) species = std::max(species, sh.species + 1);
+  if (!env_.contact.empty() && env_.species < species) {
+    throw InputError("the contact laws cover " + std::to_string(env_.species) +
+                     " species but particles use " + std::to_string(species));
+  }
+  if (!env_.inertia_factor.empty() && env_.inertia_factor.size() < species) {
+    throw InputError("an inertia factor is needed for each of the " + std::to_string(species) +
+                     " species");
+  }
+  accelerated_ = env_.has_gravity();
+  half_gravity_ = 0.5 * env_.gravity;
+  walls_ = env_.has_walls();
+  granular_contacts_ = !env_.plain() || env_.tc > 0.0;
+  double rmax = 0.0;
+  for (const Shape& sh : shapes_) rmax = std::max(rmax, sh.radius);
+  Vec<D> min_width;
+  std::array<bool, D> periodic;
+  for (int a = 0; a < D; ++a) {
+    periodic[a] = env_.periodic(a);
+    min_width[a] = 2.0 * rmax;
+    double amplitude = 0.0;
+    for (int f = 2 * a; f < 2 * a + 2; ++f)
+      if (env_.faces[f].kind == FaceKind::kWall)
+        amplitude = std::max(amplitude, env_.faces[f].wall.amplitude);
+    min_width[a] += amplitude;
+  }
+  grid_ = CellGrid<D>(box_, min_width, periodic, s.size(), options_.max_cells_per_particle);
+}
+
+// Offset of a wall's plane from its face's rest position at time t.
+template <int D, class Queue>
+double EventEngine<D, Queue>::wall_offset(int face, double t) const {
+  const Wall<D>& w = env_.faces[face].wall;
+  const double rest = face % 2 == 0 ? 0.0 : box_[face / 2];
+  return w.vibrates() ? rest + w.amplitude * std::sin(w.angular_frequency * t + w.phase) : rest;
 }
 
 // A restored cell must exist and contain the particle's position (up to round-off): a damaged
@@ -199,7 +290,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
       const std::uint32_t old = rank[k].second;
       hot[k] = hot_[old];
       pending[k] = pending_[old];
-      if (pending[k].partner != kNoPartner) pending[k].partner = new_index[pending[k].partner];
+      if (pending[k].partner < kFirstWall) pending[k].partner = new_index[pending[k].partner];
       id[k] = id_[old];
       if (queue_filled) times[k] = queue_.time_of(old);
     }
@@ -207,11 +298,15 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
     pending_.swap(pending);
     id_.swap(id);
   }
-  if (!shape_.empty()) {
-    HugeVector<std::uint16_t> shape(n + 1);
-    for (std::uint32_t k = 0; k < n; ++k) shape[k] = shape_[rank[k].second];
-    shape_.swap(shape);
-  }
+  auto permute = [&](auto& per_particle, std::size_t size) {
+    if (per_particle.empty()) return;
+    std::remove_reference_t<decltype(per_particle)> moved(size);
+    for (std::uint32_t k = 0; k < n; ++k) moved[k] = per_particle[rank[k].second];
+    per_particle.swap(moved);
+  };
+  permute(shape_, n + 1);
+  permute(spin_, n);
+  permute(last_collision_, n);
   insert_all_into_grid();
   if (queue_filled) queue_.reset(times);
 }
@@ -219,9 +314,31 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
 template <int D, class Queue>
 void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
   HotRecord<D>& h = hot_[i];
-  const double dt = t - h.time;
-  for (int a = 0; a < D; ++a) h.pos[a] += h.vel[a] * dt;
+  h.pos = position_at(h, t);
+  h.vel = velocity_at(h, t);
   h.time = t;
+}
+
+// Where a record's particle is at time t: a straight line, or a parabola under gravity. The
+// candidate loops evaluate the same expressions in the same order.
+template <int D, class Queue>
+Vec<D> EventEngine<D, Queue>::position_at(const HotRecord<D>& h, double t) const {
+  const double dt = t - h.time;
+  Vec<D> x;
+  for (int a = 0; a < D; ++a) {
+    x[a] = h.pos[a] + h.vel[a] * dt;
+    if (accelerated_) x[a] = x[a] + (half_gravity_[a] * dt) * dt;
+  }
+  return x;
+}
+
+template <int D, class Queue>
+Vec<D> EventEngine<D, Queue>::velocity_at(const HotRecord<D>& h, double t) const {
+  if (!accelerated_) return h.vel;
+  const double dt = t - h.time;
+  Vec<D> v;
+  for (int a = 0; a < D; ++a) v[a] = h.vel[a] + env_.gravity[a] * dt;
+  return v;
 }
 
 // When the particle leaves its cell, through which face. Always computed from the unchanged
@@ -231,6 +348,20 @@ template <int D, class Queue>
 typename EventEngine<D, Queue>::Crossing EventEngine<D, Queue>::next_crossing(
     const HotRecord<D>& h) const {
   Crossing x{kNever, -1, 0};
+  if (accelerated_) {
+    for (int a = 0; a < D; ++a) {
+      const double lo = grid_.lower(h.cell, a), hi = grid_.upper(h.cell, a);
+      const double g = env_.gravity[a];
+      const double dt = interval_exit_time_accelerated(h.pos[a], h.vel[a], g, lo, hi);
+      if (!(h.time + dt < x.time)) continue;
+      // The face: the direction of motion when leaving (a thrown particle may fall back).
+      const double v_exit = h.vel[a] + g * dt;
+      const double x_exit = h.pos[a] + h.vel[a] * dt + (half_gravity_[a] * dt) * dt;
+      x = {h.time + dt, a,
+           v_exit > 0.0 ? 1 : (v_exit < 0.0 ? -1 : (x_exit > 0.5 * (lo + hi) ? 1 : -1))};
+    }
+    return x;
+  }
   for (int a = 0; a < D; ++a) {
     const double v = h.vel[a];
     const double dt =
@@ -387,8 +518,12 @@ std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, 
   scan.radius_i = radius_of(i);
   scan.shape = shape_.data();
   scan.shape_radius = shape_radius_.data();
-  const std::uint32_t k = vector_scan_ ? scan_candidates_avx512<D>(scan, t, xi, hot_[i].vel, best)
-                                       : scan_candidates_scalar<D>(scan, t, xi, hot_[i].vel, best);
+  scan.accelerated = accelerated_;
+  scan.accel = env_.gravity;
+  scan.half_accel = half_gravity_;
+  const Vec<D> vi = velocity_at(hot_[i], t);
+  const std::uint32_t k = vector_scan_ ? scan_candidates_avx512<D>(scan, t, xi, vi, best)
+                                       : scan_candidates_scalar<D>(scan, t, xi, vi, best);
   return k == kNoCandidate ? kNoPartner : list.ids[k];
 }
 
@@ -406,7 +541,7 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
   const HotRecord<D>& h = hot_[i];
   const Crossing crossing = next_crossing(h);
   double best = crossing.time - t;
-  const Vec<D> xi = h.pos + (t - h.time) * h.vel;
+  const Vec<D> xi = position_at(h, t);
   const std::uint32_t partner = test_candidates(list, i, t, xi, best);
   double when = crossing.time;
   if (partner != kNoPartner) {
@@ -414,6 +549,13 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
     when = t + best;
   } else {
     pending_[i] = {kNoPartner, 0};
+  }
+  if (walls_) {
+    const auto [dt, face] = next_wall_contact(i, t, when - t);
+    if (face >= 0) {
+      pending_[i] = {kFirstWall + static_cast<std::uint32_t>(face), 0};
+      when = t + dt;
+    }
   }
   return when > t ? when : t;  // never in the past, whatever the round-off
 }
@@ -429,18 +571,23 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
   Vec<D> r;
   double g_dot_r = 0.0, r2 = 0.0;
   for (int a = 0; a < D; ++a) {
-    const double d = minimum_image(hi.pos[a] - hj.pos[a], box_[a]);
+    const double raw = hi.pos[a] - hj.pos[a];
+    const double d = grid_.periodic(a) ? minimum_image(raw, box_[a]) : raw;
     r[a] = d;
     r2 += d * d;
     g_dot_r += (hi.vel[a] - hj.vel[a]) * d;
   }
-  const double mi = mass_of(i), mj = mass_of(j);
-  const double s = HardSphere::impulse_factor(g_dot_r, r2, mi * mj / (mi + mj));  // J = s r
-  for (int a = 0; a < D; ++a) {
-    hi.vel[a] += s * r[a] / mi;
-    hj.vel[a] -= s * r[a] / mj;
+  if (granular_contacts_) {
+    collide_granular(i, j, t, r, r2);
+  } else {
+    const double mi = mass_of(i), mj = mass_of(j);
+    const double s = HardSphere::impulse_factor(g_dot_r, r2, mi * mj / (mi + mj));  // J = s r
+    for (int a = 0; a < D; ++a) {
+      hi.vel[a] += s * r[a] / mi;
+      hj.vel[a] -= s * r[a] / mj;
+    }
+    counters_.virial += s * r2;
   }
-  counters_.virial += s * r2;
   ++counters_.collisions;
   ++hi.collisions;
   ++hj.collisions;
@@ -453,6 +600,115 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
   queue_.update(j, predict_from(lists_[shared ? 0 : 1], j, t));
 }
 
+// A collision under a granular contact law (restitution, roughness, TC model). The plain
+// elastic case never comes here (collide() keeps its two-line impulse).
+template <int D, class Queue>
+void EventEngine<D, Queue>::collide_granular(std::uint32_t i, std::uint32_t j, double t,
+                                             const Vec<D>& r, double r2) {
+  HotRecord<D>& hi = hot_[i];
+  HotRecord<D>& hj = hot_[j];
+  bool elastic = false;
+  if (!last_collision_.empty()) {
+    elastic = t - last_collision_[i] < env_.tc || t - last_collision_[j] < env_.tc;
+    last_collision_[i] = t;
+    last_collision_[j] = t;
+  }
+  const std::uint32_t si = species_of(i), sj = species_of(j);
+  ContactInput<D> in;
+  in.normal = (1.0 / std::sqrt(r2)) * r;
+  in.mass_i = mass_of(i);
+  in.mass_j = mass_of(j);
+  in.radius_i = radius_of(i);
+  in.radius_j = radius_of(j);
+  in.inertia_factor_i = env_.inertia_factor_of(si);
+  in.inertia_factor_j = env_.inertia_factor_of(sj);
+  in.force_elastic = elastic;
+  Spin<D> wi{}, wj{};
+  if (!spin_.empty()) {
+    wi = to_spin<D>(spin_[i]);
+    wj = to_spin<D>(spin_[j]);
+  }
+  const ContactResult<D> res =
+      resolve_contact(*env_.contact_of(si, sj), in, hi.vel, hj.vel, wi, wj);
+  if (!spin_.empty()) {
+    spin_[i] = from_spin<D>(wi);
+    spin_[j] = from_spin<D>(wj);
+  }
+  counters_.virial += dot(r, res.impulse);
+  counters_.dissipated_in_collisions += res.dissipated;
+  counters_.elastic_by_rule += res.made_elastic ? 1u : 0u;
+  counters_.sliding_collisions += res.slid ? 1u : 0u;
+}
+
+// The soonest contact of particle i with a wall, from time t and before t + horizon. Only the
+// outer layer of cells can touch a wall (the grid is sized so).
+template <int D, class Queue>
+std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i, double t,
+                                                                double horizon) const {
+  std::pair<double, int> best{horizon, -1};
+  const HotRecord<D>& h = hot_[i];
+  const Vec<D> xt = position_at(h, t), vt = velocity_at(h, t);
+  for (int f = 0; f < 2 * D; ++f) {
+    const int a = f / 2, side = f % 2 == 0 ? -1 : 1;
+    if (env_.faces[f].kind != FaceKind::kWall || !grid_.at_face(h.cell, a, side)) continue;
+    const Wall<D>& w = env_.faces[f].wall;
+    // Along the wall's normal n (into the box): n = +e_a at the low face, -e_a at the high one.
+    const double sgn = -side;
+    const double x = sgn * xt[a], v = sgn * vt[a], g = sgn * env_.gravity[a];
+    const NormalMotion m{x - radius_of(i), v, g};
+    const double d0 = f % 2 == 0 ? 0.0 : -box_[a];  // the plane's rest offset along n
+    double when;
+    if (w.vibrates()) {
+      const VibratedPlane plane{d0, sgn * w.amplitude, w.angular_frequency,
+                                std::remainder(w.angular_frequency * t + w.phase, 2.0 * M_PI)};
+      when = vibrated_plane_event_time(m, plane, best.first);
+    } else {
+      when = fixed_plane_event_time(m, d0, best.first);
+    }
+    if (when < best.first) best = {when, f};
+  }
+  return best;
+}
+
+// A particle meets a wall: the wall is a partner of infinite mass moving with its sliding and
+// vibration velocity.
+template <int D, class Queue>
+void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
+  advance_to(i, t);
+  HotRecord<D>& h = hot_[i];
+  const Wall<D>& w = env_.faces[face].wall;
+  const int a = face / 2;
+  bool elastic = false;
+  if (!last_collision_.empty()) {
+    elastic = t - last_collision_[i] < env_.tc;
+    last_collision_[i] = t;
+  }
+  WallContactInput<D> in;
+  in.normal = Vec<D>{};
+  in.normal[a] = face % 2 == 0 ? 1.0 : -1.0;
+  in.wall_velocity = w.velocity;
+  if (w.vibrates()) {
+    in.wall_velocity[a] +=
+        w.amplitude * w.angular_frequency * std::cos(w.angular_frequency * t + w.phase);
+  }
+  in.mass = mass_of(i);
+  in.radius = radius_of(i);
+  in.inertia_factor = env_.inertia_factor_of(species_of(i));
+  in.force_elastic = elastic;
+  Spin<D> wi{};
+  if (!spin_.empty()) wi = to_spin<D>(spin_[i]);
+  const ContactResult<D> res = resolve_wall_contact(w.contact, in, h.vel, wi);
+  if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
+  counters_.dissipated_at_walls += res.dissipated;
+  counters_.work_by_walls +=
+      res.translational_energy_change + res.rotational_energy_change + res.dissipated;
+  counters_.elastic_by_rule += res.made_elastic ? 1u : 0u;
+  counters_.sliding_collisions += res.slid ? 1u : 0u;
+  ++counters_.wall_collisions;
+  ++h.collisions;  // its velocity changed: partners' predictions with it are stale
+  queue_.update(i, predict(i, t));
+}
+
 template <int D, class Queue>
 void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   HotRecord<D>& h = hot_[i];
@@ -461,7 +717,10 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   std::array<int, D> c;
   for (int a = 0; a < D; ++a) c[a] = grid_.coordinate(h.cell, a);
   c[x.axis] += x.sign;
-  if (c[x.axis] < 0) {
+  if (!grid_.periodic(x.axis)) {
+    // Outer layers are unbounded, so a crossing never leaves the grid; round-off aside.
+    c[x.axis] = std::clamp(c[x.axis], 0, grid_.cells_along(x.axis) - 1);
+  } else if (c[x.axis] < 0) {
     c[x.axis] += grid_.cells_along(x.axis);
     h.pos[x.axis] += box_[x.axis];
   } else if (c[x.axis] >= grid_.cells_along(x.axis)) {
@@ -489,9 +748,13 @@ EventKind EventEngine<D, Queue>::step() {
     __builtin_prefetch(&pending_[k]);
   }
   const PendingEvent e = pending_[i];
-  if (e.partner == kNoPartner) {
-    cross(i, t);
-    return EventKind::kCellCrossing;
+  if (e.partner >= kFirstWall) {
+    if (e.partner == kNoPartner) {
+      cross(i, t);
+      return EventKind::kCellCrossing;
+    }
+    hit_wall(i, static_cast<int>(e.partner - kFirstWall), t);
+    return EventKind::kWallCollision;
   }
   if (hot_[e.partner].collisions != e.partner_count) {
     ++counters_.stale_events;
@@ -521,6 +784,8 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
   out.events.resize(n);
   out.cell.resize(n);
   out.order.assign(id_.begin(), id_.end());
+  out.angular_velocity.resize(spin_.size());
+  out.last_collision_time.resize(last_collision_.size());
   for (std::uint32_t k = 0; k < n; ++k) {
     const std::uint32_t c = id_[k];
     const HotRecord<D>& h = hot_[k];
@@ -530,8 +795,10 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
     out.species[c] = sh.species;
     out.collision_count[c] = h.collisions;
     out.cell[c] = h.cell;
+    if (!spin_.empty()) out.angular_velocity[c] = spin_[k];
+    if (!last_collision_.empty()) out.last_collision_time[c] = last_collision_[k];
     const PendingEvent& e = pending_[k];
-    out.events[c] = {queue_.time_of(k), e.partner == kNoPartner ? kNoPartner : id_[e.partner],
+    out.events[c] = {queue_.time_of(k), e.partner >= kFirstWall ? e.partner : id_[e.partner],
                      e.partner_count};
   }
   return out;
@@ -545,6 +812,16 @@ double EventEngine<D, Queue>::kinetic_energy() const {
 }
 
 template <int D, class Queue>
+double EventEngine<D, Queue>::rotational_energy() const {
+  double e = 0.0;
+  for (std::uint32_t i = 0; i < spin_.size(); ++i) {
+    const double r = radius_of(i);
+    e += 0.5 * env_.inertia_factor_of(species_of(i)) * mass_of(i) * r * r * norm2(spin_[i]);
+  }
+  return e;
+}
+
+template <int D, class Queue>
 Vec<D> EventEngine<D, Queue>::momentum() const {
   Vec<D> p{};
   for (std::uint32_t i = 0; i < size(); ++i) p = p + mass_of(i) * hot_[i].vel;
@@ -555,9 +832,9 @@ template <int D, class Queue>
 std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
   std::vector<Vec<D>> out(size());
   for (std::uint32_t i = 0; i < size(); ++i) {
-    const HotRecord<D>& h = hot_[i];
-    Vec<D> x = h.pos + (time_ - h.time) * h.vel;
-    for (int a = 0; a < D; ++a) x[a] = wrap_into_box(x[a], box_[a]);
+    Vec<D> x = position_at(hot_[i], time_);
+    for (int a = 0; a < D; ++a)
+      if (grid_.periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
     out[id_[i]] = x;
   }
   return out;
@@ -600,13 +877,18 @@ void EventEngine<D, Queue>::validate() {
     if (listed[i] != 1)
       fail("particle " + name(i) + " listed " + std::to_string(listed[i]) + " times");
     const HotRecord<D>& h = hot_[i];
-    const Vec<D> x = h.pos + (t - h.time) * h.vel;
+    const Vec<D> x = position_at(h, t);
+    for (int f = 0; f < 2 * D; ++f) {
+      if (env_.faces[f].kind != FaceKind::kWall) continue;
+      const double gap = f % 2 == 0 ? x[f / 2] - wall_offset(f, t) : wall_offset(f, t) - x[f / 2];
+      if (gap < radius_of(i) * (1.0 - 1e-9)) fail("particle " + name(i) + " overlaps a wall");
+    }
     for (int a = 0; a < D; ++a) {
       const double tol = 1e-9 * box_[a];
       if (x[a] < grid_.lower(h.cell, a) - tol || x[a] > grid_.upper(h.cell, a) + tol)
         fail("particle " + name(i) + " outside its cell");
     }
-    if (pending_[i].partner != kNoPartner && pending_[i].partner >= n)
+    if (pending_[i].partner < kFirstWall && pending_[i].partner >= n)
       fail("particle " + name(i) + " has a partner out of range");
   }
   // Queue order: the top is the soonest stored event; nothing lies in the past.
@@ -619,7 +901,7 @@ void EventEngine<D, Queue>::validate() {
   // Prediction invariant and overlaps, brute force over all pairs: some pending event of the
   // pair (a collision, or a crossing that triggers a new scan) comes no later than its contact.
   auto check_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, const char* which) {
-    const Vec<D> g = hot_[i].vel - hot_[j].vel;
+    const Vec<D> g = velocity_at(hot_[i], t) - velocity_at(hot_[j], t);
     const double sigma = radius_of(i) + radius_of(j);
     const double due = t + pair_contact_time<D>(r.data(), g.data(), sigma);
     const double bound = std::min(queue_.time_of(i), queue_.time_of(j));
@@ -629,23 +911,24 @@ void EventEngine<D, Queue>::validate() {
     }
   };
   for (std::uint32_t i = 0; i < n; ++i) {
-    const Vec<D> xi = hot_[i].pos + (t - hot_[i].time) * hot_[i].vel;
+    const Vec<D> xi = position_at(hot_[i], t);
     const std::uint32_t ci = hot_[i].cell;
     for (std::uint32_t j = i + 1; j < n; ++j) {
-      const Vec<D> raw = xi - (hot_[j].pos + (t - hot_[j].time) * hot_[j].vel);
+      const Vec<D> raw = xi - position_at(hot_[j], t);
       // The image the engine tests (neighbouring cells).
       std::array<int, D> d;
       if (grid_.neighbour_offset(ci, hot_[j].cell, d)) {
         Vec<D> r = raw;
         for (int a = 0; a < D; ++a) {
           const int c = grid_.coordinate(ci, a) + d[a];
-          if (c < 0) r[a] += box_[a];
-          if (c >= grid_.cells_along(a)) r[a] -= box_[a];
+          if (grid_.periodic(a) && c < 0) r[a] += box_[a];
+          if (grid_.periodic(a) && c >= grid_.cells_along(a)) r[a] -= box_[a];
         }
         check_covered(i, j, r, "neighbour-cell image");
       }
       Vec<D> r = raw;
-      for (int a = 0; a < D; ++a) r[a] = minimum_image(r[a], box_[a]);
+      for (int a = 0; a < D; ++a)
+        if (grid_.periodic(a)) r[a] = minimum_image(r[a], box_[a]);
       const double sigma = radius_of(i) + radius_of(j);
       if (norm2(r) < sigma * sigma * (1.0 - 1e-9)) {
         fail("particles " + name(i) + " and " + name(j) + " overlap");

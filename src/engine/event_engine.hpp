@@ -27,13 +27,14 @@
 #include <string>
 #include <vector>
 
+#include "core/environment.hpp"
 #include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
 #include "scheduler/cell_grid.hpp"
 
 namespace kairos {
 
-enum class EventKind { kNone, kCollision, kCellCrossing, kStale };
+enum class EventKind { kNone, kCollision, kCellCrossing, kStale, kWallCollision };
 
 // How an engine starts: predict every event from the state, or resume the scheduler state the
 // ParticleSystem carries (from export_state() or a restart file) to continue bit-identically.
@@ -71,8 +72,10 @@ class EventEngine {
  public:
   // Takes the state. kResume requires the scheduler state (events and cells) and throws
   // InputError if it is missing or inconsistent with the positions.
+  // The environment (gravity, walls, contact laws) defaults to elastic hard spheres in a
+  // periodic box.
   explicit EventEngine(const ParticleSystem<D>& system, StartMode mode = StartMode::kPredict,
-                       EngineOptions options = {});
+                       EngineOptions options = {}, const Environment<D>& environment = {});
 
   // Processes the next event. Returns kNone when nothing can ever happen again.
   EventKind step();
@@ -85,8 +88,10 @@ class EventEngine {
   ParticleSystem<D> export_state() const;
   std::size_t size() const { return hot_.size(); }
 
-  double kinetic_energy() const;
+  double kinetic_energy() const;     // translational
+  double rotational_energy() const;  // 0 unless particles rotate
   Vec<D> momentum() const;
+  const Environment<D>& environment() const { return env_; }
   // Positions at the current time, wrapped into the box, in the caller's numbering.
   std::vector<Vec<D>> current_positions() const;
 
@@ -117,7 +122,22 @@ class EventEngine {
     int sign;     // +1 up, -1 down
   };
 
+  // Partner codes of a PendingEvent beyond the particle indices: a wall (one per box face),
+  // and kNoPartner for a cell crossing.
+  static constexpr std::uint32_t kFirstWall = EventSlot::kNoPartner - 2 * D;
+
   void build_shapes(const ParticleSystem<D>& s);
+  void setup_environment(const ParticleSystem<D>& s);
+  std::uint32_t species_of(std::uint32_t i) const {
+    return shapes_[shape_.empty() ? 0 : shape_[i]].species;
+  }
+  Vec<D> position_at(const HotRecord<D>& h, double t) const;
+  Vec<D> velocity_at(const HotRecord<D>& h, double t) const;
+  double wall_offset(int face, double t) const;
+  // The particle's soonest wall contact from time t before t + horizon: (relative time, face).
+  std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
+  void hit_wall(std::uint32_t i, int face, double t);
+  void collide_granular(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
   double radius_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].radius; }
   double mass_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].mass; }
   void advance_to(std::uint32_t i, double t);
@@ -159,6 +179,13 @@ class EventEngine {
   std::vector<double> shape_radius_;  // radius per shape, for the candidate loops
   bool vector_scan_ = false;
   HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
+  Environment<D> env_;
+  bool accelerated_ = false;  // uniform gravity
+  Vec<D> half_gravity_{};
+  bool walls_ = false;
+  bool granular_contacts_ = false;       // some contact law is not elastic and smooth
+  HugeVector<AngularVelocity<D>> spin_;  // rough particles only
+  HugeVector<double> last_collision_;    // TC model only
   CellGrid<D> grid_;
   Queue queue_;
   std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions

@@ -10,6 +10,7 @@
 
 #include <toml++/toml.h>
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
@@ -36,7 +37,8 @@ namespace {
 // ---------------------------------------------------------------------------------------------
 // Schema
 
-enum class Kind { kTable, kTableArray, kInteger, kUnsigned, kFloat, kString, kBoolean };
+// kArray: an array of values (numbers, strings or number pairs), read as a whole.
+enum class Kind { kTable, kTableArray, kInteger, kUnsigned, kFloat, kString, kBoolean, kArray };
 
 struct KeySpec {
   std::string_view path;  // dotted; elements of an array of tables are written "[]"
@@ -57,7 +59,46 @@ constexpr KeySpec kSchema[] = {
     {"system.species[].diameter", Kind::kFloat},
     {"system.species[].mass", Kind::kFloat},
     {"system.species[].fraction", Kind::kFloat},
+    {"system.species[].inertia_factor", Kind::kFloat},
     {"system.initial_state", Kind::kString},
+    {"system.box_scale", Kind::kArray},
+    {"contact", Kind::kTable},
+    {"contact.restitution", Kind::kFloat},
+    {"contact.restitution_model", Kind::kString},
+    {"contact.restitution_speed", Kind::kFloat},
+    {"contact.restitution_table", Kind::kArray},
+    {"contact.tangential_restitution", Kind::kFloat},
+    {"contact.friction", Kind::kFloat},
+    {"contact.elastic_below_speed", Kind::kFloat},
+    {"contact.tc", Kind::kFloat},
+    {"contact.pair", Kind::kTableArray},
+    {"contact.pair[]", Kind::kTable},
+    {"contact.pair[].species", Kind::kArray},
+    {"contact.pair[].restitution", Kind::kFloat},
+    {"contact.pair[].restitution_model", Kind::kString},
+    {"contact.pair[].restitution_speed", Kind::kFloat},
+    {"contact.pair[].restitution_table", Kind::kArray},
+    {"contact.pair[].tangential_restitution", Kind::kFloat},
+    {"contact.pair[].friction", Kind::kFloat},
+    {"contact.pair[].elastic_below_speed", Kind::kFloat},
+    {"boundary", Kind::kTable},
+    {"boundary.open", Kind::kArray},
+    {"boundary.wall", Kind::kTableArray},
+    {"boundary.wall[]", Kind::kTable},
+    {"boundary.wall[].face", Kind::kString},
+    {"boundary.wall[].restitution", Kind::kFloat},
+    {"boundary.wall[].restitution_model", Kind::kString},
+    {"boundary.wall[].restitution_speed", Kind::kFloat},
+    {"boundary.wall[].restitution_table", Kind::kArray},
+    {"boundary.wall[].tangential_restitution", Kind::kFloat},
+    {"boundary.wall[].friction", Kind::kFloat},
+    {"boundary.wall[].elastic_below_speed", Kind::kFloat},
+    {"boundary.wall[].velocity", Kind::kArray},
+    {"boundary.wall[].amplitude", Kind::kFloat},
+    {"boundary.wall[].frequency", Kind::kFloat},
+    {"boundary.wall[].phase", Kind::kFloat},
+    {"field", Kind::kTable},
+    {"field.gravity", Kind::kArray},
     {"run", Kind::kTable},
     {"run.equilibration_collisions_per_particle", Kind::kFloat},
     {"run.collisions_per_particle", Kind::kFloat},
@@ -77,6 +118,10 @@ constexpr std::string_view kLattices3D[] = {"fcc", "sc", "bcc", "random"};
 constexpr std::string_view kLattices2D[] = {"hex", "square", "random"};
 constexpr std::string_view kEventQueues[] = {"calendar", "heap", "tree"};
 constexpr std::string_view kProgressModes[] = {"auto", "always", "never"};
+constexpr std::string_view kRestitutionModels[] = {"constant", "viscoelastic", "table"};
+// Box faces: 2k is the low face of axis k, 2k + 1 the high one.
+constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+constexpr std::string_view kAxes[] = {"x", "y", "z"};
 
 std::string join_key(std::string_view prefix, std::string_view key) {
   return prefix.empty() ? std::string(key) : fmt::format("{}.{}", prefix, key);
@@ -150,34 +195,38 @@ std::string_view leaf(std::string_view path) {
 
 // " (did you mean 'system.particles'?)" or "".
 std::string suggestion(std::string_view unknown) {
-  // Inside a species table, offer that species' keys; "system.species.X" offers species 0.
-  std::optional<std::string> index;
-  constexpr std::string_view kSpecies = "system.species";
-  if (unknown.starts_with(kSpecies) && unknown.size() > kSpecies.size()) {
-    if (unknown[kSpecies.size()] == '[') {
-      const auto close = unknown.find(']', kSpecies.size());
-      if (close != std::string_view::npos) {
-        index = std::string(unknown.substr(kSpecies.size(), close - kSpecies.size() + 1));
-      }
-    } else {
-      index = "[0]";
-    }
-  }
+  // Keys of an array of tables are offered for the element the unknown key is in
+  // ("contact.pair[2].x" -> "contact.pair[2].*"), else for element 0 ("system.species.name" ->
+  // "system.species[0].name").
   std::vector<std::string> candidates;
   for (const KeySpec& spec : kSchema) {
     std::string candidate(spec.path);
     const auto brackets = candidate.find("[]");
     if (brackets != std::string::npos) {
-      if (!index) continue;
-      candidate.replace(brackets, 2, *index);
+      const std::string_view array = spec.path.substr(0, brackets);
+      std::string index = "[0]";
+      if (unknown.starts_with(array) && unknown.size() > array.size() &&
+          unknown[array.size()] == '[') {
+        const auto close = unknown.find(']', array.size());
+        if (close != std::string_view::npos) {
+          index = std::string(unknown.substr(array.size(), close - array.size() + 1));
+        }
+      }
+      candidate.replace(brackets, 2, index);
     }
     candidates.push_back(std::move(candidate));
   }
   const std::string* best = nullptr;
   std::size_t best_distance = 4;  // suggest only within edit distance 3
   for (const std::string& c : candidates) {
+    // The table holding the unknown key is no suggestion ("contact.pair[0].tc").
+    if (unknown.starts_with(c) && unknown.size() > c.size() &&
+        (unknown[c.size()] == '.' || unknown[c.size()] == '[')) {
+      continue;
+    }
     const std::size_t d = edit_distance(unknown, c);
-    if (d < best_distance) {
+    // ... nor one more edits away than the last part has letters ("tc" is no typo of "face").
+    if (d < best_distance && d < leaf(unknown).size()) {
       best_distance = d;
       best = &c;
     }
@@ -445,6 +494,10 @@ class Reader {
     const toml::table empty;
     Config config;
     read_system(section(root, "system", empty), config.system);
+    read_interactions(section(root, "contact", empty), config.system.species, config.interactions);
+    read_boundary(section(root, "boundary", empty), config.system.dimension,
+                  config.interactions.contact, config.boundary);
+    read_field(section(root, "field", empty), config.system.dimension, config.field);
     read_run(section(root, "run", empty), config.run);
     read_output(section(root, "output", empty), config.output);
     return config;
@@ -518,22 +571,118 @@ class Reader {
 
   // ----- typed getters: return the node (for error locations), nullptr when the key is absent
 
+  // The value of a number node (an integer or a float) named `path`: finite, or +inf too when
+  // allow_infinity.
+  double number_value(const toml::node& node, const std::string& path,
+                      bool allow_infinity = false) const {
+    if (const auto* i = node.as_integer()) return static_cast<double>(i->get());
+    const auto* f = node.as_floating_point();
+    if (f == nullptr) {
+      fail(&node, path, fmt::format("{}: expected a number, found {}", path, describe(node)));
+    }
+    const double v = f->get();
+    if (!std::isfinite(v) && !(allow_infinity && v > 0.0)) {
+      fail(&node, path,
+           fmt::format("{}: must be a finite number{}, got {}", path,
+                       allow_infinity ? " or inf" : "", v));
+    }
+    return v;
+  }
+
   const toml::node* get_number(const toml::table& t, std::string_view prefix, std::string_view key,
-                               double& out) const {
+                               double& out, bool allow_infinity = false) const {
+    const toml::node* node = t.get(key);
+    if (node == nullptr) return nullptr;
+    out = number_value(*node, join_key(prefix, key), allow_infinity);
+    return node;
+  }
+
+  // An array of finite numbers (elements named "key[i]" in errors).
+  const toml::node* get_numbers(const toml::table& t, std::string_view prefix, std::string_view key,
+                                std::vector<double>& out) const {
     const toml::node* node = t.get(key);
     if (node == nullptr) return nullptr;
     const std::string path = join_key(prefix, key);
-    if (const auto* i = node->as_integer()) {
-      out = static_cast<double>(i->get());
-    } else if (const auto* f = node->as_floating_point()) {
-      if (!std::isfinite(f->get())) {
-        fail(node, path, fmt::format("{}: must be a finite number, got {}", path, f->get()));
-      }
-      out = f->get();
-    } else {
-      fail(node, path, fmt::format("{}: expected a number, found {}", path, describe(*node)));
+    const toml::array* array = node->as_array();
+    if (array == nullptr) {
+      fail(node, path,
+           fmt::format("{}: expected an array of numbers, found {}", path, describe(*node)));
+    }
+    out.clear();
+    for (std::size_t i = 0; i < array->size(); ++i) {
+      out.push_back(number_value(*array->get(i), fmt::format("{}[{}]", path, i)));
     }
     return node;
+  }
+
+  // An array of exactly `dimension` finite numbers (a vector in space).
+  const toml::node* get_vector(const toml::table& t, std::string_view prefix, std::string_view key,
+                               int dimension, std::vector<double>& out) const {
+    const toml::node* node = get_numbers(t, prefix, key, out);
+    if (node != nullptr && out.size() != static_cast<std::size_t>(dimension)) {
+      const std::string path = join_key(prefix, key);
+      fail(node, path,
+           fmt::format("{}: expected {} numbers (system.dimension = {}), got {}", path, dimension,
+                       dimension, out.size()));
+    }
+    return node;
+  }
+
+  // An array of strings.
+  const toml::node* get_strings(const toml::table& t, std::string_view prefix, std::string_view key,
+                                std::vector<std::string>& out) const {
+    const toml::node* node = t.get(key);
+    if (node == nullptr) return nullptr;
+    const std::string path = join_key(prefix, key);
+    const toml::array* array = node->as_array();
+    if (array == nullptr) {
+      fail(node, path,
+           fmt::format("{}: expected an array of strings, found {}", path, describe(*node)));
+    }
+    out.clear();
+    for (std::size_t i = 0; i < array->size(); ++i) {
+      const toml::node* element = array->get(i);
+      const auto* v = element->as_string();
+      if (v == nullptr) {
+        const std::string element_path = fmt::format("{}[{}]", path, i);
+        fail(element, element_path,
+             fmt::format("{}: expected a string, found {}", element_path, describe(*element)));
+      }
+      out.push_back(v->get());
+    }
+    return node;
+  }
+
+  // Element i of an array node returned by the getters above.
+  static const toml::node* element_of(const toml::node* array, std::size_t i) {
+    return array->as_array()->get(i);
+  }
+
+  // The tables of the array of tables prefix.key (none when absent), keys checked.
+  std::vector<const toml::table*> table_array(const toml::table& parent, std::string_view prefix,
+                                              std::string_view key) const {
+    std::vector<const toml::table*> out;
+    const toml::node* node = parent.get(key);
+    if (node == nullptr) return out;
+    const std::string path = join_key(prefix, key);
+    const toml::array* array = node->as_array();
+    if (array == nullptr) {
+      fail(node, path,
+           fmt::format("{}: expected an array of tables ([[{}]]), found {}", path, path,
+                       describe(*node)));
+    }
+    for (std::size_t i = 0; i < array->size(); ++i) {
+      const toml::node* element = array->get(i);
+      const std::string element_path = fmt::format("{}[{}]", path, i);
+      const toml::table* table = element->as_table();
+      if (table == nullptr) {
+        fail(element, element_path,
+             fmt::format("{}: expected a table, found {}", element_path, describe(*element)));
+      }
+      check_keys(*table, element_path);
+      out.push_back(table);
+    }
+    return out;
   }
 
   // A value of exactly TOML type T (std::int64_t, std::string or bool), named `what` in errors.
@@ -658,32 +807,34 @@ class Reader {
 
     require_positive(n_temperature, "system.temperature", s.temperature);
     if (s.species.empty()) s.species.emplace_back();
+
+    std::vector<double> box_scale;
+    const toml::node* n_box_scale = get_vector(t, p, "box_scale", s.dimension, box_scale);
+    for (std::size_t i = 0; i < box_scale.size(); ++i) {
+      if (!(box_scale[i] >= 1.0)) {
+        fail(element_of(n_box_scale, i), "system.box_scale",
+             fmt::format("system.box_scale[{}]: must be >= 1, got {}", i, box_scale[i]));
+      }
+    }
+    // All 1 is the same as no scaling: stored as the default, empty.
+    if (std::any_of(box_scale.begin(), box_scale.end(), [](double f) { return f != 1.0; })) {
+      s.box_scale = std::move(box_scale);
+    }
   }
 
   void read_species(const toml::table& system, std::vector<SpeciesConfig>& out) const {
-    const toml::node* node = system.get("species");
-    if (node == nullptr) return;
-    const toml::array* array = node->as_array();
-    if (array == nullptr) {
-      fail(node, "system.species",
-           fmt::format("system.species: expected an array of tables ([[system.species]]), found {}",
-                       describe(*node)));
-    }
-    for (std::size_t i = 0; i < array->size(); ++i) {
-      const toml::node* element = array->get(i);
+    const std::vector<const toml::table*> tables = table_array(system, "system", "species");
+    for (std::size_t i = 0; i < tables.size(); ++i) {
+      const toml::table* t = tables[i];
+      const toml::node* element = t;
       const std::string prefix = fmt::format("system.species[{}]", i);
-      const toml::table* t = element->as_table();
-      if (t == nullptr) {
-        fail(element, prefix,
-             fmt::format("{}: expected a table, found {}", prefix, describe(*element)));
-      }
-      check_keys(*t, prefix);
 
       SpeciesConfig s;
       const toml::node* n_name = get_string(*t, prefix, "name", s.name);
       const toml::node* n_diameter = get_number(*t, prefix, "diameter", s.diameter);
       const toml::node* n_mass = get_number(*t, prefix, "mass", s.mass);
       const toml::node* n_fraction = get_number(*t, prefix, "fraction", s.fraction);
+      const toml::node* n_inertia = get_number(*t, prefix, "inertia_factor", s.inertia_factor);
 
       const std::string name_key = prefix + ".name";
       if (s.name.empty()) fail(n_name, name_key, fmt::format("{}: must not be empty", name_key));
@@ -698,7 +849,282 @@ class Reader {
       require_positive(n_diameter, prefix + ".diameter", s.diameter);
       require_positive(n_mass, prefix + ".mass", s.mass);
       require_positive(n_fraction, prefix + ".fraction", s.fraction);
+      if (!(s.inertia_factor >= 0.0)) {
+        fail(n_inertia, prefix + ".inertia_factor",
+             fmt::format("{}.inertia_factor: must be > 0 (or 0 for the default: 2/5 for spheres, "
+                         "1/2 for disks), got {}",
+                         prefix, s.inertia_factor));
+      }
       out.push_back(std::move(s));
+    }
+  }
+
+  // A contact law at `prefix` ("contact", "contact.pair[i]", "boundary.wall[i]"). On entry `c`
+  // holds the law inherited from [contact] (the defaults for [contact] itself); the keys present
+  // replace its values.
+  void read_contact(const toml::table& t, const std::string& prefix, ContactConfig& c) const {
+    const auto path = [&](std::string_view key) { return join_key(prefix, key); };
+    const toml::node* n_restitution = get_number(t, prefix, "restitution", c.restitution);
+    const toml::node* n_model = get_string(t, prefix, "restitution_model", c.restitution_model);
+    const toml::node* n_speed = get_number(t, prefix, "restitution_speed", c.restitution_speed);
+    const toml::node* n_table = get_restitution_table(t, prefix, c.restitution_table);
+    const toml::node* n_beta =
+        get_number(t, prefix, "tangential_restitution", c.tangential_restitution);
+    const toml::node* n_friction =
+        get_number(t, prefix, "friction", c.friction, /*allow_infinity=*/true);
+    const toml::node* n_elastic =
+        get_number(t, prefix, "elastic_below_speed", c.elastic_below_speed);
+
+    if (!(c.restitution >= 0.0 && c.restitution <= 1.0)) {
+      fail(n_restitution, path("restitution"),
+           fmt::format("{}: must be in [0, 1], got {}", path("restitution"), c.restitution));
+    }
+    require_choice(n_model, path("restitution_model"), c.restitution_model, kRestitutionModels);
+    require_positive(n_speed, path("restitution_speed"), c.restitution_speed);
+    if (c.restitution_model == "viscoelastic" && !(c.restitution > 0.0)) {
+      fail(n_restitution != nullptr ? n_restitution : n_model, path("restitution"),
+           fmt::format("{}: must be in (0, 1] with restitution_model = \"viscoelastic\" (it is "
+                       "e at restitution_speed), got {}",
+                       path("restitution"), c.restitution));
+    }
+    if (c.restitution_model == "table") {
+      if (n_table == nullptr && c.restitution_table.empty()) {
+        fail(n_model, path("restitution_table"),
+             fmt::format("missing required key '{}' (restitution_model = \"table\" needs "
+                         "[speed, e] pairs, e.g. [[0.0, 1.0], [1.0, 0.9]])",
+                         path("restitution_table")));
+      }
+      if (c.restitution_table.empty()) {
+        fail(n_table, path("restitution_table"),
+             fmt::format("{}: needs at least one [speed, e] pair", path("restitution_table")));
+      }
+    } else if (n_table != nullptr) {
+      fail(n_table, path("restitution_table"),
+           fmt::format("{}: only allowed with restitution_model = \"table\" (restitution_model "
+                       "is \"{}\")",
+                       path("restitution_table"), c.restitution_model));
+    } else {
+      c.restitution_table.clear();  // an inherited table does not apply to another model
+    }
+    if (!(c.tangential_restitution >= -1.0 && c.tangential_restitution <= 1.0)) {
+      fail(n_beta, path("tangential_restitution"),
+           fmt::format("{}: must be in [-1, 1], got {}", path("tangential_restitution"),
+                       c.tangential_restitution));
+    }
+    require_non_negative(n_friction, path("friction"), c.friction);
+    require_non_negative(n_elastic, path("elastic_below_speed"), c.elastic_below_speed);
+  }
+
+  // restitution_table: [[speed, e], ...], speeds >= 0 strictly increasing, e in [0, 1].
+  const toml::node* get_restitution_table(const toml::table& t, std::string_view prefix,
+                                          std::vector<std::array<double, 2>>& out) const {
+    const toml::node* node = t.get("restitution_table");
+    if (node == nullptr) return nullptr;
+    const std::string path = join_key(prefix, "restitution_table");
+    const toml::array* rows = node->as_array();
+    if (rows == nullptr) {
+      fail(node, path,
+           fmt::format("{}: expected an array of [speed, e] pairs, found {}", path,
+                       describe(*node)));
+    }
+    out.clear();
+    for (std::size_t i = 0; i < rows->size(); ++i) {
+      const toml::node* row_node = rows->get(i);
+      const std::string row_path = fmt::format("{}[{}]", path, i);
+      const toml::array* row = row_node->as_array();
+      if (row == nullptr || row->size() != 2) {
+        fail(row_node, row_path,
+             fmt::format("{}: expected a pair [speed, e], found {}", row_path,
+                         row == nullptr ? describe(*row_node)
+                                        : fmt::format("an array of {}", row->size())));
+      }
+      const double speed = number_value(*row->get(0), row_path + "[0]");
+      const double e = number_value(*row->get(1), row_path + "[1]");
+      if (!(speed >= 0.0)) {
+        fail(row->get(0), row_path,
+             fmt::format("{}: impact speed must be >= 0, got {}", row_path, speed));
+      }
+      if (!out.empty() && !(speed > out.back()[0])) {
+        fail(row->get(0), row_path,
+             fmt::format("{}: impact speeds must be strictly increasing, got {} after {}", row_path,
+                         speed, out.back()[0]));
+      }
+      if (!(e >= 0.0 && e <= 1.0)) {
+        fail(row->get(1), row_path,
+             fmt::format("{}: restitution must be in [0, 1], got {}", row_path, e));
+      }
+      out.push_back({speed, e});
+    }
+    return node;
+  }
+
+  void read_interactions(const toml::table& t, const std::vector<SpeciesConfig>& species,
+                         InteractionConfig& in) const {
+    constexpr std::string_view p = "contact";
+    read_contact(t, std::string(p), in.contact);
+    const toml::node* n_tc = get_number(t, p, "tc", in.tc);
+    require_non_negative(n_tc, "contact.tc", in.tc);
+
+    const std::vector<const toml::table*> tables = table_array(t, p, "pair");
+    for (std::size_t i = 0; i < tables.size(); ++i) {
+      const std::string prefix = fmt::format("contact.pair[{}]", i);
+      const std::string species_key = prefix + ".species";
+      std::vector<std::string> names;
+      const toml::node* n_species = get_strings(*tables[i], prefix, "species", names);
+      if (n_species == nullptr) {
+        fail(tables[i], species_key,
+             fmt::format("missing required key '{}' (the pair's two species, e.g. species = "
+                         "[\"A\", \"B\"])",
+                         species_key));
+      }
+      if (names.size() != 2) {
+        fail(n_species, species_key,
+             fmt::format("{}: expected 2 species names, got {}", species_key, names.size()));
+      }
+      for (std::size_t k = 0; k < 2; ++k) {
+        const bool declared =
+            std::any_of(species.begin(), species.end(),
+                        [&](const SpeciesConfig& s) { return s.name == names[k]; });
+        if (!declared) {
+          std::vector<std::string_view> known;
+          for (const SpeciesConfig& s : species) known.push_back(s.name);
+          fail(element_of(n_species, k), species_key,
+               fmt::format("{}: unknown species '{}' (declared species: {})", species_key, names[k],
+                           join_words(known)));
+        }
+      }
+      for (std::size_t j = 0; j < in.pairs.size(); ++j) {
+        const auto& other = in.pairs[j].species;
+        if ((other[0] == names[0] && other[1] == names[1]) ||
+            (other[0] == names[1] && other[1] == names[0])) {
+          fail(n_species, species_key,
+               fmt::format("{}: the pair ({}, {}) is already given by contact.pair[{}]",
+                           species_key, names[0], names[1], j));
+        }
+      }
+      PairContactConfig pair;
+      pair.species = {names[0], names[1]};
+      pair.contact = in.contact;
+      read_contact(*tables[i], prefix, pair.contact);
+      in.pairs.push_back(std::move(pair));
+    }
+  }
+
+  // The index in kFaces of a face name valid in `dimension`.
+  int face_index(const toml::node* node, const std::string& path, const std::string& face,
+                 int dimension) const {
+    const std::span<const std::string_view> valid(kFaces, 2 * static_cast<std::size_t>(dimension));
+    const auto it = std::find(valid.begin(), valid.end(), face);
+    if (it == valid.end()) {
+      const bool other_dimension = contains(kFaces, face);
+      fail(node, path,
+           fmt::format("{}: '{}' is not {}; valid values: {}", path, face,
+                       other_dimension ? fmt::format("a face of a {}D box", dimension)
+                                       : std::string("a valid face"),
+                       join_words(valid)));
+    }
+    return static_cast<int>(it - valid.begin());
+  }
+
+  void read_boundary(const toml::table& t, int dimension, const ContactConfig& contact,
+                     BoundaryConfig& b) const {
+    constexpr std::string_view p = "boundary";
+    // Who claims each face: the node (for error locations), its key, and what it makes it.
+    struct Claim {
+      const toml::node* node = nullptr;
+      std::string key;
+      bool wall = false;
+    };
+    std::array<Claim, 6> claims{};
+
+    const std::vector<const toml::table*> tables = table_array(t, p, "wall");
+    for (std::size_t i = 0; i < tables.size(); ++i) {
+      const toml::table& wt = *tables[i];
+      const std::string prefix = fmt::format("boundary.wall[{}]", i);
+      const std::string face_key = prefix + ".face";
+      WallConfig w;
+      w.contact = contact;
+      const toml::node* n_face = get_string(wt, prefix, "face", w.face);
+      if (n_face == nullptr) {
+        fail(tables[i], face_key,
+             fmt::format("missing required key '{}' (one of {})", face_key,
+                         join_words(std::span(kFaces, 2 * static_cast<std::size_t>(dimension)))));
+      }
+      const int f = face_index(n_face, face_key, w.face, dimension);
+      if (claims[static_cast<std::size_t>(f)].node != nullptr) {
+        fail(n_face, face_key,
+             fmt::format("{}: face {} is listed twice (already {})", face_key, w.face,
+                         claims[static_cast<std::size_t>(f)].key));
+      }
+      claims[static_cast<std::size_t>(f)] = {n_face, prefix, true};
+
+      read_contact(wt, prefix, w.contact);
+
+      std::vector<double> velocity;
+      const toml::node* n_velocity = get_vector(wt, prefix, "velocity", dimension, velocity);
+      const auto axis = static_cast<std::size_t>(f / 2);
+      if (!velocity.empty() && velocity[axis] != 0.0) {
+        fail(element_of(n_velocity, axis), prefix + ".velocity",
+             fmt::format("{}.velocity: the component along the wall's normal ({}) must be 0, got "
+                         "{} (a wall slides in its own plane; amplitude and frequency move it "
+                         "along {})",
+                         prefix, kAxes[axis], velocity[axis], kAxes[axis]));
+      }
+      // At rest is stored as the default, empty.
+      if (std::any_of(velocity.begin(), velocity.end(), [](double v) { return v != 0.0; })) {
+        w.velocity = std::move(velocity);
+      }
+
+      const toml::node* n_amplitude = get_number(wt, prefix, "amplitude", w.amplitude);
+      const toml::node* n_frequency = get_number(wt, prefix, "frequency", w.frequency);
+      get_number(wt, prefix, "phase", w.phase);
+      require_non_negative(n_amplitude, prefix + ".amplitude", w.amplitude);
+      require_non_negative(n_frequency, prefix + ".frequency", w.frequency);
+      b.walls.push_back(std::move(w));
+    }
+
+    const toml::node* n_open = get_strings(t, p, "open", b.open);
+    for (std::size_t i = 0; i < b.open.size(); ++i) {
+      const std::string& face = b.open[i];
+      const toml::node* node = element_of(n_open, i);
+      const std::string key = fmt::format("boundary.open[{}]", i);
+      const auto f = static_cast<std::size_t>(face_index(node, key, face, dimension));
+      if (claims[f].node != nullptr) {
+        fail(node, "boundary.open",
+             claims[f].wall
+                 ? fmt::format("{}: face {} is a wall ({}); a face is a wall or open, not both",
+                               key, face, claims[f].key)
+                 : fmt::format("{}: face {} is listed twice (already {})", key, face,
+                               claims[f].key));
+      }
+      claims[f] = {node, key, false};
+    }
+
+    // An axis is periodic (no wall, not open) or bounded at both ends.
+    for (std::size_t axis = 0; axis < static_cast<std::size_t>(dimension); ++axis) {
+      for (std::size_t side = 0; side < 2; ++side) {
+        const Claim& here = claims[2 * axis + side];
+        const Claim& there = claims[2 * axis + 1 - side];
+        if (here.node == nullptr || there.node != nullptr) continue;
+        const std::string_view face = kFaces[2 * axis + side];
+        const std::string_view other = kFaces[2 * axis + 1 - side];
+        fail(here.node, here.wall ? here.key + ".face" : std::string("boundary.open"),
+             fmt::format(
+                 "boundary: face {} is {} but {} is neither a wall nor in boundary.open; "
+                 "add one (or {} to keep {} periodic)",
+                 face, here.wall ? "a wall" : "open", other,
+                 here.wall ? "remove the wall" : fmt::format("remove {} from boundary.open", face),
+                 kAxes[axis]));
+      }
+    }
+  }
+
+  void read_field(const toml::table& t, int dimension, FieldConfig& f) const {
+    std::vector<double> gravity;
+    get_vector(t, "field", "gravity", dimension, gravity);
+    // No field is stored as the default, empty.
+    if (std::any_of(gravity.begin(), gravity.end(), [](double g) { return g != 0.0; })) {
+      f.gravity = std::move(gravity);
     }
   }
 
@@ -752,6 +1178,35 @@ std::string toml_unsigned(std::uint64_t v, std::string_view key) {
   return fmt::format("{}", v);
 }
 
+// "[1.0, 0.0, -1.0]"
+std::string toml_floats(const std::vector<double>& values) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    out += fmt::format("{}{}", i == 0 ? "" : ", ", toml_float(values[i]));
+  }
+  return out + "]";
+}
+
+// The keys of a contact law, one per line (restitution_table only when there is one).
+std::string contact_toml(const ContactConfig& c) {
+  std::string out;
+  out += fmt::format("restitution = {}\n", toml_float(c.restitution));
+  out += fmt::format("restitution_model = {}\n", toml_string(c.restitution_model));
+  out += fmt::format("restitution_speed = {}\n", toml_float(c.restitution_speed));
+  if (!c.restitution_table.empty()) {
+    out += "restitution_table = [";
+    for (std::size_t i = 0; i < c.restitution_table.size(); ++i) {
+      out += fmt::format("{}[{}, {}]", i == 0 ? "" : ", ", toml_float(c.restitution_table[i][0]),
+                         toml_float(c.restitution_table[i][1]));
+    }
+    out += "]\n";
+  }
+  out += fmt::format("tangential_restitution = {}\n", toml_float(c.tangential_restitution));
+  out += fmt::format("friction = {}\n", toml_float(c.friction));
+  out += fmt::format("elastic_below_speed = {}\n", toml_float(c.elastic_below_speed));
+  return out;
+}
+
 }  // namespace
 
 std::string default_lattice(int dimension) {
@@ -800,6 +1255,7 @@ std::string to_toml(const Config& config) {
   const SystemConfig& s = config.system;
   const RunConfig& r = config.run;
   const OutputConfig& o = config.output;
+  const InteractionConfig& in = config.interactions;
 
   std::string lattice = s.lattice;
   if (lattice.empty() && (s.dimension == 2 || s.dimension == 3)) {
@@ -807,6 +1263,11 @@ std::string to_toml(const Config& config) {
   }
   std::vector<SpeciesConfig> species = s.species;
   if (species.empty()) species.emplace_back();
+  // Vectors left empty (the defaults) are written with their effective values.
+  const std::size_t dimension = s.dimension == 2 ? 2 : 3;
+  const auto vector_or = [&](const std::vector<double>& v, double fill) {
+    return toml_floats(v.empty() ? std::vector<double>(dimension, fill) : v);
+  };
 
   std::string out;
   out += "# Kairos run configuration: the effective value of every key (see docs/config.md).\n";
@@ -818,13 +1279,41 @@ std::string to_toml(const Config& config) {
   out += fmt::format("temperature = {}\n", toml_float(s.temperature));
   out += fmt::format("seed = {}\n", toml_unsigned(s.seed, "system.seed"));
   out += fmt::format("initial_state = {}\n", toml_string(s.initial_state));
+  out += fmt::format("box_scale = {}\n", vector_or(s.box_scale, 1.0));
   for (const SpeciesConfig& sp : species) {
     out += "\n[[system.species]]\n";
     out += fmt::format("name = {}\n", toml_string(sp.name));
     out += fmt::format("diameter = {}\n", toml_float(sp.diameter));
     out += fmt::format("mass = {}\n", toml_float(sp.mass));
     out += fmt::format("fraction = {}\n", toml_float(sp.fraction));
+    out += fmt::format("inertia_factor = {}\n", toml_float(sp.inertia_factor));
   }
+  out += "\n[contact]\n";
+  out += contact_toml(in.contact);
+  out += fmt::format("tc = {}\n", toml_float(in.tc));
+  for (const PairContactConfig& pair : in.pairs) {
+    out += "\n[[contact.pair]]\n";
+    out += fmt::format("species = [{}, {}]\n", toml_string(pair.species[0]),
+                       toml_string(pair.species[1]));
+    out += contact_toml(pair.contact);
+  }
+  out += "\n[boundary]\n";
+  out += "open = [";
+  for (std::size_t i = 0; i < config.boundary.open.size(); ++i) {
+    out += fmt::format("{}{}", i == 0 ? "" : ", ", toml_string(config.boundary.open[i]));
+  }
+  out += "]\n";
+  for (const WallConfig& w : config.boundary.walls) {
+    out += "\n[[boundary.wall]]\n";
+    out += fmt::format("face = {}\n", toml_string(w.face));
+    out += contact_toml(w.contact);
+    out += fmt::format("velocity = {}\n", vector_or(w.velocity, 0.0));
+    out += fmt::format("amplitude = {}\n", toml_float(w.amplitude));
+    out += fmt::format("frequency = {}\n", toml_float(w.frequency));
+    out += fmt::format("phase = {}\n", toml_float(w.phase));
+  }
+  out += "\n[field]\n";
+  out += fmt::format("gravity = {}\n", vector_or(config.field.gravity, 0.0));
   out += "\n[run]\n";
   out += fmt::format("equilibration_collisions_per_particle = {}\n",
                      toml_float(r.equilibration_collisions_per_particle));

@@ -6,8 +6,10 @@
 // the user chooses the unit (typically diameter = mass = kT = 1).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -19,6 +21,8 @@ struct SpeciesConfig {
   double diameter = 1.0;
   double mass = 1.0;
   double fraction = 1.0;  // number fraction; fractions are normalised to sum 1
+  // Moment of inertia I = q m R^2 (rough particles); 0 = default: 2/5 (spheres), 1/2 (disks).
+  double inertia_factor = 0.0;
 
   bool operator==(const SpeciesConfig&) const = default;
 };
@@ -32,8 +36,65 @@ struct SystemConfig {
   std::uint64_t seed = 1;              // seeds all randomness of the run
   std::vector<SpeciesConfig> species;  // empty -> one species "A", diameter 1, mass 1
   std::string initial_state;           // GSD file to start from (last frame); "" -> generate
+  // Generated states only: the box edges are multiplied by these factors (>= 1) after the
+  // particles are placed, leaving empty space at the high end of each axis (e.g. a bed of
+  // grains at the bottom of a tall box). Empty = all 1.
+  std::vector<double> box_scale;
 
   bool operator==(const SystemConfig&) const = default;
+};
+
+// A contact law (particle-particle for a species pair, or particle-wall): formulas.md §2.2,
+// §3.5, §5.
+struct ContactConfig {
+  double restitution = 1.0;                   // e_n (constant), or e at restitution_speed
+  std::string restitution_model = "constant";  // constant | viscoelastic | table
+  double restitution_speed = 1.0;             // viscoelastic: e(restitution_speed) = restitution
+  std::vector<std::array<double, 2>> restitution_table;  // table: (impact speed, e) pairs
+  double tangential_restitution = -1.0;  // beta in [-1, 1]; -1 smooth
+  double friction = std::numeric_limits<double>::infinity();  // Coulomb mu (Walton); inf = no limit
+  double elastic_below_speed = 0.0;      // |g_n| below this: elastic (0 = off)
+
+  bool operator==(const ContactConfig&) const = default;
+};
+
+struct PairContactConfig {
+  std::array<std::string, 2> species;  // names
+  ContactConfig contact;
+
+  bool operator==(const PairContactConfig&) const = default;
+};
+
+struct InteractionConfig {
+  ContactConfig contact;                  // [contact]: every pair without an override
+  std::vector<PairContactConfig> pairs;   // [[contact.pair]]
+  double tc = 0.0;                        // contact.tc: TC model duration (0 = off)
+
+  bool operator==(const InteractionConfig&) const = default;
+};
+
+struct WallConfig {
+  std::string face;        // x- x+ y- y+ z- z+
+  ContactConfig contact;   // restitution etc. of particle-wall collisions
+  std::vector<double> velocity;  // in-plane sliding velocity (D components), empty = at rest
+  double amplitude = 0.0;  // vibration along the normal: A sin(2 pi f t + phase)
+  double frequency = 0.0;  // f, cycles per unit time
+  double phase = 0.0;      // radians
+
+  bool operator==(const WallConfig&) const = default;
+};
+
+struct BoundaryConfig {
+  std::vector<WallConfig> walls;   // [[boundary.wall]]
+  std::vector<std::string> open;   // boundary.open: faces with no wall (e.g. "z+")
+
+  bool operator==(const BoundaryConfig&) const = default;
+};
+
+struct FieldConfig {
+  std::vector<double> gravity;  // D components; empty = none
+
+  bool operator==(const FieldConfig&) const = default;
 };
 
 struct RunConfig {
@@ -61,6 +122,9 @@ struct Config {
   SystemConfig system;
   RunConfig run;
   OutputConfig output;
+  InteractionConfig interactions;  // TOML section [contact]
+  BoundaryConfig boundary;         // [boundary]
+  FieldConfig field;               // [field]
 
   bool operator==(const Config&) const = default;  // memberwise (exact doubles)
 };

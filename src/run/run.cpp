@@ -18,6 +18,7 @@
 #include "io/atomic_file.hpp"
 #include "io/gsd_snapshot.hpp"
 #include "io/progress.hpp"
+#include "run/environment_setup.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
 #include "scheduler/tournament_tree_queue.hpp"
@@ -99,6 +100,27 @@ void note_ignored_system_keys(const Config& config, std::size_t n, const std::st
   }
 }
 
+// A generated state fills a periodic box. Along an axis with walls (or open faces) the box
+// grows by the largest diameter, half on each side, so that no particle touches a wall; then
+// system.box_scale stretches the box, leaving empty space at the high end of each axis.
+template <int D>
+void make_room_for_walls(const Config& config, InitialState<D>& init) {
+  double dmax = 0.0;
+  for (const double d : init.diameter) dmax = std::max(dmax, d);
+  std::array<bool, D> bounded{};
+  for (const WallConfig& w : config.boundary.walls)
+    if (w.face.size() == 2 && w.face[0] - 'x' < D) bounded[w.face[0] - 'x'] = true;
+  for (const std::string& f : config.boundary.open)
+    if (f.size() == 2 && f[0] - 'x' < D) bounded[f[0] - 'x'] = true;
+  for (int a = 0; a < D; ++a) {
+    if (!bounded[a]) continue;
+    init.box[a] += dmax;
+    for (auto& x : init.position) x[a] += 0.5 * dmax;
+  }
+  for (int a = 0; a < D && a < static_cast<int>(config.system.box_scale.size()); ++a)
+    init.box[a] *= config.system.box_scale[a];
+}
+
 template <int D>
 ParticleSystem<D> build_start_state(const Config& config,
                                     const std::optional<fs::path>& restart_file,
@@ -126,6 +148,7 @@ ParticleSystem<D> build_start_state(const Config& config,
   }
   InitialState<D> init = make_initial_state<D>(config.system, rng);
   check_no_overlap(init, "generated initial state");
+  make_room_for_walls(config, init);
   return to_particle_system<D>(init);
 }
 
@@ -212,7 +235,9 @@ class RunDriver {
     }
     thermo_stats_.emplace(D, n_, volume_);
     try {
-      engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict);
+      const Environment<D> environment = make_environment<D>(config, start.species_names);
+      engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict,
+                      EngineOptions{}, environment);
     } catch (const InputError& e) {
       if (!restart_file) throw;
       throw InputError("restart file '" + restart_file->string() + "': " + e.what());

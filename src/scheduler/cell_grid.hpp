@@ -12,12 +12,18 @@
 // cell's members and its neighbours' sit close together in memory. The image of a neighbouring
 // cell is known from the cell offset (wrapping adds +-L), so pair tests never need a
 // minimum-image rounding.
+//
+// An axis may be non-periodic (walls or open faces). Its outer layers of cells then extend to
+// infinity (lower() of the first layer is -inf, upper() of the last +inf), so a particle can
+// never leave the grid, whatever a vibrating wall or an open top lets it do; a neighbour beyond
+// such a face is an always-empty sentinel cell, so the neighbour loops need no special case.
 #pragma once
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/error.hpp"
@@ -39,23 +45,31 @@ class CellGrid {
   static constexpr double kDefaultCellsPerParticle = 1.25;
 
   CellGrid() = default;
-  // Cells at least `min_width` wide, at least 3 per axis, at most `max_cells_per_particle` per
-  // particle (dilute systems get wider cells instead of a large, mostly empty grid) and at most
-  // kMaxCellsAlong per axis.
+  // Cells at least `min_width` wide, at least 3 per periodic axis (1 per non-periodic one), at
+  // most `max_cells_per_particle` per particle (dilute systems get wider cells instead of a
+  // large, mostly empty grid) and at most kMaxCellsAlong per axis.
   CellGrid(const Vec<D>& box, double min_width, std::size_t particles,
            double max_cells_per_particle = kDefaultCellsPerParticle)
-      : box_(box) {
+      : CellGrid(box, uniform(min_width), all_periodic(), particles, max_cells_per_particle) {}
+  CellGrid(const Vec<D>& box, const Vec<D>& min_width, const std::array<bool, D>& periodic,
+           std::size_t particles, double max_cells_per_particle = kDefaultCellsPerParticle)
+      : box_(box), periodic_(periodic) {
     double wanted[D];
     double product = 1.0;
     for (int k = 0; k < D; ++k) {
       if (!(box[k] > 0.0) || !std::isfinite(box[k])) {
         throw InputError("box edge " + std::to_string(box[k]) + " is not a finite positive length");
       }
-      wanted[k] = std::min(std::floor(box[k] / min_width), double{kMaxCellsAlong});
-      if (wanted[k] < 3.0) {
+      wanted[k] = std::min(std::floor(box[k] / min_width[k]), double{kMaxCellsAlong});
+      if (periodic[k] && wanted[k] < 3.0) {
         throw InputError("box edge " + std::to_string(box[k]) +
-                         " is shorter than 3 contact distances (" + std::to_string(min_width) +
+                         " is shorter than 3 contact distances (" + std::to_string(min_width[k]) +
                          "): use more particles or a lower packing fraction");
+      }
+      if (!periodic[k] && wanted[k] < 1.0) {
+        throw InputError("box edge " + std::to_string(box[k]) + " between walls is shorter than " +
+                         std::to_string(min_width[k]) +
+                         " (a particle diameter plus the walls' vibration amplitude)");
       }
       product *= wanted[k];
     }
@@ -64,10 +78,13 @@ class CellGrid {
     const double shrink = product > max_cells ? std::pow(max_cells / product, 1.0 / D) : 1.0;
     total_ = 1;
     for (int k = 0; k < D; ++k) {
-      n_[k] = static_cast<int>(std::max(3.0, std::floor(wanted[k] * shrink)));
+      n_[k] = static_cast<int>(std::max(periodic[k] ? 3.0 : 1.0, std::floor(wanted[k] * shrink)));
       width_[k] = box[k] / n_[k];
       stride_[k] = total_;
       total_ *= static_cast<std::uint32_t>(n_[k]);
+      constexpr double inf = std::numeric_limits<double>::infinity();
+      low_edge_[k] = periodic[k] ? 0.0 : -inf;
+      high_edge_[k] = periodic[k] ? n_[k] * width_[k] : inf;
     }
     std::array<int, D> off;
     off.fill(-1);
@@ -81,12 +98,17 @@ class CellGrid {
       }
     }
     end_ = static_cast<std::uint32_t>(particles);
-    head_.assign(total_, end_);
+    head_.assign(total_ + 1, end_);  // + the empty cell beyond non-periodic faces
     next_.assign(particles + 1, end_);
   }
 
   std::uint32_t cell_count() const { return total_; }
   int cells_along(int k) const { return n_[k]; }
+  bool periodic(int k) const { return periodic_[k]; }
+  // Whether the cell lies in an outer layer of a non-periodic axis k, on the side `sign`.
+  bool at_face(CellCode c, int k, int sign) const {
+    return !periodic_[k] && coordinate(c, k) == (sign < 0 ? 0 : n_[k] - 1);
+  }
 
   // Codes and linear indices (the position of a cell's list head).
   int coordinate(CellCode c, int k) const {
@@ -121,8 +143,15 @@ class CellGrid {
     }
     return code_at(c);
   }
-  double lower(CellCode c, int k) const { return coordinate(c, k) * width_[k]; }
-  double upper(CellCode c, int k) const { return (coordinate(c, k) + 1) * width_[k]; }
+  // Cell bounds; +-inf for the outer layers of a non-periodic axis. Selects, not branches.
+  double lower(CellCode c, int k) const {
+    const int x = coordinate(c, k);
+    return x == 0 ? low_edge_[k] : x * width_[k];
+  }
+  double upper(CellCode c, int k) const {
+    const int x = coordinate(c, k);
+    return x == n_[k] - 1 ? high_edge_[k] : (x + 1) * width_[k];
+  }
 
   // The particles of a cell (by linear index): first(), then next(i) until end(). The end
   // marker is the particle count, and next(end()) is end() again, so a loop may follow links
@@ -146,6 +175,7 @@ class CellGrid {
   }
   // Empties every cell (before particles are inserted again in a new numbering).
   void clear() {
+    // The sentinel cell (index total_) stays empty: nothing is ever inserted there.
     std::fill(head_.begin(), head_.end(), end_);
     std::fill(next_.begin(), next_.end(), end_);
   }
@@ -197,13 +227,13 @@ class CellGrid {
     }
   }
 
-  // Offset of cell b from cell a, each component wrapped into {-1, 0, 1}; false if the cells
-  // are not neighbours.
+  // Offset of cell b from cell a, each component wrapped into {-1, 0, 1} (periodic axes);
+  // false if the cells are not neighbours.
   bool neighbour_offset(CellCode a, CellCode b, std::array<int, D>& d) const {
     for (int k = 0; k < D; ++k) {
       int diff = coordinate(b, k) - coordinate(a, k);
-      if (diff > 1) diff -= n_[k];
-      if (diff < -1) diff += n_[k];
+      if (periodic_[k] && diff > 1) diff -= n_[k];
+      if (periodic_[k] && diff < -1) diff += n_[k];
       if (diff < -1 || diff > 1) return false;
       d[k] = diff;
     }
@@ -232,6 +262,17 @@ class CellGrid {
   }
 
  private:
+  static Vec<D> uniform(double w) {
+    Vec<D> v;
+    for (int k = 0; k < D; ++k) v[k] = w;
+    return v;
+  }
+  static std::array<bool, D> all_periodic() {
+    std::array<bool, D> p;
+    p.fill(true);
+    return p;
+  }
+
   Neighbour offset_cell(const std::array<int, D>& base, const std::array<int, D>& off) const {
     Neighbour nb;
     nb.shifted = false;
@@ -239,6 +280,9 @@ class CellGrid {
     for (int k = 0; k < D; ++k) {
       int c = base[k] + off[k];
       nb.shift[k] = 0.0;
+      if (!periodic_[k] && (c < 0 || c >= n_[k])) {
+        return {total_, false, {}};  // beyond a wall or open face: the empty sentinel cell
+      }
       if (c < 0) {
         c += n_[k];
         nb.shift[k] = -box_[k];
@@ -255,6 +299,8 @@ class CellGrid {
   }
 
   Vec<D> box_{};
+  std::array<bool, D> periodic_{};
+  Vec<D> low_edge_{}, high_edge_{};  // bounds of the outer layers (+-inf when not periodic)
   std::array<int, D> n_{};
   Vec<D> width_{};
   std::array<std::uint32_t, D> stride_{};

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -506,6 +509,507 @@ TEST(ConfigOverrides, SpeciesErrors) {
       {"system.species.0.mass=2"});
 }
 
+// ----- granular keys: species inertia, box_scale, [contact], [boundary], [field]
+
+TEST(ConfigGranular, DefaultsAreThePlainHardSphereCase) {
+  const Config c = parse_config(kMinimal, "t.toml");
+  EXPECT_EQ(c.system.species[0].inertia_factor, 0.0);
+  EXPECT_TRUE(c.system.box_scale.empty());
+  EXPECT_EQ(c.interactions, InteractionConfig{});
+  EXPECT_EQ(c.interactions.contact, ContactConfig{});
+  EXPECT_EQ(c.interactions.contact.friction, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(c.boundary, BoundaryConfig{});
+  EXPECT_EQ(c.field, FieldConfig{});
+  // Empty sections are the defaults too.
+  const Config d = parse_config(minimal_plus("[contact]\n[boundary]\n[field]"), "t.toml");
+  EXPECT_EQ(d, c);
+}
+
+TEST(ConfigGranular, EveryKeyIsRead) {
+  const Config c = parse_config(R"(
+[system]
+particles = 1000
+packing_fraction = 0.2
+box_scale = [1.0, 2, 4.5]
+
+[[system.species]]
+name = "A"
+inertia_factor = 0.4
+
+[[system.species]]
+name = "B"
+diameter = 2
+
+[contact]
+restitution = 0.9
+restitution_model = "viscoelastic"
+restitution_speed = 2.0
+tangential_restitution = 0.3
+friction = 0.5
+elastic_below_speed = 1e-3
+tc = 1e-4
+
+[[contact.pair]]
+species = ["A", "B"]
+restitution = 0.8
+restitution_model = "table"
+restitution_table = [[0.0, 1.0], [1, 0.9], [2.5, 0.7]]
+
+[[contact.pair]]
+species = ["B", "B"]
+restitution_model = "constant"
+friction = inf
+tangential_restitution = -1
+
+[boundary]
+open = ["z+"]
+
+[[boundary.wall]]
+face = "z-"
+restitution = 0.7
+velocity = [1.0, -0.5, 0.0]
+amplitude = 0.05
+frequency = 10
+phase = 1.5
+
+[[boundary.wall]]
+face = "x-"
+restitution_model = "constant"
+
+[[boundary.wall]]
+face = "x+"
+
+[field]
+gravity = [0.0, 0.0, -1.0]
+)",
+                                "granular.toml");
+  EXPECT_EQ(c.system.box_scale, (std::vector<double>{1.0, 2.0, 4.5}));
+  ASSERT_EQ(c.system.species.size(), 2u);
+  EXPECT_EQ(c.system.species[0].inertia_factor, 0.4);
+  EXPECT_EQ(c.system.species[1].inertia_factor, 0.0);
+
+  const ContactConfig& law = c.interactions.contact;
+  EXPECT_EQ(law.restitution, 0.9);
+  EXPECT_EQ(law.restitution_model, "viscoelastic");
+  EXPECT_EQ(law.restitution_speed, 2.0);
+  EXPECT_TRUE(law.restitution_table.empty());
+  EXPECT_EQ(law.tangential_restitution, 0.3);
+  EXPECT_EQ(law.friction, 0.5);
+  EXPECT_EQ(law.elastic_below_speed, 1e-3);
+  EXPECT_EQ(c.interactions.tc, 1e-4);
+
+  // A pair starts from [contact] and replaces the keys it sets.
+  ASSERT_EQ(c.interactions.pairs.size(), 2u);
+  const PairContactConfig& ab = c.interactions.pairs[0];
+  EXPECT_EQ(ab.species, (std::array<std::string, 2>{"A", "B"}));
+  EXPECT_EQ(ab.contact.restitution, 0.8);
+  EXPECT_EQ(ab.contact.restitution_model, "table");
+  EXPECT_EQ(ab.contact.restitution_table,
+            (std::vector<std::array<double, 2>>{{0.0, 1.0}, {1.0, 0.9}, {2.5, 0.7}}));
+  EXPECT_EQ(ab.contact.restitution_speed, 2.0);
+  EXPECT_EQ(ab.contact.tangential_restitution, 0.3);
+  EXPECT_EQ(ab.contact.friction, 0.5);
+  EXPECT_EQ(ab.contact.elastic_below_speed, 1e-3);
+  const PairContactConfig& bb = c.interactions.pairs[1];
+  EXPECT_EQ(bb.species, (std::array<std::string, 2>{"B", "B"}));
+  EXPECT_EQ(bb.contact.restitution_model, "constant");
+  EXPECT_EQ(bb.contact.restitution, 0.9);
+  EXPECT_EQ(bb.contact.friction, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(bb.contact.tangential_restitution, -1.0);
+
+  EXPECT_EQ(c.boundary.open, (std::vector<std::string>{"z+"}));
+  ASSERT_EQ(c.boundary.walls.size(), 3u);
+  const WallConfig& floor = c.boundary.walls[0];
+  EXPECT_EQ(floor.face, "z-");
+  EXPECT_EQ(floor.contact.restitution, 0.7);
+  EXPECT_EQ(floor.contact.restitution_model, "viscoelastic");  // from [contact]
+  EXPECT_EQ(floor.contact.friction, 0.5);
+  EXPECT_EQ(floor.velocity, (std::vector<double>{1.0, -0.5, 0.0}));
+  EXPECT_EQ(floor.amplitude, 0.05);
+  EXPECT_EQ(floor.frequency, 10.0);
+  EXPECT_EQ(floor.phase, 1.5);
+  EXPECT_EQ(c.boundary.walls[1].face, "x-");
+  EXPECT_EQ(c.boundary.walls[1].contact.restitution_model, "constant");
+  EXPECT_TRUE(c.boundary.walls[1].velocity.empty());
+  EXPECT_EQ(c.boundary.walls[1].amplitude, 0.0);
+  EXPECT_EQ(c.boundary.walls[2].contact, law);
+  EXPECT_EQ(c.field.gravity, (std::vector<double>{0.0, 0.0, -1.0}));
+}
+
+TEST(ConfigGranular, TwoDimensionalVectors) {
+  const Config c = parse_config(R"([system]
+dimension = 2
+particles = 500
+packing_fraction = 0.5
+box_scale = [1, 6]
+[[boundary.wall]]
+face = "y-"
+velocity = [0.5, 0]
+[boundary]
+open = ["y+"]
+[field]
+gravity = [0, -1]
+)",
+                                "t.toml");
+  EXPECT_EQ(c.system.box_scale, (std::vector<double>{1.0, 6.0}));
+  EXPECT_EQ(c.boundary.walls[0].velocity, (std::vector<double>{0.5, 0.0}));
+  EXPECT_EQ(c.field.gravity, (std::vector<double>{0.0, -1.0}));
+}
+
+TEST(ConfigGranular, DefaultValuedVectorsAreStoredEmpty) {
+  const Config c = parse_config(minimal_plus(R"(box_scale = [1, 1.0, 1]
+[[boundary.wall]]
+face = "x-"
+velocity = [0, 0, 0]
+[[boundary.wall]]
+face = "x+"
+[field]
+gravity = [0.0, 0.0, -0.0])"),
+                                "t.toml");
+  EXPECT_TRUE(c.system.box_scale.empty());
+  EXPECT_TRUE(c.boundary.walls[0].velocity.empty());
+  EXPECT_TRUE(c.field.gravity.empty());
+  EXPECT_EQ(c.field, FieldConfig{});
+}
+
+TEST(ConfigGranular, ExplicitDefaultContactIsTheDefault) {
+  const Config c = parse_config(minimal_plus(R"([contact]
+restitution = 1
+restitution_model = "constant"
+restitution_speed = 1
+tangential_restitution = -1
+friction = inf
+elastic_below_speed = 0
+tc = 0)"),
+                                "t.toml");
+  EXPECT_EQ(c.interactions, InteractionConfig{});
+}
+
+TEST(ConfigGranular, InheritedTableIsDroppedByAnotherModel) {
+  const Config c = parse_config(minimal_plus(R"([contact]
+restitution_model = "table"
+restitution_table = [[0, 0.8]]
+[[contact.pair]]
+species = ["A", "A"]
+restitution_model = "constant"
+restitution = 0.5
+[[boundary.wall]]
+face = "y-"
+[[boundary.wall]]
+face = "y+"
+restitution = 0.2)"),
+                                "t.toml");
+  EXPECT_TRUE(c.interactions.pairs[0].contact.restitution_table.empty());
+  EXPECT_EQ(c.interactions.pairs[0].contact.restitution, 0.5);
+  // The walls keep the table law (an explicit restitution is unused by it, but kept).
+  EXPECT_EQ(c.boundary.walls[0].contact, c.interactions.contact);
+  EXPECT_EQ(c.boundary.walls[1].contact.restitution_table,
+            (std::vector<std::array<double, 2>>{{0.0, 0.8}}));
+}
+
+TEST(ConfigGranular, BothFacesOfAnAxisOpenIsAllowed) {
+  const Config c = parse_config(minimal_plus("[boundary]\nopen = [\"z-\", \"z+\"]"), "t.toml");
+  EXPECT_EQ(c.boundary.open, (std::vector<std::string>{"z-", "z+"}));
+}
+
+TEST(ConfigGranularErrors, ContactRanges) {
+  expect_error(minimal_plus("[contact]\nrestitution = 1.1"),
+               {"test.toml:5:15", "contact.restitution", "[0, 1]", "got 1.1"});
+  expect_error(minimal_plus("[contact]\nrestitution = -0.1"), {"contact.restitution", "[0, 1]"});
+  expect_error(
+      minimal_plus("[contact]\nrestitution_model = \"hertz\""),
+      {"contact.restitution_model", "'hertz'", "valid values: constant, viscoelastic, table"});
+  expect_error(minimal_plus("[contact]\nrestitution_speed = 0"),
+               {"contact.restitution_speed", "> 0", "got 0"});
+  expect_error(minimal_plus("[contact]\nrestitution_model = \"viscoelastic\"\nrestitution = 0"),
+               {"contact.restitution", "(0, 1]", "viscoelastic", "got 0"});
+  expect_error(minimal_plus("[contact]\ntangential_restitution = 1.5"),
+               {"contact.tangential_restitution", "[-1, 1]", "got 1.5"});
+  expect_error(minimal_plus("[contact]\ntangential_restitution = -2"),
+               {"contact.tangential_restitution", "[-1, 1]"});
+  expect_error(minimal_plus("[contact]\nfriction = -0.5"),
+               {"test.toml:5:12", "contact.friction", ">= 0", "got -0.5"});
+  expect_error(minimal_plus("[contact]\nfriction = -inf"),
+               {"contact.friction", "finite number or inf", "got -inf"});
+  expect_error(minimal_plus("[contact]\nfriction = nan"), {"contact.friction", "got nan"});
+  expect_error(minimal_plus("[contact]\nelastic_below_speed = -1"),
+               {"contact.elastic_below_speed", ">= 0"});
+  expect_error(minimal_plus("[contact]\ntc = -1e-3"), {"contact.tc", ">= 0"});
+  expect_error(minimal_plus("[contact]\ntc = inf"), {"contact.tc", "finite"});
+  expect_error(minimal_plus("[contact]\nrestitution = \"high\""),
+               {"contact.restitution", "expected a number", "found a string"});
+  // inf is only for friction.
+  expect_error(minimal_plus("[contact]\nelastic_below_speed = inf"),
+               {"contact.elastic_below_speed", "must be a finite number, got inf"});
+}
+
+TEST(ConfigGranularErrors, RestitutionTable) {
+  expect_error(minimal_plus("[contact]\nrestitution_model = \"table\""),
+               {"test.toml:5:21", "missing required key 'contact.restitution_table'"});
+  expect_error(minimal_plus("[contact]\nrestitution_model = \"table\"\nrestitution_table = []"),
+               {"contact.restitution_table", "at least one"});
+  expect_error(minimal_plus("[contact]\nrestitution_table = [[0.0, 1.0]]"),
+               {"test.toml:5:21", "contact.restitution_table", "only allowed with",
+                "restitution_model = \"table\"", "is \"constant\""});
+  const std::string unsorted =
+      "[contact]\nrestitution_model = \"table\"\nrestitution_table = [[0.0, 1.0], [2.0, 0.9], "
+      "[1.0, 0.8]]";
+  expect_error(minimal_plus(unsorted),
+               {"contact.restitution_table[2]", "strictly increasing", "got 1 after 2"});
+  expect_error(minimal_plus("[contact]\nrestitution_model = \"table\"\nrestitution_table = "
+                            "[[1.0, 1.0], [1.0, 0.9]]"),
+               {"contact.restitution_table[1]", "strictly increasing"});
+  expect_error(minimal_plus("[contact]\nrestitution_model = \"table\"\nrestitution_table = "
+                            "[[-1.0, 1.0]]"),
+               {"contact.restitution_table[0]", "impact speed must be >= 0"});
+  expect_error(minimal_plus("[contact]\nrestitution_model = \"table\"\nrestitution_table = "
+                            "[[0.0, 1.5]]"),
+               {"contact.restitution_table[0]", "restitution must be in [0, 1]", "got 1.5"});
+  expect_error(minimal_plus("[contact]\nrestitution_model = \"table\"\nrestitution_table = "
+                            "[[0.0, 1.0, 2.0]]"),
+               {"contact.restitution_table[0]", "expected a pair [speed, e]", "an array of 3"});
+  expect_error(minimal_plus("[contact]\nrestitution_model = \"table\"\nrestitution_table = [0.5]"),
+               {"contact.restitution_table[0]", "expected a pair", "a float (0.5)"});
+  expect_error(minimal_plus("[contact]\nrestitution_model = \"table\"\nrestitution_table = "
+                            "[[0.0, nan]]"),
+               {"contact.restitution_table[0][1]", "finite"});
+  expect_error(minimal_plus("[contact]\nrestitution_model = \"table\"\nrestitution_table = 0.9"),
+               {"contact.restitution_table", "expected an array of [speed, e] pairs"});
+  // Per pair and per wall the same.
+  expect_error(minimal_plus("[[contact.pair]]\nspecies = [\"A\", \"A\"]\nrestitution_model = "
+                            "\"table\""),
+               {"missing required key 'contact.pair[0].restitution_table'"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"x-\"\nrestitution_table = [[0, 1]]"),
+               {"boundary.wall[0].restitution_table", "only allowed with"});
+}
+
+TEST(ConfigGranularErrors, SpeciesPairs) {
+  const std::string species =
+      "[[system.species]]\nname = \"A\"\n[[system.species]]\nname = \"B\"\n";
+  const std::string m =
+      expect_error(minimal_plus(species + "[[contact.pair]]\nspecies = [\"A\", \"C\"]"),
+                   {"test.toml:9:17", "contact.pair[0].species", "unknown species 'C'",
+                    "declared species: A, B"});
+  EXPECT_EQ(
+      m, "test.toml:9:17: contact.pair[0].species: unknown species 'C' (declared species: A, B)");
+  expect_error(
+      minimal_plus(species + "[[contact.pair]]\nspecies = [\"A\", \"B\"]\n[[contact.pair]]\n"
+                             "species = [\"B\", \"A\"]\nrestitution = 0.5"),
+      {"test.toml:11:11", "contact.pair[1].species", "the pair (B, A)",
+       "already given by contact.pair[0]"});
+  expect_error(minimal_plus(species + "[[contact.pair]]\nspecies = [\"A\"]"),
+               {"contact.pair[0].species", "expected 2 species names, got 1"});
+  expect_error(minimal_plus(species + "[[contact.pair]]\nspecies = [\"A\", 2]"),
+               {"contact.pair[0].species[1]", "expected a string", "an integer (2)"});
+  expect_error(minimal_plus(species + "[[contact.pair]]\nrestitution = 0.5"),
+               {"missing required key 'contact.pair[0].species'"});
+  expect_error(
+      minimal_plus(species + "[[contact.pair]]\nspecies = [\"A\", \"B\"]\nrestitution = 2"),
+      {"contact.pair[0].restitution", "[0, 1]"});
+  expect_error(minimal_plus("[contact]\npair = 3"),
+               {"contact.pair", "expected an array of tables ([[contact.pair]])"});
+  // The default species is "A".
+  expect_error(minimal_plus("[[contact.pair]]\nspecies = [\"A\", \"B\"]"),
+               {"unknown species 'B'", "declared species: A"});
+}
+
+TEST(ConfigGranularErrors, TcOnlyInContact) {
+  expect_error(minimal_plus("[[contact.pair]]\nspecies = [\"A\", \"A\"]\ntc = 1"),
+               {"unknown key 'contact.pair[0].tc'", "did you mean 'contact.tc'?"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"x-\"\ntc = 1"),
+               {"unknown key 'boundary.wall[0].tc'", "did you mean 'contact.tc'?"});
+}
+
+TEST(ConfigGranularErrors, UnknownKeysGetSuggestions) {
+  const std::string m =
+      expect_error(minimal_plus("[[boundary.wall]]\nface = \"x-\"\n[[boundary.wall]]\nface = "
+                                "\"x+\"\nrestitusion = 0.9"),
+                   {"test.toml:8:1", "unknown key 'boundary.wall[1].restitusion'",
+                    "did you mean 'boundary.wall[1].restitution'?"});
+  EXPECT_EQ(m,
+            "test.toml:8:1: unknown key 'boundary.wall[1].restitusion' (did you mean "
+            "'boundary.wall[1].restitution'?)");
+  expect_error(
+      minimal_plus("[[boundary.wall]]\nface = \"x-\"\nvelocty = [0, 1, 0]"),
+      {"unknown key 'boundary.wall[0].velocty'", "did you mean 'boundary.wall[0].velocity'?"});
+  expect_error(minimal_plus("[contact]\nfrction = 0.5"),
+               {"unknown key 'contact.frction'", "did you mean 'contact.friction'?"});
+  expect_error(minimal_plus("[boundary]\nwalls = []"),
+               {"unknown key 'boundary.walls'", "did you mean 'boundary.wall'?"});
+  expect_error(minimal_plus("[field]\ngravty = [0, 0, -1]"),
+               {"unknown key 'field.gravty'", "did you mean 'field.gravity'?"});
+  expect_error(minimal_plus("gravity = [0, 0, -1]"),
+               {"unknown key 'system.gravity'", "did you mean 'field.gravity'?"});
+  expect_error(minimal_plus("restitution = 0.9"),
+               {"unknown key 'system.restitution'", "did you mean 'contact.restitution'?"});
+  expect_error(minimal_plus("[[system.species]]\ninertia = 0.4"),
+               {"unknown key 'system.species[0].inertia'"});
+  expect_error(minimal_plus("[[contact.pair]]\nspecies = [\"A\", \"A\"]\nrestitution_modle = 1"),
+               {"unknown key 'contact.pair[0].restitution_modle'",
+                "did you mean 'contact.pair[0].restitution_model'?"});
+}
+
+TEST(ConfigGranularErrors, WallFaces) {
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"top\""),
+               {"test.toml:5:8", "boundary.wall[0].face", "'top' is not a valid face",
+                "valid values: x-, x+, y-, y+, z-, z+"});
+  const std::string m = expect_error(
+      "[system]\ndimension = 2\nparticles = 10\npacking_fraction = 0.3\n"
+      "[[boundary.wall]]\nface = \"z-\"",
+      {"test.toml:6:8", "boundary.wall[0].face", "'z-' is not a face of a 2D box",
+       "valid values: x-, x+, y-, y+"});
+  EXPECT_EQ(m.find("z+"), std::string::npos) << m;
+  expect_error(
+      "[system]\ndimension = 2\nparticles = 10\npacking_fraction = 0.3\n"
+      "[boundary]\nopen = [\"z+\"]",
+      {"boundary.open[0]", "'z+' is not a face of a 2D box"});
+  expect_error(
+      minimal_plus("[[boundary.wall]]\nface = \"z-\"\n[[boundary.wall]]\nface = \"z-\""),
+      {"test.toml:7:8", "boundary.wall[1].face", "face z- is listed twice", "boundary.wall[0]"});
+  expect_error(minimal_plus("[[boundary.wall]]\nrestitution = 0.9"),
+               {"missing required key 'boundary.wall[0].face'", "x-, x+, y-, y+, z-, z+"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = 1"),
+               {"boundary.wall[0].face", "expected a string", "an integer (1)"});
+  expect_error(minimal_plus("[boundary]\nwall = {face = \"z-\"}"),
+               {"boundary.wall", "expected an array of tables ([[boundary.wall]])"});
+}
+
+TEST(ConfigGranularErrors, OpenFaces) {
+  expect_error(
+      minimal_plus("[[boundary.wall]]\nface = \"z-\"\n[boundary]\nopen = [\"z-\", \"z+\"]"),
+      {"test.toml:7:9", "boundary.open[0]", "face z- is a wall (boundary.wall[0])", "not both"});
+  expect_error(minimal_plus("[boundary]\nopen = [\"z+\", \"z-\", \"z+\"]"),
+               {"boundary.open[2]", "face z+ is listed twice", "boundary.open[0]"});
+  expect_error(minimal_plus("[boundary]\nopen = \"z+\""),
+               {"boundary.open", "expected an array of strings", "found a string"});
+}
+
+TEST(ConfigGranularErrors, HalfPeriodicAxis) {
+  const std::string m = expect_error(minimal_plus("[[boundary.wall]]\nface = \"z-\""),
+                                     {"test.toml:5:8", "boundary:", "face z- is a wall",
+                                      "z+ is neither a wall nor in boundary.open"});
+  EXPECT_EQ(m,
+            "test.toml:5:8: boundary: face z- is a wall but z+ is neither a wall nor in "
+            "boundary.open; add one (or remove the wall to keep z periodic)");
+  expect_error(minimal_plus("[boundary]\nopen = [\"y+\"]"),
+               {"boundary: face y+ is open but y- is neither a wall nor in boundary.open",
+                "remove y+ from boundary.open to keep y periodic"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"x+\"\n[[boundary.wall]]\nface = \"y-\"\n"
+                            "[[boundary.wall]]\nface = \"y+\""),
+               {"boundary: face x+ is a wall but x- is neither"});
+}
+
+TEST(ConfigGranularErrors, WallMotion) {
+  const std::string m =
+      expect_error(minimal_plus("[[boundary.wall]]\nface = \"z-\"\nvelocity = [1.0, 0.0, 0.5]\n"
+                                "[[boundary.wall]]\nface = \"z+\""),
+                   {"test.toml:6:23", "boundary.wall[0].velocity",
+                    "component along the wall's normal (z) must be 0", "got 0.5"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"x-\"\nvelocity = [1.0, 0.0]\n"
+                            "[[boundary.wall]]\nface = \"x+\""),
+               {"boundary.wall[0].velocity", "expected 3 numbers (system.dimension = 3), got 2"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"x-\"\nvelocity = 1.0\n"
+                            "[[boundary.wall]]\nface = \"x+\""),
+               {"boundary.wall[0].velocity", "expected an array of numbers", "found a float"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"x-\"\namplitude = -0.1\n"
+                            "[[boundary.wall]]\nface = \"x+\""),
+               {"boundary.wall[0].amplitude", ">= 0", "got -0.1"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"x-\"\nfrequency = -1\n"
+                            "[[boundary.wall]]\nface = \"x+\""),
+               {"boundary.wall[0].frequency", ">= 0"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"x-\"\nphase = inf\n"
+                            "[[boundary.wall]]\nface = \"x+\""),
+               {"boundary.wall[0].phase", "finite"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"x-\"\nrestitution = 1.5\n"
+                            "[[boundary.wall]]\nface = \"x+\""),
+               {"boundary.wall[0].restitution", "[0, 1]"});
+}
+
+TEST(ConfigGranularErrors, FieldAndBoxScale) {
+  const std::string m = expect_error(minimal_plus("[field]\ngravity = [0.0, -1.0]"),
+                                     {"test.toml:5:11", "field.gravity"});
+  EXPECT_EQ(m, "test.toml:5:11: field.gravity: expected 3 numbers (system.dimension = 3), got 2");
+  expect_error(minimal_plus("[field]\ngravity = [0.0, \"down\", -1.0]"),
+               {"field.gravity[1]", "expected a number", "found a string (\"down\")"});
+  expect_error(minimal_plus("[field]\ngravity = [0.0, 0.0, nan]"),
+               {"field.gravity[2]", "must be a finite number, got nan"});
+  expect_error(minimal_plus("[field]\ngravity = [0.0, 0.0, -inf]"), {"field.gravity[2]", "finite"});
+  expect_error(minimal_plus("[field]\ngravity = -1.0"),
+               {"field.gravity", "expected an array of numbers", "found a float (-1.0)"});
+  expect_error(
+      "[system]\ndimension = 2\nparticles = 10\npacking_fraction = 0.3\n"
+      "[field]\ngravity = [0.0, 0.0, -1.0]",
+      {"field.gravity", "expected 2 numbers (system.dimension = 2), got 3"});
+
+  expect_error(minimal_plus("box_scale = [1.0, 0.5, 2.0]"),
+               {"test.toml:4:19", "system.box_scale[1]", "must be >= 1", "got 0.5"});
+  expect_error(minimal_plus("box_scale = [1.0, 2.0]"),
+               {"system.box_scale", "expected 3 numbers (system.dimension = 3), got 2"});
+  expect_error(minimal_plus("box_scale = [1.0, 2.0, inf]"), {"system.box_scale[2]", "finite"});
+  expect_error(minimal_plus("[[system.species]]\ninertia_factor = -0.4"),
+               {"system.species[0].inertia_factor", "must be > 0", "got -0.4"});
+  expect_error(minimal_plus("[contact]\nrestitution = 0.9\n[field]\ngravity = []"),
+               {"field.gravity", "got 0"});
+}
+
+TEST(ConfigGranularOverrides, ScalarsAndArrays) {
+  const Config c = parse_config(
+      kMinimal, "t.toml",
+      {"contact.restitution=0.8", "field.gravity=[0,0,-2]", "contact.friction=inf",
+       "contact.tc=1e-5", "system.box_scale=[1, 1, 3]", "system.species.0.inertia_factor=0.35",
+       "contact.restitution_model=table", "contact.restitution_table=[[0, 1], [1, 0.8]]",
+       "boundary.wall.0.face=z-", "boundary.wall[0].amplitude=0.1", "boundary.open=[\"z+\"]"});
+  EXPECT_EQ(c.interactions.contact.restitution, 0.8);
+  EXPECT_EQ(c.interactions.contact.friction, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(c.interactions.contact.restitution_model, "table");
+  EXPECT_EQ(c.interactions.contact.restitution_table,
+            (std::vector<std::array<double, 2>>{{0.0, 1.0}, {1.0, 0.8}}));
+  EXPECT_EQ(c.interactions.tc, 1e-5);
+  EXPECT_EQ(c.field.gravity, (std::vector<double>{0.0, 0.0, -2.0}));
+  EXPECT_EQ(c.system.box_scale, (std::vector<double>{1.0, 1.0, 3.0}));
+  EXPECT_EQ(c.system.species[0].inertia_factor, 0.35);
+  ASSERT_EQ(c.boundary.walls.size(), 1u);
+  EXPECT_EQ(c.boundary.walls[0].face, "z-");
+  EXPECT_EQ(c.boundary.walls[0].amplitude, 0.1);
+  EXPECT_EQ(c.boundary.walls[0].contact, c.interactions.contact);
+  EXPECT_EQ(c.boundary.open, (std::vector<std::string>{"z+"}));
+
+  // An override of [contact] reaches the pairs and walls that do not set the key themselves.
+  const Config d = parse_config(
+      minimal_plus("[[boundary.wall]]\nface = \"x-\"\n[[boundary.wall]]\nface = \"x+\"\n"
+                   "restitution = 1.0\n[[contact.pair]]\nspecies = [\"A\", \"A\"]"),
+      "t.toml", {"contact.restitution=0.8", "boundary.wall.1.friction=0.2"});
+  EXPECT_EQ(d.boundary.walls[0].contact.restitution, 0.8);
+  EXPECT_EQ(d.boundary.walls[1].contact.restitution, 1.0);
+  EXPECT_EQ(d.boundary.walls[1].contact.friction, 0.2);
+  EXPECT_EQ(d.interactions.pairs[0].contact.restitution, 0.8);
+}
+
+TEST(ConfigGranularOverrides, ErrorsNameTheOverride) {
+  expect_error(kMinimal,
+               {"override 'field.gravity=[0,-1]'",
+                "field.gravity: expected 3 numbers (system.dimension = 3), got 2"},
+               {"field.gravity=[0,-1]"});
+  expect_error(kMinimal, {"override 'field.gravity=[0,0,x]'", "expected an array of numbers"},
+               {"field.gravity=[0,0,x]"});
+  expect_error(kMinimal, {"override 'contact.restitution=1.2'", "contact.restitution", "[0, 1]"},
+               {"contact.restitution=1.2"});
+  expect_error(kMinimal,
+               {"override 'contact.restituion=0.9'", "did you mean 'contact.restitution'?"},
+               {"contact.restituion=0.9"});
+  expect_error(
+      kMinimal,
+      {"override 'boundary.wall.0.restitutoin=0.9'", "unknown key 'boundary.wall[0].restitutoin'",
+       "did you mean 'boundary.wall[0].restitution'?"},
+      {"boundary.wall.0.restitutoin=0.9"});
+  expect_error(kMinimal, {"override 'boundary.wall.0.face=z-'", "face z- is a wall but z+"},
+               {"boundary.wall.0.face=z-"});
+  // Setting the dimension re-checks the vectors of the file.
+  expect_error(minimal_plus("[field]\ngravity = [0, 0, -1]"),
+               {"test.toml:5:11", "field.gravity", "expected 2 numbers (system.dimension = 2)"},
+               {"system.dimension=2"});
+}
+
 // ----- to_toml
 
 TEST(ConfigToToml, RoundTripIsExact) {
@@ -537,6 +1041,79 @@ TEST(ConfigToToml, RoundTripIsExact) {
   EXPECT_EQ(to_toml(back), text);
 }
 
+TEST(ConfigToToml, RoundTripWithEveryGranularKey) {
+  Config c;
+  c.system.dimension = 3;
+  c.system.particles = 2000;
+  c.system.packing_fraction = 0.1;
+  c.system.lattice = "random";
+  c.system.box_scale = {1.0, 1.5, 4.0 / 3.0};
+  c.system.species = {
+      {"A", 1.0, 1.0, 1.0, 0.4}, {"B", 1.4, 2.0, 0.5, 0.0}, {"C", 0.5, 0.1, 0.1, 1.0 / 3.0}};
+  c.interactions.contact.restitution = 0.9;
+  c.interactions.contact.restitution_model = "viscoelastic";
+  c.interactions.contact.restitution_speed = 0.7;
+  c.interactions.contact.tangential_restitution = 0.1 + 0.2;
+  c.interactions.contact.friction = 0.25;
+  c.interactions.contact.elastic_below_speed = 1e-6;
+  c.interactions.tc = 1e-4;
+  PairContactConfig ab;
+  ab.species = {"A", "B"};
+  ab.contact.restitution = 0.8;
+  ab.contact.restitution_model = "table";
+  ab.contact.restitution_table = {{0.0, 1.0}, {0.5, 0.95}, {2.0 / 3.0, 0.1 + 0.7}};
+  ab.contact.tangential_restitution = -0.5;
+  PairContactConfig cc;
+  cc.species = {"C", "C"};  // everything default, friction inf
+  c.interactions.pairs = {ab, cc};
+  WallConfig floor;
+  floor.face = "z-";
+  floor.contact.restitution = 0.95;
+  floor.contact.friction = 0.0;
+  floor.velocity = {0.5, -1.0 / 3.0, 0.0};
+  floor.amplitude = 0.05;
+  floor.frequency = 12.5;
+  floor.phase = -1.0 / 7.0;
+  WallConfig left;
+  left.face = "x-";
+  left.contact = c.interactions.contact;
+  WallConfig right;
+  right.face = "x+";
+  right.contact.restitution_model = "table";
+  right.contact.restitution_table = {{1.0, 0.5}};
+  c.boundary.walls = {floor, left, right};
+  c.boundary.open = {"z+"};
+  c.field.gravity = {0.0, 1e-3, -9.81};
+
+  const std::string text = to_toml(c);
+  const Config back = parse_config(text, "config.toml");
+  EXPECT_EQ(back, c) << text;
+  EXPECT_EQ(to_toml(back), text);
+  EXPECT_NE(text.find("friction = inf"), std::string::npos) << text;
+  EXPECT_NE(text.find("restitution_table = [[0.0, 1.0], [0.5, 0.95], ["), std::string::npos)
+      << text;
+
+  // The same in 2D.
+  Config d;
+  d.system.dimension = 2;
+  d.system.particles = 500;
+  d.system.packing_fraction = 0.5;
+  d.system.box_scale = {1.0, 6.0};
+  WallConfig bottom;
+  bottom.face = "y-";
+  bottom.velocity = {0.25, 0.0};
+  bottom.amplitude = 0.1;
+  bottom.frequency = 0.87;
+  d.boundary.walls = {bottom};
+  d.boundary.open = {"y+"};
+  d.field.gravity = {0.0, -1.0};
+  const Config d_back = parse_config(to_toml(d), "config.toml");
+  EXPECT_EQ(d_back.system.box_scale, d.system.box_scale);
+  EXPECT_EQ(d_back.boundary, d.boundary);
+  EXPECT_EQ(d_back.field, d.field);
+  EXPECT_EQ(parse_config(to_toml(d_back), "config.toml"), d_back);
+}
+
 TEST(ConfigToToml, MinimalConfigWritesEveryKeyWithResolvedDefaults) {
   const Config c = parse_config(kMinimal, "t.toml");
   const std::string text = to_toml(c);
@@ -566,8 +1143,27 @@ TEST(ConfigToToml, MinimalConfigWritesEveryKeyWithResolvedDefaults) {
                           "trajectory_interval = 0.0",
                           "restart_interval = 0.0",
                           "trajectory = true",
-                          "progress = \"auto\""}) {
+                          "progress = \"auto\"",
+                          "box_scale = [1.0, 1.0, 1.0]",
+                          "inertia_factor = 0.0",
+                          "[contact]",
+                          "restitution = 1.0",
+                          "restitution_model = \"constant\"",
+                          "restitution_speed = 1.0",
+                          "tangential_restitution = -1.0",
+                          "friction = inf",
+                          "elastic_below_speed = 0.0",
+                          "tc = 0.0",
+                          "[boundary]",
+                          "open = []",
+                          "[field]",
+                          "gravity = [0.0, 0.0, 0.0]"}) {
     EXPECT_NE(text.find(key), std::string::npos) << "missing '" << key << "' in:\n" << text;
+  }
+  // Only the pairs, walls and tables that exist.
+  for (const char* absent : {"[[contact.pair]]", "[[boundary.wall]]", "restitution_table"}) {
+    EXPECT_EQ(text.find(absent), std::string::npos) << "unexpected '" << absent << "' in:\n"
+                                                    << text;
   }
 }
 
@@ -632,6 +1228,49 @@ TEST_F(ConfigFile, MissingFileIsAnInputError) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("Is a directory"), std::string::npos) << e.what();
   }
+}
+
+// Every example shipped in examples/ (and its subdirectories) is a valid configuration.
+TEST(ConfigExamples, EveryExampleParses) {
+  const std::filesystem::path root = std::filesystem::path(KAIROS_SOURCE_DIR) / "examples";
+  std::size_t count = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
+    if (!entry.is_regular_file() || entry.path().extension() != ".toml") continue;
+    ++count;
+    try {
+      const Config c = load_config(entry.path());
+      EXPECT_EQ(parse_config(to_toml(c), "config.toml"), c) << entry.path();
+    } catch (const InputError& e) {
+      ADD_FAILURE() << e.what();
+    }
+  }
+  EXPECT_GE(count, 5u);
+}
+
+TEST(ConfigExamples, GranularExamples) {
+  const std::filesystem::path dir = std::filesystem::path(KAIROS_SOURCE_DIR) / "examples";
+  const Config cooling = load_config(dir / "granular_cooling_3d.toml");
+  EXPECT_EQ(cooling.system.dimension, 3);
+  EXPECT_EQ(cooling.system.particles, 4000u);
+  EXPECT_EQ(cooling.system.packing_fraction, 0.05);
+  EXPECT_EQ(cooling.interactions.contact.restitution, 0.9);
+  EXPECT_EQ(cooling.boundary, BoundaryConfig{});
+  EXPECT_EQ(cooling.field, FieldConfig{});
+
+  const Config bed = load_config(dir / "vibrated_bed_2d.toml");
+  EXPECT_EQ(bed.system.dimension, 2);
+  EXPECT_EQ(bed.system.particles, 500u);
+  EXPECT_EQ(bed.system.box_scale, (std::vector<double>{1.0, 6.0}));
+  EXPECT_EQ(bed.field.gravity, (std::vector<double>{0.0, -1.0}));
+  EXPECT_EQ(bed.boundary.open, (std::vector<std::string>{"y+"}));
+  ASSERT_EQ(bed.boundary.walls.size(), 3u);
+  for (const WallConfig& w : bed.boundary.walls) EXPECT_EQ(w.contact.restitution, 0.9) << w.face;
+  EXPECT_EQ(bed.interactions.contact.restitution, 0.9);
+  const WallConfig& floor = bed.boundary.walls[2];
+  EXPECT_EQ(floor.face, "y-");
+  // Dimensionless peak acceleration of the floor, Gamma = A (2 pi f)^2 / g, about 3.
+  const double omega = 2.0 * 3.141592653589793 * floor.frequency;
+  EXPECT_NEAR(floor.amplitude * omega * omega / 1.0, 3.0, 0.05);
 }
 
 }  // namespace

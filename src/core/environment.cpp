@@ -1,0 +1,78 @@
+#include "core/environment.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "core/error.hpp"
+
+namespace kairos {
+
+namespace {
+const char* face_name(int face) {
+  static const char* names[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+  return names[face];
+}
+}  // namespace
+
+template <int D>
+bool Environment<D>::rotates() const {
+  for (const ContactModel& c : contact)
+    if (!c.tangential.is_smooth()) return true;
+  for (const Face<D>& f : faces)
+    if (f.kind == FaceKind::kWall && !f.wall.contact.tangential.is_smooth()) return true;
+  return false;
+}
+
+template <int D>
+bool Environment<D>::plain() const {
+  return contact.empty();
+}
+
+template <int D>
+void Environment<D>::check() const {
+  for (int a = 0; a < D; ++a) {
+    const bool low = faces[2 * a].kind == FaceKind::kPeriodic;
+    const bool high = faces[2 * a + 1].kind == FaceKind::kPeriodic;
+    if (low != high) {
+      throw InputError(std::string("boundary: face ") + face_name(2 * a + (low ? 1 : 0)) +
+                       " is a wall or open but " + face_name(2 * a + (low ? 0 : 1)) +
+                       " is periodic; an axis is periodic on both faces or on neither");
+    }
+  }
+  for (int f = 0; f < 2 * D; ++f) {
+    if (faces[f].kind != FaceKind::kWall) continue;
+    const Wall<D>& w = faces[f].wall;
+    const std::string name = std::string("wall ") + face_name(f);
+    if (w.velocity[f / 2] != 0.0) {
+      throw InputError(name + ": the sliding velocity must lie in the wall's plane (its " +
+                       std::string(1, "xyz"[f / 2]) + " component must be 0)");
+    }
+    for (int a = 0; a < D; ++a) {
+      if (!std::isfinite(w.velocity[a])) throw InputError(name + ": velocity must be finite");
+    }
+    if (!(w.amplitude >= 0.0) || !std::isfinite(w.amplitude)) {
+      throw InputError(name + ": amplitude must be finite and >= 0");
+    }
+    if (!(w.angular_frequency >= 0.0) || !std::isfinite(w.angular_frequency) ||
+        !std::isfinite(w.phase)) {
+      throw InputError(name + ": frequency must be finite and >= 0 and the phase finite");
+    }
+  }
+  for (int a = 0; a < D; ++a) {
+    if (!std::isfinite(gravity[a])) throw InputError("gravity must be finite");
+  }
+  if (!contact.empty() && contact.size() != static_cast<std::size_t>(species) * species) {
+    throw InputError("contact laws: expected one per species pair");
+  }
+  for (const double q : inertia_factor) {
+    if (!(q > 0.0) || !std::isfinite(q)) {
+      throw InputError("inertia factor (I = q m R^2) must be finite and > 0");
+    }
+  }
+  if (!(tc >= 0.0) || !std::isfinite(tc)) throw InputError("tc must be finite and >= 0");
+}
+
+template struct Environment<2>;
+template struct Environment<3>;
+
+}  // namespace kairos

@@ -1,0 +1,82 @@
+// What particles meet besides each other's hard cores: a uniform field (gravity), the faces of
+// the box (periodic, hard walls that may slide or vibrate, or open), and the contact laws of
+// every species pair (restitution, roughness). The default environment is the elastic,
+// fully periodic hard-sphere fluid.
+//
+// The environment is set up from the run configuration, never stored in a restart file: it is
+// the model, not the state. Walls are the faces of the box; a wall at the low face of axis k
+// is the plane x_k = A sin(w t + phi) with normal +e_k, one at the high face the plane
+// x_k = L_k + A sin(w t + phi) with normal -e_k (A = 0: fixed).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/vec.hpp"
+#include "interactions/granular_contact.hpp"
+
+namespace kairos {
+
+enum class FaceKind { kPeriodic, kWall, kOpen };
+
+template <int D>
+struct Wall {
+  ContactModel contact;            // restitution and roughness of particle-wall collisions
+  Vec<D> velocity{};               // sliding velocity in the wall's plane (a shear plate)
+  double amplitude = 0.0;          // vibration along the normal: offset A sin(w t + phi)
+  double angular_frequency = 0.0;  // w
+  double phase = 0.0;              // phi
+  bool vibrates() const { return amplitude > 0.0 && angular_frequency > 0.0; }
+};
+
+template <int D>
+struct Face {
+  FaceKind kind = FaceKind::kPeriodic;
+  Wall<D> wall;  // used when kind == kWall
+};
+
+template <int D>
+struct Environment {
+  Vec<D> gravity{};
+  // Face 2k is the low face of axis k, 2k + 1 the high face. An axis is periodic iff both of
+  // its faces are.
+  std::array<Face<D>, 2 * D> faces{};
+  // Contact law of species pair (a, b) at contact[a * species + b] (symmetric); empty: every
+  // pair collides elastically and smoothly.
+  std::vector<ContactModel> contact;
+  std::uint32_t species = 0;
+  // Moment of inertia I = q m R^2 per species; empty: 2/5 (spheres) or 1/2 (disks).
+  std::vector<double> inertia_factor;
+  // TC model (Luding & McNamara): a collision within tc of either partner's previous one is
+  // elastic. 0: off.
+  double tc = 0.0;
+
+  bool periodic(int axis) const { return faces[2 * axis].kind == FaceKind::kPeriodic; }
+  bool has_gravity() const {
+    for (int a = 0; a < D; ++a)
+      if (gravity[a] != 0.0) return true;
+    return false;
+  }
+  bool has_walls() const {
+    for (const Face<D>& f : faces)
+      if (f.kind == FaceKind::kWall) return true;
+    return false;
+  }
+  const ContactModel* contact_of(std::uint32_t a, std::uint32_t b) const {
+    return contact.empty() ? nullptr : &contact[a * species + b];
+  }
+  double inertia_factor_of(std::uint32_t s) const {
+    return inertia_factor.empty() ? (D == 3 ? 0.4 : 0.5) : inertia_factor[s];
+  }
+  // Whether any contact (pair or wall) can change spins: then angular velocities are tracked.
+  bool rotates() const;
+  // Whether every contact is elastic and smooth, with no field, walls or open faces.
+  bool plain() const;
+  // Throws InputError naming the first inconsistency (an axis periodic on one face only, a
+  // sliding velocity with a normal component, a negative amplitude, contact table size...).
+  void check() const;
+};
+
+}  // namespace kairos

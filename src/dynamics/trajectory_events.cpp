@@ -1,0 +1,238 @@
+// Event solvers that need iteration: the vibrated plane (transcendental) and the quartic pair
+// contact of formulas.md §3.3. See trajectory_events.hpp for the contracts.
+#include "dynamics/trajectory_events.hpp"
+
+#include <limits>
+#include <utility>
+
+namespace kairos {
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// ---------------------------------------------------------------------------------------------
+// Vibrated plane
+
+// A bound on the number of certified steps: searches take a few, near-tangencies a few dozen.
+constexpr int kMaxVibratedSteps = 1 << 20;
+
+// Gap f against a vibrated plane and its first two derivatives at one time, each with a bound
+// on its round-off, plus the particle's own (polynomial) part of f and f'.
+struct GapJet {
+  double f, f1, f2;
+  double err0, err1, err2;
+  double poly, poly1, poly1_err;
+};
+
+GapJet vibrated_gap(const NormalMotion& m, const VibratedPlane& p, double p0, double t) {
+  const double arg = p.omega * t + p.phase;
+  const double s = std::sin(arg);
+  const double c = std::cos(arg);
+  const double aw = p.amplitude * p.omega;
+  const double aw2 = aw * p.omega;
+  GapJet j{};
+  j.poly = p0 + (m.velocity + 0.5 * m.accel * t) * t;
+  j.poly1 = m.velocity + m.accel * t;
+  j.f = j.poly - p.amplitude * s;
+  j.f1 = j.poly1 - aw * c;
+  j.f2 = m.accel + aw2 * s;
+  // A few ulps per term; the sine's argument is itself rounded by |arg| ulps.
+  const double u = 8.0 * kEps;
+  const double trig = 2.0 + std::fabs(arg);
+  const double g = std::fabs(m.accel);
+  j.poly1_err = u * (std::fabs(m.velocity) + g * t);
+  j.err0 = u * (std::fabs(p0) + std::fabs(m.velocity) * t + g * t * t) +
+           u * std::fabs(p.amplitude) * trig;
+  j.err1 = j.poly1_err + u * std::fabs(aw) * trig;
+  j.err2 = u * (g + std::fabs(aw2) * trig);
+  return j;
+}
+
+// Length of [0, h) on which q0 + q1 s - k s^2/2 > 0 (q0 > 0, k >= 0): the first positive root.
+double positive_span(double q0, double q1, double k) {
+  return quadratic_event_time(q0, q1, -0.5 * k);
+}
+
+// Certified event-free length while the gap is clearly open (f > 2 err0): the larger of the
+// local bound f + f' s - k2 s^2/2 and the global one, particle height minus the plane's top.
+double open_gap_span(const GapJet& j, double accel, double amp, double k2) {
+  const double local = positive_span(j.f - j.err0, j.f1 - j.err1, k2);
+  const double above = j.poly - amp - j.err0;
+  if (!(above > 0.0)) return local;
+  return std::fmax(local, quadratic_event_time(above, j.poly1 - j.poly1_err, 0.5 * accel));
+}
+
+// Certified event-free length while the gap clearly opens (f' > 2 err1): f only grows, so no
+// event until f' can reach zero. Local bound from |f'''| <= k3, global one from |cos| <= 1.
+double opening_span(const GapJet& j, double accel, double amp_w, double k3) {
+  const double local = positive_span(j.f1 - j.err1, j.f2 - j.err2, k3);
+  const double ahead = j.poly1 - j.poly1_err - amp_w;
+  if (!(ahead > 0.0)) return local;
+  return std::fmax(local, accel < 0.0 ? ahead / -accel : kNever);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Quartic
+
+struct Quartic {
+  std::array<double, 5> c;
+  double f(double t) const { return c[0] + t * (c[1] + t * (c[2] + t * (c[3] + t * c[4]))); }
+  double df(double t) const {
+    return c[1] + t * (2.0 * c[2] + t * (3.0 * c[3] + t * (4.0 * c[4])));
+  }
+  double d2f(double t) const { return 2.0 * c[2] + t * (6.0 * c[3] + t * (12.0 * c[4])); }
+};
+
+// Real roots of a t^2 + b t + c, unordered; returns how many were written.
+int real_quadratic_roots(double a, double b, double c, double roots[2]) {
+  if (a == 0.0) {
+    if (b == 0.0) return 0;
+    roots[0] = -c / b;
+    return 1;
+  }
+  const double disc = b * b - 4.0 * a * c;
+  if (disc < 0.0) return 0;
+  const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));  // no cancellation
+  if (q == 0.0) {  // b = c = 0: a double root at zero
+    roots[0] = 0.0;
+    return 1;
+  }
+  roots[0] = q / a;
+  roots[1] = c / q;
+  return 2;
+}
+
+// First point where g, decreasing through zero on [lo, hi] (g(lo) > 0 >= g(hi)), reaches zero:
+// Newton steps, with bisection whenever Newton leaves the bracket or stops halving its step.
+// Fn returns {g(x), g'(x)}.
+template <class Fn>
+double polish_root(Fn g, double lo, double hi) {
+  double x = lo + 0.5 * (hi - lo);
+  double step = hi - lo;
+  for (int i = 0; i < 256; ++i) {
+    const auto [gx, dgx] = g(x);
+    if (gx == 0.0) return x;
+    (gx > 0.0 ? lo : hi) = x;
+    const double prev_step = step;
+    step = gx / dgx;
+    double next = x - step;
+    if (!(next > lo && next < hi && std::fabs(step) < 0.5 * std::fabs(prev_step))) {
+      next = lo + 0.5 * (hi - lo);
+      step = x - next;
+      if (next <= lo || next >= hi) return hi;  // the bracket is two adjacent doubles
+    }
+    if (std::fabs(step) <= 2.0 * kEps * std::fabs(next)) return next;  // converged
+    x = next;
+  }
+  return x;
+}
+
+// A short sorted list of split points in time.
+struct SplitPoints {
+  std::array<double, 8> t{};  // 0, two roots of f'', three of f', the horizon
+  int n = 0;
+  void insert(double x) {
+    int k = n++;
+    for (; k > 0 && t[k - 1] > x; --k) {
+      t[k] = t[k - 1];
+    }
+    t[k] = x;
+  }
+  double operator[](int i) const { return t[i]; }
+};
+
+// Smallest end = from + 2^k (k >= 0) at which done(end) holds, or kNever if none is finite.
+// Used on an unbounded monotone piece, where done(end) stays true beyond its first success.
+template <class Pred>
+double expand_until(double from, Pred done) {
+  for (double w = 1.0; std::isfinite(from + w); w *= 2.0) {
+    if (done(from + w)) return from + w;
+  }
+  return kNever;
+}
+
+// The root of f' in (lo, hi), where f' is monotone (hi may be infinite); NaN if f' keeps its
+// sign there. At infinity f' takes the sign of its leading coefficient.
+double slope_root(const Quartic& q, double lo, double hi) {
+  const double d_lo = q.df(lo);
+  if (d_lo == 0.0) return kNaN;  // lo itself is the critical point, and a split point already
+  const auto flipped = [&](double t) { return q.df(t) * d_lo <= 0.0; };
+  const double end = std::isinf(hi) ? expand_until(lo, flipped) : hi;
+  if (std::isinf(end) || !flipped(end)) return kNaN;
+  const double sign = d_lo > 0.0 ? 1.0 : -1.0;
+  return polish_root([&](double t) { return std::pair{sign * q.df(t), sign * q.d2f(t)}; }, lo, end);
+}
+
+}  // namespace
+
+double vibrated_plane_event_time(const NormalMotion& m, const VibratedPlane& p, double t_max) {
+  if (p.amplitude == 0.0 || p.omega == 0.0) {
+    return fixed_plane_event_time(m, vibrated_plane_offset(p, 0.0), t_max);
+  }
+  const double p0 = m.height - p.d0;
+  const double amp = std::fabs(p.amplitude);
+  const double w = std::fabs(p.omega);
+  const double slack = 1.0 + 16.0 * kEps;                        // the bounds' own round-off
+  const double k2 = (std::fabs(m.accel) + amp * w * w) * slack;  // >= |f''|
+  const double k3 = amp * w * w * w * slack;                     // >= |f'''|
+  double t = 0.0;
+  for (int step = 0; step < kMaxVibratedSteps; ++step) {
+    const GapJet j = vibrated_gap(m, p, p0, t);
+    const bool touching = j.f <= 2.0 * j.err0;       // in contact up to round-off, or overlapping
+    if (touching && j.f1 < -2.0 * j.err1) return t;  // ... and approaching
+    double h = touching ? 0.0 : open_gap_span(j, m.accel, amp, k2);
+    if (j.f1 > 2.0 * j.err1) {
+      h = std::fmax(h, opening_span(j, m.accel, amp * w, k3));
+    } else if (touching) {
+      // Touching at zero relative speed (up to round-off): f' is about to turn negative
+      // unless f'' > 0, which keeps f' from decreasing for (f'' - err) / k3.
+      if (j.f2 - j.err2 <= 0.0) return t;
+      h = (j.f2 - j.err2) / k3;
+    }
+    const double next = std::fmax(t + h, std::nextafter(t, kNever));  // always make progress
+    if (!(next <= t_max) || std::isinf(next)) return kNever;  // event-free up to the horizon
+    t = next;
+  }
+  return t;
+}
+
+double quartic_event_time(const std::array<double, 5>& c, double t_max) {
+  if (c[4] == 0.0 && c[3] == 0.0) {
+    return within_horizon(quadratic_event_time(c[0], c[1], c[2]), t_max);
+  }
+  if (c[0] <= 0.0 && c[1] < 0.0) return within_horizon(0.0, t_max);  // overlapping, approaching
+  const Quartic q{c};
+  // Split [0, t_max] where f'' vanishes (f' is monotone between), then where f' vanishes, so
+  // that f is monotone on every piece. Extra split points are harmless.
+  SplitPoints pts;
+  pts.insert(0.0);
+  double r2[2];
+  const int n2 = real_quadratic_roots(12.0 * c[4], 6.0 * c[3], 2.0 * c[2], r2);
+  for (int i = 0; i < n2; ++i) {
+    if (r2[i] > 0.0 && r2[i] < t_max) pts.insert(r2[i]);
+  }
+  const SplitPoints mono = pts;
+  for (int i = 0; i < mono.n; ++i) {
+    const double r = slope_root(q, mono[i], i + 1 < mono.n ? mono[i + 1] : t_max);
+    if (r == r) pts.insert(r);  // not NaN
+  }
+  pts.insert(t_max);
+
+  // Walk the monotone pieces in time order; only a falling piece can hold the event.
+  for (int i = 0; i + 1 < pts.n; ++i) {
+    const double s = pts[i];
+    const double e = pts[i + 1];
+    if (!(e > s)) continue;
+    const double probe = std::isinf(e) ? 2.0 * s + 1.0 : s + 0.5 * (e - s);
+    if (!(q.df(probe) < 0.0)) continue;
+    if (q.f(s) <= 0.0) return s;  // overlapping when f' turns negative (or at t = 0)
+    const auto below = [&](double t) { return q.f(t) < 0.0 || (q.f(t) == 0.0 && q.df(t) < 0.0); };
+    const double end = std::isinf(e) ? expand_until(s, below) : e;
+    if (std::isinf(end) || !below(end)) continue;  // stays positive, or only touches at e
+    return polish_root([&](double t) { return std::pair{q.f(t), q.df(t)}; }, s, end);
+  }
+  return kNever;
+}
+
+}  // namespace kairos

@@ -1,0 +1,451 @@
+// Event times of accelerated trajectories: formulas.md §3 rule and §7.8 values, plus randomized
+// checks against dense brute-force sampling (the solver must never report a later event than
+// the first sampled one, and at its time the stable-rule condition must hold).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <random>
+
+#include "dynamics/collision_time.hpp"
+#include "dynamics/trajectory_events.hpp"
+
+namespace kairos {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ---------------------------------------------------------------------------------------------
+// quadratic_event_time (formulas.md §3.2)
+
+TEST(QuadraticEventTime, PositiveCurvatureIsTheContactQuadratic) {
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int i = 0; i < 1000; ++i) {
+    const double a = u(rng), b = u(rng), c = std::fabs(u(rng)) + 1e-3;
+    EXPECT_EQ(quadratic_event_time(a, b, c), quadratic_contact_time(a, b, c));
+  }
+}
+
+TEST(QuadraticEventTime, NegativeCurvature) {
+  EXPECT_DOUBLE_EQ(quadratic_event_time(1.0, 0.0, -1.0), 1.0);   // closing gap
+  EXPECT_DOUBLE_EQ(quadratic_event_time(0.0, 2.0, -1.0), 2.0);   // leaves, comes back at 2
+  EXPECT_EQ(quadratic_event_time(-1.0, -1.0, -1.0), 0.0);        // overlapping, approaching
+  EXPECT_DOUBLE_EQ(quadratic_event_time(-1.0, 1.0, -1.0), 0.5);  // turns while overlapping
+  EXPECT_EQ(quadratic_event_time(0.0, 0.0, -1.0), 0.0);          // resting, pushed in: now
+  // Overlapping, rising, and back out before turning: the later root.
+  EXPECT_DOUBLE_EQ(quadratic_event_time(-0.75, 2.0, -1.0), 1.5);
+}
+
+TEST(QuadraticEventTime, ZeroCurvature) {
+  EXPECT_DOUBLE_EQ(quadratic_event_time(2.0, -1.0, 0.0), 2.0);
+  EXPECT_EQ(quadratic_event_time(-2.0, -1.0, 0.0), 0.0);
+  EXPECT_EQ(quadratic_event_time(2.0, 1.0, 0.0), kNever);
+  EXPECT_EQ(quadratic_event_time(-2.0, 0.0, 0.0), kNever);  // overlapping at rest: no approach
+}
+
+// ---------------------------------------------------------------------------------------------
+// interval_exit_time_accelerated
+
+double trajectory(double x, double v, double a, double t) {
+  return x + v * t + 0.5 * a * t * t;
+}
+
+TEST(IntervalExitAccelerated, ZeroAccelerationIsTheBallisticExit) {
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> u(-1.0, 2.0);
+  for (int i = 0; i < 1000; ++i) {
+    const double x = u(rng), v = u(rng) - 0.5;
+    EXPECT_EQ(interval_exit_time_accelerated(x, v, 0.0, 0.0, 1.0),
+              interval_exit_time(x, v, 0.0, 1.0));
+  }
+  EXPECT_EQ(interval_exit_time_accelerated(0.5, 0.0, 0.0, 0.0, 1.0), kNever);
+}
+
+TEST(IntervalExitAccelerated, AnalyticExits) {
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(0.5, 0.0, -1.0, 0.0, 1.0), 1.0);  // falls
+  // Thrown up, peaks at 0.6 inside, falls back out through lo.
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(0.1, 1.0, -1.0, 0.0, 10.0), 1.0 + std::sqrt(1.2));
+  // Thrown up hard enough to reach hi.
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(0.1, 2.0, -1.0, 0.0, 1.0), 2.0 - std::sqrt(2.2));
+  // Launched downwards against an upward acceleration, turning before lo: exits through hi.
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(0.5, -0.5, 1.0, 0.0, 1.0), 0.5 + std::sqrt(1.25));
+}
+
+TEST(IntervalExitAccelerated, Faces) {
+  EXPECT_EQ(interval_exit_time_accelerated(1.0, 1.0, -1.0, 0.0, 1.0), 0.0);  // on hi, outward
+  EXPECT_EQ(interval_exit_time_accelerated(0.0, -1.0, 1.0, 0.0, 1.0), 0.0);  // on lo, outward
+  EXPECT_EQ(interval_exit_time_accelerated(0.0, 0.0, -1.0, 0.0, 1.0), 0.0);  // at rest, pulled out
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(0.0, 0.0, 2.0, 0.0, 1.0), 1.0);  // pulled in
+  // On lo moving inward under gravity: back at lo after 2 v / g, not at 0.
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(0.0, 1.0, -1.0, 0.0, 10.0), 2.0);
+}
+
+TEST(IntervalExitAccelerated, SlightlyOutsideExitsOnlyWhenMovingOutward) {
+  const double out = 1.0 + 1e-15;
+  EXPECT_EQ(interval_exit_time_accelerated(out, 1.0, -1.0, 0.0, 1.0), 0.0);
+  EXPECT_EQ(interval_exit_time_accelerated(out, 0.0, 1.0, 0.0, 1.0), 0.0);
+  // Moving inward: treated as on the face; falls through the cell to lo.
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(out, 0.0, -2.0, 0.0, 1.0), 1.0);
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(out, -1.0, 1.0, 0.0, 1.0), 2.0);  // returns
+  EXPECT_EQ(interval_exit_time_accelerated(-1e-15, -1.0, 1.0, 0.0, 1.0), 0.0);
+}
+
+TEST(IntervalExitAccelerated, UnboundedSides) {
+  EXPECT_EQ(interval_exit_time_accelerated(0.0, 1.0, -1.0, -kInf, kInf), kNever);
+  EXPECT_EQ(interval_exit_time_accelerated(0.0, 1.0, -1.0, -kInf, 0.6), kNever);  // peaks at 0.5
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(0.0, 1.0, -1.0, -kInf, 0.4),
+                   1.0 - std::sqrt(0.2));
+  EXPECT_EQ(interval_exit_time_accelerated(5.0, -3.0, 1.0, 0.0, kInf), kNever);  // turns at 0.5
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(5.0, -3.0, 1.0, -kInf, 5.5),
+                   3.0 + std::sqrt(10.0));
+}
+
+TEST(IntervalExitAccelerated, Horizon) {
+  EXPECT_EQ(interval_exit_time_accelerated(0.5, 0.0, -1.0, 0.0, 1.0, 0.99), kNever);
+  EXPECT_DOUBLE_EQ(interval_exit_time_accelerated(0.5, 0.0, -1.0, 0.0, 1.0, 1.01), 1.0);
+  EXPECT_EQ(interval_exit_time_accelerated(0.5, 1.0, 0.0, 0.0, 1.0, 0.4), kNever);
+}
+
+TEST(IntervalExitAccelerated, RandomAgainstSampling) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 5000; ++i) {
+    const double lo = -u(rng), hi = u(rng) + 1e-3;
+    double x = lo + (hi - lo) * u(rng);
+    const int mode = i % 5;  // on a face, just outside one, or anywhere inside
+    if (mode == 1) x = hi;
+    if (mode == 2) x = lo;
+    if (mode == 3) x = std::nextafter(hi, kInf);
+    if (mode == 4) x = lo - 1e-15;
+    const double v = 4.0 * u(rng) - 2.0;
+    const double a = (i % 7 == 0) ? 0.0 : 6.0 * u(rng) - 3.0;
+    const double t = interval_exit_time_accelerated(x, v, a, lo, hi);
+    ASSERT_TRUE(t >= 0.0) << i;  // not negative, not NaN
+    if (a == 0.0 && v == 0.0) continue;
+    ASSERT_TRUE(std::isfinite(t)) << i;  // a finite cell is always left
+    const double xt = trajectory(x, v, a, t);
+    const double tol = 1e-12;
+    EXPECT_TRUE(std::fabs(xt - lo) <= tol || std::fabs(xt - hi) <= tol) << i << " " << xt;
+    // Never outside before t (x may start outside by round-off only).
+    for (int k = 1; k < 200; ++k) {
+      const double xs = trajectory(x, v, a, t * k / 200.0);
+      ASSERT_TRUE(xs >= lo - tol && xs <= hi + tol) << i << " " << k;
+    }
+    // And it really leaves: just after t it is outside (unless grazing).
+    const double dt = 1e-6 * (1.0 + t);
+    const double after = trajectory(x, v, a, t + dt);
+    EXPECT_TRUE(after < lo || after > hi || std::fabs(v + a * t) < 1e-5) << i;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fixed and moving planes
+
+NormalMotion motion(double height, double velocity, double accel) {
+  return NormalMotion{height, velocity, accel};
+}
+
+TEST(PlaneEvents, NormalMotionProjectsOntoTheNormal) {
+  const double n[3] = {0.0, 0.6, 0.8};
+  const double x[3] = {5.0, 1.0, 2.0}, v[3] = {7.0, -1.0, 0.5}, g[3] = {0.0, 0.0, -1.0};
+  const NormalMotion m = normal_motion<3>(n, x, v, g, 0.5);
+  EXPECT_DOUBLE_EQ(m.height, 0.6 + 1.6 - 0.5);
+  EXPECT_DOUBLE_EQ(m.velocity, -0.6 + 0.4);
+  EXPECT_DOUBLE_EQ(m.accel, -0.8);
+}
+
+TEST(PlaneEvents, DropOntoFloor) {
+  EXPECT_DOUBLE_EQ(fixed_plane_event_time(motion(2.0, 0.0, -1.0), 0.0), 2.0);
+  EXPECT_DOUBLE_EQ(fixed_plane_event_time(motion(3.0, 0.0, -1.0), 1.0), 2.0);  // offset plane
+  EXPECT_EQ(fixed_plane_event_time(motion(2.0, 0.0, -1.0), 0.0, 1.9), kNever);
+}
+
+TEST(PlaneEvents, BouncingBallFlightTimeIsExact) {
+  // Leaving the floor upward at v returns at exactly 2 v / g; t = 0 is not an event.
+  for (const double v : {1e-8, 0.1, 0.3, 1.0, 7.0, 123.456}) {
+    for (const double g : {0.01, 1.0, 9.81}) {
+      EXPECT_EQ(fixed_plane_event_time(motion(0.0, v, -g), 0.0), 2.0 * v / g) << v << " " << g;
+      EXPECT_EQ(fixed_plane_event_time(motion(4.0, v, -g), 4.0), 2.0 * v / g) << v << " " << g;
+    }
+  }
+}
+
+TEST(PlaneEvents, RestingContact) {
+  // f = 0, f' = 0, f'' < 0: f' < 0 right after while f <= 0, so the stable rule says now. The
+  // engine must handle the zero-speed contact (see trajectory_events.hpp).
+  EXPECT_EQ(fixed_plane_event_time(motion(0.0, 0.0, -1.0), 0.0), 0.0);
+  EXPECT_EQ(fixed_plane_event_time(motion(0.0, 0.0, 0.0), 0.0), kNever);     // no force: rests
+  EXPECT_EQ(fixed_plane_event_time(motion(0.0, 0.0, 1.0), 0.0), kNever);     // pulled away
+  EXPECT_EQ(fixed_plane_event_time(motion(0.0, 1.0, 0.0), 0.0), kNever);     // leaving
+  EXPECT_EQ(fixed_plane_event_time(motion(-1e-12, 0.0, -1.0), 0.0), 0.0);    // round-off below
+  EXPECT_EQ(fixed_plane_event_time(motion(-1e-12, -1.0, 0.0), 0.0), 0.0);    // overlap, approach
+  EXPECT_EQ(fixed_plane_event_time(motion(-1e-12, 1.0, 0.0), 0.0), kNever);  // overlap, recede
+}
+
+TEST(PlaneEvents, GrazingParallelMotionNeverCollides) {
+  EXPECT_EQ(fixed_plane_event_time(motion(0.0, 0.0, 0.0), 0.0), kNever);
+  EXPECT_EQ(fixed_plane_event_time(motion(1e-300, 0.0, 0.0), 0.0), kNever);
+  // Thrown down against an upward pull, turning just above the plane: no event.
+  EXPECT_EQ(fixed_plane_event_time(motion(0.5 + 1e-12, -1.0, 1.0), 0.0), kNever);
+  EXPECT_GT(fixed_plane_event_time(motion(0.5 - 1e-9, -1.0, 1.0), 0.0), 0.999);
+}
+
+TEST(PlaneEvents, MovingPlane) {
+  // A piston rising at 0.5 toward a particle at rest 1 above it; in-plane motion is irrelevant.
+  EXPECT_DOUBLE_EQ(moving_plane_event_time(motion(1.0, 0.0, 0.0), 0.0, 0.5), 2.0);
+  EXPECT_EQ(moving_plane_event_time(motion(1.0, 0.0, 0.0), 0.0, -0.5), kNever);
+  // Falling particle (g = 1) meeting a rising piston: 1 - 0.5 t^2 = 0.5 t... t = -0.5+sqrt(2.25).
+  EXPECT_DOUBLE_EQ(moving_plane_event_time(motion(1.0, 0.0, -1.0), 0.0, 0.5), 1.0);
+  // A particle resting on a plane that moves along it, and one receding with it.
+  EXPECT_EQ(moving_plane_event_time(motion(0.0, 0.5, 0.0), 0.0, 0.5), kNever);
+  EXPECT_EQ(moving_plane_event_time(motion(0.0, 0.0, 0.0), 0.0, 0.5), 0.0);  // plane pushes in
+  EXPECT_EQ(moving_plane_event_time(motion(1.0, 0.0, 0.0), 0.0, 0.5, 1.5), kNever);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Vibrated plane
+
+struct GapSample {
+  double f, df;
+};
+
+GapSample vibrated_gap(const NormalMotion& m, const VibratedPlane& p, double t) {
+  const double poly = m.height - p.d0 + m.velocity * t + 0.5 * m.accel * t * t;
+  return {poly - p.amplitude * std::sin(p.omega * t + p.phase),
+          m.velocity + m.accel * t - p.amplitude * p.omega * std::cos(p.omega * t + p.phase)};
+}
+
+TEST(VibratedPlane, OffsetVelocityAndRephase) {
+  const VibratedPlane p{1.0, 0.5, 3.0, 0.25};
+  EXPECT_DOUBLE_EQ(vibrated_plane_offset(p, 0.7), 1.0 + 0.5 * std::sin(2.1 + 0.25));
+  EXPECT_DOUBLE_EQ(vibrated_plane_velocity(p, 0.7), 1.5 * std::cos(2.1 + 0.25));
+  const VibratedPlane q = rephased(p, 100.0);
+  EXPECT_LE(std::fabs(q.phase), M_PI);
+  EXPECT_NEAR(vibrated_plane_offset(q, 0.7), vibrated_plane_offset(p, 100.7), 1e-12);
+}
+
+TEST(VibratedPlane, ZeroAmplitudeIsTheFixedPlane) {
+  const NormalMotion m = motion(2.0, 0.3, -1.0);
+  EXPECT_EQ(vibrated_plane_event_time(m, {0.5, 0.0, 3.0, 0.0}), fixed_plane_event_time(m, 0.5));
+  EXPECT_EQ(vibrated_plane_event_time(m, {0.5, 0.2, 0.0, 0.3}),
+            fixed_plane_event_time(m, 0.5 + 0.2 * std::sin(0.3)));
+}
+
+TEST(VibratedPlane, RisingPlaneHitsParticleAtRest) {
+  // No gravity: the event is where A sin(w t + phi) first climbs through the particle.
+  const NormalMotion m = motion(0.5, 0.0, 0.0);
+  EXPECT_NEAR(vibrated_plane_event_time(m, {0.0, 1.0, 50.0, 0.0}), M_PI / 300.0, 1e-15);
+  // Plane moving down first: it hits on the way up in the next period.
+  EXPECT_NEAR(vibrated_plane_event_time(m, {0.0, 1.0, 50.0, M_PI}), (M_PI + M_PI / 6.0) / 50.0,
+              1e-14);
+  // Large amplitude and frequency, particle just below the plane's top.
+  const NormalMotion high = motion(4.9, 0.0, 0.0);
+  EXPECT_NEAR(vibrated_plane_event_time(high, {0.0, 5.0, 200.0, 0.0}), std::asin(0.98) / 200.0,
+              1e-14);
+  // Just above the top: never, even over a long horizon (the global bound settles it at once).
+  EXPECT_EQ(vibrated_plane_event_time(motion(5.0 + 1e-9, 0.0, 0.0), {0.0, 5.0, 200.0, 0.0}),
+            kNever);
+  // With gravity, a falling particle at rest 1 above the top of a violently shaken plate.
+  const NormalMotion falling = motion(1.05, 0.0, -1.0);
+  const VibratedPlane plate{0.0, 0.05, 400.0, 0.0};
+  const double t = vibrated_plane_event_time(falling, plate);
+  EXPECT_GE(t, std::sqrt(2.0));  // cannot reach the top before falling 1
+  EXPECT_LE(t, std::sqrt(2.2));  // and has met the plate when it is at the bottom
+  EXPECT_NEAR(vibrated_gap(falling, plate, t).f, 0.0, 1e-13);
+  EXPECT_LT(vibrated_gap(falling, plate, t).df, 0.0);
+}
+
+TEST(VibratedPlane, DepartureIsNotAnEvent) {
+  // On the plane, leaving it faster than it moves: the next event is after a flight.
+  const VibratedPlane p{0.0, 0.01, 20.0, 0.0};  // plane at d0, moving up at 0.2
+  const NormalMotion m = motion(0.0, 1.2, -1.0);
+  const double t = vibrated_plane_event_time(m, p);
+  EXPECT_GT(t, 1.5);  // roughly 2 (1.2 - 0.2) / 1 plus the plane's wobble
+  EXPECT_LT(t, 2.6);
+  EXPECT_NEAR(vibrated_gap(m, p, t).f, 0.0, 1e-13);
+  // Same with the particle slightly inside the plane by round-off.
+  EXPECT_NEAR(vibrated_plane_event_time(motion(-1e-16, 1.2, -1.0), p), t, 1e-9);
+}
+
+TEST(VibratedPlane, RestingContact) {
+  // Resting on the plate at its top. If the plate decelerates faster than gravity the particle
+  // lifts off (no event now); otherwise gravity presses it in: event now.
+  const VibratedPlane p{0.0, 0.1, 10.0, M_PI / 2.0};  // A w^2 = 10
+  EXPECT_GT(vibrated_plane_event_time(motion(0.1, 0.0, -1.0), p), 0.0);
+  EXPECT_EQ(vibrated_plane_event_time(motion(0.1, 0.0, -20.0), p), 0.0);
+}
+
+TEST(VibratedPlane, OverlapTurningIsTheEvent) {
+  // Inside the plate, rising relative to it, and then overtaken by it while still inside:
+  // the event is where the relative speed turns negative, with f <= 0 there.
+  const VibratedPlane p{0.0, 0.1, 10.0, -M_PI / 2.0};  // plate at its bottom, about to rise
+  const NormalMotion m = motion(-0.2, 0.5, 0.0);
+  const double t = vibrated_plane_event_time(m, p);
+  const GapSample at = vibrated_gap(m, p, t);
+  EXPECT_LE(at.f, 0.0);
+  EXPECT_NEAR(at.df, 0.0, 1e-12);
+  for (int k = 0; k < 1000; ++k) {  // receding (f' >= 0) before it
+    EXPECT_GE(vibrated_gap(m, p, t * k / 1000.0).df, -1e-12);
+  }
+}
+
+TEST(VibratedPlane, Horizon) {
+  const NormalMotion m = motion(0.5, 0.0, 0.0);
+  const VibratedPlane p{0.0, 1.0, 50.0, 0.0};
+  EXPECT_EQ(vibrated_plane_event_time(m, p, 0.01), kNever);
+  EXPECT_NEAR(vibrated_plane_event_time(m, p, 0.011), M_PI / 300.0, 1e-15);
+}
+
+// The stable-rule event from samples: the first grid time with f <= -tol and f' < -tol (a
+// clearly overlapping, clearly approaching state), or +inf.
+template <class Gap>
+double first_sampled_event(Gap gap, double horizon, int samples, double tol) {
+  for (int k = 0; k <= samples; ++k) {
+    const double t = horizon * k / samples;
+    const auto s = gap(t);
+    if (s.f <= -tol && s.df < -tol) return t;
+  }
+  return kInf;
+}
+
+TEST(VibratedPlane, RandomAgainstSampling) {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int events = 0;
+  for (int i = 0; i < 3000; ++i) {
+    NormalMotion m =
+        motion(3.0 * u(rng) - 0.5, 6.0 * u(rng) - 3.0, (i % 4 == 0) ? 0.0 : 2.5 * u(rng) - 2.0);
+    const VibratedPlane p{0.0, u(rng), 0.1 + 30.0 * u(rng), 2.0 * M_PI * u(rng) - M_PI};
+    if (i % 3 == 0) m.height = vibrated_plane_offset(p, 0.0);  // starts on the plate
+    const double horizon = 0.5 + 4.5 * u(rng);
+    const double t = vibrated_plane_event_time(m, p, horizon);
+    ASSERT_TRUE(t >= 0.0) << i;
+    const auto gap = [&](double s) { return vibrated_gap(m, p, s); };
+    const double brute = first_sampled_event(gap, horizon, 10000, 1e-9);
+    ASSERT_LE(t, brute + 1e-12) << i;  // never later than a sampled event (never misses one)
+    if (t == kNever) continue;
+    ++events;
+    ASSERT_LE(t, horizon);
+    // The stable-rule condition at t: in contact (or overlapping) and not receding.
+    const GapSample at = gap(t);
+    ASSERT_LE(at.f, 1e-12) << i;
+    ASSERT_LE(at.df, 1e-9) << i;
+    // Reached from an open gap, the event is a contact: f = 0 up to round-off.
+    if (gap(0.0).f > 1e-12) {
+      ASSERT_NEAR(at.f, 0.0, 1e-12) << i;
+    }
+  }
+  EXPECT_GT(events, 1000);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Quartic pair contact (formulas.md §3.3, §7.8)
+
+double quartic(std::array<double, 3> r, std::array<double, 3> v, std::array<double, 3> a,
+               double t_max = kNever) {
+  return pair_contact_time_accelerated<3>(r.data(), v.data(), a.data(), 1.0, t_max);
+}
+
+TEST(QuarticContact, FormulaSheetValues) {
+  const std::array<double, 3> g{0, 0, -1};
+  EXPECT_NEAR(quartic({0.3, 0, 3}, {0.2, 0, 0}, g), 2.152736853088476, 1e-14);
+  EXPECT_NEAR(quartic({0, 0.5, 1.5}, {0, 0, 2}, g), 4.2952013402817455, 1e-14);
+  EXPECT_EQ(quartic({1.2, 0, 3}, {0.5, 0, 0}, g), kNever);
+  EXPECT_NEAR(quartic({0, 0, 0.99}, {0, 0, 0.1}, g), 0.1, 1e-15);  // turning while overlapped
+}
+
+TEST(QuarticContact, ZeroAccelerationIsTheQuadratic) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  const std::array<double, 3> zero{0, 0, 0};
+  for (int i = 0; i < 2000; ++i) {
+    const std::array<double, 3> r{u(rng), u(rng), u(rng)}, v{u(rng), u(rng), u(rng)};
+    EXPECT_EQ(quartic(r, v, zero), pair_contact_time<3>(r.data(), v.data(), 1.0));
+  }
+  // Formula-sheet quadratic values through the accelerated entry point.
+  EXPECT_EQ(quartic({0.999, 0, 0}, {-1, 0, 0}, zero), 0.0);
+  EXPECT_NEAR(quartic({1.0 + 1e-10, 0, 0}, {-1, 0, 0}, zero), 1.000000082690371e-10, 1e-24);
+}
+
+TEST(QuarticContact, StableRule) {
+  const std::array<double, 3> g{0, 0, -1};
+  EXPECT_EQ(quartic({0, 0, 0.999}, {0, 0, -1}, g), 0.0);          // overlapping, approaching
+  EXPECT_EQ(quartic({0, 0, 0.999}, {0, 0, 0}, g), 0.0);           // at rest, pulled in
+  EXPECT_EQ(quartic({0, 0, 1.0}, {0, 0, 0}, g), 0.0);             // resting on it: now
+  EXPECT_EQ(quartic({0, 0, -0.999}, {0, 0, -2}, g), kNever);      // receding below, falling
+  EXPECT_EQ(quartic({0, 0, 1.0}, {0, 0, 0}, {0, 0, 1}), kNever);  // touching, pulled away
+  EXPECT_DOUBLE_EQ(quartic({0, 0, 1.0}, {0, 0, 1}, g), 2.0);      // bounce flight time
+  EXPECT_DOUBLE_EQ(quartic({0, 0, 3.0}, {0, 0, 0}, g), 2.0);      // drop from 3 onto it
+}
+
+TEST(QuarticContact, GrazingAndTangency) {
+  const std::array<double, 3> g{0, 0, -1};
+  // Falling past at lateral distance 1 + eps: a near miss; 1 - eps: a hit near sqrt(6).
+  EXPECT_EQ(quartic({1.0 + 1e-9, 0, 3}, {0, 0, 0}, g), kNever);
+  const double hit = quartic({1.0 - 1e-9, 0, 3}, {0, 0, 0}, g);
+  EXPECT_NEAR(hit, std::sqrt(6.0), 1e-4);
+  EXPECT_LT(hit, std::sqrt(6.0));
+  // Exact tangency: no event, or one within round-off of the touching point.
+  const double touch = quartic({1.0, 0, 3}, {0, 0, 0}, g);
+  EXPECT_TRUE(touch == kNever || std::fabs(touch - std::sqrt(6.0)) < 1e-6) << touch;
+}
+
+TEST(QuarticContact, Horizon) {
+  const std::array<double, 3> g{0, 0, -1};
+  EXPECT_EQ(quartic({0.3, 0, 3}, {0.2, 0, 0}, g, 2.15), kNever);
+  EXPECT_NEAR(quartic({0.3, 0, 3}, {0.2, 0, 0}, g, 2.16), 2.152736853088476, 1e-14);
+  EXPECT_NEAR(quartic({0, 0, 0.99}, {0, 0, 0.1}, g, 0.2), 0.1, 1e-15);
+  EXPECT_EQ(quartic({0, 0, 0.99}, {0, 0, 0.1}, g, 0.05), kNever);
+}
+
+TEST(QuarticContact, DegenerateCubic) {
+  // Leading coefficient zero: 1 - t^3 falls to -inf; the unbounded piece is searched.
+  EXPECT_NEAR(quartic_event_time({1.0, 0.0, 0.0, -1.0, 0.0}), 1.0, 1e-15);
+  EXPECT_EQ(quartic_event_time({1.0, 0.0, 0.0, 1.0, 0.0}), kNever);
+  EXPECT_EQ(quartic_event_time({-1.0, -1.0, 0.0, 1.0, 1.0}, 0.0), 0.0);  // now, zero horizon
+  // A general quartic with roots 1, 2, 3, 4: falls through zero first at 1.
+  EXPECT_NEAR(quartic_event_time({24.0, -50.0, 35.0, -10.0, 1.0}), 1.0, 1e-15);
+  // Starting at its root 1, between 1 and 2 it is negative and falling: the event is now.
+  EXPECT_EQ(quartic_event_time({0.0, -6.0, 11.0, -6.0, 1.0}), 0.0);  // (t)(t-1)(t-2)(t-3)
+  // Sign flipped: positive on (0, 1), falls through zero at 1.
+  EXPECT_NEAR(quartic_event_time({0.0, 6.0, -11.0, 6.0, -1.0}), 1.0, 1e-15);
+  // (t+1)(t-1)(t-2)(t-3): overlapping at 0 but rising out at 1; the event is the fall at 2.
+  EXPECT_NEAR(quartic_event_time({-6.0, 5.0, 5.0, -5.0, 1.0}), 2.0, 1e-15);
+}
+
+TEST(QuarticContact, RandomAgainstSampling) {
+  std::mt19937_64 rng(6);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int events = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const std::array<double, 3> r{2 * u(rng), 2 * u(rng), 2 * u(rng)};
+    const std::array<double, 3> v{2 * u(rng), 2 * u(rng), 2 * u(rng)};
+    const std::array<double, 3> a{u(rng), u(rng), u(rng)};
+    const double horizon = 6.0;
+    const double t = quartic(r, v, a, horizon);
+    ASSERT_TRUE(t >= 0.0) << i;
+    const auto gap = [&](double s) {
+      double rr = 0.0, rd = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double x = r[k] + v[k] * s + 0.5 * a[k] * s * s;
+        rr += x * x;
+        rd += x * (v[k] + a[k] * s);
+      }
+      return GapSample{rr - 1.0, 2.0 * rd};
+    };
+    ASSERT_LE(t, first_sampled_event(gap, horizon, 20000, 1e-9) + 1e-12) << i;
+    if (t == kNever) continue;
+    ++events;
+    const GapSample at = gap(t);
+    ASSERT_LE(at.f, 1e-12) << i;
+    ASSERT_LE(at.df, 1e-9) << i;
+    if (gap(0.0).f > 0.0) {
+      ASSERT_NEAR(at.f, 0.0, 1e-12) << i;
+    }
+  }
+  EXPECT_GT(events, 300);
+}
+
+}  // namespace
+}  // namespace kairos
