@@ -41,7 +41,7 @@ inline __m512d gather_field(const double* records, __m256i base, __mmask8 live, 
 // while the candidate list was built); lanes past the end read record 0 and are masked out.
 // Every lane computes the full contact time; invalid lanes (receding, near miss, beaten by the
 // cheap bound) become +inf, and the lowest lane holding the minimum wins, as in list order.
-template <int D>
+template <int D, bool kAccelerated>
 std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
                                      const Vec<D>& vi, double& best) {
   const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
@@ -72,7 +72,7 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
     for (int a = 0; a < D; ++a) {
       __m512d vel = gather_field(s.records, base, live, D + a);
       __m512d xj = _mm512_add_pd(gather_field(s.records, base, live, a), _mm512_mul_pd(vel, dtj));
-      if (s.accelerated) {
+      if constexpr (kAccelerated) {
         xj = _mm512_add_pd(xj,
                            _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(s.half_accel[a]), dtj), dtj));
         vel = _mm512_add_pd(vel, _mm512_mul_pd(_mm512_set1_pd(s.accel[a]), dtj));
@@ -122,10 +122,14 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
   return found;
 }
 
-template std::uint32_t scan_candidates_avx512<2>(const CandidateScan<2>&, double, const Vec<2>&,
-                                                 const Vec<2>&, double&);
-template std::uint32_t scan_candidates_avx512<3>(const CandidateScan<3>&, double, const Vec<3>&,
-                                                 const Vec<3>&, double&);
+template std::uint32_t scan_candidates_avx512<2, false>(const CandidateScan<2>&, double,
+                                                        const Vec<2>&, const Vec<2>&, double&);
+template std::uint32_t scan_candidates_avx512<3, false>(const CandidateScan<3>&, double,
+                                                        const Vec<3>&, const Vec<3>&, double&);
+template std::uint32_t scan_candidates_avx512<2, true>(const CandidateScan<2>&, double,
+                                                       const Vec<2>&, const Vec<2>&, double&);
+template std::uint32_t scan_candidates_avx512<3, true>(const CandidateScan<3>&, double,
+                                                       const Vec<3>&, const Vec<3>&, double&);
 
 // Up to 16 lists per register (two registers for the 27 cells of 3D): gather the heads,
 // compress the non-empty ones out, gather their successors, compress again.
@@ -171,16 +175,20 @@ std::uint32_t gather_lists_avx512(const Neighbourhood& nb, std::uint32_t* out,
 
 #else
 
-template <int D>
+template <int D, bool kAccelerated>
 std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
                                      const Vec<D>& vi, double& best) {
-  return scan_candidates_scalar<D>(s, t, xi, vi, best);
+  return scan_candidates_scalar<D, kAccelerated>(s, t, xi, vi, best);
 }
 
-template std::uint32_t scan_candidates_avx512<2>(const CandidateScan<2>&, double, const Vec<2>&,
-                                                 const Vec<2>&, double&);
-template std::uint32_t scan_candidates_avx512<3>(const CandidateScan<3>&, double, const Vec<3>&,
-                                                 const Vec<3>&, double&);
+template std::uint32_t scan_candidates_avx512<2, false>(const CandidateScan<2>&, double,
+                                                        const Vec<2>&, const Vec<2>&, double&);
+template std::uint32_t scan_candidates_avx512<3, false>(const CandidateScan<3>&, double,
+                                                        const Vec<3>&, const Vec<3>&, double&);
+template std::uint32_t scan_candidates_avx512<2, true>(const CandidateScan<2>&, double,
+                                                       const Vec<2>&, const Vec<2>&, double&);
+template std::uint32_t scan_candidates_avx512<3, true>(const CandidateScan<3>&, double,
+                                                       const Vec<3>&, const Vec<3>&, double&);
 
 std::uint32_t gather_lists_avx512(const Neighbourhood&, std::uint32_t*, std::uint32_t*,
                                   std::uint32_t*, std::uint32_t*, std::uint32_t& n_third) {

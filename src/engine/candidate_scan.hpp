@@ -37,16 +37,17 @@ struct CandidateScan {
   const double* shape_radius = nullptr;  // non-uniform: per shape
   // Uniform acceleration (gravity) felt by every candidate: their positions and velocities at
   // time t gain g dt^2/2 and g dt. The pair's relative motion stays a straight line.
-  bool accelerated = false;
-  Vec<D> accel{};       // g
-  Vec<D> half_accel{};  // g / 2
+  const double* accel = nullptr;       // g (kAccelerated loops only)
+  const double* half_accel = nullptr;  // g / 2
 };
 
 inline constexpr std::uint32_t kNoCandidate = 0xffffffffu;
 
 // Scalar reference. Returns the index (into `candidates`) of the soonest contact earlier than
 // t + best and lowers best to it; kNoCandidate if none.
-template <int D>
+// kAccelerated: the loop with gravity's terms (s.accel must be set); a separate
+// instantiation keeps them out of the hard-sphere loop.
+template <int D, bool kAccelerated = false>
 std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const Vec<D>& xi,
                                      const Vec<D>& vi, double& best) {
   std::uint32_t found = kNoCandidate;
@@ -61,7 +62,7 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
     for (int a = 0; a < D; ++a) {
       double xj = rec[a] + rec[D + a] * dtj;
       double vj = rec[D + a];
-      if (s.accelerated) {
+      if constexpr (kAccelerated) {
         xj = xj + (s.half_accel[a] * dtj) * dtj;
         vj = vj + s.accel[a] * dtj;
       }
@@ -114,7 +115,7 @@ std::uint32_t gather_lists_avx512(const Neighbourhood& nb, std::uint32_t* out,
 bool cpu_has_avx512();
 
 // AVX-512 loop (defined in candidate_scan.cpp); same contract and result as the scalar loop.
-template <int D>
+template <int D, bool kAccelerated = false>
 std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
                                      const Vec<D>& vi, double& best);
 

@@ -230,6 +230,7 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
     min_width[a] += amplitude;
   }
   grid_ = CellGrid<D>(box_, min_width, periodic, s.size(), options_.max_cells_per_particle);
+  bounded_ = grid_.bounded();
 }
 
 // Offset of a wall's plane from its face's rest position at time t.
@@ -249,7 +250,7 @@ void EventEngine<D, Queue>::check_restored_cell(std::uint32_t i) const {
   for (int a = 0; ok && a < D; ++a) {
     const double x = hot_[i].pos[a];
     const double tol = 1e-9 * box_[a];
-    ok = x >= grid_.lower(c, a) - tol && x <= grid_.upper(c, a) + tol;
+    ok = x >= grid_.lower_bound(c, a) - tol && x <= grid_.upper_bound(c, a) + tol;
   }
   if (!ok) {
     throw InputError("restart state is inconsistent: particle " + std::to_string(id_[i]) +
@@ -314,8 +315,20 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
 template <int D, class Queue>
 void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
   HotRecord<D>& h = hot_[i];
-  h.pos = position_at(h, t);
+  if (accelerated_) [[unlikely]] {
+    advance_accelerated(h, t);
+    return;
+  }
+  const double dt = t - h.time;
+  for (int a = 0; a < D; ++a) h.pos[a] += h.vel[a] * dt;
+  h.time = t;
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::advance_accelerated(HotRecord<D>& h, double t) const {
+  const Vec<D> x = position_at(h, t);
   h.vel = velocity_at(h, t);
+  h.pos = x;
   h.time = t;
 }
 
@@ -347,21 +360,10 @@ Vec<D> EventEngine<D, Queue>::velocity_at(const HotRecord<D>& h, double t) const
 template <int D, class Queue>
 typename EventEngine<D, Queue>::Crossing EventEngine<D, Queue>::next_crossing(
     const HotRecord<D>& h) const {
-  Crossing x{kNever, -1, 0};
-  if (accelerated_) {
-    for (int a = 0; a < D; ++a) {
-      const double lo = grid_.lower(h.cell, a), hi = grid_.upper(h.cell, a);
-      const double g = env_.gravity[a];
-      const double dt = interval_exit_time_accelerated(h.pos[a], h.vel[a], g, lo, hi);
-      if (!(h.time + dt < x.time)) continue;
-      // The face: the direction of motion when leaving (a thrown particle may fall back).
-      const double v_exit = h.vel[a] + g * dt;
-      const double x_exit = h.pos[a] + h.vel[a] * dt + (half_gravity_[a] * dt) * dt;
-      x = {h.time + dt, a,
-           v_exit > 0.0 ? 1 : (v_exit < 0.0 ? -1 : (x_exit > 0.5 * (lo + hi) ? 1 : -1))};
-    }
-    return x;
+  if (accelerated_ || bounded_) [[unlikely]] {
+    return next_crossing_general(h);
   }
+  Crossing x{kNever, -1, 0};
   for (int a = 0; a < D; ++a) {
     const double v = h.vel[a];
     const double dt =
@@ -371,6 +373,27 @@ typename EventEngine<D, Queue>::Crossing EventEngine<D, Queue>::next_crossing(
     x.time = sooner ? when : x.time;
     x.axis = sooner ? a : x.axis;
     x.sign = sooner ? (v > 0.0 ? 1 : -1) : x.sign;
+  }
+  return x;
+}
+
+// next_crossing() under gravity or with unbounded outer layers (walls, open faces).
+template <int D, class Queue>
+typename EventEngine<D, Queue>::Crossing EventEngine<D, Queue>::next_crossing_general(
+    const HotRecord<D>& h) const {
+  Crossing x{kNever, -1, 0};
+  {
+    for (int a = 0; a < D; ++a) {
+      const double lo = grid_.lower_bound(h.cell, a), hi = grid_.upper_bound(h.cell, a);
+      const double g = env_.gravity[a];
+      const double dt = interval_exit_time_accelerated(h.pos[a], h.vel[a], g, lo, hi);
+      if (!(h.time + dt < x.time)) continue;
+      // The face: the direction of motion when leaving (a thrown particle may fall back).
+      const double v_exit = h.vel[a] + g * dt;
+      const double x_exit = h.pos[a] + h.vel[a] * dt + (half_gravity_[a] * dt) * dt;
+      x = {h.time + dt, a,
+           v_exit > 0.0 ? 1 : (v_exit < 0.0 ? -1 : (x_exit > 0.5 * (lo + hi) ? 1 : -1))};
+    }
   }
   return x;
 }
@@ -505,25 +528,33 @@ template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, std::uint32_t i,
                                                      double t, const Vec<D>& xi,
                                                      double& best) const {
-  CandidateScan<D> scan;
-  scan.records = reinterpret_cast<const double*>(hot_.data());
-  scan.stride = static_cast<int>(sizeof(HotRecord<D>) / sizeof(double));
-  scan.candidates = list.ids.data();
-  scan.shift_index = list.shift.data();
-  scan.shifts = list.shifts;
-  scan.any_shift = list.n_shifts > 1;  // else list.shift is stale and must not be read
-  scan.count = list.count;
-  scan.uniform = uniform_radius_;
-  scan.sigma = 2.0 * radius_of(i);
-  scan.radius_i = radius_of(i);
-  scan.shape = shape_.data();
-  scan.shape_radius = shape_radius_.data();
-  scan.accelerated = accelerated_;
-  scan.accel = env_.gravity;
-  scan.half_accel = half_gravity_;
-  const Vec<D> vi = velocity_at(hot_[i], t);
-  const std::uint32_t k = vector_scan_ ? scan_candidates_avx512<D>(scan, t, xi, vi, best)
-                                       : scan_candidates_scalar<D>(scan, t, xi, vi, best);
+  // Every field written once (designated initialisers): a default-constructed scan would be
+  // zeroed first with a slow `rep stos`.
+  const double r = radius_of(i);
+  const CandidateScan<D> scan{
+      .records = reinterpret_cast<const double*>(hot_.data()),
+      .stride = static_cast<int>(sizeof(HotRecord<D>) / sizeof(double)),
+      .candidates = list.ids.data(),
+      .shift_index = list.shift.data(),
+      .shifts = list.shifts,
+      .any_shift = list.n_shifts > 1,  // else list.shift is stale and must not be read
+      .count = list.count,
+      .uniform = uniform_radius_,
+      .sigma = 2.0 * r,
+      .radius_i = r,
+      .shape = shape_.data(),
+      .shape_radius = shape_radius_.data(),
+      .accel = accelerated_ ? env_.gravity.data() : nullptr,
+      .half_accel = accelerated_ ? half_gravity_.data() : nullptr};
+  std::uint32_t k;
+  if (accelerated_) {
+    const Vec<D> vi = velocity_at(hot_[i], t);
+    k = vector_scan_ ? scan_candidates_avx512<D, true>(scan, t, xi, vi, best)
+                     : scan_candidates_scalar<D, true>(scan, t, xi, vi, best);
+  } else {
+    k = vector_scan_ ? scan_candidates_avx512<D>(scan, t, xi, hot_[i].vel, best)
+                     : scan_candidates_scalar<D>(scan, t, xi, hot_[i].vel, best);
+  }
   return k == kNoCandidate ? kNoPartner : list.ids[k];
 }
 
@@ -541,7 +572,7 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
   const HotRecord<D>& h = hot_[i];
   const Crossing crossing = next_crossing(h);
   double best = crossing.time - t;
-  const Vec<D> xi = position_at(h, t);
+  const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
   const std::uint32_t partner = test_candidates(list, i, t, xi, best);
   double when = crossing.time;
   if (partner != kNoPartner) {
@@ -572,7 +603,7 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
   double g_dot_r = 0.0, r2 = 0.0;
   for (int a = 0; a < D; ++a) {
     const double raw = hi.pos[a] - hj.pos[a];
-    const double d = grid_.periodic(a) ? minimum_image(raw, box_[a]) : raw;
+    const double d = !bounded_ || grid_.periodic(a) ? minimum_image(raw, box_[a]) : raw;
     r[a] = d;
     r2 += d * d;
     g_dot_r += (hi.vel[a] - hj.vel[a]) * d;
@@ -748,11 +779,11 @@ EventKind EventEngine<D, Queue>::step() {
     __builtin_prefetch(&pending_[k]);
   }
   const PendingEvent e = pending_[i];
-  if (e.partner >= kFirstWall) {
-    if (e.partner == kNoPartner) {
-      cross(i, t);
-      return EventKind::kCellCrossing;
-    }
+  if (e.partner == kNoPartner) {
+    cross(i, t);
+    return EventKind::kCellCrossing;
+  }
+  if (e.partner >= kFirstWall) [[unlikely]] {
     hit_wall(i, static_cast<int>(e.partner - kFirstWall), t);
     return EventKind::kWallCollision;
   }
@@ -885,7 +916,7 @@ void EventEngine<D, Queue>::validate() {
     }
     for (int a = 0; a < D; ++a) {
       const double tol = 1e-9 * box_[a];
-      if (x[a] < grid_.lower(h.cell, a) - tol || x[a] > grid_.upper(h.cell, a) + tol)
+      if (x[a] < grid_.lower_bound(h.cell, a) - tol || x[a] > grid_.upper_bound(h.cell, a) + tol)
         fail("particle " + name(i) + " outside its cell");
     }
     if (pending_[i].partner < kFirstWall && pending_[i].partner >= n)

@@ -142,6 +142,8 @@ class EventEngine {
   double mass_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].mass; }
   void advance_to(std::uint32_t i, double t);
   Crossing next_crossing(const HotRecord<D>& h) const;
+  [[gnu::noinline]] Crossing next_crossing_general(const HotRecord<D>& h) const;
+  [[gnu::noinline]] void advance_accelerated(HotRecord<D>& h, double t) const;
   double predict(std::uint32_t i, double t);
   double predict_from(const CandidateList& list, std::uint32_t i, double t);
   void gather(CellCode cell, CandidateList& list);
@@ -179,10 +181,10 @@ class EventEngine {
   std::vector<double> shape_radius_;  // radius per shape, for the candidate loops
   bool vector_scan_ = false;
   HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
-  Environment<D> env_;
-  bool accelerated_ = false;  // uniform gravity
+  bool accelerated_ = false;      // uniform gravity
   Vec<D> half_gravity_{};
   bool walls_ = false;
+  bool bounded_ = false;                 // some axis has walls or open faces
   bool granular_contacts_ = false;       // some contact law is not elastic and smooth
   HugeVector<AngularVelocity<D>> spin_;  // rough particles only
   HugeVector<double> last_collision_;    // TC model only
@@ -191,6 +193,7 @@ class EventEngine {
   std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions
 
   CandidateList lists_[2];
+  Environment<D> env_;  // last: the hot members above share fewer cache lines
 };
 
 }  // namespace kairos

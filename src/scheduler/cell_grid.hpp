@@ -143,14 +143,23 @@ class CellGrid {
     }
     return code_at(c);
   }
-  // Cell bounds; +-inf for the outer layers of a non-periodic axis. Selects, not branches.
-  double lower(CellCode c, int k) const {
+  // Cell bounds as if every axis were periodic (the hard-sphere fast path).
+  double lower(CellCode c, int k) const { return coordinate(c, k) * width_[k]; }
+  double upper(CellCode c, int k) const { return (coordinate(c, k) + 1) * width_[k]; }
+  // Cell bounds with the outer layers of non-periodic axes extending to -inf / +inf.
+  double lower_bound(CellCode c, int k) const {
     const int x = coordinate(c, k);
     return x == 0 ? low_edge_[k] : x * width_[k];
   }
-  double upper(CellCode c, int k) const {
+  double upper_bound(CellCode c, int k) const {
     const int x = coordinate(c, k);
     return x == n_[k] - 1 ? high_edge_[k] : (x + 1) * width_[k];
+  }
+  // Whether some axis is not periodic.
+  bool bounded() const {
+    for (int k = 0; k < D; ++k)
+      if (!periodic_[k]) return true;
+    return false;
   }
 
   // The particles of a cell (by linear index): first(), then next(i) until end(). The end
@@ -218,8 +227,9 @@ class CellGrid {
     }
     std::array<int, D> off;
     off.fill(-1);
+    const bool bounded = this->bounded();
     for (int n = 0; n < kNeighbourCells; ++n) {
-      f(offset_cell(base, off));
+      f(bounded ? offset_cell<true>(base, off) : offset_cell<false>(base, off));
       for (int k = 0; k < D; ++k) {
         if (++off[k] <= 1) break;
         off[k] = -1;
@@ -273,6 +283,7 @@ class CellGrid {
     return p;
   }
 
+  template <bool kBounded>
   Neighbour offset_cell(const std::array<int, D>& base, const std::array<int, D>& off) const {
     Neighbour nb;
     nb.shifted = false;
@@ -280,7 +291,7 @@ class CellGrid {
     for (int k = 0; k < D; ++k) {
       int c = base[k] + off[k];
       nb.shift[k] = 0.0;
-      if (!periodic_[k] && (c < 0 || c >= n_[k])) {
+      if (kBounded && !periodic_[k] && (c < 0 || c >= n_[k])) {
         return {total_, false, {}};  // beyond a wall or open face: the empty sentinel cell
       }
       if (c < 0) {
