@@ -57,7 +57,20 @@ void print_summary(const kairos::RunOutcome& outcome) {
   fmt::print("  temperature          {:.10g}\n", num("temperature"));
   fmt::print("  compressibility Z    {:.5f} +- {:.5f}\n", zm, ze);
   fmt::print("  mean free time       {:.6g}\n", num("mean_free_time"));
-  fmt::print("  energy drift (rel.)  {:.3g}\n", num("energy_drift_relative"));
+  if (s.contains("granular")) {
+    const auto& g = s["granular"];
+    auto gnum = [&](const char* key) {
+      return g.contains(key) && g[key].is_number() ? g[key].get<double>() : std::nan("");
+    };
+    fmt::print("  rotational temp.     {:.6g}\n", gnum("rotational_temperature"));
+    fmt::print("  Sonine a2            {:.4f}\n", gnum("sonine_a2"));
+    fmt::print("  dissipated           {:.6g} in collisions, {:.6g} at walls\n",
+               gnum("dissipated_in_collisions"), gnum("dissipated_at_walls"));
+    fmt::print("  work by walls        {:.6g}\n", gnum("work_by_walls"));
+    fmt::print("  energy balance       {:.3g} (rel.)\n", gnum("energy_balance_relative"));
+  } else {
+    fmt::print("  energy drift (rel.)  {:.3g}\n", num("energy_drift_relative"));
+  }
   fmt::print("  max overlap          {:.3g}\n", num("max_overlap"));
   fmt::print("  peak memory          {:.1f} MiB\n", num("peak_rss_bytes") / 1048576.0);
   fmt::print("  outputs              {}/ (summary.json, thermo.tsv, trajectory.gsd, restart.gsd)\n",

@@ -7,6 +7,7 @@
 //     keeps its own compact layout (engine/event_engine.hpp) and converts on entry and export.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -45,6 +46,7 @@ struct EventCounters {
   std::uint64_t wall_collisions = 0;
   std::uint64_t elastic_by_rule = 0;     // made elastic by the TC model or elastic_below_speed
   std::uint64_t sliding_collisions = 0;  // Coulomb-limited (Walton) contacts that slid
+  std::uint64_t fell_asleep = 0;         // particles put to sleep (resting under gravity)
   // Kinetic energy (translational + rotational) dissipated in particle-particle and in
   // particle-wall collisions, and the work moving walls did on the particles.
   double dissipated_in_collisions = 0.0;
@@ -77,10 +79,33 @@ struct ParticleSystem {
   std::vector<std::uint32_t> order;
   EventCounters counters;
 
+  // The field and boundaries the trajectories live in (set by the engine on export; the
+  // defaults are a periodic box with no field). Positions along a non-periodic axis are never
+  // wrapped.
+  Vec<D> gravity{};
+  std::array<bool, D> periodic = all_periodic();
+  // Sleeping particles (empty: none) rest where they are and feel no gravity.
+  std::vector<std::uint8_t> asleep;
+
   std::size_t size() const { return kinematics.size(); }
+  bool is_asleep(std::size_t i) const { return !asleep.empty() && asleep[i] != 0; }
   Vec<D> position_at(std::size_t i, double t) const {
     const auto& k = kinematics[i];
-    return k.pos + (t - k.time) * k.vel;
+    const double dt = t - k.time;
+    if (is_asleep(i)) return k.pos;
+    return k.pos + dt * k.vel + (0.5 * dt * dt) * gravity;
+  }
+  Vec<D> velocity_at(std::size_t i, double t) const {
+    const auto& k = kinematics[i];
+    if (is_asleep(i)) return Vec<D>{};
+    return k.vel + (t - k.time) * gravity;
+  }
+
+ private:
+  static std::array<bool, D> all_periodic() {
+    std::array<bool, D> p;
+    p.fill(true);
+    return p;
   }
 };
 

@@ -102,6 +102,23 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
     if (!s.angular_velocity.empty())
       for (std::uint32_t k = 0; k < n; ++k) spin_[k] = s.angular_velocity[id_[k]];
   }
+  if (accelerated_ && walls_) {
+    double dmin = kNever;
+    for (const Shape& sh : shapes_) dmin = std::min(dmin, 2.0 * sh.radius);
+    sleep_speed_ = env_.sleep_speed >= 0.0
+                       ? env_.sleep_speed
+                       : std::sqrt(2.0 * std::sqrt(norm2(env_.gravity)) * 1e-6 * dmin);
+  }
+  if (sleep_speed_ > 0.0) {
+    asleep_.assign(n, 0);
+    if (s.asleep.size() == n) {
+      for (std::uint32_t k = 0; k < n; ++k) {
+        asleep_[k] = s.asleep[id_[k]] != 0 ? 1 : 0;
+        sleeping_ += asleep_[k];
+        if (asleep_[k] != 0) hot_[k].vel = Vec<D>{};
+      }
+    }
+  }
   if (env_.tc > 0.0) {
     last_collision_.assign(n, -kNever);
     if (s.last_collision_time.size() == n)
@@ -308,6 +325,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(shape_, n + 1);
   permute(spin_, n);
   permute(last_collision_, n);
+  permute(asleep_, n);
   insert_all_into_grid();
   if (queue_filled) queue_.reset(times);
 }
@@ -316,7 +334,11 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
   HotRecord<D>& h = hot_[i];
   if (accelerated_) [[unlikely]] {
-    advance_accelerated(h, t);
+    if (is_asleep(i)) {
+      h.time = t;  // it does not move
+    } else {
+      advance_accelerated(h, t);
+    }
     return;
   }
   const double dt = t - h.time;
@@ -562,6 +584,10 @@ std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, 
 // comes before the particle leaves its cell, else the crossing. Stores it; returns its time.
 template <int D, class Queue>
 double EventEngine<D, Queue>::predict(std::uint32_t i, double t) {
+  if (sleeping_ > 0 && is_asleep(i)) [[unlikely]] {
+    pending_[i] = {kNoPartner, 0};
+    return kNever;  // others find it; it has nothing to do on its own
+  }
   gather(hot_[i].cell, lists_[0]);
   return predict_from(lists_[0], i, t);
 }
@@ -570,10 +596,15 @@ double EventEngine<D, Queue>::predict(std::uint32_t i, double t) {
 template <int D, class Queue>
 double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint32_t i, double t) {
   const HotRecord<D>& h = hot_[i];
+  if (sleeping_ > 0 && is_asleep(i)) [[unlikely]] {
+    pending_[i] = {kNoPartner, 0};
+    return kNever;
+  }
   const Crossing crossing = next_crossing(h);
   double best = crossing.time - t;
   const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
-  const std::uint32_t partner = test_candidates(list, i, t, xi, best);
+  const std::uint32_t partner =
+      sleeping_ > 0 ? scan_with_sleepers(list, i, t, best) : test_candidates(list, i, t, xi, best);
   double when = crossing.time;
   if (partner != kNoPartner) {
     pending_[i] = {partner, hot_[partner].collisions};
@@ -595,6 +626,15 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) {
   // Canonical order so that which of the pair was popped never changes the arithmetic.
   if (j < i) std::swap(i, j);
+  if (sleeping_ > 0 && (is_asleep(i) || is_asleep(j))) [[unlikely]] {
+    if (is_asleep(i)) std::swap(i, j);  // i is the awake one
+    advance_to(i, t);
+    Vec<D> r = hot_[i].pos - hot_[j].pos;
+    for (int a = 0; a < D; ++a)
+      if (grid_.periodic(a)) r[a] = minimum_image(r[a], box_[a]);
+    collide_with_sleeper(i, j, t, r, norm2(r));
+    return;
+  }
   advance_to(i, t);
   advance_to(j, t);
   HotRecord<D>& hi = hot_[i];
@@ -733,11 +773,128 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
   counters_.dissipated_at_walls += res.dissipated;
   counters_.work_by_walls +=
       res.translational_energy_change + res.rotational_energy_change + res.dissipated;
+  if (sleep_speed_ > 0.0 && !w.vibrates()) {
+    counters_.dissipated_at_walls -= settle_after_contact(i, in.normal, w.velocity, t);
+  }
   counters_.elastic_by_rule += res.made_elastic ? 1u : 0u;
   counters_.sliding_collisions += res.slid ? 1u : 0u;
   ++counters_.wall_collisions;
   ++h.collisions;  // its velocity changed: partners' predictions with it are stale
   queue_.update(i, predict(i, t));
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::fall_asleep(std::uint32_t i, double t) {
+  HotRecord<D>& h = hot_[i];
+  h.time = t;
+  h.vel = Vec<D>{};
+  if (!spin_.empty()) spin_[i] = AngularVelocity<D>{};
+  asleep_[i] = 1;
+  ++sleeping_;
+  ++counters_.fell_asleep;
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::wake(std::uint32_t i, double t) {
+  asleep_[i] = 0;
+  --sleeping_;
+  hot_[i].time = t;  // at rest where it slept
+}
+
+template <int D, class Queue>
+double EventEngine<D, Queue>::settle_after_contact(std::uint32_t i, const Vec<D>& n,
+                                                   const Vec<D>& support_velocity, double t) {
+  if (sleep_speed_ <= 0.0 || !(dot(env_.gravity, n) < 0.0)) return 0.0;
+  HotRecord<D>& h = hot_[i];
+  const Vec<D> rel = h.vel - support_velocity;
+  const double vn = dot(rel, n);
+  if (vn >= sleep_speed_) return 0.0;  // a real bounce
+  const double m = mass_of(i);
+  if (norm2(support_velocity) == 0.0 && norm2(rel) < sleep_speed_ * sleep_speed_) {
+    const double r = radius_of(i);
+    const double spin_energy =
+        spin_.empty() ? 0.0
+                      : 0.5 * env_.inertia_factor_of(species_of(i)) * m * r * r * norm2(spin_[i]);
+    const double before = 0.5 * m * norm2(h.vel) + spin_energy;
+    fall_asleep(i, t);
+    return -before;
+  }
+  // Still sliding, or carried by a moving support: leave with the sleep speed along n, so
+  // that the next contact is a finite flight away.
+  const double before = 0.5 * m * norm2(h.vel);
+  h.vel = h.vel + (sleep_speed_ - vn) * n;
+  return 0.5 * m * norm2(h.vel) - before;
+}
+
+// An awake particle i meets a sleeping j. A gentle contact leaves j asleep (an immovable
+// support, as a wall of infinite mass); a harder one wakes j for an ordinary collision.
+template <int D, class Queue>
+void EventEngine<D, Queue>::collide_with_sleeper(std::uint32_t i, std::uint32_t j, double t,
+                                                 const Vec<D>& r, double r2) {
+  HotRecord<D>& hi = hot_[i];
+  const Vec<D> n = (1.0 / std::sqrt(r2)) * r;
+  const double gn = dot(hi.vel, n);
+  if (-gn >= sleep_speed_ || !(dot(env_.gravity, n) < 0.0)) {
+    wake(j, t);
+    if (granular_contacts_) {
+      collide_granular(i, j, t, r, r2);
+    } else {
+      const double mi = mass_of(i), mj = mass_of(j);
+      const double s =
+          HardSphere::impulse_factor(dot(hi.vel - hot_[j].vel, r), r2, mi * mj / (mi + mj));
+      hi.vel = hi.vel + (s / mi) * r;
+      hot_[j].vel = hot_[j].vel - (s / mj) * r;
+      counters_.virial += s * r2;
+    }
+    ++hot_[j].collisions;
+  } else {
+    const ContactModel plain;
+    WallContactInput<D> in;
+    in.normal = n;
+    in.mass = mass_of(i);
+    in.radius = radius_of(i);
+    in.inertia_factor = env_.inertia_factor_of(species_of(i));
+    const ContactModel& law =
+        env_.contact.empty() ? plain : *env_.contact_of(species_of(i), species_of(j));
+    Spin<D> wi{};
+    if (!spin_.empty()) wi = to_spin<D>(spin_[i]);
+    const ContactResult<D> res = resolve_wall_contact(law, in, hi.vel, wi);
+    if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
+    counters_.dissipated_in_collisions += res.dissipated;
+    counters_.virial += dot(r, res.impulse);
+    counters_.dissipated_in_collisions -= settle_after_contact(i, n, Vec<D>{}, t);
+  }
+  ++counters_.collisions;
+  ++hi.collisions;
+  queue_.update(i, predict(i, t));
+  if (!is_asleep(j)) queue_.update(j, predict(j, t));
+}
+
+// The candidate test when some particles sleep: a sleeping candidate does not fall, so the
+// pair's relative acceleration is +-g and its contact time a quartic. Scalar; only gravity
+// runs with resting particles take it.
+template <int D, class Queue>
+std::uint32_t EventEngine<D, Queue>::scan_with_sleepers(const CandidateList& list, std::uint32_t i,
+                                                        double t, double& best) const {
+  const Vec<D> xi = position_of(i, t), vi = velocity_of(i, t);
+  std::uint32_t found = kNoPartner;
+  for (std::uint32_t k = 0; k < list.count; ++k) {
+    const std::uint32_t j = list.ids[k];
+    if (j == i) continue;
+    const bool sj = is_asleep(j);
+    Vec<D> r = xi - position_of(j, t);
+    if (list.n_shifts > 1) r = r - list.shifts[list.shift[k]];
+    const Vec<D> g = vi - velocity_of(j, t);
+    const Vec<D> accel = sj ? env_.gravity : Vec<D>{};
+    const double sigma = radius_of(i) + radius_of(j);
+    const double dt =
+        pair_contact_time_accelerated<D>(r.data(), g.data(), accel.data(), sigma, best);
+    if (dt < best) {
+      best = dt;
+      found = j;
+    }
+  }
+  return found;
 }
 
 template <int D, class Queue>
@@ -815,6 +972,9 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
   out.events.resize(n);
   out.cell.resize(n);
   out.order.assign(id_.begin(), id_.end());
+  out.gravity = env_.gravity;
+  for (int a = 0; a < D; ++a) out.periodic[a] = grid_.periodic(a);
+  out.asleep.assign(sleeping_ > 0 ? n : 0, 0);
   out.angular_velocity.resize(spin_.size());
   out.last_collision_time.resize(last_collision_.size());
   for (std::uint32_t k = 0; k < n; ++k) {
@@ -827,6 +987,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
     out.collision_count[c] = h.collisions;
     out.cell[c] = h.cell;
     if (!spin_.empty()) out.angular_velocity[c] = spin_[k];
+    if (sleeping_ > 0) out.asleep[c] = asleep_[k];
     if (!last_collision_.empty()) out.last_collision_time[c] = last_collision_[k];
     const PendingEvent& e = pending_[k];
     out.events[c] = {queue_.time_of(k), e.partner >= kFirstWall ? e.partner : id_[e.partner],
@@ -838,6 +999,11 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
 template <int D, class Queue>
 double EventEngine<D, Queue>::kinetic_energy() const {
   double ke = 0.0;
+  if (accelerated_) {
+    for (std::uint32_t i = 0; i < size(); ++i)
+      ke += 0.5 * mass_of(i) * norm2(velocity_of(i, time_));
+    return ke;
+  }
   for (std::uint32_t i = 0; i < size(); ++i) ke += 0.5 * mass_of(i) * norm2(hot_[i].vel);
   return ke;
 }
@@ -855,7 +1021,7 @@ double EventEngine<D, Queue>::rotational_energy() const {
 template <int D, class Queue>
 Vec<D> EventEngine<D, Queue>::momentum() const {
   Vec<D> p{};
-  for (std::uint32_t i = 0; i < size(); ++i) p = p + mass_of(i) * hot_[i].vel;
+  for (std::uint32_t i = 0; i < size(); ++i) p = p + mass_of(i) * velocity_of(i, time_);
   return p;
 }
 
@@ -863,7 +1029,7 @@ template <int D, class Queue>
 std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
   std::vector<Vec<D>> out(size());
   for (std::uint32_t i = 0; i < size(); ++i) {
-    Vec<D> x = position_at(hot_[i], time_);
+    Vec<D> x = position_of(i, time_);
     for (int a = 0; a < D; ++a)
       if (grid_.periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
     out[id_[i]] = x;
@@ -908,7 +1074,7 @@ void EventEngine<D, Queue>::validate() {
     if (listed[i] != 1)
       fail("particle " + name(i) + " listed " + std::to_string(listed[i]) + " times");
     const HotRecord<D>& h = hot_[i];
-    const Vec<D> x = position_at(h, t);
+    const Vec<D> x = position_of(i, t);
     for (int f = 0; f < 2 * D; ++f) {
       if (env_.faces[f].kind != FaceKind::kWall) continue;
       const double gap = f % 2 == 0 ? x[f / 2] - wall_offset(f, t) : wall_offset(f, t) - x[f / 2];
@@ -922,6 +1088,29 @@ void EventEngine<D, Queue>::validate() {
     if (pending_[i].partner < kFirstWall && pending_[i].partner >= n)
       fail("particle " + name(i) + " has a partner out of range");
   }
+  // Wall contacts, brute force over all particles: none comes before the particle's event.
+  for (std::uint32_t i = 0; walls_ && i < n; ++i) {
+    if (is_asleep(i)) continue;
+    const Vec<D> x = position_of(i, t), v = velocity_of(i, t);
+    for (int f = 0; f < 2 * D; ++f) {
+      if (env_.faces[f].kind != FaceKind::kWall) continue;
+      const Wall<D>& w = env_.faces[f].wall;
+      const int a = f / 2;
+      const double sgn = f % 2 == 0 ? 1.0 : -1.0;
+      const NormalMotion m{sgn * x[a] - radius_of(i), sgn * v[a], sgn * env_.gravity[a]};
+      const double d0 = f % 2 == 0 ? 0.0 : -box_[a];
+      const double due =
+          t + (w.vibrates() ? vibrated_plane_event_time(
+                                  m, VibratedPlane{d0, sgn * w.amplitude, w.angular_frequency,
+                                                   std::remainder(w.angular_frequency * t + w.phase,
+                                                                  2.0 * M_PI)})
+                            : fixed_plane_event_time(m, d0));
+      if (std::isfinite(due) && queue_.time_of(i) > due * (1.0 + 1e-12) + 1e-12) {
+        fail("particle " + name(i) + " meets wall " + std::to_string(f) + " at " +
+             std::to_string(due) + " before its pending event");
+      }
+    }
+  }
   // Queue order: the top is the soonest stored event; nothing lies in the past.
   double tmin = kNever;
   for (std::uint32_t i = 0; i < n; ++i) {
@@ -932,9 +1121,14 @@ void EventEngine<D, Queue>::validate() {
   // Prediction invariant and overlaps, brute force over all pairs: some pending event of the
   // pair (a collision, or a crossing that triggers a new scan) comes no later than its contact.
   auto check_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, const char* which) {
-    const Vec<D> g = velocity_at(hot_[i], t) - velocity_at(hot_[j], t);
+    if (is_asleep(i) && is_asleep(j)) return;  // neither moves
+    const Vec<D> g = velocity_of(i, t) - velocity_of(j, t);
+    Vec<D> accel{};
+    if (is_asleep(j)) accel = env_.gravity;
+    if (is_asleep(i)) accel = -1.0 * env_.gravity;
     const double sigma = radius_of(i) + radius_of(j);
-    const double due = t + pair_contact_time<D>(r.data(), g.data(), sigma);
+    const double due =
+        t + pair_contact_time_accelerated<D>(r.data(), g.data(), accel.data(), sigma);
     const double bound = std::min(queue_.time_of(i), queue_.time_of(j));
     if (std::isfinite(due) && bound > due * (1.0 + 1e-12) + 1e-12) {
       fail("pair " + name(i) + "," + name(j) + " (" + which + ") collides at " +
@@ -942,10 +1136,10 @@ void EventEngine<D, Queue>::validate() {
     }
   };
   for (std::uint32_t i = 0; i < n; ++i) {
-    const Vec<D> xi = position_at(hot_[i], t);
+    const Vec<D> xi = position_of(i, t);
     const std::uint32_t ci = hot_[i].cell;
     for (std::uint32_t j = i + 1; j < n; ++j) {
-      const Vec<D> raw = xi - position_at(hot_[j], t);
+      const Vec<D> raw = xi - position_of(j, t);
       // The image the engine tests (neighbouring cells).
       std::array<int, D> d;
       if (grid_.neighbour_offset(ci, hot_[j].cell, d)) {

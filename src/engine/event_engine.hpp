@@ -90,6 +90,7 @@ class EventEngine {
 
   double kinetic_energy() const;     // translational
   double rotational_energy() const;  // 0 unless particles rotate
+  std::uint32_t sleeping() const { return sleeping_; }
   Vec<D> momentum() const;
   const Environment<D>& environment() const { return env_; }
   // Positions at the current time, wrapped into the box, in the caller's numbering.
@@ -137,6 +138,23 @@ class EventEngine {
   // The particle's soonest wall contact from time t before t + horizon: (relative time, face).
   std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
   void hit_wall(std::uint32_t i, int face, double t);
+  // Sleeping particles (gravity with walls): see Environment::sleep_speed.
+  bool is_asleep(std::uint32_t i) const { return !asleep_.empty() && asleep_[i] != 0; }
+  Vec<D> position_of(std::uint32_t i, double t) const {
+    return is_asleep(i) ? hot_[i].pos : position_at(hot_[i], t);
+  }
+  Vec<D> velocity_of(std::uint32_t i, double t) const {
+    return is_asleep(i) ? Vec<D>{} : velocity_at(hot_[i], t);
+  }
+  void fall_asleep(std::uint32_t i, double t);
+  void wake(std::uint32_t i, double t);
+  // Leaves a resting contact (normal n, gravity into it) asleep or with at least the sleep
+  // speed along n: no endless cascade of ever smaller bounces. Returns the energy added.
+  double settle_after_contact(std::uint32_t i, const Vec<D>& n, const Vec<D>& support_velocity,
+                              double t);
+  void collide_with_sleeper(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
+  std::uint32_t scan_with_sleepers(const CandidateList& list, std::uint32_t i, double t,
+                                   double& best) const;
   void collide_granular(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
   double radius_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].radius; }
   double mass_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].mass; }
@@ -188,6 +206,9 @@ class EventEngine {
   bool granular_contacts_ = false;       // some contact law is not elastic and smooth
   HugeVector<AngularVelocity<D>> spin_;  // rough particles only
   HugeVector<double> last_collision_;    // TC model only
+  HugeVector<std::uint8_t> asleep_;      // gravity with walls only
+  std::uint32_t sleeping_ = 0;           // how many are asleep
+  double sleep_speed_ = 0.0;
   CellGrid<D> grid_;
   Queue queue_;
   std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions

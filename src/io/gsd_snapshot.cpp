@@ -12,7 +12,8 @@ namespace kairos {
 
 namespace {
 
-constexpr std::uint32_t kRestartFormat = 2;  // 2: one event time per particle, order
+// 2: one event time per particle, order; 3: granular counters, spins, TC times, sleepers
+constexpr std::uint32_t kRestartFormat = 3;
 
 // HOOMD stores type names as an N_types x M int8 array of 0-padded strings.
 std::vector<std::int8_t> pack_type_names(const std::vector<std::string>& names, std::uint32_t& m) {
@@ -39,8 +40,10 @@ std::vector<std::string> unpack_type_names(const std::vector<std::int8_t>& raw, 
 }
 
 // x as a float32 coordinate in HOOMD's centred box [-L/2, L/2). A coordinate just below L/2
-// can round up to L/2 in float32; that point is the periodic image of -L/2.
-float hoomd_coordinate(double x, double L) {
+// can round up to L/2 in float32; that point is the periodic image of -L/2. Along a
+// non-periodic axis (walls, open faces) the coordinate is shifted, never wrapped.
+float hoomd_coordinate(double x, double L, bool periodic = true) {
+  if (!periodic) return static_cast<float>(x - 0.5 * L);
   const float half = static_cast<float>(0.5 * L);
   const float c = static_cast<float>(wrap_into_box(x, L) - 0.5 * L);
   return c >= half ? -half : c;
@@ -64,13 +67,28 @@ void write_standard_chunks(gsd::Writer& w, const ParticleSystem<D>& sys, bool wi
   std::vector<float> pos(3 * n, 0.0f), vel(3 * n, 0.0f);
   for (std::uint32_t i = 0; i < n; ++i) {
     const Vec<D> x = sys.position_at(i, sys.time);
+    const Vec<D> v = sys.velocity_at(i, sys.time);
     for (int a = 0; a < D; ++a) {
-      pos[3 * i + a] = hoomd_coordinate(x[a], sys.box[a]);
-      vel[3 * i + a] = static_cast<float>(sys.kinematics[i].vel[a]);
+      pos[3 * i + a] = hoomd_coordinate(x[a], sys.box[a], sys.periodic[a]);
+      vel[3 * i + a] = static_cast<float>(v[a]);
     }
   }
   w.write_chunk("particles/position", n, 3, pos.data());
   w.write_chunk("particles/velocity", n, 3, vel.data());
+  if (!sys.angular_velocity.empty()) {
+    // Per-particle log data: OVITO and python-gsd read log/particles/* as particle
+    // properties. In 2D the spin is the z component.
+    std::vector<float> w3(3 * n, 0.0f);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const auto& om = sys.angular_velocity[i];
+      if constexpr (D == 3) {
+        for (int a = 0; a < 3; ++a) w3[3 * i + a] = static_cast<float>(om[a]);
+      } else {
+        w3[3 * i + 2] = static_cast<float>(om[0]);
+      }
+    }
+    w.write_chunk("log/particles/angular_velocity", n, 3, w3.data());
+  }
   if (with_static) {
     std::uint32_t m = 0;
     const auto names = pack_type_names(sys.species_names, m);
@@ -140,7 +158,8 @@ void validate_restart(const ParticleSystem<D>& s, const std::filesystem::path& p
       throw bad("mass" + who + " is not positive");
     if (s.species[i] >= s.species_names.size()) throw bad("typeid" + who + " out of range");
     if (std::isnan(e.time)) throw bad("pending event time" + who + " is NaN");
-    if (e.partner != EventSlot::kNoPartner && e.partner >= n)
+    // Codes above the particle indices name walls (the 2D faces below kNoPartner).
+    if (e.partner < EventSlot::kNoPartner - 2 * D && e.partner >= n)
       throw bad("collision partner" + who + " out of range");
   }
   std::vector<char> seen(n, 0);
@@ -194,7 +213,7 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
       for (int a = 0; a < D; ++a) {
         pos[i * D + a] = k.pos[a];
         vel[i * D + a] = k.vel[a];
-        now[i * D + a] = wrap_into_box(x[a], s.box[a]);
+        now[i * D + a] = s.periodic[a] ? wrap_into_box(x[a], s.box[a]) : x[a];
       }
       local[i] = k.time;
       radius[i] = k.radius;
@@ -228,6 +247,22 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     if (!s.order.empty()) w.write_chunk("kairos/state/order", n, 1, s.order.data());
     w.write_chunk("kairos/state/counters", 4, 1, counters);
     w.write_chunk("kairos/state/virial", 1, 1, &s.counters.virial);
+    const std::uint64_t granular[4] = {s.counters.wall_collisions, s.counters.elastic_by_rule,
+                                       s.counters.sliding_collisions, s.counters.fell_asleep};
+    const double energies[3] = {s.counters.dissipated_in_collisions, s.counters.dissipated_at_walls,
+                                s.counters.work_by_walls};
+    w.write_chunk("kairos/state/granular_counters", 4, 1, granular);
+    w.write_chunk("kairos/state/granular_energies", 3, 1, energies);
+    if (!s.angular_velocity.empty()) {
+      constexpr std::uint32_t kSpin = D == 3 ? 3 : 1;
+      std::vector<double> flat(n * kSpin);
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::uint32_t a = 0; a < kSpin; ++a) flat[i * kSpin + a] = s.angular_velocity[i][a];
+      w.write_chunk("kairos/state/angular_velocity", n, kSpin, flat.data());
+    }
+    if (!s.last_collision_time.empty())
+      w.write_chunk("kairos/state/last_collision_time", n, 1, s.last_collision_time.data());
+    if (!s.asleep.empty()) w.write_chunk("kairos/state/asleep", n, 1, s.asleep.data());
     w.write_chunk("kairos/state/rng", rng_bytes.size(), 1, rng_bytes.data());
     w.write_chunk("kairos/run/equilibration_remaining", 1, 1, &progress.equilibration_remaining);
     w.end_frame();
@@ -285,6 +320,26 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   const auto counters = require<std::uint64_t>(r, f, "kairos/state/counters", path, 4);
   s.counters = {counters[0], counters[1], counters[2], counters[3],
                 require<double>(r, f, "kairos/state/virial", path, 1)[0]};
+  const auto granular = require<std::uint64_t>(r, f, "kairos/state/granular_counters", path, 4);
+  const auto energies = require<double>(r, f, "kairos/state/granular_energies", path, 3);
+  s.counters.wall_collisions = granular[0];
+  s.counters.elastic_by_rule = granular[1];
+  s.counters.sliding_collisions = granular[2];
+  s.counters.fell_asleep = granular[3];
+  s.counters.dissipated_in_collisions = energies[0];
+  s.counters.dissipated_at_walls = energies[1];
+  s.counters.work_by_walls = energies[2];
+  constexpr std::size_t kSpin = D == 3 ? 3 : 1;
+  if (r.find(f, "kairos/state/angular_velocity")) {
+    const auto w = require<double>(r, f, "kairos/state/angular_velocity", path, n * kSpin);
+    s.angular_velocity.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t a = 0; a < kSpin; ++a) s.angular_velocity[i][a] = w[i * kSpin + a];
+  }
+  if (r.find(f, "kairos/state/last_collision_time"))
+    s.last_collision_time = require<double>(r, f, "kairos/state/last_collision_time", path, n);
+  if (r.find(f, "kairos/state/asleep"))
+    s.asleep = require<std::uint8_t>(r, f, "kairos/state/asleep", path, n);
   s.kinematics.resize(n);
   s.events.resize(n);
   for (std::size_t i = 0; i < n; ++i) {

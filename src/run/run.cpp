@@ -167,15 +167,23 @@ class ThermoWriter {
     if (header) {
       write_line(
           "phase\ttime\tevents\tcollisions\tcollisions_per_particle\ttemperature\tpressure\t"
-          "compressibility\tkinetic_energy\tmean_free_time\n");
+          "compressibility\tkinetic_energy\tmean_free_time\trotational_temperature\t"
+          "dissipated_energy\twall_work\n");
     }
   }
   // One row per line, each flushed at once: an interrupted run keeps every earlier row.
-  void write(const std::string& phase, const ThermoRow& r) {
+  // Granular columns: rotational temperature, and the energy dissipated and the work done by
+  // moving walls since the start of the simulation (zero for elastic hard spheres).
+  struct Granular {
+    double rotational_temperature = 0.0, dissipated = 0.0, wall_work = 0.0;
+  };
+  void write(const std::string& phase, const ThermoRow& r, const Granular& g) {
     write_line(fmt::format(
-        "{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\n", phase,
-        r.at.time, r.at.events, r.at.collisions, r.collisions_per_particle, r.temperature,
-        r.pressure, r.compressibility, r.kinetic_energy, r.mean_free_time));
+        "{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t"
+        "{:.17g}\t{:.17g}\n",
+        phase, r.at.time, r.at.events, r.at.collisions, r.collisions_per_particle, r.temperature,
+        r.pressure, r.compressibility, r.kinetic_energy, r.mean_free_time, g.rotational_temperature,
+        g.dissipated, g.wall_work));
   }
 
  private:
@@ -238,6 +246,8 @@ class RunDriver {
       const Environment<D> environment = make_environment<D>(config, start.species_names);
       engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict,
                       EngineOptions{}, environment);
+      granular_ = !environment.plain() || environment.has_gravity();
+      for (int a = 0; a < D; ++a) granular_ = granular_ || !environment.periodic(a);
     } catch (const InputError& e) {
       if (!restart_file) throw;
       throw InputError("restart file '" + restart_file->string() + "': " + e.what());
@@ -265,6 +275,8 @@ class RunDriver {
       }
     }
     ke_start_ = engine_->kinetic_energy();
+    energy_start_ = total_energy();
+    counters_start_ = engine_->counters();
     p_start_ = engine_->momentum();
     events_start_ = engine_->counters().events;
     collisions_start_ = engine_->counters().collisions;
@@ -388,8 +400,51 @@ class RunDriver {
   }
 
   void write_thermo_row(const std::string& phase) {
+    const auto& c = engine_->counters();
     thermo_->write(phase,
-                   thermo_stats_->row(point(), engine_->kinetic_energy(), phase == "production"));
+                   thermo_stats_->row(point(), engine_->kinetic_energy(), phase == "production"),
+                   {rotational_temperature(), c.dissipated_in_collisions + c.dissipated_at_walls,
+                    c.work_by_walls});
+  }
+
+  // Per rotational degree of freedom (3 for spheres, 1 for disks); 0 without spins.
+  double rotational_temperature() const {
+    return 2.0 * engine_->rotational_energy() / ((D == 3 ? 3.0 : 1.0) * static_cast<double>(n_));
+  }
+
+  // Kinetic (translational and rotational) plus potential energy in the gravity field, when
+  // the field has no component along a periodic axis (else the potential is unbounded: NaN).
+  double total_energy() const {
+    const Environment<D>& env = engine_->environment();
+    double e = engine_->kinetic_energy() + engine_->rotational_energy();
+    if (!env.has_gravity()) return e;
+    for (int a = 0; a < D; ++a)
+      if (env.periodic(a) && env.gravity[a] != 0.0) return std::nan("");
+    const ParticleSystem<D> s = engine_->export_state();
+    const std::vector<Vec<D>> x = engine_->current_positions();
+    for (std::size_t i = 0; i < n_; ++i) e -= s.mass[i] * dot(env.gravity, x[i]);
+    return e;
+  }
+
+  // Sonine coefficient of the velocity distribution, a2 = d/(d+2) <v^4>/<v^2>^2 - 1, with
+  // velocities taken relative to the mean.
+  double sonine_a2_now() const {
+    const ParticleSystem<D> s = engine_->export_state();
+    Vec<D> mean{};
+    std::vector<Vec<D>> v(n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+      v[i] = s.velocity_at(i, s.time);
+      mean = mean + (1.0 / static_cast<double>(n_)) * v[i];
+    }
+    double m2 = 0.0, m4 = 0.0;
+    for (const Vec<D>& u : v) {
+      const double c2 = norm2(u - mean);
+      m2 += c2;
+      m4 += c2 * c2;
+    }
+    m2 /= static_cast<double>(n_);
+    m4 /= static_cast<double>(n_);
+    return m2 > 0.0 ? D / (D + 2.0) * m4 / (m2 * m2) - 1.0 : std::nan("");
   }
 
   nlohmann::json summary(double wall) const {
@@ -449,6 +504,31 @@ class RunDriver {
     j["max_overlap"] = overlap;
     j["peak_rss_bytes"] = peak_rss_bytes();
     j["bytes_per_particle"] = engine_->bytes_per_particle();
+    if (!granular_) return j;
+    // Granular runs: where the energy went in this invocation, and the velocity statistics.
+    const double dissipated =
+        (c.dissipated_in_collisions - counters_start_.dissipated_in_collisions) +
+        (c.dissipated_at_walls - counters_start_.dissipated_at_walls);
+    const double work = c.work_by_walls - counters_start_.work_by_walls;
+    const double energy = total_energy();
+    const double balance = energy - energy_start_ + dissipated - work;
+    const double scale = std::max({std::abs(energy_start_), dissipated, std::abs(work)});
+    nlohmann::json g;
+    g["rotational_temperature"] = rotational_temperature();
+    g["sonine_a2"] = sonine_a2_now();
+    g["wall_collisions"] = c.wall_collisions - counters_start_.wall_collisions;
+    g["elastic_by_rule"] = c.elastic_by_rule - counters_start_.elastic_by_rule;
+    g["sliding_collisions"] = c.sliding_collisions - counters_start_.sliding_collisions;
+    g["fell_asleep"] = c.fell_asleep - counters_start_.fell_asleep;
+    g["sleeping_now"] = engine_->sleeping();
+    g["dissipated_in_collisions"] =
+        c.dissipated_in_collisions - counters_start_.dissipated_in_collisions;
+    g["dissipated_at_walls"] = c.dissipated_at_walls - counters_start_.dissipated_at_walls;
+    g["work_by_walls"] = work;
+    g["energy_start"] = energy_start_;
+    g["energy_end"] = energy;
+    g["energy_balance_relative"] = scale > 0.0 ? std::abs(balance) / scale : 0.0;
+    j["granular"] = g;
     return j;
   }
 
@@ -464,7 +544,9 @@ class RunDriver {
   std::uint64_t frame_collisions_ = 0;
   std::optional<Thermodynamics> thermo_stats_;
   ThermoPoint prod_start_;
-  double ke_start_ = 0.0, prod_ke_ = 0.0;
+  double ke_start_ = 0.0, prod_ke_ = 0.0, energy_start_ = 0.0;
+  EventCounters counters_start_;
+  bool granular_ = false;  // walls, gravity or contact laws: report the energy budget
   Vec<D> p_start_{};
   std::uint64_t events_start_ = 0, collisions_start_ = 0;
   std::string phase_ = "production";
