@@ -71,6 +71,7 @@ constexpr KeySpec kSchema[] = {
     {"contact.friction", Kind::kFloat},
     {"contact.elastic_below_speed", Kind::kFloat},
     {"contact.tc", Kind::kFloat},
+    {"contact.sleep_speed", Kind::kFloat},
     {"contact.pair", Kind::kTableArray},
     {"contact.pair[]", Kind::kTable},
     {"contact.pair[].species", Kind::kArray},
@@ -964,6 +965,12 @@ class Reader {
     read_contact(t, std::string(p), in.contact);
     const toml::node* n_tc = get_number(t, p, "tc", in.tc);
     require_non_negative(n_tc, "contact.tc", in.tc);
+    const toml::node* n_sleep = get_number(t, p, "sleep_speed", in.sleep_speed);
+    if (!(in.sleep_speed >= 0.0 || in.sleep_speed == -1.0)) {
+      fail(n_sleep, "contact.sleep_speed",
+           fmt::format("contact.sleep_speed: must be >= 0 (or -1 for automatic), got {}",
+                       in.sleep_speed));
+    }
 
     const std::vector<const toml::table*> tables = table_array(t, p, "pair");
     for (std::size_t i = 0; i < tables.size(); ++i) {
@@ -1291,6 +1298,7 @@ std::string to_toml(const Config& config) {
   out += "\n[contact]\n";
   out += contact_toml(in.contact);
   out += fmt::format("tc = {}\n", toml_float(in.tc));
+  out += fmt::format("sleep_speed = {}\n", toml_float(in.sleep_speed));
   for (const PairContactConfig& pair : in.pairs) {
     out += "\n[[contact.pair]]\n";
     out += fmt::format("species = [{}, {}]\n", toml_string(pair.species[0]),

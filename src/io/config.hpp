@@ -69,6 +69,9 @@ struct InteractionConfig {
   ContactConfig contact;                  // [contact]: every pair without an override
   std::vector<PairContactConfig> pairs;   // [[contact.pair]]
   double tc = 0.0;                        // contact.tc: TC model duration (0 = off)
+  // contact.sleep_speed: resting particles under gravity sleep below this speed; -1 = automatic
+  // (sqrt(2 |g| 1e-6 d_min)), 0 = never.
+  double sleep_speed = -1.0;
 
   bool operator==(const InteractionConfig&) const = default;
 };

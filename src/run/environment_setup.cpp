@@ -71,6 +71,7 @@ Environment<D> make_environment(const Config& config,
     }
     env.tc = in.tc;
   }
+  env.sleep_speed = in.sleep_speed;
   env.inertia_factor.assign(n, D == 3 ? kSolidSphereInertia : kDiskInertia);
   for (std::uint32_t s = 0; s < species_names.size(); ++s) {
     for (const SpeciesConfig& sc : config.system.species)

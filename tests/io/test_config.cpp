@@ -736,6 +736,12 @@ TEST(ConfigGranularErrors, ContactRanges) {
                {"contact.elastic_below_speed", ">= 0"});
   expect_error(minimal_plus("[contact]\ntc = -1e-3"), {"contact.tc", ">= 0"});
   expect_error(minimal_plus("[contact]\ntc = inf"), {"contact.tc", "finite"});
+  expect_error(minimal_plus("[contact]\nsleep_speed = -0.5"),
+               {"contact.sleep_speed", ">= 0 (or -1 for automatic)", "got -0.5"});
+  EXPECT_EQ(parse_config(minimal_plus("[contact]\nsleep_speed = 0.01"), "test.toml")
+                .interactions.sleep_speed,
+            0.01);
+  EXPECT_EQ(parse_config(minimal_plus(""), "test.toml").interactions.sleep_speed, -1.0);
   expect_error(minimal_plus("[contact]\nrestitution = \"high\""),
                {"contact.restitution", "expected a number", "found a string"});
   // inf is only for friction.
