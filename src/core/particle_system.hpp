@@ -47,11 +47,13 @@ struct EventCounters {
   std::uint64_t elastic_by_rule = 0;     // made elastic by the TC model or elastic_below_speed
   std::uint64_t sliding_collisions = 0;  // Coulomb-limited (Walton) contacts that slid
   std::uint64_t fell_asleep = 0;         // particles put to sleep (resting under gravity)
+  std::uint64_t driving_kicks = 0;       // velocities set by a thermostat or random kick
   // Kinetic energy (translational + rotational) dissipated in particle-particle and in
   // particle-wall collisions, and the work moving walls did on the particles.
   double dissipated_in_collisions = 0.0;
   double dissipated_at_walls = 0.0;
   double work_by_walls = 0.0;
+  double work_by_driving = 0.0;  // kinetic energy added by thermostat or random kicks
 };
 
 // Angular velocity: a vector in 3D, the z component alone in 2D.

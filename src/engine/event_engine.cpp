@@ -898,6 +898,23 @@ std::uint32_t EventEngine<D, Queue>::scan_with_sleepers(const CandidateList& lis
 }
 
 template <int D, class Queue>
+void EventEngine<D, Queue>::set_velocity(std::uint32_t k, double t, const Vec<D>& v) {
+  if (!(t >= time_) || !(t <= queue_.top_time()) || k >= size()) {
+    throw std::logic_error(
+        "set_velocity: time outside [time(), next_event_time()] or no such particle");
+  }
+  time_ = t;
+  if (is_asleep(k)) wake(k, t);
+  advance_to(k, t);
+  HotRecord<D>& h = hot_[k];
+  counters_.work_by_driving += 0.5 * mass_of(k) * (norm2(v) - norm2(h.vel));
+  h.vel = v;
+  ++h.collisions;
+  ++counters_.driving_kicks;
+  queue_.update(k, predict(k, t));
+}
+
+template <int D, class Queue>
 void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   HotRecord<D>& h = hot_[i];
   const Crossing x = next_crossing(h);

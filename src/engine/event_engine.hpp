@@ -81,6 +81,16 @@ class EventEngine {
   EventKind step();
 
   double time() const { return time_; }
+  // When the next event happens (kNever if nothing ever will).
+  double next_event_time() { return queue_.top_time(); }
+
+  // Driving (thermostats, random kicks) acts between events: it sets the velocity of particle k
+  // at time t, with time() <= t <= next_event_time(), wakes it if it sleeps, invalidates
+  // predictions made against it and re-predicts it. k is the engine's internal index: any
+  // numbering serves a uniform random choice, and it is restored on resume.
+  Vec<D> velocity(std::uint32_t k, double t) const { return velocity_of(k, t); }
+  double particle_mass(std::uint32_t k) const { return mass_of(k); }
+  void set_velocity(std::uint32_t k, double t, const Vec<D>& v);
   const EventCounters& counters() const { return counters_; }
   const Vec<D>& box() const { return box_; }
   // The complete state in the caller's particle numbering, scheduler state included: an engine

@@ -62,12 +62,16 @@ double viscoelastic_restitution(double x) {
 
 NormalRestitution NormalRestitution::constant(double e) {
   require_restitution(e, "the restitution coefficient");
-  return NormalRestitution(Constant{e});
+  NormalRestitution r;  // emplaced, not moved in: GCC 12 misreads the variant's move
+  r.model_.emplace<Constant>(Constant{e});
+  return r;
 }
 
 NormalRestitution NormalRestitution::viscoelastic(double k) {
   require_non_negative(k, "the viscoelastic constant k");
-  return NormalRestitution(Viscoelastic{k});
+  NormalRestitution r;
+  r.model_.emplace<Viscoelastic>(Viscoelastic{k});
+  return r;
 }
 
 NormalRestitution NormalRestitution::viscoelastic_from_material(double dissipative_time,
@@ -107,7 +111,9 @@ NormalRestitution NormalRestitution::table(std::vector<double> speeds, std::vect
       throw InputError(fmt::format("restitution table: e = {} at speed {} is outside [0, 1]",
                                    values[k], speeds[k]));
   }
-  return NormalRestitution(Table{std::move(speeds), std::move(values)});
+  NormalRestitution r;
+  r.model_.emplace<Table>(Table{std::move(speeds), std::move(values)});
+  return r;
 }
 
 double NormalRestitution::operator()(double impact_speed) const {

@@ -87,7 +87,6 @@ class NormalRestitution {
     std::vector<double> speeds, values;
   };
   using Model = std::variant<Constant, Viscoelastic, Table>;
-  explicit NormalRestitution(Model m) : model_(std::move(m)) {}
 
   Model model_{Constant{}};
 };

@@ -98,6 +98,11 @@ constexpr KeySpec kSchema[] = {
     {"boundary.wall[].amplitude", Kind::kFloat},
     {"boundary.wall[].frequency", Kind::kFloat},
     {"boundary.wall[].phase", Kind::kFloat},
+    {"driving", Kind::kTable},
+    {"driving.kind", Kind::kString},
+    {"driving.rate", Kind::kFloat},
+    {"driving.temperature", Kind::kFloat},
+    {"driving.strength", Kind::kFloat},
     {"field", Kind::kTable},
     {"field.gravity", Kind::kArray},
     {"run", Kind::kTable},
@@ -119,6 +124,7 @@ constexpr std::string_view kLattices3D[] = {"fcc", "sc", "bcc", "random"};
 constexpr std::string_view kLattices2D[] = {"hex", "square", "random"};
 constexpr std::string_view kEventQueues[] = {"calendar", "heap", "tree"};
 constexpr std::string_view kProgressModes[] = {"auto", "always", "never"};
+constexpr std::string_view kDrivingKinds[] = {"none", "andersen", "white_noise"};
 constexpr std::string_view kRestitutionModels[] = {"constant", "viscoelastic", "table"};
 // Box faces: 2k is the low face of axis k, 2k + 1 the high one.
 constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
@@ -499,6 +505,7 @@ class Reader {
     read_boundary(section(root, "boundary", empty), config.system.dimension,
                   config.interactions.contact, config.boundary);
     read_field(section(root, "field", empty), config.system.dimension, config.field);
+    read_driving(section(root, "driving", empty), config.driving);
     read_run(section(root, "run", empty), config.run);
     read_output(section(root, "output", empty), config.output);
     return config;
@@ -1135,6 +1142,23 @@ class Reader {
     }
   }
 
+  void read_driving(const toml::table& t, DrivingConfig& d) const {
+    constexpr std::string_view p = "driving";
+    const toml::node* n_kind = get_string(t, p, "kind", d.kind);
+    const toml::node* n_rate = get_number(t, p, "rate", d.rate);
+    const toml::node* n_temperature = get_number(t, p, "temperature", d.temperature);
+    const toml::node* n_strength = get_number(t, p, "strength", d.strength);
+    require_choice(n_kind, "driving.kind", d.kind, kDrivingKinds);
+    require_positive(n_rate, "driving.rate", d.rate);
+    require_positive(n_temperature, "driving.temperature", d.temperature);
+    require_non_negative(n_strength, "driving.strength", d.strength);
+    if (d.kind == "white_noise" && !(d.strength > 0.0)) {
+      fail(n_strength != nullptr ? n_strength : n_kind, "driving.strength",
+           "driving.strength: white_noise driving needs a strength > 0 (velocity variance per "
+           "unit time)");
+    }
+  }
+
   void read_run(const toml::table& t, RunConfig& r) const {
     constexpr std::string_view p = "run";
     const toml::node* n_equilibration = get_number(t, p, "equilibration_collisions_per_particle",
@@ -1320,6 +1344,11 @@ std::string to_toml(const Config& config) {
     out += fmt::format("frequency = {}\n", toml_float(w.frequency));
     out += fmt::format("phase = {}\n", toml_float(w.phase));
   }
+  out += "\n[driving]\n";
+  out += fmt::format("kind = {}\n", toml_string(config.driving.kind));
+  out += fmt::format("rate = {}\n", toml_float(config.driving.rate));
+  out += fmt::format("temperature = {}\n", toml_float(config.driving.temperature));
+  out += fmt::format("strength = {}\n", toml_float(config.driving.strength));
   out += "\n[field]\n";
   out += fmt::format("gravity = {}\n", vector_or(config.field.gravity, 0.0));
   out += "\n[run]\n";

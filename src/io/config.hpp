@@ -47,13 +47,13 @@ struct SystemConfig {
 // A contact law (particle-particle for a species pair, or particle-wall): formulas.md §2.2,
 // §3.5, §5.
 struct ContactConfig {
-  double restitution = 1.0;                   // e_n (constant), or e at restitution_speed
+  double restitution = 1.0;                    // e_n (constant), or e at restitution_speed
   std::string restitution_model = "constant";  // constant | viscoelastic | table
-  double restitution_speed = 1.0;             // viscoelastic: e(restitution_speed) = restitution
-  std::vector<std::array<double, 2>> restitution_table;  // table: (impact speed, e) pairs
-  double tangential_restitution = -1.0;  // beta in [-1, 1]; -1 smooth
+  double restitution_speed = 1.0;              // viscoelastic: e(restitution_speed) = restitution
+  std::vector<std::array<double, 2>> restitution_table;       // table: (impact speed, e) pairs
+  double tangential_restitution = -1.0;                       // beta in [-1, 1]; -1 smooth
   double friction = std::numeric_limits<double>::infinity();  // Coulomb mu (Walton); inf = no limit
-  double elastic_below_speed = 0.0;      // |g_n| below this: elastic (0 = off)
+  double elastic_below_speed = 0.0;                           // |g_n| below this: elastic (0 = off)
 
   bool operator==(const ContactConfig&) const = default;
 };
@@ -66,9 +66,9 @@ struct PairContactConfig {
 };
 
 struct InteractionConfig {
-  ContactConfig contact;                  // [contact]: every pair without an override
-  std::vector<PairContactConfig> pairs;   // [[contact.pair]]
-  double tc = 0.0;                        // contact.tc: TC model duration (0 = off)
+  ContactConfig contact;                 // [contact]: every pair without an override
+  std::vector<PairContactConfig> pairs;  // [[contact.pair]]
+  double tc = 0.0;                       // contact.tc: TC model duration (0 = off)
   // contact.sleep_speed: resting particles under gravity sleep below this speed; -1 = automatic
   // (sqrt(2 |g| 1e-6 d_min)), 0 = never.
   double sleep_speed = -1.0;
@@ -77,19 +77,19 @@ struct InteractionConfig {
 };
 
 struct WallConfig {
-  std::string face;        // x- x+ y- y+ z- z+
-  ContactConfig contact;   // restitution etc. of particle-wall collisions
+  std::string face;              // x- x+ y- y+ z- z+
+  ContactConfig contact;         // restitution etc. of particle-wall collisions
   std::vector<double> velocity;  // in-plane sliding velocity (D components), empty = at rest
-  double amplitude = 0.0;  // vibration along the normal: A sin(2 pi f t + phase)
-  double frequency = 0.0;  // f, cycles per unit time
-  double phase = 0.0;      // radians
+  double amplitude = 0.0;        // vibration along the normal: A sin(2 pi f t + phase)
+  double frequency = 0.0;        // f, cycles per unit time
+  double phase = 0.0;            // radians
 
   bool operator==(const WallConfig&) const = default;
 };
 
 struct BoundaryConfig {
-  std::vector<WallConfig> walls;   // [[boundary.wall]]
-  std::vector<std::string> open;   // boundary.open: faces with no wall (e.g. "z+")
+  std::vector<WallConfig> walls;  // [[boundary.wall]]
+  std::vector<std::string> open;  // boundary.open: faces with no wall (e.g. "z+")
 
   bool operator==(const BoundaryConfig&) const = default;
 };
@@ -121,6 +121,20 @@ struct OutputConfig {
   bool operator==(const OutputConfig&) const = default;
 };
 
+// Stochastic driving: random events at `rate` per particle per unit time, each acting on one
+// random particle. andersen: a new Maxwell-Boltzmann velocity at `temperature` (a thermostat);
+// white_noise: a Gaussian velocity kick whose variance per component is strength / rate, so
+// that the velocity diffuses with variance `strength` per unit time (energy input D m
+// strength / 2 per particle per unit time).
+struct DrivingConfig {
+  std::string kind = "none";  // none | andersen | white_noise
+  double rate = 1.0;          // > 0
+  double temperature = 1.0;   // andersen: > 0
+  double strength = 0.0;      // white_noise: > 0
+
+  bool operator==(const DrivingConfig&) const = default;
+};
+
 struct Config {
   SystemConfig system;
   RunConfig run;
@@ -128,6 +142,7 @@ struct Config {
   InteractionConfig interactions;  // TOML section [contact]
   BoundaryConfig boundary;         // [boundary]
   FieldConfig field;               // [field]
+  DrivingConfig driving;           // [driving]
 
   bool operator==(const Config&) const = default;  // memberwise (exact doubles)
 };

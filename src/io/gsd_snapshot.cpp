@@ -247,12 +247,14 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     if (!s.order.empty()) w.write_chunk("kairos/state/order", n, 1, s.order.data());
     w.write_chunk("kairos/state/counters", 4, 1, counters);
     w.write_chunk("kairos/state/virial", 1, 1, &s.counters.virial);
-    const std::uint64_t granular[4] = {s.counters.wall_collisions, s.counters.elastic_by_rule,
-                                       s.counters.sliding_collisions, s.counters.fell_asleep};
-    const double energies[3] = {s.counters.dissipated_in_collisions, s.counters.dissipated_at_walls,
-                                s.counters.work_by_walls};
-    w.write_chunk("kairos/state/granular_counters", 4, 1, granular);
-    w.write_chunk("kairos/state/granular_energies", 3, 1, energies);
+    const std::uint64_t granular[5] = {s.counters.wall_collisions, s.counters.elastic_by_rule,
+                                       s.counters.sliding_collisions, s.counters.fell_asleep,
+                                       s.counters.driving_kicks};
+    const double energies[4] = {s.counters.dissipated_in_collisions, s.counters.dissipated_at_walls,
+                                s.counters.work_by_walls, s.counters.work_by_driving};
+    w.write_chunk("kairos/state/granular_counters", 5, 1, granular);
+    w.write_chunk("kairos/state/granular_energies", 4, 1, energies);
+    w.write_chunk("kairos/run/next_kick_time", 1, 1, &progress.next_kick_time);
     if (!s.angular_velocity.empty()) {
       constexpr std::uint32_t kSpin = D == 3 ? 3 : 1;
       std::vector<double> flat(n * kSpin);
@@ -320,8 +322,10 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   const auto counters = require<std::uint64_t>(r, f, "kairos/state/counters", path, 4);
   s.counters = {counters[0], counters[1], counters[2], counters[3],
                 require<double>(r, f, "kairos/state/virial", path, 1)[0]};
-  const auto granular = require<std::uint64_t>(r, f, "kairos/state/granular_counters", path, 4);
-  const auto energies = require<double>(r, f, "kairos/state/granular_energies", path, 3);
+  const auto granular = require<std::uint64_t>(r, f, "kairos/state/granular_counters", path, 5);
+  const auto energies = require<double>(r, f, "kairos/state/granular_energies", path, 4);
+  s.counters.driving_kicks = granular[4];
+  s.counters.work_by_driving = energies[3];
   s.counters.wall_collisions = granular[0];
   s.counters.elastic_by_rule = granular[1];
   s.counters.sliding_collisions = granular[2];
@@ -366,6 +370,8 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
       }
       progress->equilibration_remaining = left;
     }
+    if (r.find(f, "kairos/run/next_kick_time"))
+      progress->next_kick_time = require<double>(r, f, "kairos/run/next_kick_time", path, 1)[0];
   }
   return s;
 }

@@ -27,6 +27,7 @@ void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& syste
 // Where the run that wrote a restart file stood, beyond the physical state.
 struct RunProgress {
   double equilibration_remaining = 0.0;  // collisions per particle still to equilibrate
+  double next_kick_time = -1.0;          // driving: when the next random event is due (< 0: draw)
 };
 
 // Writes the restart file atomically (temporary file + rename).

@@ -246,7 +246,8 @@ class RunDriver {
       const Environment<D> environment = make_environment<D>(config, start.species_names);
       engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict,
                       EngineOptions{}, environment);
-      granular_ = !environment.plain() || environment.has_gravity();
+      driven_ = config.driving.kind != "none";
+      granular_ = !environment.plain() || environment.has_gravity() || driven_;
       for (int a = 0; a < D; ++a) granular_ = granular_ || !environment.periodic(a);
     } catch (const InputError& e) {
       if (!restart_file) throw;
@@ -276,6 +277,11 @@ class RunDriver {
     }
     ke_start_ = engine_->kinetic_energy();
     energy_start_ = total_energy();
+    if (driven_) {
+      next_kick_ = restart_ && resumed_.next_kick_time >= engine_->time()
+                       ? resumed_.next_kick_time
+                       : engine_->time() + draw_kick_interval();
+    }
     counters_start_ = engine_->counters();
     p_start_ = engine_->momentum();
     events_start_ = engine_->counters().events;
@@ -340,7 +346,35 @@ class RunDriver {
     if (phase_ == "equilibration" && c < equilibration_target_) {
       p.equilibration_remaining = per_particle(equilibration_target_ - c);
     }
+    p.next_kick_time = driven_ ? next_kick_ : -1.0;
     return p;
+  }
+
+  // Stochastic driving ([driving]): Poisson events at rate N * rate, each on one random
+  // particle, applied between the engine's events. The RNG and the next event's time are in
+  // the restart file, so a continued run draws the same kicks.
+  double draw_kick_interval() {
+    std::exponential_distribution<double> wait(config_.driving.rate * static_cast<double>(n_));
+    return wait(rng_);
+  }
+  void apply_due_kicks() {
+    while (next_kick_ <= engine_->next_event_time()) {
+      std::uniform_int_distribution<std::uint32_t> pick(0, static_cast<std::uint32_t>(n_ - 1));
+      const std::uint32_t k = pick(rng_);
+      const DrivingConfig& d = config_.driving;
+      Vec<D> v{};
+      if (d.kind == "andersen") {
+        std::normal_distribution<double> maxwell(
+            0.0, std::sqrt(d.temperature / engine_->particle_mass(k)));
+        for (int a = 0; a < D; ++a) v[a] = maxwell(rng_);
+      } else {
+        std::normal_distribution<double> kick(0.0, std::sqrt(d.strength / d.rate));
+        v = engine_->velocity(k, next_kick_);
+        for (int a = 0; a < D; ++a) v[a] += kick(rng_);
+      }
+      engine_->set_velocity(k, next_kick_, v);
+      next_kick_ += draw_kick_interval();
+    }
   }
 
   ThermoPoint point() const {
@@ -365,6 +399,7 @@ class RunDriver {
                             [&](double c) { return collisions_for(c); });
     progress.update({phase, 0.0, length, engine_->time(), engine_->counters().events});
     while (engine_->counters().collisions < target) {
+      if (driven_) apply_due_kicks();
       if (engine_->step() == EventKind::kNone) {
         stop_reason_ = "no_more_events";  // every particle at rest, or alone
         break;
@@ -509,7 +544,8 @@ class RunDriver {
     const double dissipated =
         (c.dissipated_in_collisions - counters_start_.dissipated_in_collisions) +
         (c.dissipated_at_walls - counters_start_.dissipated_at_walls);
-    const double work = c.work_by_walls - counters_start_.work_by_walls;
+    const double work = (c.work_by_walls - counters_start_.work_by_walls) +
+                        (c.work_by_driving - counters_start_.work_by_driving);
     const double energy = total_energy();
     const double balance = energy - energy_start_ + dissipated - work;
     const double scale = std::max({std::abs(energy_start_), dissipated, std::abs(work)});
@@ -524,7 +560,9 @@ class RunDriver {
     g["dissipated_in_collisions"] =
         c.dissipated_in_collisions - counters_start_.dissipated_in_collisions;
     g["dissipated_at_walls"] = c.dissipated_at_walls - counters_start_.dissipated_at_walls;
-    g["work_by_walls"] = work;
+    g["work_by_walls"] = c.work_by_walls - counters_start_.work_by_walls;
+    g["work_by_driving"] = c.work_by_driving - counters_start_.work_by_driving;
+    g["driving_kicks"] = c.driving_kicks - counters_start_.driving_kicks;
     g["energy_start"] = energy_start_;
     g["energy_end"] = energy;
     g["energy_balance_relative"] = scale > 0.0 ? std::abs(balance) / scale : 0.0;
@@ -547,6 +585,8 @@ class RunDriver {
   double ke_start_ = 0.0, prod_ke_ = 0.0, energy_start_ = 0.0;
   EventCounters counters_start_;
   bool granular_ = false;  // walls, gravity or contact laws: report the energy budget
+  bool driven_ = false;    // [driving]: thermostat or random kicks
+  double next_kick_ = 0.0;
   Vec<D> p_start_{};
   std::uint64_t events_start_ = 0, collisions_start_ = 0;
   std::string phase_ = "production";

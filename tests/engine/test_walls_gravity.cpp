@@ -233,8 +233,12 @@ void check_granular_resume() {
   EXPECT_NEAR(balance, 0.0, 1e-9 * (e0 + c.dissipated_in_collisions));
 }
 
-TEST(WallsAndGravity, GranularRunResumesBitForBit3D) { check_granular_resume<3>(); }
-TEST(WallsAndGravity, GranularRunResumesBitForBit2D) { check_granular_resume<2>(); }
+TEST(WallsAndGravity, GranularRunResumesBitForBit3D) {
+  check_granular_resume<3>();
+}
+TEST(WallsAndGravity, GranularRunResumesBitForBit2D) {
+  check_granular_resume<2>();
+}
 
 }  // namespace
 }  // namespace kairos

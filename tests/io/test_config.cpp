@@ -736,6 +736,19 @@ TEST(ConfigGranularErrors, ContactRanges) {
                {"contact.elastic_below_speed", ">= 0"});
   expect_error(minimal_plus("[contact]\ntc = -1e-3"), {"contact.tc", ">= 0"});
   expect_error(minimal_plus("[contact]\ntc = inf"), {"contact.tc", "finite"});
+  expect_error(minimal_plus("[driving]\nkind = \"langevin\""),
+               {"driving.kind", "'langevin'", "none, andersen, white_noise"});
+  expect_error(minimal_plus("[driving]\nkind = \"white_noise\""),
+               {"driving.strength", "white_noise driving needs a strength > 0"});
+  expect_error(minimal_plus("[driving]\nrate = 0"), {"driving.rate", "> 0"});
+  {
+    const Config c = parse_config(
+        minimal_plus("[driving]\nkind = \"andersen\"\ntemperature = 2.5\nrate = 0.1"), "test.toml");
+    EXPECT_EQ(c.driving.kind, "andersen");
+    EXPECT_EQ(c.driving.temperature, 2.5);
+    EXPECT_EQ(c.driving.rate, 0.1);
+    EXPECT_EQ(parse_config(to_toml(c), "round-trip"), c);
+  }
   expect_error(minimal_plus("[contact]\nsleep_speed = -0.5"),
                {"contact.sleep_speed", ">= 0 (or -1 for automatic)", "got -0.5"});
   EXPECT_EQ(parse_config(minimal_plus("[contact]\nsleep_speed = 0.01"), "test.toml")

@@ -55,7 +55,10 @@ class GsdInterop : public ::testing::Test {
     const fs::path script = dir_ / ("script" + std::to_string(scripts_++) + ".py");
     std::ofstream(script) << code;
     std::string command = std::string(KAIROS_PYTHON) + " " + quote(script.string());
-    for (const auto& a : args) command += " " + quote(a.string());
+    for (const auto& a : args) {
+      command += ' ';
+      command += quote(a.string());
+    }
     command += " 2>&1";
     PythonRun run{-1, ""};
     FILE* pipe = ::popen(command.c_str(), "r");

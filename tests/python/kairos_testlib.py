@@ -68,6 +68,8 @@ def _toml_value(v):
         return repr(v)
     if isinstance(v, str):
         return json.dumps(v)  # a JSON string of ASCII text is a valid TOML basic string
+    if isinstance(v, (list, tuple)):
+        return "[%s]" % ", ".join(_toml_value(x) for x in v)
     raise TypeError("no TOML form for %r" % (v,))
 
 

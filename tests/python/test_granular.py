@@ -1,0 +1,110 @@
+"""Granular runs end to end: driving (Andersen thermostat, white-noise kicks) against theory,
+the energy budget in summary.json, spins in the trajectory, unwrapped positions along open
+axes, and exact restarts of a driven, rough, walled run with gravity.
+"""
+
+import math
+import os
+
+import numpy as np
+
+import kairos_testlib as kt
+
+
+def mean_temperature(outdir, phase="production"):
+    header, rows, _ = kt.read_thermo(os.path.join(outdir, "thermo.tsv"))
+    col = header.index("temperature")
+    values = [r[col] for r in rows if r[0] == phase]
+    return float(np.mean(values)), float(np.std(values) / math.sqrt(len(values)))
+
+
+class Driving(kt.KairosTestCase):
+    def test_andersen_thermostat_brings_an_elastic_gas_to_the_bath_temperature(self):
+        config = kt.base_config(particles=2000, packing_fraction=0.1, equilibration=20.0,
+                                production=40.0,
+                                driving={"kind": "andersen", "temperature": 2.0, "rate": 0.5},
+                                output={"thermo_interval": 1.0})
+        self.run_ok("run", self.write_config(config), "-o", self.path("andersen"))
+        t, err = mean_temperature(self.path("andersen"))
+        # The kinetic temperature counts D (N - 1) degrees of freedom; the bath acts on D N.
+        self.assertAlmostEqual(t, 2.0 * 2000 / 1999, delta=max(4 * err, 0.01))
+        g = self.summary(self.path("andersen"))["granular"]
+        self.assertGreater(g["driving_kicks"], 1000)
+        self.assertLess(g["energy_balance_relative"], 1e-9)
+
+    def test_white_noise_balances_inelastic_cooling_at_the_enskog_temperature(self):
+        # Input D xi^2 / 2 per particle per time equals the dissipation (1 - e^2) w_E(T) T / 2:
+        # T^(3/2) = D xi^2 / ((1 - e^2) 4 n g(sigma) sqrt(pi)) in 3D (sigma = m = 1).
+        eta, e, xi2 = 0.05, 0.9, 0.1
+        config = kt.base_config(particles=2000, packing_fraction=eta, lattice="random",
+                                equilibration=30.0, production=60.0,
+                                contact={"restitution": e},
+                                driving={"kind": "white_noise", "strength": xi2, "rate": 2.0},
+                                output={"thermo_interval": 1.0})
+        self.run_ok("run", self.write_config(config), "-o", self.path("noise"))
+        n = 6 * eta / math.pi
+        g = (1 - eta / 2) / (1 - eta) ** 3
+        predicted = (3 * xi2 / ((1 - e * e) * 4 * n * g * math.sqrt(math.pi))) ** (2.0 / 3.0)
+        t, err = mean_temperature(self.path("noise"))
+        # Enskog's collision frequency and the Maxwellian dissipation hold to ~1 % here.
+        self.assertAlmostEqual(t / predicted, 1.0, delta=0.04 + 4 * err / predicted)
+        s = self.summary(self.path("noise"))["granular"]
+        self.assertLess(s["energy_balance_relative"], 1e-9)
+        self.assertGreater(s["work_by_driving"], 0.0)
+
+
+class GranularOutputs(kt.KairosTestCase):
+    def rough_bed(self, production):
+        return kt.base_config(
+            dimension=2, particles=200, packing_fraction=0.3, lattice="random", seed=3,
+            equilibration=0.0, production=production,
+            system={"box_scale": [1.0, 4.0]},
+            contact={"restitution": 0.85, "tangential_restitution": 0.4, "tc": 1e-4},
+            boundary={"open": ["y+"],
+                      "wall": [{"face": "x-"}, {"face": "x+"},
+                               {"face": "y-", "amplitude": 0.1, "frequency": 1.0}]},
+            field={"gravity": [0.0, -1.0]},
+            driving={"kind": "white_noise", "strength": 0.01, "rate": 0.2},
+            output={"trajectory_interval": 10.0})
+
+    def test_budget_spins_and_unwrapped_positions(self):
+        self.run_ok("run", self.write_config(self.rough_bed(40.0)), "-o", self.path("bed"))
+        s = self.summary(self.path("bed"))
+        g = s["granular"]
+        for key in ("rotational_temperature", "sonine_a2", "wall_collisions",
+                    "dissipated_in_collisions", "dissipated_at_walls", "work_by_walls",
+                    "work_by_driving", "energy_balance_relative"):
+            self.assertIn(key, g)
+        self.assertGreater(g["rotational_temperature"], 0.0)
+        self.assertGreater(g["wall_collisions"], 0)
+        self.assertLess(g["energy_balance_relative"], 1e-9)
+        self.assertEqual(s["max_overlap"], 0.0)
+        traj = kt.open_trajectory(self.path("bed", "trajectory.gsd"))
+        last = traj[len(traj) - 1]
+        spins = last.log["particles/angular_velocity"]
+        self.assertEqual(spins.shape, (200, 3))
+        self.assertTrue(np.any(spins[:, 2] != 0.0))
+        self.assertTrue(np.all(spins[:, :2] == 0.0))
+        # Along the bounded y axis nothing is wrapped: every particle is above the floor's
+        # lowest position (y = -A, i.e. -L/2 - A in HOOMD's centred coordinates).
+        ly = last.configuration.box[1]
+        self.assertTrue(np.all(last.particles.position[:, 1] > -0.5 * ly - 0.1))
+
+    def test_driven_walled_run_restarts_bit_for_bit(self):
+        half = self.write_config(self.rough_bed(20.0), "half.toml")
+        full = self.write_config(self.rough_bed(40.0), "full.toml")
+        self.run_ok("run", half, "-o", self.path("first"))
+        self.run_ok("run", half, "--restart", self.path("first", "restart.gsd"),
+                    "-o", self.path("second"))
+        self.run_ok("run", full, "-o", self.path("whole"))
+        split = kt.read_exact_state(self.path("second", "restart.gsd"))
+        whole = kt.read_exact_state(self.path("whole", "restart.gsd"))
+        for name in kt.EXACT_CHUNKS:
+            self.assertTrue(np.array_equal(split[name], whole[name]), name)
+        a = kt.restart_chunk(self.path("second", "restart.gsd"), "kairos/state/angular_velocity")
+        b = kt.restart_chunk(self.path("whole", "restart.gsd"), "kairos/state/angular_velocity")
+        self.assertTrue(np.array_equal(a, b))
+
+
+if __name__ == "__main__":
+    kt.main()
