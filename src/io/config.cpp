@@ -118,6 +118,8 @@ constexpr KeySpec kSchema[] = {
     {"output.restart_interval", Kind::kFloat},
     {"output.trajectory", Kind::kBoolean},
     {"output.progress", Kind::kString},
+    {"output.profile_axis", Kind::kString},
+    {"output.profile_bins", Kind::kInteger},
 };
 
 constexpr std::string_view kLattices3D[] = {"fcc", "sc", "bcc", "random"};
@@ -507,7 +509,7 @@ class Reader {
     read_field(section(root, "field", empty), config.system.dimension, config.field);
     read_driving(section(root, "driving", empty), config.driving);
     read_run(section(root, "run", empty), config.run);
-    read_output(section(root, "output", empty), config.output);
+    read_output(section(root, "output", empty), config.system.dimension, config.output);
     return config;
   }
 
@@ -1176,7 +1178,7 @@ class Reader {
     require_non_negative(n_wall, "run.max_wall_seconds", r.max_wall_seconds);
   }
 
-  void read_output(const toml::table& t, OutputConfig& o) const {
+  void read_output(const toml::table& t, int dimension, OutputConfig& o) const {
     constexpr std::string_view p = "output";
     const toml::node* n_directory = get_string(t, p, "directory", o.directory);
     const toml::node* n_thermo = get_number(t, p, "thermo_interval", o.thermo_interval);
@@ -1184,6 +1186,19 @@ class Reader {
     const toml::node* n_restart = get_number(t, p, "restart_interval", o.restart_interval);
     get_bool(t, p, "trajectory", o.trajectory);
     const toml::node* n_progress = get_string(t, p, "progress", o.progress);
+    const toml::node* n_axis = get_string(t, p, "profile_axis", o.profile_axis);
+    const toml::node* n_bins = get_integer(t, p, "profile_bins", o.profile_bins);
+    if (!(o.profile_axis.empty() || o.profile_axis == "x" || o.profile_axis == "y" ||
+          (o.profile_axis == "z" && dimension == 3))) {
+      fail(n_axis, "output.profile_axis",
+           fmt::format("output.profile_axis: '{}' is not an axis of a {}D box (x, y{}, or \"\" for "
+                       "no profile)",
+                       o.profile_axis, dimension, dimension == 3 ? ", z" : ""));
+    }
+    if (o.profile_bins < 1 || o.profile_bins > 100000) {
+      fail(n_bins, "output.profile_bins",
+           fmt::format("output.profile_bins: must be in [1, 100000], got {}", o.profile_bins));
+    }
 
     if (o.directory.empty()) {
       fail(n_directory, "output.directory", "output.directory: must not be empty");
@@ -1365,6 +1380,8 @@ std::string to_toml(const Config& config) {
   out += fmt::format("restart_interval = {}\n", toml_float(o.restart_interval));
   out += fmt::format("trajectory = {}\n", o.trajectory);
   out += fmt::format("progress = {}\n", toml_string(o.progress));
+  out += fmt::format("profile_axis = {}\n", toml_string(o.profile_axis));
+  out += fmt::format("profile_bins = {}\n", o.profile_bins);
   return out;
 }
 

@@ -117,6 +117,10 @@ struct OutputConfig {
   double restart_interval = 0.0;     // collisions per particle between restart files; 0 = end
   bool trajectory = true;            // write trajectory.gsd at all
   std::string progress = "auto";     // auto (when stderr is a terminal) | always | never
+  // Profiles along an axis (profile.tsv), sampled at every production thermo row: "" = none,
+  // else x, y or z, in profile_bins slabs.
+  std::string profile_axis;
+  std::int64_t profile_bins = 50;
 
   bool operator==(const OutputConfig&) const = default;
 };

@@ -11,8 +11,10 @@
 
 #include <fmt/format.h>
 
+#include "analysis/profile.hpp"
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
+#include "core/periodic.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
 #include "io/atomic_file.hpp"
@@ -253,6 +255,14 @@ class RunDriver {
       if (!restart_file) throw;
       throw InputError("restart file '" + restart_file->string() + "': " + e.what());
     }
+    if (!config.output.profile_axis.empty()) {
+      const int axis = config.output.profile_axis[0] - 'x';
+      const Vec<D>& box = engine_->box();
+      double cross = 1.0;
+      for (int a = 0; a < D; ++a)
+        if (a != axis) cross *= box[a];
+      profile_.emplace(axis, static_cast<int>(config.output.profile_bins), 0.0, box[axis], cross);
+    }
     dir_ = config.output.directory;
     std::error_code ec;
     fs::create_directories(dir_, ec);
@@ -318,6 +328,7 @@ class RunDriver {
     outcome.interrupted = stopped;
     outcome.summary = summary(wall);  // before the restart copy inflates the peak memory
     write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
+    if (profile_) profile_->write(dir_ / "profile.tsv");
     write_text_atomically(dir_ / "summary.json", outcome.summary.dump(2) + "\n");
     return outcome;
   }
@@ -434,7 +445,23 @@ class RunDriver {
     return false;
   }
 
+  void sample_profile() {
+    const ParticleSystem<D> s = engine_->export_state();
+    std::vector<Vec<D>> x(n_), v(n_);
+    std::vector<double> volume(n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+      x[i] = s.position_at(i, s.time);
+      for (int a = 0; a < D; ++a)
+        if (s.periodic[a]) x[i][a] = wrap_into_box(x[i][a], s.box[a]);
+      v[i] = s.velocity_at(i, s.time);
+      const double r = s.kinematics[i].radius;
+      volume[i] = D == 3 ? 4.0 / 3.0 * std::numbers::pi * r * r * r : std::numbers::pi * r * r;
+    }
+    profile_->sample(x, v, s.mass, volume);
+  }
+
   void write_thermo_row(const std::string& phase) {
+    if (profile_ && phase == "production") sample_profile();
     const auto& c = engine_->counters();
     thermo_->write(phase,
                    thermo_stats_->row(point(), engine_->kinetic_energy(), phase == "production"),
@@ -586,6 +613,7 @@ class RunDriver {
   EventCounters counters_start_;
   bool granular_ = false;  // walls, gravity or contact laws: report the energy budget
   bool driven_ = false;    // [driving]: thermostat or random kicks
+  std::optional<AxisProfile<D>> profile_;  // output.profile_axis
   double next_kick_ = 0.0;
   Vec<D> p_start_{};
   std::uint64_t events_start_ = 0, collisions_start_ = 0;

@@ -741,6 +741,9 @@ TEST(ConfigGranularErrors, ContactRanges) {
   expect_error(minimal_plus("[driving]\nkind = \"white_noise\""),
                {"driving.strength", "white_noise driving needs a strength > 0"});
   expect_error(minimal_plus("[driving]\nrate = 0"), {"driving.rate", "> 0"});
+  expect_error(minimal_plus("[output]\nprofile_axis = \"w\""),
+               {"output.profile_axis", "'w' is not an axis of a 3D box"});
+  expect_error(minimal_plus("[output]\nprofile_bins = 0"), {"output.profile_bins", "got 0"});
   {
     const Config c = parse_config(
         minimal_plus("[driving]\nkind = \"andersen\"\ntemperature = 2.5\nrate = 0.1"), "test.toml");

@@ -65,7 +65,7 @@ class GranularOutputs(kt.KairosTestCase):
                                {"face": "y-", "amplitude": 0.1, "frequency": 1.0}]},
             field={"gravity": [0.0, -1.0]},
             driving={"kind": "white_noise", "strength": 0.01, "rate": 0.2},
-            output={"trajectory_interval": 10.0})
+            output={"trajectory_interval": 10.0, "profile_axis": "y", "profile_bins": 20})
 
     def test_budget_spins_and_unwrapped_positions(self):
         self.run_ok("run", self.write_config(self.rough_bed(40.0)), "-o", self.path("bed"))
@@ -89,6 +89,20 @@ class GranularOutputs(kt.KairosTestCase):
         # lowest position (y = -A, i.e. -L/2 - A in HOOMD's centred coordinates).
         ly = last.configuration.box[1]
         self.assertTrue(np.all(last.particles.position[:, 1] > -0.5 * ly - 0.1))
+        # The profile accounts for every particle: slabs plus those outside the binned range.
+        with open(self.path("bed", "profile.tsv")) as f:
+            comment = f.readline()
+            header = f.readline().rstrip("\n").split("\t")
+            rows = [[float(x) for x in line.split("\t")] for line in f]
+        outside = float(comment.rsplit(":", 1)[1])
+        lx = last.configuration.box[0]
+        width = ly / len(rows)
+        counted = sum(r[header.index("number_density")] * width * lx for r in rows)
+        self.assertEqual(len(rows), 20)
+        self.assertAlmostEqual(counted + outside, 200.0, delta=1e-4)  # 10 printed digits
+        fractions = [r[header.index("packing_fraction")] for r in rows]
+        self.assertGreater(max(fractions), 0.3)  # the bed sits at the bottom
+        self.assertGreater(fractions[0], fractions[-1])
 
     def test_driven_walled_run_restarts_bit_for_bit(self):
         half = self.write_config(self.rough_bed(20.0), "half.toml")
