@@ -607,17 +607,28 @@ class Reader {
     return node;
   }
 
+  // The array at `key` (nullptr when the key is absent; `node` receives its node); anything
+  // else is an error expecting an array of `what`.
+  const toml::array* get_array(const toml::table& t, std::string_view prefix, std::string_view key,
+                               std::string_view what, const toml::node*& node) const {
+    node = t.get(key);
+    if (node == nullptr) return nullptr;
+    const toml::array* array = node->as_array();
+    if (array == nullptr) {
+      const std::string path = join_key(prefix, key);
+      fail(node, path,
+           fmt::format("{}: expected an array of {}, found {}", path, what, describe(*node)));
+    }
+    return array;
+  }
+
   // An array of finite numbers (elements named "key[i]" in errors).
   const toml::node* get_numbers(const toml::table& t, std::string_view prefix, std::string_view key,
                                 std::vector<double>& out) const {
-    const toml::node* node = t.get(key);
-    if (node == nullptr) return nullptr;
+    const toml::node* node = nullptr;
+    const toml::array* array = get_array(t, prefix, key, "numbers", node);
+    if (array == nullptr) return nullptr;
     const std::string path = join_key(prefix, key);
-    const toml::array* array = node->as_array();
-    if (array == nullptr) {
-      fail(node, path,
-           fmt::format("{}: expected an array of numbers, found {}", path, describe(*node)));
-    }
     out.clear();
     for (std::size_t i = 0; i < array->size(); ++i) {
       out.push_back(number_value(*array->get(i), fmt::format("{}[{}]", path, i)));
@@ -641,14 +652,10 @@ class Reader {
   // An array of strings.
   const toml::node* get_strings(const toml::table& t, std::string_view prefix, std::string_view key,
                                 std::vector<std::string>& out) const {
-    const toml::node* node = t.get(key);
-    if (node == nullptr) return nullptr;
+    const toml::node* node = nullptr;
+    const toml::array* array = get_array(t, prefix, key, "strings", node);
+    if (array == nullptr) return nullptr;
     const std::string path = join_key(prefix, key);
-    const toml::array* array = node->as_array();
-    if (array == nullptr) {
-      fail(node, path,
-           fmt::format("{}: expected an array of strings, found {}", path, describe(*node)));
-    }
     out.clear();
     for (std::size_t i = 0; i < array->size(); ++i) {
       const toml::node* element = array->get(i);
