@@ -42,6 +42,9 @@ struct EventCounters {
   std::uint64_t cell_crossings = 0;
   std::uint64_t stale_events = 0;  // popped events invalidated by a partner's collision
   double virial = 0.0;             // sum over collisions of r_ij . J_i (J_i: impulse on i)
+  // The same sum as a tensor, r_ij,a J_i,b (row-major D x D; its trace is `virial`): the
+  // collisional part of the pressure tensor.
+  std::array<double, 9> virial_tensor{};
   // Granular bookkeeping (zero for elastic hard spheres in a periodic box).
   std::uint64_t wall_collisions = 0;
   std::uint64_t elastic_by_rule = 0;     // made elastic by the TC model or elastic_below_speed

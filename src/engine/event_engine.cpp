@@ -658,6 +658,7 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
       hj.vel[a] -= s * r[a] / mj;
     }
     counters_.virial += s * r2;
+    add_virial_tensor(r, s * r);
   }
   ++counters_.collisions;
   ++hi.collisions;
@@ -706,6 +707,7 @@ void EventEngine<D, Queue>::collide_granular(std::uint32_t i, std::uint32_t j, d
     spin_[j] = from_spin<D>(wj);
   }
   counters_.virial += dot(r, res.impulse);
+  add_virial_tensor(r, res.impulse);
   counters_.dissipated_in_collisions += res.dissipated;
   counters_.elastic_by_rule += res.made_elastic ? 1u : 0u;
   counters_.sliding_collisions += res.slid ? 1u : 0u;
@@ -784,6 +786,12 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
 }
 
 template <int D, class Queue>
+void EventEngine<D, Queue>::add_virial_tensor(const Vec<D>& r, const Vec<D>& impulse) {
+  for (int a = 0; a < D; ++a)
+    for (int b = 0; b < D; ++b) counters_.virial_tensor[a * D + b] += r[a] * impulse[b];
+}
+
+template <int D, class Queue>
 void EventEngine<D, Queue>::fall_asleep(std::uint32_t i, double t) {
   HotRecord<D>& h = hot_[i];
   h.time = t;
@@ -845,6 +853,7 @@ void EventEngine<D, Queue>::collide_with_sleeper(std::uint32_t i, std::uint32_t 
       hi.vel = hi.vel + (s / mi) * r;
       hot_[j].vel = hot_[j].vel - (s / mj) * r;
       counters_.virial += s * r2;
+      add_virial_tensor(r, s * r);
     }
     ++hot_[j].collisions;
   } else {
@@ -862,6 +871,7 @@ void EventEngine<D, Queue>::collide_with_sleeper(std::uint32_t i, std::uint32_t 
     if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
     counters_.dissipated_in_collisions += res.dissipated;
     counters_.virial += dot(r, res.impulse);
+    add_virial_tensor(r, res.impulse);
     counters_.dissipated_in_collisions -= settle_after_contact(i, n, Vec<D>{}, t);
   }
   ++counters_.collisions;

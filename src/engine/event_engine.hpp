@@ -156,6 +156,7 @@ class EventEngine {
   Vec<D> velocity_of(std::uint32_t i, double t) const {
     return is_asleep(i) ? Vec<D>{} : velocity_at(hot_[i], t);
   }
+  void add_virial_tensor(const Vec<D>& r, const Vec<D>& impulse);
   void fall_asleep(std::uint32_t i, double t);
   void wake(std::uint32_t i, double t);
   // Leaves a resting contact (normal n, gravity into it) asleep or with at least the sleep

@@ -1,5 +1,6 @@
 #include "io/gsd_snapshot.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -252,6 +253,7 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
                                        s.counters.driving_kicks};
     const double energies[4] = {s.counters.dissipated_in_collisions, s.counters.dissipated_at_walls,
                                 s.counters.work_by_walls, s.counters.work_by_driving};
+    w.write_chunk("kairos/state/virial_tensor", 9, 1, s.counters.virial_tensor.data());
     w.write_chunk("kairos/state/granular_counters", 5, 1, granular);
     w.write_chunk("kairos/state/granular_energies", 4, 1, energies);
     w.write_chunk("kairos/run/next_kick_time", 1, 1, &progress.next_kick_time);
@@ -325,6 +327,8 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   const auto granular = require<std::uint64_t>(r, f, "kairos/state/granular_counters", path, 5);
   const auto energies = require<double>(r, f, "kairos/state/granular_energies", path, 4);
   s.counters.driving_kicks = granular[4];
+  const auto tensor = require<double>(r, f, "kairos/state/virial_tensor", path, 9);
+  std::copy(tensor.begin(), tensor.end(), s.counters.virial_tensor.begin());
   s.counters.work_by_driving = energies[3];
   s.counters.wall_collisions = granular[0];
   s.counters.elastic_by_rule = granular[1];

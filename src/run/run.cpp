@@ -311,6 +311,7 @@ class RunDriver {
       }
     }
     prod_start_ = point();
+    virial_tensor_start_ = engine_->counters().virial_tensor;
     prod_ke_ = engine_->kinetic_energy();
     if (!stopped)
       stopped = run_phase("production", config_.run.collisions_per_particle, progress, wall_start);
@@ -460,8 +461,32 @@ class RunDriver {
     profile_->sample(x, v, s.mass, volume);
   }
 
+  // Kinetic part of the pressure tensor, sum of m c_a c_b with c the velocity relative to the
+  // mean, sampled at production thermo rows.
+  void sample_kinetic_tensor() {
+    const ParticleSystem<D> s = engine_->export_state();
+    std::vector<Vec<D>> v(n_);
+    Vec<D> mean{};
+    double mass = 0.0;
+    for (std::size_t i = 0; i < n_; ++i) {
+      v[i] = s.velocity_at(i, s.time);
+      mean = mean + s.mass[i] * v[i];
+      mass += s.mass[i];
+    }
+    mean = (1.0 / mass) * mean;
+    for (std::size_t i = 0; i < n_; ++i) {
+      const Vec<D> c = v[i] - mean;
+      for (int a = 0; a < D; ++a)
+        for (int b = 0; b < D; ++b) kinetic_tensor_sum_[a * D + b] += s.mass[i] * c[a] * c[b];
+    }
+    ++kinetic_tensor_samples_;
+  }
+
   void write_thermo_row(const std::string& phase) {
-    if (profile_ && phase == "production") sample_profile();
+    if (phase == "production") {
+      if (profile_) sample_profile();
+      sample_kinetic_tensor();
+    }
     const auto& c = engine_->counters();
     thermo_->write(phase,
                    thermo_stats_->row(point(), engine_->kinetic_energy(), phase == "production"),
@@ -559,6 +584,22 @@ class RunDriver {
                             {"blocks", z_blocks.samples},
                             {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
     j["pressure"] = th.pressure(z_mean, kT_prod);
+    if (kinetic_tensor_samples_ > 0 && t_prod > 0.0) {
+      // Kinetic part averaged over the production rows, collisional part from the impulses
+      // over the production time.
+      nlohmann::json tensor = nlohmann::json::array();
+      for (int a = 0; a < D; ++a) {
+        nlohmann::json row = nlohmann::json::array();
+        for (int b = 0; b < D; ++b) {
+          const int k = a * D + b;
+          row.push_back((kinetic_tensor_sum_[k] / kinetic_tensor_samples_ +
+                         (c.virial_tensor[k] - virial_tensor_start_[k]) / t_prod) /
+                        volume_);
+        }
+        tensor.push_back(row);
+      }
+      j["pressure_tensor"] = tensor;
+    }
     j["mean_free_time"] = th.mean_free_time(t_prod, coll_prod);
     j["mean_free_time_stderr"] = th.mean_free_time_blocks().stderr_;
     j["energy_drift_relative"] = ke_start_ > 0 ? std::abs(ke - ke_start_) / ke_start_ : 0.0;
@@ -614,6 +655,8 @@ class RunDriver {
   bool granular_ = false;  // walls, gravity or contact laws: report the energy budget
   bool driven_ = false;    // [driving]: thermostat or random kicks
   std::optional<AxisProfile<D>> profile_;  // output.profile_axis
+  std::array<double, 9> kinetic_tensor_sum_{}, virial_tensor_start_{};
+  int kinetic_tensor_samples_ = 0;
   double next_kick_ = 0.0;
   Vec<D> p_start_{};
   std::uint64_t events_start_ = 0, collisions_start_ = 0;

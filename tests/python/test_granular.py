@@ -28,7 +28,11 @@ class Driving(kt.KairosTestCase):
         t, err = mean_temperature(self.path("andersen"))
         # The kinetic temperature counts D (N - 1) degrees of freedom; the bath acts on D N.
         self.assertAlmostEqual(t, 2.0 * 2000 / 1999, delta=max(4 * err, 0.01))
-        g = self.summary(self.path("andersen"))["granular"]
+        summary = self.summary(self.path("andersen"))
+        tensor = np.array(summary["pressure_tensor"])
+        # Its trace is the scalar pressure (up to the temperature used: mean of rows vs start).
+        self.assertAlmostEqual(np.trace(tensor) / 3 / summary["pressure"], 1.0, delta=0.02)
+        g = summary["granular"]
         self.assertGreater(g["driving_kicks"], 1000)
         self.assertLess(g["energy_balance_relative"], 1e-9)
 
