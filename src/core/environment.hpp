@@ -55,7 +55,8 @@ struct Environment {
   // Resting particles under gravity: a particle that leaves a fixed wall, or a sleeping
   // particle, slower than this is put to sleep (it stops and feels no gravity until something
   // hits it harder than this). < 0: automatic, sqrt(2 |g| 1e-6 d_min) with gravity and walls;
-  // 0: never (then resting particles need the TC model or elastic_below_speed).
+  // 0: never (then resting particles need the TC model or elastic_below_speed). Never with a
+  // vibrating wall.
   double sleep_speed = -1.0;
 
   bool periodic(int axis) const { return faces[2 * axis].kind == FaceKind::kPeriodic; }
