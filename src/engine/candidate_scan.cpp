@@ -122,6 +122,9 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
   return found;
 }
 
+// Instantiated here, inside the AVX-512 target region: an instantiation after the region
+// cannot inline the intrinsics (GCC: "target specific option mismatch"). The scalar stand-in
+// below repeats the list for builds without AVX-512.
 template std::uint32_t scan_candidates_avx512<2, false>(const CandidateScan<2>&, double,
                                                         const Vec<2>&, const Vec<2>&, double&);
 template std::uint32_t scan_candidates_avx512<3, false>(const CandidateScan<3>&, double,

@@ -446,8 +446,7 @@ class RunDriver {
     return false;
   }
 
-  void sample_profile() {
-    const ParticleSystem<D> s = engine_->export_state();
+  void sample_profile(const ParticleSystem<D>& s) {
     std::vector<Vec<D>> x(n_), v(n_);
     std::vector<double> volume(n_);
     for (std::size_t i = 0; i < n_; ++i) {
@@ -463,8 +462,7 @@ class RunDriver {
 
   // Kinetic part of the pressure tensor, sum of m c_a c_b with c the velocity relative to the
   // mean, sampled at production thermo rows.
-  void sample_kinetic_tensor() {
-    const ParticleSystem<D> s = engine_->export_state();
+  void sample_kinetic_tensor(const ParticleSystem<D>& s) {
     std::vector<Vec<D>> v(n_);
     Vec<D> mean{};
     double mass = 0.0;
@@ -484,8 +482,9 @@ class RunDriver {
 
   void write_thermo_row(const std::string& phase) {
     if (phase == "production") {
-      if (profile_) sample_profile();
-      sample_kinetic_tensor();
+      const ParticleSystem<D> s = engine_->export_state();  // one copy for both samples
+      if (profile_) sample_profile(s);
+      sample_kinetic_tensor(s);
     }
     const auto& c = engine_->counters();
     thermo_->write(phase,

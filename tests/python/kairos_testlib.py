@@ -202,6 +202,17 @@ class KairosTestCase(unittest.TestCase):
 
     # ----- outputs
 
+    def run_split_and_whole(self, half, full):
+        """Runs config `half` twice (the second time from the first's restart file) and config
+        `full` once; returns the output directories (first, second, whole)."""
+        half = self.write_config(half, "half.toml")
+        full = self.write_config(full, "full.toml")
+        first, second, whole = self.path("first"), self.path("second"), self.path("whole")
+        self.run_ok("run", half, "-o", first)
+        self.run_ok("run", half, "--restart", os.path.join(first, "restart.gsd"), "-o", second)
+        self.run_ok("run", full, "-o", whole)
+        return first, second, whole
+
     def summary(self, outdir):
         with open(os.path.join(outdir, "summary.json")) as f:
             return json.load(f)

@@ -137,12 +137,7 @@ class GranularOutputs(kt.KairosTestCase):
         self.assertGreater(fractions[0], fractions[-1])
 
     def test_driven_walled_run_restarts_bit_for_bit(self):
-        half = self.write_config(self.rough_bed(20.0), "half.toml")
-        full = self.write_config(self.rough_bed(40.0), "full.toml")
-        self.run_ok("run", half, "-o", self.path("first"))
-        self.run_ok("run", half, "--restart", self.path("first", "restart.gsd"),
-                    "-o", self.path("second"))
-        self.run_ok("run", full, "-o", self.path("whole"))
+        self.run_split_and_whole(self.rough_bed(20.0), self.rough_bed(40.0))
         split = kt.read_exact_state(self.path("second", "restart.gsd"))
         whole = kt.read_exact_state(self.path("whole", "restart.gsd"))
         for name in kt.EXACT_CHUNKS:

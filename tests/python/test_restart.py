@@ -23,12 +23,7 @@ def config(dimension, queue, production, equilibration=0.0, **output):
 
 class ExactRestart(kt.KairosTestCase):
     def check_exact(self, dimension, queue):
-        half = self.write_config(config(dimension, queue, 50.0), "half.toml")
-        full = self.write_config(config(dimension, queue, 100.0), "full.toml")
-        self.run_ok("run", half, "-o", self.path("first"))
-        self.run_ok("run", half, "--restart", self.path("first", "restart.gsd"),
-                    "-o", self.path("second"))
-        self.run_ok("run", full, "-o", self.path("whole"))
+        self.run_split_and_whole(config(dimension, queue, 50.0), config(dimension, queue, 100.0))
 
         split = kt.read_exact_state(self.path("second", "restart.gsd"))
         whole = kt.read_exact_state(self.path("whole", "restart.gsd"))
