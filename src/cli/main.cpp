@@ -68,6 +68,14 @@ void print_summary(const kairos::RunOutcome& outcome) {
                gnum("dissipated_in_collisions"), gnum("dissipated_at_walls"));
     fmt::print("  work by walls        {:.6g}\n", gnum("work_by_walls"));
     fmt::print("  energy balance       {:.3g} (rel.)\n", gnum("energy_balance_relative"));
+    if (s.contains("shear")) {
+      const auto& sh = s["shear"];
+      fmt::print("  shear stress P_xy    {:.6g} +- {:.2g} at shear rate {:.6g}\n",
+                 sh["shear_stress"].get<double>(), sh["shear_stress_stderr"].get<double>(),
+                 sh["shear_rate"].get<double>());
+      fmt::print("  viscosity            {:.6g} +- {:.2g}\n", sh["viscosity"].get<double>(),
+                 sh["viscosity_stderr"].get<double>());
+    }
   } else {
     fmt::print("  energy drift (rel.)  {:.3g}\n", num("energy_drift_relative"));
   }

@@ -70,6 +70,15 @@ void Environment<D>::check() const {
     }
   }
   if (!(tc >= 0.0) || !std::isfinite(tc)) throw InputError("tc must be finite and >= 0");
+  if (!std::isfinite(shear_rate)) throw InputError("boundary.shear_rate must be finite");
+  if (sheared()) {
+    if (!periodic(0) || !periodic(1)) {
+      throw InputError(
+          "boundary.shear_rate: Lees-Edwards shear needs periodic x (flow) and y (gradient) axes; "
+          "remove the walls or open faces on x and y");
+    }
+    if (has_gravity()) throw InputError("boundary.shear_rate: shear with gravity is not supported");
+  }
 }
 
 template struct Environment<2>;

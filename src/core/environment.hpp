@@ -58,12 +58,24 @@ struct Environment {
   // 0: never (then resting particles need the TC model or elastic_below_speed). Never with a
   // vibrating wall.
   double sleep_speed = -1.0;
+  // Lees-Edwards sliding-brick boundaries for simple shear: the periodic images above the box
+  // (y + L_y) are displaced along x by shear_rate * L_y * t and move at shear_rate * L_y, so
+  // the mean flow is u_x = shear_rate * (y - L_y / 2). Flow along x, gradient along y; both
+  // axes periodic, no gravity. 0: an ordinary periodic box.
+  double shear_rate = 0.0;
 
   bool periodic(int axis) const { return faces[2 * axis].kind == FaceKind::kPeriodic; }
   bool has_gravity() const {
     for (int a = 0; a < D; ++a)
       if (gravity[a] != 0.0) return true;
     return false;
+  }
+  bool sheared() const { return shear_rate != 0.0; }
+  // The mean shear flow at position x in a box of edges `box` (zero without shear).
+  Vec<D> streaming_velocity(const Vec<D>& x, const Vec<D>& box) const {
+    Vec<D> u{};
+    u[0] = shear_rate * (x[1] - 0.5 * box[1]);
+    return u;
   }
   bool has_walls() const {
     for (const Face<D>& f : faces)

@@ -57,6 +57,10 @@ struct EventCounters {
   double dissipated_at_walls = 0.0;
   double work_by_walls = 0.0;
   double work_by_driving = 0.0;  // kinetic energy added by thermostat or random kicks
+  // Lees-Edwards shear: kinetic energy (box frame) added where particles meet or become images
+  // across the sliding y faces. Closes the energy budget; the heating of the peculiar motion is
+  // -P_xy shear_rate V on average.
+  double work_by_shear = 0.0;
 };
 
 // Angular velocity: a vector in 3D, the z component alone in 2D.

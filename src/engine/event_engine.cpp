@@ -253,6 +253,12 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   }
   grid_ = CellGrid<D>(box_, min_width, periodic, s.size(), options_.max_cells_per_particle);
   bounded_ = grid_.bounded();
+  sheared_ = env_.sheared();
+  if (sheared_) {
+    shear_speed_ = env_.shear_rate * box_[1];
+    image_step_ = image_step_at(time_);
+    next_image_shift_ = image_shift_time(image_step_);
+  }
 }
 
 // Offset of a wall's plane from its face's rest position at time t.
@@ -464,6 +470,13 @@ template <int D, class Queue>
 // faces (most) need no periodic shifts and take a loop over fixed index offsets.
 template <int D, class Queue>
 void EventEngine<D, Queue>::gather(CellCode cell, CandidateList& list) {
+  if (sheared_) [[unlikely]] {
+    list.sheared = next_to_shear_face(cell);
+    if (list.sheared) {
+      gather_sheared(cell, list);
+      return;
+    }
+  }
   if (vector_scan_) {
     gather_vector(cell, list);
     return;
@@ -608,8 +621,12 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
   const Crossing crossing = next_crossing(h);
   double best = crossing.time - t;
   const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
-  const std::uint32_t partner =
-      sleeping_ > 0 ? scan_with_sleepers(list, i, t, best) : test_candidates(list, i, t, xi, best);
+  std::uint32_t partner;
+  if (sleeping_ > 0 || list.sheared) [[unlikely]] {
+    partner = list.sheared ? scan_sheared(list, i, t, best) : scan_with_sleepers(list, i, t, best);
+  } else {
+    partner = test_candidates(list, i, t, xi, best);
+  }
   double when = crossing.time;
   if (partner != kNoPartner) {
     pending_[i] = {partner, hot_[partner].collisions};
@@ -631,6 +648,10 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) {
   // Canonical order so that which of the pair was popped never changes the arithmetic.
   if (j < i) std::swap(i, j);
+  if (sheared_) [[unlikely]] {
+    collide_sheared(i, j, t);
+    return;
+  }
   if (sleeping_ > 0 && (is_asleep(i) || is_asleep(j))) [[unlikely]] {
     if (is_asleep(i)) std::swap(i, j);  // i is the awake one
     advance_to(i, t);
@@ -668,11 +689,16 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
   ++counters_.collisions;
   ++hi.collisions;
   ++hj.collisions;
-  // Both neighbourhoods are gathered (and their records prefetched) before either is tested;
-  // partners in one cell share one list.
-  gather(hi.cell, lists_[0]);
-  const bool shared = hj.cell == hi.cell;
-  if (!shared) gather(hj.cell, lists_[1]);
+  predict_pair(i, j, t);
+}
+
+// New events for both partners of a collision. Both neighbourhoods are gathered (and their
+// records prefetched) before either is tested; partners in one cell share one list.
+template <int D, class Queue>
+inline void EventEngine<D, Queue>::predict_pair(std::uint32_t i, std::uint32_t j, double t) {
+  gather(hot_[i].cell, lists_[0]);
+  const bool shared = hot_[j].cell == hot_[i].cell;
+  if (!shared) gather(hot_[j].cell, lists_[1]);
   queue_.update(i, predict_from(lists_[0], i, t));
   queue_.update(j, predict_from(lists_[shared ? 0 : 1], j, t));
 }
@@ -914,7 +940,7 @@ std::uint32_t EventEngine<D, Queue>::scan_with_sleepers(const CandidateList& lis
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::set_velocity(std::uint32_t k, double t, const Vec<D>& v) {
-  if (!(t >= time_) || !(t <= queue_.top_time()) || k >= size()) {
+  if (!(t >= time_) || !(t <= next_event_time()) || k >= size()) {
     throw std::logic_error(
         "set_velocity: time outside [time(), next_event_time()] or no such particle");
   }
@@ -943,9 +969,11 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   } else if (c[x.axis] < 0) {
     c[x.axis] += grid_.cells_along(x.axis);
     h.pos[x.axis] += box_[x.axis];
+    if (sheared_ && x.axis == 1) cross_shear_face(i, -1, t, c);
   } else if (c[x.axis] >= grid_.cells_along(x.axis)) {
     c[x.axis] -= grid_.cells_along(x.axis);
     h.pos[x.axis] -= box_[x.axis];
+    if (sheared_ && x.axis == 1) cross_shear_face(i, 1, t, c);
   }
   grid_.erase(i, h.cell);
   h.cell = grid_.code_at(c);
@@ -956,6 +984,10 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
 
 template <int D, class Queue>
 EventKind EventEngine<D, Queue>::step() {
+  if (sheared_ && next_image_shift_ <= queue_.top_time()) [[unlikely]] {
+    shift_images();
+    return EventKind::kImageShift;
+  }
   const std::uint32_t i = queue_.top();
   const double t = queue_.top_time();
   if (!std::isfinite(t)) return EventKind::kNone;
@@ -1041,6 +1073,18 @@ double EventEngine<D, Queue>::kinetic_energy() const {
 }
 
 template <int D, class Queue>
+double EventEngine<D, Queue>::peculiar_kinetic_energy() const {
+  if (!sheared_) return kinetic_energy();
+  double ke = 0.0;
+  for (std::uint32_t i = 0; i < size(); ++i) {
+    Vec<D> x = position_of(i, time_);
+    x[1] = wrap_into_box(x[1], box_[1]);
+    ke += 0.5 * mass_of(i) * norm2(velocity_of(i, time_) - env_.streaming_velocity(x, box_));
+  }
+  return ke;
+}
+
+template <int D, class Queue>
 double EventEngine<D, Queue>::rotational_energy() const {
   double e = 0.0;
   for (std::uint32_t i = 0; i < spin_.size(); ++i) {
@@ -1078,6 +1122,206 @@ double EventEngine<D, Queue>::bytes_per_particle() const {
   return static_cast<double>(sizeof(HotRecord<D>) + sizeof(PendingEvent) + sizeof(std::uint32_t) +
                              (shape_.empty() ? 0 : sizeof(std::uint16_t))) +
          shapes + grid_.bytes_per_particle() + static_cast<double>(queue_.bytes_per_particle());
+}
+
+// --- Lees-Edwards shear ---------------------------------------------------------------------
+//
+// The images above the box (y + L_y) sit displaced along x by image_offset(t) and move at
+// shear_speed_ = shear_rate L_y; those below by the opposite. A particle leaving through a y
+// face re-enters as its image: x and v_x jump by the offset and the image velocity. Pairs
+// across a y face are searched in the row of cells beyond the face, 4 cells wide in x around
+// where the image of the particle's own column sits now; that window stays right while the
+// offset moves by less than a cell width, so every time it has moved one cell width on
+// (image_step_ counts those, unwrapped) the particles next to the y faces are predicted again.
+
+// The offset, consistent with image_step_: in [k w, (k + 1) w] up to round-off, where
+// k = image_step_ mod n_x and w the cell width along x.
+template <int D, class Queue>
+double EventEngine<D, Queue>::image_offset(double t) const {
+  const std::int64_t nx = grid_.cells_along(0);
+  const std::int64_t wraps = image_step_ >= 0 ? image_step_ / nx : -((-image_step_ + nx - 1) / nx);
+  return shear_speed_ * t - static_cast<double>(wraps) * box_[0];
+}
+
+// When the image offset, now image_step cell widths (rounded down), reaches the next step.
+template <int D, class Queue>
+double EventEngine<D, Queue>::image_shift_time(std::int64_t step) const {
+  const double edge = static_cast<double>(shear_speed_ > 0 ? step + 1 : step);
+  return edge * grid_.width(0) / shear_speed_;
+}
+
+// The image step at time t: every shift due at or before t has happened (as in a run that
+// reached t), so a resumed run continues with the same step.
+template <int D, class Queue>
+std::int64_t EventEngine<D, Queue>::image_step_at(double t) const {
+  auto step = static_cast<std::int64_t>(std::floor(shear_speed_ * t / grid_.width(0)));
+  const std::int64_t back = shear_speed_ > 0 ? -1 : 1;
+  while (image_shift_time(step) <= t) step = next_image_step(step);
+  while (image_shift_time(step + back) > t) step += back;
+  return step;
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::shift_images() {
+  time_ = next_image_shift_;
+  image_step_ = next_image_step(image_step_);
+  next_image_shift_ = image_shift_time(image_step_);
+  const int ny = grid_.cells_along(1), nz = D == 3 ? grid_.cells_along(D - 1) : 1;
+  std::array<int, D> at{};
+  for (const int y : {0, ny - 1}) {
+    at[1] = y;
+    for (int z = 0; z < nz; ++z) {
+      at[D - 1] = D == 3 ? z : y;
+      for (at[0] = 0; at[0] < grid_.cells_along(0); ++at[0]) {
+        const std::uint32_t cell = grid_.index(grid_.code_at(at));
+        for (std::uint32_t p = grid_.first(cell); p != grid_.end(); p = grid_.next(p))
+          queue_.update(p, predict(p, time_));
+      }
+    }
+  }
+}
+
+// The neighbourhood of a cell in the first or last row along y: its own row and the inner one
+// as usual, the row beyond the face through the sliding images.
+template <int D, class Queue>
+void EventEngine<D, Queue>::gather_sheared(CellCode cell, CandidateList& list) {
+  const int nx = grid_.cells_along(0), ny = grid_.cells_along(1);
+  std::array<int, D> c;
+  for (int a = 0; a < D; ++a) c[a] = grid_.coordinate(cell, a);
+  const std::int64_t k = ((image_step_ % nx) + nx) % nx;
+  const double offset = image_offset(time_);  // predictions happen at time_
+  std::uint32_t n = 0, n_shifts = 1;          // shifts[0]: none
+  list.shifts[0] = Vec<D>{};
+  list.velocity_shifts[0] = Vec<D>{};
+  auto add_cell = [&](const std::array<int, D>& at, const Vec<D>& shift, const Vec<D>& vshift) {
+    const std::uint32_t tag = n_shifts++;
+    list.shifts[tag] = shift;
+    list.velocity_shifts[tag] = vshift;
+    for (std::uint32_t p = grid_.first(grid_.index(grid_.code_at(at))); p != grid_.end();
+         p = grid_.next(p)) {
+      if (list.ids.size() - n < kCandidateSlack) grow(list);
+      list.ids[n] = p;
+      list.shift[n++] = tag;
+    }
+  };
+  for (int dy = -1; dy <= 1; ++dy) {
+    std::array<int, D> at = c;
+    Vec<D> shift{}, vshift{};
+    at[1] = c[1] + dy;
+    const int side = at[1] < 0 ? -1 : (at[1] >= ny ? 1 : 0);
+    at[1] -= side * ny;
+    shift[1] = side * box_[1];
+    vshift[0] = side * shear_speed_;
+    // Columns m (unwrapped) whose members, moved by the image offset, can reach column c[0].
+    const int first =
+        side == 0 ? c[0] - 1
+                  : (side > 0 ? c[0] - static_cast<int>(k) - 2 : c[0] + static_cast<int>(k) - 1);
+    const int columns = side == 0 ? 3 : 4;
+    for (int q = 0; q < columns; ++q) {
+      const int m = first + q;
+      const int wraps = m >= 0 ? m / nx : -((-m + nx - 1) / nx);
+      at[0] = m - wraps * nx;
+      shift[0] = side * offset + wraps * box_[0];
+      if constexpr (D == 3) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          at[2] = c[2] + dz;
+          Vec<D> s = shift;
+          if (at[2] < 0 || at[2] >= grid_.cells_along(2)) {
+            if (!grid_.periodic(2)) continue;  // beyond a wall or open face: nothing there
+            const int wz = at[2] < 0 ? -1 : 1;
+            at[2] -= wz * grid_.cells_along(2);
+            s[2] = wz * box_[2];
+          }
+          add_cell(at, s, vshift);
+        }
+      } else {
+        add_cell(at, shift, vshift);
+      }
+    }
+  }
+  list.count = n;
+  list.n_shifts = n_shifts;
+}
+
+// The candidate test for a sheared list: like the scalar loop, with each image's velocity.
+template <int D, class Queue>
+std::uint32_t EventEngine<D, Queue>::scan_sheared(const CandidateList& list, std::uint32_t i,
+                                                  double t, double& best) const {
+  const Vec<D> xi = position_at(hot_[i], t), vi = hot_[i].vel;
+  std::uint32_t found = kNoPartner;
+  for (std::uint32_t k = 0; k < list.count; ++k) {
+    const std::uint32_t j = list.ids[k];
+    const std::uint32_t tag = list.shift[k];
+    const Vec<D> r = xi - (position_at(hot_[j], t) + list.shifts[tag]);
+    const Vec<D> g = vi - (hot_[j].vel + list.velocity_shifts[tag]);
+    const double dt = pair_contact_time<D>(r.data(), g.data(), radius_of(i) + radius_of(j));
+    if (dt < best) {
+      best = dt;
+      found = j;
+    }
+  }
+  return found;
+}
+
+// Pairs in contact are closer than a third of the box along y, so the image is unambiguous.
+template <int D, class Queue>
+Vec<D> EventEngine<D, Queue>::sheared_separation(std::uint32_t i, std::uint32_t j, double t,
+                                                 Vec<D>& image_velocity) const {
+  Vec<D> r = position_of(i, t) - position_of(j, t);
+  image_velocity = Vec<D>{};
+  const int side = r[1] > 0.5 * box_[1] ? 1 : (r[1] < -0.5 * box_[1] ? -1 : 0);
+  r[1] -= side * box_[1];
+  r[0] -= side * image_offset(t);
+  image_velocity[0] = side * shear_speed_;
+  for (int a = 0; a < D; ++a)
+    if (a != 1 && grid_.periodic(a)) r[a] = minimum_image(r[a], box_[a]);
+  return r;
+}
+
+// A collision under shear: the impulse is the ordinary one between i and the image of j it
+// meets; only the velocity j's image has beyond j's own is taken out again. The kinetic energy
+// that adds in the box frame is work done by the shearing boundaries.
+template <int D, class Queue>
+void EventEngine<D, Queue>::collide_sheared(std::uint32_t i, std::uint32_t j, double t) {
+  advance_to(i, t);
+  advance_to(j, t);
+  HotRecord<D>& hi = hot_[i];
+  HotRecord<D>& hj = hot_[j];
+  Vec<D> u;
+  const Vec<D> r = sheared_separation(i, j, t, u);
+  const double r2 = norm2(r);
+  const Vec<D> vj_before = hj.vel;
+  hj.vel = hj.vel + u;
+  if (granular_contacts_) {
+    collide_granular(i, j, t, r, r2);
+  } else {
+    const double mi = mass_of(i), mj = mass_of(j);
+    const double s = HardSphere::impulse_factor(dot(hi.vel - hj.vel, r), r2, mi * mj / (mi + mj));
+    hi.vel = hi.vel + (s / mi) * r;
+    hj.vel = hj.vel - (s / mj) * r;
+    counters_.virial += s * r2;
+    add_virial_tensor(r, s * r);
+  }
+  hj.vel = hj.vel - u;
+  counters_.work_by_shear -= mass_of(j) * dot(u, hj.vel - vj_before);
+  ++counters_.collisions;
+  ++hi.collisions;
+  ++hj.collisions;
+  predict_pair(i, j, t);
+}
+
+// Particle i leaves through the high (side +1) or low (-1) y face and comes back as its image:
+// its y is already wrapped; x and v_x follow the image, and its column is found again.
+template <int D, class Queue>
+void EventEngine<D, Queue>::cross_shear_face(std::uint32_t i, int side, double t,
+                                             std::array<int, D>& c) {
+  HotRecord<D>& h = hot_[i];
+  const double ke = norm2(h.vel);
+  h.pos[0] = wrap_into_box(h.pos[0] - side * image_offset(t), box_[0]);
+  h.vel[0] -= side * shear_speed_;
+  counters_.work_by_shear += 0.5 * mass_of(i) * (norm2(h.vel) - ke);
+  c[0] = std::clamp(static_cast<int>(std::floor(h.pos[0] / grid_.width(0))), 0,
+                    grid_.cells_along(0) - 1);
 }
 
 template <int D, class Queue>
@@ -1152,16 +1396,20 @@ void EventEngine<D, Queue>::validate() {
   if (queue_.top_time() != tmin) fail("queue top is not the soonest event");
   // Prediction invariant and overlaps, brute force over all pairs: some pending event of the
   // pair (a collision, or a crossing that triggers a new scan) comes no later than its contact.
-  auto check_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, const char* which) {
+  auto check_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, const char* which,
+                           const Vec<D>& image_velocity = Vec<D>{}) {
     if (is_asleep(i) && is_asleep(j)) return;  // neither moves
-    const Vec<D> g = velocity_of(i, t) - velocity_of(j, t);
+    const Vec<D> g = velocity_of(i, t) - (velocity_of(j, t) + image_velocity);
     Vec<D> accel{};
     if (is_asleep(j)) accel = env_.gravity;
     if (is_asleep(i)) accel = -1.0 * env_.gravity;
     const double sigma = radius_of(i) + radius_of(j);
     const double due =
         t + pair_contact_time_accelerated<D>(r.data(), g.data(), accel.data(), sigma);
-    const double bound = std::min(queue_.time_of(i), queue_.time_of(j));
+    double bound = std::min(queue_.time_of(i), queue_.time_of(j));
+    // Under shear the next image shift predicts the particles next to the y faces again.
+    if (sheared_ && (next_to_shear_face(hot_[i].cell) || next_to_shear_face(hot_[j].cell)))
+      bound = std::min(bound, next_image_shift_);
     if (std::isfinite(due) && bound > due * (1.0 + 1e-12) + 1e-12) {
       fail("pair " + name(i) + "," + name(j) + " (" + which + ") collides at " +
            std::to_string(due) + " but no pending event comes first");
@@ -1171,6 +1419,15 @@ void EventEngine<D, Queue>::validate() {
     const Vec<D> xi = position_of(i, t);
     const std::uint32_t ci = hot_[i].cell;
     for (std::uint32_t j = i + 1; j < n; ++j) {
+      const double sigma = radius_of(i) + radius_of(j);
+      if (sheared_) {
+        Vec<D> u;
+        const Vec<D> r = sheared_separation(i, j, t, u);
+        if (norm2(r) < sigma * sigma * (1.0 - 1e-9))
+          fail("particles " + name(i) + " and " + name(j) + " overlap");
+        check_covered(i, j, r, "sheared image", u);
+        continue;
+      }
       const Vec<D> raw = xi - position_of(j, t);
       // The image the engine tests (neighbouring cells).
       std::array<int, D> d;
@@ -1186,7 +1443,6 @@ void EventEngine<D, Queue>::validate() {
       Vec<D> r = raw;
       for (int a = 0; a < D; ++a)
         if (grid_.periodic(a)) r[a] = minimum_image(r[a], box_[a]);
-      const double sigma = radius_of(i) + radius_of(j);
       if (norm2(r) < sigma * sigma * (1.0 - 1e-9)) {
         fail("particles " + name(i) + " and " + name(j) + " overlap");
       }

@@ -23,6 +23,8 @@
 // small table of shapes indexed by a 2-byte shape number (absent for a single shape).
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -30,11 +32,14 @@
 #include "core/environment.hpp"
 #include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
+#include "dynamics/collision_time.hpp"
 #include "scheduler/cell_grid.hpp"
 
 namespace kairos {
 
-enum class EventKind { kNone, kCollision, kCellCrossing, kStale, kWallCollision };
+// kImageShift: under Lees-Edwards shear, the images across the y faces moved on by a cell width
+// and the particles next to those faces were predicted again.
+enum class EventKind { kNone, kCollision, kCellCrossing, kStale, kWallCollision, kImageShift };
 
 // How an engine starts: predict every event from the state, or resume the scheduler state the
 // ParticleSystem carries (from export_state() or a restart file) to continue bit-identically.
@@ -82,13 +87,14 @@ class EventEngine {
 
   double time() const { return time_; }
   // When the next event happens (kNever if nothing ever will).
-  double next_event_time() { return queue_.top_time(); }
+  double next_event_time() { return std::min(queue_.top_time(), next_image_shift_); }
 
   // Driving (thermostats, random kicks) acts between events: it sets the velocity of particle k
   // at time t, with time() <= t <= next_event_time(), wakes it if it sleeps, invalidates
   // predictions made against it and re-predicts it. k is the engine's internal index: any
   // numbering serves a uniform random choice, and it is restored on resume.
   Vec<D> velocity(std::uint32_t k, double t) const { return velocity_of(k, t); }
+  Vec<D> position(std::uint32_t k, double t) const { return position_of(k, t); }
   double particle_mass(std::uint32_t k) const { return mass_of(k); }
   void set_velocity(std::uint32_t k, double t, const Vec<D>& v);
   const EventCounters& counters() const { return counters_; }
@@ -98,7 +104,10 @@ class EventEngine {
   ParticleSystem<D> export_state() const;
   std::size_t size() const { return hot_.size(); }
 
-  double kinetic_energy() const;     // translational
+  double kinetic_energy() const;  // translational
+  // Translational, of the velocities relative to the mean shear flow (Lees-Edwards); equal to
+  // kinetic_energy() without shear.
+  double peculiar_kinetic_energy() const;
   double rotational_energy() const;  // 0 unless particles rotate
   std::uint32_t sleeping() const { return sleeping_; }
   Vec<D> momentum() const;
@@ -121,11 +130,16 @@ class EventEngine {
   };
   // Scratch of a prediction: candidate partners and the periodic shift of each one's cell. Two,
   // so that both partners of a collision gather (and prefetch) before either is tested.
+  // Under shear, the row of cells beyond a y face is searched 4 cells wide (its images slide),
+  // and images there also move at +-shear_rate L_y: `sheared` lists carry velocity shifts.
+  static constexpr int kMaxShifts = CellGrid<D>::kNeighbourCells * 4 / 3 + 1;
   struct CandidateList {
     std::vector<std::uint32_t> ids;
     std::vector<std::uint32_t> shift;  // per candidate, into shifts; read only if n_shifts > 1
-    Vec<D> shifts[CellGrid<D>::kNeighbourCells + 1] = {};
+    Vec<D> shifts[kMaxShifts] = {};
+    Vec<D> velocity_shifts[kMaxShifts] = {};  // read only if sheared
     std::uint32_t count = 0, n_shifts = 1;
+    bool sheared = false;
   };
   struct Crossing {
     double time;  // absolute
@@ -190,6 +204,27 @@ class EventEngine {
   std::uint32_t test_candidates(const CandidateList& list, std::uint32_t i, double t,
                                 const Vec<D>& xi, double& best) const;
   void collide(std::uint32_t i, std::uint32_t j, double t);
+  void predict_pair(std::uint32_t i, std::uint32_t j, double t);
+  // Lees-Edwards shear (see Environment::shear_rate).
+  double image_offset(double t) const;  // x displacement of the images above the box
+  double image_shift_time(std::int64_t step) const;
+  std::int64_t next_image_step(std::int64_t step) const {
+    return step + (shear_speed_ > 0 ? 1 : -1);
+  }
+  std::int64_t image_step_at(double t) const;
+  void shift_images();
+  bool next_to_shear_face(CellCode c) const {
+    const int y = grid_.coordinate(c, 1);
+    return y == 0 || y == grid_.cells_along(1) - 1;
+  }
+  void gather_sheared(CellCode cell, CandidateList& list);
+  std::uint32_t scan_sheared(const CandidateList& list, std::uint32_t i, double t,
+                             double& best) const;
+  // Separation of i from the image of j it meets (and that image's extra velocity).
+  Vec<D> sheared_separation(std::uint32_t i, std::uint32_t j, double t,
+                            Vec<D>& image_velocity) const;
+  void collide_sheared(std::uint32_t i, std::uint32_t j, double t);
+  void cross_shear_face(std::uint32_t i, int side, double t, std::array<int, D>& c);
   void cross(std::uint32_t i, double t);
   void renumber(bool queue_filled);
   void insert_all_into_grid();
@@ -223,6 +258,10 @@ class EventEngine {
   CellGrid<D> grid_;
   Queue queue_;
   std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions
+  bool sheared_ = false;
+  double shear_speed_ = 0.0;     // shear_rate * L_y: velocity of the images above the box
+  std::int64_t image_step_ = 0;  // image offset in cell widths, rounded down (unwrapped)
+  double next_image_shift_ = kNever;
 
   CandidateList lists_[2];
   Environment<D> env_;  // last: the hot members above share fewer cache lines

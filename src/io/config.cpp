@@ -84,6 +84,7 @@ constexpr KeySpec kSchema[] = {
     {"contact.pair[].elastic_below_speed", Kind::kFloat},
     {"boundary", Kind::kTable},
     {"boundary.open", Kind::kArray},
+    {"boundary.shear_rate", Kind::kFloat},
     {"boundary.wall", Kind::kTableArray},
     {"boundary.wall[]", Kind::kTable},
     {"boundary.wall[].face", Kind::kString},
@@ -1123,6 +1124,16 @@ class Reader {
       claims[f] = {node, key, false};
     }
 
+    const toml::node* n_shear = get_number(t, p, "shear_rate", b.shear_rate);
+    for (std::size_t f = 0; n_shear != nullptr && b.shear_rate != 0.0 && f < 4; ++f) {
+      if (claims[f].node != nullptr) {
+        fail(n_shear, "boundary.shear_rate",
+             fmt::format("boundary.shear_rate: Lees-Edwards shear needs periodic x (flow) and y "
+                         "(gradient) axes, but face {} is {} ({})",
+                         kFaces[f], claims[f].wall ? "a wall" : "open", claims[f].key));
+      }
+    }
+
     // An axis is periodic (no wall, not open) or bounded at both ends.
     for (std::size_t axis = 0; axis < static_cast<std::size_t>(dimension); ++axis) {
       for (std::size_t side = 0; side < 2; ++side) {
@@ -1357,6 +1368,7 @@ std::string to_toml(const Config& config) {
     out += fmt::format("{}{}", i == 0 ? "" : ", ", toml_string(config.boundary.open[i]));
   }
   out += "]\n";
+  out += fmt::format("shear_rate = {}\n", toml_float(config.boundary.shear_rate));
   for (const WallConfig& w : config.boundary.walls) {
     out += "\n[[boundary.wall]]\n";
     out += fmt::format("face = {}\n", toml_string(w.face));

@@ -90,6 +90,7 @@ struct WallConfig {
 struct BoundaryConfig {
   std::vector<WallConfig> walls;  // [[boundary.wall]]
   std::vector<std::string> open;  // boundary.open: faces with no wall (e.g. "z+")
+  double shear_rate = 0.0;        // Lees-Edwards: flow along x, gradient along y; 0: none
 
   bool operator==(const BoundaryConfig&) const = default;
 };

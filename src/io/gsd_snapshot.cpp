@@ -256,6 +256,8 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     w.write_chunk("kairos/state/virial_tensor", 9, 1, s.counters.virial_tensor.data());
     w.write_chunk("kairos/state/granular_counters", 5, 1, granular);
     w.write_chunk("kairos/state/granular_energies", 4, 1, energies);
+    if (s.counters.work_by_shear != 0.0)
+      w.write_chunk("kairos/state/shear_work", 1, 1, &s.counters.work_by_shear);
     w.write_chunk("kairos/run/next_kick_time", 1, 1, &progress.next_kick_time);
     if (!s.angular_velocity.empty()) {
       constexpr std::uint32_t kSpin = D == 3 ? 3 : 1;
@@ -337,6 +339,8 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   s.counters.dissipated_in_collisions = energies[0];
   s.counters.dissipated_at_walls = energies[1];
   s.counters.work_by_walls = energies[2];
+  if (r.find(f, "kairos/state/shear_work"))
+    s.counters.work_by_shear = require<double>(r, f, "kairos/state/shear_work", path, 1)[0];
   constexpr std::size_t kSpin = D == 3 ? 3 : 1;
   if (r.find(f, "kairos/state/angular_velocity")) {
     const auto w = require<double>(r, f, "kairos/state/angular_velocity", path, n * kSpin);

@@ -94,6 +94,7 @@ Environment<D> make_environment(const Config& config,
     env.faces[face_index(open, D)].kind = FaceKind::kOpen;
   for (int a = 0; a < D && a < static_cast<int>(config.field.gravity.size()); ++a)
     env.gravity[a] = config.field.gravity[a];
+  env.shear_rate = config.boundary.shear_rate;
   env.check();
   return env;
 }

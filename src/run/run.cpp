@@ -123,6 +123,38 @@ void make_room_for_walls(const Config& config, InitialState<D>& init) {
     init.box[a] *= config.system.box_scale[a];
 }
 
+// max_overlap() under Lees-Edwards shear: the particles within the largest diameter of the low
+// y face are copied above the box as their images (displaced along x by `offset`), in a box
+// tall enough that nothing else wraps around along y.
+template <int D>
+double max_overlap_sheared(const Vec<D>& box, std::vector<Vec<D>> x, std::vector<double> diameter,
+                           double offset) {
+  const double dmax = *std::max_element(diameter.begin(), diameter.end());
+  const std::size_t n = x.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i][1] = wrap_into_box(x[i][1], box[1]);
+    if (x[i][1] >= dmax) continue;
+    Vec<D> image = x[i];
+    image[0] = wrap_into_box(image[0] + offset, box[0]);
+    image[1] += box[1];
+    x.push_back(image);
+    diameter.push_back(diameter[i]);
+  }
+  Vec<D> tall = box;
+  tall[1] += 3.0 * dmax;
+  return max_overlap<D>(tall, x, diameter);
+}
+
+// Velocities drawn from the temperature are peculiar: under Lees-Edwards shear the mean flow
+// u_x = shear_rate (y - L_y / 2) is added, so the run starts in the shear flow.
+template <int D>
+void add_shear_flow(const Config& config, InitialState<D>& init) {
+  const double rate = config.boundary.shear_rate;
+  if (rate == 0.0) return;
+  for (std::size_t i = 0; i < init.position.size(); ++i)
+    init.velocity[i][0] += rate * (init.position[i][1] - 0.5 * init.box[1]);
+}
+
 template <int D>
 ParticleSystem<D> build_start_state(const Config& config,
                                     const std::optional<fs::path>& restart_file,
@@ -145,12 +177,16 @@ ParticleSystem<D> build_start_state(const Config& config,
     if (!holds_exact_positions(path)) expand_away_rounding_overlaps(init);
     check_no_overlap(init, "system.initial_state '" + path.string() + "'");
     note_ignored_system_keys(config, init.position.size(), "system.initial_state");
-    if (!has_velocities) assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
+    if (!has_velocities) {
+      assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
+      add_shear_flow(config, init);
+    }
     return to_particle_system<D>(init);
   }
   InitialState<D> init = make_initial_state<D>(config.system, rng);
   check_no_overlap(init, "generated initial state");
   make_room_for_walls(config, init);
+  add_shear_flow(config, init);
   return to_particle_system<D>(init);
 }
 
@@ -249,7 +285,9 @@ class RunDriver {
       engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict,
                       EngineOptions{}, environment);
       driven_ = config.driving.kind != "none";
-      granular_ = !environment.plain() || environment.has_gravity() || driven_;
+      granular_ =
+          !environment.plain() || environment.has_gravity() || driven_ || environment.sheared();
+      sheared_ = environment.sheared();
       for (int a = 0; a < D; ++a) granular_ = granular_ || !environment.periodic(a);
     } catch (const InputError& e) {
       if (!restart_file) throw;
@@ -312,7 +350,8 @@ class RunDriver {
     }
     prod_start_ = point();
     virial_tensor_start_ = engine_->counters().virial_tensor;
-    prod_ke_ = engine_->kinetic_energy();
+    prod_ke_ = thermal_energy();
+    shear_row_start_ = {engine_->time(), engine_->counters().virial_tensor[1]};
     if (!stopped)
       stopped = run_phase("production", config_.run.collisions_per_particle, progress, wall_start);
     progress.finish();
@@ -379,6 +418,11 @@ class RunDriver {
         std::normal_distribution<double> maxwell(
             0.0, std::sqrt(d.temperature / engine_->particle_mass(k)));
         for (int a = 0; a < D; ++a) v[a] = maxwell(rng_);
+        if (sheared_) {
+          Vec<D> x = engine_->position(k, next_kick_);
+          x[1] = wrap_into_box(x[1], engine_->box()[1]);
+          v = v + engine_->environment().streaming_velocity(x, engine_->box());
+        }
       } else {
         std::normal_distribution<double> kick(0.0, std::sqrt(d.strength / d.rate));
         v = engine_->velocity(k, next_kick_);
@@ -461,8 +505,30 @@ class RunDriver {
   }
 
   // Kinetic part of the pressure tensor, sum of m c_a c_b with c the velocity relative to the
-  // mean, sampled at production thermo rows.
+  // mean (under shear: to the mean flow at the particle), sampled at production thermo rows.
+  // Under shear each row also gives one sample of the shear stress P_xy: this kinetic part
+  // plus the collisional one since the previous row.
   void sample_kinetic_tensor(const ParticleSystem<D>& s) {
+    const std::vector<Vec<D>> c = peculiar_velocities(s);
+    std::array<double, 9> sample{};
+    for (std::size_t i = 0; i < n_; ++i) {
+      for (int a = 0; a < D; ++a)
+        for (int b = 0; b < D; ++b) sample[a * D + b] += s.mass[i] * c[i][a] * c[i][b];
+    }
+    for (int k = 0; k < D * D; ++k) kinetic_tensor_sum_[k] += sample[k];
+    ++kinetic_tensor_samples_;
+    if (sheared_ && s.time > shear_row_start_.time) {
+      const double virial_xy = s.counters.virial_tensor[1];  // row x, column y
+      shear_stress_rows_.push_back((sample[1] + (virial_xy - shear_row_start_.virial_xy) /
+                                                    (s.time - shear_row_start_.time)) /
+                                   volume_);
+      shear_row_start_ = {s.time, virial_xy};
+    }
+  }
+
+  // Velocities relative to the mean: the centre-of-mass velocity, or under shear the flow at
+  // each particle's position.
+  std::vector<Vec<D>> peculiar_velocities(const ParticleSystem<D>& s) const {
     std::vector<Vec<D>> v(n_);
     Vec<D> mean{};
     double mass = 0.0;
@@ -473,11 +539,20 @@ class RunDriver {
     }
     mean = (1.0 / mass) * mean;
     for (std::size_t i = 0; i < n_; ++i) {
-      const Vec<D> c = v[i] - mean;
-      for (int a = 0; a < D; ++a)
-        for (int b = 0; b < D; ++b) kinetic_tensor_sum_[a * D + b] += s.mass[i] * c[a] * c[b];
+      if (sheared_) {
+        Vec<D> x = s.position_at(i, s.time);
+        x[1] = wrap_into_box(x[1], s.box[1]);
+        v[i] = v[i] - engine_->environment().streaming_velocity(x, s.box);
+      } else {
+        v[i] = v[i] - mean;
+      }
     }
-    ++kinetic_tensor_samples_;
+    return v;
+  }
+
+  // The kinetic energy that makes the temperature: of the peculiar velocities under shear.
+  double thermal_energy() const {
+    return sheared_ ? engine_->peculiar_kinetic_energy() : engine_->kinetic_energy();
   }
 
   void write_thermo_row(const std::string& phase) {
@@ -487,8 +562,7 @@ class RunDriver {
       sample_kinetic_tensor(s);
     }
     const auto& c = engine_->counters();
-    thermo_->write(phase,
-                   thermo_stats_->row(point(), engine_->kinetic_energy(), phase == "production"),
+    thermo_->write(phase, thermo_stats_->row(point(), thermal_energy(), phase == "production"),
                    {rotational_temperature(), c.dissipated_in_collisions + c.dissipated_at_walls,
                     c.work_by_walls});
   }
@@ -515,16 +589,10 @@ class RunDriver {
   // Sonine coefficient of the velocity distribution, a2 = d/(d+2) <v^4>/<v^2>^2 - 1, with
   // velocities taken relative to the mean.
   double sonine_a2_now() const {
-    const ParticleSystem<D> s = engine_->export_state();
-    Vec<D> mean{};
-    std::vector<Vec<D>> v(n_);
-    for (std::size_t i = 0; i < n_; ++i) {
-      v[i] = s.velocity_at(i, s.time);
-      mean = mean + (1.0 / static_cast<double>(n_)) * v[i];
-    }
+    const std::vector<Vec<D>> v = peculiar_velocities(engine_->export_state());
     double m2 = 0.0, m4 = 0.0;
     for (const Vec<D>& u : v) {
-      const double c2 = norm2(u - mean);
+      const double c2 = norm2(u);
       m2 += c2;
       m4 += c2 * c2;
     }
@@ -535,7 +603,7 @@ class RunDriver {
 
   nlohmann::json summary(double wall) const {
     const auto& c = engine_->counters();
-    const double ke = engine_->kinetic_energy();
+    const double ke = thermal_energy();
     const Thermodynamics& th = *thermo_stats_;
     const double kT = th.temperature(ke);
     const Vec<D> p = engine_->momentum();
@@ -551,7 +619,12 @@ class RunDriver {
     const double z_mean = th.compressibility(c.virial - prod_start_.virial, kT_prod, t_prod);
     std::vector<double> diameters(n_);
     for (std::size_t i = 0; i < n_; ++i) diameters[i] = 2.0 * state.kinematics[i].radius;
-    const double overlap = max_overlap<D>(state.box, engine_->current_positions(), diameters);
+    const double overlap =
+        sheared_ ? max_overlap_sheared<D>(
+                       state.box, engine_->current_positions(), diameters,
+                       std::fmod(engine_->environment().shear_rate * state.box[1] * state.time,
+                                 state.box[0]))
+                 : max_overlap<D>(state.box, engine_->current_positions(), diameters);
     const std::uint64_t events = c.events - events_start_;
     const std::uint64_t collisions = c.collisions - collisions_start_;
     nlohmann::json j;
@@ -601,7 +674,8 @@ class RunDriver {
     }
     j["mean_free_time"] = th.mean_free_time(t_prod, coll_prod);
     j["mean_free_time_stderr"] = th.mean_free_time_blocks().stderr_;
-    j["energy_drift_relative"] = ke_start_ > 0 ? std::abs(ke - ke_start_) / ke_start_ : 0.0;
+    j["energy_drift_relative"] =
+        ke_start_ > 0 ? std::abs(engine_->kinetic_energy() - ke_start_) / ke_start_ : 0.0;
     j["momentum_drift"] = pscale > 0 ? std::sqrt(dp2) / pscale : 0.0;
     j["max_overlap"] = overlap;
     j["peak_rss_bytes"] = peak_rss_bytes();
@@ -612,7 +686,8 @@ class RunDriver {
         (c.dissipated_in_collisions - counters_start_.dissipated_in_collisions) +
         (c.dissipated_at_walls - counters_start_.dissipated_at_walls);
     const double work = (c.work_by_walls - counters_start_.work_by_walls) +
-                        (c.work_by_driving - counters_start_.work_by_driving);
+                        (c.work_by_driving - counters_start_.work_by_driving) +
+                        (c.work_by_shear - counters_start_.work_by_shear);
     const double energy = total_energy();
     const double balance = energy - energy_start_ + dissipated - work;
     const double scale = std::max({std::abs(energy_start_), dissipated, std::abs(work)});
@@ -630,11 +705,30 @@ class RunDriver {
     g["work_by_walls"] = c.work_by_walls - counters_start_.work_by_walls;
     g["work_by_driving"] = c.work_by_driving - counters_start_.work_by_driving;
     g["driving_kicks"] = c.driving_kicks - counters_start_.driving_kicks;
+    g["work_by_shear"] = c.work_by_shear - counters_start_.work_by_shear;
     g["energy_start"] = energy_start_;
     g["energy_end"] = energy;
     g["energy_balance_relative"] = scale > 0.0 ? std::abs(balance) / scale : 0.0;
     j["granular"] = g;
+    if (sheared_) j["shear"] = shear_summary(kT_prod);
     return j;
+  }
+
+  // Simple shear: the stress P_xy from the production rows (blocked for its error) and the
+  // viscosity -P_xy / shear_rate.
+  nlohmann::json shear_summary(double temperature_at_production_start) const {
+    const double rate = engine_->environment().shear_rate;
+    const BlockAverage p = block_average(shear_stress_rows_);
+    nlohmann::json s;
+    s["shear_rate"] = rate;
+    s["shear_stress"] = p.mean;  // P_xy
+    s["shear_stress_stderr"] = p.stderr_;
+    s["viscosity"] = -p.mean / rate;
+    s["viscosity_stderr"] = p.stderr_ / std::abs(rate);
+    s["samples"] = p.samples;
+    s["temperature_production_start"] = temperature_at_production_start;
+    s["temperature"] = thermo_stats_->temperature(thermal_energy());
+    return s;
   }
 
   Config config_;
@@ -653,6 +747,11 @@ class RunDriver {
   EventCounters counters_start_;
   bool granular_ = false;  // walls, gravity or contact laws: report the energy budget
   bool driven_ = false;    // [driving]: thermostat or random kicks
+  bool sheared_ = false;   // Lees-Edwards boundaries
+  struct ShearRowStart {
+    double time = 0.0, virial_xy = 0.0;
+  } shear_row_start_;
+  std::vector<double> shear_stress_rows_;  // P_xy per production thermo row
   std::optional<AxisProfile<D>> profile_;  // output.profile_axis
   std::array<double, 9> kinetic_tensor_sum_{}, virial_tensor_start_{};
   int kinetic_tensor_samples_ = 0;

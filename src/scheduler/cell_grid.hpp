@@ -104,6 +104,7 @@ class CellGrid {
 
   std::uint32_t cell_count() const { return total_; }
   int cells_along(int k) const { return n_[k]; }
+  double width(int k) const { return width_[k]; }
   bool periodic(int k) const { return periodic_[k]; }
   // Whether the cell lies in an outer layer of a non-periodic axis k, on the side `sign`.
   bool at_face(CellCode c, int k, int sign) const {
