@@ -175,9 +175,18 @@ class EventEngine {
   void wake(std::uint32_t i, double t);
   // Leaves a resting contact (normal n, gravity into it) asleep or with at least the sleep
   // speed along n: no endless cascade of ever smaller bounces. Returns the energy added.
+  // `again`: the particle already had a contact at this instant (it is wedged: it stops).
   double settle_after_contact(std::uint32_t i, const Vec<D>& n, const Vec<D>& support_velocity,
-                              double t);
-  void collide_with_sleeper(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
+                              double t, bool again);
+  double spin_energy(std::uint32_t i) const;
+  // Whether a contact of normal n (unit, from the support to the particle) holds the particle
+  // up against gravity: n within 60 degrees of straight up. Steeper contacts are side contacts.
+  bool holds_up(const Vec<D>& n) const {
+    return dot(env_.gravity, n) < -0.5 * std::sqrt(norm2(env_.gravity));
+  }
+  bool resting_on_support(std::uint32_t i, double t);
+  void collide_with_sleeper(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2,
+                            bool again);
   std::uint32_t scan_with_sleepers(const CandidateList& list, std::uint32_t i, double t,
                                    double& best) const;
   void collide_granular(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
@@ -189,6 +198,7 @@ class EventEngine {
   [[gnu::noinline]] void advance_accelerated(HotRecord<D>& h, double t) const;
   double predict(std::uint32_t i, double t);
   double predict_from(const CandidateList& list, std::uint32_t i, double t);
+  double predict_asleep(const CandidateList& list, std::uint32_t i, double t);
   void gather(CellCode cell, CandidateList& list);
   void gather_vector(CellCode cell, CandidateList& list);
   struct Links {
