@@ -43,10 +43,6 @@ void Environment<D>::check() const {
     if (faces[f].kind != FaceKind::kWall) continue;
     const Wall<D>& w = faces[f].wall;
     const std::string name = std::string("wall ") + face_name(f);
-    if (w.velocity[f / 2] != 0.0) {
-      throw InputError(name + ": the sliding velocity must lie in the wall's plane (its " +
-                       std::string(1, "xyz"[f / 2]) + " component must be 0)");
-    }
     for (int a = 0; a < D; ++a) {
       if (!std::isfinite(w.velocity[a])) throw InputError(name + ": velocity must be finite");
     }

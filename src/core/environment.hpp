@@ -5,8 +5,10 @@
 //
 // The environment is set up from the run configuration, never stored in a restart file: it is
 // the model, not the state. Walls are the faces of the box; a wall at the low face of axis k
-// is the plane x_k = A sin(w t + phi) with normal +e_k, one at the high face the plane
-// x_k = L_k + A sin(w t + phi) with normal -e_k (A = 0: fixed).
+// is the plane x_k = u_k t + A sin(w t + phi) with normal +e_k, one at the high face the plane
+// x_k = L_k + u_k t + A sin(w t + phi) with normal -e_k (u_k = A = 0: fixed), where u is the
+// wall's velocity and t the absolute simulation time (so the plane is a function of the state's
+// time alone, and restarts need nothing more).
 #pragma once
 
 #include <array>
@@ -23,8 +25,10 @@ enum class FaceKind { kPeriodic, kWall, kOpen };
 
 template <int D>
 struct Wall {
-  ContactModel contact;            // restitution and roughness of particle-wall collisions
-  Vec<D> velocity{};               // sliding velocity in the wall's plane (a shear plate)
+  ContactModel contact;  // restitution and roughness of particle-wall collisions
+  // Velocity of the wall: the components in its plane slide it (a shear plate), the one along
+  // its normal moves the plane at that constant speed (a piston).
+  Vec<D> velocity{};
   double amplitude = 0.0;          // vibration along the normal: offset A sin(w t + phi)
   double angular_frequency = 0.0;  // w
   double phase = 0.0;              // phi
@@ -56,7 +60,7 @@ struct Environment {
   // particle, slower than this is put to sleep (it stops and feels no gravity until something
   // hits it harder than this). < 0: automatic, sqrt(2 |g| 1e-6 d_min) with gravity and walls;
   // 0: never (then resting particles need the TC model or elastic_below_speed). Never with a
-  // vibrating wall.
+  // wall that moves along its normal (vibrating or a piston).
   double sleep_speed = -1.0;
   // Lees-Edwards sliding-brick boundaries for simple shear: the periodic images above the box
   // (y + L_y) are displaced along x by shear_rate * L_y * t and move at shear_rate * L_y, so
@@ -77,6 +81,11 @@ struct Environment {
     u[0] = shear_rate * (x[1] - 0.5 * box[1]);
     return u;
   }
+  // Whether face f is a wall whose plane moves (a normal velocity or a vibration).
+  bool wall_moves(int f) const {
+    const Wall<D>& w = faces[f].wall;
+    return faces[f].kind == FaceKind::kWall && (w.velocity[f / 2] != 0.0 || w.vibrates());
+  }
   bool has_walls() const {
     for (const Face<D>& f : faces)
       if (f.kind == FaceKind::kWall) return true;
@@ -93,7 +102,7 @@ struct Environment {
   // Whether every contact is elastic and smooth, with no field, walls or open faces.
   bool plain() const;
   // Throws InputError naming the first inconsistency (an axis periodic on one face only, a
-  // sliding velocity with a normal component, a negative amplitude, contact table size...).
+  // velocity that is not finite, a negative amplitude, contact table size...).
   void check() const;
 };
 

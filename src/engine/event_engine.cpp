@@ -102,12 +102,11 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
     if (!s.angular_velocity.empty())
       for (std::uint32_t k = 0; k < n; ++k) spin_[k] = s.angular_velocity[id_[k]];
   }
-  // Sleepers predict no events of their own, so a vibrating wall could move into one unseen:
-  // with a vibrating wall nothing sleeps (resting piles there need the TC model).
-  bool vibrating = false;
-  for (const Face<D>& f : env_.faces)
-    vibrating = vibrating || (f.kind == FaceKind::kWall && f.wall.vibrates());
-  if (accelerated_ && walls_ && !vibrating) {
+  // Sleepers predict no events of their own, so a wall moving along its normal (vibrating or a
+  // piston) could move into one unseen: then nothing sleeps (resting piles need the TC model).
+  bool moving = false;
+  for (int f = 0; f < 2 * D; ++f) moving = moving || env_.wall_moves(f);
+  if (accelerated_ && walls_ && !moving) {
     double dmin = kNever;
     for (const Shape& sh : shapes_) dmin = std::min(dmin, 2.0 * sh.radius);
     sleep_speed_ = env_.sleep_speed >= 0.0
@@ -219,8 +218,8 @@ void EventEngine<D, Queue>::build_shapes(const ParticleSystem<D>& s) {
 }
 
 // Checks the environment against the particles and sizes the cell grid for it: periodic axes
-// need 3 cells; along a wall axis, only the outer layer may touch a wall (cells at least a
-// diameter plus the vibration amplitude wide).
+// need 3 cells; along a wall axis, only the outer layer may touch a fixed or vibrating wall
+// (cells at least a diameter plus the vibration amplitude wide; a piston reaches any layer).
 template <int D, class Queue>
 void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   env_.check();
@@ -259,14 +258,94 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
     image_step_ = image_step_at(time_);
     next_image_shift_ = image_shift_time(image_step_);
   }
+  find_squeeze_time(rmax);
+  if (time_ >= squeeze_time_) throw_squeezed(time_);
 }
 
-// Offset of a wall's plane from its face's rest position at time t.
+// Relative margin of find_squeeze_time: a lone particle squeezed between approaching walls
+// bounces ever faster (speed times gap is an adiabatic invariant), so the exact limit would take
+// without end to reach; this one is reached after some 1e6 bounces.
+constexpr double kSqueezeMargin = 1e-6;
+
+// The first time at which the walls of an axis, moving towards each other, are no more than the
+// largest diameter (times 1 + kSqueezeMargin) apart, vibration amplitudes counted as if both
+// walls were at their innermost: from then on the largest particle has no room between them.
+template <int D, class Queue>
+void EventEngine<D, Queue>::find_squeeze_time(double rmax) {
+  squeeze_time_ = kNever;
+  for (int a = 0; a < D; ++a) {
+    const Face<D>& lo = env_.faces[2 * a];
+    const Face<D>& hi = env_.faces[2 * a + 1];
+    if (lo.kind != FaceKind::kWall || hi.kind != FaceKind::kWall) continue;
+    const double approach = lo.wall.velocity[a] - hi.wall.velocity[a];
+    if (!(approach > 0.0)) continue;
+    const double room =
+        box_[a] - lo.wall.amplitude - hi.wall.amplitude - 2.0 * rmax * (1.0 + kSqueezeMargin);
+    if (room / approach < squeeze_time_) {
+      squeeze_time_ = room / approach;
+      squeeze_axis_ = a;
+    }
+  }
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::throw_squeezed(double t) const {
+  const int a = squeeze_axis_;
+  const std::string lo = std::string(1, "xyz"[a]) + "-", hi = std::string(1, "xyz"[a]) + "+";
+  const Wall<D>& wl = env_.faces[2 * a].wall;
+  const Wall<D>& wh = env_.faces[2 * a + 1].wall;
+  double dmax = 0.0;
+  for (const Shape& sh : shapes_) dmax = std::max(dmax, 2.0 * sh.radius);
+  std::ostringstream msg;
+  msg.precision(10);
+  msg << "boundary: at t = " << t << " the walls " << lo << " and " << hi << " are "
+      << box_[a] + (wh.velocity[a] - wl.velocity[a]) * t << " apart";
+  if (wl.vibrates() || wh.vibrates()) {
+    msg << " (their vibrations take up to " << wl.amplitude + wh.amplitude << " of that)";
+  }
+  msg << ", no more than the largest particle diameter " << dmax
+      << ": there is no room left between them (";
+  if (wl.velocity[a] != 0.0 && wh.velocity[a] != 0.0) {
+    msg << "the walls " << lo << " and " << hi << " move towards each other";
+  } else {
+    msg << "the wall " << (wl.velocity[a] != 0.0 ? lo : hi) << " moves towards "
+        << (wl.velocity[a] != 0.0 ? hi : lo);
+  }
+  msg << " at " << wl.velocity[a] - wh.velocity[a]
+      << ", from the box's faces at t = 0); end the run before t = " << squeeze_time_
+      << ", or move the walls more slowly or less far";
+  throw InputError(msg.str());
+}
+
+// Position of a wall's plane along its axis at time t.
 template <int D, class Queue>
 double EventEngine<D, Queue>::wall_offset(int face, double t) const {
   const Wall<D>& w = env_.faces[face].wall;
-  const double rest = face % 2 == 0 ? 0.0 : box_[face / 2];
-  return w.vibrates() ? rest + w.amplitude * std::sin(w.angular_frequency * t + w.phase) : rest;
+  double x = face % 2 == 0 ? 0.0 : box_[face / 2];
+  if (w.velocity[face / 2] != 0.0) x += w.velocity[face / 2] * t;
+  return w.vibrates() ? x + w.amplitude * std::sin(w.angular_frequency * t + w.phase) : x;
+}
+
+// Along the wall's normal n (into the box: +e_a at the low face, -e_a at the high one) the
+// plane's offset is d(t) = d0 + u t (+ the vibration): in the frame moving with u the particle's
+// normal velocity is v - u, and the solvers of a fixed or vibrated plane apply. With u = 0 the
+// result is the fixed (vibrated) plane's bit for bit.
+template <int D, class Queue>
+double EventEngine<D, Queue>::wall_event_time(int face, const Vec<D>& x, const Vec<D>& v,
+                                              double radius, double t, double horizon) const {
+  const Wall<D>& w = env_.faces[face].wall;
+  const int a = face / 2;
+  const double sgn = face % 2 == 0 ? 1.0 : -1.0;
+  const NormalMotion m{sgn * x[a] - radius, sgn * v[a], sgn * env_.gravity[a]};
+  const double u = sgn * w.velocity[a];
+  const double d = (face % 2 == 0 ? 0.0 : -box_[a]) + (u != 0.0 ? u * t : 0.0);
+  if (w.vibrates()) {
+    const NormalMotion rel{m.height, m.velocity - u, m.accel};
+    const VibratedPlane plane{d, sgn * w.amplitude, w.angular_frequency,
+                              std::remainder(w.angular_frequency * t + w.phase, 2.0 * M_PI)};
+    return vibrated_plane_event_time(rel, plane, horizon);
+  }
+  return moving_plane_event_time(m, d, u, horizon);
 }
 
 // A restored cell must exist and contain the particle's position (up to round-off): a damaged
@@ -753,7 +832,8 @@ void EventEngine<D, Queue>::collide_granular(std::uint32_t i, std::uint32_t j, d
 }
 
 // The soonest contact of particle i with a wall, from time t and before t + horizon. Only the
-// outer layer of cells can touch a wall (the grid is sized so).
+// outer layer of cells can touch a fixed or vibrating wall (the grid is sized so); a wall with
+// a normal velocity (a piston) may reach any layer.
 template <int D, class Queue>
 std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i, double t,
                                                                 double horizon) const {
@@ -762,30 +842,20 @@ std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i,
   const Vec<D> xt = position_at(h, t), vt = velocity_at(h, t);
   for (int f = 0; f < 2 * D; ++f) {
     const int a = f / 2, side = f % 2 == 0 ? -1 : 1;
-    if (env_.faces[f].kind != FaceKind::kWall || !grid_.at_face(h.cell, a, side)) continue;
-    const Wall<D>& w = env_.faces[f].wall;
-    // Along the wall's normal n (into the box): n = +e_a at the low face, -e_a at the high one.
-    const double sgn = -side;
-    const double x = sgn * xt[a], v = sgn * vt[a], g = sgn * env_.gravity[a];
-    const NormalMotion m{x - radius_of(i), v, g};
-    const double d0 = f % 2 == 0 ? 0.0 : -box_[a];  // the plane's rest offset along n
-    double when;
-    if (w.vibrates()) {
-      const VibratedPlane plane{d0, sgn * w.amplitude, w.angular_frequency,
-                                std::remainder(w.angular_frequency * t + w.phase, 2.0 * M_PI)};
-      when = vibrated_plane_event_time(m, plane, best.first);
-    } else {
-      when = fixed_plane_event_time(m, d0, best.first);
-    }
+    if (env_.faces[f].kind != FaceKind::kWall) continue;
+    if (env_.faces[f].wall.velocity[a] == 0.0 && !grid_.at_face(h.cell, a, side)) continue;
+    const double when = wall_event_time(f, xt, vt, radius_of(i), t, best.first);
     if (when < best.first) best = {when, f};
   }
   return best;
 }
 
-// A particle meets a wall: the wall is a partner of infinite mass moving with its sliding and
-// vibration velocity.
+// A particle meets a wall: the wall is a partner of infinite mass moving with its velocity
+// (sliding and normal) plus its vibration velocity, so restitution applies to the normal
+// velocity relative to the wall.
 template <int D, class Queue>
 void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
+  if (t >= squeeze_time_) throw_squeezed(t);
   const bool again = hot_[i].time == t;  // its second contact at this instant
   advance_to(i, t);
   HotRecord<D>& h = hot_[i];
@@ -1442,18 +1512,10 @@ void EventEngine<D, Queue>::validate() {
     const Vec<D> x = position_of(i, t), v = velocity_of(i, t);
     for (int f = 0; f < 2 * D; ++f) {
       if (env_.faces[f].kind != FaceKind::kWall) continue;
-      const Wall<D>& w = env_.faces[f].wall;
+      const double due = t + wall_event_time(f, x, v, radius_of(i), t, kNever);
       const int a = f / 2;
-      const double sgn = f % 2 == 0 ? 1.0 : -1.0;
-      const NormalMotion m{sgn * x[a] - radius_of(i), sgn * v[a], sgn * env_.gravity[a]};
-      const double d0 = f % 2 == 0 ? 0.0 : -box_[a];
-      const double due =
-          t + (w.vibrates() ? vibrated_plane_event_time(
-                                  m, VibratedPlane{d0, sgn * w.amplitude, w.angular_frequency,
-                                                   std::remainder(w.angular_frequency * t + w.phase,
-                                                                  2.0 * M_PI)})
-                            : fixed_plane_event_time(m, d0));
-      const double speed_at_contact = std::abs(v[a] + env_.gravity[a] * (due - t));
+      const double speed_at_contact =
+          std::abs(v[a] + env_.gravity[a] * (due - t) - env_.faces[f].wall.velocity[a]);
       if (std::isfinite(due) && late(queue_.time_of(i), due, speed_at_contact)) {
         fail("particle " + name(i) + " meets wall " + std::to_string(f) + " at " +
              std::to_string(due) + " before its pending event (at " +

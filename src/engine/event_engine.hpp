@@ -159,9 +159,16 @@ class EventEngine {
   Vec<D> position_at(const HotRecord<D>& h, double t) const;
   Vec<D> velocity_at(const HotRecord<D>& h, double t) const;
   double wall_offset(int face, double t) const;
+  // Relative time from t of the contact of a particle (position x, velocity v at t) with the
+  // plane of face f, kNever if after t + horizon.
+  double wall_event_time(int face, const Vec<D>& x, const Vec<D>& v, double radius, double t,
+                         double horizon) const;
   // The particle's soonest wall contact from time t before t + horizon: (relative time, face).
   std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
   void hit_wall(std::uint32_t i, int face, double t);
+  // Walls moving towards each other: when they leave no room for the largest particle.
+  void find_squeeze_time(double rmax);
+  [[noreturn]] void throw_squeezed(double t) const;
   // Sleeping particles (gravity with walls): see Environment::sleep_speed.
   bool is_asleep(std::uint32_t i) const { return !asleep_.empty() && asleep_[i] != 0; }
   Vec<D> position_of(std::uint32_t i, double t) const {
@@ -258,6 +265,8 @@ class EventEngine {
   bool accelerated_ = false;      // uniform gravity
   Vec<D> half_gravity_{};
   bool walls_ = false;
+  double squeeze_time_ = 0.0;  // see find_squeeze_time: kNever unless walls approach
+  int squeeze_axis_ = -1;
   bool bounded_ = false;                 // some axis has walls or open faces
   bool granular_contacts_ = false;       // some contact law is not elastic and smooth
   HugeVector<AngularVelocity<D>> spin_;  // rough particles only

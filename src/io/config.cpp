@@ -1084,16 +1084,10 @@ class Reader {
 
       read_contact(wt, prefix, w.contact);
 
+      // In-plane components slide the wall, the normal one moves it as a piston; finite (the
+      // getter says so), and whether approaching walls leave room is checked as the run goes.
       std::vector<double> velocity;
-      const toml::node* n_velocity = get_vector(wt, prefix, "velocity", dimension, velocity);
-      const auto axis = static_cast<std::size_t>(f / 2);
-      if (!velocity.empty() && velocity[axis] != 0.0) {
-        fail(element_of(n_velocity, axis), prefix + ".velocity",
-             fmt::format("{}.velocity: the component along the wall's normal ({}) must be 0, got "
-                         "{} (a wall slides in its own plane; amplitude and frequency move it "
-                         "along {})",
-                         prefix, kAxes[axis], velocity[axis], kAxes[axis]));
-      }
+      get_vector(wt, prefix, "velocity", dimension, velocity);
       // At rest is stored as the default, empty.
       if (std::any_of(velocity.begin(), velocity.end(), [](double v) { return v != 0.0; })) {
         w.velocity = std::move(velocity);

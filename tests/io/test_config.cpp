@@ -921,12 +921,23 @@ TEST(ConfigGranularErrors, HalfPeriodicAxis) {
                {"boundary: face x+ is a wall but x- is neither"});
 }
 
+TEST(ConfigGranular, WallVelocityAlongTheNormalIsAPiston) {
+  const Config c = parse_config(minimal_plus("[[boundary.wall]]\nface = \"z-\"\n"
+                                             "[[boundary.wall]]\nface = \"z+\"\n"
+                                             "velocity = [0.25, 0.0, -0.5]\namplitude = 0.1"),
+                                "t.toml");
+  EXPECT_TRUE(c.boundary.walls[0].velocity.empty());
+  EXPECT_EQ(c.boundary.walls[1].velocity, (std::vector<double>{0.25, 0.0, -0.5}));
+  EXPECT_EQ(c.boundary.walls[1].amplitude, 0.1);
+}
+
 TEST(ConfigGranularErrors, WallMotion) {
-  const std::string m =
-      expect_error(minimal_plus("[[boundary.wall]]\nface = \"z-\"\nvelocity = [1.0, 0.0, 0.5]\n"
-                                "[[boundary.wall]]\nface = \"z+\""),
-                   {"test.toml:6:23", "boundary.wall[0].velocity",
-                    "component along the wall's normal (z) must be 0", "got 0.5"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"z-\"\nvelocity = [0.0, 0.0, nan]\n"
+                            "[[boundary.wall]]\nface = \"z+\""),
+               {"test.toml:6:23", "boundary.wall[0].velocity[2]", "finite", "nan"});
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"z-\"\n[[boundary.wall]]\nface = "
+                            "\"z+\"\nvelocity = [0.0, 0.0, -inf]"),
+               {"boundary.wall[1].velocity[2]", "finite"});
   expect_error(minimal_plus("[[boundary.wall]]\nface = \"x-\"\nvelocity = [1.0, 0.0]\n"
                             "[[boundary.wall]]\nface = \"x+\""),
                {"boundary.wall[0].velocity", "expected 3 numbers (system.dimension = 3), got 2"});

@@ -232,6 +232,33 @@ class ConfigErrors(kt.KairosTestCase):
         self.check_set(["system.species.5.diameter=1.2"], "system.species")
 
 
+class PistonErrors(kt.KairosTestCase):
+    def test_nan_wall_velocity(self):
+        config = kt.base_config(boundary={"wall": [{"face": "z-"}, {"face": "z+"}]})
+        path = self.write_config(config)
+        result = self.kairos("run", path, "-o", self.path("out"),
+                             "--set", "boundary.wall.1.velocity=[0.0, 0.0, nan]")
+        self.assert_user_error(result, "boundary.wall[1].velocity[2]", "finite", "nan")
+
+    def test_walls_that_leave_no_room_stop_the_run(self):
+        # Two spheres (d = 1, 0.4) between a floor and a lid 3 apart that comes down at 5: at
+        # t = (3 - 1.000001) / 5 the large one has no room. The run stops there with an error
+        # naming the walls and the time, not with an overlap or a hang.
+        p = kt.write_hoomd_file(self.path("slab.gsd"), [[-2, -2, 0], [2, 2, -0.5]],
+                                [10, 10, 3], diameter=[1, 0.4],
+                                velocity=[[0, 0, 0.125], [0, 0, -0.25]])
+        config = kt.base_config(production=10.0)
+        config["system"] = {"dimension": 3, "initial_state": p}
+        config["boundary"] = {"wall": [{"face": "z-"},
+                                       {"face": "z+", "velocity": [0.0, 0.0, -5.0]}]}
+        result = self.kairos("run", self.write_config(config), "-o", self.path("out"))
+        line = self.assert_user_error(result, "boundary: at t = 0.3999", "the walls z- and z+",
+                                      "largest particle diameter 1", "no room left",
+                                      "the wall z+ moves towards z- at 5",
+                                      "end the run before t = 0.3999998")
+        self.assertNotIn("internal", line)
+
+
 class InitialStateErrors(kt.KairosTestCase):
     def run_from(self, gsd_path, dimension=3, *needles):
         config = kt.base_config(dimension=dimension, production=1.0)
