@@ -925,38 +925,30 @@ double EventEngine<D, Queue>::settle_after_contact(std::uint32_t i, const Vec<D>
                                                    bool again) {
   if (sleep_speed_ <= 0.0) return 0.0;
   HotRecord<D>& h = hot_[i];
-  if (again && norm2(support_velocity) == 0.0) {
-    // A second contact with resting things at one instant: the particle is wedged between
-    // them with no clearance (a gap of exactly its size, to round-off). Bouncing on would take
-    // endless contacts without time passing; it stops (plastic) and sleeps.
-    const double before = 0.5 * mass_of(i) * norm2(h.vel) + spin_energy(i);
-    fall_asleep(i, t);
-    return -before;
-  }
-  if (!holds_up(n)) {
-    // A contact from the side (a side wall, a sleeper beside it) does not hold the particle
-    // up. A slow particle that rests on something else sleeps; otherwise it moves on: without
-    // this, a particle on the floor squeezed between sleepers would bounce between them ever
-    // faster (inelastic collapse).
-    if (norm2(support_velocity) != 0.0 || !(norm2(h.vel) < sleep_speed_ * sleep_speed_) ||
-        !resting_on_support(i, t)) {
-      return 0.0;
-    }
-    const double before = 0.5 * mass_of(i) * norm2(h.vel) + spin_energy(i);
-    fall_asleep(i, t);
-    return -before;
-  }
-  const Vec<D> rel = h.vel - support_velocity;
-  const double vn = dot(rel, n);
-  if (vn >= sleep_speed_) return 0.0;  // a real bounce
   const double m = mass_of(i);
-  if (norm2(support_velocity) == 0.0 && norm2(rel) < sleep_speed_ * sleep_speed_) {
+  auto sleep = [&] {
     const double before = 0.5 * m * norm2(h.vel) + spin_energy(i);
     fall_asleep(i, t);
     return -before;
+  };
+  const bool still = norm2(support_velocity) == 0.0;
+  // A second contact with resting things at one instant: the particle is wedged between them
+  // with no clearance (a gap of exactly its size, to round-off). Bouncing on would take
+  // endless contacts without time passing; it stops (plastic) and sleeps.
+  if (again && still) return sleep();
+  // Slow and held up: by this contact, or (a contact from the side, e.g. a sleeper beside it
+  // on the floor) by something under it.
+  const Vec<D> rel = h.vel - support_velocity;
+  if (still && norm2(rel) < sleep_speed_ * sleep_speed_ &&
+      (holds_up(n) || resting_on_support(i, t))) {
+    return sleep();
   }
-  // Still sliding, or carried by a moving support: leave with the sleep speed along n, so
-  // that the next contact is a finite flight away.
+  if (!(dot(env_.gravity, n) < 0.0)) return 0.0;  // gravity does not press it into this contact
+  const double vn = dot(rel, n);
+  if (vn >= sleep_speed_) return 0.0;  // a real bounce
+  // Pressed into the contact but still sliding, on a slope too steep to rest on, or carried by
+  // a moving support: leave with the sleep speed along n, so that the next contact is a finite
+  // flight away, not the first of an endless cascade of ever smaller bounces.
   const double before = 0.5 * m * norm2(h.vel);
   h.vel = h.vel + (sleep_speed_ - vn) * n;
   return 0.5 * m * norm2(h.vel) - before;
