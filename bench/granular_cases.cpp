@@ -80,7 +80,7 @@ constexpr double kPileSleepSpeed = 0.2;
 constexpr double kPileInterval = 1;      // simulated time per row while settling
 constexpr double kPileMaxTime = 50;      // stop settling rows here even if some are awake
 constexpr double kPileAfter = 1000;      // the interval after settling
-constexpr double kPileWallBudget = 600;  // seconds: stop settling rows after this
+constexpr double kPileWallBudget = 300;  // seconds for the settling rows, and for the last
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -127,10 +127,15 @@ void advance_collisions(Engine<D>& e, double per_particle) {
   }
 }
 
-// Steps the engine through every event up to simulated time t.
+// Steps the engine through every event up to simulated time t, or until the wall clock passes
+// `deadline` (checked every 4096 events). Returns whether it reached t.
 template <int D>
-void advance_time(Engine<D>& e, double t) {
-  while (e.next_event_time() <= t) e.step();
+bool advance_time(Engine<D>& e, double t, Clock::time_point deadline = Clock::time_point::max()) {
+  for (std::uint64_t k = 1; e.next_event_time() <= t; ++k) {
+    e.step();
+    if (k % 4096 == 0 && Clock::now() > deadline) return false;
+  }
+  return true;
 }
 
 template <int D>
@@ -439,18 +444,25 @@ void run_pile(const GranularPlan& p, const Emit& emit, Notes& notes) {
   env.sleep_speed = kPileSleepSpeed;
   Engine<D> e(column_state<D>(c), StartMode::kPredict, EngineOptions{}, env);
   notes.push_back(fmt::format("pile {}D: engine built in {:.2f} s", D, seconds_since(w0)));
+  // Settling rows share one wall-clock budget; the last row (after settling) gets its own.
+  const auto budget =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kPileWallBudget));
+  const auto settling_deadline = Clock::now() + budget;
   double t = 0;
-  bool settled = false;
-  while (!settled) {
-    const bool stop =
-        t >= kPileMaxTime || e.sleeping() == e.size() || seconds_since(w0) > kPileWallBudget;
-    const double to = t + (stop ? kPileAfter : kPileInterval);
-    settled = to - t == kPileAfter;
+  for (bool last = false; !last;) {
+    last = t >= kPileMaxTime || e.sleeping() == e.size() || Clock::now() > settling_deadline;
+    const double to = t + (last ? kPileAfter : kPileInterval);
     const Counts c0 = counts_of(e.counters());
     const auto w1 = Clock::now();
-    advance_time(e, to);
-    emit(pile_row(e, t, to, counts_of(e.counters()) - c0, seconds_since(w1)));
-    t = to;
+    const bool reached = advance_time(e, to, last ? w1 + budget : settling_deadline);
+    const double end = reached ? to : e.time();
+    emit(pile_row(e, t, end, counts_of(e.counters()) - c0, seconds_since(w1)));
+    if (!reached) {
+      notes.push_back(
+          fmt::format("pile {}D: the wall-clock budget ({:g} s) ran out at simulated time {:.4g}",
+                      D, kPileWallBudget, end));
+    }
+    t = end;
   }
 }
 
