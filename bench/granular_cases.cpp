@@ -512,13 +512,15 @@ std::string granular_protocol(const GranularPlan& p) {
       "before it is timed; variants of a case interleaved, best of {} (events/s) with the "
       "spread; ratios best/best and (in brackets) the range over the interleaved pairs. gas: "
       "e = {:g}, start equilibrated elastically {:g} collisions per particle; bed: gravity "
-      "{:g}, floor amplitude {:g}, Γ = {:g}, e = {:g}, tc = {:g}, {} layers (3D; 2D: {}) at "
-      "η = {:g}, driven {:g} periods before it is timed; pile: {} loose layers (3D; 2D: {}), "
-      "spacing {:g}, e = {:g}, automatic sleep speed, rows every {:g} time units until all "
-      "sleep (or t = {:g}), then one of {:g}.",
+      "{:g}, periodic sides, open top, floor amplitude {:g}, Γ = {:g}, e = {:g}, tc = {:g}, {} "
+      "layers (3D; 2D: {}) at η = {:g}, driven {:g} periods before it is timed; pile: {} "
+      "body-centred layers (3D; 2D: {}), spacing {:g}, gap {:g}, e = {:g}, tc = {:g}, sleep "
+      "speed {:g}, rows every {:g} time units until all sleep (or t = {:g}, or {:g} wall "
+      "seconds), then one of {:g}.",
       kWarmup, p.repeat, kRestitution, p.equilibrate, kGravity, kBedAmplitude, kBedGamma,
       kRestitution, kBedTc, kBedLayers, 2 * kBedLayers, kBedEta, kBedPeriods, kPileLayers,
-      2 * kPileLayers, kPileSpacing, kPileRestitution, kPileInterval, kPileMaxTime, kPileAfter);
+      2 * kPileLayers, kPileSpacing, kPileGap, kPileRestitution, kPileTc, kPileSleepSpeed,
+      kPileInterval, kPileMaxTime, kPileWallBudget, kPileAfter);
 }
 
 void run_granular(const GranularPlan& plan, const std::function<void(const std::string&)>& emit) {
