@@ -6,6 +6,8 @@
 //   kairos_bench --suite full             # the performance issue's matrix (bench/README.md)
 //   kairos_bench --suite quick            # a few seconds: smoke test
 //   kairos_bench --particles 32000 --eta 0.45 --sizes mono,1.4 --queue calendar,heap --repeat 3
+//   kairos_bench --suite granular         # inelastic gas, vibrated bed, settling pile
+//   kairos_bench --case gas --dimension 3 # one granular case (granular_cases.hpp)
 //
 // Cases given several queues are run interleaved (A B A B ...) so that machine noise hits
 // every variant alike; the best of the repeats is reported with the spread.
@@ -34,6 +36,7 @@
 
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
+#include "granular_cases.hpp"
 #include "init/initial_state.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -435,7 +438,8 @@ Plan suite_plan(const std::string& suite) {
     p.equilibrate_large = 10;
     p.timed_large = 20;
   } else {
-    throw UsageError(fmt::format("unknown --suite \"{}\"; use one of default, quick, full", suite));
+    throw UsageError(
+        fmt::format("unknown --suite \"{}\"; use one of default, quick, full, granular", suite));
   }
   return p;
 }
@@ -511,22 +515,112 @@ std::string lengths_text(const Plan& p) {
          large;
 }
 
+// The output document: printed as it grows, and rewritten to --output (if any) after every
+// piece, so an interrupted run keeps what it measured.
+class Output {
+ public:
+  explicit Output(std::string path) : path_(std::move(path)) {}
+  void add(const std::string& text) {
+    fmt::print("{}", text);
+    std::fflush(stdout);
+    doc_ += text;
+    if (path_.empty()) return;
+    if (!written_) {
+      try {
+        write_atomically(path_, doc_);
+      } catch (const std::exception& e) {
+        throw UsageError(fmt::format("--output {}: {}", path_, e.what()));
+      }
+      written_ = true;
+    } else {
+      write_atomically(path_, doc_);
+    }
+  }
+
+ private:
+  std::string path_, doc_;
+  bool written_ = false;
+};
+
+// Date, command, machine and protocol: one line each, Markdown bullets or TSV comments.
+std::string preamble(int argc, char** argv, const std::string& protocol, Format f) {
+  std::string command = "kairos_bench";
+  for (int i = 1; i < argc; ++i) command += " " + quote_arg(argv[i]);
+  std::vector<std::string> facts;
+#ifdef KAIROS_VERSION
+  facts.push_back(fmt::format("Kairos {} benchmark, {}", KAIROS_VERSION, utc_now()));
+#else
+  facts.push_back(fmt::format("Kairos benchmark, {}", utc_now()));
+#endif
+  facts.push_back(fmt::format("Command: `{}`", command));
+  for (auto& fact : machine_facts()) facts.push_back(fact);
+  facts.push_back(protocol);
+  std::string doc;
+  for (const auto& fact : facts) doc += f == Format::kTsv ? "# " + fact + "\n" : "- " + fact + "\n";
+  return doc;
+}
+
+std::string hard_sphere_protocol(const Plan& plan) {
+  return fmt::format(
+      "Protocol: {}; best of {} run(s) per case, queues interleaved; seed 1. Starts: "
+      "monodisperse on the fcc (3D) / hex (2D) lattice; 50:50 mixtures by random insertion, or "
+      "on that lattice with the species shuffled over the sites where random insertion is "
+      "refused (too dense). Collisions per particle = 2 x collisions / N. Rates are over the "
+      "timed part only; crossings and stale (invalidated) events are the other event types.",
+      lengths_text(plan), plan.repeat);
+}
+
+void run_hard_spheres(const Plan& plan, Format fmt_kind, Output& out) {
+  out.add(header(fmt_kind));
+  for (std::uint64_t n : plan.particles) {
+    for (int d : plan.dims) {
+      for (double ratio : plan.size_ratios) {
+        for (double eta : plan.etas) {
+          const bool large = n > plan.large_from;
+          const Case c{d,
+                       n,
+                       eta,
+                       ratio,
+                       large ? plan.equilibrate_large : plan.equilibrate,
+                       large ? plan.timed_large : plan.timed};
+          std::vector<Row> rows;
+          try {
+            rows = run_case(c, plan.queues, plan.repeat);
+          } catch (const InputError& e) {
+            throw InputError(fmt::format("{}D N={} eta={} sizes={}: {}", d, n, eta,
+                                         sizes_text(ratio), e.what()));
+          }
+          std::string lines;
+          for (const auto& row : rows) lines += format_row(row, fmt_kind);
+          out.add(lines);
+        }
+      }
+    }
+  }
+}
+
 int run(int argc, char** argv) {
   CLI::App app{"Kairos benchmark driver (see bench/README.md)"};
   std::string suite = "default";
   std::vector<std::int64_t> particles;  // signed: "-5" is an error, not 2^64 - 5
   std::vector<double> etas, ratios;
   std::vector<int> dims;
-  std::vector<std::string> queues, sizes;
+  std::vector<std::string> queues, sizes, cases;
   double eq = 0, timed = 0;
   int repeat = 1;
   std::string format = "markdown", output;
-  app.add_option("--suite", suite,
-                 "case set: default (3D, eta 0.45, N 32000 and 1000000, calendar and heap, "
-                 "20 + 100 collisions per particle); quick (smoke test, a few seconds: 3D and "
-                 "2D, eta 0.1 and 0.45, N 4000, mono and 1.4, both queues, 2 + 10); full (3D "
-                 "and 2D, eta 0.1 0.3 0.45 0.5, N 4000 32000 1000000, mono and 1.4, calendar, "
-                 "20 + 100, but 10 + 20 at N > 32000). The options below override its parts");
+  auto* o_suite = app.add_option(
+      "--suite", suite,
+      "case set: default (3D, eta 0.45, N 32000 and 1000000, calendar and heap, "
+      "20 + 100 collisions per particle); quick (smoke test, a few seconds: 3D and "
+      "2D, eta 0.1 and 0.45, N 4000, mono and 1.4, both queues, 2 + 10); full (3D "
+      "and 2D, eta 0.1 0.3 0.45 0.5, N 4000 32000 1000000, mono and 1.4, calendar, "
+      "20 + 100, but 10 + 20 at N > 32000); granular (--case gas,bed,pile: an inelastic gas "
+      "and a vibrated bed against the elastic fluid, a pile settling with sleeping particles). "
+      "The options below override its parts");
+  auto* o_case =
+      app.add_option("--case", cases, "granular cases: gas, bed, pile (implies --suite granular)")
+          ->delimiter(',');
   auto* o_particles = app.add_option("--particles", particles, "particle numbers")->delimiter(',');
   auto* o_eta =
       app.add_option("--eta", etas, "packing fractions (area fractions in 2D)")->delimiter(',');
@@ -558,6 +652,45 @@ int run(int argc, char** argv) {
     throw UsageError(e.what());
   }
 
+  Format fmt_kind = Format::kMarkdown;
+  if (format == "tsv") {
+    fmt_kind = Format::kTsv;
+  } else if (format != "markdown" && format != "md") {
+    throw UsageError(fmt::format("--format \"{}\" is unknown; use markdown or tsv", format));
+  }
+
+  if (o_case->count() > 0 && o_suite->count() == 0) suite = "granular";
+  if (suite == "granular") {
+    if (o_queue->count() > 0 || o_sizes->count() > 0 || o_ratio->count() > 0 ||
+        fmt_kind == Format::kTsv) {
+      throw UsageError("--suite granular takes no --queue, --sizes or --format tsv");
+    }
+    if (particles.size() > 1 || etas.size() > 1) {
+      throw UsageError("--suite granular takes one --particles and one --eta");
+    }
+    bench::GranularPlan g;
+    if (o_case->count() > 0) g.cases = cases;
+    g.dims = dims;
+    if (!particles.empty()) {
+      if (particles[0] < 1) throw UsageError("--particles must be positive");
+      g.particles = static_cast<std::uint64_t>(particles[0]);
+    }
+    if (!etas.empty()) g.eta = etas[0];
+    if (o_eq->count() > 0) g.equilibrate = eq;
+    if (o_timed->count() > 0) g.timed = timed;
+    if (o_repeat->count() > 0) g.repeat = repeat;
+    try {
+      bench::validate(g);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+    Output out(output);
+    out.add(preamble(argc, argv, bench::granular_protocol(g), fmt_kind));
+    bench::run_granular(g, [&](const std::string& text) { out.add(text); });
+    return 0;
+  }
+  if (o_case->count() > 0) throw UsageError("--case needs --suite granular");
+
   Plan plan = suite_plan(suite);
   if (o_particles->count() > 0) {
     plan.particles.clear();
@@ -577,77 +710,12 @@ int run(int argc, char** argv) {
   if (o_eq->count() > 0) plan.equilibrate = plan.equilibrate_large = eq;
   if (o_timed->count() > 0) plan.timed = plan.timed_large = timed;
   if (o_repeat->count() > 0) plan.repeat = repeat;
-  Format fmt_kind = Format::kMarkdown;
-  if (format == "tsv") {
-    fmt_kind = Format::kTsv;
-  } else if (format != "markdown" && format != "md") {
-    throw UsageError(fmt::format("--format \"{}\" is unknown; use markdown or tsv", format));
-  }
   validate(plan);
 
-  std::string command = "kairos_bench";
-  for (int i = 1; i < argc; ++i) command += " " + quote_arg(argv[i]);
-  std::vector<std::string> facts;
-#ifdef KAIROS_VERSION
-  facts.push_back(fmt::format("Kairos {} benchmark, {}", KAIROS_VERSION, utc_now()));
-#else
-  facts.push_back(fmt::format("Kairos benchmark, {}", utc_now()));
-#endif
-  facts.push_back(fmt::format("Command: `{}`", command));
-  for (auto& f : machine_facts()) facts.push_back(f);
-  facts.push_back(fmt::format(
-      "Protocol: {}; best of {} run(s) per case, queues interleaved; seed 1. Starts: "
-      "monodisperse on the fcc (3D) / hex (2D) lattice; 50:50 mixtures by random insertion, or "
-      "on that lattice with the species shuffled over the sites where random insertion is "
-      "refused (too dense). Collisions per particle = 2 x collisions / N. Rates are over the "
-      "timed part only; crossings and stale (invalidated) events are the other event types.",
-      lengths_text(plan), plan.repeat));
-
-  std::string doc;
-  for (const auto& f : facts) {
-    doc += fmt_kind == Format::kTsv ? "# " + f + "\n" : "- " + f + "\n";
-  }
-  doc += fmt_kind == Format::kTsv ? "" : "\n";
-  doc += header(fmt_kind);
-  if (!output.empty()) {
-    try {
-      write_atomically(output, doc);
-    } catch (const std::exception& e) {
-      throw UsageError(fmt::format("--output {}: {}", output, e.what()));
-    }
-  }
-  fmt::print("{}", doc);
-  std::fflush(stdout);
-
-  for (std::uint64_t n : plan.particles) {
-    for (int d : plan.dims) {
-      for (double ratio : plan.size_ratios) {
-        for (double eta : plan.etas) {
-          const bool large = n > plan.large_from;
-          const Case c{d,
-                       n,
-                       eta,
-                       ratio,
-                       large ? plan.equilibrate_large : plan.equilibrate,
-                       large ? plan.timed_large : plan.timed};
-          std::vector<Row> rows;
-          try {
-            rows = run_case(c, plan.queues, plan.repeat);
-          } catch (const InputError& e) {
-            throw InputError(fmt::format("{}D N={} eta={} sizes={}: {}", d, n, eta,
-                                         sizes_text(ratio), e.what()));
-          }
-          for (const auto& row : rows) {
-            const std::string line = format_row(row, fmt_kind);
-            fmt::print("{}", line);
-            doc += line;
-          }
-          std::fflush(stdout);
-          if (!output.empty()) write_atomically(output, doc);
-        }
-      }
-    }
-  }
+  Output out(output);
+  out.add(preamble(argc, argv, hard_sphere_protocol(plan), fmt_kind) +
+          (fmt_kind == Format::kTsv ? "" : "\n"));
+  run_hard_spheres(plan, fmt_kind, out);
   return 0;
 }
 
