@@ -244,14 +244,21 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   for (int a = 0; a < D; ++a) {
     periodic[a] = env_.periodic(a);
     min_width[a] = 2.0 * rmax;
-    double amplitude = 0.0;
-    for (int f = 2 * a; f < 2 * a + 2; ++f)
-      if (env_.faces[f].kind == FaceKind::kWall)
-        amplitude = std::max(amplitude, env_.faces[f].wall.amplitude);
-    min_width[a] += amplitude;
   }
-  grid_ = CellGrid<D>(box_, min_width, periodic, s.size(), options_.max_cells_per_particle);
+  // A box with walls or open faces is often mostly empty (a bed under open headroom, a pile):
+  // the cap on cells per particle, meant to bound memory, would make the occupied cells wide.
+  const bool bounded = std::find(periodic.begin(), periodic.end(), false) != periodic.end();
+  const double cells_per_particle =
+      bounded ? std::max(options_.max_cells_per_particle, kBoundedCellsPerParticle)
+              : options_.max_cells_per_particle;
+  grid_ = CellGrid<D>(box_, min_width, periodic, s.size(), cells_per_particle);
   bounded_ = grid_.bounded();
+  // Layers of cells next to a face that a fixed or vibrating wall can reach: the particle's
+  // centre lies within its radius of the plane, which moves up to the amplitude into the box.
+  for (int f = 0; f < 2 * D; ++f) {
+    const double reach = env_.faces[f].wall.amplitude + rmax;
+    wall_layers_[f] = 1 + static_cast<int>(std::floor(reach / grid_.width(f / 2)));
+  }
   sheared_ = env_.sheared();
   if (sheared_) {
     shear_speed_ = env_.shear_rate * box_[1];
@@ -696,7 +703,7 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
   double best = crossing.time - t;
   const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
   std::uint32_t partner;
-  if (sleeping_ > 0 || list.sheared) [[unlikely]] {
+  if ((sleeping_ > 0 && sleeper_among(list)) || list.sheared) [[unlikely]] {
     partner = list.sheared ? scan_sheared(list, i, t, best) : scan_with_sleepers(list, i, t, best);
   } else {
     partner = test_candidates(list, i, t, xi, best);
@@ -716,6 +723,16 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
     }
   }
   return when > t ? when : t;  // never in the past, whatever the round-off
+}
+
+// Whether some candidate sleeps: only then does a pair need the quartic of scan_with_sleepers;
+// predictions away from the resting particles keep the vector loop.
+template <int D, class Queue>
+bool EventEngine<D, Queue>::sleeper_among(const CandidateList& list) const {
+  const std::uint8_t* asleep = asleep_.data();
+  std::uint8_t any = 0;
+  for (std::uint32_t k = 0; k < list.count; ++k) any |= asleep[list.ids[k]];
+  return any != 0;
 }
 
 // A sleeper moves on no event of its own (no crossing, no wall), but the awake particles around
@@ -739,8 +756,8 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
     return;
   }
   if (sleeping_ > 0 && (is_asleep(i) || is_asleep(j))) [[unlikely]] {
-    if (is_asleep(i)) std::swap(i, j);     // i is the awake one
-    const bool again = hot_[i].time == t;  // its second contact at this instant
+    if (is_asleep(i)) std::swap(i, j);  // i is the awake one
+    const bool again = wedged(i, t);
     advance_to(i, t);
     Vec<D> r = hot_[i].pos - hot_[j].pos;
     for (int a = 0; a < D; ++a)
@@ -829,11 +846,42 @@ void EventEngine<D, Queue>::collide_granular(std::uint32_t i, std::uint32_t j, d
   counters_.dissipated_in_collisions += res.dissipated;
   counters_.elastic_by_rule += res.made_elastic ? 1u : 0u;
   counters_.sliding_collisions += res.slid ? 1u : 0u;
+  separate(i, j, r, r2);
+}
+
+// After an inelastic collision the pair must recede as the candidate loops see it. A grazing
+// pair whose approach speed is at round-off level may come out of the contact law still
+// "approaching" in the loops' arithmetic (or not approaching in the law's, so no impulse), and
+// would then collide again and again at one instant. A momentum-conserving nudge along r makes
+// r.g slightly positive; its energy (round-off level) counts as dissipated with a minus sign.
+template <int D, class Queue>
+void EventEngine<D, Queue>::separate(std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2) {
+  HotRecord<D>& hi = hot_[i];
+  HotRecord<D>& hj = hot_[j];
+  const double speed = std::sqrt(norm2(hi.vel)) + std::sqrt(norm2(hj.vel));
+  const double wanted = 1e-12 * std::sqrt(r2) * speed;
+  const double rg = dot(r, hi.vel - hj.vel);
+  if (rg >= wanted) return;
+  const double mi = mass_of(i), mj = mass_of(j);
+  const double before = 0.5 * (mi * norm2(hi.vel) + mj * norm2(hj.vel));
+  const double lambda = (wanted - rg) / (r2 * (1.0 / mi + 1.0 / mj));
+  hi.vel = hi.vel + (lambda / mi) * r;
+  hj.vel = hj.vel - (lambda / mj) * r;
+  counters_.dissipated_in_collisions -= 0.5 * (mi * norm2(hi.vel) + mj * norm2(hj.vel)) - before;
+  counters_.virial += lambda * r2;
+  add_virial_tensor(r, lambda * r);
+}
+
+// Whether a cell lies within wall_layers_[f] layers of face f (a non-periodic axis).
+template <int D, class Queue>
+bool EventEngine<D, Queue>::near_face(CellCode c, int f) const {
+  const int a = f / 2, k = grid_.coordinate(c, a);
+  return f % 2 == 0 ? k < wall_layers_[f] : grid_.cells_along(a) - 1 - k < wall_layers_[f];
 }
 
 // The soonest contact of particle i with a wall, from time t and before t + horizon. Only the
-// outer layer of cells can touch a fixed or vibrating wall (the grid is sized so); a wall with
-// a normal velocity (a piston) may reach any layer.
+// layers next to a face that its wall's vibration can reach (near_face) can touch a fixed or
+// vibrating wall; a wall with a normal velocity (a piston) may reach any layer.
 template <int D, class Queue>
 std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i, double t,
                                                                 double horizon) const {
@@ -841,9 +889,9 @@ std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i,
   const HotRecord<D>& h = hot_[i];
   const Vec<D> xt = position_at(h, t), vt = velocity_at(h, t);
   for (int f = 0; f < 2 * D; ++f) {
-    const int a = f / 2, side = f % 2 == 0 ? -1 : 1;
+    const int a = f / 2;
     if (env_.faces[f].kind != FaceKind::kWall) continue;
-    if (env_.faces[f].wall.velocity[a] == 0.0 && !grid_.at_face(h.cell, a, side)) continue;
+    if (env_.faces[f].wall.velocity[a] == 0.0 && !near_face(h.cell, f)) continue;
     const double when = wall_event_time(f, xt, vt, radius_of(i), t, best.first);
     if (when < best.first) best = {when, f};
   }
@@ -856,7 +904,7 @@ std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i,
 template <int D, class Queue>
 void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
   if (t >= squeeze_time_) throw_squeezed(t);
-  const bool again = hot_[i].time == t;  // its second contact at this instant
+  const bool again = wedged(i, t);
   advance_to(i, t);
   HotRecord<D>& h = hot_[i];
   const Wall<D>& w = env_.faces[face].wall;
@@ -932,9 +980,8 @@ double EventEngine<D, Queue>::settle_after_contact(std::uint32_t i, const Vec<D>
     return -before;
   };
   const bool still = norm2(support_velocity) == 0.0;
-  // A second contact with resting things at one instant: the particle is wedged between them
-  // with no clearance (a gap of exactly its size, to round-off). Bouncing on would take
-  // endless contacts without time passing; it stops (plastic) and sleeps.
+  // Wedged between resting things with no clearance (see wedged()): bouncing on would take
+  // endless contacts; it stops (plastic) and sleeps.
   if (again && still) return sleep();
   // Slow and held up: by this contact, or (a contact from the side, e.g. a sleeper beside it
   // on the floor) by something under it.
@@ -947,11 +994,22 @@ double EventEngine<D, Queue>::settle_after_contact(std::uint32_t i, const Vec<D>
   const double vn = dot(rel, n);
   if (vn >= sleep_speed_) return 0.0;  // a real bounce
   // Pressed into the contact but still sliding, on a slope too steep to rest on, or carried by
-  // a moving support: leave with the sleep speed along n, so that the next contact is a finite
-  // flight away, not the first of an endless cascade of ever smaller bounces.
+  // a moving support: leave with half the sleep speed along n, so that the next contact is a
+  // finite flight away, not the first of an endless cascade of ever smaller bounces. Half: a
+  // particle rattling in a pocket then lands slower than the sleep speed and sleeps.
   const double before = 0.5 * m * norm2(h.vel);
-  h.vel = h.vel + (sleep_speed_ - vn) * n;
+  h.vel = h.vel + (0.5 * sleep_speed_ - vn) * n;
   return 0.5 * m * norm2(h.vel) - before;
+}
+
+// Whether particle i meets something again after moving less than 1e-9 of its diameter since
+// its previous event: between resting things with no clearance (a gap of exactly its size, to
+// round-off) the contacts would follow each other without end, at one instant or in a Zeno
+// sequence. (Called before the particle is advanced to t.)
+template <int D, class Queue>
+bool EventEngine<D, Queue>::wedged(std::uint32_t i, double t) const {
+  const double moved = (t - hot_[i].time) * std::sqrt(norm2(velocity_of(i, t)));
+  return moved <= 2e-9 * radius_of(i);
 }
 
 template <int D, class Queue>

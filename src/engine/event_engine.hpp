@@ -150,6 +150,8 @@ class EventEngine {
   // Partner codes of a PendingEvent beyond the particle indices: a wall (one per box face),
   // and kNoPartner for a cell crossing.
   static constexpr std::uint32_t kFirstWall = EventSlot::kNoPartner - 2 * D;
+  // Cells per particle allowed when some axis has walls or open faces (see setup_environment).
+  static constexpr double kBoundedCellsPerParticle = 4.0;
 
   void build_shapes(const ParticleSystem<D>& s);
   void setup_environment(const ParticleSystem<D>& s);
@@ -165,6 +167,7 @@ class EventEngine {
                          double horizon) const;
   // The particle's soonest wall contact from time t before t + horizon: (relative time, face).
   std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
+  bool near_face(CellCode c, int f) const;
   void hit_wall(std::uint32_t i, int face, double t);
   // Walls moving towards each other: when they leave no room for the largest particle.
   void find_squeeze_time(double rmax);
@@ -182,10 +185,11 @@ class EventEngine {
   void wake(std::uint32_t i, double t);
   // Leaves a resting contact (normal n, gravity into it) asleep or with at least the sleep
   // speed along n: no endless cascade of ever smaller bounces. Returns the energy added.
-  // `again`: the particle already had a contact at this instant (it is wedged: it stops).
+  // `again`: the particle is wedged (see wedged()): it stops.
   double settle_after_contact(std::uint32_t i, const Vec<D>& n, const Vec<D>& support_velocity,
                               double t, bool again);
   double spin_energy(std::uint32_t i) const;
+  bool wedged(std::uint32_t i, double t) const;
   // Whether a contact of normal n (unit, from the support to the particle) holds the particle
   // up against gravity: n within 60 degrees of straight up. Steeper contacts are side contacts.
   bool holds_up(const Vec<D>& n) const {
@@ -197,6 +201,7 @@ class EventEngine {
   std::uint32_t scan_with_sleepers(const CandidateList& list, std::uint32_t i, double t,
                                    double& best) const;
   void collide_granular(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
+  void separate(std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2);
   double radius_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].radius; }
   double mass_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].mass; }
   void advance_to(std::uint32_t i, double t);
@@ -206,6 +211,7 @@ class EventEngine {
   double predict(std::uint32_t i, double t);
   double predict_from(const CandidateList& list, std::uint32_t i, double t);
   double predict_asleep(const CandidateList& list, std::uint32_t i, double t);
+  bool sleeper_among(const CandidateList& list) const;
   void gather(CellCode cell, CandidateList& list);
   void gather_vector(CellCode cell, CandidateList& list);
   struct Links {
@@ -277,6 +283,7 @@ class EventEngine {
   CellGrid<D> grid_;
   Queue queue_;
   std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions
+  std::array<int, 2 * D> wall_layers_{};  // layers next to each face a wall can reach
   bool sheared_ = false;
   double shear_speed_ = 0.0;     // shear_rate * L_y: velocity of the images above the box
   std::int64_t image_step_ = 0;  // image offset in cell widths, rounded down (unwrapped)

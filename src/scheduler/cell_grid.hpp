@@ -69,7 +69,7 @@ class CellGrid {
       if (!periodic[k] && wanted[k] < 1.0) {
         throw InputError("box edge " + std::to_string(box[k]) + " between walls is shorter than " +
                          std::to_string(min_width[k]) +
-                         " (a particle diameter plus the walls' vibration amplitude)");
+                         " (a particle diameter)");
       }
       product *= wanted[k];
     }

@@ -141,11 +141,9 @@ TEST(SettlingPile, SphereSlidesOffASteepSlope) {
   ParticleSystem<D> s;
   s.box = {8.0, 8.0, 8.0};
   const double angle = 70.0 * M_PI / 180.0;
-  s.kinematics = {{{4.0, 4.0, 0.5}, {0.0, 0.0, 0.0}, 0.0, 0.5},
-                  {{4.0 + std::sin(angle), 4.0, 0.5 + std::cos(angle) + 1e-9},
-                   {0.0, 0.0, 0.0},
-                   0.0,
-                   0.5}};
+  s.kinematics = {
+      {{4.0, 4.0, 0.5}, {0.0, 0.0, 0.0}, 0.0, 0.5},
+      {{4.0 + std::sin(angle), 4.0, 0.5 + std::cos(angle) + 1e-9}, {0.0, 0.0, 0.0}, 0.0, 0.5}};
   s.mass = {1.0, 1.0};
   s.species = {0, 0};
   s.species_names = {"A"};
@@ -157,7 +155,7 @@ TEST(SettlingPile, SphereSlidesOffASteepSlope) {
   }
   EXPECT_EQ(engine.sleeping(), 2u);
   const std::vector<Vec<D>> x = engine.current_positions();
-  EXPECT_NEAR(x[1][2], 0.5, 1e-5);                       // on the floor
+  EXPECT_NEAR(x[1][2], 0.5, 1e-5);                                  // on the floor
   EXPECT_GE(std::hypot(x[1][0] - 4.0, x[1][1] - 4.0), 1.0 - 1e-9);  // beside the other
 }
 
