@@ -3,9 +3,11 @@
 
 Left: side view of the last trajectory frame (all spheres projected on the x-z plane), sleeping
 spheres (velocity exactly zero in the frame) in red. Middle: events per unit time, from the
-thermo.tsv rows. Right: the number of sleeping spheres in each trajectory frame, and the
-kinetic energy per sphere. A pile that falls asleep shows the event rate dropping to zero and
-the sleeper count reaching N (the run then stops with stop_reason = "no_more_events").
+thermo.tsv rows (each row's events over its time step). Right: the number of sleeping spheres in
+each trajectory frame, and the kinetic energy per sphere. Both on a logarithmic time axis: the
+grains land and settle within t ~ 10, the last ones can take several times longer. A pile that
+falls asleep shows the event rate dropping to zero and the sleeper count reaching N: the run then
+stops with stop_reason = "no_more_events" (dotted line), after which nothing happens.
 
     /usr/bin/python3 examples/plot/plot_pile_3d.py OUTDIR -o pile.png
 """
@@ -65,7 +67,12 @@ def main():
     t, events = thermo["time"], thermo["events"]
     dt = np.diff(np.r_[0.0, t])
     rate = np.diff(np.r_[0.0, events]) / np.where(dt > 0, dt, np.nan)
-    ax.semilogy(t, rate, "-", color="C0")
+    ax.loglog(t, rate, "-", drawstyle="steps-pre", color="C0")
+    stopped = summary["stop_reason"] == "no_more_events"
+    if stopped:
+        ax.axvline(t[-1], color="k", lw=0.8, ls=":")
+        ax.text(t[-1], 0.5, "no more events: \nrate 0 from here ",
+                transform=ax.get_xaxis_transform(), ha="right", va="center", fontsize=8)
     ax.set_xlabel("time")
     ax.set_ylabel("events per unit time")
     ax.set_title("N = %d, e = %g, tc = %g: %s" % (n, config["contact"]["restitution"],
@@ -77,13 +84,15 @@ def main():
     times = np.array([traj.time(f) for f in range(traj.frames)])
     sleepers = np.array([np.all(traj.chunk("particles/velocity", f) == 0, axis=1).sum()
                          for f in range(traj.frames)])
-    ax.plot(times, sleepers, "o-", ms=3, color="#d62728", label="asleep (trajectory frames)")
+    ax.semilogx(times[1:], sleepers[1:], "o-", ms=3, color="#d62728",
+                label="asleep (trajectory frames)")
     ax.axhline(n, color="k", lw=0.8, ls=":")
     ax.set_ylim(0, n * 1.05)
     ax.set_xlabel("time")
     ax.set_ylabel("spheres asleep")
     ax2 = ax.twinx()
-    ax2.semilogy(t, thermo["kinetic_energy"] / n, "-", color="C2", label="kinetic energy / N")
+    ke = thermo["kinetic_energy"] / n
+    ax2.loglog(t[ke > 0], ke[ke > 0], "-", color="C2", label="kinetic energy / N")
     ax2.set_ylabel("kinetic energy per sphere", color="C2")
     g = summary.get("granular", {})
     ax.set_title("fell asleep %d times in all, %d asleep at the end"

@@ -1,8 +1,9 @@
 """The granular examples of docs/examples.md stay runnable, and their plotting scripts work.
 
 Each example runs shortened by --set overrides (fewer particles, a few collisions per particle;
-well under a second each), then its script in examples/plot/ draws a PNG from the output, if
-Debian's python3-matplotlib is installed (otherwise that step is skipped). The GSD reader the
+about a second each; the pile runs until it has settled), then its script in examples/plot/
+draws a PNG from the output, if Debian's python3-matplotlib is installed (otherwise that step is
+skipped). The GSD reader the
 scripts use (examples/plot/kairos_output.py) is checked against python3-gsd.
 """
 
@@ -25,9 +26,14 @@ EXAMPLES = {
     "granular_damper_3d.toml": ("plot_damper_3d.py", [
         "system.particles=200", "run.collisions_per_particle=40",
         "output.thermo_interval=1", "output.trajectory_interval=2"]),
+    # No collision budget override: the pile (300 spheres, about a second) must settle and end
+    # the run by itself (the config's budget is only a cap).
     "granular_pile_3d.toml": ("plot_pile_3d.py", [
-        "system.particles=200", "run.collisions_per_particle=20",
-        "output.thermo_interval=1", "output.trajectory_interval=2"]),
+        "system.particles=300", "output.thermo_interval=1", "output.trajectory_interval=2"]),
+    "shear_flow_2d.toml": ("plot_shear_flow_2d.py", [
+        "system.particles=2000", "run.equilibration_collisions_per_particle=2",
+        "run.collisions_per_particle=5", "output.trajectory_interval=2",
+        "output.profile_bins=10"]),
 }
 
 
@@ -53,11 +59,19 @@ class GranularExamples(kt.KairosTestCase):
         self.assert_outputs_exist(out)
         return out
 
-    def check_example(self, name):
+    def check_run(self, name):
+        """Runs the example shortened; no overlap, energy budget closed. -> (outdir, summary)"""
         out = self.run_example(name)
         s = self.summary(out)
         self.assertLess(s["max_overlap"], 1e-9)
         self.assertLess(s["granular"]["energy_balance_relative"], 1e-9)
+        return out, s
+
+    def check_example(self, name):
+        out, _ = self.check_run(name)
+        self.draw_picture(name, out)
+
+    def draw_picture(self, name, out):
         if not have_matplotlib():
             self.skipTest("python3-matplotlib not installed: plotting script not run")
         png = self.path(name.replace(".toml", ".png"))
@@ -78,7 +92,19 @@ class GranularExamples(kt.KairosTestCase):
         self.check_example("granular_damper_3d.toml")
 
     def test_pile_3d(self):
-        self.check_example("granular_pile_3d.toml")
+        out, s = self.check_run("granular_pile_3d.toml")
+        # The pile falls asleep and the run ends by itself, long before the collision budget.
+        self.assertEqual(s["stop_reason"], "no_more_events")
+        self.assertEqual(s["granular"]["sleeping_now"], s["particles"])
+        self.assertEqual(s["kinetic_energy"], 0.0)
+        self.draw_picture("granular_pile_3d.toml", out)
+
+    def test_shear_flow_2d(self):
+        out, s = self.check_run("shear_flow_2d.toml")
+        self.assertGreater(s["shear"]["viscosity"], 0.0)  # the shear stress opposes the flow
+        self.assertGreater(s["granular"]["work_by_shear"], 0.0)
+        self.assertTrue(os.path.exists(os.path.join(out, "profile.tsv")))
+        self.draw_picture("shear_flow_2d.toml", out)
 
     def test_every_granular_example_is_listed_in_the_docs(self):
         with open(os.path.join(kt.SOURCE_DIR, "docs", "examples.md")) as f:
