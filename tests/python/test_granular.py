@@ -110,7 +110,7 @@ class GranularOutputs(kt.KairosTestCase):
         self.assertGreater(g["rotational_temperature"], 0.0)
         self.assertGreater(g["wall_collisions"], 0)
         self.assertLess(g["energy_balance_relative"], 1e-9)
-        self.assertEqual(s["max_overlap"], 0.0)
+        self.assertLess(s["max_overlap"], 1e-12)  # resting contacts touch to round-off
         traj = kt.open_trajectory(self.path("bed", "trajectory.gsd"))
         last = traj[len(traj) - 1]
         spins = last.log["particles/angular_velocity"]
