@@ -93,3 +93,19 @@ def read_config(outdir):
     (the TOML value `inf` becomes float('inf'))."""
     with open(os.path.join(outdir, "config.toml"), "rb") as f:
         return tomllib.load(f)
+
+
+class Frame:
+    """One frame of OUTDIR/trajectory.gsd: `pos`, `vel`, `diameter`, `box` (float arrays),
+    `index` (the frame number), and `traj` (the open GsdFile, for other chunks and frames)."""
+
+    def __init__(self, outdir, frame=-1):
+        self.traj = GsdFile(os.path.join(outdir, "trajectory.gsd"))
+        self.index = frame % self.traj.frames
+        self.pos = self.chunk("particles/position")
+        self.vel = self.chunk("particles/velocity")
+        self.diameter = self.chunk("particles/diameter")
+        self.box = self.chunk("configuration/box")
+
+    def chunk(self, name):
+        return self.traj.chunk(name, self.index).astype(float)

@@ -36,11 +36,9 @@ def main():
     config = ko.read_config(args.outdir)
     e = config["contact"]["restitution"]
     dim = config["system"]["dimension"]
-    traj = ko.GsdFile(os.path.join(args.outdir, "trajectory.gsd"))
-    frame = args.frame % traj.frames
-    pos = traj.chunk("particles/position", frame)
-    diameter = traj.chunk("particles/diameter", frame)
-    box = traj.chunk("configuration/box", frame)
+    snap = ko.Frame(args.outdir, args.frame)
+    traj, frame = snap.traj, snap.index
+    pos, diameter, box = snap.pos, snap.diameter, snap.box
     lx, ly = float(box[0]), float(box[1])
     time = traj.time(frame)
     c = 2.0 * float(traj.chunk("log/collisions", frame)[0]) / len(pos)

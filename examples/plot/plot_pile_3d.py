@@ -35,12 +35,9 @@ def main():
 
     config = ko.read_config(args.outdir)
     summary = ko.read_summary(args.outdir)
-    traj = ko.GsdFile(os.path.join(args.outdir, "trajectory.gsd"))
-    last = traj.frames - 1
-    box = traj.chunk("configuration/box", last).astype(float)
-    pos = traj.chunk("particles/position", last).astype(float)
-    vel = traj.chunk("particles/velocity", last)
-    diameter = traj.chunk("particles/diameter", last).astype(float)
+    snap = ko.Frame(args.outdir)
+    traj, last = snap.traj, snap.index
+    box, pos, vel, diameter = snap.box, snap.pos, snap.vel, snap.diameter
     n = len(pos)
     asleep = np.all(vel == 0, axis=1)
 

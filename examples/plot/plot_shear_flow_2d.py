@@ -39,12 +39,9 @@ def main():
     summary = ko.read_summary(args.outdir)
     rate = config["boundary"]["shear_rate"]
     e = config["contact"]["restitution"]
-    traj = ko.GsdFile(os.path.join(args.outdir, "trajectory.gsd"))
-    frame = args.frame % traj.frames
-    pos = traj.chunk("particles/position", frame).astype(float)
-    vel = traj.chunk("particles/velocity", frame).astype(float)
-    diameter = traj.chunk("particles/diameter", frame).astype(float)
-    box = traj.chunk("configuration/box", frame).astype(float)
+    snap = ko.Frame(args.outdir, args.frame)
+    traj, frame = snap.traj, snap.index
+    pos, vel, diameter, box = snap.pos, snap.vel, snap.diameter, snap.box
     lx, ly = box[0], box[1]
     time = traj.time(frame)
     n = len(pos)

@@ -47,12 +47,9 @@ def main():
     amplitude, frequency = floor["amplitude"], floor["frequency"]
     g = -config["field"]["gravity"][2]
     gamma = amplitude * (2 * np.pi * frequency) ** 2 / g
-    traj = ko.GsdFile(os.path.join(args.outdir, "trajectory.gsd"))
-    frame = args.frame % traj.frames
-    pos = traj.chunk("particles/position", frame).astype(float)
-    vel = traj.chunk("particles/velocity", frame).astype(float)
-    diameter = traj.chunk("particles/diameter", frame).astype(float)
-    box = traj.chunk("configuration/box", frame).astype(float)
+    snap = ko.Frame(args.outdir, args.frame)
+    traj, frame = snap.traj, snap.index
+    pos, vel, diameter, box = snap.pos, snap.vel, snap.diameter, snap.box
     lx, lz = box[0], box[2]
     z = pos[:, 2] + lz / 2  # GSD positions are centred; height above the floor's rest position
     profile = ko.read_tsv(os.path.join(args.outdir, "profile.tsv"))
