@@ -151,7 +151,7 @@ class EventEngine {
   // and kNoPartner for a cell crossing.
   static constexpr std::uint32_t kFirstWall = EventSlot::kNoPartner - 2 * D;
   // Cells per particle allowed when some axis has walls or open faces (see setup_environment).
-  static constexpr double kBoundedCellsPerParticle = 4.0;
+  static constexpr double kBoundedCellsPerParticle = 8.0;
 
   void build_shapes(const ParticleSystem<D>& s);
   void setup_environment(const ParticleSystem<D>& s);
