@@ -151,9 +151,8 @@ Sample timed_collisions(Engine<D>& e, double per_particle) {
 
 // A fresh engine from `start`, warmed up, then timed.
 template <int D>
-Sample sample(const ParticleSystem<D>& start, const Environment<D>& env, double timed,
-              EngineOptions options = {}) {
-  Engine<D> e(start, StartMode::kPredict, options, env);
+Sample sample(const ParticleSystem<D>& start, const Environment<D>& env, double timed) {
+  Engine<D> e(start, StartMode::kPredict, EngineOptions{}, env);
   advance_collisions(e, kWarmup);
   return timed_collisions(e, timed);
 }

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/periodic.hpp"
 #include "core/vec.hpp"
 #include "interactions/granular_contact.hpp"
 
@@ -75,10 +76,11 @@ struct Environment {
     return false;
   }
   bool sheared() const { return shear_rate != 0.0; }
-  // The mean shear flow at position x in a box of edges `box` (zero without shear).
+  // The mean shear flow at position x (any periodic image) in a box of edges `box`: zero
+  // without shear.
   Vec<D> streaming_velocity(const Vec<D>& x, const Vec<D>& box) const {
     Vec<D> u{};
-    u[0] = shear_rate * (x[1] - 0.5 * box[1]);
+    u[0] = shear_rate * (wrap_into_box(x[1], box[1]) - 0.5 * box[1]);
     return u;
   }
   // Whether face f is a wall whose plane moves (a normal velocity or a vibration).

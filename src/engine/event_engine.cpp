@@ -33,6 +33,11 @@ Spin<D> to_spin(const AngularVelocity<D>& w) {
     return w[0];
   }
 }
+// a / b rounded down (b > 0), for negative a too.
+constexpr std::int64_t floor_div(std::int64_t a, std::int64_t b) {
+  return a >= 0 ? a / b : -((-a + b - 1) / b);
+}
+
 template <int D>
 AngularVelocity<D> from_spin(const Spin<D>& w) {
   if constexpr (D == 3) {
@@ -252,7 +257,7 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
       bounded ? std::max(options_.max_cells_per_particle, kBoundedCellsPerParticle)
               : options_.max_cells_per_particle;
   grid_ = CellGrid<D>(box_, min_width, periodic, s.size(), cells_per_particle);
-  bounded_ = grid_.bounded();
+  bounded_ = bounded;
   // Layers of cells next to a face that a fixed or vibrating wall can reach: the particle's
   // centre lies within its radius of the plane, which moves up to the amplitude into the box.
   for (int f = 0; f < 2 * D; ++f) {
@@ -807,6 +812,26 @@ inline void EventEngine<D, Queue>::predict_pair(std::uint32_t i, std::uint32_t j
   queue_.update(j, predict_from(lists_[shared ? 0 : 1], j, t));
 }
 
+// The impulse of a pair collision at separation r (i minus j) with the particles' present
+// velocities: the contact law's, or the elastic one. For the rarer paths (a sleeper woken, a
+// collision through a sheared face); collide() keeps its own one-pass elastic loop.
+template <int D, class Queue>
+void EventEngine<D, Queue>::resolve_pair(std::uint32_t i, std::uint32_t j, double t,
+                                         const Vec<D>& r, double r2) {
+  if (granular_contacts_) {
+    collide_granular(i, j, t, r, r2);
+    return;
+  }
+  HotRecord<D>& hi = hot_[i];
+  HotRecord<D>& hj = hot_[j];
+  const double mi = mass_of(i), mj = mass_of(j);
+  const double s = HardSphere::impulse_factor(dot(hi.vel - hj.vel, r), r2, mi * mj / (mi + mj));
+  hi.vel = hi.vel + (s / mi) * r;
+  hj.vel = hj.vel - (s / mj) * r;
+  counters_.virial += s * r2;
+  add_virial_tensor(r, s * r);
+}
+
 // A collision under a granular contact law (restitution, roughness, TC model). The plain
 // elastic case never comes here (collide() keeps its two-line impulse).
 template <int D, class Queue>
@@ -1059,17 +1084,7 @@ void EventEngine<D, Queue>::collide_with_sleeper(std::uint32_t i, std::uint32_t 
   const double gn = dot(hi.vel, n);
   if (-gn >= sleep_speed_) {
     wake(j, t);
-    if (granular_contacts_) {
-      collide_granular(i, j, t, r, r2);
-    } else {
-      const double mi = mass_of(i), mj = mass_of(j);
-      const double s =
-          HardSphere::impulse_factor(dot(hi.vel - hot_[j].vel, r), r2, mi * mj / (mi + mj));
-      hi.vel = hi.vel + (s / mi) * r;
-      hot_[j].vel = hot_[j].vel - (s / mj) * r;
-      counters_.virial += s * r2;
-      add_virial_tensor(r, s * r);
-    }
+    resolve_pair(i, j, t, r, r2);
     ++hot_[j].collisions;
   } else {
     const ContactModel plain;
@@ -1263,9 +1278,8 @@ double EventEngine<D, Queue>::peculiar_kinetic_energy() const {
   if (!sheared_) return kinetic_energy();
   double ke = 0.0;
   for (std::uint32_t i = 0; i < size(); ++i) {
-    Vec<D> x = position_of(i, time_);
-    x[1] = wrap_into_box(x[1], box_[1]);
-    ke += 0.5 * mass_of(i) * norm2(velocity_of(i, time_) - env_.streaming_velocity(x, box_));
+    const Vec<D> u = env_.streaming_velocity(position_of(i, time_), box_);
+    ke += 0.5 * mass_of(i) * norm2(velocity_of(i, time_) - u);
   }
   return ke;
 }
@@ -1325,7 +1339,7 @@ double EventEngine<D, Queue>::bytes_per_particle() const {
 template <int D, class Queue>
 double EventEngine<D, Queue>::image_offset(double t) const {
   const std::int64_t nx = grid_.cells_along(0);
-  const std::int64_t wraps = image_step_ >= 0 ? image_step_ / nx : -((-image_step_ + nx - 1) / nx);
+  const std::int64_t wraps = floor_div(image_step_, nx);
   return shear_speed_ * t - static_cast<double>(wraps) * box_[0];
 }
 
@@ -1352,17 +1366,18 @@ void EventEngine<D, Queue>::shift_images() {
   time_ = next_image_shift_;
   image_step_ = next_image_step(image_step_);
   next_image_shift_ = image_shift_time(image_step_);
-  const int ny = grid_.cells_along(1), nz = D == 3 ? grid_.cells_along(D - 1) : 1;
-  std::array<int, D> at{};
+  // The cells of the two face rows: every (x, z) column at y = 0 and y = n_y - 1.
+  const int nx = grid_.cells_along(0), ny = grid_.cells_along(1);
+  const int nz = D == 3 ? grid_.cells_along(D - 1) : 1;
   for (const int y : {0, ny - 1}) {
-    at[1] = y;
-    for (int z = 0; z < nz; ++z) {
-      at[D - 1] = D == 3 ? z : y;
-      for (at[0] = 0; at[0] < grid_.cells_along(0); ++at[0]) {
-        const std::uint32_t cell = grid_.index(grid_.code_at(at));
-        for (std::uint32_t p = grid_.first(cell); p != grid_.end(); p = grid_.next(p))
-          queue_.update(p, predict(p, time_));
-      }
+    for (int column = 0; column < nx * nz; ++column) {
+      std::array<int, D> at{};
+      at[0] = column % nx;
+      at[1] = y;
+      if constexpr (D == 3) at[2] = column / nx;
+      const std::uint32_t cell = grid_.index(grid_.code_at(at));
+      for (std::uint32_t p = grid_.first(cell); p != grid_.end(); p = grid_.next(p))
+        queue_.update(p, predict(p, time_));
     }
   }
 }
@@ -1374,7 +1389,7 @@ void EventEngine<D, Queue>::gather_sheared(CellCode cell, CandidateList& list) {
   const int nx = grid_.cells_along(0), ny = grid_.cells_along(1);
   std::array<int, D> c;
   for (int a = 0; a < D; ++a) c[a] = grid_.coordinate(cell, a);
-  const std::int64_t k = ((image_step_ % nx) + nx) % nx;
+  const std::int64_t k = image_step_ - floor_div(image_step_, nx) * nx;
   const double offset = image_offset(time_);  // predictions happen at time_
   std::uint32_t n = 0, n_shifts = 1;          // shifts[0]: none
   list.shifts[0] = Vec<D>{};
@@ -1405,7 +1420,7 @@ void EventEngine<D, Queue>::gather_sheared(CellCode cell, CandidateList& list) {
     const int columns = side == 0 ? 3 : 4;
     for (int q = 0; q < columns; ++q) {
       const int m = first + q;
-      const int wraps = m >= 0 ? m / nx : -((-m + nx - 1) / nx);
+      const int wraps = static_cast<int>(floor_div(m, nx));
       at[0] = m - wraps * nx;
       shift[0] = side * offset + wraps * box_[0];
       if constexpr (D == 3) {
@@ -1478,16 +1493,7 @@ void EventEngine<D, Queue>::collide_sheared(std::uint32_t i, std::uint32_t j, do
   const double r2 = norm2(r);
   const Vec<D> vj_before = hj.vel;
   hj.vel = hj.vel + u;
-  if (granular_contacts_) {
-    collide_granular(i, j, t, r, r2);
-  } else {
-    const double mi = mass_of(i), mj = mass_of(j);
-    const double s = HardSphere::impulse_factor(dot(hi.vel - hj.vel, r), r2, mi * mj / (mi + mj));
-    hi.vel = hi.vel + (s / mi) * r;
-    hj.vel = hj.vel - (s / mj) * r;
-    counters_.virial += s * r2;
-    add_virial_tensor(r, s * r);
-  }
+  resolve_pair(i, j, t, r, r2);
   hj.vel = hj.vel - u;
   counters_.work_by_shear -= mass_of(j) * dot(u, hj.vel - vj_before);
   ++counters_.collisions;

@@ -200,6 +200,7 @@ class EventEngine {
                             bool again);
   std::uint32_t scan_with_sleepers(const CandidateList& list, std::uint32_t i, double t,
                                    double& best) const;
+  void resolve_pair(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
   void collide_granular(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
   void separate(std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2);
   double radius_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].radius; }

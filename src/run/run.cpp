@@ -419,9 +419,8 @@ class RunDriver {
             0.0, std::sqrt(d.temperature / engine_->particle_mass(k)));
         for (int a = 0; a < D; ++a) v[a] = maxwell(rng_);
         if (sheared_) {
-          Vec<D> x = engine_->position(k, next_kick_);
-          x[1] = wrap_into_box(x[1], engine_->box()[1]);
-          v = v + engine_->environment().streaming_velocity(x, engine_->box());
+          v = v + engine_->environment().streaming_velocity(engine_->position(k, next_kick_),
+                                                            engine_->box());
         }
       } else {
         std::normal_distribution<double> kick(0.0, std::sqrt(d.strength / d.rate));
@@ -540,9 +539,7 @@ class RunDriver {
     mean = (1.0 / mass) * mean;
     for (std::size_t i = 0; i < n_; ++i) {
       if (sheared_) {
-        Vec<D> x = s.position_at(i, s.time);
-        x[1] = wrap_into_box(x[1], s.box[1]);
-        v[i] = v[i] - engine_->environment().streaming_velocity(x, s.box);
+        v[i] = v[i] - engine_->environment().streaming_velocity(s.position_at(i, s.time), s.box);
       } else {
         v[i] = v[i] - mean;
       }
