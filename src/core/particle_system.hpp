@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,28 @@ struct EventCounters {
   // across the sliding y faces. Closes the energy budget; the heating of the peculiar motion is
   // -P_xy shear_rate V on average.
   double work_by_shear = 0.0;
+  // Stepped potentials: events where a pair met a step of its potential (outside the hard
+  // core) and crossed it or bounced off it. Both also count in `collisions`.
+  std::uint64_t step_crossings = 0;
+  std::uint64_t step_bounces = 0;
+};
+
+// A bond of a molecule (chain): particles i and j (the caller's numbering) interact through
+// the bond table of `type` instead of their species pair's potential.
+struct Bond {
+  std::uint32_t i = 0, j = 0;
+  std::uint32_t type = 0;
+  bool operator==(const Bond&) const = default;
+};
+
+// Stepped potentials: which step ("zone") of its potential a pair sits in. Zone 0 is beyond the
+// cut-off (never stored for non-bonded pairs), zone z >= 1 the shell between boundaries r_z and
+// r_{z-1} of the pair's table. Part of the exact state: a pair that just bounced off a step
+// sits on its boundary, where the distance alone cannot tell the two zones apart.
+struct PairZone {
+  std::uint32_t i = 0, j = 0;  // the caller's numbering, i < j
+  std::uint32_t zone = 0;
+  bool operator==(const PairZone&) const = default;
 };
 
 // Angular velocity: a vector in 3D, the z component alone in 2D.
@@ -95,6 +118,12 @@ struct ParticleSystem {
   std::array<bool, D> periodic = all_periodic();
   // Sleeping particles (empty: none) rest where they are and feel no gravity.
   std::vector<std::uint8_t> asleep;
+  // Molecules: the bonds (topology, not scheduler state) and the names of their types.
+  std::vector<Bond> bonds;
+  std::vector<std::string> bond_types;
+  // Stepped potentials: the zone of every pair inside some step (scheduler state: empty
+  // optional = compute from the distances; resumed engines require it).
+  std::optional<std::vector<PairZone>> zones;
 
   std::size_t size() const { return kinematics.size(); }
   bool is_asleep(std::size_t i) const { return !asleep.empty() && asleep[i] != 0; }

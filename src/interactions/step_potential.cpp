@@ -70,7 +70,7 @@ double shell_energy(const ContinuousPotential& p, double inner, double outer, St
 }  // namespace
 
 double StepTable::energy_at(double r) const {
-  if (r > boundary.front()) return 0.0;
+  if (r > boundary.front()) return beyond;
   for (std::size_t k = 0; k + 1 < boundary.size(); ++k)
     if (r > boundary[k + 1]) return energy[k];
   return kInfinity;
@@ -93,6 +93,8 @@ void StepTable::check() const {
   }
   for (const double u : energy)
     if (!std::isfinite(u)) throw InputError("step energies must be finite");
+  if (beyond != 0.0 && beyond != kInfinity)
+    throw InputError("the energy beyond a step table's cut-off must be 0 or infinite (a bond)");
 }
 
 StepTable square_well(double sigma, double lambda, double eps) {

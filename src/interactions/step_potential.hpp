@@ -16,10 +16,13 @@ namespace kairos {
 struct StepTable {
   std::vector<double> boundary;  // r_0 (cut-off) > r_1 > ... > r_K (hard core)
   std::vector<double> energy;    // energy[k] on (r_{k+1}, r_k); one fewer than boundaries
+  // Energy beyond the cut-off: 0 for a pair potential, +inf for a bond (the pair can never
+  // separate further than r_0).
+  double beyond = 0.0;
 
   double core() const { return boundary.back(); }
   double cutoff() const { return boundary.front(); }
-  // U(r): 0 beyond the cut-off, +inf inside the core; on a boundary, the outer shell's value.
+  // U(r): `beyond` beyond the cut-off, +inf inside the core; on a boundary, the outer shell's value.
   double energy_at(double r) const;
   // Throws InputError naming the first problem (too few boundaries, not decreasing, not
   // positive, energies not finite or of the wrong count).
