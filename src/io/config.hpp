@@ -40,6 +40,11 @@ struct SystemConfig {
   // particles are placed, leaving empty space at the high end of each axis (e.g. a bed of
   // grains at the bottom of a tall box). Empty = all 1.
   std::vector<double> box_scale;
+  // Molecules: with chain_length L > 0, the particles form N / L linear chains of L beads each
+  // (consecutive particles bonded), generated on a simple cubic (3D) or square (2D) lattice of
+  // spacing chain_spacing (0: the largest diameter) along a snake path. Bonds use [bond].
+  std::uint64_t chain_length = 0;
+  double chain_spacing = 0.0;
 
   bool operator==(const SystemConfig&) const = default;
 };
