@@ -50,12 +50,38 @@ struct PotentialSpec {
 };
 
 // The step table of the spec for a pair whose hard core is `core` (the sum of the two radii):
-// its last boundary is `core`. Throws InputError naming the problem (a table whose core is not
-// `core`, a cut-off inside the core, an unknown kind, placement or rule, an unreadable file).
+// its last boundary is `core`. Throws InputError naming the problem, prefixed "potential
+// <kind>: " ("bond <kind>: " for tether and spring): a table whose core is not `core`, a
+// cut-off inside the core, a bad parameter, an unknown kind, placement or rule, an unreadable
+// file. What each kind takes (defaults in brackets; lengths absolute, not scaled by the core):
+//   square_well, square_shoulder: lambda > 1, depth > 0; boundaries {lambda core, core},
+//     energy -depth (well) or +depth (shoulder).
+//   steps: boundaries and energies as given; the last boundary must be `core` within 1e-12
+//     (relative) and is then set to it exactly.
+//   lennard_jones: epsilon, sigma > 0, cutoff [2.5 sigma], shifted.
+//   wca: epsilon, sigma > 0; the cut-off is always 2^(1/6) sigma (cutoff must be left 0).
+//   yukawa: epsilon != 0 (< 0: attractive), sigma > 0, kappa >= 0, cutoff [3 sigma], shifted.
+//   morse: epsilon, alpha > 0, r_min [sigma], cutoff [r_min + 6 / alpha, where U = -0.005 eps].
+//   tabulated: file; the cut-off is the file's last r (cutoff must be left 0), shifted.
+//   tether (bond): max_length > core; boundaries {max_length, core}, energy {0}, beyond +inf.
+//   spring (bond): stiffness > 0, core < length < max_length; the harmonic spring stepped like
+//     a continuous potential (its well is at `length`), beyond +inf.
+// The continuous kinds and spring are stepped by step_potential with `steps` (>= 1),
+// `placement` (energy | distance | volume), `shell_energy` (midpoint | volume | mid_volume |
+// virial) and `temperature` (> 0, used by the virial rule). The two-argument form is 3D; the
+// dimension (2 or 3) matters for the volume placement and the volume, mid_volume and virial
+// energies.
 StepTable make_step_table(const PotentialSpec& spec, double core);
+StepTable make_step_table(const PotentialSpec& spec, double core, int dimension);
 
-// The continuous potential of a spec (empty name for square_well, square_shoulder, steps,
-// tether): what `kairos steps` draws next to the table.
+// The continuous potential of a spec, defaults filled in (empty name for square_well,
+// square_shoulder, steps, tether): what `kairos steps` draws next to the table. Throws
+// InputError like make_step_table for its parameters (those that do not involve the core).
 ContinuousPotential continuous_potential(const PotentialSpec& spec);
+
+// "energy" | "distance" | "volume", and "midpoint" | "volume" | "mid_volume" | "virial"; throw
+// InputError listing the accepted names.
+StepPlacement parse_step_placement(const std::string& name);
+StepEnergyRule parse_step_energy_rule(const std::string& name);
 
 }  // namespace kairos
