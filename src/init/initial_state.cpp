@@ -645,6 +645,173 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
   }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Chains.
+
+// Coordinates of site s (0 <= s < n^D) of the snake path through an n^D grid: the last axis
+// is the slowest; within each layer the path of the lower axes runs forwards on even layers and
+// backwards on odd ones, so consecutive sites always differ by 1 along exactly one axis.
+template <int D>
+std::array<std::uint64_t, D> snake_site(std::uint64_t s, std::uint64_t n) {
+  std::array<std::uint64_t, D> c{};
+  std::uint64_t layer = 1;  // sites per layer of the axes below k
+  for (int k = 0; k < D - 1; ++k) layer *= n;
+  for (int k = D - 1; k >= 0; --k) {
+    c[k] = s / layer;
+    s %= layer;
+    if (c[k] % 2 == 1) s = layer - 1 - s;
+    if (k > 0) layer /= n;
+  }
+  return c;
+}
+
+// Site coordinates along one axis, (c + 1/2) a, each rounded up where needed so that the
+// computed distance between neighbours is never below a; and the number of sites that fit in
+// [0, L) with the gap across the periodic boundary (computed as minimum_image does) >= a. At
+// most 2^20 sites per axis (more than N needs; at absurdly low densities the chains then fill
+// only the low corner of the box).
+std::vector<double> chain_axis(double L, double a) {
+  constexpr double kMaxSitesPerAxis = 1 << 20;
+  std::vector<double> x;
+  const auto n = static_cast<std::uint64_t>(std::min(std::floor(L / a), kMaxSitesPerAxis));
+  x.reserve(n);
+  for (std::uint64_t c = 0; c < n; ++c) {
+    double v = (static_cast<double>(c) + 0.5) * a;
+    if (c > 0) {
+      v = std::max(v, x.back() + a);
+      while (v - x.back() < a) v = std::nextafter(v, std::numeric_limits<double>::infinity());
+    }
+    x.push_back(v);
+  }
+  const auto gap_ok = [&] {
+    if (x.size() < 2) return x.empty() || x[0] < L;
+    const double last = x.back();
+    return last < L && std::abs(minimum_image(last - x[0], L)) >= a &&
+           std::abs(minimum_image(x[0] - last, L)) >= a;
+  };
+  while (!x.empty() && !gap_ok()) x.pop_back();
+  return x;
+}
+
+// Sites per axis of the grid a box of edge L holds at spacing a.
+std::uint64_t chain_sites_per_axis(double L, double a) {
+  return chain_axis(L, a).size();
+}
+
+template <int D>
+std::uint64_t power(std::uint64_t n) {
+  std::uint64_t p = 1;
+  for (int k = 0; k < D; ++k) {
+    if (n != 0 && p > std::numeric_limits<std::uint64_t>::max() / n) {
+      return std::numeric_limits<std::uint64_t>::max();
+    }
+    p *= n;
+  }
+  return p;
+}
+
+template <int D>
+InitialState<D> make_chain_state(const SystemConfig& system,
+                                 const std::vector<SpeciesConfig>& species, std::uint64_t N,
+                                 double eta, std::mt19937_64& rng) {
+  const std::uint64_t L = system.chain_length;
+  if (N % L != 0) {
+    throw InputError(
+        fmt::format("system.particles ({}) must be a multiple of system.chain_length ({})", N, L));
+  }
+  double dmax = 0.0;
+  for (const auto& s : species) dmax = std::max(dmax, s.diameter);
+  const double spacing = system.chain_spacing;
+  if (!(std::isfinite(spacing) && spacing >= 0.0)) {
+    throw InputError(fmt::format(
+        "system.chain_spacing = {} is invalid: must be finite and >= 0 (0: the largest diameter)",
+        spacing));
+  }
+  const double a = spacing == 0.0 ? dmax : spacing;
+  if (a < dmax) {
+    throw InputError(fmt::format(
+        "system.chain_spacing = {} is smaller than the largest diameter {}: bonded neighbours "
+        "would overlap",
+        spacing, dmax));
+  }
+  const Layout<D> layout = make_layout<D>(species, N, eta, nullptr);
+  if (!fits_cell_list(layout, dmax)) {
+    constexpr std::uint64_t kScan = 1'000'000;
+    std::uint64_t needed = 0;
+    for (std::uint64_t n = N + L; n <= N + kScan && n < kNoParticle; n += L) {
+      if (fits_cell_list(make_layout<D>(species, n, eta, nullptr), dmax)) {
+        needed = n;
+        break;
+      }
+    }
+    const std::string need_text = needed != 0
+                                      ? fmt::format("at least {} particles are needed", needed)
+                                      : fmt::format("more than {} particles are needed", N + kScan);
+    throw InputError(fmt::format(
+        "system.particles = {} is too few for packing fraction {} with chains: the box edge "
+        "{:.6g} is shorter than 3 x the largest diameter {:.6g} (the cell list needs 3 cells per "
+        "axis); {}",
+        N, eta, layout.box[0], dmax, need_text));
+  }
+  const std::vector<double> axis = chain_axis(layout.box[0], a);
+  const std::uint64_t n = axis.size();
+  const std::uint64_t sites = power<D>(n);
+  if (sites < N) {
+    // The smallest grid holding N sites, m per axis, needs a box edge of m a.
+    std::uint64_t m = 1;
+    while (power<D>(m) < N) ++m;
+    const double edge = static_cast<double>(m) * a;
+    double largest = round_down_6(layout.solid_volume / std::pow(edge, D));
+    for (int tries = 0; tries < 64; ++tries) {
+      const double Lb = D == 3 ? std::cbrt(layout.solid_volume / largest)
+                               : std::sqrt(layout.solid_volume / largest);
+      if (chain_sites_per_axis(Lb, a) >= m) break;
+      largest = round_down_6(largest * (1.0 - 1e-6));
+    }
+    throw InputError(fmt::format(
+        "system.packing_fraction = {} is too high for {} chains of {} beads at spacing {:.6g}: "
+        "the box (edge {:.6g}) holds {} sites per axis, {} in all; the largest possible is "
+        "{:.6g}",
+        eta, N / L, L, a, layout.box[0], n, sites, largest));
+  }
+
+  InitialState<D> state;
+  state.box = layout.box;
+  for (const auto& s : species) state.species_names.push_back(s.name);
+  state.species.reserve(N);
+  for (std::size_t s = 0; s < species.size(); ++s) {
+    state.species.insert(state.species.end(), layout.counts[s], static_cast<std::uint32_t>(s));
+  }
+  shuffle(state.species, rng);
+  state.diameter.resize(N);
+  state.mass.resize(N);
+  for (std::size_t i = 0; i < N; ++i) {
+    state.diameter[i] = species[state.species[i]].diameter;
+    state.mass[i] = species[state.species[i]].mass;
+  }
+  // Chain c starts at path site floor(c S / C): consecutive chains at least L sites apart.
+  const std::uint64_t chains = N / L;
+  const std::uint64_t whole = sites / chains, part = sites % chains;
+  state.position.resize(N);
+  for (std::uint64_t c = 0; c < chains; ++c) {
+    // floor(c * sites / chains) without overflow
+    const std::uint64_t first = c * whole + (c * part) / chains;  // c, part < chains < 2^32
+    for (std::uint64_t b = 0; b < L; ++b) {
+      const auto site = snake_site<D>(first + b, n);
+      for (int k = 0; k < D; ++k) state.position[c * L + b][k] = axis[site[k]];
+    }
+  }
+  state.bond_types = {"backbone"};
+  state.bonds.reserve(chains * (L - 1));
+  for (std::uint64_t c = 0; c < chains; ++c) {
+    for (std::uint64_t b = 0; b + 1 < L; ++b) {
+      const auto i = static_cast<std::uint32_t>(c * L + b);
+      state.bonds.push_back(Bond{i, i + 1, 0});
+    }
+  }
+  assign_maxwell_boltzmann_velocities(state, system.temperature, rng);
+  return state;
+}
 }  // namespace
 
 std::vector<std::uint64_t> largest_remainder_counts(const std::vector<double>& weights,
@@ -720,6 +887,8 @@ InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& 
     throw InputError(fmt::format("system.temperature = {} is invalid: must be finite and >= 0",
                                  system.temperature));
   }
+
+  if (system.chain_length > 0) return make_chain_state<D>(system, species, N, eta, rng);
 
   const std::string name =
       system.lattice.empty() ? std::string(D == 3 ? "fcc" : "hex") : system.lattice;
@@ -860,6 +1029,14 @@ void sort_spatially(InitialState<D>& state) {
     sorted.diameter[i] = state.diameter[from];
     sorted.mass[i] = state.mass[from];
     if (!state.velocity.empty()) sorted.velocity[i] = state.velocity[from];
+  }
+  if (!state.bonds.empty()) {
+    std::vector<std::uint32_t> new_index(n);
+    for (std::size_t i = 0; i < n; ++i) new_index[keys[i].second] = static_cast<std::uint32_t>(i);
+    for (Bond& b : sorted.bonds) {
+      b.i = new_index[b.i];
+      b.j = new_index[b.j];
+    }
   }
   state = std::move(sorted);
 }

@@ -45,6 +45,10 @@ struct InitialState {
   std::vector<double> diameter;        // per particle
   std::vector<double> mass;            // per particle
   std::vector<std::string> species_names;
+  // Molecules (empty: none): bonds between particles of this state (its numbering) and the
+  // names of the bond types they index.
+  std::vector<Bond> bonds;
+  std::vector<std::string> bond_types;
 };
 
 // Sum of the particle volumes divided by the box volume.
@@ -63,6 +67,19 @@ double packing_fraction(const InitialState<D>& state);
 //   sites each, nx = ceil(N / (2 ny)) and ny giving the box closest to square. With more sites
 //   than N, particle i sits on site floor(i * sites / N) (uniform density). Offset by a quarter
 //   cell along each axis, so no particle lies on the boundary.
+// - Chains (system.chain_length L > 0; system.lattice is then ignored): N / L linear chains of
+//   L beads, chain c = particles c L .. c L + L - 1, bonds (k, k + 1) within each chain, all of
+//   bond type "backbone". The box is cubic/square (volume from the packing fraction as above);
+//   the sites are a simple cubic/square lattice of spacing a = system.chain_spacing (0: the
+//   largest diameter), floor(box / a) sites per axis at (c + 1/2) a, so that the gap across the
+//   periodic boundary is at least a. The sites are ordered along a snake (boustrophedon) path:
+//   consecutive sites of the path are neighbours at distance a (never across the boundary;
+//   coordinates rounded so that the computed distance is never below a). Chain c occupies the
+//   consecutive path sites from floor(c S / C) on (S sites, C chains): the chains fill the
+//   path evenly, each on a straight-or-folded piece of it; with S = N particle k sits on site k.
+//   Species as on a lattice (counts by fraction, shuffled over the particles). Not sorted
+//   spatially. InputError when N is not a multiple of L, a < the largest diameter, or the box
+//   holds fewer than N sites (the message gives the largest possible packing fraction).
 // - "random": random sequential insertion in a cubic/square box, exact RSA statistics,
 //   accelerated by a cell grid and a voxel list of the remaining free space; refused above
 //   packing fraction 0.35 (3D) / 0.50 (2D) since it jams near 0.38 / 0.547.
@@ -88,12 +105,15 @@ ParticleSystem<D> to_particle_system(const InitialState<D>& init) {
   s.mass = init.mass;
   s.species = init.species;
   s.species_names = init.species_names;
+  s.bonds = init.bonds;
+  s.bond_types = init.bond_types;
   return s;
 }
 
 // Renumbers the particles in row-major order of cells as wide as the largest diameter, so
 // particles close in space are close in memory (random insertion otherwise leaves them in
-// insertion order). Applied to generated random states; files keep their particle order.
+// insertion order). Applied to generated random states; files keep their particle order. Bonds
+// are renumbered with their particles.
 template <int D>
 void sort_spatially(InitialState<D>& state);
 
