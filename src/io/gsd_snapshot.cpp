@@ -13,8 +13,11 @@ namespace kairos {
 
 namespace {
 
-// 2: one event time per particle, order; 3: granular counters, spins, TC times, sleepers
-constexpr std::uint32_t kRestartFormat = 3;
+// 2: one event time per particle, order; 3: granular counters, spins, TC times, sleepers;
+// 4: bonds, pair zones, step counters. Version 3 files are still read (no bonds, zones absent,
+// step counters 0): the chunks added in 4 are optional.
+constexpr std::uint32_t kRestartFormat = 4;
+constexpr std::uint32_t kOldestRestartFormat = 3;
 
 // HOOMD stores type names as an N_types x M int8 array of 0-padded strings.
 std::vector<std::int8_t> pack_type_names(const std::vector<std::string>& names, std::uint32_t& m) {
@@ -48,6 +51,29 @@ float hoomd_coordinate(double x, double L, bool periodic = true) {
   const float half = static_cast<float>(0.5 * L);
   const float c = static_cast<float>(wrap_into_box(x, L) - 0.5 * L);
   return c >= half ? -half : c;
+}
+
+// The bonds in HOOMD's schema (bonds/N, types, typeid, group), only when there are bonds or
+// bond types (readers default to none).
+template <int D>
+void write_bonds(gsd::Writer& w, const ParticleSystem<D>& sys) {
+  if (sys.bonds.empty() && sys.bond_types.empty()) return;
+  const auto nb = static_cast<std::uint32_t>(sys.bonds.size());
+  w.write_chunk("bonds/N", 1, 1, &nb);
+  if (!sys.bond_types.empty()) {
+    std::uint32_t m = 0;
+    const auto names = pack_type_names(sys.bond_types, m);
+    w.write_chunk("bonds/types", sys.bond_types.size(), m, names.data());
+  }
+  if (nb == 0) return;
+  std::vector<std::uint32_t> type_id(nb), group(2 * std::size_t{nb});
+  for (std::size_t b = 0; b < nb; ++b) {
+    type_id[b] = sys.bonds[b].type;
+    group[2 * b] = sys.bonds[b].i;
+    group[2 * b + 1] = sys.bonds[b].j;
+  }
+  w.write_chunk("bonds/typeid", nb, 1, type_id.data());
+  w.write_chunk("bonds/group", nb, 2, group.data());
 }
 
 template <int D>
@@ -102,6 +128,7 @@ void write_standard_chunks(gsd::Writer& w, const ParticleSystem<D>& sys, bool wi
     }
     w.write_chunk("particles/diameter", n, 1, diameter.data());
     w.write_chunk("particles/mass", n, 1, mass.data());
+    write_bonds(w, sys);
   }
   w.write_chunk("log/time", 1, 1, &sys.time);
   w.write_chunk("log/collisions", 1, 1, &sys.counters.collisions);
@@ -126,6 +153,53 @@ std::vector<T> require(const gsd::Reader& r, std::uint64_t frame, std::string_vi
                      std::to_string(v->size()) + " values, expected " + std::to_string(expected));
   }
   return std::move(*v);
+}
+
+// Default name of the one bond type of a file that has bonds but no bonds/types chunk (as
+// HOOMD files written without types): that of generated chains.
+constexpr const char* kDefaultBondType = "backbone";
+
+struct BondData {
+  std::vector<Bond> bonds;
+  std::vector<std::string> types;
+};
+
+// The bonds of frame f (or frame 0) in HOOMD's schema. `what` names the file in messages.
+// InputError when a chunk has the wrong size, a bond names a particle >= n or the same
+// particle twice, or a typeid has no entry in bonds/types.
+BondData read_bonds(const gsd::Reader& r, std::uint64_t f, const std::filesystem::path& path,
+                    std::size_t n, const std::string& what) {
+  BondData out;
+  const auto bad = [&](const std::string& why) { return InputError(what + ": " + why); };
+  const std::uint64_t types_frame = r.find(f, "bonds/types") ? f : 0;
+  if (const auto info = r.find(types_frame, "bonds/types")) {
+    out.types = unpack_type_names(r.read<std::int8_t>(types_frame, "bonds/types"), info->M);
+  }
+  const auto count = read_latest<std::uint32_t>(r, f, "bonds/N");
+  const std::size_t nb = count && !count->empty() ? (*count)[0] : 0;
+  if (nb == 0) return out;
+  const auto group = require<std::uint32_t>(r, f, "bonds/group", path, 2 * nb);
+  std::vector<std::uint32_t> type_id(nb, 0);
+  if (r.find(f, "bonds/typeid") || r.find(0, "bonds/typeid"))
+    type_id = require<std::uint32_t>(r, f, "bonds/typeid", path, nb);
+  if (out.types.empty()) out.types = {kDefaultBondType};
+  out.bonds.resize(nb);
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Bond bond{group[2 * b], group[2 * b + 1], type_id[b]};
+    const std::string who = "bond " + std::to_string(b) + " (" + std::to_string(bond.i) + ", " +
+                            std::to_string(bond.j) + ")";
+    if (bond.i >= n || bond.j >= n) {
+      throw bad(who + " names a particle beyond the " + std::to_string(n) +
+                " particles (bonds/group)");
+    }
+    if (bond.i == bond.j) throw bad(who + " bonds a particle to itself (bonds/group)");
+    if (bond.type >= out.types.size()) {
+      throw bad(who + " has typeid " + std::to_string(bond.type) +
+                ", which has no entry in bonds/types");
+    }
+    out.bonds[b] = bond;
+  }
+  return out;
 }
 
 // A restart file is trusted to index arrays (partners, types); reject a damaged one with an
@@ -167,6 +241,14 @@ void validate_restart(const ParticleSystem<D>& s, const std::filesystem::path& p
   for (std::uint32_t k : s.order) {
     if (k >= n || seen[k]) throw bad("kairos/state/order is not a permutation");
     seen[k] = 1;
+  }
+  if (s.zones) {
+    for (const PairZone& z : *s.zones) {
+      if (!(z.i < z.j && z.j < n)) {
+        throw bad("kairos/state/zones holds the pair (" + std::to_string(z.i) + ", " +
+                  std::to_string(z.j) + "), not two particles i < j < " + std::to_string(n));
+      }
+    }
   }
 }
 
@@ -258,6 +340,23 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     w.write_chunk("kairos/state/granular_energies", 4, 1, energies);
     if (s.counters.work_by_shear != 0.0)
       w.write_chunk("kairos/state/shear_work", 1, 1, &s.counters.work_by_shear);
+    const std::uint64_t steps[2] = {s.counters.step_crossings, s.counters.step_bounces};
+    w.write_chunk("kairos/state/step_counters", 2, 1, steps);
+    if (s.zones) {
+      // The count marks the list as present (also when empty); the pairs follow when any.
+      const std::uint64_t nz = s.zones->size();
+      w.write_chunk("kairos/state/zone_count", 1, 1, &nz);
+      if (nz > 0) {
+        std::vector<std::uint32_t> flat(3 * nz);
+        for (std::size_t z = 0; z < nz; ++z) {
+          const PairZone& pz = (*s.zones)[z];
+          flat[3 * z] = pz.i;
+          flat[3 * z + 1] = pz.j;
+          flat[3 * z + 2] = pz.zone;
+        }
+        w.write_chunk("kairos/state/zones", nz, 3, flat.data());
+      }
+    }
     w.write_chunk("kairos/run/next_kick_time", 1, 1, &progress.next_kick_time);
     if (!s.angular_velocity.empty()) {
       constexpr std::uint32_t kSpin = D == 3 ? 3 : 1;
@@ -292,10 +391,11 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
     throw InputError("'" + path.string() + "' is not a Kairos restart file (no kairos/format)");
   }
   if (const auto v = require<std::uint32_t>(r, f, "kairos/format", path, 1)[0];
-      v != kRestartFormat) {
+      v < kOldestRestartFormat || v > kRestartFormat) {
     throw InputError("'" + path.string() + "': restart format version " + std::to_string(v) +
-                     ", this Kairos reads version " + std::to_string(kRestartFormat) +
-                     " (restart files are not portable across these versions)");
+                     ", this Kairos reads versions " + std::to_string(kOldestRestartFormat) +
+                     " to " + std::to_string(kRestartFormat) +
+                     " (restart files are not portable across other versions)");
   }
   const int dim = require<std::uint8_t>(r, f, "kairos/dimension", path, 1)[0];
   if (dim != D) {
@@ -341,6 +441,29 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   s.counters.work_by_walls = energies[2];
   if (r.find(f, "kairos/state/shear_work"))
     s.counters.work_by_shear = require<double>(r, f, "kairos/state/shear_work", path, 1)[0];
+  if (r.find(f, "kairos/state/step_counters")) {
+    const auto steps = require<std::uint64_t>(r, f, "kairos/state/step_counters", path, 2);
+    s.counters.step_crossings = steps[0];
+    s.counters.step_bounces = steps[1];
+  }
+  if (r.find(f, "kairos/state/zone_count")) {
+    const std::uint64_t nz = require<std::uint64_t>(r, f, "kairos/state/zone_count", path, 1)[0];
+    s.zones.emplace();
+    if (nz > 0) {
+      const auto flat = require<std::uint32_t>(r, f, "kairos/state/zones", path, 3 * nz);
+      s.zones->resize(nz);
+      for (std::size_t z = 0; z < nz; ++z)
+        (*s.zones)[z] = {flat[3 * z], flat[3 * z + 1], flat[3 * z + 2]};
+    }
+  }
+  {
+    std::string what = "'";  // (not "'" + ...: a GCC 12 -Wrestrict false positive)
+    what += path.string();
+    what += '\'';
+    BondData bonds = read_bonds(r, f, path, n, what);
+    s.bonds = std::move(bonds.bonds);
+    s.bond_types = std::move(bonds.types);
+  }
   constexpr std::size_t kSpin = D == 3 ? 3 : 1;
   if (r.find(f, "kairos/state/angular_velocity")) {
     const auto w = require<double>(r, f, "kairos/state/angular_velocity", path, n * kSpin);
@@ -479,6 +602,9 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
       throw InputError("system.initial_state '" + path.string() + "': typeid of particle " +
                        std::to_string(i) + " has no entry in particles/types");
   }
+  BondData bonds = read_bonds(r, f, path, n, "system.initial_state '" + path.string() + "'");
+  s.bonds = std::move(bonds.bonds);
+  s.bond_types = std::move(bonds.types);
   return s;
 }
 

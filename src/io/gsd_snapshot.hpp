@@ -5,6 +5,15 @@
 // MDAnalysis read them. A restart file is one such frame plus `kairos/` chunks holding the exact
 // state in float64 together with the scheduler's pending events, counters and RNG state: an
 // engine rebuilt from it continues bit-identically. HOOMD readers ignore the `kairos/` chunks.
+//
+// Bonds (ParticleSystem::bonds, bond_types) are stored in HOOMD's schema: bonds/N (uint32),
+// bonds/types (int8 names), bonds/typeid (uint32, N), bonds/group (uint32, N x 2, particle
+// indices of the frame), written with the other static data (trajectory: frame 0 only) and only
+// when the system has bonds or bond types. Restart format 4 adds to format 3:
+//   kairos/state/step_counters  uint64 x 2: counters.step_crossings, step_bounces
+//   kairos/state/zone_count     uint64 x 1: present iff ParticleSystem::zones has a value
+//   kairos/state/zones          uint32 zone_count x 3 (i, j, zone), only when zone_count > 0
+// Format 3 files are still read: no bonds, zones = nullopt, step counters 0.
 #pragma once
 
 #include <cstdint>
@@ -46,8 +55,10 @@ int gsd_dimension(const std::filesystem::path& path);
 
 // Reads the last frame of any HOOMD-schema GSD file as an initial state: float64 `kairos/`
 // positions and velocities when present, else the float32 standard chunks. `has_velocities`
-// tells whether the file held velocities. InputError on a missing file, missing positions,
-// a box too small, or particles outside the box.
+// tells whether the file held velocities. Bonds come from bonds/* (of that frame, else frame 0;
+// typeid defaults to 0 and, when there are bonds but no bonds/types, the one type is named
+// "backbone"). InputError on a missing file, missing positions, a box too small, particles
+// outside the box, or a bond naming a particle out of range (or twice) or an unknown type.
 template <int D>
 InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_velocities);
 

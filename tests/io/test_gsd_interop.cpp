@@ -8,10 +8,14 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
+#include "init/initial_state.hpp"
+#include "io/config.hpp"
 #include "io/gsd_file.hpp"
+#include "io/gsd_snapshot.hpp"
 
 #ifndef KAIROS_PYTHON
 #define KAIROS_PYTHON "/usr/bin/python3"
@@ -19,6 +23,7 @@
 
 namespace fs = std::filesystem;
 using namespace kairos::gsd;
+using kairos::ParticleSystem;
 
 namespace {
 
@@ -343,6 +348,52 @@ TEST_F(GsdInterop, PythonReadsAFileRepairedByAppending) {
     write_hoomd_frame(w, 2, false);
   }
   EXPECT_PYTHON_OK(python(kCheckHoomd, {file("cut.gsd"), "3"}));
+}
+
+// Bonds of chains in a Kairos trajectory (frame 0 only, inherited by later frames) and in a
+// restart file, as python-gsd's HOOMD reader sees them.
+TEST_F(GsdInterop, PythonReadsOurBonds) {
+  kairos::SystemConfig sys;
+  sys.particles = 40;
+  sys.packing_fraction = 0.1;
+  sys.chain_length = 4;
+  std::mt19937_64 rng(1);
+  ParticleSystem<3> s = kairos::to_particle_system<3>(kairos::make_initial_state<3>(sys, rng));
+  s.events.assign(s.size(), kairos::EventSlot{});
+  s.cell.assign(s.size(), 0);
+  s.collision_count.assign(s.size(), 0);
+  s.bond_types.push_back("spare");
+  s.bonds[1].type = 1;                      // (1, 2) of chain 0
+  for (auto& k : s.kinematics) k.vel = {};  // bond lengths stay 1 in every frame
+  {
+    auto w = Writer::create(file("chains.gsd"), "kairos-test");
+    kairos::append_trajectory_frame<3>(w, s);
+    s.time = 0.5;
+    kairos::append_trajectory_frame<3>(w, s);
+  }
+  kairos::write_restart<3>(file("restart.gsd"), s, rng);
+  const char* const check = R"PY(
+import sys
+import numpy as np
+import gsd.hoomd
+expected = np.array([[4 * c + k, 4 * c + k + 1] for c in range(10) for k in range(3)])
+for name, nframes in ((sys.argv[1], 2), (sys.argv[2], 1)):
+    with gsd.hoomd.open(name, 'rb') as traj:
+        assert len(traj) == nframes, len(traj)
+        for s in traj:
+            assert s.bonds.N == 30, s.bonds.N
+            assert s.bonds.types == ['backbone', 'spare'], s.bonds.types
+            np.testing.assert_array_equal(s.bonds.group, expected)
+            typeid = np.zeros(30, np.uint32)
+            typeid[1] = 1
+            np.testing.assert_array_equal(s.bonds.typeid, typeid)
+            assert s.bonds.group.dtype == np.uint32 and s.bonds.typeid.dtype == np.uint32
+            p = s.particles.position
+            d = np.linalg.norm(p[expected[:, 0]] - p[expected[:, 1]], axis=1)
+            assert np.all(np.abs(d - 1) < 1e-5), d
+print('ok')
+)PY";
+  EXPECT_PYTHON_OK(python(check, {file("chains.gsd"), file("restart.gsd")}));
 }
 
 }  // namespace
