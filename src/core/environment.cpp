@@ -65,6 +65,18 @@ void Environment<D>::check() const {
       throw InputError("inertia factor (I = q m R^2) must be finite and > 0");
     }
   }
+  if (!pair_table.empty() && pair_table.size() != static_cast<std::size_t>(species) * species) {
+    throw InputError("step potentials: expected one table index per species pair");
+  }
+  for (const auto* indices : {&pair_table, &bond_table}) {
+    for (const int t : *indices) {
+      if (t >= static_cast<int>(tables.size()) || t < -1 || (t < 0 && indices == &bond_table))
+        throw InputError("step potentials: a table index is out of range");
+    }
+  }
+  for (const StepTable& t : tables) t.check();
+  if (stepped() && sheared())
+    throw InputError("boundary.shear_rate: shear with stepped potentials is not supported yet");
   if (!(tc >= 0.0) || !std::isfinite(tc)) throw InputError("tc must be finite and >= 0");
   if (!std::isfinite(shear_rate)) throw InputError("boundary.shear_rate must be finite");
   if (sheared()) {

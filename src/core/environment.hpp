@@ -19,6 +19,7 @@
 #include "core/periodic.hpp"
 #include "core/vec.hpp"
 #include "interactions/granular_contact.hpp"
+#include "interactions/step_potential.hpp"
 
 namespace kairos {
 
@@ -68,7 +69,19 @@ struct Environment {
   // the mean flow is u_x = shear_rate * (y - L_y / 2). Flow along x, gradient along y; both
   // axes periodic, no gravity. 0: an ordinary periodic box.
   double shear_rate = 0.0;
+  // Stepped potentials (formulas.md §4): the step table of species pair (a, b) is
+  // tables[pair_table[a * species + b]] (symmetric; -1: hard spheres), that of a bond of type k
+  // tables[bond_table[k]]. A table's hard core must be the pair's contact distance (the sum of
+  // the radii). Empty pair_table and bond_table: hard spheres only.
+  std::vector<StepTable> tables;
+  std::vector<int> pair_table;
+  std::vector<int> bond_table;
 
+  bool stepped() const {
+    for (const int t : pair_table)
+      if (t >= 0) return true;
+    return !bond_table.empty();
+  }
   bool periodic(int axis) const { return faces[2 * axis].kind == FaceKind::kPeriodic; }
   bool has_gravity() const {
     for (int a = 0; a < D; ++a)

@@ -64,6 +64,8 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
     throw InputError("the state needs a mass and a species for every particle");
   }
   build_shapes(s);
+  bonds_ = s.bonds;
+  bond_types_ = s.bond_types;
   setup_environment(s);
   for (CandidateList& list : lists_) {
     list.ids.resize(256);
@@ -111,7 +113,12 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
   // piston) could move into one unseen: then nothing sleeps (resting piles need the TC model).
   bool moving = false;
   for (int f = 0; f < 2 * D; ++f) moving = moving || env_.wall_moves(f);
-  if (accelerated_ && walls_ && !moving) {
+  if (stepped_ && env_.sleep_speed > 0.0) {
+    throw InputError(
+        "contact.sleep_speed: resting particles cannot sleep under stepped potentials (a "
+        "sleeper would miss its steps); set it to 0");
+  }
+  if (accelerated_ && walls_ && !moving && !stepped_) {
     double dmin = kNever;
     for (const Shape& sh : shapes_) dmin = std::min(dmin, 2.0 * sh.radius);
     sleep_speed_ = env_.sleep_speed >= 0.0
@@ -158,6 +165,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
       check_restored_cell(k);
     }
     insert_all_into_grid();
+    init_zones(s, mode);
   } else {
     for (std::uint32_t k = 0; k < n; ++k) {
       advance_to(k, time_);
@@ -182,6 +190,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
     } else {
       insert_all_into_grid();
     }
+    init_zones(s, mode);
     for (std::uint32_t k = 0; k < n; ++k) times[k] = predict(k, time_);
   }
   queue_.reset(times);
@@ -244,11 +253,24 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   granular_contacts_ = !env_.plain() || env_.tc > 0.0;
   double rmax = 0.0;
   for (const Shape& sh : shapes_) rmax = std::max(rmax, sh.radius);
+  if (!bonds_.empty() && env_.bond_table.empty())
+    throw InputError("the state has bonds but no bond potential is given ([bond])");
+  stepped_ = env_.stepped();
+  double range = 2.0 * rmax;
+  if (stepped_) {
+    if (!env_.pair_table.empty() && env_.species < species) {
+      throw InputError("the step potentials cover " + std::to_string(env_.species) +
+                       " species but particles use " + std::to_string(species));
+    }
+    steps_ = PairSteps(env_.tables, env_.pair_table, env_.species, s.size());
+    // Pairs interact up to the largest cut-off: neighbouring cells must hold every such pair.
+    range = std::max(range, steps_.max_range());
+  }
   Vec<D> min_width;
   std::array<bool, D> periodic;
   for (int a = 0; a < D; ++a) {
     periodic[a] = env_.periodic(a);
-    min_width[a] = 2.0 * rmax;
+    min_width[a] = range;
   }
   // A box with walls or open faces is often mostly empty (a bed under open headroom, a pile):
   // the cap on cells per particle, meant to bound memory, would make the occupied cells wide.
@@ -428,6 +450,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(spin_, n);
   permute(last_collision_, n);
   permute(asleep_, n);
+  if (stepped_) steps_.renumber(new_index);
   insert_all_into_grid();
   if (queue_filled) queue_.reset(times);
 }
@@ -708,8 +731,10 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
   double best = crossing.time - t;
   const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
   std::uint32_t partner;
-  if ((sleeping_ > 0 && sleeper_among(list)) || list.sheared) [[unlikely]] {
-    partner = list.sheared ? scan_sheared(list, i, t, best) : scan_with_sleepers(list, i, t, best);
+  if (stepped_ || (sleeping_ > 0 && sleeper_among(list)) || list.sheared) [[unlikely]] {
+    partner = stepped_       ? scan_stepped(list, i, t, best)
+              : list.sheared ? scan_sheared(list, i, t, best)
+                             : scan_with_sleepers(list, i, t, best);
   } else {
     partner = test_candidates(list, i, t, xi, best);
   }
@@ -770,6 +795,8 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
     collide_with_sleeper(i, j, t, r, norm2(r), again);
     return;
   }
+  if (stepped_ && step_pair(i, j, t)) [[unlikely]]
+    return;
   advance_to(i, t);
   advance_to(j, t);
   HotRecord<D>& hi = hot_[i];
@@ -1242,6 +1269,9 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
   out.asleep.assign(sleeping_ > 0 ? n : 0, 0);
   out.angular_velocity.resize(spin_.size());
   out.last_collision_time.resize(last_collision_.size());
+  out.bonds = bonds_;
+  out.bond_types = bond_types_;
+  if (stepped_) out.zones = steps_.export_zones(id_.data());
   for (std::uint32_t k = 0; k < n; ++k) {
     const std::uint32_t c = id_[k];
     const HotRecord<D>& h = hot_[k];
@@ -1590,6 +1620,43 @@ void EventEngine<D, Queue>::validate() {
   if (queue_.top_time() != tmin) fail("queue top is not the soonest event");
   // Prediction invariant and overlaps, brute force over all pairs: some pending event of the
   // pair (a collision, or a crossing that triggers a new scan) comes no later than its contact.
+  // A pair under a step potential: its zone holds its distance, and its next boundary comes no
+  // sooner than a pending event.
+  auto check_step_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, const Vec<D>& g,
+                                PairSteps::Zone z) {
+    const ZoneTable& table = steps_.table(z.table);
+    const double r2 = norm2(r), rg = dot(r, g), g2 = norm2(g);
+    const double inner = std::sqrt(table.r2[z.zone]);
+    const double outer = z.zone > 0 ? std::sqrt(table.r2[z.zone - 1]) : kNever;
+    const double distance = std::sqrt(r2);
+    auto describe = [&] {
+      std::ostringstream os;
+      os.precision(17);
+      os << "pair " << name(i) << "," << name(j) << " in zone " << z.zone << " (between " << inner
+         << " and " << outer << ") at distance " << distance;
+      return os.str();
+    };
+    if (distance < inner * (1.0 - 1e-9) || distance > outer * (1.0 + 1e-9))
+      fail(describe() + " is outside its zone");
+    const double dt = table.event_time(z.zone, r2, rg, g2);
+    if (!std::isfinite(dt)) return;
+    const bool inward = rg < 0.0 && rg * rg - g2 * (r2 - table.r2[z.zone]) > 0.0;
+    const double boundary = inward ? inner : outer;
+    if (inward && g2 > 0.0) {  // a graze of the inner boundary may be a hit or a miss
+      const double closest = std::sqrt(std::max(0.0, r2 - rg * rg / g2));
+      if (boundary - closest < 1e-9 * boundary) return;
+    }
+    const double normal_speed = std::abs(dot(r + dt * g, g)) / boundary;
+    const double bound = std::min(queue_.time_of(i), queue_.time_of(j));
+    if (late(bound, t + dt, normal_speed)) {
+      std::ostringstream os;
+      os.precision(17);
+      os << describe() << " meets its step at " << boundary << " at time " << t + dt
+         << " but no pending event comes first (theirs: " << queue_.time_of(i) << ", "
+         << queue_.time_of(j) << ")";
+      fail(os.str());
+    }
+  };
   auto check_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, const char* which,
                            const Vec<D>& image_velocity = Vec<D>{}) {
     if (is_asleep(i) && is_asleep(j)) return;  // neither moves
@@ -1597,6 +1664,13 @@ void EventEngine<D, Queue>::validate() {
     Vec<D> accel{};
     if (is_asleep(j)) accel = env_.gravity;
     if (is_asleep(i)) accel = -1.0 * env_.gravity;
+    if (stepped_) {
+      const PairSteps::Zone z = steps_.find(i, j, steps_.pair_table(species_of(i), species_of(j)));
+      if (z.table != PairSteps::kHard) {
+        check_step_covered(i, j, r, g, z);
+        return;
+      }
+    }
     const double sigma = radius_of(i) + radius_of(j);
     const double due =
         t + pair_contact_time_accelerated<D>(r.data(), g.data(), accel.data(), sigma);
@@ -1660,6 +1734,171 @@ void EventEngine<D, Queue>::validate() {
       check_covered(i, j, r, "nearest image");
     }
   }
+}
+
+// --- Stepped potentials ----------------------------------------------------------------------
+
+template <int D, class Queue>
+Vec<D> EventEngine<D, Queue>::separation(std::uint32_t i, std::uint32_t j, double t) const {
+  Vec<D> r = position_of(i, t) - position_of(j, t);
+  for (int a = 0; a < D; ++a)
+    if (grid_.periodic(a)) r[a] = minimum_image(r[a], box_[a]);
+  return r;
+}
+
+// The capture map at the start: bonds first (each always listed), then the stored zones, or,
+// for a fresh state, every non-bonded pair's zone from its distance.
+template <int D, class Queue>
+void EventEngine<D, Queue>::init_zones(const ParticleSystem<D>& s, StartMode mode) {
+  if (!stepped_) return;
+  const auto n = static_cast<std::uint32_t>(size());
+  std::vector<std::uint32_t> internal(n);
+  for (std::uint32_t k = 0; k < n; ++k) internal[id_[k]] = k;
+  auto pair_name = [](std::uint32_t a, std::uint32_t b) {
+    return std::to_string(a) + "-" + std::to_string(b);
+  };
+  for (const Bond& b : bonds_) {
+    if (b.i >= n || b.j >= n || b.i == b.j) {
+      throw InputError("bond " + pair_name(b.i, b.j) + " names a particle that does not exist");
+    }
+    if (b.type >= env_.bond_table.size()) {
+      throw InputError("bond " + pair_name(b.i, b.j) + " has type " + std::to_string(b.type) +
+                       " but only " + std::to_string(env_.bond_table.size()) +
+                       " bond potential(s) are given");
+    }
+    const auto table = static_cast<std::uint16_t>(env_.bond_table[b.type]);
+    const std::uint32_t i = internal[b.i], j = internal[b.j];
+    const double r2 = norm2(separation(i, j, time_));
+    const std::uint16_t zone = steps_.table(table).zone_at(r2);
+    if (zone == 0 && !s.zones) {
+      throw InputError("bond " + pair_name(b.i, b.j) + " is stretched to " +
+                       std::to_string(std::sqrt(r2)) + ", beyond its maximum length " +
+                       std::to_string(std::sqrt(steps_.table(table).r2[0])));
+    }
+    steps_.set(i, j, {table, zone});
+  }
+  if (s.zones) {
+    for (const PairZone& z : *s.zones) {
+      if (z.i >= n || z.j >= n || z.i == z.j) {
+        throw InputError("the zone of pair " + pair_name(z.i, z.j) +
+                         " names a particle that does not exist");
+      }
+      const std::uint32_t i = internal[z.i], j = internal[z.j];
+      const PairSteps::Zone now =
+          steps_.find(i, j, steps_.pair_table(species_of(i), species_of(j)));
+      if (now.table == PairSteps::kHard || z.zone > steps_.table(now.table).core_zone ||
+          (z.zone == 0 && !steps_.bonded(now.table))) {
+        throw InputError("the stored zone " + std::to_string(z.zone) + " of pair " +
+                         pair_name(z.i, z.j) + " does not fit its step potential");
+      }
+      steps_.set(i, j, {now.table, static_cast<std::uint16_t>(z.zone)});
+    }
+    return;
+  }
+  if (mode == StartMode::kResume) {
+    throw InputError("cannot resume: the state carries no pair zones of the stepped potentials");
+  }
+  const Vec<D> no_shift{};
+  for (std::uint32_t i = 0; i < n; ++i) {
+    gather(hot_[i].cell, lists_[0]);
+    const CandidateList& list = lists_[0];
+    const Vec<D> xi = position_of(i, time_);
+    for (std::uint32_t k = 0; k < list.count; ++k) {
+      const std::uint32_t j = list.ids[k];
+      if (j <= i) continue;
+      const std::uint16_t table = steps_.pair_table(species_of(i), species_of(j));
+      if (table == PairSteps::kHard ||
+          steps_.find(i, j, PairSteps::kHard).table != PairSteps::kHard)
+        continue;  // no steps, or bonded
+      const Vec<D>& shift = list.n_shifts > 1 ? list.shifts[list.shift[k]] : no_shift;
+      const double r2 = norm2(xi - (position_of(j, time_) + shift));
+      const std::uint16_t zone = steps_.table(table).zone_at(r2);
+      if (zone > 0) steps_.set(i, j, {table, zone});
+    }
+  }
+}
+
+// The candidate loop of stepped potentials: per candidate, the zone from the capture map and
+// the time to the zone's next boundary (or, for a pair without steps, its contact).
+template <int D, class Queue>
+std::uint32_t EventEngine<D, Queue>::scan_stepped(const CandidateList& list, std::uint32_t i,
+                                                  double t, double& best) {
+  steps_.load(i);
+  const HotRecord<D>& h = hot_[i];
+  const Vec<D> xi = position_at(h, t), vi = velocity_at(h, t);
+  const std::uint32_t si = species_of(i);
+  const double ri = radius_of(i);
+  const Vec<D> no_shift{};
+  std::uint32_t found = kNoPartner;
+  for (std::uint32_t k = 0; k < list.count; ++k) {
+    const std::uint32_t j = list.ids[k];
+    if (j == i) continue;
+    const Vec<D>& shift = list.n_shifts > 1 ? list.shifts[list.shift[k]] : no_shift;
+    const Vec<D> r = xi - (position_at(hot_[j], t) + shift);
+    const Vec<D> g = vi - velocity_at(hot_[j], t);
+    const double r2 = norm2(r), rg = dot(r, g), g2 = norm2(g);
+    const PairSteps::Zone z = steps_.lookup(j, steps_.pair_table(si, species_of(j)));
+    double dt;
+    if (z.table == PairSteps::kHard) {
+      const double sigma = ri + radius_of(j);
+      dt = quadratic_contact_time(r2 - sigma * sigma, 2.0 * rg, g2);
+    } else {
+      dt = steps_.table(z.table).event_time(z.zone, r2, rg, g2);
+    }
+    if (dt < best) {
+      best = dt;
+      found = j;
+    }
+  }
+  return found;
+}
+
+// A pair event under a stepped potential. Approaching, the pair meets its zone's inner boundary
+// (the hard core in the innermost zone: returns false, an ordinary collision); receding, the
+// outer one. It crosses into the next zone if its normal kinetic energy pays the step, else
+// bounces (formulas.md §4.2).
+template <int D, class Queue>
+bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t) {
+  const PairSteps::Zone z = steps_.find(i, j, steps_.pair_table(species_of(i), species_of(j)));
+  if (z.table == PairSteps::kHard) return false;
+  advance_to(i, t);
+  advance_to(j, t);
+  HotRecord<D>& hi = hot_[i];
+  HotRecord<D>& hj = hot_[j];
+  const Vec<D> r = separation(i, j, t);
+  const double r2 = norm2(r), rg = dot(r, hi.vel - hj.vel);
+  const ZoneTable& table = steps_.table(z.table);
+  std::uint16_t next;
+  if (rg < 0.0) {
+    if (z.zone == table.core_zone) return false;
+    next = static_cast<std::uint16_t>(z.zone + 1);
+  } else {
+    if (z.zone == 0) {  // a graze of the cut-off that round-off calls a miss: nothing happens
+      predict_pair(i, j, t);
+      return true;
+    }
+    next = static_cast<std::uint16_t>(z.zone - 1);
+  }
+  const double distance = std::sqrt(r2);
+  const double mi = mass_of(i), mj = mass_of(j);
+  const StepOutcome out =
+      step_event(mi * mj / (mi + mj), rg / distance, table.energy[next] - table.energy[z.zone]);
+  const Vec<D> impulse = (out.impulse / distance) * r;
+  hi.vel = hi.vel + (1.0 / mi) * impulse;
+  hj.vel = hj.vel - (1.0 / mj) * impulse;
+  counters_.virial += out.impulse * distance;
+  add_virial_tensor(r, impulse);
+  if (out.crosses) {
+    steps_.set(i, j, {z.table, next});
+    ++counters_.step_crossings;
+  } else {
+    ++counters_.step_bounces;
+  }
+  ++counters_.collisions;
+  ++hi.collisions;
+  ++hj.collisions;
+  predict_pair(i, j, t);
+  return true;
 }
 
 template class EventEngine<2, BinaryHeapQueue>;

@@ -33,6 +33,7 @@
 #include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
 #include "dynamics/collision_time.hpp"
+#include "engine/pair_steps.hpp"
 #include "scheduler/cell_grid.hpp"
 
 namespace kairos {
@@ -109,6 +110,10 @@ class EventEngine {
   // kinetic_energy() without shear.
   double peculiar_kinetic_energy() const;
   double rotational_energy() const;  // 0 unless particles rotate
+  // Configurational energy of the stepped potentials (0 for hard spheres), exact: the sum of
+  // the energies of the zones the pairs sit in.
+  double potential_energy() const { return stepped_ ? steps_.energy() : 0.0; }
+  bool stepped() const { return stepped_; }
   std::uint32_t sleeping() const { return sleeping_; }
   Vec<D> momentum() const;
   const Environment<D>& environment() const { return env_; }
@@ -228,6 +233,13 @@ class EventEngine {
   std::uint32_t test_candidates(const CandidateList& list, std::uint32_t i, double t,
                                 const Vec<D>& xi, double& best) const;
   void collide(std::uint32_t i, std::uint32_t j, double t);
+  // Stepped potentials: the zones of all pairs at the start, the candidate loop, and a pair
+  // event at a step (false: the pair meets its hard core, an ordinary collision).
+  void init_zones(const ParticleSystem<D>& s, StartMode mode);
+  std::uint32_t scan_stepped(const CandidateList& list, std::uint32_t i, double t, double& best);
+  bool step_pair(std::uint32_t i, std::uint32_t j, double t);
+  // The pair's separation i - j under the box's boundaries (nearest image on periodic axes).
+  Vec<D> separation(std::uint32_t i, std::uint32_t j, double t) const;
   void predict_pair(std::uint32_t i, std::uint32_t j, double t);
   // Lees-Edwards shear (see Environment::shear_rate).
   double image_offset(double t) const;  // x displacement of the images above the box
@@ -289,6 +301,10 @@ class EventEngine {
   double shear_speed_ = 0.0;     // shear_rate * L_y: velocity of the images above the box
   std::int64_t image_step_ = 0;  // image offset in cell widths, rounded down (unwrapped)
   double next_image_shift_ = kNever;
+  bool stepped_ = false;  // some pair has a step potential, or there are bonds
+  PairSteps steps_;
+  std::vector<Bond> bonds_;  // the caller's numbering, kept for export
+  std::vector<std::string> bond_types_;
 
   CandidateList lists_[2];
   Environment<D> env_;  // last: the hot members above share fewer cache lines
