@@ -1,11 +1,14 @@
 // The `kairos` command line.
 //
 //   kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE]
+//   kairos steps CONFIG.toml [--set key=value ...] [--temperature KT] [-o DIR]
 //
 // User errors (config, files, impossible requests) print one line "kairos: error: ..." and exit
 // with status 2; SIGINT/SIGTERM finish the current event, write every output and exit 130/143.
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -13,6 +16,8 @@
 #include <CLI/CLI.hpp>
 
 #include "core/error.hpp"
+#include "interactions/potential_spec.hpp"
+#include "io/atomic_file.hpp"
 #include "io/config.hpp"
 #include "io/progress.hpp"
 #include "run/run.hpp"
@@ -85,6 +90,56 @@ void print_summary(const kairos::RunOutcome& outcome) {
              outcome.directory.string());
 }
 
+// `kairos steps`: the step table of every [[potential]] (per species pair) and [[bond]] of the
+// config, for the species' diameters as contact distances, with B2 at kT; with a directory,
+// each table and its continuous curve as TSV files for examples/plot/plot_steps.py.
+void print_step_tables(const kairos::Config& config, double kT, const std::string& dir) {
+  const auto& species = config.system.species;
+  const int dim = config.system.dimension;
+  struct Item {
+    std::string label;
+    const kairos::PotentialSpec* spec;
+    double core;
+  };
+  std::vector<Item> items;
+  for (std::size_t p = 0; p < config.potentials.size(); ++p) {
+    const auto& pc = config.potentials[p];
+    for (std::size_t a = 0; a < species.size(); ++a) {
+      for (std::size_t b = a; b < species.size(); ++b) {
+        const bool named = pc.species.empty() ||
+                           (pc.species[0] == species[a].name && pc.species[1] == species[b].name) ||
+                           (pc.species[0] == species[b].name && pc.species[1] == species[a].name);
+        if (!named) continue;
+        items.push_back({fmt::format("potential{}_{}_{}", p, species[a].name, species[b].name),
+                         &pc.potential, 0.5 * (species[a].diameter + species[b].diameter)});
+      }
+    }
+  }
+  double dmax = 0.0;
+  for (const auto& sp : species) dmax = std::max(dmax, sp.diameter);
+  for (std::size_t k = 0; k < config.bonds.size(); ++k)
+    items.push_back(
+        {fmt::format("bond{}_{}", k, config.bonds[k].type), &config.bonds[k].potential, dmax});
+  if (items.empty()) throw kairos::InputError("the config has no [[potential]] and no [[bond]]");
+  for (const Item& item : items) {
+    const kairos::StepTable table = kairos::make_step_table(*item.spec, item.core, dim);
+    const kairos::ContinuousPotential curve = kairos::continuous_potential(*item.spec);
+    const bool has_curve = !curve.name.empty();
+    const std::string report =
+        kairos::step_table_report(table, has_curve ? &curve : nullptr, kT, dim);
+    fmt::print("# {} ({}), contact distance {}\n{}\n", item.label, item.spec->kind, item.core,
+               report);
+    if (dir.empty()) continue;
+    std::filesystem::create_directories(dir);
+    kairos::write_text_atomically(std::filesystem::path(dir) / (item.label + ".tsv"), report);
+    if (has_curve) {
+      kairos::write_text_atomically(
+          std::filesystem::path(dir) / (item.label + "_curve.tsv"),
+          kairos::continuous_curve_tsv(curve, table.core(), table.cutoff() * 1.05));
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -121,6 +176,21 @@ int main(int argc, char** argv) {
       "Outputs in OUTDIR: config.toml, thermo.tsv, trajectory.gsd, restart.gsd, summary.json.\n"
       "SIGINT/SIGTERM stop after the current event and still write every output.");
 
+  std::string steps_config;
+  std::vector<std::string> steps_overrides;
+  double steps_kT = 0.0;
+  std::string steps_dir;
+  auto* steps = app.add_subcommand(
+      "steps", "Print the step tables of a config's potentials and bonds with their B2(T).");
+  steps->add_option("config", steps_config, "TOML configuration file")->required();
+  steps->add_option("--set", steps_overrides, "Override a config key (repeatable)")
+      ->take_all()
+      ->allow_extra_args(false);
+  steps->add_option("--temperature", steps_kT, "kT for B2 (default: system.temperature)");
+  steps->add_option("-o,--output", steps_dir,
+                    "Also write each table and its continuous curve as TSV files in this directory "
+                    "(for examples/plot/plot_steps.py)");
+
   // Usage errors are user errors too: one line "kairos: error: ...", exit status 2 (not CLI11's
   // own codes and two-line message). --help and --version still print and exit 0.
   try {
@@ -144,6 +214,13 @@ int main(int argc, char** argv) {
     }
     if (restart_option->count() > 0 && restart.empty()) {
       throw kairos::InputError("--restart: the restart file name must not be empty");
+    }
+    if (steps->parsed()) {
+      const kairos::Config config = kairos::load_config(steps_config, steps_overrides);
+      if (steps_kT < 0.0 || !std::isfinite(steps_kT))
+        throw kairos::InputError("--temperature: must be a finite number > 0");
+      print_step_tables(config, steps_kT > 0.0 ? steps_kT : config.system.temperature, steps_dir);
+      return 0;
     }
     kairos::Config config = kairos::load_config(config_path, overrides);
     if (!outdir.empty()) config.output.directory = outdir;

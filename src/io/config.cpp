@@ -62,6 +62,54 @@ constexpr KeySpec kSchema[] = {
     {"system.species[].inertia_factor", Kind::kFloat},
     {"system.initial_state", Kind::kString},
     {"system.box_scale", Kind::kArray},
+    {"system.chain_length", Kind::kUnsigned},
+    {"system.chain_spacing", Kind::kFloat},
+    {"potential", Kind::kTableArray},
+    {"potential[]", Kind::kTable},
+    {"potential[].species", Kind::kArray},
+    {"potential[].kind", Kind::kString},
+    {"potential[].lambda", Kind::kFloat},
+    {"potential[].depth", Kind::kFloat},
+    {"potential[].boundaries", Kind::kArray},
+    {"potential[].energies", Kind::kArray},
+    {"potential[].epsilon", Kind::kFloat},
+    {"potential[].sigma", Kind::kFloat},
+    {"potential[].cutoff", Kind::kFloat},
+    {"potential[].shifted", Kind::kBoolean},
+    {"potential[].kappa", Kind::kFloat},
+    {"potential[].alpha", Kind::kFloat},
+    {"potential[].r_min", Kind::kFloat},
+    {"potential[].file", Kind::kString},
+    {"potential[].max_length", Kind::kFloat},
+    {"potential[].stiffness", Kind::kFloat},
+    {"potential[].length", Kind::kFloat},
+    {"potential[].steps", Kind::kInteger},
+    {"potential[].placement", Kind::kString},
+    {"potential[].shell_energy", Kind::kString},
+    {"potential[].temperature", Kind::kFloat},
+    {"bond", Kind::kTableArray},
+    {"bond[]", Kind::kTable},
+    {"bond[].type", Kind::kString},
+    {"bond[].kind", Kind::kString},
+    {"bond[].lambda", Kind::kFloat},
+    {"bond[].depth", Kind::kFloat},
+    {"bond[].boundaries", Kind::kArray},
+    {"bond[].energies", Kind::kArray},
+    {"bond[].epsilon", Kind::kFloat},
+    {"bond[].sigma", Kind::kFloat},
+    {"bond[].cutoff", Kind::kFloat},
+    {"bond[].shifted", Kind::kBoolean},
+    {"bond[].kappa", Kind::kFloat},
+    {"bond[].alpha", Kind::kFloat},
+    {"bond[].r_min", Kind::kFloat},
+    {"bond[].file", Kind::kString},
+    {"bond[].max_length", Kind::kFloat},
+    {"bond[].stiffness", Kind::kFloat},
+    {"bond[].length", Kind::kFloat},
+    {"bond[].steps", Kind::kInteger},
+    {"bond[].placement", Kind::kString},
+    {"bond[].shell_energy", Kind::kString},
+    {"bond[].temperature", Kind::kFloat},
     {"contact", Kind::kTable},
     {"contact.restitution", Kind::kFloat},
     {"contact.restitution_model", Kind::kString},
@@ -132,6 +180,12 @@ constexpr std::string_view kRestitutionModels[] = {"constant", "viscoelastic", "
 // Box faces: 2k is the low face of axis k, 2k + 1 the high one.
 constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
 constexpr std::string_view kAxes[] = {"x", "y", "z"};
+constexpr std::string_view kPairPotentials[] = {
+    "square_well", "square_shoulder", "steps", "lennard_jones",
+    "wca",         "yukawa",          "morse", "tabulated"};
+constexpr std::string_view kBondPotentials[] = {"tether", "spring"};
+constexpr std::string_view kPlacements[] = {"energy", "distance", "volume"};
+constexpr std::string_view kShellEnergies[] = {"midpoint", "volume", "mid_volume", "virial"};
 
 std::string join_key(std::string_view prefix, std::string_view key) {
   return prefix.empty() ? std::string(key) : fmt::format("{}.{}", prefix, key);
@@ -511,6 +565,13 @@ class Reader {
     read_driving(section(root, "driving", empty), config.driving);
     read_run(section(root, "run", empty), config.run);
     read_output(section(root, "output", empty), config.system.dimension, config.output);
+    read_potentials(root, config.system.species, config.potentials);
+    read_bonds(root, config.bonds);
+    if (config.system.chain_length > 0 && config.bonds.empty()) {
+      fail(nullptr, "system.chain_length",
+           "system.chain_length: chains need a bond potential ([[bond]] with kind = \"tether\" "
+           "or \"spring\")");
+    }
     return config;
   }
 
@@ -784,6 +845,13 @@ class Reader {
     const toml::node* n_temperature = get_number(t, p, "temperature", s.temperature);
     get_unsigned(t, p, "seed", s.seed);
     get_string(t, p, "initial_state", s.initial_state);
+    const toml::node* n_chain = get_unsigned(t, p, "chain_length", s.chain_length);
+    const toml::node* n_spacing = get_number(t, p, "chain_spacing", s.chain_spacing);
+    require_non_negative(n_spacing, "system.chain_spacing", s.chain_spacing);
+    if (s.chain_length == 1) {
+      fail(n_chain, "system.chain_length",
+           "system.chain_length: a chain needs at least 2 beads (0: no chains)");
+    }
     read_species(t, s.species);
 
     const bool from_file = !s.initial_state.empty();
@@ -1147,6 +1215,108 @@ class Reader {
     }
   }
 
+  // The keys of a potential at `prefix` ("potential[i]", "bond[i]"), its kind among `kinds`.
+  void read_potential_spec(const toml::table& t, const std::string& prefix,
+                           std::span<const std::string_view> kinds, PotentialSpec& spec) const {
+    const toml::node* n_kind = get_string(t, prefix, "kind", spec.kind);
+    if (n_kind == nullptr) {
+      fail(&t, prefix + ".kind",
+           fmt::format("missing required key '{}.kind' (one of: {})", prefix, join_words(kinds)));
+    }
+    require_choice(n_kind, prefix + ".kind", spec.kind, kinds);
+    for (const auto& [key, value] : {std::pair<std::string_view, double*>{"lambda", &spec.lambda},
+                                     {"depth", &spec.depth},
+                                     {"epsilon", &spec.epsilon},
+                                     {"sigma", &spec.sigma},
+                                     {"cutoff", &spec.cutoff},
+                                     {"kappa", &spec.kappa},
+                                     {"alpha", &spec.alpha},
+                                     {"r_min", &spec.r_min},
+                                     {"max_length", &spec.max_length},
+                                     {"stiffness", &spec.stiffness},
+                                     {"length", &spec.length},
+                                     {"temperature", &spec.temperature}}) {
+      get_number(t, prefix, key, *value);
+    }
+    get_numbers(t, prefix, "boundaries", spec.boundaries);
+    get_numbers(t, prefix, "energies", spec.energies);
+    get_bool(t, prefix, "shifted", spec.shifted);
+    get_string(t, prefix, "file", spec.file);
+    std::int64_t steps = spec.steps;
+    const toml::node* n_steps = get_integer(t, prefix, "steps", steps);
+    if (steps < 1 || steps > 100000) {
+      fail(n_steps, prefix + ".steps",
+           fmt::format("{}.steps: must be in [1, 100000], got {}", prefix, steps));
+    }
+    spec.steps = static_cast<int>(steps);
+    const toml::node* n_placement = get_string(t, prefix, "placement", spec.placement);
+    require_choice(n_placement, prefix + ".placement", spec.placement, kPlacements);
+    const toml::node* n_shell = get_string(t, prefix, "shell_energy", spec.shell_energy);
+    require_choice(n_shell, prefix + ".shell_energy", spec.shell_energy, kShellEnergies);
+    require_positive(t.get("temperature"), prefix + ".temperature", spec.temperature);
+  }
+
+  void read_potentials(const toml::table& root, const std::vector<SpeciesConfig>& species,
+                       std::vector<PairPotentialConfig>& out) const {
+    const std::vector<const toml::table*> tables = table_array(root, "", "potential");
+    for (std::size_t i = 0; i < tables.size(); ++i) {
+      const std::string prefix = fmt::format("potential[{}]", i);
+      const std::string species_key = prefix + ".species";
+      PairPotentialConfig pc;
+      const toml::node* n_species = get_strings(*tables[i], prefix, "species", pc.species);
+      if (n_species != nullptr && pc.species.size() != 2) {
+        fail(n_species, species_key,
+             fmt::format("{}: expected 2 species names (or no key: every pair), got {}",
+                         species_key, pc.species.size()));
+      }
+      for (std::size_t k = 0; k < pc.species.size(); ++k) {
+        const bool declared =
+            std::any_of(species.begin(), species.end(),
+                        [&](const SpeciesConfig& s) { return s.name == pc.species[k]; });
+        if (!declared) {
+          std::vector<std::string_view> known;
+          for (const SpeciesConfig& s : species) known.push_back(s.name);
+          fail(element_of(n_species, k), species_key,
+               fmt::format("{}: unknown species '{}' (declared species: {})", species_key,
+                           pc.species[k], join_words(known)));
+        }
+      }
+      for (std::size_t j = 0; j < out.size(); ++j) {
+        const auto& other = out[j].species;
+        const bool same =
+            other.size() == pc.species.size() &&
+            (other.empty() || (other[0] == pc.species[0] && other[1] == pc.species[1]) ||
+             (other[0] == pc.species[1] && other[1] == pc.species[0]));
+        if (same) {
+          fail(n_species != nullptr ? n_species : tables[i], species_key,
+               fmt::format("{}: the same pair{} is already given by potential[{}]", prefix,
+                           pc.species.empty() ? "s (all)" : "", j));
+        }
+      }
+      read_potential_spec(*tables[i], prefix, kPairPotentials, pc.potential);
+      out.push_back(std::move(pc));
+    }
+  }
+
+  void read_bonds(const toml::table& root, std::vector<BondConfig>& out) const {
+    const std::vector<const toml::table*> tables = table_array(root, "", "bond");
+    for (std::size_t i = 0; i < tables.size(); ++i) {
+      const std::string prefix = fmt::format("bond[{}]", i);
+      BondConfig bc;
+      const toml::node* n_type = get_string(*tables[i], prefix, "type", bc.type);
+      for (std::size_t j = 0; j < out.size(); ++j) {
+        if (out[j].type == bc.type) {
+          fail(n_type != nullptr ? n_type : tables[i], prefix + ".type",
+               fmt::format("{}.type: bond type '{}' is already given by bond[{}]", prefix, bc.type,
+                           j));
+        }
+      }
+      bc.potential.kind = "";
+      read_potential_spec(*tables[i], prefix, kBondPotentials, bc.potential);
+      out.push_back(std::move(bc));
+    }
+  }
+
   void read_field(const toml::table& t, int dimension, FieldConfig& f) const {
     std::vector<double> gravity;
     get_vector(t, "field", "gravity", dimension, gravity);
@@ -1265,6 +1435,34 @@ std::string contact_toml(const ContactConfig& c) {
   return out;
 }
 
+// The keys of a potential, one per line.
+std::string potential_toml(const PotentialSpec& p) {
+  std::string out;
+  out += fmt::format("kind = {}\n", toml_string(p.kind));
+  for (const auto& [key, value] : {std::pair<const char*, double>{"lambda", p.lambda},
+                                   {"depth", p.depth},
+                                   {"epsilon", p.epsilon},
+                                   {"sigma", p.sigma},
+                                   {"cutoff", p.cutoff},
+                                   {"kappa", p.kappa},
+                                   {"alpha", p.alpha},
+                                   {"r_min", p.r_min},
+                                   {"max_length", p.max_length},
+                                   {"stiffness", p.stiffness},
+                                   {"length", p.length},
+                                   {"temperature", p.temperature}}) {
+    out += fmt::format("{} = {}\n", key, toml_float(value));
+  }
+  out += fmt::format("boundaries = {}\n", toml_floats(p.boundaries));
+  out += fmt::format("energies = {}\n", toml_floats(p.energies));
+  out += fmt::format("shifted = {}\n", p.shifted);
+  out += fmt::format("file = {}\n", toml_string(p.file));
+  out += fmt::format("steps = {}\n", p.steps);
+  out += fmt::format("placement = {}\n", toml_string(p.placement));
+  out += fmt::format("shell_energy = {}\n", toml_string(p.shell_energy));
+  return out;
+}
+
 }  // namespace
 
 std::string default_lattice(int dimension) {
@@ -1338,6 +1536,8 @@ std::string to_toml(const Config& config) {
   out += fmt::format("seed = {}\n", toml_unsigned(s.seed, "system.seed"));
   out += fmt::format("initial_state = {}\n", toml_string(s.initial_state));
   out += fmt::format("box_scale = {}\n", vector_or(s.box_scale, 1.0));
+  out += fmt::format("chain_length = {}\n", toml_unsigned(s.chain_length, "system.chain_length"));
+  out += fmt::format("chain_spacing = {}\n", toml_float(s.chain_spacing));
   for (const SpeciesConfig& sp : species) {
     out += "\n[[system.species]]\n";
     out += fmt::format("name = {}\n", toml_string(sp.name));
@@ -1345,6 +1545,19 @@ std::string to_toml(const Config& config) {
     out += fmt::format("mass = {}\n", toml_float(sp.mass));
     out += fmt::format("fraction = {}\n", toml_float(sp.fraction));
     out += fmt::format("inertia_factor = {}\n", toml_float(sp.inertia_factor));
+  }
+  for (const PairPotentialConfig& pc : config.potentials) {
+    out += "\n[[potential]]\n";
+    if (!pc.species.empty()) {
+      out += fmt::format("species = [{}, {}]\n", toml_string(pc.species[0]),
+                         toml_string(pc.species[1]));
+    }
+    out += potential_toml(pc.potential);
+  }
+  for (const BondConfig& bc : config.bonds) {
+    out += "\n[[bond]]\n";
+    out += fmt::format("type = {}\n", toml_string(bc.type));
+    out += potential_toml(bc.potential);
   }
   out += "\n[contact]\n";
   out += contact_toml(in.contact);

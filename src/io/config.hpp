@@ -14,6 +14,8 @@
 #include <string_view>
 #include <vector>
 
+#include "interactions/potential_spec.hpp"
+
 namespace kairos {
 
 struct SpeciesConfig {
@@ -145,8 +147,27 @@ struct DrivingConfig {
   bool operator==(const DrivingConfig&) const = default;
 };
 
+// [[potential]]: the stepped potential of a species pair (both names), or of every pair not
+// named by another entry (species empty). Pairs without a potential are hard spheres.
+struct PairPotentialConfig {
+  std::vector<std::string> species;
+  PotentialSpec potential;
+
+  bool operator==(const PairPotentialConfig&) const = default;
+};
+
+// [[bond]]: the potential of the bonds of one type (tether or spring; formulas.md §4).
+struct BondConfig {
+  std::string type = "backbone";
+  PotentialSpec potential;
+
+  bool operator==(const BondConfig&) const = default;
+};
+
 struct Config {
   SystemConfig system;
+  std::vector<PairPotentialConfig> potentials;  // [[potential]]
+  std::vector<BondConfig> bonds;                // [[bond]]
   RunConfig run;
   OutputConfig output;
   InteractionConfig interactions;  // TOML section [contact]

@@ -1,7 +1,9 @@
 #include "run/environment_setup.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 
 #include <fmt/format.h>
 
@@ -23,6 +25,97 @@ std::uint32_t species_index(const std::vector<std::string>& names, const std::st
   for (std::size_t k = 0; k < names.size(); ++k)
     if (names[k] == name) return static_cast<std::uint32_t>(k);
   throw InputError(fmt::format("{}: the system has no species '{}'", where, name));
+}
+
+// The diameter of each species of the state (NaN for a species whose particles differ in size).
+template <int D>
+std::vector<double> species_diameters(const ParticleSystem<D>& s, std::size_t species) {
+  std::vector<double> d(species, 0.0);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    double& di = d[s.species[i]];
+    const double here = 2.0 * s.kinematics[i].radius;
+    di = di == 0.0 || di == here ? here : std::nan("");
+  }
+  return d;
+}
+
+StepTable build_table(const PotentialSpec& spec, double core, int dimension,
+                      const std::string& where) {
+  try {
+    return make_step_table(spec, core, dimension);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", where, e.what()));
+  }
+}
+
+// The step tables of [[potential]] and [[bond]] for the state's sizes and bond types.
+template <int D>
+void add_step_potentials(const Config& config, const ParticleSystem<D>& s, Environment<D>& env) {
+  const std::vector<std::string>& names = s.species_names;
+  const auto n = static_cast<std::uint32_t>(std::max<std::size_t>(1, names.size()));
+  if (!config.potentials.empty()) {
+    const std::vector<double> diameter = species_diameters(s, n);
+    env.pair_table.assign(static_cast<std::size_t>(n) * n, -1);
+    // The entry without species first, so that named pairs override it.
+    std::vector<std::size_t> order(config.potentials.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_partition(order.begin(), order.end(),
+                          [&](std::size_t p) { return config.potentials[p].species.empty(); });
+    for (const std::size_t p : order) {
+      const PairPotentialConfig& pc = config.potentials[p];
+      const std::string where = fmt::format("potential[{}]", p);
+      std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+      if (pc.species.empty()) {
+        for (std::uint32_t a = 0; a < n; ++a)
+          for (std::uint32_t b = a; b < n; ++b) pairs.emplace_back(a, b);
+      } else {
+        pairs.emplace_back(species_index(names, pc.species[0], where),
+                           species_index(names, pc.species[1], where));
+      }
+      for (const auto& [a, b] : pairs) {
+        const double core = 0.5 * (diameter[a] + diameter[b]);
+        if (std::isnan(core)) {
+          throw InputError(fmt::format(
+              "{}: species {} and {} need one contact distance each; the particles of a species "
+              "with a potential must all have the same diameter",
+              where, names[a], names[b]));
+        }
+        if (core == 0.0) continue;  // a species without particles
+        env.tables.push_back(build_table(pc.potential, core, D, where));
+        const int t = static_cast<int>(env.tables.size()) - 1;
+        env.pair_table[a * n + b] = t;
+        env.pair_table[b * n + a] = t;
+      }
+    }
+  }
+  // Bonds: one table per type of the state; every bond of a type must have one contact distance.
+  std::vector<double> bond_core(s.bond_types.size(), 0.0);
+  for (const Bond& b : s.bonds) {
+    if (b.type >= bond_core.size() || b.i >= s.size() || b.j >= s.size()) continue;  // engine
+    const double core = s.kinematics[b.i].radius + s.kinematics[b.j].radius;
+    double& c = bond_core[b.type];
+    if (c != 0.0 && c != core) {
+      throw InputError(fmt::format(
+          "bonds of type '{}' join particles of different sizes; give each size pair its own bond "
+          "type",
+          s.bond_types[b.type]));
+    }
+    c = core;
+  }
+  for (std::size_t k = 0; k < s.bond_types.size(); ++k) {
+    const auto it = std::find_if(config.bonds.begin(), config.bonds.end(),
+                                 [&](const BondConfig& bc) { return bc.type == s.bond_types[k]; });
+    if (it == config.bonds.end()) {
+      throw InputError(fmt::format(
+          "the state has bonds of type '{}' but no [[bond]] with type = \"{}\" is given",
+          s.bond_types[k], s.bond_types[k]));
+    }
+    const std::string where = fmt::format("bond[{}]", it - config.bonds.begin());
+    if (bond_core[k] == 0.0) bond_core[k] = 2.0 * s.kinematics[0].radius;  // type unused
+    env.tables.push_back(build_table(it->potential, bond_core[k], D, where));
+    env.bond_table.push_back(static_cast<int>(env.tables.size()) - 1);
+  }
+  if (!env.pair_table.empty()) env.species = n;
 }
 
 }  // namespace
@@ -53,8 +146,8 @@ ContactModel make_contact_model(const ContactConfig& c, const std::string& where
 }
 
 template <int D>
-Environment<D> make_environment(const Config& config,
-                                const std::vector<std::string>& species_names) {
+Environment<D> make_environment(const Config& config, const ParticleSystem<D>& state) {
+  const std::vector<std::string>& species_names = state.species_names;
   Environment<D> env;
   const auto n = static_cast<std::uint32_t>(std::max<std::size_t>(1, species_names.size()));
   const InteractionConfig& in = config.interactions;
@@ -95,11 +188,12 @@ Environment<D> make_environment(const Config& config,
   for (int a = 0; a < D && a < static_cast<int>(config.field.gravity.size()); ++a)
     env.gravity[a] = config.field.gravity[a];
   env.shear_rate = config.boundary.shear_rate;
+  add_step_potentials(config, state, env);
   env.check();
   return env;
 }
 
-template Environment<2> make_environment<2>(const Config&, const std::vector<std::string>&);
-template Environment<3> make_environment<3>(const Config&, const std::vector<std::string>&);
+template Environment<2> make_environment<2>(const Config&, const ParticleSystem<2>&);
+template Environment<3> make_environment<3>(const Config&, const ParticleSystem<3>&);
 
 }  // namespace kairos

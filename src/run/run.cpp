@@ -206,22 +206,24 @@ class ThermoWriter {
       write_line(
           "phase\ttime\tevents\tcollisions\tcollisions_per_particle\ttemperature\tpressure\t"
           "compressibility\tkinetic_energy\tmean_free_time\trotational_temperature\t"
-          "dissipated_energy\twall_work\n");
+          "dissipated_energy\twall_work\tpotential_energy\n");
     }
   }
   // One row per line, each flushed at once: an interrupted run keeps every earlier row.
   // Granular columns: rotational temperature, and the energy dissipated and the work done by
   // moving walls since the start of the simulation (zero for elastic hard spheres).
+  // potential_energy: of the stepped potentials (0 for hard spheres).
   struct Granular {
     double rotational_temperature = 0.0, dissipated = 0.0, wall_work = 0.0;
+    double potential_energy = 0.0;
   };
   void write(const std::string& phase, const ThermoRow& r, const Granular& g) {
     write_line(fmt::format(
         "{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t"
-        "{:.17g}\t{:.17g}\n",
+        "{:.17g}\t{:.17g}\t{:.17g}\n",
         phase, r.at.time, r.at.events, r.at.collisions, r.collisions_per_particle, r.temperature,
         r.pressure, r.compressibility, r.kinetic_energy, r.mean_free_time, g.rotational_temperature,
-        g.dissipated, g.wall_work));
+        g.dissipated, g.wall_work, g.potential_energy));
   }
 
  private:
@@ -281,7 +283,7 @@ class RunDriver {
     }
     thermo_stats_.emplace(D, n_, volume_);
     try {
-      const Environment<D> environment = make_environment<D>(config, start.species_names);
+      const Environment<D> environment = make_environment<D>(config, start);
       engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict,
                       EngineOptions{}, environment);
       driven_ = config.driving.kind != "none";
@@ -324,6 +326,7 @@ class RunDriver {
       }
     }
     ke_start_ = engine_->kinetic_energy();
+    u_start_ = engine_->potential_energy();
     energy_start_ = total_energy();
     if (driven_) {
       next_kick_ = restart_ && resumed_.next_kick_time >= engine_->time()
@@ -559,9 +562,11 @@ class RunDriver {
       sample_kinetic_tensor(s);
     }
     const auto& c = engine_->counters();
+    const double u = engine_->potential_energy();
+    if (phase == "production" && engine_->stepped()) potential_rows_.push_back(u);
     thermo_->write(phase, thermo_stats_->row(point(), thermal_energy(), phase == "production"),
                    {rotational_temperature(), c.dissipated_in_collisions + c.dissipated_at_walls,
-                    c.work_by_walls});
+                    c.work_by_walls, u});
   }
 
   // Per rotational degree of freedom (3 for spheres, 1 for disks); 0 without spins.
@@ -569,11 +574,13 @@ class RunDriver {
     return 2.0 * engine_->rotational_energy() / ((D == 3 ? 3.0 : 1.0) * static_cast<double>(n_));
   }
 
-  // Kinetic (translational and rotational) plus potential energy in the gravity field, when
-  // the field has no component along a periodic axis (else the potential is unbounded: NaN).
+  // Kinetic (translational and rotational) plus the stepped potentials' energy plus potential
+  // energy in the gravity field, when the field has no component along a periodic axis (else
+  // the potential is unbounded: NaN).
   double total_energy() const {
     const Environment<D>& env = engine_->environment();
-    double e = engine_->kinetic_energy() + engine_->rotational_energy();
+    double e =
+        engine_->kinetic_energy() + engine_->rotational_energy() + engine_->potential_energy();
     if (!env.has_gravity()) return e;
     for (int a = 0; a < D; ++a)
       if (env.periodic(a) && env.gravity[a] != 0.0) return std::nan("");
@@ -671,8 +678,13 @@ class RunDriver {
     }
     j["mean_free_time"] = th.mean_free_time(t_prod, coll_prod);
     j["mean_free_time_stderr"] = th.mean_free_time_blocks().stderr_;
+    // Kinetic plus stepped-potential energy against the starting kinetic energy.
     j["energy_drift_relative"] =
-        ke_start_ > 0 ? std::abs(engine_->kinetic_energy() - ke_start_) / ke_start_ : 0.0;
+        ke_start_ > 0 ? std::abs(engine_->kinetic_energy() + engine_->potential_energy() -
+                                 (ke_start_ + u_start_)) /
+                            ke_start_
+                      : 0.0;
+    if (engine_->stepped()) j["stepped"] = stepped_summary(c);
     j["momentum_drift"] = pscale > 0 ? std::sqrt(dp2) / pscale : 0.0;
     j["max_overlap"] = overlap;
     j["peak_rss_bytes"] = peak_rss_bytes();
@@ -711,6 +723,25 @@ class RunDriver {
     return j;
   }
 
+  // Stepped potentials: the configurational energy over the production rows (blocked for its
+  // error) and how the pair events split between the hard cores and the steps.
+  nlohmann::json stepped_summary(const EventCounters& c) const {
+    const BlockAverage u = block_average(potential_rows_);
+    const auto n = static_cast<double>(n_);
+    const std::uint64_t steps = (c.step_crossings - counters_start_.step_crossings) +
+                                (c.step_bounces - counters_start_.step_bounces);
+    nlohmann::json s;
+    s["potential_energy"] = engine_->potential_energy();
+    s["potential_energy_per_particle_mean"] = u.mean / n;
+    s["potential_energy_per_particle_stderr"] = u.stderr_ / n;
+    s["potential_energy_rows"] = potential_rows_.size();
+    s["total_energy"] = engine_->kinetic_energy() + engine_->potential_energy();
+    s["step_crossings"] = c.step_crossings - counters_start_.step_crossings;
+    s["step_bounces"] = c.step_bounces - counters_start_.step_bounces;
+    s["core_collisions"] = (c.collisions - counters_start_.collisions) - steps;
+    return s;
+  }
+
   // Simple shear: the stress P_xy from the production rows (blocked for its error) and the
   // viscosity -P_xy / shear_rate.
   nlohmann::json shear_summary(double temperature_at_production_start) const {
@@ -740,7 +771,8 @@ class RunDriver {
   std::uint64_t frame_collisions_ = 0;
   std::optional<Thermodynamics> thermo_stats_;
   ThermoPoint prod_start_;
-  double ke_start_ = 0.0, prod_ke_ = 0.0, energy_start_ = 0.0;
+  double ke_start_ = 0.0, prod_ke_ = 0.0, energy_start_ = 0.0, u_start_ = 0.0;
+  std::vector<double> potential_rows_;  // stepped potentials: U at each production thermo row
   EventCounters counters_start_;
   bool granular_ = false;  // walls, gravity or contact laws: report the energy budget
   bool driven_ = false;    // [driving]: thermostat or random kicks
