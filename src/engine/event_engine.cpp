@@ -1250,7 +1250,7 @@ EventKind EventEngine<D, Queue>::step() {
 }
 
 template <int D, class Queue>
-ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
+ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
   const std::size_t n = size();
   ParticleSystem<D> out;
   out.box = box_;
@@ -1271,7 +1271,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state() const {
   out.last_collision_time.resize(last_collision_.size());
   out.bonds = bonds_;
   out.bond_types = bond_types_;
-  if (stepped_) out.zones = steps_.export_zones(id_.data());
+  if (stepped_ && with_zones) out.zones = steps_.export_zones(id_.data());
   for (std::uint32_t k = 0; k < n; ++k) {
     const std::uint32_t c = id_[k];
     const HotRecord<D>& h = hot_[k];
@@ -1819,29 +1819,72 @@ void EventEngine<D, Queue>::init_zones(const ParticleSystem<D>& s, StartMode mod
 }
 
 // The candidate loop of stepped potentials: per candidate, the zone from the capture map and
-// the time to the zone's next boundary (or, for a pair without steps, its contact).
+// the time to the zone's next boundary (or, for a pair without steps, its contact). Most
+// candidates sit beyond every step (zone 0): for them only an approach to the outermost
+// boundary counts, and the hard-sphere loop's cheap bound rejects most before a square root.
 template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::scan_stepped(const CandidateList& list, std::uint32_t i,
                                                   double t, double& best) {
   steps_.load(i);
-  const HotRecord<D>& h = hot_[i];
-  const Vec<D> xi = position_at(h, t), vi = velocity_at(h, t);
+  // Per shape of the candidate: its pair's table with i, and the squared distance of the
+  // pair's outermost boundary (the contact distance of a pair without steps).
   const std::uint32_t si = species_of(i);
   const double ri = radius_of(i);
+  const std::size_t shapes = shapes_.size();
+  step_row_table_.resize(shapes);
+  step_row_reach2_.resize(shapes);
+  for (std::size_t k = 0; k < shapes; ++k) {
+    const std::uint16_t table = steps_.pair_table(si, shapes_[k].species);
+    const double sigma = ri + shapes_[k].radius;
+    step_row_table_[k] = table;
+    step_row_reach2_[k] = table == PairSteps::kHard ? sigma * sigma : steps_.table(table).r2[0];
+  }
+  return accelerated_ ? scan_stepped_loop<true>(list, i, t, best)
+                      : scan_stepped_loop<false>(list, i, t, best);
+}
+
+template <int D, class Queue>
+template <bool kAccelerated>
+std::uint32_t EventEngine<D, Queue>::scan_stepped_loop(const CandidateList& list, std::uint32_t i,
+                                                       double t, double& best) const {
+  const HotRecord<D>& h = hot_[i];
+  const Vec<D> xi = position_at(h, t), vi = velocity_at(h, t);
+  const HotRecord<D>* hot = hot_.data();
+  const std::uint16_t* shape = shape_.empty() ? nullptr : shape_.data();
+  const std::uint16_t* row_table = step_row_table_.data();
+  const double* row_reach2 = step_row_reach2_.data();
   const Vec<D> no_shift{};
   std::uint32_t found = kNoPartner;
   for (std::uint32_t k = 0; k < list.count; ++k) {
     const std::uint32_t j = list.ids[k];
     if (j == i) continue;
     const Vec<D>& shift = list.n_shifts > 1 ? list.shifts[list.shift[k]] : no_shift;
-    const Vec<D> r = xi - (position_at(hot_[j], t) + shift);
-    const Vec<D> g = vi - velocity_at(hot_[j], t);
-    const double r2 = norm2(r), rg = dot(r, g), g2 = norm2(g);
-    const PairSteps::Zone z = steps_.lookup(j, steps_.pair_table(si, species_of(j)));
+    const HotRecord<D>& hj = hot[j];
+    const double dtj = t - hj.time;
+    double r2 = 0.0, rg = 0.0, g2 = 0.0;
+    for (int a = 0; a < D; ++a) {
+      double xj = hj.pos[a] + hj.vel[a] * dtj;
+      double vj = hj.vel[a];
+      if constexpr (kAccelerated) {
+        xj = xj + (half_gravity_[a] * dtj) * dtj;
+        vj = vj + env_.gravity[a] * dtj;
+      }
+      const double r = xi[a] - (xj + shift[a]);
+      const double g = vi[a] - vj;
+      r2 = r2 + r * r;
+      rg = rg + r * g;
+      g2 = g2 + g * g;
+    }
+    const std::uint16_t sj = shape != nullptr ? shape[j] : 0;
+    const PairSteps::Zone z = steps_.lookup(j, row_table[sj]);
     double dt;
-    if (z.table == PairSteps::kHard) {
-      const double sigma = ri + radius_of(j);
-      dt = quadratic_contact_time(r2 - sigma * sigma, 2.0 * rg, g2);
+    if (z.zone == 0) {
+      const double gap = r2 - row_reach2[sj];
+      if (!(rg < 0.0) || gap > -2.0 * rg * best) continue;
+      const double disc = rg * rg - g2 * gap;
+      if (!(disc > 0.0)) continue;
+      dt = gap / (-rg + std::sqrt(disc));
+      if (!(dt > 0.0)) dt = 0.0;
     } else {
       dt = steps_.table(z.table).event_time(z.zone, r2, rg, g2);
     }

@@ -101,8 +101,9 @@ class EventEngine {
   const EventCounters& counters() const { return counters_; }
   const Vec<D>& box() const { return box_; }
   // The complete state in the caller's particle numbering, scheduler state included: an engine
-  // resumed from it continues bit-identically.
-  ParticleSystem<D> export_state() const;
+  // resumed from it continues bit-identically. Without zones (stepped potentials' capture map,
+  // the costly part), enough for outputs but not for a resume.
+  ParticleSystem<D> export_state(bool with_zones = true) const;
   std::size_t size() const { return hot_.size(); }
 
   double kinetic_energy() const;  // translational
@@ -237,6 +238,9 @@ class EventEngine {
   // event at a step (false: the pair meets its hard core, an ordinary collision).
   void init_zones(const ParticleSystem<D>& s, StartMode mode);
   std::uint32_t scan_stepped(const CandidateList& list, std::uint32_t i, double t, double& best);
+  template <bool kAccelerated>
+  std::uint32_t scan_stepped_loop(const CandidateList& list, std::uint32_t i, double t,
+                                  double& best) const;
   bool step_pair(std::uint32_t i, std::uint32_t j, double t);
   // The pair's separation i - j under the box's boundaries (nearest image on periodic axes).
   Vec<D> separation(std::uint32_t i, std::uint32_t j, double t) const;
@@ -303,6 +307,8 @@ class EventEngine {
   double next_image_shift_ = kNever;
   bool stepped_ = false;  // some pair has a step potential, or there are bonds
   PairSteps steps_;
+  std::vector<std::uint16_t> step_row_table_;  // scan_stepped's scratch, per shape
+  std::vector<double> step_row_reach2_;
   std::vector<Bond> bonds_;  // the caller's numbering, kept for export
   std::vector<std::string> bond_types_;
 

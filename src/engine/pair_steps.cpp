@@ -19,7 +19,10 @@ PairSteps::PairSteps(const std::vector<StepTable>& tables, const std::vector<int
                      std::uint32_t species, std::size_t n)
     : species_(species), list_(n), seen_(n, 0) {
   if (tables.size() >= kHard) throw InputError("too many step tables (at most 65534)");
-  for (const StepTable& t : tables) tables_.emplace_back(t);
+  for (const StepTable& t : tables) {
+    tables_.emplace_back(t);
+    count_.emplace_back(tables_.back().energy.size(), 0);
+  }
   for (const int k : pair_table)
     pair_table_.push_back(k < 0 ? kHard : static_cast<std::uint16_t>(k));
 }
@@ -58,27 +61,23 @@ void PairSteps::erase(std::uint32_t i, std::uint32_t j) {
 }
 
 void PairSteps::set(std::uint32_t i, std::uint32_t j, Zone z) {
+  const Zone listed = find(i, j, kHard);
+  if (listed.table != kHard) --count_[listed.table][listed.zone];
   if (z.zone == 0 && !bonded(z.table)) {
     erase(i, j);
     erase(j, i);
   } else {
     insert_or_update(i, j, z);
     insert_or_update(j, i, z);
+    ++count_[z.table][z.zone];
   }
 }
 
-// Counted per (table, zone) first, so the sum does not depend on the order of the lists (a
-// resumed engine reports the same bits).
 double PairSteps::energy() const {
-  std::vector<std::vector<std::uint64_t>> count(tables_.size());
-  for (std::size_t t = 0; t < tables_.size(); ++t) count[t].assign(tables_[t].energy.size(), 0);
-  for (std::uint32_t i = 0; i < list_.size(); ++i)
-    for (const Entry& e : list_[i])
-      if (e.partner > i) ++count[e.zone.table][e.zone.zone];
   double u = 0.0;
   for (std::size_t t = 0; t < tables_.size(); ++t)
-    for (std::size_t z = 0; z < count[t].size(); ++z)
-      if (count[t][z] > 0) u += static_cast<double>(count[t][z]) * tables_[t].energy[z];
+    for (std::size_t z = 0; z < count_[t].size(); ++z)
+      if (count_[t][z] > 0) u += static_cast<double>(count_[t][z]) * tables_[t].energy[z];
   return u;
 }
 
@@ -94,18 +93,22 @@ void PairSteps::renumber(const std::vector<std::uint32_t>& new_index) {
   epoch_ = 0;
 }
 
+// In the caller's order (by i, then j) without a global sort: particles visited in caller
+// order, each one's short list sorted.
 std::vector<PairZone> PairSteps::export_zones(const std::uint32_t* id) const {
+  const auto n = static_cast<std::uint32_t>(list_.size());
+  std::vector<std::uint32_t> internal(n);
+  for (std::uint32_t k = 0; k < n; ++k) internal[id[k]] = k;
   std::vector<PairZone> out;
-  for (std::uint32_t i = 0; i < list_.size(); ++i) {
-    for (const Entry& e : list_[i]) {
-      if (e.partner < i) continue;
-      const std::uint32_t a = id[i], b = id[e.partner];
-      out.push_back({std::min(a, b), std::max(a, b), e.zone.zone});
-    }
+  std::vector<PairZone> mine;
+  for (std::uint32_t c = 0; c < n; ++c) {
+    mine.clear();
+    for (const Entry& e : list_[internal[c]])
+      if (id[e.partner] > c) mine.push_back({c, id[e.partner], e.zone.zone});
+    std::sort(mine.begin(), mine.end(),
+              [](const PairZone& x, const PairZone& y) { return x.j < y.j; });
+    out.insert(out.end(), mine.begin(), mine.end());
   }
-  std::sort(out.begin(), out.end(), [](const PairZone& x, const PairZone& y) {
-    return x.i != y.i ? x.i < y.i : x.j < y.j;
-  });
   return out;
 }
 

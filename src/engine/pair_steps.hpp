@@ -110,7 +110,8 @@ class PairSteps {
   void set(std::uint32_t i, std::uint32_t j, Zone z);
 
   const std::vector<Entry>& entries(std::uint32_t i) const { return list_[i]; }
-  // Potential energy: the sum over listed pairs of their zone's energy.
+  // Potential energy: the sum over listed pairs of their zone's energy (from the counts per
+  // zone: exact, and the same bits whatever the order of the lists).
   double energy() const;
   // Particles renumbered: new_index[old] is the new number.
   void renumber(const std::vector<std::uint32_t>& new_index);
@@ -125,6 +126,9 @@ class PairSteps {
   std::vector<std::uint16_t> pair_table_;
   std::uint32_t species_ = 0;
   std::vector<std::vector<Entry>> list_;
+  // Listed pairs per (table, zone), kept as pairs move: energy() without a pass over the lists,
+  // and independent of their order.
+  std::vector<std::vector<std::uint64_t>> count_;
   std::vector<std::uint64_t> seen_;  // per particle: epoch << 32 | table << 16 | zone
   std::uint32_t epoch_ = 0;
 };

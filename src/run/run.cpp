@@ -322,7 +322,7 @@ class RunDriver {
         trajectory_.emplace(gsd::Writer::open_append(traj));
       } else {
         trajectory_.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
-        append_trajectory_frame(*trajectory_, engine_->export_state());
+        append_trajectory_frame(*trajectory_, engine_->export_state(/*with_zones=*/false));
       }
     }
     ke_start_ = engine_->kinetic_energy();
@@ -363,7 +363,7 @@ class RunDriver {
 
     if (trajectory_) {
       if (frame_collisions_ != engine_->counters().collisions)
-        append_trajectory_frame(*trajectory_, engine_->export_state());
+        append_trajectory_frame(*trajectory_, engine_->export_state(/*with_zones=*/false));
       trajectory_->close();
     }
     RunOutcome outcome;
@@ -466,7 +466,7 @@ class RunDriver {
       const std::uint64_t c = engine_->counters().collisions;
       if (schedule.thermo.due(c)) write_thermo_row(phase);
       if (schedule.trajectory.due(c) && trajectory_) {
-        append_trajectory_frame(*trajectory_, engine_->export_state());
+        append_trajectory_frame(*trajectory_, engine_->export_state(/*with_zones=*/false));
         frame_collisions_ = c;
       }
       if (schedule.restart.due(c)) {
@@ -557,7 +557,8 @@ class RunDriver {
 
   void write_thermo_row(const std::string& phase) {
     if (phase == "production") {
-      const ParticleSystem<D> s = engine_->export_state();  // one copy for both samples
+      const ParticleSystem<D> s =
+          engine_->export_state(/*with_zones=*/false);  // one copy for both samples
       if (profile_) sample_profile(s);
       sample_kinetic_tensor(s);
     }
@@ -584,7 +585,7 @@ class RunDriver {
     if (!env.has_gravity()) return e;
     for (int a = 0; a < D; ++a)
       if (env.periodic(a) && env.gravity[a] != 0.0) return std::nan("");
-    const ParticleSystem<D> s = engine_->export_state();
+    const ParticleSystem<D> s = engine_->export_state(/*with_zones=*/false);
     const std::vector<Vec<D>> x = engine_->current_positions();
     for (std::size_t i = 0; i < n_; ++i) e -= s.mass[i] * dot(env.gravity, x[i]);
     return e;
@@ -593,7 +594,7 @@ class RunDriver {
   // Sonine coefficient of the velocity distribution, a2 = d/(d+2) <v^4>/<v^2>^2 - 1, with
   // velocities taken relative to the mean.
   double sonine_a2_now() const {
-    const std::vector<Vec<D>> v = peculiar_velocities(engine_->export_state());
+    const std::vector<Vec<D>> v = peculiar_velocities(engine_->export_state(/*with_zones=*/false));
     double m2 = 0.0, m4 = 0.0;
     for (const Vec<D>& u : v) {
       const double c2 = norm2(u);
@@ -611,7 +612,7 @@ class RunDriver {
     const Thermodynamics& th = *thermo_stats_;
     const double kT = th.temperature(ke);
     const Vec<D> p = engine_->momentum();
-    const ParticleSystem<D> state = engine_->export_state();
+    const ParticleSystem<D> state = engine_->export_state(/*with_zones=*/false);
     double pscale = 0.0, dp2 = 0.0;
     for (std::size_t i = 0; i < n_; ++i)
       pscale += state.mass[i] * std::sqrt(norm2(state.kinematics[i].vel));
