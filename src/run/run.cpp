@@ -565,7 +565,9 @@ class RunDriver {
     const auto& c = engine_->counters();
     const double u = engine_->potential_energy();
     if (phase == "production" && engine_->stepped()) potential_rows_.push_back(u);
-    thermo_->write(phase, thermo_stats_->row(point(), thermal_energy(), phase == "production"),
+    const ThermoRow row = thermo_stats_->row(point(), thermal_energy(), phase == "production");
+    if (phase == "production") production_temperatures_.push_back(row.temperature);
+    thermo_->write(phase, row,
                    {rotational_temperature(), c.dissipated_in_collisions + c.dissipated_at_walls,
                     c.work_by_walls, u});
   }
@@ -619,7 +621,12 @@ class RunDriver {
     for (int a = 0; a < D; ++a) dp2 += (p[a] - p_start_[a]) * (p[a] - p_start_[a]);
     const double t_prod = engine_->time() - prod_start_.time;
     const std::uint64_t coll_prod = c.collisions - prod_start_.collisions;
-    const double kT_prod = th.temperature(prod_ke_);
+    // The production temperature: constant kinetic energy for elastic hard spheres; with steps
+    // (kinetic energy turns into potential) or a thermostat, the mean over the production rows.
+    double kT_prod = th.temperature(prod_ke_);
+    if ((engine_->stepped() || driven_) && !production_temperatures_.empty()) {
+      kT_prod = block_average(production_temperatures_).mean;
+    }
     const BlockAverage z_blocks = th.compressibility_blocks();
     const double z_mean = th.compressibility(c.virial - prod_start_.virial, kT_prod, t_prod);
     std::vector<double> diameters(n_);
@@ -661,6 +668,7 @@ class RunDriver {
                             {"blocks", z_blocks.samples},
                             {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
     j["pressure"] = th.pressure(z_mean, kT_prod);
+    j["production_temperature"] = kT_prod;
     if (kinetic_tensor_samples_ > 0 && t_prod > 0.0) {
       // Kinetic part averaged over the production rows, collisional part from the impulses
       // over the production time.
@@ -773,7 +781,9 @@ class RunDriver {
   std::optional<Thermodynamics> thermo_stats_;
   ThermoPoint prod_start_;
   double ke_start_ = 0.0, prod_ke_ = 0.0, energy_start_ = 0.0, u_start_ = 0.0;
-  std::vector<double> potential_rows_;  // stepped potentials: U at each production thermo row
+  std::vector<double> potential_rows_;
+  std::vector<double> production_temperatures_;  // at each production thermo row  // stepped
+                                                 // potentials: U at each production thermo row
   EventCounters counters_start_;
   bool granular_ = false;  // walls, gravity or contact laws: report the energy budget
   bool driven_ = false;    // [driving]: thermostat or random kicks
