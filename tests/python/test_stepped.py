@@ -71,6 +71,7 @@ class LowDensity(kt.KairosTestCase):
         u = s["stepped"]["potential_energy_per_particle_mean"]
         du = s["stepped"]["potential_energy_per_particle_stderr"]
         u_dilute = -2 * math.pi / 3 * RHO * 2.375 * math.exp(1 / t)
+        print("square well: u = %.4f +- %.4f, dilute limit %.4f" % (u, du, u_dilute))
         self.assertLess(abs(u - u_dilute), 3.5 * du + 0.06 * abs(u_dilute), (u, du, u_dilute))
         self.assertLess(s["energy_drift_relative"], 1.0)  # thermostatted: bounded, not conserved
         self.assertEqual(s["max_overlap"], 0.0)
