@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "engine_fixtures.hpp"
+#include "interactions/potential_spec.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
 
@@ -163,6 +164,41 @@ TEST(Stepped, TetheredChainsKeepTheirBonds) {
     }
   }
   EXPECT_NEAR(total_energy(engine), e0, 1e-11 * std::abs(e0));
+  EXPECT_GT(engine.counters().step_bounces, 0u);
+}
+
+// Bead-spring chains in 2D: harmonic springs (k = 50, rest length 1.1, at most 1.3) stepped in
+// 8 equal-energy steps; no pair potential between beads. Bonds stay within [1, 1.3], energy is
+// conserved, and the springs store energy (beads are not all at the rest length).
+TEST(Stepped, SteppedSpringChains2D) {
+  ParticleSystem<2> s = testing::lattice_system<2>(12, 0.5, 9);
+  const double spacing = s.box[0] / 12.0;
+  ASSERT_GT(spacing, 1.0);
+  ASSERT_LT(spacing, 1.3);
+  for (std::uint32_t i = 0; i + 1 < s.size(); ++i)
+    if ((i + 1) % 12 != 0) s.bonds.push_back({i, i + 1, 0});
+  s.bond_types = {"backbone"};
+  PotentialSpec spring;
+  spring.kind = "spring";
+  spring.stiffness = 50.0;
+  spring.length = 1.1;
+  spring.max_length = 1.3;
+  spring.steps = 8;
+  Environment<2> env;
+  env.tables = {make_step_table(spring, 1.0, 2)};
+  env.bond_table = {0};
+  ASSERT_GT(env.tables[0].energy.size(), 4u);
+  EventEngine<2, CalendarQueue> engine(s, StartMode::kPredict, {}, env);
+  const double e0 = engine.kinetic_energy() + engine.potential_energy();
+  double u_max = 0.0;
+  for (int k = 0; k < 20000; ++k) {
+    ASSERT_NE(engine.step(), EventKind::kNone);
+    if (k % 25 == 0) engine.validate();  // bonded pairs stay in their zones
+    u_max = std::max(u_max, engine.potential_energy());
+  }
+  EXPECT_NEAR(engine.kinetic_energy() + engine.potential_energy(), e0, 1e-11 * std::abs(e0));
+  EXPECT_GT(u_max, 0.0);
+  EXPECT_GT(engine.counters().step_crossings, 0u);
   EXPECT_GT(engine.counters().step_bounces, 0u);
 }
 
