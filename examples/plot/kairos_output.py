@@ -109,3 +109,129 @@ class Frame:
 
     def chunk(self, name):
         return self.traj.chunk(name, self.index).astype(float)
+
+
+# --- Stepped potentials, bonds and chains --------------------------------------------------------
+
+def read_step_tables(stepsdir):
+    """The TSV files `kairos steps CONFIG.toml -o STEPSDIR` writes -> list of dicts, one per table,
+    in file-name order: `name` (e.g. potential0_A_A, bond0_backbone), `comments` (the header lines
+    without '#'), `bond` (True for a bond: infinite energy beyond the cut-off), `r_outer`,
+    `r_inner`, `U_step`, `U_continuous` (numpy arrays, one entry per shell, outermost first;
+    U_continuous is nan for kinds without a continuous potential) and, when NAME_curve.tsv
+    exists, `curve_r`, `curve_U` (the continuous potential, finely sampled)."""
+    tables = []
+    for fname in sorted(os.listdir(stepsdir)):
+        if not fname.endswith(".tsv") or fname.endswith("_curve.tsv"):
+            continue
+        path = os.path.join(stepsdir, fname)
+        with open(path) as f:
+            comments = [ln[1:].strip() for ln in f if ln.startswith("#")]
+        table = read_tsv(path)
+        entry = {"name": fname[:-4], "comments": comments,
+                 "bond": any("a bond" in c for c in comments)}
+        for key in ("r_outer", "r_inner", "U_step", "U_continuous"):
+            entry[key] = table[key]
+        curve = os.path.join(stepsdir, fname[:-4] + "_curve.tsv")
+        if os.path.exists(curve):
+            c = read_tsv(curve)
+            entry["curve_r"], entry["curve_U"] = c["r"], c["U"]
+        tables.append(entry)
+    return tables
+
+
+def box_lengths(box):
+    """The edge lengths of a GSD `configuration/box` (Lx, Ly, Lz, ...), as used for the minimum
+    image: a zero edge (Lz of a 2D box) is returned as inf, so that axis is never wrapped."""
+    L = np.array(box[:3], dtype=float)
+    L[L == 0] = np.inf
+    return L
+
+
+def minimum_image(dr, box):
+    """Displacement vectors dr (..., 3) wrapped to their nearest periodic image (no tilt)."""
+    L = box_lengths(box)
+    wrapped = dr - L * np.round(dr / L)
+    return np.where(np.isfinite(L), wrapped, dr)
+
+
+def unwrap_bonded(pos, bonds, box):
+    """Positions with every bonded molecule made whole across the periodic boundaries: starting
+    from the lowest-numbered particle of each molecule, each bonded neighbour is placed at the
+    nearest image of its bond partner (walking the bond graph breadth first). `bonds` is the
+    (M, 2) `bonds/group` array of the trajectory. Unbonded particles are unchanged."""
+    pos = np.asarray(pos, dtype=float)
+    n = len(pos)
+    neighbours = [[] for _ in range(n)]
+    for a, b in np.asarray(bonds, dtype=int):
+        neighbours[a].append(b)
+        neighbours[b].append(a)
+    out = pos.copy()
+    done = np.zeros(n, dtype=bool)
+    for root in range(n):
+        if done[root]:
+            continue
+        done[root] = True
+        queue = [root]
+        while queue:
+            a = queue.pop(0)
+            for b in neighbours[a]:
+                if not done[b]:
+                    out[b] = out[a] + minimum_image(pos[b] - pos[a], box)
+                    done[b] = True
+                    queue.append(b)
+    return out
+
+
+def molecules(bonds, n):
+    """Molecule index of each of the n particles (connected components of the bond graph,
+    numbered by their lowest particle); unbonded particles are molecules of their own."""
+    parent = np.arange(n)
+
+    def find(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for a, b in np.asarray(bonds, dtype=int):
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)
+    roots = np.array([find(i) for i in range(n)])
+    _, index = np.unique(roots, return_inverse=True)
+    return index
+
+
+def radius_of_gyration(unwrapped, masses=None):
+    """Rg of one molecule from its unwrapped positions (N, 3): sqrt(sum m |r - r_cm|^2 / M)."""
+    r = np.asarray(unwrapped, dtype=float)
+    m = np.ones(len(r)) if masses is None else np.asarray(masses, dtype=float)
+    cm = (m[:, None] * r).sum(0) / m.sum()
+    return float(np.sqrt((m * ((r - cm) ** 2).sum(1)).sum() / m.sum()))
+
+
+def neighbour_counts(pos, box, cutoff, chunk=512):
+    """For each particle, the number of others within `cutoff` (minimum image), by brute force
+    in chunks of rows (numpy only; fine up to some 10^4 particles)."""
+    pos = np.asarray(pos, dtype=float)
+    counts = np.zeros(len(pos), dtype=int)
+    for start in range(0, len(pos), chunk):
+        dr = minimum_image(pos[start:start + chunk, None, :] - pos[None, :, :], box)
+        close = (dr ** 2).sum(-1) < cutoff * cutoff
+        counts[start:start + chunk] = close.sum(1) - 1  # not itself
+    return counts
+
+
+def pair_distance_histogram(pos, box, edges, chunk=512):
+    """Histogram of all pair distances (each pair once, minimum image) over the bin `edges`:
+    the raw counts behind a radial distribution function."""
+    pos = np.asarray(pos, dtype=float)
+    hist = np.zeros(len(edges) - 1)
+    for start in range(0, len(pos), chunk):
+        dr = minimum_image(pos[start:start + chunk, None, :] - pos[None, :, :], box)
+        r = np.sqrt((dr ** 2).sum(-1))
+        i = np.arange(start, min(start + chunk, len(pos)))
+        upper = np.arange(len(pos))[None, :] > i[:, None]  # j > i: each pair once
+        hist += np.histogram(r[upper], bins=edges)[0]
+    return hist
