@@ -151,8 +151,9 @@ def box_lengths(box):
 def minimum_image(dr, box):
     """Displacement vectors dr (..., 3) wrapped to their nearest periodic image (no tilt)."""
     L = box_lengths(box)
-    wrapped = dr - L * np.round(dr / L)
-    return np.where(np.isfinite(L), wrapped, dr)
+    periodic = np.isfinite(L)
+    Lp = np.where(periodic, L, 1.0)
+    return np.where(periodic, dr - Lp * np.round(dr / Lp), dr)
 
 
 def unwrap_bonded(pos, bonds, box):
@@ -211,27 +212,52 @@ def radius_of_gyration(unwrapped, masses=None):
     return float(np.sqrt((m * ((r - cm) ** 2).sum(1)).sum() / m.sum()))
 
 
-def neighbour_counts(pos, box, cutoff, chunk=512):
-    """For each particle, the number of others within `cutoff` (minimum image), by brute force
-    in chunks of rows (numpy only; fine up to some 10^4 particles)."""
+def close_pairs(pos, box, rmax):
+    """All pairs (i, j), i < j, closer than rmax (minimum image), and their distances r, as three
+    arrays. numpy only: a cell list (cells at least rmax wide; an axis too short for three cells,
+    or not periodic, is one cell), each particle against the padded contents of its 27 (9 in 2D)
+    neighbour cells."""
     pos = np.asarray(pos, dtype=float)
-    counts = np.zeros(len(pos), dtype=int)
-    for start in range(0, len(pos), chunk):
-        dr = minimum_image(pos[start:start + chunk, None, :] - pos[None, :, :], box)
-        close = (dr ** 2).sum(-1) < cutoff * cutoff
-        counts[start:start + chunk] = close.sum(1) - 1  # not itself
-    return counts
+    n = len(pos)
+    L = box_lengths(box)
+    nc = np.where(np.isfinite(L), np.floor(L / rmax), 1).astype(int)
+    nc[nc < 3] = 1
+    cell3 = np.zeros((n, 3), dtype=int)
+    for a in range(3):
+        if nc[a] > 1:
+            cell3[:, a] = np.floor((pos[:, a] / L[a] + 0.5) * nc[a]).astype(int) % nc[a]
+    cell = (cell3[:, 0] * nc[1] + cell3[:, 1]) * nc[2] + cell3[:, 2]
+    order = np.argsort(cell, kind="stable")
+    counts = np.bincount(cell, minlength=int(nc.prod()))
+    starts = np.r_[0, np.cumsum(counts)[:-1]]
+    slots = np.full((len(counts), max(1, counts.max())), -1, dtype=int)
+    rank = np.arange(n) - starts[cell[order]]
+    slots[cell[order], rank] = order
+    offsets = [np.array([dx, dy, dz]) for dx in (range(-1, 2) if nc[0] > 1 else [0])
+               for dy in (range(-1, 2) if nc[1] > 1 else [0])
+               for dz in (range(-1, 2) if nc[2] > 1 else [0])]
+    out_i, out_j, out_r = [], [], []
+    for off in offsets:
+        c = (cell3 + off) % nc
+        other = slots[(c[:, 0] * nc[1] + c[:, 1]) * nc[2] + c[:, 2]]  # (n, max occupancy)
+        i = np.repeat(np.arange(n), other.shape[1]).reshape(other.shape)
+        keep = other > i  # also drops the -1 padding
+        i, j = i[keep], other[keep]
+        r = np.sqrt((minimum_image(pos[j] - pos[i], box) ** 2).sum(-1))
+        close = r < rmax
+        out_i.append(i[close])
+        out_j.append(j[close])
+        out_r.append(r[close])
+    return np.concatenate(out_i), np.concatenate(out_j), np.concatenate(out_r)
 
 
-def pair_distance_histogram(pos, box, edges, chunk=512):
-    """Histogram of all pair distances (each pair once, minimum image) over the bin `edges`:
-    the raw counts behind a radial distribution function."""
-    pos = np.asarray(pos, dtype=float)
-    hist = np.zeros(len(edges) - 1)
-    for start in range(0, len(pos), chunk):
-        dr = minimum_image(pos[start:start + chunk, None, :] - pos[None, :, :], box)
-        r = np.sqrt((dr ** 2).sum(-1))
-        i = np.arange(start, min(start + chunk, len(pos)))
-        upper = np.arange(len(pos))[None, :] > i[:, None]  # j > i: each pair once
-        hist += np.histogram(r[upper], bins=edges)[0]
-    return hist
+def neighbour_counts(pos, box, cutoff):
+    """For each particle, the number of others within `cutoff` (minimum image)."""
+    i, j, _ = close_pairs(pos, box, cutoff)
+    return np.bincount(i, minlength=len(pos)) + np.bincount(j, minlength=len(pos))
+
+
+def pair_distances(pos, box, rmax):
+    """All pair distances below rmax (each pair once, minimum image): the raw material of a
+    radial distribution function or a pair energy."""
+    return close_pairs(pos, box, rmax)[2]

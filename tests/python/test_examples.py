@@ -1,10 +1,11 @@
-"""The granular examples of docs/examples.md stay runnable, and their plotting scripts work.
+"""The examples of docs/examples.md stay runnable, and their plotting scripts work.
 
 Each example runs shortened by --set overrides (fewer particles, a few collisions per particle;
 about a second each; the pile runs until it has settled), then its script in examples/plot/
 draws a PNG from the output, if Debian's python3-matplotlib is installed (otherwise that step is
 skipped). The GSD reader the
-scripts use (examples/plot/kairos_output.py) is checked against python3-gsd.
+scripts use (examples/plot/kairos_output.py) is checked against python3-gsd, and its helpers
+for bonded chains and pair distances against direct computations.
 """
 
 import os
@@ -34,6 +35,22 @@ EXAMPLES = {
         "system.particles=2000", "run.equilibration_collisions_per_particle=2",
         "run.collisions_per_particle=5", "output.trajectory_interval=2",
         "output.profile_bins=10"]),
+}
+
+# Stepped-potential examples (docs/examples.md, "Stepped potentials"): config -> (plotting
+# script, overrides that make it a quick run).
+STEPPED_EXAMPLES = {
+    "square_well_fluid_3d.toml": ("plot_square_well.py", [
+        "system.particles=500", "run.collisions_per_particle=100",
+        "output.thermo_interval=2", "output.trajectory_interval=10"]),
+    "stepped_lj_liquid_3d.toml": ("plot_lj_liquid.py", [
+        # 500 particles (the config's): the box must be 3 cut-offs wide.
+        "run.equilibration_collisions_per_particle=10", "run.collisions_per_particle=30",
+        "output.thermo_interval=1", "output.trajectory_interval=3"]),
+    "sw_homopolymer_collapse_3d.toml": ("plot_homopolymer.py", [
+        "system.particles=32", "system.chain_length=32",
+        "run.equilibration_collisions_per_particle=200", "run.collisions_per_particle=200",
+        "output.thermo_interval=5", "output.trajectory_interval=20"]),
 }
 
 
@@ -137,6 +154,135 @@ class GranularExamples(kt.KairosTestCase):
         thermo = kairos_output.read_tsv(os.path.join(out, "thermo.tsv"))
         self.assertEqual(thermo["phase"][0], "production")
         self.assertEqual(kairos_output.read_config(out)["boundary"]["wall"][1]["face"], "z+")
+
+
+class SteppedExamples(kt.KairosTestCase):
+    """The square-well fluid, the stepped LJ liquid and the collapsing square-well chain, each
+    shortened (a second or two), and their pictures."""
+
+    def plot_dir(self):
+        return os.path.join(kt.SOURCE_DIR, "examples", "plot")
+
+    def run_example(self, name, out, *extra, restart=None):
+        args = ["run", kt.example(name), "-o", out, "--set", "output.progress=never"]
+        if restart:
+            args += ["--restart", restart]
+        for override in STEPPED_EXAMPLES[name][1] + list(extra):
+            args += ["--set", override]
+        self.run_ok(*args)
+        self.assert_outputs_exist(out)
+        s = self.summary(out)
+        self.assertEqual(s["max_overlap"], 0.0)
+        # The Andersen thermostat's work closes the energy budget, potential energy included.
+        self.assertLess(s["granular"]["energy_balance_relative"], 1e-9)
+        self.assertIn("stepped", s)
+        thermo = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        self.assertIn("potential_energy", thermo[0])
+        return s
+
+    def plot(self, script, *args):
+        if not have_matplotlib():
+            self.skipTest("python3-matplotlib not installed: plotting script not run")
+        png = self.path(script.replace(".py", ".png"))
+        result = subprocess.run([sys.executable, os.path.join(self.plot_dir(), script)]
+                                + list(args) + ["-o", png, "--dpi", "40"],
+                                capture_output=True, text=True, timeout=kt.RUN_TIMEOUT)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        with open(png, "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        return result.stdout
+
+    def kairos_output(self):
+        sys.path.insert(0, self.plot_dir())
+        try:
+            import kairos_output
+        finally:
+            sys.path.pop(0)
+        return kairos_output
+
+    def test_square_well_fluid_below_and_above_tc(self):
+        name = "square_well_fluid_3d.toml"
+        cold, hot = self.path("sw-T0.8"), self.path("sw-T2.0")
+        s_cold = self.run_example(name, cold, "system.temperature=0.8", "driving.temperature=0.8")
+        s_hot = self.run_example(name, hot, "system.temperature=2.0", "driving.temperature=2.0")
+        u_cold = s_cold["stepped"]["potential_energy_per_particle_mean"]
+        u_hot = s_hot["stepped"]["potential_energy_per_particle_mean"]
+        self.assertLess(u_cold, u_hot)  # more pairs in the well when cold
+        self.assertLess(u_hot, 0.0)
+        out = self.plot(STEPPED_EXAMPLES[name][0], cold, hot, "--frames", "2")
+        self.assertIn("T = 0.8: U/N", out)
+
+    def test_stepped_lj_liquid_and_its_step_table(self):
+        name = "stepped_lj_liquid_3d.toml"
+        steps = self.path("lj-steps")
+        result = self.run_ok("steps", kt.example(name), "-o", steps)
+        self.assertIn("B2 at kT = 2", result.stdout)
+        self.assertTrue(os.path.isfile(os.path.join(steps, "potential0_A_A.tsv")))
+        self.assertTrue(os.path.isfile(os.path.join(steps, "potential0_A_A_curve.tsv")))
+        self.plot("plot_steps.py", steps)
+        out = self.path("lj")
+        s = self.run_example(name, out)
+        self.assertLess(s["stepped"]["potential_energy_per_particle_mean"], 0.0)
+        # U(core) = 17.5 epsilon at kT = 2: the hard core is (almost) never reached.
+        self.assertLess(s["stepped"]["core_collisions"], 1e-3 * s["collisions"])
+        text = self.plot(STEPPED_EXAMPLES[name][0], out, "--steps", steps)
+        # The step table applied to the frames' pair distances gives the engine's energy.
+        self.assertIn("continuous - stepped U/N", text)
+
+    def test_homopolymer_collapse_hot_then_cold(self):
+        name = "sw_homopolymer_collapse_3d.toml"
+        coil, globule = self.path("coil"), self.path("globule")
+        self.run_example(name, coil)
+        # Cooled: continues from the hot run's restart file with the thermostat set lower.
+        s = self.run_example(name, globule, "driving.temperature=1.0",
+                             "run.collisions_per_particle=400",
+                             restart=os.path.join(coil, "restart.gsd"))
+        self.assertTrue(s["restarted"])
+        self.assertGreater(s["sim_time"], self.summary(coil)["sim_time"])
+        text = self.plot(STEPPED_EXAMPLES[name][0], coil, globule)
+        self.assertIn("longest bond", text)
+
+        # The helpers the script uses: bonds as python3-gsd reads them, every bond within its
+        # max_length once made whole, and Rg against a direct computation.
+        ko = self.kairos_output()
+        mine = ko.GsdFile(os.path.join(globule, "trajectory.gsd"))
+        theirs = kt.open_trajectory(os.path.join(globule, "trajectory.gsd"))
+        np.testing.assert_array_equal(mine.chunk("bonds/group"), theirs[0].bonds.group)
+        bonds = mine.chunk("bonds/group").astype(int)
+        self.assertEqual(len(bonds), 31)
+        for f in range(mine.frames):
+            pos = mine.chunk("particles/position", f).astype(float)
+            u = ko.unwrap_bonded(pos, bonds, mine.chunk("configuration/box", f))
+            length = np.sqrt(((u[bonds[:, 1]] - u[bonds[:, 0]]) ** 2).sum(1))
+            self.assertLessEqual(length.max(), 1.25 * (1 + 1e-5))  # float32 frames
+            self.assertGreaterEqual(length.min(), 1.0 * (1 - 1e-5))
+            rg = np.sqrt(((u - u.mean(0)) ** 2).sum(1).mean())
+            self.assertAlmostEqual(ko.radius_of_gyration(u), rg, places=12)
+        self.assertEqual(ko.molecules(bonds, 32).max(), 0)
+
+    def test_pair_helpers_match_brute_force(self):
+        ko = self.kairos_output()
+        rng = np.random.default_rng(3)
+        for box, n, rmax in (([9.0, 7.5, 11.0, 0, 0, 0], 400, 1.5),   # 3D
+                             ([6.0, 6.0, 6.0, 0, 0, 0], 200, 2.5),    # fewer than 3 cells
+                             ([10.0, 10.0, 0.0, 0, 0, 0], 300, 1.2)):  # 2D
+            box = np.array(box)
+            pos = (rng.random((n, 3)) - 0.5) * np.where(box[:3] > 0, box[:3], 0.0)
+            dr = ko.minimum_image(pos[:, None, :] - pos[None, :, :], box)
+            r = np.sqrt((dr ** 2).sum(-1))
+            iu = np.triu_indices(n, 1)
+            expected = np.sort(r[iu][r[iu] < rmax])
+            np.testing.assert_allclose(np.sort(ko.pair_distances(pos, box, rmax)), expected)
+            np.testing.assert_array_equal(ko.neighbour_counts(pos, box, rmax),
+                                          (r < rmax).sum(1) - 1)
+
+    def test_every_stepped_example_is_listed_in_the_docs(self):
+        with open(os.path.join(kt.SOURCE_DIR, "docs", "examples.md")) as f:
+            doc = f.read()
+        for text in ["examples/plot/plot_steps.py"] + [
+                t for name, (script, _) in STEPPED_EXAMPLES.items()
+                for t in ("examples/" + name, "examples/plot/" + script)]:
+            self.assertTrue(text in doc, "%s is not in docs/examples.md" % text)
 
 
 if __name__ == "__main__":
