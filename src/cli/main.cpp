@@ -84,6 +84,15 @@ void print_summary(const kairos::RunOutcome& outcome) {
   } else {
     fmt::print("  energy drift (rel.)  {:.3g}\n", num("energy_drift_relative"));
   }
+  if (s.contains("stepped")) {
+    const auto& st = s["stepped"];
+    fmt::print("  potential energy/N   {:.6g} +- {:.2g}\n",
+               st["potential_energy_per_particle_mean"].get<double>(),
+               st["potential_energy_per_particle_stderr"].get<double>());
+    fmt::print("  pair events          {} core, {} step crossings, {} step bounces\n",
+               st["core_collisions"].get<std::uint64_t>(),
+               st["step_crossings"].get<std::uint64_t>(), st["step_bounces"].get<std::uint64_t>());
+  }
   fmt::print("  max overlap          {:.3g}\n", num("max_overlap"));
   fmt::print("  peak memory          {:.1f} MiB\n", num("peak_rss_bytes") / 1048576.0);
   fmt::print("  outputs              {}/ (summary.json, thermo.tsv, trajectory.gsd, restart.gsd)\n",
@@ -144,12 +153,14 @@ void print_step_tables(const kairos::Config& config, double kT, const std::strin
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Kairos: event-driven molecular dynamics of hard spheres (3D) and hard disks (2D).\n"
+      "Kairos: event-driven molecular dynamics of hard, granular and stepped-potential spheres "
+      "(3D) and disks (2D).\n"
       "Configuration keys are documented in docs/config.md."};
   app.set_version_flag("--version", std::string("kairos ") + KAIROS_VERSION);
   app.require_subcommand(1);
   app.footer(
       "Usage of run: kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE]\n"
+      "Usage of steps: kairos steps CONFIG.toml [--set key=value ...] [--temperature KT] [-o DIR]\n"
       "  -o,--output OUTDIR   output directory (overrides output.directory)\n"
       "  --set key=value      override a config key (repeatable)\n"
       "  --restart FILE       continue from a restart file (OUTDIR/restart.gsd)\n"
@@ -187,6 +198,11 @@ int main(int argc, char** argv) {
       ->take_all()
       ->allow_extra_args(false);
   steps->add_option("--temperature", steps_kT, "kT for B2 (default: system.temperature)");
+  steps->footer(
+      "Prints, for every [[potential]] (each species pair it covers) and [[bond]] of the config, "
+      "the step table for the species' contact distances with B2 at kT, beside the continuous "
+      "potential's; -o DIR also writes NAME.tsv and NAME_curve.tsv per table for "
+      "examples/plot/plot_steps.py.");
   steps->add_option("-o,--output", steps_dir,
                     "Also write each table and its continuous curve as TSV files in this directory "
                     "(for examples/plot/plot_steps.py)");

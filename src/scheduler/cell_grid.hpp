@@ -63,13 +63,14 @@ class CellGrid {
       wanted[k] = std::min(std::floor(box[k] / min_width[k]), double{kMaxCellsAlong});
       if (periodic[k] && wanted[k] < 3.0) {
         throw InputError("box edge " + std::to_string(box[k]) +
-                         " is shorter than 3 contact distances (" + std::to_string(min_width[k]) +
-                         "): use more particles or a lower packing fraction");
+                         " is shorter than 3 interaction ranges (" + std::to_string(min_width[k]) +
+                         ": the largest contact distance or potential cut-off): use more "
+                         "particles or a lower packing fraction");
       }
       if (!periodic[k] && wanted[k] < 1.0) {
         throw InputError("box edge " + std::to_string(box[k]) + " between walls is shorter than " +
                          std::to_string(min_width[k]) +
-                         " (a particle diameter)");
+                         " (the interaction range: the largest diameter or potential cut-off)");
       }
       product *= wanted[k];
     }
