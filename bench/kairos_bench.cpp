@@ -8,6 +8,8 @@
 //   kairos_bench --particles 32000 --eta 0.45 --sizes mono,1.4 --queue calendar,heap --repeat 3
 //   kairos_bench --suite granular         # inelastic gas, vibrated bed, settling pile
 //   kairos_bench --case gas --dimension 3 # one granular case (granular_cases.hpp)
+//   kairos_bench --suite stepped          # square well and stepped Lennard-Jones vs hard spheres
+//   kairos_bench --case sw --scan vector,scalar   # one stepped case (stepped_cases.hpp)
 //
 // Cases given several queues are run interleaved (A B A B ...) so that machine noise hits
 // every variant alike; the best of the repeats is reported with the spread.
@@ -41,6 +43,7 @@
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
 #include "scheduler/tournament_tree_queue.hpp"
+#include "stepped_cases.hpp"
 
 #ifndef KAIROS_BENCH_BUILD_TYPE
 #define KAIROS_BENCH_BUILD_TYPE "unknown"
@@ -438,8 +441,8 @@ Plan suite_plan(const std::string& suite) {
     p.equilibrate_large = 10;
     p.timed_large = 20;
   } else {
-    throw UsageError(
-        fmt::format("unknown --suite \"{}\"; use one of default, quick, full, granular", suite));
+    throw UsageError(fmt::format(
+        "unknown --suite \"{}\"; use one of default, quick, full, granular, stepped", suite));
   }
   return p;
 }
@@ -605,7 +608,8 @@ int run(int argc, char** argv) {
   std::vector<std::int64_t> particles;  // signed: "-5" is an error, not 2^64 - 5
   std::vector<double> etas, ratios;
   std::vector<int> dims;
-  std::vector<std::string> queues, sizes, cases;
+  std::vector<std::string> queues, sizes, cases, scans;
+  std::vector<int> lj_steps;
   double eq = 0, timed = 0;
   int repeat = 1;
   std::string format = "markdown", output;
@@ -616,11 +620,22 @@ int run(int argc, char** argv) {
       "2D, eta 0.1 and 0.45, N 4000, mono and 1.4, both queues, 2 + 10); full (3D "
       "and 2D, eta 0.1 0.3 0.45 0.5, N 4000 32000 1000000, mono and 1.4, calendar, "
       "20 + 100, but 10 + 20 at N > 32000); granular (--case gas,bed,pile: an inelastic gas "
-      "and a vibrated bed against the elastic fluid, a pile settling with sleeping particles). "
-      "The options below override its parts");
-  auto* o_case =
-      app.add_option("--case", cases, "granular cases: gas, bed, pile (implies --suite granular)")
+      "and a vibrated bed against the elastic fluid, a pile settling with sleeping particles); "
+      "stepped (--case sw,lj: the square-well fluid and stepped Lennard-Jones tables against "
+      "hard spheres). The options below override its parts");
+  auto* o_case = app.add_option("--case", cases,
+                                "granular cases: gas, bed, pile (imply --suite granular); "
+                                "stepped cases: sw, lj (imply --suite stepped)")
+                     ->delimiter(',');
+  auto* o_steps =
+      app.add_option("--steps", lj_steps,
+                     "stepped suite: attractive steps of the Lennard-Jones tables (default "
+                     "5,10,20,40)")
           ->delimiter(',');
+  auto* o_scan = app.add_option("--scan", scans,
+                                "stepped suite: candidate loops, run interleaved: vector "
+                                "(AVX-512 where available, the default) and/or scalar")
+                     ->delimiter(',');
   auto* o_particles = app.add_option("--particles", particles, "particle numbers")->delimiter(',');
   auto* o_eta =
       app.add_option("--eta", etas, "packing fractions (area fractions in 2D)")->delimiter(',');
@@ -659,7 +674,41 @@ int run(int argc, char** argv) {
     throw UsageError(fmt::format("--format \"{}\" is unknown; use markdown or tsv", format));
   }
 
-  if (o_case->count() > 0 && o_suite->count() == 0) suite = "granular";
+  if (o_case->count() > 0 && o_suite->count() == 0) {
+    const bool stepped_cases = std::all_of(
+        cases.begin(), cases.end(), [](const std::string& c) { return c == "sw" || c == "lj"; });
+    suite = stepped_cases ? "stepped" : "granular";
+  }
+  if (suite != "stepped" && (o_steps->count() > 0 || o_scan->count() > 0))
+    throw UsageError("--steps and --scan need --suite stepped");
+  if (suite == "stepped") {
+    if (o_queue->count() > 0 || o_sizes->count() > 0 || o_ratio->count() > 0 ||
+        o_eta->count() > 0 || o_dim->count() > 0 || fmt_kind == Format::kTsv) {
+      throw UsageError(
+          "--suite stepped takes no --queue, --sizes, --eta, --dimension or --format tsv");
+    }
+    if (particles.size() > 1) throw UsageError("--suite stepped takes one --particles");
+    bench::SteppedPlan sp;
+    if (o_case->count() > 0) sp.cases = cases;
+    if (o_steps->count() > 0) sp.lj_steps = lj_steps;
+    if (o_scan->count() > 0) sp.scans = scans;
+    if (!particles.empty()) {
+      if (particles[0] < 1) throw UsageError("--particles must be positive");
+      sp.particles = static_cast<std::uint64_t>(particles[0]);
+    }
+    if (o_eq->count() > 0) sp.equilibrate = eq;
+    if (o_timed->count() > 0) sp.timed = timed;
+    if (o_repeat->count() > 0) sp.repeat = repeat;
+    try {
+      bench::validate(sp);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+    Output out(output);
+    out.add(preamble(argc, argv, bench::stepped_protocol(sp), fmt_kind));
+    bench::run_stepped(sp, [&](const std::string& text) { out.add(text); });
+    return 0;
+  }
   if (suite == "granular") {
     if (o_queue->count() > 0 || o_sizes->count() > 0 || o_ratio->count() > 0 ||
         fmt_kind == Format::kTsv) {
@@ -689,7 +738,7 @@ int run(int argc, char** argv) {
     bench::run_granular(g, [&](const std::string& text) { out.add(text); });
     return 0;
   }
-  if (o_case->count() > 0) throw UsageError("--case needs --suite granular");
+  if (o_case->count() > 0) throw UsageError("--case needs --suite granular or stepped");
 
   Plan plan = suite_plan(suite);
   if (o_particles->count() > 0) {

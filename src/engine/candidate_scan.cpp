@@ -134,6 +134,180 @@ template std::uint32_t scan_candidates_avx512<2, true>(const CandidateScan<2>&, 
 template std::uint32_t scan_candidates_avx512<3, true>(const CandidateScan<3>&, double,
                                                        const Vec<3>&, const Vec<3>&, double&);
 
+// The stepped loop, eight candidates per iteration. Every lane computes r.r, r.g and g.g as
+// the scalar loop does. Zone-0 lanes (unlisted: the most) then take the hard-sphere loop's cheap
+// bound and the approach to their outermost boundary. Listed lanes (zone >= 1) are compressed
+// into the held arrays and tested together at the end, eight at a time, by ZoneTable::event_time
+// (the approach to the inner boundary if it comes, else the exit through the outer one, both
+// branches evaluated and blended): a square-well prediction has ~5 of them among ~49
+// candidates, spread over most blocks. The soonest event is the scalar loop's: the lowest
+// index among equal times, whichever pass found it.
+template <int D, bool kAccelerated>
+std::uint32_t scan_stepped_avx512(const SteppedScan<D>& s, double t, const Vec<D>& xi,
+                                  const Vec<D>& vi, double& best) {
+  const CandidateScan<D>& c = s.base;
+  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512d vt = _mm512_set1_pd(t);
+  const __m512d minus_two = _mm512_set1_pd(-2.0);
+  __m512d vxi[D], vvi[D];
+  for (int a = 0; a < D; ++a) {
+    vxi[a] = _mm512_set1_pd(xi[a]);
+    vvi[a] = _mm512_set1_pd(vi[a]);
+  }
+  const __m256i vstride = _mm256_set1_epi32(c.stride);
+  const __m256i vself = _mm256_set1_epi32(static_cast<int>(s.self));
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m512i vepoch = _mm512_set1_epi64(static_cast<long long>(s.epoch));
+  const __m512i low16 = _mm512_set1_epi64(0xffff);
+  const __m512d reach2_one = _mm512_set1_pd(s.row_reach2[0]);
+  std::uint32_t found = kNoCandidate;
+  std::uint32_t held = 0;
+  for (std::uint32_t k = 0; k < c.count; k += 8) {
+    const std::uint32_t left = c.count - k;
+    __mmask8 live = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
+    const __m256i ids = _mm256_maskz_loadu_epi32(live, c.candidates + k);
+    live = _mm256_mask_cmpneq_epu32_mask(live, ids, vself);
+    const __m256i base = _mm256_mullo_epi32(ids, vstride);
+    const __m512d dtj = _mm512_sub_pd(vt, gather_field(c.records, base, live, 2 * D));
+    __m512d r2 = zero, rg = zero, g2 = zero;
+    __m256i shift_base = _mm256_setzero_si256();
+    if (c.any_shift) {
+      const __m256i sidx = _mm256_maskz_loadu_epi32(live, c.shift_index + k);
+      shift_base = _mm256_mullo_epi32(sidx, _mm256_set1_epi32(D));
+    }
+    for (int a = 0; a < D; ++a) {
+      __m512d vel = gather_field(c.records, base, live, D + a);
+      __m512d xj = _mm512_add_pd(gather_field(c.records, base, live, a), _mm512_mul_pd(vel, dtj));
+      if constexpr (kAccelerated) {
+        xj = _mm512_add_pd(xj,
+                           _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(c.half_accel[a]), dtj), dtj));
+        vel = _mm512_add_pd(vel, _mm512_mul_pd(_mm512_set1_pd(c.accel[a]), dtj));
+      }
+      if (c.any_shift) {
+        const __m512d sh =
+            _mm512_mask_i32gather_pd(zero, live, _mm256_add_epi32(shift_base, _mm256_set1_epi32(a)),
+                                     reinterpret_cast<const double*>(c.shifts), 8);
+        xj = _mm512_add_pd(xj, sh);
+      }
+      const __m512d r = _mm512_sub_pd(vxi[a], xj);
+      const __m512d g = _mm512_sub_pd(vvi[a], vel);
+      r2 = _mm512_add_pd(r2, _mm512_mul_pd(r, r));
+      rg = _mm512_add_pd(rg, _mm512_mul_pd(r, g));
+      g2 = _mm512_add_pd(g2, _mm512_mul_pd(g, g));
+    }
+    // Zones from the capture map's stamps: listed lanes in zone >= 1 are held back.
+    const __m512i stamp =
+        _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), live, ids, s.stamps, 8);
+    const __mmask8 listed =
+        _mm512_mask_cmpeq_epu64_mask(live, _mm512_srli_epi64(stamp, 32), vepoch);
+    const __mmask8 inside = _mm512_mask_test_epi64_mask(listed, stamp, low16);
+    if (inside != 0) {
+      _mm512_mask_compressstoreu_pd(s.held_r2 + held, inside, r2);
+      _mm512_mask_compressstoreu_pd(s.held_rg + held, inside, rg);
+      _mm512_mask_compressstoreu_pd(s.held_g2 + held, inside, g2);
+      _mm512_mask_compressstoreu_epi64(s.held_stamp + held, inside, stamp);
+      _mm256_mask_compressstoreu_epi32(
+          s.held_index + held, inside,
+          _mm256_add_epi32(lane, _mm256_set1_epi32(static_cast<int>(k))));
+      held += static_cast<std::uint32_t>(__builtin_popcount(inside));
+    }
+    // Zone 0: the approach to the outermost boundary, after the cheap bound.
+    const __mmask8 outside = static_cast<__mmask8>(live & ~inside);
+    __m512d reach2 = reach2_one;
+    if (s.shape != nullptr) {
+      const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(outside),
+                                                      _mm512_castsi256_si512(ids), s.shape, 2);
+      const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
+      reach2 = _mm512_mask_i32gather_pd(zero, outside, shp, s.row_reach2, 8);
+    }
+    const __m512d gap = _mm512_sub_pd(r2, reach2);
+    const __m512d bound = _mm512_mul_pd(_mm512_mul_pd(minus_two, rg), _mm512_set1_pd(best));
+    __mmask8 ok = _mm512_mask_cmp_pd_mask(outside, rg, zero, _CMP_LT_OQ);
+    ok = _mm512_mask_cmp_pd_mask(ok, gap, bound, _CMP_LE_OQ);
+    if (ok == 0) continue;
+    const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(rg, rg), _mm512_mul_pd(g2, gap));
+    ok = _mm512_mask_cmp_pd_mask(ok, disc, zero, _CMP_GT_OQ);
+    if (ok == 0) continue;
+    __m512d dt = _mm512_div_pd(gap, _mm512_sub_pd(_mm512_sqrt_pd(disc), rg));
+    dt = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(dt, zero, _CMP_GT_OQ), zero, dt);
+    dt = _mm512_mask_blend_pd(ok, inf, dt);
+    const double m = _mm512_reduce_min_pd(dt);
+    if (m < best) {
+      const __mmask8 at = _mm512_mask_cmp_pd_mask(ok, dt, _mm512_set1_pd(m), _CMP_EQ_OQ);
+      best = m;
+      found = k + static_cast<std::uint32_t>(__builtin_ctz(at));
+    }
+  }
+  // The held (listed) candidates, in list order: ZoneTable::event_time.
+  const __m512i sign = _mm512_set1_epi64(static_cast<long long>(0x8000000000000000ull));
+  for (std::uint32_t h = 0; h < held; h += 8) {
+    const std::uint32_t left = held - h;
+    const __mmask8 live = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
+    const __m512d r2 = _mm512_maskz_loadu_pd(live, s.held_r2 + h);
+    const __m512d rg = _mm512_maskz_loadu_pd(live, s.held_rg + h);
+    const __m512d g2 = _mm512_maskz_loadu_pd(live, s.held_g2 + h);
+    const __m512i stamp = _mm512_maskz_loadu_epi64(live, s.held_stamp + h);
+    __m256i at = _mm512_cvtepi64_epi32(_mm512_and_si512(stamp, low16));  // the zone
+    if (s.table_offset != nullptr) {
+      const __m256i table =
+          _mm512_cvtepi64_epi32(_mm512_and_si512(_mm512_srli_epi64(stamp, 16), low16));
+      at = _mm256_add_epi32(
+          at, _mm256_mmask_i32gather_epi32(_mm256_setzero_si256(), live, table, s.table_offset, 4));
+    }
+    const __m512d inner = _mm512_mask_i32gather_pd(zero, live, at, s.flat_r2, 8);
+    const __m512d outer = _mm512_mask_i32gather_pd(
+        zero, live, _mm256_sub_epi32(at, _mm256_set1_epi32(1)), s.flat_r2, 8);
+    const __m512d rg_rg = _mm512_mul_pd(rg, rg);
+    // Approaching, and the inner boundary is reached.
+    const __m512d gap_in = _mm512_sub_pd(r2, inner);
+    const __m512d disc_in = _mm512_sub_pd(rg_rg, _mm512_mul_pd(g2, gap_in));
+    const __mmask8 approaching = _mm512_mask_cmp_pd_mask(live, rg, zero, _CMP_LT_OQ);
+    const __mmask8 hits = _mm512_mask_cmp_pd_mask(approaching, disc_in, zero, _CMP_GT_OQ);
+    __m512d t_in = _mm512_div_pd(gap_in, _mm512_sub_pd(_mm512_sqrt_pd(disc_in), rg));
+    t_in = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(t_in, zero, _CMP_GT_OQ), zero, t_in);
+    // Otherwise the later root at the outer boundary (never if g.g is not > 0; now if the pair
+    // is past it already).
+    const __mmask8 rest =
+        _mm512_mask_cmp_pd_mask(static_cast<__mmask8>(live & ~hits), g2, zero, _CMP_GT_OQ);
+    const __m512d gap_out = _mm512_sub_pd(r2, outer);
+    const __m512d disc_out = _mm512_sub_pd(rg_rg, _mm512_mul_pd(g2, gap_out));
+    const __mmask8 leaves = _mm512_mask_cmp_pd_mask(rest, disc_out, zero, _CMP_GT_OQ);
+    const __m512d root = _mm512_sqrt_pd(disc_out);
+    const __m512d receding_t =
+        _mm512_div_pd(_mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(gap_out), sign)),
+                      _mm512_add_pd(rg, root));
+    const __m512d closing_t = _mm512_div_pd(_mm512_sub_pd(root, rg), g2);
+    __m512d t_out =
+        _mm512_mask_blend_pd(_mm512_cmp_pd_mask(rg, zero, _CMP_GT_OQ), closing_t, receding_t);
+    t_out = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(t_out, zero, _CMP_GT_OQ), zero, t_out);
+    __m512d dt = _mm512_mask_blend_pd(hits, inf, t_in);
+    dt = _mm512_mask_blend_pd(static_cast<__mmask8>(rest & ~leaves), dt, zero);
+    dt = _mm512_mask_blend_pd(leaves, dt, t_out);
+    const double m = _mm512_reduce_min_pd(dt);
+    if (m <= best) {
+      const __mmask8 first = _mm512_mask_cmp_pd_mask(live, dt, _mm512_set1_pd(m), _CMP_EQ_OQ);
+      const std::uint32_t index =
+          s.held_index[h + static_cast<std::uint32_t>(__builtin_ctz(first))];
+      // Equal to the best of the other candidates: the one earlier in the list wins.
+      if (m < best || (found != kNoCandidate && index < found)) {
+        best = m;
+        found = index;
+      }
+    }
+  }
+  return found;
+}
+
+template std::uint32_t scan_stepped_avx512<2, false>(const SteppedScan<2>&, double, const Vec<2>&,
+                                                     const Vec<2>&, double&);
+template std::uint32_t scan_stepped_avx512<3, false>(const SteppedScan<3>&, double, const Vec<3>&,
+                                                     const Vec<3>&, double&);
+template std::uint32_t scan_stepped_avx512<2, true>(const SteppedScan<2>&, double, const Vec<2>&,
+                                                    const Vec<2>&, double&);
+template std::uint32_t scan_stepped_avx512<3, true>(const SteppedScan<3>&, double, const Vec<3>&,
+                                                    const Vec<3>&, double&);
+
 // Up to 16 lists per register (two registers for the 27 cells of 3D): gather the heads,
 // compress the non-empty ones out, gather their successors, compress again.
 std::uint32_t gather_lists_avx512(const Neighbourhood& nb, std::uint32_t* out,
@@ -192,6 +366,21 @@ template std::uint32_t scan_candidates_avx512<2, true>(const CandidateScan<2>&, 
                                                        const Vec<2>&, const Vec<2>&, double&);
 template std::uint32_t scan_candidates_avx512<3, true>(const CandidateScan<3>&, double,
                                                        const Vec<3>&, const Vec<3>&, double&);
+
+template <int D, bool kAccelerated>
+std::uint32_t scan_stepped_avx512(const SteppedScan<D>&, double, const Vec<D>&, const Vec<D>&,
+                                  double&) {
+  return kNoCandidate;  // never called: cpu_has_avx512() is false on this platform
+}
+
+template std::uint32_t scan_stepped_avx512<2, false>(const SteppedScan<2>&, double, const Vec<2>&,
+                                                     const Vec<2>&, double&);
+template std::uint32_t scan_stepped_avx512<3, false>(const SteppedScan<3>&, double, const Vec<3>&,
+                                                     const Vec<3>&, double&);
+template std::uint32_t scan_stepped_avx512<2, true>(const SteppedScan<2>&, double, const Vec<2>&,
+                                                    const Vec<2>&, double&);
+template std::uint32_t scan_stepped_avx512<3, true>(const SteppedScan<3>&, double, const Vec<3>&,
+                                                    const Vec<3>&, double&);
 
 std::uint32_t gather_lists_avx512(const Neighbourhood&, std::uint32_t*, std::uint32_t*,
                                   std::uint32_t*, std::uint32_t*, std::uint32_t& n_third) {

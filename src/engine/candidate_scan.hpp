@@ -119,4 +119,38 @@ template <int D, bool kAccelerated = false>
 std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
                                      const Vec<D>& vi, double& best);
 
+// The candidate loop of stepped potentials (EventEngine::scan_stepped): the hard-sphere loop's
+// records and candidates (`base`: its contact-distance fields are not read), the predicted
+// particle (skipped), and the capture map as PairSteps::load() left it. A candidate whose stamp
+// carries `epoch` is listed, in the zone and table the stamp names; any other sits in zone 0 of
+// its species pair's table, where only an approach to the outermost boundary (squared distance
+// row_reach2[its shape], the contact distance for a pair without steps) counts.
+template <int D>
+struct SteppedScan {
+  CandidateScan<D> base;
+  std::uint32_t self = 0;
+  const std::uint64_t* stamps = nullptr;  // per particle: epoch << 32 | table << 16 | zone
+  std::uint32_t epoch = 0;
+  const std::uint16_t* shape = nullptr;  // per particle (padded by one), null: a single shape
+  const double* row_reach2 = nullptr;    // per shape
+  const double* flat_r2 = nullptr;       // every table's squared boundaries, back to back
+  const std::uint32_t* table_offset = nullptr;  // per table, into flat_r2; null: one table
+  // Scratch for the listed candidates, held back and tested together after the others: room
+  // for base.count + 8 entries each (r.r, r.g, g.g, stamp, index into base.candidates).
+  double* held_r2 = nullptr;
+  double* held_rg = nullptr;
+  double* held_g2 = nullptr;
+  std::uint64_t* held_stamp = nullptr;
+  std::uint32_t* held_index = nullptr;
+};
+
+// AVX-512 version of EventEngine::scan_stepped_loop: the same zone-0 test (cheap bound, then
+// the approach to the outermost boundary) and, for listed lanes, ZoneTable::event_time, with
+// the same expressions in the same order, so the result is bit-identical. Returns the index
+// (into base.candidates) of the soonest event earlier than t + best and lowers best to it;
+// kNoCandidate if none. Only called when cpu_has_avx512().
+template <int D, bool kAccelerated = false>
+std::uint32_t scan_stepped_avx512(const SteppedScan<D>& s, double t, const Vec<D>& xi,
+                                  const Vec<D>& vi, double& best);
+
 }  // namespace kairos

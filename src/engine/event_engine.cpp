@@ -1825,6 +1825,8 @@ void EventEngine<D, Queue>::init_zones(const ParticleSystem<D>& s, StartMode mod
 // the time to the zone's next boundary (or, for a pair without steps, its contact). Most
 // candidates sit beyond every step (zone 0): for them only an approach to the outermost
 // boundary counts, and the hard-sphere loop's cheap bound rejects most before a square root.
+// With AVX-512, scan_stepped_avx512 (candidate_scan.cpp) tests them eight at a time and the
+// listed ones together at the end, with the same result as scan_stepped_loop.
 template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::scan_stepped(const CandidateList& list, std::uint32_t i,
                                                   double t, double& best) {
@@ -1842,8 +1844,48 @@ std::uint32_t EventEngine<D, Queue>::scan_stepped(const CandidateList& list, std
     step_row_table_[k] = table;
     step_row_reach2_[k] = table == PairSteps::kHard ? sigma * sigma : steps_.table(table).r2[0];
   }
-  return accelerated_ ? scan_stepped_loop<true>(list, i, t, best)
-                      : scan_stepped_loop<false>(list, i, t, best);
+  if (!vector_scan_) {
+    return accelerated_ ? scan_stepped_loop<true>(list, i, t, best)
+                        : scan_stepped_loop<false>(list, i, t, best);
+  }
+  const std::size_t room = list.count + 8;
+  if (step_held_index_.size() < room) {
+    step_held_.resize(3 * room);
+    step_held_stamp_.resize(room);
+    step_held_index_.resize(room);
+  }
+  const HotRecord<D>& h = hot_[i];
+  const SteppedScan<D> scan{
+      .base = {.records = reinterpret_cast<const double*>(hot_.data()),
+               .stride = static_cast<int>(sizeof(HotRecord<D>) / sizeof(double)),
+               .candidates = list.ids.data(),
+               .shift_index = list.shift.data(),
+               .shifts = list.shifts,
+               .any_shift = list.n_shifts > 1,
+               .count = list.count,
+               .uniform = true,
+               .sigma = 0.0,
+               .radius_i = 0.0,
+               .shape = nullptr,
+               .shape_radius = nullptr,
+               .accel = accelerated_ ? env_.gravity.data() : nullptr,
+               .half_accel = accelerated_ ? half_gravity_.data() : nullptr},
+      .self = i,
+      .stamps = steps_.stamps(),
+      .epoch = steps_.epoch(),
+      .shape = shape_.empty() ? nullptr : shape_.data(),
+      .row_reach2 = step_row_reach2_.data(),
+      .flat_r2 = steps_.flat_r2(),
+      .table_offset = steps_.tables() > 1 ? steps_.table_offset() : nullptr,
+      .held_r2 = step_held_.data(),
+      .held_rg = step_held_.data() + room,
+      .held_g2 = step_held_.data() + 2 * room,
+      .held_stamp = step_held_stamp_.data(),
+      .held_index = step_held_index_.data()};
+  const Vec<D> xi = position_at(h, t), vi = velocity_at(h, t);
+  const std::uint32_t k = accelerated_ ? scan_stepped_avx512<D, true>(scan, t, xi, vi, best)
+                                       : scan_stepped_avx512<D, false>(scan, t, xi, vi, best);
+  return k == kNoCandidate ? kNoPartner : list.ids[k];
 }
 
 template <int D, class Queue>

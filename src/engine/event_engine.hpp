@@ -309,6 +309,9 @@ class EventEngine {
   PairSteps steps_;
   std::vector<std::uint16_t> step_row_table_;  // scan_stepped's scratch, per shape
   std::vector<double> step_row_reach2_;
+  std::vector<double> step_held_;  // the vector loop's held candidates: r.r, r.g, g.g
+  std::vector<std::uint64_t> step_held_stamp_;
+  std::vector<std::uint32_t> step_held_index_;
   std::vector<Bond> bonds_;  // the caller's numbering, kept for export
   std::vector<std::string> bond_types_;
 

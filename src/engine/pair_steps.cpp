@@ -17,11 +17,13 @@ ZoneTable::ZoneTable(const StepTable& t) {
 
 PairSteps::PairSteps(const std::vector<StepTable>& tables, const std::vector<int>& pair_table,
                      std::uint32_t species, std::size_t n)
-    : species_(species), list_(n), seen_(n, 0) {
+    : species_(species), n_(n), slabs_(n * stride_, Entry{0, {}}), seen_(n, 0) {
   if (tables.size() >= kHard) throw InputError("too many step tables (at most 65534)");
   for (const StepTable& t : tables) {
     tables_.emplace_back(t);
     count_.emplace_back(tables_.back().energy.size(), 0);
+    table_offset_.push_back(static_cast<std::uint32_t>(flat_r2_.size()));
+    flat_r2_.insert(flat_r2_.end(), tables_.back().r2.begin(), tables_.back().r2.end());
   }
   for (const int k : pair_table)
     pair_table_.push_back(k < 0 ? kHard : static_cast<std::uint16_t>(k));
@@ -34,41 +36,69 @@ double PairSteps::max_range() const {
 }
 
 PairSteps::Zone PairSteps::find(std::uint32_t i, std::uint32_t j, std::uint16_t fallback) const {
-  for (const Entry& e : list_[i])
-    if (e.partner == j) return e.zone;
+  const Entry* slab = slab_of(i);
+  const std::uint32_t n = slab[0].partner;
+  for (std::uint32_t k = 1; k <= n; ++k)
+    if (slab[k].partner == j) return slab[k].zone;
   return {fallback, 0};
 }
 
-void PairSteps::insert_or_update(std::uint32_t i, std::uint32_t j, Zone z) {
-  for (Entry& e : list_[i]) {
-    if (e.partner == j) {
-      e.zone = z;
-      return;
-    }
+// Every slab moved to a stride half as large again (rounded to whole cache lines).
+void PairSteps::grow_slabs() {
+  const std::size_t stride = (stride_ + stride_ / 2 + 7) / 8 * 8;
+  HugeVector<Entry> moved(n_ * stride, Entry{0, {}});
+  for (std::size_t i = 0; i < n_; ++i) {
+    const Entry* from = slabs_.data() + i * stride_;
+    std::copy(from, from + 1 + from[0].partner, moved.data() + i * stride);
   }
-  list_[i].push_back({j, z});
+  slabs_.swap(moved);
+  stride_ = stride;
 }
 
-void PairSteps::erase(std::uint32_t i, std::uint32_t j) {
-  auto& l = list_[i];
-  for (std::size_t k = 0; k < l.size(); ++k) {
-    if (l[k].partner == j) {
-      l[k] = l.back();
-      l.pop_back();
-      return;
-    }
-  }
+std::uint32_t PairSteps::slot(std::uint32_t i, std::uint32_t j) const {
+  const Entry* slab = slab_of(i);
+  const std::uint32_t n = slab[0].partner;
+  for (std::uint32_t k = 1; k <= n; ++k)
+    if (slab[k].partner == j) return k;
+  return 0;
 }
 
+void PairSteps::append(std::uint32_t i, std::uint32_t j, Zone z) {
+  if (slab_of(i)[0].partner + 1 >= stride_) grow_slabs();
+  Entry* slab = slab_of(i);
+  const std::uint32_t n = slab[0].partner + 1;
+  slab[n] = {j, z};
+  slab[0].partner = n;
+}
+
+void PairSteps::remove(std::uint32_t i, std::uint32_t k) {
+  Entry* slab = slab_of(i);
+  const std::uint32_t n = slab[0].partner;
+  slab[k] = slab[n];
+  slab[0].partner = n - 1;
+}
+
+// A pair is listed under both particles or neither: one scan of i's list tells which, and j's
+// is scanned only to update or remove an entry it has.
 void PairSteps::set(std::uint32_t i, std::uint32_t j, Zone z) {
-  const Zone listed = find(i, j, kHard);
-  if (listed.table != kHard) --count_[listed.table][listed.zone];
-  if (z.zone == 0 && !bonded(z.table)) {
-    erase(i, j);
-    erase(j, i);
+  const bool unlisted = z.zone == 0 && !bonded(z.table);
+  const std::uint32_t ki = slot(i, j);
+  if (ki == 0) {
+    if (unlisted) return;
+    append(i, j, z);
+    append(j, i, z);
+    ++count_[z.table][z.zone];
+    return;
+  }
+  const Zone was = slab_of(i)[ki].zone;
+  --count_[was.table][was.zone];
+  const std::uint32_t kj = slot(j, i);
+  if (unlisted) {
+    remove(i, ki);
+    remove(j, kj);
   } else {
-    insert_or_update(i, j, z);
-    insert_or_update(j, i, z);
+    slab_of(i)[ki].zone = z;
+    slab_of(j)[kj].zone = z;
     ++count_[z.table][z.zone];
   }
 }
@@ -82,13 +112,15 @@ double PairSteps::energy() const {
 }
 
 void PairSteps::renumber(const std::vector<std::uint32_t>& new_index) {
-  std::vector<std::vector<Entry>> moved(list_.size());
-  for (std::uint32_t old = 0; old < list_.size(); ++old) {
-    auto& l = moved[new_index[old]];
-    l = std::move(list_[old]);
-    for (Entry& e : l) e.partner = new_index[e.partner];
+  HugeVector<Entry> moved(slabs_.size(), Entry{0, {}});
+  for (std::uint32_t old = 0; old < n_; ++old) {
+    const Entry* from = slab_of(old);
+    Entry* to = moved.data() + std::size_t{new_index[old]} * stride_;
+    const std::uint32_t n = from[0].partner;
+    to[0].partner = n;
+    for (std::uint32_t k = 1; k <= n; ++k) to[k] = {new_index[from[k].partner], from[k].zone};
   }
-  list_.swap(moved);
+  slabs_.swap(moved);
   std::fill(seen_.begin(), seen_.end(), 0);
   epoch_ = 0;
 }
@@ -96,15 +128,16 @@ void PairSteps::renumber(const std::vector<std::uint32_t>& new_index) {
 // In the caller's order (by i, then j) without a global sort: particles visited in caller
 // order, each one's short list sorted.
 std::vector<PairZone> PairSteps::export_zones(const std::uint32_t* id) const {
-  const auto n = static_cast<std::uint32_t>(list_.size());
+  const auto n = static_cast<std::uint32_t>(n_);
   std::vector<std::uint32_t> internal(n);
   for (std::uint32_t k = 0; k < n; ++k) internal[id[k]] = k;
   std::vector<PairZone> out;
   std::vector<PairZone> mine;
   for (std::uint32_t c = 0; c < n; ++c) {
     mine.clear();
-    for (const Entry& e : list_[internal[c]])
-      if (id[e.partner] > c) mine.push_back({c, id[e.partner], e.zone.zone});
+    const Entry* slab = slab_of(internal[c]);
+    for (std::uint32_t k = 1; k <= slab[0].partner; ++k)
+      if (id[slab[k].partner] > c) mine.push_back({c, id[slab[k].partner], slab[k].zone.zone});
     std::sort(mine.begin(), mine.end(),
               [](const PairZone& x, const PairZone& y) { return x.j < y.j; });
     out.insert(out.end(), mine.begin(), mine.end());

@@ -12,12 +12,18 @@
 // under both particles; a non-bonded pair is listed only while inside its cut-off, a bonded
 // pair always. Before a prediction of particle i, load(i) stamps i's entries into an array
 // indexed by partner, so a candidate's zone is one read (lookup()).
+//
+// The lists live in one array of fixed-stride slabs, particle i's at i * stride (a count, then
+// the entries): its address follows from i alone, so a list costs one cache miss, not two
+// dependent ones (a vector header, then its heap block). The stride grows (every slab moved)
+// when some list outgrows it: 8 entries (one cache line) hold a square-well fluid's lists.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
+#include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
 #include "dynamics/collision_time.hpp"
 #include "interactions/step_potential.hpp"
@@ -80,6 +86,7 @@ class PairSteps {
             std::uint32_t species, std::size_t n);
 
   const ZoneTable& table(std::uint16_t t) const { return tables_[t]; }
+  std::size_t tables() const { return tables_.size(); }
   std::uint16_t pair_table(std::uint32_t a, std::uint32_t b) const {
     return pair_table_.empty() ? kHard : pair_table_[a * species_ + b];
   }
@@ -94,8 +101,10 @@ class PairSteps {
       epoch_ = 1;
     }
     const std::uint64_t e = std::uint64_t{epoch_} << 32;
-    for (const Entry& en : list_[i])
-      seen_[en.partner] = e | (std::uint64_t{en.zone.table} << 16) | en.zone.zone;
+    const Entry* slab = slab_of(i);
+    const std::uint32_t n = slab[0].partner;
+    for (std::uint32_t k = 1; k <= n; ++k)
+      seen_[slab[k].partner] = e | (std::uint64_t{slab[k].zone.table} << 16) | slab[k].zone.zone;
   }
   // The zone of (loaded particle, j); `fallback` (the species pair's table) in zone 0 if the
   // pair is not listed.
@@ -104,12 +113,21 @@ class PairSteps {
     if ((s >> 32) != epoch_) return {fallback, 0};
     return {static_cast<std::uint16_t>(s >> 16), static_cast<std::uint16_t>(s)};
   }
+  // What lookup() reads, for the vector candidate loop: the stamps (per particle, epoch << 32 |
+  // table << 16 | zone; a stamp whose epoch is not epoch() belongs to an unlisted pair), and
+  // every table's squared boundaries back to back, table t's from flat_r2()[table_offset()[t]].
+  const std::uint64_t* stamps() const { return seen_.data(); }
+  std::uint32_t epoch() const { return epoch_; }
+  const double* flat_r2() const { return flat_r2_.data(); }
+  const std::uint32_t* table_offset() const { return table_offset_.data(); }
   // The same without load(), by a scan of i's list.
   Zone find(std::uint32_t i, std::uint32_t j, std::uint16_t fallback) const;
   // Moves pair (i, j) into zone z: listed, or unlisted if z is zone 0 of a non-bonded table.
   void set(std::uint32_t i, std::uint32_t j, Zone z);
 
-  const std::vector<Entry>& entries(std::uint32_t i) const { return list_[i]; }
+  // Particle i's entries: [entries_begin(i), entries_begin(i) + entry_count(i)).
+  const Entry* entries_begin(std::uint32_t i) const { return slab_of(i) + 1; }
+  std::uint32_t entry_count(std::uint32_t i) const { return slab_of(i)[0].partner; }
   // Potential energy: the sum over listed pairs of their zone's energy (from the counts per
   // zone: exact, and the same bits whatever the order of the lists).
   double energy() const;
@@ -119,18 +137,28 @@ class PairSteps {
   std::vector<PairZone> export_zones(const std::uint32_t* id) const;
 
  private:
-  void insert_or_update(std::uint32_t i, std::uint32_t j, Zone z);
-  void erase(std::uint32_t i, std::uint32_t j);
+  // Position of j in i's slab (1..count), 0 if absent.
+  std::uint32_t slot(std::uint32_t i, std::uint32_t j) const;
+  void append(std::uint32_t i, std::uint32_t j, Zone z);  // j not in i's list
+  void remove(std::uint32_t i, std::uint32_t k);          // the entry at slot k of i's list
+  // Slab of particle i: slot 0 holds the entry count (in `partner`), slots 1.. the entries.
+  Entry* slab_of(std::uint32_t i) { return slabs_.data() + std::size_t{i} * stride_; }
+  const Entry* slab_of(std::uint32_t i) const { return slabs_.data() + std::size_t{i} * stride_; }
+  void grow_slabs();
 
   std::vector<ZoneTable> tables_;
   std::vector<std::uint16_t> pair_table_;
   std::uint32_t species_ = 0;
-  std::vector<std::vector<Entry>> list_;
+  std::size_t n_ = 0;        // particles
+  std::size_t stride_ = 8;   // slots per slab (count + entries)
+  HugeVector<Entry> slabs_;  // n_ * stride_
   // Listed pairs per (table, zone), kept as pairs move: energy() without a pass over the lists,
   // and independent of their order.
   std::vector<std::vector<std::uint64_t>> count_;
   std::vector<std::uint64_t> seen_;  // per particle: epoch << 32 | table << 16 | zone
   std::uint32_t epoch_ = 0;
+  std::vector<double> flat_r2_;
+  std::vector<std::uint32_t> table_offset_;
 };
 
 }  // namespace kairos
