@@ -1,0 +1,401 @@
+#include "dem/dem_integrator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "core/periodic.hpp"
+
+namespace kairos {
+
+double dem_default_time_step(const SoftContactLaw& law, double reduced_mass, double reference_speed,
+                             double steps_per_contact) {
+  if (!(steps_per_contact > 0.0) || !std::isfinite(steps_per_contact))
+    throw InputError(fmt::format("DEM: steps_per_contact must be positive and finite, got {}",
+                                 steps_per_contact));
+  const double t_c = law.model == SoftModel::LinearDashpot
+                         ? dashpot_head_on(reduced_mass, law.stiffness, law.damping).contact_time
+                         : hertz_elastic_contact_time(reduced_mass, law.stiffness, reference_speed);
+  return t_c / steps_per_contact;
+}
+
+namespace {
+
+inline double wrap_once(double x, double L) {
+  if (x >= L) return x - L;
+  if (x < 0.0) return x + L;
+  return x;
+}
+
+inline double min_image_once(double d, double half_L, double L) {
+  if (d > half_L) return d - L;
+  if (d < -half_L) return d + L;
+  return d;
+}
+
+}  // namespace
+
+template <int D>
+DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system, const SoftContactLaw& law,
+                                const DemOptions& options)
+    : base_(system), law_(law), box_(system.box), time_(system.time) {
+  // The law (SoftContactLaw's factories validate; a hand-built one is checked here).
+  if (law.model == SoftModel::LinearDashpot)
+    law_ = SoftContactLaw::linear_dashpot(law.stiffness, law.damping);
+  else
+    law_ = SoftContactLaw::viscoelastic_hertz(law.stiffness, law.damping);
+
+  const std::size_t n = system.size();
+  if (n == 0) throw InputError("DEM: the system has no particles");
+  if (system.mass.size() != n)
+    throw InputError(fmt::format("DEM: {} masses for {} particles", system.mass.size(), n));
+  if (!std::isfinite(system.time)) throw InputError("DEM: the system time is not finite");
+  for (int k = 0; k < D; ++k) {
+    if (!(box_[k] > 0.0) || !std::isfinite(box_[k]))
+      throw InputError(
+          fmt::format("DEM: box length {} along axis {} must be positive", box_[k], k));
+    if (!system.periodic[k])
+      throw InputError(fmt::format("DEM: axis {} is not periodic (only periodic boxes)", k));
+    if (system.gravity[k] != 0.0) throw InputError("DEM: gravity is not supported");
+  }
+  if (!system.bonds.empty()) throw InputError("DEM: bonds are not supported");
+  for (std::size_t i = 0; i < n; ++i)
+    if (system.is_asleep(i)) throw InputError("DEM: sleeping particles are not supported");
+  if (!(options.skin > 0.0) || !std::isfinite(options.skin))
+    throw InputError(fmt::format("DEM: skin must be positive, got {}", options.skin));
+  if (!(options.dt >= 0.0) || !std::isfinite(options.dt) || std::signbit(options.dt))
+    throw InputError(
+        fmt::format("DEM: time step dt must be positive (0 = default), got {}", options.dt));
+
+  for (int k = 0; k < D; ++k) {
+    x_[k].resize(n);
+    v_[k].resize(n);
+    f_[k].assign(n, 0.0);
+    vp_[k].resize(n);
+  }
+  mass_.resize(n);
+  inv_mass_.resize(n);
+  radius_.resize(n);
+  double m_min = std::numeric_limits<double>::infinity(), v_max = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double m = system.mass[i], R = system.kinematics[i].radius;
+    if (!(m > 0.0) || !std::isfinite(m))
+      throw InputError(fmt::format("DEM: mass of particle {} must be positive, got {}", i, m));
+    if (!(R > 0.0) || !std::isfinite(R))
+      throw InputError(fmt::format("DEM: radius of particle {} must be positive, got {}", i, R));
+    mass_[i] = m;
+    inv_mass_[i] = 1.0 / m;
+    radius_[i] = R;
+    m_min = std::min(m_min, m);
+    max_diameter_ = std::max(max_diameter_, 2.0 * R);
+    if (!std::isfinite(system.kinematics[i].time))
+      throw InputError(fmt::format("DEM: local time of particle {} is not finite", i));
+    for (int k = 0; k < D; ++k) {
+      if (!std::isfinite(system.kinematics[i].vel[k]))
+        throw InputError(fmt::format("DEM: velocity of particle {} is not finite", i));
+      if (!std::isfinite(system.kinematics[i].pos[k]))
+        throw InputError(fmt::format("DEM: position of particle {} is not finite", i));
+    }
+    const Vec<D> p = system.position_at(i, system.time);
+    const Vec<D> v = system.velocity_at(i, system.time);
+    double v2 = 0.0;
+    for (int k = 0; k < D; ++k) {
+      if (!std::isfinite(p[k]))
+        throw InputError(fmt::format("DEM: position of particle {} is not finite", i));
+      if (!std::isfinite(v[k]))
+        throw InputError(fmt::format("DEM: velocity of particle {} is not finite", i));
+      x_[k][i] = wrap_into_box(p[k], box_[k]);
+      v_[k][i] = v[k];
+      vp_[k][i] = v[k];
+      v2 += v[k] * v[k];
+    }
+    v_max = std::max(v_max, std::sqrt(v2));
+  }
+  skin_ = options.skin * max_diameter_;
+  for (int k = 0; k < D; ++k)
+    if (!(box_[k] > 2.0 * (max_diameter_ + skin_)))
+      throw InputError(
+          fmt::format("DEM: box length {} along axis {} must exceed 2 (d_max + skin) = {}", box_[k],
+                      k, 2.0 * (max_diameter_ + skin_)));
+
+  if (options.dt > 0.0) {
+    dt_ = options.dt;
+  } else {
+    double v_ref = options.reference_speed;
+    if (!(v_ref >= 0.0) || !std::isfinite(v_ref))
+      throw InputError(fmt::format("DEM: reference_speed must be >= 0, got {}", v_ref));
+    if (v_ref == 0.0) v_ref = v_max > 0.0 ? 2.0 * v_max : 1.0;
+    dt_ = dem_default_time_step(law_, 0.5 * m_min, v_ref, options.steps_per_contact);
+  }
+
+  build_neighbours();
+  compute_forces();  // also rejects absurd initial overlaps
+}
+
+template <int D>
+void DemIntegrator<D>::build_neighbours() {
+  const std::size_t n = size();
+  const double cutoff = max_diameter_ + skin_;
+  const double cutoff2 = cutoff * cutoff;
+  std::array<int, D> nc;
+  std::size_t ncells = 1;
+  for (int k = 0; k < D; ++k) {
+    nc[k] = std::max(1, static_cast<int>(std::floor(box_[k] / cutoff)));
+    ncells *= static_cast<std::size_t>(nc[k]);
+  }
+  std::vector<std::uint32_t> cell_of(n), cell_start(ncells + 1, 0), cell_list(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t c = 0;
+    for (int k = D - 1; k >= 0; --k) {
+      int ck = static_cast<int>(x_[k][i] / box_[k] * nc[k]);
+      ck = std::clamp(ck, 0, nc[k] - 1);
+      c = c * static_cast<std::size_t>(nc[k]) + static_cast<std::size_t>(ck);
+    }
+    cell_of[i] = static_cast<std::uint32_t>(c);
+    ++cell_start[c + 1];
+  }
+  for (std::size_t c = 0; c < ncells; ++c) cell_start[c + 1] += cell_start[c];
+  {
+    std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      cell_list[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+  }
+
+  Vec<D> half;
+  for (int k = 0; k < D; ++k) half[k] = 0.5 * box_[k];
+  // Per axis, the distinct neighbouring cell coordinates of coordinate c (3 of them, fewer when
+  // the axis has fewer than 3 cells), as offsets into the flat index.
+  bool all_three = true;
+  for (int k = 0; k < D; ++k) all_three = all_three && nc[k] >= 3;
+  start_.assign(n + 1, 0);
+  nbr_.clear();
+  std::vector<std::uint32_t> around;
+  around.reserve(27);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::array<int, D> ci;
+    std::size_t c = cell_of[i];
+    for (int k = 0; k < D; ++k) {
+      ci[k] = static_cast<int>(c % static_cast<std::size_t>(nc[k]));
+      c /= static_cast<std::size_t>(nc[k]);
+    }
+    std::array<std::array<std::size_t, 3>, D> axis;  // neighbour coordinate times its stride
+    std::size_t stride = 1;
+    for (int k = 0; k < D; ++k) {
+      for (int off = -1; off <= 1; ++off) {
+        int ck = ci[k] + off;
+        if (ck < 0) ck += nc[k];
+        if (ck >= nc[k]) ck -= nc[k];
+        axis[k][static_cast<std::size_t>(off + 1)] = static_cast<std::size_t>(ck) * stride;
+      }
+      stride *= static_cast<std::size_t>(nc[k]);
+    }
+    around.clear();
+    if constexpr (D == 3) {
+      for (const std::size_t a : axis[2])
+        for (const std::size_t b2 : axis[1])
+          for (const std::size_t c0 : axis[0])
+            around.push_back(static_cast<std::uint32_t>(a + b2 + c0));
+    } else {
+      for (const std::size_t b2 : axis[1])
+        for (const std::size_t c0 : axis[0]) around.push_back(static_cast<std::uint32_t>(b2 + c0));
+    }
+    if (!all_three) {  // some cells appear twice: keep one of each
+      std::sort(around.begin(), around.end());
+      around.erase(std::unique(around.begin(), around.end()), around.end());
+    }
+    Vec<D> xi;
+    for (int k = 0; k < D; ++k) xi[k] = x_[k][i];
+    for (const std::uint32_t cc : around) {
+      for (std::uint32_t q = cell_start[cc]; q < cell_start[cc + 1]; ++q) {
+        const std::uint32_t j = cell_list[q];
+        if (j <= i) continue;
+        double r2 = 0.0;
+        for (int k = 0; k < D; ++k) {
+          const double d = min_image_once(xi[k] - x_[k][j], half[k], box_[k]);
+          r2 += d * d;
+        }
+        if (r2 < cutoff2) nbr_.push_back(j);
+      }
+    }
+    start_[i + 1] = static_cast<std::uint32_t>(nbr_.size());
+  }
+  moved_since_build_ = 0.0;
+  ++builds_;
+}
+
+template <int D>
+template <SoftModel M>
+void DemIntegrator<D>::compute_forces_for() {
+  const std::size_t n = size();
+  for (int k = 0; k < D; ++k) std::fill(f_[k].begin(), f_[k].end(), 0.0);
+  Vec<D> half;
+  for (int k = 0; k < D; ++k) half[k] = 0.5 * box_[k];
+  const double stiffness = law_.stiffness;
+  double potential = 0.0, power = 0.0;
+  std::size_t contacts = 0;
+  const SoftContactLaw law = law_;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t b = start_[i], e = start_[i + 1];
+    if (b == e) continue;
+    Vec<D> xi, vi, fi{};
+    for (int k = 0; k < D; ++k) {
+      xi[k] = x_[k][i];
+      vi[k] = vp_[k][i];
+    }
+    const double Ri = radius_[i];
+    for (std::uint32_t q = b; q < e; ++q) {
+      const std::uint32_t j = nbr_[q];
+      Vec<D> d;
+      double r2 = 0.0;
+      for (int k = 0; k < D; ++k) {
+        d[k] = min_image_once(xi[k] - x_[k][j], half[k], box_[k]);
+        r2 += d[k] * d[k];
+      }
+      const double l = Ri + radius_[j];
+      if (r2 >= l * l) continue;
+      // Overlapping pair.
+      const double r = std::sqrt(r2);
+      const double overlap = l - r;
+      if (overlap > max_overlap_fraction_ * std::min(Ri, radius_[j]))
+        throw InputError(fmt::format(
+            "DEM: particles {} and {} overlap by {} (more than {} of the smaller radius) at t = "
+            "{}: time step dt = {} too large or the initial state overlapping",
+            i, j, overlap, max_overlap_fraction_, time_, dt_));
+      const double inv_r = 1.0 / r;
+      double rdot = 0.0;
+      for (int k = 0; k < D; ++k) rdot += d[k] * (vi[k] - vp_[k][j]);
+      rdot *= inv_r;
+      double elastic, energy;
+      if constexpr (M == SoftModel::LinearDashpot) {
+        elastic = stiffness * overlap;
+        energy = 0.5 * elastic * overlap;
+      } else {
+        elastic = stiffness * overlap * std::sqrt(overlap);
+        energy = 0.4 * elastic * overlap;
+      }
+      potential += energy;
+      const double F = std::max(0.0, law.force(overlap, rdot));
+      power += (elastic - F) * rdot;
+      if (F > 0.0) {
+        ++contacts;
+        const double s = F * inv_r;
+        for (int k = 0; k < D; ++k) {
+          fi[k] += s * d[k];
+          f_[k][j] -= s * d[k];
+        }
+      }
+    }
+    for (int k = 0; k < D; ++k) f_[k][i] += fi[k];
+  }
+  potential_ = potential;
+  power_ = power;
+  contacts_ = contacts;
+}
+
+template <int D>
+void DemIntegrator<D>::compute_forces() {
+  if (law_.model == SoftModel::LinearDashpot)
+    compute_forces_for<SoftModel::LinearDashpot>();
+  else
+    compute_forces_for<SoftModel::ViscoelasticHertz>();
+}
+
+template <int D>
+void DemIntegrator<D>::step(long n) {
+  if (n < 0) throw InputError(fmt::format("DEM: step count must be >= 0, got {}", n));
+  const std::size_t np = size();
+  const double h = 0.5 * dt_;
+  for (long s = 0; s < n; ++s) {
+    // Half kick, drift, predicted velocity at the new positions.
+    double vmax2 = 0.0, vsum2 = 0.0;
+    for (std::size_t i = 0; i < np; ++i) {
+      const double hm = h * inv_mass_[i];
+      double v2 = 0.0;
+      for (int k = 0; k < D; ++k) {
+        const double a = hm * f_[k][i];
+        const double v = v_[k][i] + a;
+        v_[k][i] = v;
+        x_[k][i] = wrap_once(x_[k][i] + dt_ * v, box_[k]);
+        vp_[k][i] = v + a;
+        v2 += v * v;
+      }
+      vmax2 = std::max(vmax2, v2);
+      vsum2 += v2;
+    }
+    if (!std::isfinite(vsum2))
+      throw InputError(
+          fmt::format("DEM: a velocity turned non-finite at t = {} (dt = {})", time_, dt_));
+    moved_since_build_ += dt_ * std::sqrt(vmax2);
+    if (2.0 * moved_since_build_ >= skin_) build_neighbours();
+    const double power_before = power_;
+    compute_forces();
+    dissipated_ += h * (power_before + power_);
+    for (std::size_t i = 0; i < np; ++i) {
+      const double hm = h * inv_mass_[i];
+      for (int k = 0; k < D; ++k) v_[k][i] += hm * f_[k][i];
+    }
+    ++steps_;
+    time_ = base_.time + static_cast<double>(steps_) * dt_;
+  }
+}
+
+template <int D>
+double DemIntegrator<D>::kinetic_energy() const {
+  double e = 0.0;
+  for (std::size_t i = 0; i < size(); ++i) {
+    double v2 = 0.0;
+    for (int k = 0; k < D; ++k) v2 += v_[k][i] * v_[k][i];
+    e += 0.5 * mass_[i] * v2;
+  }
+  return e;
+}
+
+template <int D>
+Vec<D> DemIntegrator<D>::momentum() const {
+  Vec<D> p{};
+  for (std::size_t i = 0; i < size(); ++i)
+    for (int k = 0; k < D; ++k) p[k] += mass_[i] * v_[k][i];
+  return p;
+}
+
+template <int D>
+Vec<D> DemIntegrator<D>::position(std::size_t i) const {
+  Vec<D> p;
+  for (int k = 0; k < D; ++k) p[k] = x_[k][i];
+  return p;
+}
+
+template <int D>
+Vec<D> DemIntegrator<D>::velocity(std::size_t i) const {
+  Vec<D> v;
+  for (int k = 0; k < D; ++k) v[k] = v_[k][i];
+  return v;
+}
+
+template <int D>
+ParticleSystem<D> DemIntegrator<D>::export_state() const {
+  ParticleSystem<D> s = base_;
+  s.time = time_;
+  for (std::size_t i = 0; i < size(); ++i) {
+    auto& kin = s.kinematics[i];
+    for (int k = 0; k < D; ++k) {
+      kin.pos[k] = wrap_into_box(x_[k][i], box_[k]);
+      kin.vel[k] = v_[k][i];
+    }
+    kin.time = time_;
+  }
+  s.events.clear();
+  s.cell.clear();
+  s.order.clear();
+  s.zones.reset();
+  s.counters.dissipated_in_collisions = dissipated_;
+  return s;
+}
+
+template class DemIntegrator<2>;
+template class DemIntegrator<3>;
+
+}  // namespace kairos
