@@ -131,6 +131,9 @@ DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system, const SoftConta
     dt_ = dem_default_time_step(law_, 0.5 * m_min, v_ref, options.steps_per_contact);
   }
 
+  id_.resize(n);
+  slot_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) id_[i] = slot_[i] = static_cast<std::uint32_t>(i);
   build_neighbours();
   compute_forces();  // also rejects absurd initial overlaps
 }
@@ -162,6 +165,33 @@ void DemIntegrator<D>::build_neighbours() {
     std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
     for (std::size_t i = 0; i < n; ++i)
       cell_list[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+  }
+  // Renumber the particles in cell order (spatial locality of the pair loops); cell_list then
+  // becomes the identity.
+  {
+    std::vector<double> tmp(n);
+    auto permute = [&](std::vector<double>& a) {
+      for (std::size_t q = 0; q < n; ++q) tmp[q] = a[cell_list[q]];
+      a.swap(tmp);
+    };
+    for (int k = 0; k < D; ++k) {
+      permute(x_[k]);
+      permute(v_[k]);
+      permute(vp_[k]);
+      permute(f_[k]);
+    }
+    permute(mass_);
+    permute(inv_mass_);
+    permute(radius_);
+    std::vector<std::uint32_t> tmp_u(n);
+    for (std::size_t q = 0; q < n; ++q) tmp_u[q] = id_[cell_list[q]];
+    id_.swap(tmp_u);
+    for (std::size_t q = 0; q < n; ++q) {
+      slot_[id_[q]] = static_cast<std::uint32_t>(q);
+      tmp_u[q] = cell_of[cell_list[q]];
+    }
+    cell_of.swap(tmp_u);
+    for (std::size_t q = 0; q < n; ++q) cell_list[q] = static_cast<std::uint32_t>(q);
   }
 
   Vec<D> half;
@@ -202,16 +232,10 @@ void DemIntegrator<D>::build_neighbours() {
       for (const std::size_t b2 : axis[1])
         for (const std::size_t c0 : axis[0]) around.push_back(static_cast<std::uint32_t>(b2 + c0));
     }
-    if (!all_three) {  // some cells appear twice: keep one of each
-      std::sort(around.begin(), around.end());
-      around.erase(std::unique(around.begin(), around.end()), around.end());
-    }
     Vec<D> xi;
     for (int k = 0; k < D; ++k) xi[k] = x_[k][i];
-    for (const std::uint32_t cc : around) {
-      for (std::uint32_t q = cell_start[cc]; q < cell_start[cc + 1]; ++q) {
-        const std::uint32_t j = cell_list[q];
-        if (j <= i) continue;
+    auto scan = [&](std::uint32_t from, std::uint32_t to) {
+      for (std::uint32_t j = from; j < to; ++j) {  // cell_list is the identity after the sort
         double r2 = 0.0;
         for (int k = 0; k < D; ++k) {
           const double d = min_image_once(xi[k] - x_[k][j], half[k], box_[k]);
@@ -219,6 +243,21 @@ void DemIntegrator<D>::build_neighbours() {
         }
         if (r2 < cutoff2) nbr_.push_back(j);
       }
+    };
+    const auto self = static_cast<std::uint32_t>(i);
+    if (all_three) {
+      // Half stencil: i's own cell (partners after i) and the (3^D - 1)/2 cells after it in
+      // the (z, y, x) lexicographic order of the offsets; all distinct with >= 3 cells per axis,
+      // so every pair is found once.
+      const std::size_t centre = around.size() / 2;
+      scan(self + 1, cell_start[around[centre] + 1]);
+      for (std::size_t m = centre + 1; m < around.size(); ++m)
+        scan(cell_start[around[m]], cell_start[around[m] + 1]);
+    } else {  // some cells appear twice: keep one of each, pairs j > i
+      std::sort(around.begin(), around.end());
+      around.erase(std::unique(around.begin(), around.end()), around.end());
+      for (const std::uint32_t cc : around)
+        scan(std::max(cell_start[cc], self + 1), std::max(cell_start[cc + 1], self + 1));
     }
     start_[i + 1] = static_cast<std::uint32_t>(nbr_.size());
   }
@@ -230,7 +269,7 @@ template <int D>
 template <SoftModel M>
 void DemIntegrator<D>::compute_forces_for() {
   const std::size_t n = size();
-  for (int k = 0; k < D; ++k) std::fill(f_[k].begin(), f_[k].end(), 0.0);
+  // f_ is zero here (cleared by the constructor or by step's kick pass).
   Vec<D> half;
   for (int k = 0; k < D; ++k) half[k] = 0.5 * box_[k];
   const double stiffness = law_.stiffness;
@@ -263,7 +302,7 @@ void DemIntegrator<D>::compute_forces_for() {
         throw InputError(fmt::format(
             "DEM: particles {} and {} overlap by {} (more than {} of the smaller radius) at t = "
             "{}: time step dt = {} too large or the initial state overlapping",
-            i, j, overlap, max_overlap_fraction_, time_, dt_));
+            id_[i], id_[j], overlap, max_overlap_fraction_, time_, dt_));
       const double inv_r = 1.0 / r;
       double rdot = 0.0;
       for (int k = 0; k < D; ++k) rdot += d[k] * (vi[k] - vp_[k][j]);
@@ -308,18 +347,23 @@ void DemIntegrator<D>::step(long n) {
   if (n < 0) throw InputError(fmt::format("DEM: step count must be >= 0, got {}", n));
   const std::size_t np = size();
   const double h = 0.5 * dt_;
+  if (n == 0) return;
+  // Velocity Verlet with the closing half kick of one step and the opening half kick of the
+  // next fused into one kick by dt (one pass over the arrays less); v_ holds v(t) only between
+  // calls. The same pass clears the forces for the next evaluation.
   for (long s = 0; s < n; ++s) {
-    // Half kick, drift, predicted velocity at the new positions.
+    const double kick = s == 0 ? h : dt_;
     double vmax2 = 0.0, vsum2 = 0.0;
     for (std::size_t i = 0; i < np; ++i) {
-      const double hm = h * inv_mass_[i];
+      const double w = inv_mass_[i];
       double v2 = 0.0;
       for (int k = 0; k < D; ++k) {
-        const double a = hm * f_[k][i];
-        const double v = v_[k][i] + a;
+        const double f = f_[k][i];
+        f_[k][i] = 0.0;
+        const double v = v_[k][i] + kick * w * f;
         v_[k][i] = v;
         x_[k][i] = wrap_once(x_[k][i] + dt_ * v, box_[k]);
-        vp_[k][i] = v + a;
+        vp_[k][i] = v + h * w * f;  // predicted v(t + dt) for the damping force
         v2 += v * v;
       }
       vmax2 = std::max(vmax2, v2);
@@ -333,12 +377,12 @@ void DemIntegrator<D>::step(long n) {
     const double power_before = power_;
     compute_forces();
     dissipated_ += h * (power_before + power_);
-    for (std::size_t i = 0; i < np; ++i) {
-      const double hm = h * inv_mass_[i];
-      for (int k = 0; k < D; ++k) v_[k][i] += hm * f_[k][i];
-    }
     ++steps_;
     time_ = base_.time + static_cast<double>(steps_) * dt_;
+  }
+  for (std::size_t i = 0; i < np; ++i) {  // the closing half kick of the last step
+    const double hw = h * inv_mass_[i];
+    for (int k = 0; k < D; ++k) v_[k][i] += hw * f_[k][i];
   }
 }
 
@@ -362,14 +406,16 @@ Vec<D> DemIntegrator<D>::momentum() const {
 }
 
 template <int D>
-Vec<D> DemIntegrator<D>::position(std::size_t i) const {
+Vec<D> DemIntegrator<D>::position(std::size_t particle) const {
+  const std::size_t i = slot_.at(particle);
   Vec<D> p;
   for (int k = 0; k < D; ++k) p[k] = x_[k][i];
   return p;
 }
 
 template <int D>
-Vec<D> DemIntegrator<D>::velocity(std::size_t i) const {
+Vec<D> DemIntegrator<D>::velocity(std::size_t particle) const {
+  const std::size_t i = slot_.at(particle);
   Vec<D> v;
   for (int k = 0; k < D; ++k) v[k] = v_[k][i];
   return v;
@@ -380,7 +426,7 @@ ParticleSystem<D> DemIntegrator<D>::export_state() const {
   ParticleSystem<D> s = base_;
   s.time = time_;
   for (std::size_t i = 0; i < size(); ++i) {
-    auto& kin = s.kinematics[i];
+    auto& kin = s.kinematics[id_[i]];
     for (int k = 0; k < D; ++k) {
       kin.pos[k] = wrap_into_box(x_[k][i], box_[k]);
       kin.vel[k] = v_[k][i];

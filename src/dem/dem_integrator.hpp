@@ -19,7 +19,8 @@
 //
 // Neighbours: a half neighbour list (pairs closer than d_max + skin), built from a linked-cell
 // grid (cells >= d_max + skin) and rebuilt when the particles may have moved skin/2.
-// Hot data are structure-of-arrays (x, y, z, vx, ... separately).
+// Hot data are structure-of-arrays (x, y, z, vx, ... separately), renumbered into cell order at
+// every build.
 #pragma once
 
 #include <cstdint>
@@ -81,6 +82,7 @@ class DemIntegrator {
   Vec<D> momentum() const;
   long neighbour_list_builds() const { return builds_; }
 
+  // Of particle i in the caller's numbering (the integrator renumbers internally).
   Vec<D> position(std::size_t i) const;
   Vec<D> velocity(std::size_t i) const;
 
@@ -99,6 +101,9 @@ class DemIntegrator {
 
   std::vector<double> x_[D], v_[D], f_[D], vp_[D];  // positions, velocities, forces, predicted
   std::vector<double> mass_, inv_mass_, radius_;
+  // Internal numbering, cell order of the last neighbour-list build: id_[slot] = the caller's
+  // index, slot_[index] = its slot.
+  std::vector<std::uint32_t> id_, slot_;
   double max_diameter_ = 0.0, skin_ = 0.0, max_overlap_fraction_ = 0.5;
 
   // Half neighbour list, CSR: neighbours of i (all j > i in the list sense) in

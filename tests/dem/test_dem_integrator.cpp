@@ -337,6 +337,74 @@ TEST(Dem, InelasticGasCoolsAndTheDissipationCounterClosesTheBudget) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Neighbour search: the elastic energy (a sum over overlapping pairs) against all pairs by brute
+// force, for boxes of 2 (deduplicated stencil), 3 and many cells per axis, after renumbering.
+
+template <int D>
+double brute_force_energy(const ParticleSystem<D>& s, double k) {
+  double u = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (std::size_t j = i + 1; j < s.size(); ++j) {
+      double r2 = 0.0;
+      for (int a = 0; a < D; ++a) {
+        double d = s.kinematics[i].pos[a] - s.kinematics[j].pos[a];
+        d -= s.box[a] * std::round(d / s.box[a]);
+        r2 += d * d;
+      }
+      const double xi = s.kinematics[i].radius + s.kinematics[j].radius - std::sqrt(r2);
+      if (xi > 0.0) u += 0.5 * k * xi * xi;
+    }
+  return u;
+}
+
+template <int D>
+void check_neighbour_search(double L, int N) {
+  ParticleSystem<D> s = make_system<D>(L);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  while (static_cast<int>(s.size()) < N) {
+    Vec<D> r, v;
+    for (int a = 0; a < D; ++a) {
+      r[a] = L * u01(rng);
+      v[a] = u01(rng) - 0.5;
+    }
+    const double R = s.size() % 2 == 0 ? 0.5 : 0.35;
+    bool ok = true;
+    for (std::size_t j = 0; j < s.size() && ok; ++j) {
+      double r2 = 0.0;
+      for (int a = 0; a < D; ++a) {
+        double d = r[a] - s.kinematics[j].pos[a];
+        d -= L * std::round(d / L);
+        r2 += d * d;
+      }
+      ok = std::sqrt(r2) > R + s.kinematics[j].radius - 0.1;  // shallow overlaps allowed
+    }
+    if (ok) add<D>(s, r, v, 1.0, R);
+  }
+  const double k = 1e3;
+  DemIntegrator<D> dem(s, SoftContactLaw::linear_dashpot(k, 0.0));
+  const double u0 = brute_force_energy(s, k);
+  EXPECT_GT(u0, 0.0) << "no overlaps to find, L = " << L;
+  EXPECT_NEAR(dem.potential_energy(), u0, 1e-12 * u0) << "L = " << L;
+  dem.step(3000);
+  EXPECT_GE(dem.neighbour_list_builds(), 3);
+  const ParticleSystem<D> out = dem.export_state();
+  const double u1 = brute_force_energy(out, k);
+  EXPECT_NEAR(dem.potential_energy(), u1, 1e-9 * (u0 + u1) + 1e-300) << "L = " << L;
+  for (std::size_t i = 0; i < out.size(); ++i)
+    for (int a = 0; a < D; ++a) EXPECT_EQ(out.kinematics[i].pos[a], dem.position(i)[a]);
+}
+
+TEST(Dem, NeighbourSearchFindsEveryOverlappingPair) {
+  check_neighbour_search<3>(3.0, 20);   // 2 cells per axis
+  check_neighbour_search<3>(3.5, 30);   // 3
+  check_neighbour_search<3>(8.0, 300);  // 7
+  check_neighbour_search<2>(3.0, 9);
+  check_neighbour_search<2>(3.5, 12);
+  check_neighbour_search<2>(20.0, 250);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Default time step, export, validation.
 
 TEST(Dem, DefaultTimeStepIsAFiftiethOfTheContactTime) {
