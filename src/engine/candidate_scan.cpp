@@ -35,6 +35,46 @@ inline __m512d gather_field(const double* records, __m256i base, __mmask8 live, 
                                   _mm256_add_epi32(base, _mm256_set1_epi32(f)), records, 8);
 }
 
+// r.r, r.g and g.g of the eight candidates k..k+7 (lanes `live`, records at offsets `base`)
+// against particle i (position vxi, velocity vvi, broadcast): the part both AVX-512 loops share,
+// in the scalar loop's order of operations.
+template <int D, bool kAccelerated>
+[[gnu::always_inline]] inline void pair_terms(const CandidateScan<D>& s, std::uint32_t k,
+                                              __m256i base, __mmask8 live, __m512d vt,
+                                              const __m512d* vxi, const __m512d* vvi, __m512d& r2,
+                                              __m512d& rg, __m512d& g2) {
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512d dtj = _mm512_sub_pd(vt, gather_field(s.records, base, live, 2 * D));
+  r2 = zero;
+  rg = zero;
+  g2 = zero;
+  __m256i shift_base = _mm256_setzero_si256();
+  if (s.any_shift) {
+    const __m256i sidx = _mm256_maskz_loadu_epi32(live, s.shift_index + k);
+    shift_base = _mm256_mullo_epi32(sidx, _mm256_set1_epi32(D));
+  }
+  for (int a = 0; a < D; ++a) {
+    __m512d vel = gather_field(s.records, base, live, D + a);
+    __m512d xj = _mm512_add_pd(gather_field(s.records, base, live, a), _mm512_mul_pd(vel, dtj));
+    if constexpr (kAccelerated) {
+      xj = _mm512_add_pd(xj,
+                         _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(s.half_accel[a]), dtj), dtj));
+      vel = _mm512_add_pd(vel, _mm512_mul_pd(_mm512_set1_pd(s.accel[a]), dtj));
+    }
+    if (s.any_shift) {
+      const __m512d sh =
+          _mm512_mask_i32gather_pd(zero, live, _mm256_add_epi32(shift_base, _mm256_set1_epi32(a)),
+                                   reinterpret_cast<const double*>(s.shifts), 8);
+      xj = _mm512_add_pd(xj, sh);
+    }
+    const __m512d r = _mm512_sub_pd(vxi[a], xj);
+    const __m512d g = _mm512_sub_pd(vvi[a], vel);
+    r2 = _mm512_add_pd(r2, _mm512_mul_pd(r, r));
+    rg = _mm512_add_pd(rg, _mm512_mul_pd(r, g));
+    g2 = _mm512_add_pd(g2, _mm512_mul_pd(g, g));
+  }
+}
+
 }  // namespace
 
 // Eight candidates per iteration. Record fields come in by gathers (the records were prefetched
@@ -62,33 +102,8 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
     const __mmask8 live = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
     const __m256i ids = _mm256_maskz_loadu_epi32(live, s.candidates + k);
     const __m256i base = _mm256_mullo_epi32(ids, vstride);
-    const __m512d dtj = _mm512_sub_pd(vt, gather_field(s.records, base, live, 2 * D));
-    __m512d r2 = zero, rg = zero, g2 = zero;
-    __m256i shift_base = _mm256_setzero_si256();
-    if (s.any_shift) {
-      const __m256i sidx = _mm256_maskz_loadu_epi32(live, s.shift_index + k);
-      shift_base = _mm256_mullo_epi32(sidx, _mm256_set1_epi32(D));
-    }
-    for (int a = 0; a < D; ++a) {
-      __m512d vel = gather_field(s.records, base, live, D + a);
-      __m512d xj = _mm512_add_pd(gather_field(s.records, base, live, a), _mm512_mul_pd(vel, dtj));
-      if constexpr (kAccelerated) {
-        xj = _mm512_add_pd(xj,
-                           _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(s.half_accel[a]), dtj), dtj));
-        vel = _mm512_add_pd(vel, _mm512_mul_pd(_mm512_set1_pd(s.accel[a]), dtj));
-      }
-      if (s.any_shift) {
-        const __m512d sh =
-            _mm512_mask_i32gather_pd(zero, live, _mm256_add_epi32(shift_base, _mm256_set1_epi32(a)),
-                                     reinterpret_cast<const double*>(s.shifts), 8);
-        xj = _mm512_add_pd(xj, sh);
-      }
-      const __m512d r = _mm512_sub_pd(vxi[a], xj);
-      const __m512d g = _mm512_sub_pd(vvi[a], vel);
-      r2 = _mm512_add_pd(r2, _mm512_mul_pd(r, r));
-      rg = _mm512_add_pd(rg, _mm512_mul_pd(r, g));
-      g2 = _mm512_add_pd(g2, _mm512_mul_pd(g, g));
-    }
+    __m512d r2, rg, g2;
+    pair_terms<D, kAccelerated>(s, k, base, live, vt, vxi, vvi, r2, rg, g2);
     __m512d sigma2 = vsigma2;
     if (!s.uniform) {
       // Shape numbers are 16-bit: gather 32 bits at each and keep the low half (the array is
@@ -169,33 +184,8 @@ std::uint32_t scan_stepped_avx512(const SteppedScan<D>& s, double t, const Vec<D
     const __m256i ids = _mm256_maskz_loadu_epi32(live, c.candidates + k);
     live = _mm256_mask_cmpneq_epu32_mask(live, ids, vself);
     const __m256i base = _mm256_mullo_epi32(ids, vstride);
-    const __m512d dtj = _mm512_sub_pd(vt, gather_field(c.records, base, live, 2 * D));
-    __m512d r2 = zero, rg = zero, g2 = zero;
-    __m256i shift_base = _mm256_setzero_si256();
-    if (c.any_shift) {
-      const __m256i sidx = _mm256_maskz_loadu_epi32(live, c.shift_index + k);
-      shift_base = _mm256_mullo_epi32(sidx, _mm256_set1_epi32(D));
-    }
-    for (int a = 0; a < D; ++a) {
-      __m512d vel = gather_field(c.records, base, live, D + a);
-      __m512d xj = _mm512_add_pd(gather_field(c.records, base, live, a), _mm512_mul_pd(vel, dtj));
-      if constexpr (kAccelerated) {
-        xj = _mm512_add_pd(xj,
-                           _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(c.half_accel[a]), dtj), dtj));
-        vel = _mm512_add_pd(vel, _mm512_mul_pd(_mm512_set1_pd(c.accel[a]), dtj));
-      }
-      if (c.any_shift) {
-        const __m512d sh =
-            _mm512_mask_i32gather_pd(zero, live, _mm256_add_epi32(shift_base, _mm256_set1_epi32(a)),
-                                     reinterpret_cast<const double*>(c.shifts), 8);
-        xj = _mm512_add_pd(xj, sh);
-      }
-      const __m512d r = _mm512_sub_pd(vxi[a], xj);
-      const __m512d g = _mm512_sub_pd(vvi[a], vel);
-      r2 = _mm512_add_pd(r2, _mm512_mul_pd(r, r));
-      rg = _mm512_add_pd(rg, _mm512_mul_pd(r, g));
-      g2 = _mm512_add_pd(g2, _mm512_mul_pd(g, g));
-    }
+    __m512d r2, rg, g2;
+    pair_terms<D, kAccelerated>(c, k, base, live, vt, vxi, vvi, r2, rg, g2);
     // Zones from the capture map's stamps: listed lanes in zone >= 1 are held back.
     const __m512i stamp =
         _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), live, ids, s.stamps, 8);
