@@ -12,28 +12,12 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "input_error_matchers.hpp"
 
 namespace kairos {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-#define EXPECT_INPUT_ERROR(statement, substring)                                                  \
-  do {                                                                                            \
-    const std::string message_ = error_of([&] { (void)(statement); });                            \
-    EXPECT_NE(message_.find(substring), std::string::npos)                                        \
-        << "expected an InputError containing '" << (substring) << "', got '" << message_ << "'"; \
-  } while (false)
 
 PotentialSpec spec_of(const std::string& kind) {
   PotentialSpec s;

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "input_error_matchers.hpp"
 #include "interactions/step_potential.hpp"
 
 namespace kairos {
@@ -125,24 +126,6 @@ TEST(StepTable, BadTablesAreRejectedWithAReason) {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// The message of the InputError that `f` throws ("" if it throws none).
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-#define EXPECT_INPUT_ERROR(statement, substring)                                                  \
-  do {                                                                                            \
-    const std::string message_ = error_of([&] { (void)(statement); });                            \
-    EXPECT_NE(message_.find(substring), std::string::npos)                                        \
-        << "expected an InputError containing '" << (substring) << "', got '" << message_ << "'"; \
-  } while (false)
 
 // Unshifted Lennard-Jones, written out here independently of the library.
 double lj(double r) {
