@@ -2,7 +2,7 @@
 """Stepped Lennard-Jones against the continuous one at liquid density.
 
 Reference: our own force-based molecular dynamics of the same potential (Lennard-Jones cut at
-2.5 sigma and shifted to zero there), velocity Verlet with an Andersen thermostat, written here
+2.5 sigma and shifted to zero there), velocity Verlet (dt = 0.001) with an Andersen thermostat, written here
 in numpy (all pairs, minimum image), so that the comparison is between the same model at the
 same state point and the same N. Kairos then runs the stepped versions (equal-energy steps,
 volume-averaged shell energies, hard core at 0.8 sigma) for several numbers of attractive
@@ -26,7 +26,7 @@ import numpy as np
 RHO, T, N, RC = 0.8, 2.0, 500, 2.5
 
 
-def lj_md(steps, dt=0.002, rate=2.0, seed=1, equilibrate=2000):
+def lj_md(steps, dt=0.001, rate=2.0, seed=2, equilibrate=2000):
     """Continuous truncated-shifted LJ: returns (u, u_err, z, z_err) from block averages."""
     rng = np.random.default_rng(seed)
     n_side = math.ceil(N ** (1 / 3))
@@ -137,15 +137,15 @@ def main():
     # Runs of about 25 time units after as many of equilibration (the lattice melts and the
     # thermostat brings the heat back; pair events per particle per unit time grow with the
     # number of steps: ~80 per attractive step here).
-    md_steps = 1000 if args.quick else 4000
+    md_steps = 1000 if args.quick else 6000
     if args.md:
         u, du, z, dz = (float(x) for x in args.md.split(","))
     else:
-        u, du, z, dz = lj_md(md_steps, equilibrate=500 if args.quick else 1000)
+        u, du, z, dz = lj_md(md_steps, equilibrate=500 if args.quick else 2000)
     print(f"rho = {RHO}, T = {T}, N = {N}, LJ cut and shifted at {RC}")
     print("| model | u = U/N | Z = PV/NkT | T measured | events/s |")
     print("|---|---|---|---|---|")
-    print(f"| continuous LJ (MD, dt = 0.002) | {u:.4f} ± {du:.4f} | {z:.3f} ± {dz:.3f} | "
+    print(f"| continuous LJ (MD, dt = 0.001) | {u:.4f} ± {du:.4f} | {z:.3f} ± {dz:.3f} | "
           f"{T} (set) | |", flush=True)
     with tempfile.TemporaryDirectory() as work:
         for steps in (int(k) for k in args.steps.split(",")):
