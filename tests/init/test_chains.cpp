@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "init/initial_state.hpp"
+#include "initial_state_errors.hpp"
 
 namespace kairos {
 namespace {
@@ -29,13 +30,7 @@ SystemConfig chain_system(int dimension, std::uint64_t particles, double eta,
 
 template <int D>
 std::string error_of(const SystemConfig& system) {
-  std::mt19937_64 rng(1);
-  try {
-    (void)make_initial_state<D>(system, rng);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+  return test_util::initial_state_error<D>(system);
 }
 
 // Particles i and j sit on neighbouring sites a apart, without wrapping across the boundary:

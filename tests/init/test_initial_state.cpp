@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "initial_state_errors.hpp"
 
 namespace kairos {
 namespace {
@@ -31,16 +32,9 @@ std::vector<SpeciesConfig> binary_mixture() {
   return {SpeciesConfig{"S", 1.0, 1.0, 0.5}, SpeciesConfig{"L", 1.4, 2.0, 0.5}};
 }
 
-// The InputError message of make_initial_state, or "" when it does not throw.
 template <int D>
 std::string error_of(const SystemConfig& system) {
-  std::mt19937_64 rng(1);
-  try {
-    (void)make_initial_state<D>(system, rng);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+  return test_util::initial_state_error<D>(system);
 }
 
 template <int D>
