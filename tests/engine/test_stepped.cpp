@@ -39,6 +39,21 @@ StepTable staircase() {
   return t;
 }
 
+// Beads of a square-well (depth 0.5) solvent, consecutive ones in each lattice row of 6 tethered
+// between the core (1) and 1.3.
+void bond_rows_of_six(ParticleSystem<3>& s) {
+  for (std::uint32_t i = 0; i + 1 < s.size(); ++i)
+    if ((i + 1) % 6 != 0) s.bonds.push_back({i, i + 1, 0});
+  s.bond_types = {"backbone"};
+}
+
+Environment<3> tethered_in_square_well() {
+  Environment<3> env = with_table<3>(square_well(1.0, 1.5, 0.5));
+  env.tables.push_back({{1.3, 1.0}, {0.0}, std::numeric_limits<double>::infinity()});
+  env.bond_table = {1};
+  return env;
+}
+
 template <int D>
 double total_energy(const EventEngine<D, CalendarQueue>& e) {
   return e.kinetic_energy() + e.potential_energy();
@@ -190,12 +205,8 @@ TEST(Stepped, TetheredChainsKeepTheirBonds) {
   ParticleSystem<3> s = testing::lattice_system<3>(6, 0.3, 6);
   const double spacing = s.box[0] / 6.0;
   ASSERT_LT(spacing, 1.3);
-  for (std::uint32_t i = 0; i + 1 < s.size(); ++i)
-    if ((i + 1) % 6 != 0) s.bonds.push_back({i, i + 1, 0});
-  s.bond_types = {"backbone"};
-  Environment<3> env = with_table<3>(square_well(1.0, 1.5, 0.5));
-  env.tables.push_back({{1.3, 1.0}, {0.0}, std::numeric_limits<double>::infinity()});
-  env.bond_table = {1};
+  bond_rows_of_six(s);
+  const Environment<3> env = tethered_in_square_well();
   EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, {}, env);
   const double e0 = total_energy(engine);
   for (int k = 0; k < 20000; ++k) {
@@ -254,9 +265,7 @@ TEST(Stepped, StretchedBondIsAnInputError) {
   ParticleSystem<3> s = testing::lattice_system<3>(4, 0.05, 7);
   s.bonds = {{0, 2, 0}};  // two spacings apart
   s.bond_types = {"backbone"};
-  Environment<3> env = with_table<3>(square_well(1.0, 1.5, 0.5));
-  env.tables.push_back({{1.3, 1.0}, {0.0}, std::numeric_limits<double>::infinity()});
-  env.bond_table = {1};
+  const Environment<3> env = tethered_in_square_well();
   try {
     EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, {}, env);
     FAIL() << "expected an InputError";
@@ -350,13 +359,8 @@ TEST(Stepped, VectorAndScalarLoopsGiveBitIdenticalRuns) {
   }
   {
     ParticleSystem<3> s = testing::lattice_system<3>(6, 0.3, 35);
-    for (std::uint32_t i = 0; i + 1 < s.size(); ++i)
-      if ((i + 1) % 6 != 0) s.bonds.push_back({i, i + 1, 0});
-    s.bond_types = {"backbone"};
-    Environment<3> env = with_table<3>(square_well(1.0, 1.5, 0.5));
-    env.tables.push_back({{1.3, 1.0}, {0.0}, std::numeric_limits<double>::infinity()});
-    env.bond_table = {1};
-    expect_stepped_loops_agree<3>(s, env, 40000);
+    bond_rows_of_six(s);
+    expect_stepped_loops_agree<3>(s, tethered_in_square_well(), 40000);
   }
   expect_stepped_loops_agree<3>(testing::lattice_system<3>(3, 0.12, 36),
                                 with_table<3>(square_well(1.0, 1.5, 1.0)), 20000);
