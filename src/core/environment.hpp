@@ -18,12 +18,23 @@
 
 #include "core/periodic.hpp"
 #include "core/vec.hpp"
+#include <memory>
+
 #include "interactions/granular_contact.hpp"
+#include "interactions/soft_contact.hpp"
+#include "interactions/soft_map_table.hpp"
 #include "interactions/step_potential.hpp"
 
 namespace kairos {
 
 enum class FaceKind { kPeriodic, kWall, kOpen };
+
+// How a soft contact is carried out (formulas.md §1.6): kMapped, the Müller–Pöschel algorithm
+// (the pair is placed where the contact ends, frozen in its centre-of-mass frame, and released
+// with the post-contact velocities t_c later); kInstantaneous, a hard-sphere collision at first
+// contact with the same normal restitution e(v_n) = -eps_rdot (the model the mapping improves
+// on, kept for comparisons).
+enum class SoftCollisions { kMapped, kInstantaneous };
 
 template <int D>
 struct Wall {
@@ -76,7 +87,18 @@ struct Environment {
   std::vector<StepTable> tables;
   std::vector<int> pair_table;
   std::vector<int> bond_table;
+  // Soft spheres (formulas.md §1): the soft contact law of species pair (a, b) at
+  // soft[a * species + b] (symmetric), and of species s against every wall at soft_wall[s].
+  // Empty: contacts are hard (the `contact` laws). A soft law replaces the pair's ContactModel.
+  // soft_tables / soft_wall_tables (same indices, null or empty: none) hold the lookup tables
+  // of the map; collisions outside a table, or without one, integrate the map directly.
+  std::vector<SoftContactLaw> soft;
+  std::vector<SoftContactLaw> soft_wall;
+  std::vector<std::shared_ptr<const SoftMapTable>> soft_tables;
+  std::vector<std::shared_ptr<const SoftMapTable>> soft_wall_tables;
+  SoftCollisions soft_collisions = SoftCollisions::kMapped;
 
+  bool soft_spheres() const { return !soft.empty(); }
   bool stepped() const {
     for (const int t : pair_table)
       if (t >= 0) return true;

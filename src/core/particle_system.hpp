@@ -66,6 +66,16 @@ struct EventCounters {
   // core) and crossed it or bounced off it. Both also count in `collisions`.
   std::uint64_t step_crossings = 0;
   std::uint64_t step_bounces = 0;
+  // Soft spheres (formulas.md §1.6). soft_contacts: contacts carried out by the mapping (pair
+  // and wall contacts; they also count in `collisions` / `wall_collisions`). Exception A
+  // (soft_overlap_fallbacks): the placed pair would overlap a third body, so the contact was
+  // instantaneous with e = -eps_rdot. Exception B (soft_early_releases): a third body met a
+  // frozen pair before its release, which was then released at once. soft_direct_maps: maps
+  // integrated directly because the collision lay outside the lookup table (or no table).
+  std::uint64_t soft_contacts = 0;
+  std::uint64_t soft_overlap_fallbacks = 0;
+  std::uint64_t soft_early_releases = 0;
+  std::uint64_t soft_direct_maps = 0;
 };
 
 // A bond of a molecule (chain): particles i and j (the caller's numbering) interact through
@@ -84,6 +94,20 @@ struct PairZone {
   std::uint32_t i = 0, j = 0;  // the caller's numbering, i < j
   std::uint32_t zone = 0;
   bool operator==(const PairZone&) const = default;
+};
+
+// Soft spheres (formulas.md §1.6): a pair frozen inside a mapped contact, moving with its
+// centre-of-mass velocity until its release gives it the post-contact velocities (or a
+// particle frozen against wall `face`). Scheduler state: part of an exact restart.
+template <int D>
+struct FrozenContact {
+  static constexpr std::uint32_t kWall = 0xffffffffu;
+  std::uint32_t i = 0;            // the caller's numbering
+  std::uint32_t j = kWall;        // the partner (caller's numbering), or kWall
+  std::uint32_t face = 0;         // the wall's face when j == kWall
+  double release_time = 0.0;      // absolute
+  Vec<D> velocity_i{}, velocity_j{};  // after the release (velocity_j unused for a wall)
+  bool operator==(const FrozenContact&) const = default;
 };
 
 // Angular velocity: a vector in 3D, the z component alone in 2D.
@@ -124,6 +148,8 @@ struct ParticleSystem {
   // Stepped potentials: the zone of every pair inside some step (scheduler state: empty
   // optional = compute from the distances; resumed engines require it).
   std::optional<std::vector<PairZone>> zones;
+  // Soft spheres: the contacts in progress (mapped contacts waiting for their release).
+  std::vector<FrozenContact<D>> frozen;
 
   std::size_t size() const { return kinematics.size(); }
   bool is_asleep(std::size_t i) const { return !asleep.empty() && asleep[i] != 0; }
