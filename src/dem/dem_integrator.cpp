@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <fmt/format.h>
@@ -41,12 +42,55 @@ inline double min_image_once(double d, double half_L, double L) {
 template <int D>
 DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system, const SoftContactLaw& law,
                                 const DemOptions& options)
-    : base_(system), law_(law), box_(system.box), time_(system.time) {
-  // The law (SoftContactLaw's factories validate; a hand-built one is checked here).
-  if (law.model == SoftModel::LinearDashpot)
-    law_ = SoftContactLaw::linear_dashpot(law.stiffness, law.damping);
-  else
-    law_ = SoftContactLaw::viscoelastic_hertz(law.stiffness, law.damping);
+    : base_(system), laws_{law}, species_(1), box_(system.box), time_(system.time) {
+  init(options);
+}
+
+template <int D>
+DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system,
+                                const std::vector<SoftContactLaw>& laws, std::uint32_t species,
+                                const DemOptions& options)
+    : base_(system), laws_(laws), species_(species), box_(system.box), time_(system.time) {
+  if (species == 0 || laws.size() != static_cast<std::size_t>(species) * species)
+    throw InputError(fmt::format("DEM: {} contact laws for {} species (one per species pair)",
+                                 laws.size(), species));
+  init(options);
+}
+
+template <int D>
+void DemIntegrator<D>::init(const DemOptions& options) {
+  const ParticleSystem<D>& system = base_;
+  // The laws (SoftContactLaw's factories validate; a hand-built one is checked here).
+  const std::size_t ns = species_;
+  stiffness_.resize(ns * ns);
+  damping_coefficient_.resize(ns * ns);
+  hertz_.resize(ns * ns);
+  for (std::size_t a = 0; a < ns; ++a) {
+    for (std::size_t b = 0; b < ns; ++b) {
+      SoftContactLaw& law = laws_[a * ns + b];
+      law = law.model == SoftModel::LinearDashpot
+                ? SoftContactLaw::linear_dashpot(law.stiffness, law.damping)
+                : SoftContactLaw::viscoelastic_hertz(law.stiffness, law.damping);
+      const SoftContactLaw& other = laws_[b * ns + a];
+      if (law.model != other.model || law.stiffness != other.stiffness ||
+          law.damping != other.damping)
+        throw InputError(fmt::format(
+            "DEM: the contact laws of species pairs ({}, {}) and ({}, {}) differ (must be "
+            "symmetric)",
+            a, b, b, a));
+      const bool hertz = law.model == SoftModel::ViscoelasticHertz;
+      hertz_[a * ns + b] = hertz ? 1 : 0;
+      stiffness_[a * ns + b] = law.stiffness;
+      damping_coefficient_[a * ns + b] = hertz ? 1.5 * law.damping * law.stiffness : law.damping;
+    }
+  }
+  const auto hertz_pairs = std::count(hertz_.begin(), hertz_.end(), std::uint8_t{1});
+  kind_ = hertz_pairs == 0                                            ? Laws::kDashpot
+          : hertz_pairs == static_cast<std::ptrdiff_t>(hertz_.size()) ? Laws::kHertz
+                                                                      : Laws::kMixed;
+  collisions_ = system.counters.collisions;
+  virial_ = system.counters.virial;
+  dissipated_ = system.counters.dissipated_in_collisions;
 
   const std::size_t n = system.size();
   if (n == 0) throw InputError("DEM: the system has no particles");
@@ -79,7 +123,21 @@ DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system, const SoftConta
   mass_.resize(n);
   inv_mass_.resize(n);
   radius_.resize(n);
-  double m_min = std::numeric_limits<double>::infinity(), v_max = 0.0;
+  sp_.assign(n, 0);
+  if (species_ > 1) {
+    if (system.species.size() != n)
+      throw InputError(
+          fmt::format("DEM: {} species indices for {} particles", system.species.size(), n));
+    for (std::size_t i = 0; i < n; ++i) {
+      if (system.species[i] >= species_)
+        throw InputError(fmt::format("DEM: particle {} has species {}, but laws are given for {}",
+                                     i, system.species[i], species_));
+      sp_[i] = system.species[i];
+    }
+  }
+  // Per species: the lightest particle (for the default time step); infinity when absent.
+  std::vector<double> m_min(species_, std::numeric_limits<double>::infinity());
+  double v_max = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const double m = system.mass[i], R = system.kinematics[i].radius;
     if (!(m > 0.0) || !std::isfinite(m))
@@ -89,7 +147,7 @@ DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system, const SoftConta
     mass_[i] = m;
     inv_mass_[i] = 1.0 / m;
     radius_[i] = R;
-    m_min = std::min(m_min, m);
+    m_min[sp_[i]] = std::min(m_min[sp_[i]], m);
     max_diameter_ = std::max(max_diameter_, 2.0 * R);
     if (!std::isfinite(system.kinematics[i].time))
       throw InputError(fmt::format("DEM: local time of particle {} is not finite", i));
@@ -128,14 +186,22 @@ DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system, const SoftConta
     if (!(v_ref >= 0.0) || !std::isfinite(v_ref))
       throw InputError(fmt::format("DEM: reference_speed must be >= 0, got {}", v_ref));
     if (v_ref == 0.0) v_ref = v_max > 0.0 ? 2.0 * v_max : 1.0;
-    dt_ = dem_default_time_step(law_, 0.5 * m_min, v_ref, options.steps_per_contact);
+    dt_ = std::numeric_limits<double>::infinity();
+    for (std::size_t a = 0; a < species_; ++a) {
+      for (std::size_t b = a; b < species_; ++b) {
+        if (!std::isfinite(m_min[a]) || !std::isfinite(m_min[b])) continue;  // no such pair
+        const double mu = m_min[a] * m_min[b] / (m_min[a] + m_min[b]);
+        dt_ = std::min(dt_, dem_default_time_step(laws_[a * species_ + b], mu, v_ref,
+                                                  options.steps_per_contact));
+      }
+    }
   }
 
   id_.resize(n);
   slot_.resize(n);
   for (std::size_t i = 0; i < n; ++i) id_[i] = slot_[i] = static_cast<std::uint32_t>(i);
   build_neighbours();
-  compute_forces();  // also rejects absurd initial overlaps
+  compute_forces(/*count_collisions=*/false);  // also rejects absurd initial overlaps
 }
 
 template <int D>
@@ -184,6 +250,8 @@ void DemIntegrator<D>::build_neighbours() {
     permute(inv_mass_);
     permute(radius_);
     std::vector<std::uint32_t> tmp_u(n);
+    for (std::size_t q = 0; q < n; ++q) tmp_u[q] = sp_[cell_list[q]];
+    sp_.swap(tmp_u);
     for (std::size_t q = 0; q < n; ++q) tmp_u[q] = id_[cell_list[q]];
     id_.swap(tmp_u);
     for (std::size_t q = 0; q < n; ++q) {
@@ -266,16 +334,18 @@ void DemIntegrator<D>::build_neighbours() {
 }
 
 template <int D>
-template <SoftModel M>
-void DemIntegrator<D>::compute_forces_for() {
+template <typename DemIntegrator<D>::Laws L>
+void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
   const std::size_t n = size();
   // f_ is zero here (cleared by the constructor or by step's kick pass).
   Vec<D> half;
   for (int k = 0; k < D; ++k) half[k] = 0.5 * box_[k];
-  const double stiffness = law_.stiffness;
-  double potential = 0.0, power = 0.0;
+  double potential = 0.0, power = 0.0, virial = 0.0;
   std::size_t contacts = 0;
-  const SoftContactLaw law = law_;
+  std::uint64_t entered = 0;
+  const std::size_t ns = species_;
+  const double* const stiffness = stiffness_.data();
+  const double* const damping = damping_coefficient_.data();
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t b = start_[i], e = start_[i + 1];
     if (b == e) continue;
@@ -285,6 +355,7 @@ void DemIntegrator<D>::compute_forces_for() {
       vi[k] = vp_[k][i];
     }
     const double Ri = radius_[i];
+    const std::size_t row = ns == 1 ? 0 : sp_[i] * ns;
     for (std::uint32_t q = b; q < e; ++q) {
       const std::uint32_t j = nbr_[q];
       Vec<D> d;
@@ -303,23 +374,39 @@ void DemIntegrator<D>::compute_forces_for() {
             "DEM: particles {} and {} overlap by {} (more than {} of the smaller radius) at t = "
             "{}: time step dt = {} too large or the initial state overlapping",
             id_[i], id_[j], overlap, max_overlap_fraction_, time_, dt_));
+      if (count_collisions) {  // apart one step earlier (v_ holds the drift velocity)?
+        double r2_before = 0.0;
+        for (int k = 0; k < D; ++k) {
+          const double dk = d[k] - dt_ * (v_[k][i] - v_[k][j]);
+          r2_before += dk * dk;
+        }
+        if (r2_before >= l * l) ++entered;
+      }
       const double inv_r = 1.0 / r;
       double rdot = 0.0;
       for (int k = 0; k < D; ++k) rdot += d[k] * (vi[k] - vp_[k][j]);
       rdot *= inv_r;
-      double elastic, energy;
-      if constexpr (M == SoftModel::LinearDashpot) {
-        elastic = stiffness * overlap;
+      const std::size_t ab = ns == 1 ? 0 : row + sp_[j];
+      const double kk = stiffness[ab], c = damping[ab];
+      bool hertz = L == Laws::kHertz;
+      if constexpr (L == Laws::kMixed) hertz = hertz_[ab] != 0;
+      double elastic, energy, F;
+      if (!hertz) {
+        elastic = kk * overlap;
         energy = 0.5 * elastic * overlap;
+        F = elastic - c * rdot;
       } else {
-        elastic = stiffness * overlap * std::sqrt(overlap);
+        const double root = std::sqrt(overlap);
+        elastic = kk * overlap * root;
         energy = 0.4 * elastic * overlap;
+        F = elastic - c * rdot * root;
       }
+      F = std::max(0.0, F);  // the force-zero end: no attraction
       potential += energy;
-      const double F = std::max(0.0, law.force(overlap, rdot));
       power += (elastic - F) * rdot;
       if (F > 0.0) {
         ++contacts;
+        virial += F * r;
         const double s = F * inv_r;
         for (int k = 0; k < D; ++k) {
           fi[k] += s * d[k];
@@ -331,27 +418,47 @@ void DemIntegrator<D>::compute_forces_for() {
   }
   potential_ = potential;
   power_ = power;
+  virial_power_ = virial;
   contacts_ = contacts;
+  collisions_ += entered;
 }
 
 template <int D>
-void DemIntegrator<D>::compute_forces() {
-  if (law_.model == SoftModel::LinearDashpot)
-    compute_forces_for<SoftModel::LinearDashpot>();
-  else
-    compute_forces_for<SoftModel::ViscoelasticHertz>();
+void DemIntegrator<D>::compute_forces(bool count_collisions) {
+  switch (kind_) {
+    case Laws::kDashpot:
+      compute_forces_for<Laws::kDashpot>(count_collisions);
+      break;
+    case Laws::kHertz:
+      compute_forces_for<Laws::kHertz>(count_collisions);
+      break;
+    case Laws::kMixed:
+      compute_forces_for<Laws::kMixed>(count_collisions);
+      break;
+  }
 }
 
 template <int D>
 void DemIntegrator<D>::step(long n) {
+  advance(n, std::numeric_limits<std::uint64_t>::max());
+}
+
+template <int D>
+long DemIntegrator<D>::step_until(long n, std::uint64_t collisions) {
+  return advance(n, collisions);
+}
+
+template <int D>
+long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
   if (n < 0) throw InputError(fmt::format("DEM: step count must be >= 0, got {}", n));
   const std::size_t np = size();
   const double h = 0.5 * dt_;
-  if (n == 0) return;
+  if (n == 0) return 0;
+  long s = 0;
   // Velocity Verlet with the closing half kick of one step and the opening half kick of the
   // next fused into one kick by dt (one pass over the arrays less); v_ holds v(t) only between
   // calls. The same pass clears the forces for the next evaluation.
-  for (long s = 0; s < n; ++s) {
+  while (s < n && collisions_ < collisions) {
     const double kick = s == 0 ? h : dt_;
     double vmax2 = 0.0, vsum2 = 0.0;
     for (std::size_t i = 0; i < np; ++i) {
@@ -374,16 +481,19 @@ void DemIntegrator<D>::step(long n) {
           fmt::format("DEM: a velocity turned non-finite at t = {} (dt = {})", time_, dt_));
     moved_since_build_ += dt_ * std::sqrt(vmax2);
     if (2.0 * moved_since_build_ >= skin_) build_neighbours();
-    const double power_before = power_;
+    const double power_before = power_, virial_before = virial_power_;
     compute_forces();
     dissipated_ += h * (power_before + power_);
+    virial_ += h * (virial_before + virial_power_);
     ++steps_;
+    ++s;
     time_ = base_.time + static_cast<double>(steps_) * dt_;
   }
   for (std::size_t i = 0; i < np; ++i) {  // the closing half kick of the last step
     const double hw = h * inv_mass_[i];
     for (int k = 0; k < D; ++k) v_[k][i] += hw * f_[k][i];
   }
+  return s;
 }
 
 template <int D>
@@ -438,6 +548,9 @@ ParticleSystem<D> DemIntegrator<D>::export_state() const {
   s.order.clear();
   s.zones.reset();
   s.counters.dissipated_in_collisions = dissipated_;
+  s.counters.collisions = collisions_;
+  s.counters.events = base_.counters.events + static_cast<std::uint64_t>(steps_);
+  s.counters.virial = virial_;
   return s;
 }
 

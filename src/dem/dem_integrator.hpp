@@ -17,6 +17,16 @@
 // accumulates, by the trapezoidal rule, the power sum over pairs (F_el - F) rdot: the work of
 // the damping force, and after the force-zero end the elastic energy left in the overlap.
 //
+// Laws per species pair: laws[a * species + b] (symmetric) for particles of species a and b
+// (ParticleSystem::species); one law for all pairs is the case species = 1. Dashpot and Hertz
+// pairs may be mixed (a slower loop then tests the model per pair).
+//
+// Collisions: a pair *enters contact* when r < R_i + R_j now and r >= R_i + R_j one step
+// earlier (positions of the previous step recomputed from the drift); collisions() counts these
+// events, the DEM's analogue of the event-driven collision count (a run's length in collisions
+// per particle). The virial sum_pairs r F (time-integrated by the trapezoidal rule, like the
+// dissipation) gives the pressure as the collisional virial does for hard spheres.
+//
 // Neighbours: a half neighbour list (pairs closer than d_max + skin), built from a linked-cell
 // grid (cells >= d_max + skin) and rebuilt when the particles may have moved skin/2.
 // Hot data are structure-of-arrays (x, y, z, vx, ... separately), renumbered into cell order at
@@ -57,10 +67,20 @@ class DemIntegrator {
   // Each particle's position is taken at system.time (position_at).
   DemIntegrator(const ParticleSystem<D>& system, const SoftContactLaw& law,
                 const DemOptions& options = {});
+  // One law per species pair: laws.size() == species * species, symmetric, every particle's
+  // species < species. The default time step is the smallest over the species pairs present
+  // (each at the reduced mass of its lightest particles). The counters of `system`
+  // (collisions, events, virial, dissipated_in_collisions) are continued, so a state exported
+  // and handed back in (a restart) keeps counting.
+  DemIntegrator(const ParticleSystem<D>& system, const std::vector<SoftContactLaw>& laws,
+                std::uint32_t species, const DemOptions& options = {});
 
   // n velocity Verlet steps. InputError if a pair overlaps by more than half its smaller radius
   // (time step far too large) or a coordinate turns non-finite.
   void step(long n = 1);
+  // Up to n steps, stopping after the step in which collisions() reaches `collisions`;
+  // returns the number of steps taken.
+  long step_until(long n, std::uint64_t collisions);
 
   double time() const { return time_; }
   double dt() const { return dt_; }
@@ -79,6 +99,10 @@ class DemIntegrator {
   double dissipated_energy() const { return dissipated_; }
   // Pairs with r < R_i + R_j and a positive force at the last force evaluation.
   std::size_t contact_count() const { return contacts_; }
+  // Pairs that entered contact, including those counted in the constructor's system.
+  std::uint64_t collisions() const { return collisions_; }
+  // Time integral of sum over pairs of r_ij F_ij (F > 0 repulsive), including the system's.
+  double virial() const { return virial_; }
   Vec<D> momentum() const;
   long neighbour_list_builds() const { return builds_; }
 
@@ -87,13 +111,24 @@ class DemIntegrator {
   Vec<D> velocity(std::size_t i) const;
 
  private:
+  void init(const DemOptions& options);
+  long advance(long n, std::uint64_t collisions);
   void build_neighbours();
-  void compute_forces();  // forces, potential_, power_, contacts_ at x with predicted velocity
-  template <SoftModel M>
-  void compute_forces_for();
+  // Forces, potential_, power_, virial_power_, contacts_ at x with the predicted velocity;
+  // counts pairs entering contact when count_collisions.
+  void compute_forces(bool count_collisions = true);
+  enum class Laws { kDashpot, kHertz, kMixed };
+  template <Laws L>
+  void compute_forces_for(bool count_collisions);
 
   ParticleSystem<D> base_;
-  SoftContactLaw law_;
+  // Per species pair a * species_ + b: the model, the stiffness (k or rho) and the damping
+  // coefficient (gamma, or (3/2) A rho for Hertz: F = rho xi^1.5 - c rdot xi^0.5).
+  std::vector<SoftContactLaw> laws_;
+  std::uint32_t species_ = 1;
+  std::vector<double> stiffness_, damping_coefficient_;
+  std::vector<std::uint8_t> hertz_;
+  Laws kind_ = Laws::kDashpot;
   Vec<D> box_{};
   double dt_ = 0.0;
   double time_ = 0.0;
@@ -101,6 +136,7 @@ class DemIntegrator {
 
   std::vector<double> x_[D], v_[D], f_[D], vp_[D];  // positions, velocities, forces, predicted
   std::vector<double> mass_, inv_mass_, radius_;
+  std::vector<std::uint32_t> sp_;  // species per slot
   // Internal numbering, cell order of the last neighbour-list build: id_[slot] = the caller's
   // index, slot_[index] = its slot.
   std::vector<std::uint32_t> id_, slot_;
@@ -113,7 +149,9 @@ class DemIntegrator {
   long builds_ = 0;
 
   double potential_ = 0.0, power_ = 0.0, dissipated_ = 0.0;
+  double virial_power_ = 0.0, virial_ = 0.0;
   std::size_t contacts_ = 0;
+  std::uint64_t collisions_ = 0;
 };
 
 extern template class DemIntegrator<2>;

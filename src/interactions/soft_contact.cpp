@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -592,6 +593,75 @@ double viscoelastic_restitution_series(double x, int order) {
   double e = 0.0;
   for (int k = order; k >= 2; --k) e = (e + viscoelastic_series_coefficient(k)) * x;
   return 1.0 + e * x;
+}
+
+namespace {
+
+// The x >= 0 where the decreasing e_of(x) equals e in (0, 1), by bracketing from [0, 1] upwards
+// and bisecting to round-off; `what` names the parameter in errors.
+template <class F>
+double solve_decreasing(F&& e_of, double e, double x_max, const char* what) {
+  double lo = 0.0, hi = 1.0;
+  while (e_of(hi) > e) {
+    lo = hi;
+    hi *= 2.0;
+    if (hi > x_max)
+      throw InputError(fmt::format(
+          "soft contact: no {} gives a coefficient of restitution as small as {}", what, e));
+  }
+  for (int it = 0; it < 200 && hi - lo > 4.0 * std::numeric_limits<double>::epsilon() * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (e_of(mid) > e ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+void require_restitution(double e) {
+  if (!(e > 0.0 && e <= 1.0))
+    throw InputError(
+        fmt::format("soft contact: the coefficient of restitution must be in (0, 1], got {}", e));
+}
+
+}  // namespace
+
+double dashpot_zeta_for_restitution(double e) {
+  require_restitution(e);
+  if (e == 1.0) return 0.0;
+  return solve_decreasing([](double zeta) { return dashpot_head_on_reduced(zeta).restitution; }, e,
+                          1e12, "damping");
+}
+
+double dashpot_damping_for_restitution(double reduced_mass, double k, double e) {
+  require_positive(reduced_mass, "the reduced mass mu");
+  require_positive(k, "the stiffness k");
+  return 2.0 * dashpot_zeta_for_restitution(e) * std::sqrt(k * reduced_mass);
+}
+
+double viscoelastic_head_on_restitution(double c_dis) {
+  require_non_negative(c_dis, "c_dis");
+  if (c_dis == 0.0) return 1.0;
+  // Head-on, the reduced equations depend on l~ - x only: any l~ above the penetration will do.
+  ReducedCollision r;
+  r.model = SoftModel::ViscoelasticHertz;
+  r.c_phi = 0.0;
+  r.l_tilde = 10.0;
+  r.c_dis = c_dis;
+  return -collision_map(r).eps_rdot;
+}
+
+double viscoelastic_c_dis_for_restitution(double e) {
+  require_restitution(e);
+  if (e == 1.0) return 0.0;
+  return solve_decreasing(viscoelastic_head_on_restitution, e, 1e6, "dissipation");
+}
+
+double viscoelastic_dissipation_for_restitution(double reduced_mass, double rho, double e,
+                                                double v) {
+  require_positive(reduced_mass, "the reduced mass mu");
+  require_positive(rho, "the Hertz prefactor rho");
+  require_positive(v, "the impact speed v");
+  const double T = std::pow(reduced_mass * reduced_mass / (rho * rho * v), 0.2);
+  return viscoelastic_c_dis_for_restitution(e) * T;
 }
 
 double hertz_contact_time_constant() {

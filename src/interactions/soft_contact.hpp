@@ -180,6 +180,20 @@ double viscoelastic_series_variable(double c_dis);
 double viscoelastic_series_coefficient(int k);  // h_k, k = 2..7
 double viscoelastic_restitution_series(double x, int order = 5);
 
+// Inverse problems: the dissipation that gives a head-on coefficient of restitution e in (0, 1]
+// (e = 1: none). Both e maps are strictly decreasing; solved by bisection to round-off.
+// Dashpot with the force-zero end: e depends only on zeta = gamma / (2 sqrt(k mu)); returns zeta.
+double dashpot_zeta_for_restitution(double e);
+// ... and gamma = 2 zeta sqrt(k mu) for mu > 0, k > 0.
+double dashpot_damping_for_restitution(double reduced_mass, double k, double e);
+// Viscoelastic Hertz: the exact head-on e(c_dis) = -eps_rdot of collision_map (not the series
+// or the Padé form), and its inverse c_dis(e).
+double viscoelastic_head_on_restitution(double c_dis);
+double viscoelastic_c_dis_for_restitution(double e);
+// ... and A = c_dis T with T = (mu^2 / (rho^2 v))^(1/5): e at impact speed v > 0.
+double viscoelastic_dissipation_for_restitution(double reduced_mass, double rho, double e,
+                                                double v);
+
 // Elastic Hertz spheres: t_H = K (mu^2 / (rho^2 v))^(1/5), K = 2 (5/4)^(2/5) (2/5) B(2/5, 1/2)
 // = 3.2180654597, and the maximum overlap xi_max = (5 mu v^2 / (4 rho))^(2/5); mu, rho, v > 0.
 double hertz_contact_time_constant();

@@ -160,6 +160,29 @@ constexpr KeySpec kSchema[] = {
     {"run.event_queue", Kind::kString},
     {"run.max_wall_seconds", Kind::kFloat},
     {"run.validate", Kind::kBoolean},
+    {"run.integrator", Kind::kString},
+    {"run.time_step", Kind::kFloat},
+    {"soft", Kind::kTable},
+    {"soft.collisions", Kind::kString},
+    {"soft.model", Kind::kString},
+    {"soft.stiffness", Kind::kFloat},
+    {"soft.damping", Kind::kFloat},
+    {"soft.young", Kind::kFloat},
+    {"soft.poisson", Kind::kFloat},
+    {"soft.dissipation", Kind::kFloat},
+    {"soft.restitution", Kind::kFloat},
+    {"soft.restitution_speed", Kind::kFloat},
+    {"soft.pair", Kind::kTableArray},
+    {"soft.pair[]", Kind::kTable},
+    {"soft.pair[].species", Kind::kArray},
+    {"soft.pair[].model", Kind::kString},
+    {"soft.pair[].stiffness", Kind::kFloat},
+    {"soft.pair[].damping", Kind::kFloat},
+    {"soft.pair[].young", Kind::kFloat},
+    {"soft.pair[].poisson", Kind::kFloat},
+    {"soft.pair[].dissipation", Kind::kFloat},
+    {"soft.pair[].restitution", Kind::kFloat},
+    {"soft.pair[].restitution_speed", Kind::kFloat},
     {"output", Kind::kTable},
     {"output.directory", Kind::kString},
     {"output.thermo_interval", Kind::kFloat},
@@ -176,6 +199,9 @@ constexpr std::string_view kLattices2D[] = {"hex", "square", "random"};
 constexpr std::string_view kEventQueues[] = {"calendar", "heap", "tree"};
 constexpr std::string_view kProgressModes[] = {"auto", "always", "never"};
 constexpr std::string_view kDrivingKinds[] = {"none", "andersen", "white_noise"};
+constexpr std::string_view kIntegrators[] = {"event", "dem"};
+constexpr std::string_view kSoftModels[] = {"dashpot", "hertz"};
+constexpr std::string_view kSoftCollisions[] = {"mapped", "instantaneous"};
 constexpr std::string_view kRestitutionModels[] = {"constant", "viscoelastic", "table"};
 // Box faces: 2k is the low face of axis k, 2k + 1 the high one.
 constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
@@ -567,6 +593,10 @@ class Reader {
     read_output(section(root, "output", empty), config.system.dimension, config.output);
     read_potentials(root, config.system.species, config.potentials);
     read_bonds(root, config.bonds);
+    if (root.contains("soft")) {
+      read_soft(section(root, "soft", empty), config.system.species, config.soft);
+    }
+    check_soft_and_dem(root, config);
     if (config.system.chain_length > 0 && config.bonds.empty()) {
       fail(nullptr, "system.chain_length",
            "system.chain_length: chains need a bond potential ([[bond]] with kind = \"tether\" "
@@ -1317,6 +1347,210 @@ class Reader {
     }
   }
 
+  // A soft law at `prefix` ("soft", "soft.pair[i]"). On entry `law` holds the law inherited
+  // from [soft] (the defaults for [soft] itself); the keys present replace its values. A pair
+  // that gives damping / dissipation drops an inherited restitution and vice versa.
+  void read_soft_law(const toml::table& t, const std::string& prefix, SoftLawConfig& law) const {
+    const auto path = [&](std::string_view key) { return join_key(prefix, key); };
+    const bool pair = prefix != "soft";
+    const toml::node* n_model = get_string(t, prefix, "model", law.model);
+    const toml::node* n_k = get_number(t, prefix, "stiffness", law.stiffness);
+    const toml::node* n_gamma = get_number(t, prefix, "damping", law.damping);
+    const toml::node* n_young = get_number(t, prefix, "young", law.young);
+    const toml::node* n_poisson = get_number(t, prefix, "poisson", law.poisson);
+    const toml::node* n_a = get_number(t, prefix, "dissipation", law.dissipation);
+    const toml::node* n_e = get_number(t, prefix, "restitution", law.restitution);
+    const toml::node* n_speed = get_number(t, prefix, "restitution_speed", law.restitution_speed);
+    if (n_model == nullptr && law.model.empty()) {
+      fail(&t, path("model"),
+           fmt::format("missing required key '{}' (\"dashpot\" or \"hertz\"): [soft] makes every "
+                       "contact soft",
+                       path("model")));
+    }
+    require_choice(n_model, path("model"), law.model, kSoftModels);
+    const bool dashpot = law.model == "dashpot";
+    // Keys of the other model given here are an error (inherited ones are just not used).
+    const std::pair<const toml::node*, std::string_view> foreign[] = {
+        {n_young, "young"},   {n_poisson, "poisson"},
+        {n_a, "dissipation"}, {n_speed, "restitution_speed"},
+        {n_k, "stiffness"},   {n_gamma, "damping"}};
+    for (const auto& [node, key] :
+         dashpot ? std::span(foreign).first(4) : std::span(foreign).last(2)) {
+      if (node != nullptr) {
+        fail(node, path(key),
+             fmt::format("{}: not a key of model \"{}\" (dashpot: stiffness, damping or "
+                         "restitution; hertz: young, poisson, dissipation or restitution with "
+                         "restitution_speed)",
+                         path(key), law.model));
+      }
+    }
+    const toml::node* n_dissipative = dashpot ? n_gamma : n_a;
+    const std::string_view dissipative_key = dashpot ? "damping" : "dissipation";
+    double& dissipative = dashpot ? law.damping : law.dissipation;
+    if (n_dissipative != nullptr && n_e != nullptr && dissipative > 0.0 && law.restitution > 0.0) {
+      fail(n_e, path("restitution"),
+           fmt::format("{}: give either {} or restitution, not both", path("restitution"),
+                       path(dissipative_key)));
+    }
+    if (pair && n_dissipative != nullptr && n_e == nullptr) law.restitution = 0.0;
+    if (pair && n_e != nullptr && n_dissipative == nullptr) dissipative = 0.0;
+    // Only positive finite parameters make a contact law.
+    if (dashpot) {
+      if (n_k == nullptr && law.stiffness == 0.0) {
+        fail(n_model != nullptr ? n_model : &t, path("stiffness"),
+             fmt::format("missing required key '{}' (the spring constant k of model "
+                         "\"dashpot\", > 0)",
+                         path("stiffness")));
+      }
+      require_positive(n_k, path("stiffness"), law.stiffness);
+      require_non_negative(n_gamma, path("damping"), law.damping);
+    } else {
+      if (n_young == nullptr && law.young == 0.0) {
+        fail(n_model != nullptr ? n_model : &t, path("young"),
+             fmt::format("missing required key '{}' (Young's modulus of model \"hertz\", > 0)",
+                         path("young")));
+      }
+      require_positive(n_young, path("young"), law.young);
+      if (!(law.poisson > -1.0 && law.poisson <= 0.5)) {
+        fail(n_poisson, path("poisson"),
+             fmt::format("{}: must be in (-1, 0.5], got {}", path("poisson"), law.poisson));
+      }
+      require_non_negative(n_a, path("dissipation"), law.dissipation);
+      require_positive(n_speed, path("restitution_speed"), law.restitution_speed);
+    }
+    if (!(law.restitution == 0.0 || (law.restitution > 0.0 && law.restitution <= 1.0)) ||
+        (n_e != nullptr && law.restitution == 0.0)) {
+      fail(n_e, path("restitution"),
+           fmt::format("{}: must be in (0, 1] (the head-on coefficient of restitution{}), got {}",
+                       path("restitution"), dashpot ? "" : " at restitution_speed",
+                       law.restitution));
+    }
+  }
+
+  void read_soft(const toml::table& t, const std::vector<SpeciesConfig>& species,
+                 SoftConfig& soft) const {
+    constexpr std::string_view p = "soft";
+    read_soft_law(t, std::string(p), soft.law);
+    const toml::node* n_collisions = get_string(t, p, "collisions", soft.collisions);
+    require_choice(n_collisions, "soft.collisions", soft.collisions, kSoftCollisions);
+    const std::vector<const toml::table*> tables = table_array(t, p, "pair");
+    for (std::size_t i = 0; i < tables.size(); ++i) {
+      const std::string prefix = fmt::format("soft.pair[{}]", i);
+      const std::string species_key = prefix + ".species";
+      std::vector<std::string> names;
+      const toml::node* n_species = get_strings(*tables[i], prefix, "species", names);
+      if (n_species == nullptr) {
+        fail(tables[i], species_key,
+             fmt::format("missing required key '{}' (the pair's two species, e.g. species = "
+                         "[\"A\", \"B\"])",
+                         species_key));
+      }
+      if (names.size() != 2) {
+        fail(n_species, species_key,
+             fmt::format("{}: expected 2 species names, got {}", species_key, names.size()));
+      }
+      for (std::size_t k = 0; k < 2; ++k) {
+        const bool declared =
+            std::any_of(species.begin(), species.end(),
+                        [&](const SpeciesConfig& s) { return s.name == names[k]; });
+        if (!declared) {
+          std::vector<std::string_view> known;
+          for (const SpeciesConfig& s : species) known.push_back(s.name);
+          fail(element_of(n_species, k), species_key,
+               fmt::format("{}: unknown species '{}' (declared species: {})", species_key, names[k],
+                           join_words(known)));
+        }
+      }
+      for (std::size_t j = 0; j < soft.pairs.size(); ++j) {
+        const auto& other = soft.pairs[j].species;
+        if ((other[0] == names[0] && other[1] == names[1]) ||
+            (other[0] == names[1] && other[1] == names[0])) {
+          fail(n_species, species_key,
+               fmt::format("{}: the pair ({}, {}) is already given by soft.pair[{}]", species_key,
+                           names[0], names[1], j));
+        }
+      }
+      SoftPairConfig pair;
+      pair.species = {names[0], names[1]};
+      pair.law = soft.law;
+      read_soft_law(*tables[i], prefix, pair.law);
+      soft.pairs.push_back(std::move(pair));
+    }
+  }
+
+  // The first key of a contact law that differs from the elastic, smooth default ("" if none).
+  static std::string_view non_default_contact_key(const ContactConfig& c) {
+    const ContactConfig hard{};
+    if (c.restitution != hard.restitution) return "restitution";
+    if (c.restitution_model != hard.restitution_model) return "restitution_model";
+    if (c.restitution_speed != hard.restitution_speed) return "restitution_speed";
+    if (!c.restitution_table.empty()) return "restitution_table";
+    if (c.tangential_restitution != hard.tangential_restitution) return "tangential_restitution";
+    if (c.friction != hard.friction) return "friction";
+    if (c.elastic_below_speed != hard.elastic_below_speed) return "elastic_below_speed";
+    return {};
+  }
+
+  // The node at a dotted path of plain tables ("contact.restitution"), or nullptr.
+  static const toml::node* node_at(const toml::table& root, std::string_view path) {
+    return root.at_path(path).node();
+  }
+
+  // What soft spheres and the DEM integrator cannot be combined with (yet).
+  void check_soft_and_dem(const toml::table& root, const Config& c) const {
+    const toml::node* n_model = node_at(root, "soft.model");
+    if (c.soft.enabled()) {
+      const auto conflict = [&](std::string_view key, std::string_view why) {
+        const toml::node* n = node_at(root, key);
+        fail(n != nullptr ? n : n_model, key,
+             fmt::format("{}: not allowed with soft spheres (soft.model = \"{}\"): {}", key,
+                         c.soft.law.model, why));
+      };
+      const std::string_view laws =
+          "soft contacts replace the [contact] laws (set the dissipation in [soft])";
+      if (const std::string_view key = non_default_contact_key(c.interactions.contact);
+          !key.empty()) {
+        conflict(join_key("contact", key), laws);
+      }
+      if (c.interactions.tc != 0.0) conflict("contact.tc", laws);
+      if (!c.interactions.pairs.empty()) conflict("contact.pair", "use [[soft.pair]] instead");
+      for (std::size_t w = 0; w < c.boundary.walls.size(); ++w) {
+        if (const std::string_view key = non_default_contact_key(c.boundary.walls[w].contact);
+            !key.empty()) {
+          conflict(fmt::format("boundary.wall[{}].{}", w, key),
+                   "soft contacts with walls use the [soft] material");
+        }
+      }
+      if (!c.potentials.empty())
+        conflict("potential", "stepped potentials and soft spheres do not mix");
+      if (!c.bonds.empty()) conflict("bond", "stepped potentials and soft spheres do not mix");
+      if (c.boundary.shear_rate != 0.0) {
+        conflict("boundary.shear_rate",
+                 "Lees-Edwards shear is not supported with soft spheres yet");
+      }
+      if (!c.field.gravity.empty()) {
+        conflict("field.gravity", "gravity is not supported with soft spheres yet");
+      }
+    }
+    if (c.run.integrator != "dem") return;
+    const toml::node* n_integrator = node_at(root, "run.integrator");
+    const auto unsupported = [&](std::string_view key, std::string_view what) {
+      const toml::node* n = node_at(root, key);
+      fail(n != nullptr ? n : n_integrator, key,
+           fmt::format("{}: {} not supported by the DEM integrator (run.integrator = \"dem\")", key,
+                       what));
+    };
+    if (!c.soft.enabled()) {
+      fail(n_integrator, "run.integrator",
+           "run.integrator: \"dem\" integrates soft contact forces and needs a [soft] table "
+           "(model = \"dashpot\" or \"hertz\")");
+    }
+    if (!c.boundary.walls.empty()) unsupported("boundary.wall", "walls are");
+    if (!c.boundary.open.empty()) unsupported("boundary.open", "open faces are");
+    if (c.driving.kind != "none") unsupported("driving.kind", "driving is");
+    if (c.run.validate) unsupported("run.validate", "engine validation is");
+  }
+
   void read_field(const toml::table& t, int dimension, FieldConfig& f) const {
     std::vector<double> gravity;
     get_vector(t, "field", "gravity", dimension, gravity);
@@ -1358,6 +1592,16 @@ class Reader {
     require_positive(n_production, "run.collisions_per_particle", r.collisions_per_particle);
     require_choice(n_queue, "run.event_queue", r.event_queue, kEventQueues);
     require_non_negative(n_wall, "run.max_wall_seconds", r.max_wall_seconds);
+    const toml::node* n_integrator = get_string(t, p, "integrator", r.integrator);
+    const toml::node* n_step = get_number(t, p, "time_step", r.time_step);
+    require_choice(n_integrator, "run.integrator", r.integrator, kIntegrators);
+    require_non_negative(n_step, "run.time_step", r.time_step);
+    if (r.time_step > 0.0 && r.integrator != "dem") {
+      fail(n_step, "run.time_step",
+           fmt::format("run.time_step: only used by the DEM integrator (run.integrator = \"dem\"; "
+                       "it is \"{}\"), which has a time step",
+                       r.integrator));
+    }
   }
 
   void read_output(const toml::table& t, int dimension, OutputConfig& o) const {
@@ -1432,6 +1676,24 @@ std::string contact_toml(const ContactConfig& c) {
   out += fmt::format("tangential_restitution = {}\n", toml_float(c.tangential_restitution));
   out += fmt::format("friction = {}\n", toml_float(c.friction));
   out += fmt::format("elastic_below_speed = {}\n", toml_float(c.elastic_below_speed));
+  return out;
+}
+
+// The keys of a soft law that its model uses, one per line: restitution when given, else the
+// damping (dissipation).
+std::string soft_law_toml(const SoftLawConfig& law) {
+  std::string out = fmt::format("model = {}\n", toml_string(law.model));
+  if (law.model == "dashpot") {
+    out += fmt::format("stiffness = {}\n", toml_float(law.stiffness));
+    out += law.restitution > 0.0 ? fmt::format("restitution = {}\n", toml_float(law.restitution))
+                                 : fmt::format("damping = {}\n", toml_float(law.damping));
+  } else {
+    out += fmt::format("young = {}\n", toml_float(law.young));
+    out += fmt::format("poisson = {}\n", toml_float(law.poisson));
+    out += law.restitution > 0.0 ? fmt::format("restitution = {}\n", toml_float(law.restitution))
+                                 : fmt::format("dissipation = {}\n", toml_float(law.dissipation));
+    out += fmt::format("restitution_speed = {}\n", toml_float(law.restitution_speed));
+  }
   return out;
 }
 
@@ -1592,6 +1854,18 @@ std::string to_toml(const Config& config) {
   out += fmt::format("strength = {}\n", toml_float(config.driving.strength));
   out += "\n[field]\n";
   out += fmt::format("gravity = {}\n", vector_or(config.field.gravity, 0.0));
+  const SoftConfig& soft = config.soft;
+  if (soft.enabled()) {
+    out += "\n[soft]\n";
+    out += soft_law_toml(soft.law);
+    out += fmt::format("collisions = {}\n", toml_string(soft.collisions));
+    for (const SoftPairConfig& pair : soft.pairs) {
+      out += "\n[[soft.pair]]\n";
+      out += fmt::format("species = [{}, {}]\n", toml_string(pair.species[0]),
+                         toml_string(pair.species[1]));
+      out += soft_law_toml(pair.law);
+    }
+  }
   out += "\n[run]\n";
   out += fmt::format("equilibration_collisions_per_particle = {}\n",
                      toml_float(r.equilibration_collisions_per_particle));
@@ -1599,6 +1873,8 @@ std::string to_toml(const Config& config) {
   out += fmt::format("event_queue = {}\n", toml_string(r.event_queue));
   out += fmt::format("max_wall_seconds = {}\n", toml_float(r.max_wall_seconds));
   out += fmt::format("validate = {}\n", r.validate);
+  out += fmt::format("integrator = {}\n", toml_string(r.integrator));
+  out += fmt::format("time_step = {}\n", toml_float(r.time_step));
   out += "\n[output]\n";
   out += fmt::format("directory = {}\n", toml_string(o.directory));
   out += fmt::format("thermo_interval = {}\n", toml_float(o.thermo_interval));

@@ -114,6 +114,10 @@ struct RunConfig {
   std::string event_queue = "calendar";    // calendar | heap
   double max_wall_seconds = 0.0;           // 0 = no limit; stop cleanly when exceeded
   bool validate = false;  // debug: check neighbour structure and queue against brute force
+  // event: the event-driven engine; dem: the force-based velocity Verlet integrator (needs
+  // [soft], periodic boxes only).
+  std::string integrator = "event";
+  double time_step = 0.0;  // dem: the time step; 0 = t_c / 50 of the stiffest, lightest pair
 
   bool operator==(const RunConfig&) const = default;
 };
@@ -164,6 +168,38 @@ struct BondConfig {
   bool operator==(const BondConfig&) const = default;
 };
 
+// A soft contact law, [soft] or [[soft.pair]] (formulas.md §1.2, docs/config.md). The keys of
+// the other model are kept (inherited by pairs) but not used.
+struct SoftLawConfig {
+  std::string model;               // dashpot | hertz; "" only when there is no [soft]
+  double stiffness = 0.0;          // dashpot: k > 0 (required)
+  double damping = 0.0;            // dashpot: gamma >= 0 (when restitution is 0)
+  double young = 0.0;              // hertz: Young's modulus Y > 0 (required)
+  double poisson = 0.3;            // hertz: Poisson's ratio in (-1, 0.5]
+  double dissipation = 0.0;        // hertz: the dissipative time constant A >= 0
+  double restitution = 0.0;        // head-on e in (0, 1] fixing gamma or A per pair; 0 = not given
+  double restitution_speed = 1.0;  // hertz: the impact speed at which e = restitution
+
+  bool operator==(const SoftLawConfig&) const = default;
+};
+
+struct SoftPairConfig {
+  std::array<std::string, 2> species;  // names
+  SoftLawConfig law;
+
+  bool operator==(const SoftPairConfig&) const = default;
+};
+
+// [soft]: soft spheres. Every contact (pairs and walls) is soft when law.model is set.
+struct SoftConfig {
+  SoftLawConfig law;                  // every pair without an override, and the walls
+  std::vector<SoftPairConfig> pairs;  // [[soft.pair]]
+  std::string collisions = "mapped";  // event integrator: mapped | instantaneous
+
+  bool enabled() const { return !law.model.empty(); }
+  bool operator==(const SoftConfig&) const = default;
+};
+
 struct Config {
   SystemConfig system;
   std::vector<PairPotentialConfig> potentials;  // [[potential]]
@@ -174,6 +210,7 @@ struct Config {
   BoundaryConfig boundary;         // [boundary]
   FieldConfig field;               // [field]
   DrivingConfig driving;           // [driving]
+  SoftConfig soft;                 // [soft]
 
   bool operator==(const Config&) const = default;  // memberwise (exact doubles)
 };

@@ -370,6 +370,11 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     if (!s.asleep.empty()) w.write_chunk("kairos/state/asleep", n, 1, s.asleep.data());
     w.write_chunk("kairos/state/rng", rng_bytes.size(), 1, rng_bytes.data());
     w.write_chunk("kairos/run/equilibration_remaining", 1, 1, &progress.equilibration_remaining);
+    if (progress.integrator != "event") {
+      const std::vector<std::int8_t> name(progress.integrator.begin(), progress.integrator.end());
+      w.write_chunk("kairos/run/integrator", name.size(), 1, name.data());
+      w.write_chunk("kairos/run/dem_time_step", 1, 1, &progress.dem_time_step);
+    }
     w.end_frame();
     w.close();
   });
@@ -503,6 +508,15 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
     }
     if (r.find(f, "kairos/run/next_kick_time"))
       progress->next_kick_time = require<double>(r, f, "kairos/run/next_kick_time", path, 1)[0];
+    if (r.find(f, "kairos/run/integrator")) {
+      const auto name = r.read<std::int8_t>(f, "kairos/run/integrator");
+      progress->integrator.assign(name.begin(), name.end());
+      progress->dem_time_step = require<double>(r, f, "kairos/run/dem_time_step", path, 1)[0];
+      if (!(progress->dem_time_step > 0.0) || !std::isfinite(progress->dem_time_step)) {
+        throw InputError("'" + path.string() + "': kairos/run/dem_time_step is " +
+                         std::to_string(progress->dem_time_step));
+      }
+    }
   }
   return s;
 }

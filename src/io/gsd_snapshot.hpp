@@ -37,6 +37,10 @@ void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& syste
 struct RunProgress {
   double equilibration_remaining = 0.0;  // collisions per particle still to equilibrate
   double next_kick_time = -1.0;          // driving: when the next random event is due (< 0: draw)
+  // The integrator that wrote the state (run.integrator: "event" or "dem"; files without the
+  // chunk are "event"), and the DEM's time step (0 for the event integrator).
+  std::string integrator = "event";
+  double dem_time_step = 0.0;
 };
 
 // Writes the restart file atomically (temporary file + rename).

@@ -118,6 +118,115 @@ void add_step_potentials(const Config& config, const ParticleSystem<D>& s, Envir
   if (!env.pair_table.empty()) env.species = n;
 }
 
+// Per species of the state: the mass and radius every particle of it has (NaN when its
+// particles differ); a species without particles takes its [[system.species]] values.
+struct SpeciesShape {
+  double mass = 1.0, radius = 0.5;
+};
+template <int D>
+std::vector<SpeciesShape> species_shapes(const Config& config, const ParticleSystem<D>& s,
+                                         std::size_t species) {
+  std::vector<SpeciesShape> shape(species, SpeciesShape{0.0, 0.0});
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    SpeciesShape& sh = shape[s.species[i]];
+    const double m = s.mass[i], r = s.kinematics[i].radius;
+    sh.mass = sh.mass == 0.0 || sh.mass == m ? m : std::nan("");
+    sh.radius = sh.radius == 0.0 || sh.radius == r ? r : std::nan("");
+  }
+  for (std::size_t k = 0; k < species; ++k) {
+    if (shape[k].mass != 0.0) continue;
+    shape[k] = SpeciesShape{};
+    for (const SpeciesConfig& sc : config.system.species) {
+      if (k < s.species_names.size() && sc.name == s.species_names[k])
+        shape[k] = {sc.mass, 0.5 * sc.diameter};
+    }
+  }
+  return shape;
+}
+
+// The force law a soft config describes for a pair of reduced mass mu and effective radius
+// R_eff (NaN when the species' particles differ: an error if the law needs it). `what` names
+// the pair in errors.
+SoftContactLaw make_soft_law(const SoftLawConfig& c, double mu, double r_eff,
+                             const std::string& where, const std::string& what) {
+  const auto need = [&](double value, const char* quantity) {
+    if (std::isnan(value)) {
+      throw InputError(fmt::format(
+          "{}: {} needs one {} per species, but the particles of {} differ in size or mass; "
+          "soft laws are set per species pair",
+          where, c.model == "hertz" ? "model = \"hertz\"" : "restitution", quantity, what));
+    }
+  };
+  try {
+    if (c.model == "dashpot") {
+      double gamma = c.damping;
+      if (c.restitution > 0.0) {
+        need(mu, "mass");
+        gamma = dashpot_damping_for_restitution(mu, c.stiffness, c.restitution);
+      }
+      return SoftContactLaw::linear_dashpot(c.stiffness, gamma);
+    }
+    need(r_eff, "radius");
+    const double rho = hertz_rho_one_material(c.young, c.poisson, r_eff);
+    double a = c.dissipation;
+    if (c.restitution > 0.0) {
+      need(mu, "mass");
+      a = viscoelastic_dissipation_for_restitution(mu, rho, c.restitution, c.restitution_speed);
+    }
+    return SoftContactLaw::viscoelastic_hertz(rho, a);
+  } catch (const InputError& e) {
+    if (std::string(e.what()).starts_with(where)) throw;
+    throw InputError(fmt::format("{}: {}: {}", where, what, e.what()));
+  }
+}
+
+// [soft]: the law of every species pair (from [[soft.pair]] or [soft]) and, with walls, of
+// every species against a wall ([soft] with R_eff = R and mu = m: a wall of the same material
+// and infinite mass and radius).
+template <int D>
+void add_soft_laws(const Config& config, const ParticleSystem<D>& s, Environment<D>& env) {
+  const SoftConfig& soft = config.soft;
+  if (!soft.enabled()) return;
+  const std::vector<std::string>& names = s.species_names;
+  const auto n = static_cast<std::uint32_t>(std::max<std::size_t>(1, names.size()));
+  const std::vector<SpeciesShape> shape = species_shapes(config, s, n);
+  const auto name = [&](std::uint32_t a) { return a < names.size() ? names[a] : std::string("A"); };
+  std::vector<int> pair_of(static_cast<std::size_t>(n) * n, -1);
+  for (std::size_t p = 0; p < soft.pairs.size(); ++p) {
+    const std::string where = fmt::format("soft.pair[{}]", p);
+    const std::uint32_t a = species_index(names, soft.pairs[p].species[0], where);
+    const std::uint32_t b = species_index(names, soft.pairs[p].species[1], where);
+    pair_of[a * n + b] = pair_of[b * n + a] = static_cast<int>(p);
+  }
+  env.species = n;
+  env.soft.assign(static_cast<std::size_t>(n) * n, SoftContactLaw{});
+  for (std::uint32_t a = 0; a < n; ++a) {
+    for (std::uint32_t b = a; b < n; ++b) {
+      const int p = pair_of[a * n + b];
+      const SoftLawConfig& c = p >= 0 ? soft.pairs[static_cast<std::size_t>(p)].law : soft.law;
+      const std::string where = p >= 0 ? fmt::format("soft.pair[{}]", p) : std::string("soft");
+      const auto known = [](double x, double y) { return !std::isnan(x) && !std::isnan(y); };
+      const double mu = known(shape[a].mass, shape[b].mass)
+                            ? reduced_mass(shape[a].mass, shape[b].mass)
+                            : std::nan("");
+      const double r_eff = known(shape[a].radius, shape[b].radius)
+                               ? effective_radius(shape[a].radius, shape[b].radius)
+                               : std::nan("");
+      env.soft[a * n + b] = env.soft[b * n + a] =
+          make_soft_law(c, mu, r_eff, where, fmt::format("species {} and {}", name(a), name(b)));
+    }
+  }
+  if (!config.boundary.walls.empty()) {
+    env.soft_wall.resize(n);
+    for (std::uint32_t a = 0; a < n; ++a) {
+      env.soft_wall[a] = make_soft_law(soft.law, shape[a].mass, shape[a].radius, "soft",
+                                       fmt::format("species {} against a wall", name(a)));
+    }
+  }
+  env.soft_collisions =
+      soft.collisions == "instantaneous" ? SoftCollisions::kInstantaneous : SoftCollisions::kMapped;
+}
+
 }  // namespace
 
 ContactModel make_contact_model(const ContactConfig& c, const std::string& where) {
@@ -189,6 +298,7 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
     env.gravity[a] = config.field.gravity[a];
   env.shear_rate = config.boundary.shear_rate;
   add_step_potentials(config, state, env);
+  add_soft_laws(config, state, env);
   env.check();
   return env;
 }

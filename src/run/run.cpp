@@ -1,7 +1,5 @@
 #include "run/run.hpp"
 
-#include <sys/resource.h>
-
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -21,6 +19,7 @@
 #include "io/gsd_snapshot.hpp"
 #include "io/progress.hpp"
 #include "run/environment_setup.hpp"
+#include "run/run_support.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
 #include "scheduler/tournament_tree_queue.hpp"
@@ -155,6 +154,14 @@ void add_shear_flow(const Config& config, InitialState<D>& init) {
     init.velocity[i][0] += rate * (init.position[i][1] - 0.5 * init.box[1]);
 }
 
+}  // namespace
+
+namespace run_detail {
+
+bool stop_requested() noexcept {
+  return g_stop.load(std::memory_order_relaxed);
+}
+
 template <int D>
 ParticleSystem<D> build_start_state(const Config& config,
                                     const std::optional<fs::path>& restart_file,
@@ -190,82 +197,20 @@ ParticleSystem<D> build_start_state(const Config& config,
   return to_particle_system<D>(init);
 }
 
-std::uint64_t peak_rss_bytes() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024u;
-}
+template ParticleSystem<2> build_start_state<2>(const Config&, const std::optional<fs::path>&,
+                                                std::mt19937_64&, RunProgress&);
+template ParticleSystem<3> build_start_state<3>(const Config&, const std::optional<fs::path>&,
+                                                std::mt19937_64&, RunProgress&);
 
-class ThermoWriter {
- public:
-  ThermoWriter(const fs::path& path, bool append) {
-    const bool header = !append || !fs::exists(path) || fs::file_size(path) == 0;
-    out_.open(path, append ? std::ios::app : std::ios::trunc);
-    if (!out_) throw InputError("cannot write '" + path.string() + "'");
-    if (header) {
-      write_line(
-          "phase\ttime\tevents\tcollisions\tcollisions_per_particle\ttemperature\tpressure\t"
-          "compressibility\tkinetic_energy\tmean_free_time\trotational_temperature\t"
-          "dissipated_energy\twall_work\tpotential_energy\n");
-    }
-  }
-  // One row per line, each flushed at once: an interrupted run keeps every earlier row.
-  // Granular columns: rotational temperature, and the energy dissipated and the work done by
-  // moving walls since the start of the simulation (zero for elastic hard spheres).
-  // potential_energy: of the stepped potentials (0 for hard spheres).
-  struct Granular {
-    double rotational_temperature = 0.0, dissipated = 0.0, wall_work = 0.0;
-    double potential_energy = 0.0;
-  };
-  void write(const std::string& phase, const ThermoRow& r, const Granular& g) {
-    write_line(fmt::format(
-        "{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t"
-        "{:.17g}\t{:.17g}\t{:.17g}\n",
-        phase, r.at.time, r.at.events, r.at.collisions, r.collisions_per_particle, r.temperature,
-        r.pressure, r.compressibility, r.kinetic_energy, r.mean_free_time, g.rotational_temperature,
-        g.dissipated, g.wall_work, g.potential_energy));
-  }
+}  // namespace run_detail
 
- private:
-  void write_line(const std::string& line) {
-    out_ << line;
-    out_.flush();
-  }
+namespace {
 
-  std::ofstream out_;
-};
+using run_detail::build_start_state;
 
-// When the periodic outputs of a phase are due, in collisions (not time: the same schedule at
-// any density). Intervals of 0 in the config mean: thermo 100 rows and trajectory 10 frames per
-// production length; restart files only at the end.
-struct OutputSchedule {
-  struct Every {
-    std::uint64_t step = 0, next = ~0ull;  // step 0: never
-    // True (once) when `collisions` has reached the next multiple.
-    bool due(std::uint64_t collisions) {
-      if (collisions < next) return false;
-      next += step;
-      return true;
-    }
-  };
-  Every thermo, trajectory, restart;
-
-  template <class ToCollisions>
-  OutputSchedule(const OutputConfig& out, double production, std::uint64_t begin,
-                 ToCollisions&& collisions_for) {
-    auto every = [&](double per_particle) {
-      Every e;
-      if (per_particle > 0.0) {
-        e.step = std::max<std::uint64_t>(1, collisions_for(per_particle));
-        e.next = begin + e.step;
-      }
-      return e;
-    };
-    thermo = every(out.thermo_interval > 0 ? out.thermo_interval : production / 100.0);
-    trajectory = every(out.trajectory_interval > 0 ? out.trajectory_interval : production / 10.0);
-    restart = every(out.restart_interval);
-  }
-};
+using run_detail::OutputSchedule;
+using run_detail::peak_rss_bytes;
+using run_detail::ThermoWriter;
 
 template <int D, class Queue>
 class RunDriver {
@@ -273,6 +218,13 @@ class RunDriver {
   RunDriver(const Config& config, const std::optional<fs::path>& restart_file)
       : config_(config), restart_(restart_file.has_value()), rng_(config.system.seed) {
     ParticleSystem<D> start = build_start_state<D>(config, restart_file, rng_, resumed_);
+    if (restart_file && resumed_.integrator != "event") {
+      throw InputError(fmt::format(
+          "restart file '{}' was written by run.integrator = \"{}\", this run uses \"event\"; "
+          "continue it with the same integrator, or start a new run from its state with "
+          "system.initial_state",
+          restart_file->string(), resumed_.integrator));
+    }
     n_ = start.size();
     volume_ = 1.0;
     for (int a = 0; a < D; ++a) volume_ *= start.box[a];
@@ -379,18 +331,7 @@ class RunDriver {
  private:
   // Appending to another system's trajectory would corrupt it for every reader.
   void check_same_system(const fs::path& traj) const {
-    const gsd::Reader r(traj);
-    const auto n = r.find(0, "particles/N") ? r.read<std::uint32_t>(0, "particles/N")
-                                            : std::vector<std::uint32_t>{};
-    const auto dims = r.find(0, "configuration/dimensions")
-                          ? r.read<std::uint8_t>(0, "configuration/dimensions")
-                          : std::vector<std::uint8_t>{3};
-    if (n.empty() || n[0] != n_ || dims.empty() || dims[0] != D) {
-      throw InputError(fmt::format(
-          "output.directory '{}' holds a trajectory.gsd of another system ({} particles in {}D, "
-          "this run has {} in {}D): write the continued run to another directory (-o)",
-          dir_.string(), n.empty() ? 0u : n[0], dims.empty() ? 0 : dims[0], n_, D));
-    }
+    run_detail::check_same_trajectory(traj, n_, D, dir_);
   }
 
   // Equilibration still owed if the run stops now (a restart file records it).
@@ -645,6 +586,7 @@ class RunDriver {
     j["particles"] = n_;
     j["packing_fraction"] = particle_volume_ / volume_;
     j["number_density"] = static_cast<double>(n_) / volume_;
+    j["integrator"] = "event";
     j["event_queue"] = engine_->queue_name();
     j["restarted"] = restart_;
     j["stop_reason"] = stop_reason_;
@@ -806,6 +748,7 @@ class RunDriver {
 
 template <int D>
 RunOutcome run_with_dimension(const Config& config, const std::optional<fs::path>& restart) {
+  if (config.run.integrator == "dem") return run_detail::run_dem<D>(config, restart);
   if (config.run.event_queue == "heap") return RunDriver<D, BinaryHeapQueue>(config, restart).run();
   if (config.run.event_queue == "tree") {
     return RunDriver<D, TournamentTreeQueue>(config, restart).run();

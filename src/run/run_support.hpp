@@ -1,0 +1,142 @@
+// What the two run drivers share (run/run.cpp for the event-driven engine, run/dem_run.cpp for
+// the DEM integrator): the start state, the thermo.tsv writer, the output schedule in
+// collisions, the stop flag. Internal to src/run.
+#pragma once
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "analysis/thermodynamics.hpp"
+#include "core/error.hpp"
+#include "core/particle_system.hpp"
+#include "io/config.hpp"
+#include "io/gsd_file.hpp"
+#include "io/gsd_snapshot.hpp"
+#include "run/run.hpp"
+
+namespace kairos::run_detail {
+
+namespace fs = std::filesystem;
+
+// The state a run starts from: the restart file (its progress into `progress`), else
+// system.initial_state, else a generated one (run/run.cpp).
+template <int D>
+ParticleSystem<D> build_start_state(const Config& config,
+                                    const std::optional<fs::path>& restart_file,
+                                    std::mt19937_64& rng, RunProgress& progress);
+
+// Whether SIGINT/SIGTERM asked the run to stop (request_stop()).
+bool stop_requested() noexcept;
+
+// run.integrator = "dem" (run/dem_run.cpp).
+template <int D>
+RunOutcome run_dem(const Config& config, const std::optional<fs::path>& restart_file);
+
+// Appending to another system's trajectory would corrupt it for every reader: InputError unless
+// `traj` holds n particles in `dimension` D (the run's output directory `dir` named).
+inline void check_same_trajectory(const fs::path& traj, std::size_t n, int dimension,
+                                  const fs::path& dir) {
+  const gsd::Reader r(traj);
+  const auto stored_n = r.find(0, "particles/N") ? r.read<std::uint32_t>(0, "particles/N")
+                                                 : std::vector<std::uint32_t>{};
+  const auto dims = r.find(0, "configuration/dimensions")
+                        ? r.read<std::uint8_t>(0, "configuration/dimensions")
+                        : std::vector<std::uint8_t>{3};
+  if (stored_n.empty() || stored_n[0] != n || dims.empty() || dims[0] != dimension) {
+    throw InputError(fmt::format(
+        "output.directory '{}' holds a trajectory.gsd of another system ({} particles in {}D, "
+        "this run has {} in {}D): write the continued run to another directory (-o)",
+        dir.string(), stored_n.empty() ? 0u : stored_n[0], dims.empty() ? 0 : dims[0], n,
+        dimension));
+  }
+}
+
+inline std::uint64_t peak_rss_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024u;
+}
+
+class ThermoWriter {
+ public:
+  ThermoWriter(const fs::path& path, bool append) {
+    const bool header = !append || !fs::exists(path) || fs::file_size(path) == 0;
+    out_.open(path, append ? std::ios::app : std::ios::trunc);
+    if (!out_) throw InputError("cannot write '" + path.string() + "'");
+    if (header) {
+      write_line(
+          "phase\ttime\tevents\tcollisions\tcollisions_per_particle\ttemperature\tpressure\t"
+          "compressibility\tkinetic_energy\tmean_free_time\trotational_temperature\t"
+          "dissipated_energy\twall_work\tpotential_energy\n");
+    }
+  }
+  // One row per line, each flushed at once: an interrupted run keeps every earlier row.
+  // Granular columns: rotational temperature, and the energy dissipated and the work done by
+  // moving walls since the start of the simulation (zero for elastic hard spheres).
+  // potential_energy: of the stepped potentials (0 for hard spheres), or the elastic energy of
+  // the overlapping soft pairs (DEM).
+  struct Granular {
+    double rotational_temperature = 0.0, dissipated = 0.0, wall_work = 0.0;
+    double potential_energy = 0.0;
+  };
+  void write(const std::string& phase, const ThermoRow& r, const Granular& g) {
+    write_line(fmt::format(
+        "{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t"
+        "{:.17g}\t{:.17g}\t{:.17g}\n",
+        phase, r.at.time, r.at.events, r.at.collisions, r.collisions_per_particle, r.temperature,
+        r.pressure, r.compressibility, r.kinetic_energy, r.mean_free_time, g.rotational_temperature,
+        g.dissipated, g.wall_work, g.potential_energy));
+  }
+
+ private:
+  void write_line(const std::string& line) {
+    out_ << line;
+    out_.flush();
+  }
+
+  std::ofstream out_;
+};
+
+// When the periodic outputs of a phase are due, in collisions (not time: the same schedule at
+// any density). Intervals of 0 in the config mean: thermo 100 rows and trajectory 10 frames per
+// production length; restart files only at the end.
+struct OutputSchedule {
+  struct Every {
+    std::uint64_t step = 0, next = ~0ull;  // step 0: never
+    // True (once) when `collisions` has reached the next multiple.
+    bool due(std::uint64_t collisions) {
+      if (collisions < next) return false;
+      next += step;
+      return true;
+    }
+  };
+  Every thermo, trajectory, restart;
+
+  template <class ToCollisions>
+  OutputSchedule(const OutputConfig& out, double production, std::uint64_t begin,
+                 ToCollisions&& collisions_for) {
+    auto every = [&](double per_particle) {
+      Every e;
+      if (per_particle > 0.0) {
+        e.step = std::max<std::uint64_t>(1, collisions_for(per_particle));
+        e.next = begin + e.step;
+      }
+      return e;
+    };
+    thermo = every(out.thermo_interval > 0 ? out.thermo_interval : production / 100.0);
+    trajectory = every(out.trajectory_interval > 0 ? out.trajectory_interval : production / 10.0);
+    restart = every(out.restart_interval);
+  }
+};
+
+}  // namespace kairos::run_detail
