@@ -1,0 +1,138 @@
+"""The DEM integrator as a run choice (run.integrator = "dem", [soft]) end to end: energy of
+elastic soft gases conserved to O(dt^2), Haff cooling of a dashpot gas of constant restitution
+against formulas.md §6, the outputs, restarts that continue, and the errors.
+"""
+
+import json
+import math
+import os
+
+import numpy as np
+import gsd.hoomd
+
+import kairos_testlib as kt
+
+DASHPOT = {"model": "dashpot", "stiffness": 1.0e4}
+HERTZ = {"model": "hertz", "young": 1.0e5, "poisson": 0.3}
+
+
+def dem_config(soft, particles=1000, production=5.0, **sections):
+    run = {"integrator": "dem"}
+    run.update(sections.pop("run", {}))
+    return kt.base_config(particles=particles, packing_fraction=0.05, lattice="random",
+                          production=production, soft=soft, run=run, **sections)
+
+
+def energy_error(outdir):
+    """RMS over the thermo rows of (K + U + E_dissipated - E_0) / E_0, E_0 from the summary."""
+    header, rows, _ = kt.read_thermo(os.path.join(outdir, "thermo.tsv"))
+    e = np.array([r[header.index("kinetic_energy")] + r[header.index("potential_energy")] +
+                  r[header.index("dissipated_energy")] for r in rows])
+    with open(os.path.join(outdir, "summary.json")) as f:
+        e0 = json.load(f)["dem"]["energy_start"]
+    return float(np.sqrt(np.mean((e - e0) ** 2)) / e0)
+
+
+class DemRuns(kt.KairosTestCase):
+    def run_dem(self, name, config, *args):
+        self.run_ok("run", self.write_config(config, name + ".toml"), "-o", self.path(name), *args)
+        return self.summary(self.path(name))
+
+    def test_elastic_laws_conserve_energy_to_second_order_in_the_time_step(self):
+        # One collision per particle: the runs at dt and dt/2 meet the same collisions, whose
+        # energy errors shrink as dt^2 (a factor ~4; asserted > 2.5).
+        for soft in (DASHPOT, HERTZ):
+            base = self.run_dem("auto", dem_config(soft, production=1.0))
+            dt = 2.0 * base["dem"]["time_step"]  # t_c / 25
+            errors = []
+            for f in (1.0, 0.5):
+                name = "%s-%g" % (soft["model"], f)
+                s = self.run_dem(name, dem_config(soft, production=1.0,
+                                                  run={"time_step": f * dt}))
+                self.assertAlmostEqual(s["dem"]["time_step"], f * dt, delta=1e-15)
+                self.assertNotIn("granular", s)  # elastic: nothing dissipated
+                errors.append(energy_error(self.path(name)))
+            self.assertLess(errors[0], 1e-4, soft)
+            self.assertGreater(errors[0] / errors[1], 2.5, (soft, errors))
+
+    def test_dashpot_gas_of_constant_restitution_cools_as_haff(self):
+        # formulas.md §6: T = T0 exp(-(1 - e^2) c / 3) in collisions per particle c, and
+        # T0 / (1 + t / tau0)^2 in time with the Enskog frequency at T0.
+        e, eta, n_particles = 0.9, 0.05, 2000
+        config = dem_config(dict(DASHPOT, restitution=e), particles=n_particles, production=10.0,
+                            output={"thermo_interval": 1.0})
+        s = self.run_dem("haff", config)
+        header, rows, _ = kt.read_thermo(self.path("haff", "thermo.tsv"))
+        t0 = 1.0
+        for r in rows:
+            c = r[header.index("collisions_per_particle")]
+            expected = t0 * math.exp(-(1 - e * e) * c / 3.0)
+            self.assertAlmostEqual(r[header.index("temperature")] / expected, 1.0, delta=0.03,
+                                   msg="c = %g" % c)
+        n = 6 * eta / math.pi
+        g = (1 - eta / 2) / (1 - eta) ** 3
+        omega = 4 * n * g * math.sqrt(math.pi * t0)
+        tau0 = 6.0 / ((1 - e * e) * omega)
+        t = s["sim_time"]
+        self.assertAlmostEqual(s["temperature"] / (t0 / (1 + t / tau0) ** 2), 1.0, delta=0.05)
+        # The energy budget: kinetic + elastic + dissipated is the start energy to O(dt^2).
+        self.assertLess(s["granular"]["energy_balance_relative"], 2e-3)
+        self.assertGreater(s["granular"]["dissipated_in_collisions"], 0.3 * s["dem"]["energy_start"])
+
+    def test_outputs_are_present_and_well_formed(self):
+        config = dem_config(dict(HERTZ, restitution=0.8, restitution_speed=1.0), production=4.0)
+        s = self.run_dem("out", config)
+        self.assert_outputs_exist(self.path("out"))
+        self.assertEqual(s["integrator"], "dem")
+        self.assertEqual(s["stop_reason"], "completed")
+        self.assertAlmostEqual(s["production_collisions_per_particle"], 4.0, delta=0.01)
+        d = s["dem"]
+        self.assertEqual(d["steps"], s["events"])
+        self.assertAlmostEqual(d["steps"] * d["time_step"], s["sim_time"], delta=1e-9)
+        self.assertGreater(d["ns_per_particle_step"], 0.0)
+        self.assertGreater(s["compressibility"]["mean"], 1.0)
+        header, rows, _ = kt.read_thermo(self.path("out", "thermo.tsv"))
+        self.assertEqual(len(rows), 100)
+        self.assertTrue(all(r[header.index("potential_energy")] >= 0 for r in rows))
+        cumulative = [r[header.index("dissipated_energy")] for r in rows]
+        self.assertTrue(all(b >= a for a, b in zip(cumulative, cumulative[1:])))
+        frames = gsd.hoomd.open(self.path("out", "trajectory.gsd"), "rb")
+        self.assertEqual(len(frames), 11)
+        self.assertEqual(frames[-1].particles.N, 1000)
+        with open(self.path("out", "config.toml")) as f:
+            text = f.read()
+        self.assertIn('integrator = "dem"', text)
+        self.assertIn("[soft]", text)
+
+    def test_a_restart_continues_the_run(self):
+        config = dem_config(dict(DASHPOT, restitution=0.9), production=3.0)
+        one = self.run_dem("one", config)
+        two = self.run_dem("two", config, "--restart", self.path("one", "restart.gsd"))
+        self.assertTrue(two["restarted"])
+        self.assertEqual(two["dem"]["time_step"], one["dem"]["time_step"])  # kept, not re-derived
+        self.assertGreater(two["sim_time"], one["sim_time"])
+        self.assertEqual(two["dem"]["steps_since_start"], one["events"] + two["events"])
+        self.assertEqual(two["dem"]["collisions_since_start"], one["collisions"] + two["collisions"])
+        # Cooling continues from where it stopped: T = exp(-(1 - e^2) c / 3) over both parts.
+        c = (one["collisions"] + two["collisions"]) * 2.0 / 1000
+        self.assertAlmostEqual(two["temperature"] / math.exp(-0.19 * c / 3), 1.0, delta=0.04)
+        # The continuation's first thermo row starts from the saved state.
+        header, rows, _ = kt.read_thermo(self.path("two", "thermo.tsv"))
+        self.assertGreater(rows[0][header.index("time")], one["sim_time"])
+        # An event-driven run cannot continue a DEM state.
+        event = dict(config, run=dict(config["run"], integrator="event"))
+        result = self.kairos("run", self.write_config(event, "event.toml"), "-o",
+                             self.path("event"), "--restart", self.path("one", "restart.gsd"))
+        self.assert_user_error(result, "run.integrator", "dem")
+
+    def test_errors(self):
+        no_soft = kt.base_config(run={"integrator": "dem"})
+        result = self.kairos("run", self.write_config(no_soft, "a.toml"), "-o", self.path("a"))
+        self.assert_user_error(result, "run.integrator", "[soft]")
+        walls = dem_config(DASHPOT, boundary={"wall": [{"face": "z-"}, {"face": "z+"}]})
+        result = self.kairos("run", self.write_config(walls, "b.toml"), "-o", self.path("b"))
+        self.assert_user_error(result, "boundary.wall", "not supported by the DEM integrator")
+
+
+if __name__ == "__main__":
+    kt.main()
