@@ -76,6 +76,9 @@ struct EventCounters {
   std::uint64_t soft_overlap_fallbacks = 0;
   std::uint64_t soft_early_releases = 0;
   std::uint64_t soft_direct_maps = 0;
+  // The kinetic energy the frozen contacts give back at their release (part of the state:
+  // kinetic + this + dissipated energy is what a contact conserves).
+  double soft_contact_energy = 0.0;
 };
 
 // A bond of a molecule (chain): particles i and j (the caller's numbering) interact through

@@ -60,7 +60,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
       env_(environment) {
   const std::size_t n = s.size();
   if (n < 2) throw InputError("a simulation needs at least 2 particles");
-  if (n >= kFirstWall) throw InputError("too many particles (at most 2^32 - 16)");
+  if (n >= kFirstCode) throw InputError("too many particles (at most 2^32 - 16)");
   if (s.mass.size() != n || s.species.size() != n) {
     throw InputError("the state needs a mass and a species for every particle");
   }
@@ -68,6 +68,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
   bonds_ = s.bonds;
   bond_types_ = s.bond_types;
   setup_environment(s);
+  setup_soft(s);
   for (CandidateList& list : lists_) {
     list.ids.resize(256);
     list.shift.resize(256);
@@ -101,6 +102,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
     const Kinematics<D>& kin = s.kinematics[id_[k]];
     hot_[k] = {kin.pos, kin.vel, kin.time, has_counts ? s.collision_count[id_[k]] : 0u, 0u};
   }
+  restore_frozen(s);
   // Spins are tracked when contacts can change them, or when the state carries them.
   if (env_.rotates() || !s.angular_velocity.empty()) {
     if (!s.angular_velocity.empty() && s.angular_velocity.size() != n) {
@@ -156,7 +158,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
                          " is not at or after the state's time");
       }
       const bool particle = e.partner < n;
-      if (!particle && e.partner < kFirstWall) {
+      if (!particle && e.partner < kFirstCode) {
         throw InputError("cannot resume: particle " + std::to_string(id_[k]) +
                          " has an event partner code out of range");
       }
@@ -175,6 +177,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
       hot_[k].cell = grid_.locate(hot_[k].pos);
       for (int f = 0; f < 2 * D; ++f) {
         if (env_.faces[f].kind != FaceKind::kWall) continue;
+        if (soft_ && frozen_with_[k] != kNoPartner) continue;  // pressed into its wall
         const int a = f / 2;
         const double gap = f % 2 == 0 ? hot_[k].pos[a] - wall_offset(f, time_)
                                       : wall_offset(f, time_) - hot_[k].pos[a];
@@ -433,7 +436,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
       const std::uint32_t old = rank[k].second;
       hot[k] = hot_[old];
       pending[k] = pending_[old];
-      if (pending[k].partner < kFirstWall) pending[k].partner = new_index[pending[k].partner];
+      if (pending[k].partner < kFirstCode) pending[k].partner = new_index[pending[k].partner];
       id[k] = id_[old];
       if (queue_filled) times[k] = queue_.time_of(old);
     }
@@ -451,6 +454,11 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(spin_, n);
   permute(last_collision_, n);
   permute(asleep_, n);
+  permute(frozen_with_, n);
+  permute(release_time_, n);
+  permute(release_velocity_, n);
+  for (std::uint32_t& p : frozen_with_)
+    if (p < kFirstCode) p = new_index[p];
   if (stepped_) steps_.renumber(new_index);
   insert_all_into_grid();
   if (queue_filled) queue_.reset(times);
@@ -753,6 +761,10 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
       when = t + dt;
     }
   }
+  if (soft_ && frozen_with_[i] != kNoPartner && release_time_[i] <= when) [[unlikely]] {
+    pending_[i] = {kRelease, 0};
+    when = release_time_[i];
+  }
   return when > t ? when : t;  // never in the past, whatever the round-off
 }
 
@@ -782,6 +794,10 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) {
   // Canonical order so that which of the pair was popped never changes the arithmetic.
   if (j < i) std::swap(i, j);
+  if (soft_) [[unlikely]] {
+    collide_soft(i, j, t);
+    return;
+  }
   if (sheared_) [[unlikely]] {
     collide_sheared(i, j, t);
     return;
@@ -957,6 +973,10 @@ std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i,
 template <int D, class Queue>
 void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
   if (t >= squeeze_time_) throw_squeezed(t);
+  if (soft_) [[unlikely]] {
+    hit_wall_soft(i, face, t);
+    return;
+  }
   const bool again = wedged(i, t);
   advance_to(i, t);
   HotRecord<D>& h = hot_[i];
@@ -1175,6 +1195,10 @@ void EventEngine<D, Queue>::set_velocity(std::uint32_t k, double t, const Vec<D>
   }
   time_ = t;
   if (is_asleep(k)) wake(k, t);
+  if (soft_) {  // a kick ends a soft contact in progress (exception B)
+    const std::uint32_t partner = release(k, t, /*early=*/true);
+    if (partner < kFirstCode) queue_.update(partner, predict(partner, t));
+  }
   advance_to(k, t);
   HotRecord<D>& h = hot_[k];
   counters_.work_by_driving += 0.5 * mass_of(k) * (norm2(v) - norm2(h.vel));
@@ -1233,7 +1257,11 @@ EventKind EventEngine<D, Queue>::step() {
     cross(i, t);
     return EventKind::kCellCrossing;
   }
-  if (e.partner >= kFirstWall) [[unlikely]] {
+  if (e.partner >= kFirstCode) [[unlikely]] {
+    if (e.partner == kRelease) {
+      release_event(i, t);
+      return EventKind::kSoftRelease;
+    }
     hit_wall(i, static_cast<int>(e.partner - kFirstWall), t);
     return EventKind::kWallCollision;
   }
@@ -1273,6 +1301,21 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
   out.bonds = bonds_;
   out.bond_types = bond_types_;
   if (stepped_ && with_zones) out.zones = steps_.export_zones(id_.data());
+  for (std::uint32_t k = 0; soft_ && k < n; ++k) {
+    const std::uint32_t p = frozen_with_[k];
+    if (p == kNoPartner || (p < kFirstCode && p < k)) continue;  // each pair once
+    FrozenContact<D> c;
+    c.i = id_[k];
+    c.release_time = release_time_[k];
+    c.velocity_i = release_velocity_[k];
+    if (p < kFirstCode) {
+      c.j = id_[p];
+      c.velocity_j = release_velocity_[p];
+    } else {
+      c.face = p - kFirstWall;
+    }
+    out.frozen.push_back(c);
+  }
   for (std::uint32_t k = 0; k < n; ++k) {
     const std::uint32_t c = id_[k];
     const HotRecord<D>& h = hot_[k];
@@ -1286,7 +1329,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
     if (sleeping_ > 0) out.asleep[c] = asleep_[k];
     if (!last_collision_.empty()) out.last_collision_time[c] = last_collision_[k];
     const PendingEvent& e = pending_[k];
-    out.events[c] = {queue_.time_of(k), e.partner >= kFirstWall ? e.partner : id_[e.partner],
+    out.events[c] = {queue_.time_of(k), e.partner >= kFirstCode ? e.partner : id_[e.partner],
                      e.partner_count};
   }
   return out;
@@ -1577,14 +1620,22 @@ void EventEngine<D, Queue>::validate() {
     for (int f = 0; f < 2 * D; ++f) {
       if (env_.faces[f].kind != FaceKind::kWall) continue;
       const double gap = f % 2 == 0 ? x[f / 2] - wall_offset(f, t) : wall_offset(f, t) - x[f / 2];
-      if (gap < radius_of(i) * (1.0 - 1e-9)) fail("particle " + name(i) + " overlaps a wall");
+      if (gap >= radius_of(i) * (1.0 - 1e-9)) continue;
+      // A soft contact overlaps its wall while frozen and after its release, leaving; turned
+      // back towards the wall (by a third body), it meets the wall now.
+      const double leaving = (f % 2 == 0 ? 1.0 : -1.0) * (velocity_of(i, t)[f / 2] -
+                                                           env_.faces[f].wall.velocity[f / 2]);
+      const bool soft_ok = soft_ && gap > 0.75 * radius_of(i) &&
+                           (frozen_with_[i] == kFirstWall + static_cast<std::uint32_t>(f) ||
+                            leaving >= 0.0 || queue_.time_of(i) <= t);
+      if (!soft_ok) fail("particle " + name(i) + " overlaps a wall");
     }
     for (int a = 0; a < D; ++a) {
       const double tol = 1e-9 * box_[a];
       if (x[a] < grid_.lower_bound(h.cell, a) - tol || x[a] > grid_.upper_bound(h.cell, a) + tol)
         fail("particle " + name(i) + " outside its cell");
     }
-    if (pending_[i].partner < kFirstWall && pending_[i].partner >= n)
+    if (pending_[i].partner < kFirstCode && pending_[i].partner >= n)
       fail("particle " + name(i) + " has a partner out of range");
   }
   // Whether a pending event lies after a contact due at `due`, beyond round-off: positions are
@@ -1732,7 +1783,13 @@ void EventEngine<D, Queue>::validate() {
       for (int a = 0; a < D; ++a)
         if (grid_.periodic(a)) r[a] = minimum_image(r[a], box_[a]);
       if (norm2(r) < sigma * sigma * (1.0 - 1e-9)) {
-        fail("particles " + name(i) + " and " + name(j) + " overlap");
+        // Soft spheres overlap while frozen in a contact and after its release, receding; an
+        // approaching overlap must collide now (check_covered).
+        const bool soft_ok =
+            soft_ && norm2(r) > 0.5625 * sigma * sigma &&
+            (frozen_pair(i, j) || dot(r, velocity_of(i, t) - velocity_of(j, t)) >= 0.0 ||
+             std::min(queue_.time_of(i), queue_.time_of(j)) <= t);
+        if (!soft_ok) fail("particles " + name(i) + " and " + name(j) + " overlap");
       }
       check_covered(i, j, r, "nearest image");
     }

@@ -40,7 +40,16 @@ namespace kairos {
 
 // kImageShift: under Lees-Edwards shear, the images across the y faces moved on by a cell width
 // and the particles next to those faces were predicted again.
-enum class EventKind { kNone, kCollision, kCellCrossing, kStale, kWallCollision, kImageShift };
+// kSoftRelease: a soft contact ended, its frozen pair got its post-contact velocities.
+enum class EventKind {
+  kNone,
+  kCollision,
+  kCellCrossing,
+  kStale,
+  kWallCollision,
+  kImageShift,
+  kSoftRelease
+};
 
 // How an engine starts: predict every event from the state, or resume the scheduler state the
 // ParticleSystem carries (from export_state() or a restart file) to continue bit-identically.
@@ -112,8 +121,15 @@ class EventEngine {
   double peculiar_kinetic_energy() const;
   double rotational_energy() const;  // 0 unless particles rotate
   // Configurational energy of the stepped potentials (0 for hard spheres), exact: the sum of
-  // the energies of the zones the pairs sit in.
-  double potential_energy() const { return stepped_ ? steps_.energy() : 0.0; }
+  // the energies of the zones the pairs sit in. Soft spheres: the kinetic energy the frozen
+  // contacts will give back at their release (what the contacts hold, so that kinetic +
+  // potential + dissipated energy stays constant through a contact).
+  double potential_energy() const {
+    return stepped_ ? steps_.energy() : counters_.soft_contact_energy;
+  }
+  bool soft() const { return soft_; }
+  // How many particles sit in a frozen soft contact now.
+  std::uint32_t frozen() const;
   bool stepped() const { return stepped_; }
   std::uint32_t sleeping() const { return sleeping_; }
   Vec<D> momentum() const;
@@ -156,6 +172,10 @@ class EventEngine {
   // Partner codes of a PendingEvent beyond the particle indices: a wall (one per box face),
   // and kNoPartner for a cell crossing.
   static constexpr std::uint32_t kFirstWall = EventSlot::kNoPartner - 2 * D;
+  // Soft spheres: the release of the frozen contact the particle sits in. Codes from
+  // kFirstCode on are not particles.
+  static constexpr std::uint32_t kRelease = kFirstWall - 1;
+  static constexpr std::uint32_t kFirstCode = kRelease;
   // Cells per particle allowed when some axis has walls or open faces (see setup_environment).
   static constexpr double kBoundedCellsPerParticle = 8.0;
 
@@ -266,6 +286,27 @@ class EventEngine {
   void collide_sheared(std::uint32_t i, std::uint32_t j, double t);
   void cross_shear_face(std::uint32_t i, int side, double t, std::array<int, D>& c);
   void cross(std::uint32_t i, double t);
+  // Soft spheres (formulas.md §1.6; engine/soft_contacts.cpp).
+  void setup_soft(const ParticleSystem<D>& s);
+  void restore_frozen(const ParticleSystem<D>& s);
+  void collide_soft(std::uint32_t i, std::uint32_t j, double t);
+  void hit_wall_soft(std::uint32_t i, int face, double t);
+  // Gives the contact particle i is frozen in its post-contact velocities at time t (early:
+  // before its release time, exception B). Returns the partner (a particle, whose prediction
+  // is now the caller's business, or a wall code), kNoPartner if i is not frozen.
+  std::uint32_t release(std::uint32_t i, double t, bool early);
+  void release_event(std::uint32_t i, double t);
+  // The map from the table, or integrated directly outside it (counted).
+  CollisionMap soft_map(const SoftMapTable* table, const CollisionUnits& units);
+  // Whether i at xi (and j at xj, unless j is kNoPartner) at time t would overlap a third
+  // particle or a wall (other than face skip_face).
+  bool placement_overlaps(std::uint32_t i, const Vec<D>& xi, std::uint32_t j, const Vec<D>& xj,
+                          double t, int skip_face);
+  // Moves particle i into the cell of its (changed) position.
+  void relocate(std::uint32_t i);
+  bool frozen_pair(std::uint32_t i, std::uint32_t j) const {
+    return soft_ && frozen_with_[i] == j;
+  }
   void renumber(bool queue_filled);
   void insert_all_into_grid();
   void check_restored_cell(std::uint32_t i) const;
@@ -314,6 +355,13 @@ class EventEngine {
   std::vector<std::uint32_t> step_held_index_;
   std::vector<Bond> bonds_;  // the caller's numbering, kept for export
   std::vector<std::string> bond_types_;
+
+  // Soft spheres: per particle, the partner of its frozen contact (kFirstWall + face for a wall,
+  // kNoPartner: none), when it is released and with what velocity. Empty unless soft_.
+  bool soft_ = false;
+  HugeVector<std::uint32_t> frozen_with_;
+  HugeVector<double> release_time_;
+  HugeVector<Vec<D>> release_velocity_;
 
   CandidateList lists_[2];
   Environment<D> env_;  // last: the hot members above share fewer cache lines

@@ -1,0 +1,377 @@
+// Soft spheres in the event-driven engine: the Müller–Pöschel algorithm (formulas.md §1.6).
+//
+// At first contact (r = l, found by the ordinary hard-sphere prediction) the collision map
+// gives where and how the contact ends. The pair is placed at once where it will be at the end
+// of the contact, seen from its centre of mass (the line of centres rotated by phi_c, the
+// separation eps_r l), and both particles move with the centre-of-mass velocity V: frozen, they
+// cannot meet each other (g = 0 exactly). A release event eps_t T later gives them the
+// post-contact velocities. Isolated binary collisions are then exact from the end of the
+// contact on. Exceptions: (A) if the placed pair would overlap a third body or a wall, the
+// contact is instantaneous at first contact with e = -eps_rdot; (B) a third body (or a wall)
+// meeting a frozen particle before the release releases its pair first.
+//
+// A released pair still overlaps by the contact's end overlap and recedes: the hard-sphere
+// prediction never sees an overlapping, receding pair collide (collision_time.hpp), which is
+// the force-zero end of formulas.md §1.3. Wall contacts are the head-on map with mu = m and
+// l = R: the particle is pushed into the wall by the end overlap and keeps only its tangential
+// velocity until its release.
+#include <cmath>
+#include <string>
+
+#include "core/error.hpp"
+#include "core/periodic.hpp"
+#include "engine/event_engine.hpp"
+#include "scheduler/binary_heap_queue.hpp"
+#include "scheduler/calendar_queue.hpp"
+#include "scheduler/tournament_tree_queue.hpp"
+
+namespace kairos {
+
+namespace {
+constexpr std::uint32_t kNone = EventSlot::kNoPartner;
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
+  soft_ = env_.soft_spheres();
+  if (!soft_) {
+    if (!s.frozen.empty())
+      throw InputError("the state has soft contacts in progress but no soft contact law ([soft])");
+    return;
+  }
+  std::uint32_t species = 1;
+  for (const Shape& sh : shapes_) species = std::max(species, sh.species + 1);
+  const std::size_t pairs = static_cast<std::size_t>(env_.species) * env_.species;
+  if (env_.species < species || env_.soft.size() != pairs) {
+    throw InputError("the soft contact laws cover " + std::to_string(env_.species) + " species (" +
+                     std::to_string(env_.soft.size()) + " pair laws) but particles use " +
+                     std::to_string(species));
+  }
+  if (!env_.soft_tables.empty() && env_.soft_tables.size() != pairs)
+    throw InputError("soft spheres: one lookup table (or none) per species pair is needed");
+  if (walls_ && env_.soft_wall.size() < species)
+    throw InputError("soft spheres: walls need a soft contact law for every species");
+  if (!env_.soft_wall_tables.empty() && env_.soft_wall_tables.size() != env_.soft_wall.size())
+    throw InputError("soft spheres: one wall lookup table (or none) per species is needed");
+  // The map is exact for a free pair: the uniform field, steps, shear and instantaneous laws
+  // would all act during the contact, where the algorithm has nothing to say.
+  if (stepped_) throw InputError("soft spheres cannot be combined with stepped potentials");
+  if (sheared_) throw InputError("soft spheres cannot be combined with Lees-Edwards shear");
+  if (accelerated_) throw InputError("soft spheres cannot be combined with gravity (yet)");
+  if (!env_.contact.empty() || env_.tc > 0.0) {
+    throw InputError(
+        "soft spheres replace the contact laws: [contact] restitution, roughness and tc must be "
+        "left at their elastic defaults");
+  }
+  for (int f = 0; f < 2 * D; ++f) {
+    if (env_.wall_moves(f))
+      throw InputError("soft spheres cannot meet walls that vibrate or move along their normal");
+  }
+  const std::size_t n = s.size();
+  frozen_with_.assign(n, kNone);
+  release_time_.assign(n, kNever);
+  release_velocity_.assign(n, Vec<D>{});
+}
+
+// The contacts in progress of the state, in the engine's numbering (id_ is set, the hot
+// records hold the frozen velocities).
+template <int D, class Queue>
+void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s) {
+  if (!soft_) return;
+  const auto n = static_cast<std::uint32_t>(size());
+  std::vector<std::uint32_t> internal(n);
+  for (std::uint32_t k = 0; k < n; ++k) internal[id_[k]] = k;
+  for (const FrozenContact<D>& c : s.frozen) {
+    const bool wall = c.j == FrozenContact<D>::kWall;
+    if (c.i >= n || (!wall && (c.j >= n || c.j == c.i)) || (wall && c.face >= 2 * D) ||
+        !(c.release_time >= s.time) || !std::isfinite(c.release_time)) {
+      throw InputError("the state's soft contact of particle " + std::to_string(c.i) +
+                       " is inconsistent (partner, face or release time)");
+    }
+    const std::uint32_t i = internal[c.i];
+    if (frozen_with_[i] != kNone)
+      throw InputError("particle " + std::to_string(c.i) + " is in two soft contacts");
+    if (wall) {
+      if (env_.faces[c.face].kind != FaceKind::kWall)
+        throw InputError("particle " + std::to_string(c.i) +
+                         " is in contact with a face that is "
+                         "not a wall");
+      frozen_with_[i] = kFirstWall + c.face;
+    } else {
+      const std::uint32_t j = internal[c.j];
+      if (frozen_with_[j] != kNone)
+        throw InputError("particle " + std::to_string(c.j) + " is in two soft contacts");
+      frozen_with_[i] = j;
+      frozen_with_[j] = i;
+      release_time_[j] = c.release_time;
+      release_velocity_[j] = c.velocity_j;
+    }
+    release_time_[i] = c.release_time;
+    release_velocity_[i] = c.velocity_i;
+  }
+}
+
+template <int D, class Queue>
+std::uint32_t EventEngine<D, Queue>::frozen() const {
+  std::uint32_t count = 0;
+  for (const std::uint32_t p : frozen_with_) count += p != kNone ? 1u : 0u;
+  return count;
+}
+
+template <int D, class Queue>
+CollisionMap EventEngine<D, Queue>::soft_map(const SoftMapTable* table,
+                                             const CollisionUnits& units) {
+  // WIRE-TABLE: table->lookup(units, map) once soft_map_table.cpp lands.
+  (void)table;
+  ++counters_.soft_direct_maps;
+  return collision_map(units.reduced);
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::relocate(std::uint32_t i) {
+  HotRecord<D>& h = hot_[i];
+  for (int a = 0; a < D; ++a)
+    if (grid_.periodic(a)) h.pos[a] = wrap_into_box(h.pos[a], box_[a]);
+  const CellCode c = grid_.locate(h.pos);
+  if (c == h.cell) return;
+  grid_.erase(i, h.cell);
+  h.cell = c;
+  grid_.insert(i, c);
+}
+
+template <int D, class Queue>
+bool EventEngine<D, Queue>::placement_overlaps(std::uint32_t i, const Vec<D>& xi, std::uint32_t j,
+                                               const Vec<D>& xj, double t, int skip_face) {
+  auto overlaps = [&](std::uint32_t p, Vec<D> x) {
+    const double radius = radius_of(p);
+    for (int f = 0; f < 2 * D; ++f) {
+      if (f == skip_face || env_.faces[f].kind != FaceKind::kWall) continue;
+      const double gap = f % 2 == 0 ? x[f / 2] - wall_offset(f, t) : wall_offset(f, t) - x[f / 2];
+      if (gap < radius) return true;
+    }
+    for (int a = 0; a < D; ++a)
+      if (grid_.periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
+    CandidateList& list = lists_[0];
+    gather(grid_.locate(x), list);
+    for (std::uint32_t k = 0; k < list.count; ++k) {
+      const std::uint32_t q = list.ids[k];
+      if (q == i || q == j) continue;
+      Vec<D> d = x - position_of(q, t);
+      for (int a = 0; a < D; ++a)
+        if (grid_.periodic(a)) d[a] = minimum_image(d[a], box_[a]);
+      const double sigma = radius + radius_of(q);
+      if (norm2(d) < sigma * sigma) return true;
+    }
+    return false;
+  };
+  return overlaps(i, xi) || (j != kNone && overlaps(j, xj));
+}
+
+template <int D, class Queue>
+std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool early) {
+  const std::uint32_t p = frozen_with_[i];
+  if (p == kNone) return kNone;
+  auto give_back = [&](std::uint32_t k) {
+    advance_to(k, t);
+    HotRecord<D>& h = hot_[k];
+    counters_.soft_contact_energy -=
+        0.5 * mass_of(k) * (norm2(release_velocity_[k]) - norm2(h.vel));
+    h.vel = release_velocity_[k];
+    ++h.collisions;
+    frozen_with_[k] = kNone;
+    release_time_[k] = kNever;
+  };
+  give_back(i);
+  if (p < kFirstCode) give_back(p);
+  if (early) ++counters_.soft_early_releases;
+  return p;
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::release_event(std::uint32_t i, double t) {
+  const std::uint32_t p = release(i, t, /*early=*/false);
+  if (p < kFirstCode) {
+    predict_pair(i, p, t);
+  } else {
+    queue_.update(i, predict(i, t));
+  }
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, double t) {
+  // Exception B: a frozen particle met by another is released (with its partner) first.
+  const std::uint32_t released[2] = {release(i, t, true), release(j, t, true)};
+  advance_to(i, t);
+  advance_to(j, t);
+  HotRecord<D>& hi = hot_[i];
+  HotRecord<D>& hj = hot_[j];
+  auto predict_released = [&] {
+    for (const std::uint32_t p : released)
+      if (p < kFirstCode && p != i && p != j) queue_.update(p, predict(p, t));
+  };
+  Vec<D> r;
+  for (int a = 0; a < D; ++a) {
+    const double raw = hi.pos[a] - hj.pos[a];
+    r[a] = !bounded_ || grid_.periodic(a) ? minimum_image(raw, box_[a]) : raw;
+  }
+  const Vec<D> g = hi.vel - hj.vel;
+  const double r2 = norm2(r), rg = dot(r, g);
+  if (!(rg < 0.0)) {  // the release turned them apart: no contact after all
+    predict_pair(i, j, t);
+    predict_released();
+    return;
+  }
+  const double mi = mass_of(i), mj = mass_of(j), total = mi + mj, mu = mi * mj / total;
+  const double l = radius_of(i) + radius_of(j);
+  const double distance = std::sqrt(r2);
+  const Vec<D> n0 = (1.0 / distance) * r;
+  const double vn = -rg / distance;
+  const Vec<D> gt = g + vn * n0;
+  const double vt = std::sqrt(norm2(gt));
+  const std::size_t pair = static_cast<std::size_t>(species_of(i)) * env_.species + species_of(j);
+  const SoftContactLaw& law = env_.soft[pair];
+  const SoftMapTable* table = env_.soft_tables.empty() ? nullptr : env_.soft_tables[pair].get();
+  // A pair found already overlapping (one just released, turned back by a third body) has no
+  // first contact to start the map from: it collides instantaneously.
+  const bool overlapping = distance < l * (1.0 - 1e-9);
+  const bool mapped = env_.soft_collisions == SoftCollisions::kMapped && !overlapping;
+  const CollisionUnits units = reduce_collision(law, mu, l, vn, mapped ? vt : 0.0);
+  const CollisionMap map = soft_map(table, units);
+  const Vec<D> V = (1.0 / total) * (mi * hi.vel + mj * hj.vel);
+  const double ke_before = 0.5 * (mi * norm2(hi.vel) + mj * norm2(hj.vel));
+  bool placed = false;
+  if (mapped) {
+    const double phi = map.eps_phi * units.angle_unit;
+    const Vec<D> t0 = vt > 0.0 ? (1.0 / vt) * gt : Vec<D>{};
+    const double c = std::cos(phi), s = std::sin(phi);
+    const Vec<D> nc = c * n0 + s * t0, tc = c * t0 - s * n0;
+    const Vec<D> rc = (map.eps_r * l) * nc;
+    // Each particle's displacement from its place at first contact (R stays): no images.
+    const Vec<D> xi = hi.pos + (mj / total) * (rc - r), xj = hj.pos - (mi / total) * (rc - r);
+    if (!placement_overlaps(i, xi, j, xj, t, -1)) {
+      const Vec<D> gc = (-map.eps_rdot * vn) * nc + (vt / map.eps_r) * tc;
+      release_velocity_[i] = V + (mj / total) * gc;
+      release_velocity_[j] = V - (mi / total) * gc;
+      const Vec<D> impulse = mi * (release_velocity_[i] - hi.vel);
+      // The impulse acts while the line of centres turns from r to rc: the mean lever arm.
+      const Vec<D> arm = 0.5 * (r + rc);
+      counters_.virial += dot(arm, impulse);
+      add_virial_tensor(arm, impulse);
+      const double ke_after =
+          0.5 * (mi * norm2(release_velocity_[i]) + mj * norm2(release_velocity_[j]));
+      counters_.dissipated_in_collisions += ke_before - ke_after;
+      counters_.soft_contact_energy += ke_after - 0.5 * total * norm2(V);
+      hi.pos = xi;
+      hj.pos = xj;
+      hi.vel = V;
+      hj.vel = V;
+      relocate(i);
+      relocate(j);
+      frozen_with_[i] = j;
+      frozen_with_[j] = i;
+      release_time_[i] = release_time_[j] = t + map.eps_t * units.time_unit;
+      ++counters_.soft_contacts;
+      placed = true;
+    } else {
+      ++counters_.soft_overlap_fallbacks;  // exception A
+    }
+  } else if (overlapping) {
+    ++counters_.soft_overlap_fallbacks;
+  }
+  if (!placed) {
+    // Instantaneous, smooth: g.n -> -e g.n with e = -eps_rdot of this collision's map.
+    const double e = -map.eps_rdot;
+    const Vec<D> impulse = ((1.0 + e) * mu * vn) * n0;
+    hi.vel = hi.vel + (1.0 / mi) * impulse;
+    hj.vel = hj.vel - (1.0 / mj) * impulse;
+    counters_.virial += dot(r, impulse);
+    add_virial_tensor(r, impulse);
+    counters_.dissipated_in_collisions += 0.5 * mu * vn * vn * (1.0 - e * e);
+    separate(i, j, r, r2);
+  }
+  ++counters_.collisions;
+  ++hi.collisions;
+  ++hj.collisions;
+  predict_pair(i, j, t);
+  predict_released();
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
+  const std::uint32_t partner = release(i, t, true);
+  if (partner < kFirstCode) queue_.update(partner, predict(partner, t));
+  advance_to(i, t);
+  HotRecord<D>& h = hot_[i];
+  const int a = face / 2;
+  const double sgn = face % 2 == 0 ? 1.0 : -1.0;
+  const double wall_speed = env_.faces[face].wall.velocity[a];  // 0: walls do not move (setup)
+  const double vn = -sgn * (h.vel[a] - wall_speed);
+  if (!(vn > 0.0)) {  // released early, it now leaves the wall
+    ++h.collisions;
+    queue_.update(i, predict(i, t));
+    return;
+  }
+  const std::uint32_t s = species_of(i);
+  const double m = mass_of(i), radius = radius_of(i);
+  const SoftMapTable* table =
+      env_.soft_wall_tables.empty() ? nullptr : env_.soft_wall_tables[s].get();
+  const CollisionUnits units = reduce_collision(env_.soft_wall[s], m, radius, vn, 0.0);
+  const CollisionMap map = soft_map(table, units);
+  const double e = -map.eps_rdot;
+  Vec<D> after = h.vel;
+  after[a] = wall_speed + sgn * e * vn;
+  counters_.dissipated_at_walls += 0.5 * m * vn * vn * (1.0 - e * e);
+  // Already overlapping the wall (released from it, then turned back by a third body): no
+  // first contact to start the map from, so the contact is instantaneous.
+  const double gap = sgn * (h.pos[a] - wall_offset(face, t));
+  const bool overlapping = gap < radius * (1.0 - 1e-9);
+  if (overlapping) ++counters_.soft_overlap_fallbacks;
+  bool placed = false;
+  if (env_.soft_collisions == SoftCollisions::kMapped && !overlapping) {
+    Vec<D> x = h.pos;
+    x[a] -= sgn * map.end_overlap * units.length_unit;  // into the wall by the end overlap
+    if (!placement_overlaps(i, x, kNone, x, t, face)) {
+      Vec<D> frozen_velocity = h.vel;
+      frozen_velocity[a] = wall_speed;
+      counters_.soft_contact_energy += 0.5 * m * (norm2(after) - norm2(frozen_velocity));
+      h.pos = x;
+      h.vel = frozen_velocity;
+      relocate(i);
+      frozen_with_[i] = kFirstWall + static_cast<std::uint32_t>(face);
+      release_time_[i] = t + map.eps_t * units.time_unit;
+      release_velocity_[i] = after;
+      ++counters_.soft_contacts;
+      placed = true;
+    } else {
+      ++counters_.soft_overlap_fallbacks;
+    }
+  }
+  if (!placed) h.vel = after;
+  ++counters_.wall_collisions;
+  ++h.collisions;
+  queue_.update(i, predict(i, t));
+}
+
+#define KAIROS_SOFT_MEMBERS(D, Q)                                                                  \
+  template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                           \
+  template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&);                       \
+  template std::uint32_t EventEngine<D, Q>::frozen() const;                                        \
+  template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&);   \
+  template void EventEngine<D, Q>::relocate(std::uint32_t);                                        \
+  template bool EventEngine<D, Q>::placement_overlaps(std::uint32_t, const Vec<D>&, std::uint32_t, \
+                                                      const Vec<D>&, double, int);                 \
+  template std::uint32_t EventEngine<D, Q>::release(std::uint32_t, double, bool);                  \
+  template void EventEngine<D, Q>::release_event(std::uint32_t, double);                           \
+  template void EventEngine<D, Q>::collide_soft(std::uint32_t, std::uint32_t, double);             \
+  template void EventEngine<D, Q>::hit_wall_soft(std::uint32_t, int, double);
+
+KAIROS_SOFT_MEMBERS(2, BinaryHeapQueue)
+KAIROS_SOFT_MEMBERS(3, BinaryHeapQueue)
+KAIROS_SOFT_MEMBERS(2, CalendarQueue)
+KAIROS_SOFT_MEMBERS(3, CalendarQueue)
+KAIROS_SOFT_MEMBERS(2, TournamentTreeQueue)
+KAIROS_SOFT_MEMBERS(3, TournamentTreeQueue)
+
+#undef KAIROS_SOFT_MEMBERS
+
+}  // namespace kairos

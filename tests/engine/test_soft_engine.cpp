@@ -1,0 +1,375 @@
+// Soft spheres in the event-driven engine (formulas.md §1.6, Müller–Pöschel):
+// an isolated oblique collision of unequal spheres ends where Newton's
+// equations put it (direct integration, and the DEM integrator at a tiny time
+// step); gases under both laws keep every invariant (brute-force validation
+// after every event, the energy budget kinetic + contact + dissipated,
+// momentum); both exceptions happen where constructed and are counted; a wall
+// contact reproduces the closed-form dashpot; the instantaneous mode is the
+// hard-sphere model with e(v_n); resumes with contacts in progress are
+// bit-identical.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "dem/dem_integrator.hpp"
+#include "engine/event_engine.hpp"
+#include "engine_fixtures.hpp"
+#include "interactions/soft_contact.hpp"
+#include "scheduler/calendar_queue.hpp"
+
+namespace kairos {
+namespace {
+
+using Engine3 = EventEngine<3, CalendarQueue>;
+
+template <int D>
+Environment<D> soft_environment(const SoftContactLaw& law, std::uint32_t species = 2) {
+  Environment<D> env;
+  env.species = species;
+  env.soft.assign(static_cast<std::size_t>(species) * species, law);
+  env.soft_wall.assign(species, law);
+  return env;
+}
+
+// Two spheres (radii 0.5 and 0.7, masses 1 and 2.3) that first touch at t0 =
+// 0.2, obliquely (v_t / v_n about 0.6), in a periodic box far larger than they
+// are.
+ParticleSystem<3> oblique_pair() {
+  ParticleSystem<3> s;
+  s.box = {12.0, 12.0, 12.0};
+  const Vec<3> vi{1.0, 0.3, -0.1}, vj{-0.6, 0.1, 0.25};
+  Vec<3> n{1.0, 0.45, -0.2};  // from j to i at contact; g.n < 0
+  n = (1.0 / std::sqrt(norm2(n))) * n;
+  const double t0 = 0.2, l = 1.2;
+  const Vec<3> ci{6.0, 6.0, 6.0};
+  const Vec<3> cj = ci - l * n;
+  s.kinematics = {{ci - t0 * vi, vi, 0.0, 0.5}, {cj - t0 * vj, vj, 0.0, 0.7}};
+  s.mass = {1.0, 2.3};
+  s.species = {0, 1};
+  s.species_names = {"A", "B"};
+  return s;
+}
+
+// Runs until the first release has been processed; returns the state then.
+ParticleSystem<3> through_first_release(Engine3& engine) {
+  for (int k = 0; k < 100000; ++k) {
+    const EventKind kind = engine.step();
+    if (kind == EventKind::kSoftRelease) return engine.export_state();
+    if (kind == EventKind::kNone) break;
+  }
+  ADD_FAILURE() << "no release";
+  return engine.export_state();
+}
+
+class SoftBinary : public ::testing::TestWithParam<SoftModel> {
+ protected:
+  SoftContactLaw law() const {
+    // Contact times of a few 0.01 at these speeds: l~ ~ 100 (dashpot) / ~ 50
+    // (Hertz).
+    return GetParam() == SoftModel::LinearDashpot ? SoftContactLaw::linear_dashpot(4.0e4, 30.0)
+                                                  : SoftContactLaw::viscoelastic_hertz(2.0e5, 2e-3);
+  }
+};
+
+TEST_P(SoftBinary, ObliqueUnequalPairEndsWhereNewtonPutsIt) {
+  const ParticleSystem<3> start = oblique_pair();
+  Engine3 engine(start, StartMode::kPredict, {}, soft_environment<3>(law()));
+  const ParticleSystem<3> after = through_first_release(engine);
+  EXPECT_EQ(after.counters.soft_contacts, 1u);
+  EXPECT_EQ(after.counters.collisions, 1u);
+
+  // Direct 3D integration of Newton's equations from first contact (t0 = 0.2).
+  const double t0 = 0.2, t_end = 0.45;
+  PairState at_contact;
+  for (int k = 0; k < 2; ++k) {
+    (k == 0 ? at_contact.r_i : at_contact.r_j) = start.position_at(k, t0);
+    (k == 0 ? at_contact.v_i : at_contact.v_j) = start.kinematics[k].vel;
+  }
+  const SoftPair pair{1.0, 2.3, 0.5, 0.7};
+  const DirectContact direct = integrate_contact_directly(law(), pair, at_contact);
+  EXPECT_NEAR(after.time, t0 + direct.contact_time, 1e-9 * direct.contact_time);
+  const double tc = direct.contact_time;
+  ASSERT_LT(t0 + tc, t_end);
+  const double free_time = t_end - t0 - tc;
+  const Vec<3> xi = direct.state.r_i + free_time * direct.state.v_i;
+  const Vec<3> xj = direct.state.r_j + free_time * direct.state.v_j;
+  const double g0 = std::sqrt(norm2(start.kinematics[0].vel - start.kinematics[1].vel));
+  auto image = [&](Vec<3> d) {
+    for (int a = 0; a < 3; ++a) d[a] = std::remainder(d[a], start.box[a]);
+    return d;
+  };
+  // The map is good to its integration tolerance: 1e-10 of the size and of the
+  // speed.
+  EXPECT_LT(std::sqrt(norm2(image(after.position_at(0, t_end) - xi))), 1e-10);
+  EXPECT_LT(std::sqrt(norm2(image(after.position_at(1, t_end) - xj))), 1e-10);
+  EXPECT_LT(std::sqrt(norm2(after.kinematics[0].vel - direct.state.v_i)), 1e-10 * g0);
+  EXPECT_LT(std::sqrt(norm2(after.kinematics[1].vel - direct.state.v_j)), 1e-10 * g0);
+
+  // The DEM integrator at t_c / 5000 from the same initial state to the same
+  // time.
+  DemOptions options;
+  const long steps = static_cast<long>(std::ceil(t_end / (tc / 5000.0)));
+  options.dt = t_end / static_cast<double>(steps);
+  DemIntegrator<3> dem(start, std::vector<SoftContactLaw>(4, law()), 2, options);
+  dem.step(steps);
+  ASSERT_NEAR(dem.time(), t_end, 1e-12);
+  const double l = 1.2;
+  for (int k = 0; k < 2; ++k) {
+    const double dx = std::sqrt(norm2(image(dem.position(k) - after.position_at(k, t_end))));
+    const double dv = std::sqrt(norm2(dem.velocity(k) - after.kinematics[k].vel));
+    EXPECT_LT(dx / l, 1e-6) << "particle " << k;
+    EXPECT_LT(dv / g0, 1e-6) << "particle " << k;
+  }
+}
+
+TEST_P(SoftBinary, InstantaneousModeIsTheHardSphereWithTheHeadOnRestitution) {
+  const ParticleSystem<3> start = oblique_pair();
+  Environment<3> env = soft_environment<3>(law());
+  env.soft_collisions = SoftCollisions::kInstantaneous;
+  Engine3 engine(start, StartMode::kPredict, {}, env);
+  while (engine.counters().collisions == 0) ASSERT_NE(engine.step(), EventKind::kNone);
+  const ParticleSystem<3> after = engine.export_state();
+  EXPECT_EQ(after.counters.soft_contacts, 0u);
+  EXPECT_DOUBLE_EQ(after.time, 0.2);
+  // Normal relative velocity reversed and scaled by the head-on map's e,
+  // tangential kept.
+  const Vec<3> r = after.position_at(0, 0.2) - after.position_at(1, 0.2);
+  const Vec<3> n = (1.0 / std::sqrt(norm2(r))) * r;
+  const Vec<3> g0 = start.kinematics[0].vel - start.kinematics[1].vel;
+  const Vec<3> g1 = after.kinematics[0].vel - after.kinematics[1].vel;
+  const double mu = reduced_mass(1.0, 2.3);
+  const CollisionUnits units = reduce_collision(law(), mu, 1.2, -dot(g0, n), 0.0);
+  const double e = -collision_map(units.reduced).eps_rdot;
+  EXPECT_NEAR(dot(g1, n), -e * dot(g0, n), 1e-12);
+  EXPECT_LT(std::sqrt(norm2((g1 - dot(g1, n) * n) - (g0 - dot(g0, n) * n))), 1e-12);
+  if (GetParam() == SoftModel::LinearDashpot) {
+    EXPECT_NEAR(e, dashpot_head_on(mu, law().stiffness, law().damping).restitution, 1e-10);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(BothLaws, SoftBinary,
+                         ::testing::Values(SoftModel::LinearDashpot, SoftModel::ViscoelasticHertz),
+                         [](const auto& p) {
+                           return p.param == SoftModel::LinearDashpot ? "Dashpot" : "Hertz";
+                         });
+
+// Kinetic energy + what the frozen contacts hold + what was dissipated:
+// constant.
+template <int D>
+double energy_budget(const EventEngine<D, CalendarQueue>& e) {
+  return e.kinetic_energy() + e.potential_energy() + e.counters().dissipated_in_collisions +
+         e.counters().dissipated_at_walls;
+}
+
+template <int D>
+void run_validated_gas(ParticleSystem<D> s, const Environment<D>& env, int events) {
+  EventEngine<D, CalendarQueue> engine(s, StartMode::kPredict, {}, env);
+  const double budget = energy_budget(engine);
+  const Vec<D> p0 = engine.momentum();
+  bool walls = env.has_walls();
+  std::uint32_t most_frozen = 0;
+  for (int k = 0; k < events; ++k) {
+    ASSERT_NE(engine.step(), EventKind::kNone);
+    ASSERT_NO_THROW(engine.validate()) << "after event " << k;
+    most_frozen = std::max(most_frozen, engine.frozen());
+    ASSERT_NEAR(energy_budget(engine), budget, 1e-11 * budget) << "after event " << k;
+    if (!walls) {
+      const Vec<D> p = engine.momentum();
+      for (int a = 0; a < D; ++a) ASSERT_NEAR(p[a], p0[a], 1e-11 * std::sqrt(budget));
+    }
+  }
+  const EventCounters& c = engine.counters();
+  EXPECT_GT(c.soft_contacts, 50u);
+  EXPECT_GE(most_frozen, 2u);
+  EXPECT_GT(c.dissipated_in_collisions, 0.0);
+  if (walls) {
+    EXPECT_GT(c.wall_collisions, 0u);
+  }
+}
+
+TEST(SoftGas, DashpotGasIn3DKeepsEveryInvariant) {
+  run_validated_gas(testing::lattice_system<3>(5, 0.15, 3, 1.7, 1.3),
+                    soft_environment<3>(SoftContactLaw::linear_dashpot(2.0e3, 8.0)), 3000);
+}
+
+TEST(SoftGas, HertzGasIn2DKeepsEveryInvariant) {
+  run_validated_gas(testing::lattice_system<2>(10, 0.2, 4, 0.6, 0.8),
+                    soft_environment<2>(SoftContactLaw::viscoelastic_hertz(5.0e3, 5e-3)), 3000);
+}
+
+TEST(SoftGas, DashpotGasBetweenWallsKeepsEveryInvariant) {
+  ParticleSystem<3> s = testing::lattice_system<3>(5, 0.15, 5);
+  for (auto& k : s.kinematics) k.pos[2] += 0.3;  // clear of the walls at z = 0 and z = L
+  Environment<3> env = soft_environment<3>(SoftContactLaw::linear_dashpot(2.0e3, 8.0));
+  env.faces[4].kind = env.faces[5].kind = FaceKind::kWall;
+  run_validated_gas(s, env, 3000);
+}
+
+TEST(SoftGas, ElasticDashpotConservesKineticEnergyOutsideContacts) {
+  ParticleSystem<3> s = testing::lattice_system<3>(5, 0.15, 6);
+  Engine3 engine(s, StartMode::kPredict, {},
+                 soft_environment<3>(SoftContactLaw::linear_dashpot(2.0e3, 0.0)));
+  const double ke0 = engine.kinetic_energy();
+  for (int k = 0; k < 2000; ++k) ASSERT_NE(engine.step(), EventKind::kNone);
+  EXPECT_NEAR(engine.counters().dissipated_in_collisions, 0.0, 1e-12 * ke0);
+  EXPECT_NEAR(engine.kinetic_energy() + engine.potential_energy(), ke0, 1e-12 * ke0);
+}
+
+// Exception B: a third sphere k meets i while i and j are frozen in their
+// contact; the pair is released at once and k's collision follows.
+TEST(SoftExceptions, ThirdBodyDuringTheContactReleasesThePairEarly) {
+  const SoftContactLaw law = SoftContactLaw::linear_dashpot(400.0, 4.0);  // t_c ~ 0.1
+  ParticleSystem<3> s;
+  s.box = {10.0, 10.0, 10.0};
+  // i at rest at the origin (shifted into the box), j coming along -x: contact
+  // at t0 = 0.5.
+  const Vec<3> c{5.0, 5.0, 5.0};
+  const double t0 = 0.5;
+  s.kinematics = {{c, {0.0, 0.0, 0.0}, 0.0, 0.5},
+                  {c + Vec<3>{1.0 + t0, 0.0, 0.0}, {-1.0, 0, 0}, 0.0, 0.5}};
+  s.mass = {1.0, 1.0};
+  // Where i sits frozen: pushed towards j by half the end overlap, then moving
+  // with V.
+  const CollisionUnits units = reduce_collision(law, 0.5, 1.0, 1.0, 0.0);
+  const CollisionMap map = collision_map(units.reduced);
+  const double tc = map.eps_t * units.time_unit;
+  const double th = t0 + 0.5 * tc;
+  const double xi = c[0] + 0.5 * map.end_overlap * units.length_unit - 0.5 * (th - t0);
+  // k comes up along +y, touching i at th.
+  const double u = 2.0;
+  s.kinematics.push_back({{xi, c[1] - 1.0 - u * th, c[2]}, {0.0, u, 0.0}, 0.0, 0.5});
+  s.mass.push_back(1.0);
+  s.species = {0, 0, 0};
+  s.species_names = {"A"};
+  Engine3 engine(s, StartMode::kPredict, {}, soft_environment<3>(law, 1));
+  const Vec<3> p0 = engine.momentum();
+  while (engine.time() < th + 0.5 * tc) {
+    ASSERT_NE(engine.step(), EventKind::kNone);
+    ASSERT_NO_THROW(engine.validate());
+  }
+  EXPECT_EQ(engine.counters().soft_early_releases, 1u);
+  EXPECT_EQ(engine.counters().collisions, 2u);
+  const Vec<3> p = engine.momentum();
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(p[a], p0[a], 1e-12);
+}
+
+// Exception A: i's place at the end of its contact with j overlaps a resting
+// third sphere k, which it does not touch at first contact; the contact is then
+// instantaneous.
+TEST(SoftExceptions, PlacementOverlappingAThirdBodyFallsBackToAnInstantaneousCollision) {
+  const SoftContactLaw law = SoftContactLaw::linear_dashpot(100.0, 6.0);  // end overlap ~ 0.05
+  ParticleSystem<3> s;
+  s.box = {10.0, 10.0, 10.0};
+  const Vec<3> c{5.0, 5.0, 5.0};
+  const double t0 = 0.5;
+  s.kinematics = {{c, {0.0, 0.0, 0.0}, 0.0, 0.5},
+                  {c + Vec<3>{1.0 + t0, 0.0, 0.0}, {-1.0, 0, 0}, 0.0, 0.5}};
+  s.mass = {1.0, 1.0};
+  const CollisionUnits units = reduce_collision(law, 0.5, 1.0, 1.0, 0.0);
+  const CollisionMap map = collision_map(units.reduced);
+  const double shift = 0.5 * map.end_overlap * units.length_unit;  // i moves +x by this
+  ASSERT_GT(shift, 0.01);
+  // k (radius 0.1) at 60 degrees from +x, a quarter of the shift's approach
+  // beyond contact.
+  const double d = 0.6 + 0.25 * shift;
+  s.kinematics.push_back({c + Vec<3>{0.5 * d, std::sqrt(0.75) * d, 0.0}, {}, 0.0, 0.1});
+  s.mass.push_back(0.2);
+  s.species = {0, 0, 1};
+  s.species_names = {"A", "B"};
+  Engine3 engine(s, StartMode::kPredict, {}, soft_environment<3>(law));
+  while (engine.counters().collisions == 0) {
+    ASSERT_NE(engine.step(), EventKind::kNone);
+    ASSERT_NO_THROW(engine.validate());
+  }
+  EXPECT_EQ(engine.counters().soft_overlap_fallbacks, 1u);
+  EXPECT_EQ(engine.counters().soft_contacts, 0u);
+  EXPECT_EQ(engine.frozen(), 0u);
+  const ParticleSystem<3> after = engine.export_state();
+  EXPECT_NEAR(after.kinematics[1].vel[0] - after.kinematics[0].vel[0], -map.eps_rdot, 1e-12);
+}
+
+// A sphere meeting a fixed wall obliquely: after the contact its normal
+// velocity is e v_n and it sits where the closed-form dashpot puts it; the
+// tangential motion never changes.
+TEST(SoftWalls, WallContactMatchesTheClosedFormDashpot) {
+  const double k = 900.0, gamma = 9.0, m = 1.5;
+  ParticleSystem<3> s;
+  s.box = {10.0, 10.0, 10.0};
+  const Vec<3> v{0.3, -0.2, -1.3};
+  s.kinematics = {{{5.0, 5.0, 0.5 + 1.3 * 0.4}, v, 0.0, 0.5}, {{2.0, 2.0, 8.0}, {}, 0.0, 0.5}};
+  s.mass = {m, m};
+  s.species = {0, 0};
+  s.species_names = {"A"};
+  Environment<3> env = soft_environment<3>(SoftContactLaw::linear_dashpot(k, gamma), 1);
+  env.faces[4].kind = env.faces[5].kind = FaceKind::kWall;
+  Engine3 engine(s, StartMode::kPredict, {}, env);
+  EventKind kind;
+  while ((kind = engine.step()) != EventKind::kSoftRelease) ASSERT_NE(kind, EventKind::kNone);
+  const HeadOn closed = dashpot_head_on(m, k, gamma);
+  EXPECT_NEAR(engine.time(), 0.4 + closed.contact_time, 1e-10);
+  const ParticleSystem<3> after = engine.export_state();
+  EXPECT_NEAR(after.kinematics[0].vel[2], 1.3 * closed.restitution, 1e-10);
+  EXPECT_EQ(after.kinematics[0].vel[0], v[0]);
+  EXPECT_EQ(after.kinematics[0].vel[1], v[1]);
+  const double t = engine.time();
+  const Vec<3> x = after.position_at(0, t);
+  EXPECT_NEAR(x[2], 0.5 - dashpot_end_overlap(m, k, gamma, 1.3), 1e-10);
+  EXPECT_NEAR(x[0], 5.0 + v[0] * t, 1e-10);
+  EXPECT_NEAR(x[1], 5.0 + v[1] * t, 1e-10);
+  EXPECT_NEAR(after.counters.dissipated_at_walls,
+              0.5 * m * 1.3 * 1.3 * (1.0 - closed.restitution * closed.restitution), 1e-10);
+}
+
+TEST(SoftResume, ResumingWithContactsInProgressIsBitIdentical) {
+  const ParticleSystem<3> s = testing::lattice_system<3>(5, 0.15, 7, 1.4, 1.2);
+  const Environment<3> env = soft_environment<3>(SoftContactLaw::viscoelastic_hertz(3.0e3, 4e-3));
+  Engine3 a(s, StartMode::kPredict, {}, env);
+  for (int k = 0; k < 800 || a.frozen() == 0; ++k) ASSERT_NE(a.step(), EventKind::kNone);
+  const ParticleSystem<3> mid = a.export_state();
+  ASSERT_FALSE(mid.frozen.empty());
+  Engine3 b(mid, StartMode::kResume, {}, env);
+  for (int k = 0; k < 3000; ++k) {
+    ASSERT_NE(a.step(), EventKind::kNone);
+    ASSERT_NE(b.step(), EventKind::kNone);
+  }
+  const ParticleSystem<3> ea = a.export_state(), eb = b.export_state();
+  EXPECT_EQ(ea.time, eb.time);
+  for (std::size_t i = 0; i < ea.size(); ++i) {
+    ASSERT_EQ(ea.kinematics[i].pos, eb.kinematics[i].pos) << i;
+    ASSERT_EQ(ea.kinematics[i].vel, eb.kinematics[i].vel) << i;
+  }
+  EXPECT_EQ(ea.frozen, eb.frozen);
+  EXPECT_EQ(ea.counters.soft_contacts, eb.counters.soft_contacts);
+  EXPECT_EQ(ea.counters.dissipated_in_collisions, eb.counters.dissipated_in_collisions);
+}
+
+TEST(SoftErrors, UnsupportedCombinationsAreRefusedByName) {
+  const ParticleSystem<3> s = testing::lattice_system<3>(4, 0.1, 1);
+  const SoftContactLaw law = SoftContactLaw::linear_dashpot(1e3, 1.0);
+  auto refused = [&](const Environment<3>& env, const std::string& word) {
+    try {
+      Engine3 e(s, StartMode::kPredict, {}, env);
+      ADD_FAILURE() << "accepted: " << word;
+    } catch (const InputError& err) {
+      EXPECT_NE(std::string(err.what()).find(word), std::string::npos) << err.what();
+    }
+  };
+  Environment<3> env = soft_environment<3>(law);
+  env.gravity = {0.0, 0.0, -1.0};
+  refused(env, "gravity");
+  env = soft_environment<3>(law);
+  env.shear_rate = 0.1;
+  refused(env, "shear");
+  env = soft_environment<3>(law);
+  env.contact.assign(4, ContactModel{});
+  refused(env, "contact");
+  env = soft_environment<3>(law);
+  env.soft.resize(1);
+  refused(env, "soft contact laws");
+}
+
+}  // namespace
+}  // namespace kairos
