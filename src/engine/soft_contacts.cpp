@@ -121,8 +121,8 @@ std::uint32_t EventEngine<D, Queue>::frozen() const {
 template <int D, class Queue>
 CollisionMap EventEngine<D, Queue>::soft_map(const SoftMapTable* table,
                                              const CollisionUnits& units) {
-  // WIRE-TABLE: table->lookup(units, map) once soft_map_table.cpp lands.
-  (void)table;
+  CollisionMap map;
+  if (table != nullptr && table->lookup(units, map)) return map;
   ++counters_.soft_direct_maps;
   return collision_map(units.reduced);
 }

@@ -1,15 +1,14 @@
-// Soft spheres in the event-driven engine (formulas.md §1.6, Müller–Pöschel):
-// an isolated oblique collision of unequal spheres ends where Newton's
-// equations put it (direct integration, and the DEM integrator at a tiny time
-// step); gases under both laws keep every invariant (brute-force validation
-// after every event, the energy budget kinetic + contact + dissipated,
-// momentum); both exceptions happen where constructed and are counted; a wall
-// contact reproduces the closed-form dashpot; the instantaneous mode is the
-// hard-sphere model with e(v_n); resumes with contacts in progress are
-// bit-identical.
+// Soft spheres in the event-driven engine (formulas.md §1.6, Müller–Pöschel): an isolated oblique
+// collision of unequal spheres ends where Newton's equations put it (direct integration, and the
+// DEM integrator at a tiny time step); gases under both laws keep every invariant (brute-force
+// validation after every event, the energy budget kinetic + contact + dissipated, momentum); both
+// exceptions happen where constructed and are counted; a wall contact reproduces the closed-form
+// dashpot; the instantaneous mode is the hard-sphere model with e(v_n); resumes with contacts in
+// progress are bit-identical.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,6 +17,7 @@
 #include "engine/event_engine.hpp"
 #include "engine_fixtures.hpp"
 #include "interactions/soft_contact.hpp"
+#include "interactions/soft_map_table.hpp"
 #include "scheduler/calendar_queue.hpp"
 
 namespace kairos {
@@ -35,13 +35,12 @@ Environment<D> soft_environment(const SoftContactLaw& law, std::uint32_t species
 }
 
 // Two spheres (radii 0.5 and 0.7, masses 1 and 2.3) that first touch at t0 =
-// 0.2, obliquely (v_t / v_n about 0.6), in a periodic box far larger than they
-// are.
+// 0.2, obliquely (v_t / v_n about 0.6), in a periodic box far larger than they are.
 ParticleSystem<3> oblique_pair() {
   ParticleSystem<3> s;
   s.box = {12.0, 12.0, 12.0};
   const Vec<3> vi{1.0, 0.3, -0.1}, vj{-0.6, 0.1, 0.25};
-  Vec<3> n{1.0, 0.45, -0.2};  // from j to i at contact; g.n < 0
+  Vec<3> n{-1.0, -0.45, 0.2};  // from j to i at contact; g.n < 0
   n = (1.0 / std::sqrt(norm2(n))) * n;
   const double t0 = 0.2, l = 1.2;
   const Vec<3> ci{6.0, 6.0, 6.0};
@@ -67,8 +66,7 @@ ParticleSystem<3> through_first_release(Engine3& engine) {
 class SoftBinary : public ::testing::TestWithParam<SoftModel> {
  protected:
   SoftContactLaw law() const {
-    // Contact times of a few 0.01 at these speeds: l~ ~ 100 (dashpot) / ~ 50
-    // (Hertz).
+    // Contact times of a few 0.01 at these speeds: l~ ~ 100 (dashpot) / ~ 50 (Hertz).
     return GetParam() == SoftModel::LinearDashpot ? SoftContactLaw::linear_dashpot(4.0e4, 30.0)
                                                   : SoftContactLaw::viscoelastic_hertz(2.0e5, 2e-3);
   }
@@ -101,17 +99,16 @@ TEST_P(SoftBinary, ObliqueUnequalPairEndsWhereNewtonPutsIt) {
     for (int a = 0; a < 3; ++a) d[a] = std::remainder(d[a], start.box[a]);
     return d;
   };
-  // The map is good to its integration tolerance: 1e-10 of the size and of the
-  // speed.
+  // The map is good to its integration tolerance: 1e-10 of the size and of the speed.
   EXPECT_LT(std::sqrt(norm2(image(after.position_at(0, t_end) - xi))), 1e-10);
   EXPECT_LT(std::sqrt(norm2(image(after.position_at(1, t_end) - xj))), 1e-10);
   EXPECT_LT(std::sqrt(norm2(after.kinematics[0].vel - direct.state.v_i)), 1e-10 * g0);
   EXPECT_LT(std::sqrt(norm2(after.kinematics[1].vel - direct.state.v_j)), 1e-10 * g0);
 
-  // The DEM integrator at t_c / 5000 from the same initial state to the same
-  // time.
+  // The DEM integrator at t_c / 50000 (the dashpot force jumps at first contact, which costs
+  // DEM an error of first order in dt) from the same initial state to the same time.
   DemOptions options;
-  const long steps = static_cast<long>(std::ceil(t_end / (tc / 5000.0)));
+  const long steps = static_cast<long>(std::ceil(t_end / (tc / 50000.0)));
   options.dt = t_end / static_cast<double>(steps);
   DemIntegrator<3> dem(start, std::vector<SoftContactLaw>(4, law()), 2, options);
   dem.step(steps);
@@ -125,6 +122,37 @@ TEST_P(SoftBinary, ObliqueUnequalPairEndsWhereNewtonPutsIt) {
   }
 }
 
+// The same collision through a lookup table (tolerance 1e-6): no direct integration, and the state
+// after the contact within the table's tolerance of the directly mapped one.
+TEST_P(SoftBinary, LookupTableGivesTheMappedStateToItsTolerance) {
+  const ParticleSystem<3> start = oblique_pair();
+  Engine3 direct(start, StartMode::kPredict, {}, soft_environment<3>(law()));
+  const ParticleSystem<3> exact = through_first_release(direct);
+  SoftTableSpec spec;
+  spec.law = law();
+  spec.reduced_mass = reduced_mass(1.0, 2.3);
+  spec.contact_distance = 1.2;
+  spec.min_normal_speed = 1.0;
+  spec.max_normal_speed = 2.5;
+  spec.max_tangential_ratio = 3.0;
+  SoftTableBuildOptions options;
+  options.check_points = 200;
+  Environment<3> env = soft_environment<3>(law());
+  env.soft_tables.assign(4,
+                         std::make_shared<const SoftMapTable>(SoftMapTable::build(spec, options)));
+  Engine3 tabulated(start, StartMode::kPredict, {}, env);
+  const ParticleSystem<3> after = through_first_release(tabulated);
+  EXPECT_EQ(after.counters.soft_direct_maps, 0u);
+  EXPECT_EQ(exact.counters.soft_direct_maps, 1u);
+  EXPECT_NEAR(after.time, exact.time, 1e-6 * (exact.time - 0.2));
+  const double g0 = std::sqrt(norm2(start.kinematics[0].vel - start.kinematics[1].vel));
+  for (int k = 0; k < 2; ++k) {
+    // Positions move by at most the end overlap and the rotation: 1e-6 of those, far below.
+    EXPECT_LT(std::sqrt(norm2(after.position_at(k, 0.45) - exact.position_at(k, 0.45))), 1e-7);
+    EXPECT_LT(std::sqrt(norm2(after.kinematics[k].vel - exact.kinematics[k].vel)), 1e-6 * g0);
+  }
+}
+
 TEST_P(SoftBinary, InstantaneousModeIsTheHardSphereWithTheHeadOnRestitution) {
   const ParticleSystem<3> start = oblique_pair();
   Environment<3> env = soft_environment<3>(law());
@@ -134,8 +162,7 @@ TEST_P(SoftBinary, InstantaneousModeIsTheHardSphereWithTheHeadOnRestitution) {
   const ParticleSystem<3> after = engine.export_state();
   EXPECT_EQ(after.counters.soft_contacts, 0u);
   EXPECT_DOUBLE_EQ(after.time, 0.2);
-  // Normal relative velocity reversed and scaled by the head-on map's e,
-  // tangential kept.
+  // Normal relative velocity reversed and scaled by the head-on map's e, tangential kept.
   const Vec<3> r = after.position_at(0, 0.2) - after.position_at(1, 0.2);
   const Vec<3> n = (1.0 / std::sqrt(norm2(r))) * r;
   const Vec<3> g0 = start.kinematics[0].vel - start.kinematics[1].vel;
@@ -156,8 +183,7 @@ INSTANTIATE_TEST_SUITE_P(BothLaws, SoftBinary,
                            return p.param == SoftModel::LinearDashpot ? "Dashpot" : "Hertz";
                          });
 
-// Kinetic energy + what the frozen contacts hold + what was dissipated:
-// constant.
+// Kinetic energy + what the frozen contacts hold + what was dissipated: constant.
 template <int D>
 double energy_budget(const EventEngine<D, CalendarQueue>& e) {
   return e.kinetic_energy() + e.potential_energy() + e.counters().dissipated_in_collisions +
@@ -218,21 +244,19 @@ TEST(SoftGas, ElasticDashpotConservesKineticEnergyOutsideContacts) {
   EXPECT_NEAR(engine.kinetic_energy() + engine.potential_energy(), ke0, 1e-12 * ke0);
 }
 
-// Exception B: a third sphere k meets i while i and j are frozen in their
-// contact; the pair is released at once and k's collision follows.
+// Exception B: a third sphere k meets i while i and j are frozen in their contact; the pair is
+// released at once and k's collision follows.
 TEST(SoftExceptions, ThirdBodyDuringTheContactReleasesThePairEarly) {
   const SoftContactLaw law = SoftContactLaw::linear_dashpot(400.0, 4.0);  // t_c ~ 0.1
   ParticleSystem<3> s;
   s.box = {10.0, 10.0, 10.0};
-  // i at rest at the origin (shifted into the box), j coming along -x: contact
-  // at t0 = 0.5.
+  // i at rest at the origin (shifted into the box), j coming along -x: contact at t0 = 0.5.
   const Vec<3> c{5.0, 5.0, 5.0};
   const double t0 = 0.5;
   s.kinematics = {{c, {0.0, 0.0, 0.0}, 0.0, 0.5},
                   {c + Vec<3>{1.0 + t0, 0.0, 0.0}, {-1.0, 0, 0}, 0.0, 0.5}};
   s.mass = {1.0, 1.0};
-  // Where i sits frozen: pushed towards j by half the end overlap, then moving
-  // with V.
+  // Where i sits frozen: pushed towards j by half the end overlap, then moving with V.
   const CollisionUnits units = reduce_collision(law, 0.5, 1.0, 1.0, 0.0);
   const CollisionMap map = collision_map(units.reduced);
   const double tc = map.eps_t * units.time_unit;
@@ -256,9 +280,8 @@ TEST(SoftExceptions, ThirdBodyDuringTheContactReleasesThePairEarly) {
   for (int a = 0; a < 3; ++a) EXPECT_NEAR(p[a], p0[a], 1e-12);
 }
 
-// Exception A: i's place at the end of its contact with j overlaps a resting
-// third sphere k, which it does not touch at first contact; the contact is then
-// instantaneous.
+// Exception A: i's place at the end of its contact with j overlaps a resting third sphere k, which
+// it does not touch at first contact; the contact is then instantaneous.
 TEST(SoftExceptions, PlacementOverlappingAThirdBodyFallsBackToAnInstantaneousCollision) {
   const SoftContactLaw law = SoftContactLaw::linear_dashpot(100.0, 6.0);  // end overlap ~ 0.05
   ParticleSystem<3> s;
@@ -272,8 +295,7 @@ TEST(SoftExceptions, PlacementOverlappingAThirdBodyFallsBackToAnInstantaneousCol
   const CollisionMap map = collision_map(units.reduced);
   const double shift = 0.5 * map.end_overlap * units.length_unit;  // i moves +x by this
   ASSERT_GT(shift, 0.01);
-  // k (radius 0.1) at 60 degrees from +x, a quarter of the shift's approach
-  // beyond contact.
+  // k (radius 0.1) at 60 degrees from +x, a quarter of the shift's approach beyond contact.
   const double d = 0.6 + 0.25 * shift;
   s.kinematics.push_back({c + Vec<3>{0.5 * d, std::sqrt(0.75) * d, 0.0}, {}, 0.0, 0.1});
   s.mass.push_back(0.2);
@@ -291,9 +313,8 @@ TEST(SoftExceptions, PlacementOverlappingAThirdBodyFallsBackToAnInstantaneousCol
   EXPECT_NEAR(after.kinematics[1].vel[0] - after.kinematics[0].vel[0], -map.eps_rdot, 1e-12);
 }
 
-// A sphere meeting a fixed wall obliquely: after the contact its normal
-// velocity is e v_n and it sits where the closed-form dashpot puts it; the
-// tangential motion never changes.
+// A sphere meeting a fixed wall obliquely: after the contact its normal velocity is e v_n and it
+// sits where the closed-form dashpot puts it; the tangential motion never changes.
 TEST(SoftWalls, WallContactMatchesTheClosedFormDashpot) {
   const double k = 900.0, gamma = 9.0, m = 1.5;
   ParticleSystem<3> s;
