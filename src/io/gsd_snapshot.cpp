@@ -14,9 +14,10 @@ namespace kairos {
 namespace {
 
 // 2: one event time per particle, order; 3: granular counters, spins, TC times, sleepers;
-// 4: bonds, pair zones, step counters. Version 3 files are still read (no bonds, zones absent,
-// step counters 0): the chunks added in 4 are optional.
-constexpr std::uint32_t kRestartFormat = 4;
+// 4: bonds, pair zones, step counters; 5: soft contacts in progress and soft counters (a
+// format-4 reader would drop the contacts in progress silently, hence the new number).
+// Versions 3 and 4 are still read: the chunks added since are optional.
+constexpr std::uint32_t kRestartFormat = 5;
 constexpr std::uint32_t kOldestRestartFormat = 3;
 
 // HOOMD stores type names as an N_types x M int8 array of 0-padded strings.
@@ -233,8 +234,9 @@ void validate_restart(const ParticleSystem<D>& s, const std::filesystem::path& p
       throw bad("mass" + who + " is not positive");
     if (s.species[i] >= s.species_names.size()) throw bad("typeid" + who + " out of range");
     if (std::isnan(e.time)) throw bad("pending event time" + who + " is NaN");
-    // Codes above the particle indices name walls (the 2D faces below kNoPartner).
-    if (e.partner < EventSlot::kNoPartner - 2 * D && e.partner >= n)
+    // Codes above the particle indices name walls (the 2D faces below kNoPartner) and, just
+    // below those, a soft contact's release.
+    if (e.partner < EventSlot::kNoPartner - 2 * D - 1 && e.partner >= n)
       throw bad("collision partner" + who + " out of range");
   }
   std::vector<char> seen(n, 0);
@@ -357,6 +359,29 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
         w.write_chunk("kairos/state/zones", nz, 3, flat.data());
       }
     }
+    const std::uint64_t soft[4] = {s.counters.soft_contacts, s.counters.soft_overlap_fallbacks,
+                                   s.counters.soft_early_releases, s.counters.soft_direct_maps};
+    w.write_chunk("kairos/state/soft_counters", 4, 1, soft);
+    w.write_chunk("kairos/state/soft_contact_energy", 1, 1, &s.counters.soft_contact_energy);
+    if (!s.frozen.empty()) {
+      const std::uint64_t nf = s.frozen.size();
+      std::vector<std::uint32_t> who(3 * nf);
+      std::vector<double> when(nf * (1 + 2 * D));
+      for (std::size_t k = 0; k < nf; ++k) {
+        const FrozenContact<D>& c = s.frozen[k];
+        who[3 * k] = c.i;
+        who[3 * k + 1] = c.j;
+        who[3 * k + 2] = c.face;
+        double* row = &when[k * (1 + 2 * D)];
+        row[0] = c.release_time;
+        for (int a = 0; a < D; ++a) {
+          row[1 + a] = c.velocity_i[a];
+          row[1 + D + a] = c.velocity_j[a];
+        }
+      }
+      w.write_chunk("kairos/state/frozen_contacts", nf, 3, who.data());
+      w.write_chunk("kairos/state/frozen_release", nf, 1 + 2 * D, when.data());
+    }
     w.write_chunk("kairos/run/next_kick_time", 1, 1, &progress.next_kick_time);
     if (!s.angular_velocity.empty()) {
       constexpr std::uint32_t kSpin = D == 3 ? 3 : 1;
@@ -450,6 +475,34 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
     const auto steps = require<std::uint64_t>(r, f, "kairos/state/step_counters", path, 2);
     s.counters.step_crossings = steps[0];
     s.counters.step_bounces = steps[1];
+  }
+  if (r.find(f, "kairos/state/soft_counters")) {
+    const auto soft = require<std::uint64_t>(r, f, "kairos/state/soft_counters", path, 4);
+    s.counters.soft_contacts = soft[0];
+    s.counters.soft_overlap_fallbacks = soft[1];
+    s.counters.soft_early_releases = soft[2];
+    s.counters.soft_direct_maps = soft[3];
+    s.counters.soft_contact_energy =
+        require<double>(r, f, "kairos/state/soft_contact_energy", path, 1)[0];
+  }
+  if (const auto chunk = r.find(f, "kairos/state/frozen_contacts")) {
+    const std::size_t nf = chunk->N;
+    const auto who = require<std::uint32_t>(r, f, "kairos/state/frozen_contacts", path, 3 * nf);
+    const auto when =
+        require<double>(r, f, "kairos/state/frozen_release", path, nf * (1 + 2 * D));
+    s.frozen.resize(nf);
+    for (std::size_t k = 0; k < nf; ++k) {
+      FrozenContact<D>& c = s.frozen[k];
+      c.i = who[3 * k];
+      c.j = who[3 * k + 1];
+      c.face = who[3 * k + 2];
+      const double* row = &when[k * (1 + 2 * D)];
+      c.release_time = row[0];
+      for (int a = 0; a < D; ++a) {
+        c.velocity_i[a] = row[1 + a];
+        c.velocity_j[a] = row[1 + D + a];
+      }
+    }
   }
   if (r.find(f, "kairos/state/zone_count")) {
     const std::uint64_t nz = require<std::uint64_t>(r, f, "kairos/state/zone_count", path, 1)[0];

@@ -13,7 +13,14 @@
 //   kairos/state/step_counters  uint64 x 2: counters.step_crossings, step_bounces
 //   kairos/state/zone_count     uint64 x 1: present iff ParticleSystem::zones has a value
 //   kairos/state/zones          uint32 zone_count x 3 (i, j, zone), only when zone_count > 0
-// Format 3 files are still read: no bonds, zones = nullopt, step counters 0.
+// Format 3 files are still read: no bonds, zones = nullopt, step counters 0. Format 5 adds:
+//   kairos/state/soft_counters        uint64 x 4: counters.soft_contacts, soft_overlap_fallbacks,
+//                                     soft_early_releases, soft_direct_maps
+//   kairos/state/soft_contact_energy  float64 x 1: counters.soft_contact_energy
+//   kairos/state/frozen_contacts      uint32 F x 3 (i, j, face) of ParticleSystem::frozen, and
+//   kairos/state/frozen_release       float64 F x (1 + 2D): release time, velocity_i, velocity_j
+//                                     (both only when some soft contact is in progress)
+// Format 4 files are read with no soft contacts.
 #pragma once
 
 #include <cstdint>

@@ -7,8 +7,12 @@
 // progress are bit-identical.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -18,6 +22,7 @@
 #include "engine_fixtures.hpp"
 #include "interactions/soft_contact.hpp"
 #include "interactions/soft_map_table.hpp"
+#include "io/gsd_snapshot.hpp"
 #include "scheduler/calendar_queue.hpp"
 
 namespace kairos {
@@ -344,13 +349,22 @@ TEST(SoftWalls, WallContactMatchesTheClosedFormDashpot) {
               0.5 * m * 1.3 * 1.3 * (1.0 - closed.restitution * closed.restitution), 1e-10);
 }
 
-TEST(SoftResume, ResumingWithContactsInProgressIsBitIdentical) {
+TEST(SoftResume, ResumingFromARestartFileWithContactsInProgressIsBitIdentical) {
   const ParticleSystem<3> s = testing::lattice_system<3>(5, 0.15, 7, 1.4, 1.2);
   const Environment<3> env = soft_environment<3>(SoftContactLaw::viscoelastic_hertz(3.0e3, 4e-3));
   Engine3 a(s, StartMode::kPredict, {}, env);
   for (int k = 0; k < 800 || a.frozen() == 0; ++k) ASSERT_NE(a.step(), EventKind::kNone);
-  const ParticleSystem<3> mid = a.export_state();
-  ASSERT_FALSE(mid.frozen.empty());
+  ASSERT_FALSE(a.export_state().frozen.empty());
+  // Through a restart file: the contacts in progress and the soft counters survive it.
+  const std::filesystem::path file = std::filesystem::temp_directory_path() /
+                                     ("kairos_soft_resume_" + std::to_string(::getpid()) + ".gsd");
+  std::mt19937_64 rng(5);
+  write_restart(file, a.export_state(), rng);
+  const ParticleSystem<3> mid = read_restart<3>(file, rng);
+  std::filesystem::remove(file);
+  EXPECT_EQ(mid.frozen, a.export_state().frozen);
+  EXPECT_EQ(mid.counters.soft_contacts, a.counters().soft_contacts);
+  EXPECT_EQ(mid.counters.soft_contact_energy, a.counters().soft_contact_energy);
   Engine3 b(mid, StartMode::kResume, {}, env);
   for (int k = 0; k < 3000; ++k) {
     ASSERT_NE(a.step(), EventKind::kNone);
