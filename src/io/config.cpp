@@ -1510,7 +1510,8 @@ class Reader {
           "soft contacts replace the [contact] laws (set the dissipation in [soft])";
       if (const std::string_view key = non_default_contact_key(c.interactions.contact);
           !key.empty()) {
-        conflict(join_key("contact", key), laws);
+        const bool rough = key == "tangential_restitution" || key == "friction";
+        conflict(join_key("contact", key), rough ? "soft spheres are frictionless (smooth)" : laws);
       }
       if (c.interactions.tc != 0.0) conflict("contact.tc", laws);
       if (!c.interactions.pairs.empty()) conflict("contact.pair", "use [[soft.pair]] instead");
