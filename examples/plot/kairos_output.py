@@ -261,3 +261,32 @@ def pair_distances(pos, box, rmax):
     """All pair distances below rmax (each pair once, minimum image): the raw material of a
     radial distribution function or a pair energy."""
     return close_pairs(pos, box, rmax)[2]
+
+
+# --- Soft-sphere collision map tables ------------------------------------------------------------
+
+def read_soft_table(plotdir):
+    """The files `kairos table plot ... -o PLOTDIR` writes -> dict: `u`, `w` (the node axes:
+    log10(v_t/v_n) and log10(l~); u is [-inf] for a head-on table), `report` (report.txt's text),
+    for every column of nodes.tsv (eps_t, eps_r, eps_rdot, eps_phi, end_overlap, l_tilde, c_phi,
+    c_dis) a grid of shape (len(w), len(u)), and, when errors.tsv exists, `errors`: a dict with
+    its axes `u`, `w` and grids of the relative errors (err_eps_t, ...)."""
+    def grids(table):
+        u, w = np.unique(table["u"]), np.unique(table["w"])
+        iu, iw = np.searchsorted(u, table["u"]), np.searchsorted(w, table["w"])
+        out = {"u": u, "w": w}
+        for key, column in table.items():
+            if key in ("u", "w"):
+                continue
+            g = np.full((len(w), len(u)), np.nan)
+            g[iw, iu] = column
+            out[key] = g
+        return out
+
+    result = grids(read_tsv(os.path.join(plotdir, "nodes.tsv")))
+    with open(os.path.join(plotdir, "report.txt")) as f:
+        result["report"] = f.read()
+    errors = os.path.join(plotdir, "errors.tsv")
+    if os.path.exists(errors):
+        result["errors"] = grids(read_tsv(errors))
+    return result

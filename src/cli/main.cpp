@@ -2,6 +2,7 @@
 //
 //   kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE]
 //   kairos steps CONFIG.toml [--set key=value ...] [--temperature KT] [-o DIR]
+//   kairos table build|inspect|plot ...   (cli/table_command.hpp)
 //
 // User errors (config, files, impossible requests) print one line "kairos: error: ..." and exit
 // with status 2; SIGINT/SIGTERM finish the current event, write every output and exit 130/143.
@@ -15,6 +16,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "cli/table_command.hpp"
 #include "core/error.hpp"
 #include "interactions/potential_spec.hpp"
 #include "io/atomic_file.hpp"
@@ -161,6 +163,7 @@ int main(int argc, char** argv) {
   app.footer(
       "Usage of run: kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE]\n"
       "Usage of steps: kairos steps CONFIG.toml [--set key=value ...] [--temperature KT] [-o DIR]\n"
+      "Usage of table: kairos table build|inspect|plot ... (soft-sphere collision map tables)\n"
       "  -o,--output OUTDIR   output directory (overrides output.directory)\n"
       "  --set key=value      override a config key (repeatable)\n"
       "  --restart FILE       continue from a restart file (OUTDIR/restart.gsd)\n"
@@ -207,6 +210,8 @@ int main(int argc, char** argv) {
                     "Also write each table and its continuous curve as TSV files in this directory "
                     "(for examples/plot/plot_steps.py)");
 
+  const auto table_command = kairos::cli::add_table_command(app);
+
   // Usage errors are user errors too: one line "kairos: error: ...", exit status 2 (not CLI11's
   // own codes and two-line message). --help and --version still print and exit 0.
   try {
@@ -231,6 +236,7 @@ int main(int argc, char** argv) {
     if (restart_option->count() > 0 && restart.empty()) {
       throw kairos::InputError("--restart: the restart file name must not be empty");
     }
+    if (table_command->parsed()) return table_command->run();
     if (steps->parsed()) {
       const kairos::Config config = kairos::load_config(steps_config, steps_overrides);
       if (steps_kT < 0.0 || !std::isfinite(steps_kT))
