@@ -298,15 +298,15 @@ class EventEngine {
   void release_event(std::uint32_t i, double t);
   // The map from the table, or integrated directly outside it (counted).
   CollisionMap soft_map(const SoftMapTable* table, const CollisionUnits& units);
-  // Whether i at xi (and j at xj, unless j is kNoPartner) at time t would overlap a third
-  // particle or a wall (other than face skip_face).
-  bool placement_overlaps(std::uint32_t i, const Vec<D>& xi, std::uint32_t j, const Vec<D>& xj,
-                          double t, int skip_face);
+  // Places i at xi (and j at xj, unless j is kNoPartner) at time t unless that overlaps a third
+  // particle or a wall (other than face skip_face; exception A): then nothing changes and the
+  // result is false. Placed, the neighbourhoods of i and j are left gathered in lists_[0] and
+  // (unless `shared`, one cell) lists_[1].
+  bool try_place(std::uint32_t i, const Vec<D>& xi, std::uint32_t j, const Vec<D>& xj, double t,
+                 int skip_face, bool& shared);
   // Moves particle i into the cell of its (changed) position.
   void relocate(std::uint32_t i);
-  bool frozen_pair(std::uint32_t i, std::uint32_t j) const {
-    return soft_ && frozen_with_[i] == j;
-  }
+  bool frozen_pair(std::uint32_t i, std::uint32_t j) const { return soft_ && frozen_with_[i] == j; }
   void renumber(bool queue_filled);
   void insert_all_into_grid();
   void check_restored_cell(std::uint32_t i) const;

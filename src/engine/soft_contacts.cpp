@@ -139,20 +139,34 @@ void EventEngine<D, Queue>::relocate(std::uint32_t i) {
   grid_.insert(i, c);
 }
 
+// The placed particles are moved first and their neighbourhoods gathered from their new cells:
+// the same lists serve the overlap test and, when the placement stands, the predictions.
 template <int D, class Queue>
-bool EventEngine<D, Queue>::placement_overlaps(std::uint32_t i, const Vec<D>& xi, std::uint32_t j,
-                                               const Vec<D>& xj, double t, int skip_face) {
-  auto overlaps = [&](std::uint32_t p, Vec<D> x) {
+bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::uint32_t j,
+                                      const Vec<D>& xj, double t, int skip_face, bool& shared) {
+  const std::uint32_t both[2] = {i, j};
+  const Vec<D> to[2] = {xi, xj};
+  Vec<D> from[2];
+  CellCode cell[2];
+  const int count = j == kNone ? 1 : 2;
+  for (int k = 0; k < count; ++k) {
+    HotRecord<D>& h = hot_[both[k]];
+    from[k] = h.pos;
+    cell[k] = h.cell;
+    h.pos = to[k];
+    relocate(both[k]);
+  }
+  gather(hot_[i].cell, lists_[0]);
+  shared = count == 1 || hot_[j].cell == hot_[i].cell;
+  if (!shared) gather(hot_[j].cell, lists_[1]);
+  auto overlaps = [&](std::uint32_t p, const CandidateList& list) {
+    const Vec<D>& x = hot_[p].pos;
     const double radius = radius_of(p);
     for (int f = 0; f < 2 * D; ++f) {
       if (f == skip_face || env_.faces[f].kind != FaceKind::kWall) continue;
       const double gap = f % 2 == 0 ? x[f / 2] - wall_offset(f, t) : wall_offset(f, t) - x[f / 2];
       if (gap < radius) return true;
     }
-    for (int a = 0; a < D; ++a)
-      if (grid_.periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
-    CandidateList& list = lists_[0];
-    gather(grid_.locate(x), list);
     for (std::uint32_t k = 0; k < list.count; ++k) {
       const std::uint32_t q = list.ids[k];
       if (q == i || q == j) continue;
@@ -164,7 +178,17 @@ bool EventEngine<D, Queue>::placement_overlaps(std::uint32_t i, const Vec<D>& xi
     }
     return false;
   };
-  return overlaps(i, xi) || (j != kNone && overlaps(j, xj));
+  if (!overlaps(i, lists_[0]) && (count == 1 || !overlaps(j, lists_[shared ? 0 : 1]))) return true;
+  for (int k = 0; k < count; ++k) {  // put back, cells included
+    HotRecord<D>& h = hot_[both[k]];
+    h.pos = from[k];
+    if (h.cell != cell[k]) {
+      grid_.erase(both[k], h.cell);
+      h.cell = cell[k];
+      grid_.insert(both[k], h.cell);
+    }
+  }
+  return false;
 }
 
 template <int D, class Queue>
@@ -248,7 +272,8 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
     const Vec<D> rc = (map.eps_r * l) * nc;
     // Each particle's displacement from its place at first contact (R stays): no images.
     const Vec<D> xi = hi.pos + (mj / total) * (rc - r), xj = hj.pos - (mi / total) * (rc - r);
-    if (!placement_overlaps(i, xi, j, xj, t, -1)) {
+    bool shared = false;
+    if (try_place(i, xi, j, xj, t, -1, shared)) {
       const Vec<D> gc = (-map.eps_rdot * vn) * nc + (vt / map.eps_r) * tc;
       release_velocity_[i] = V + (mj / total) * gc;
       release_velocity_[j] = V - (mi / total) * gc;
@@ -261,17 +286,19 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
           0.5 * (mi * norm2(release_velocity_[i]) + mj * norm2(release_velocity_[j]));
       counters_.dissipated_in_collisions += ke_before - ke_after;
       counters_.soft_contact_energy += ke_after - 0.5 * total * norm2(V);
-      hi.pos = xi;
-      hj.pos = xj;
       hi.vel = V;
       hj.vel = V;
-      relocate(i);
-      relocate(j);
       frozen_with_[i] = j;
       frozen_with_[j] = i;
       release_time_[i] = release_time_[j] = t + map.eps_t * units.time_unit;
       ++counters_.soft_contacts;
-      placed = true;
+      ++counters_.collisions;
+      ++hi.collisions;
+      ++hj.collisions;
+      queue_.update(i, predict_from(lists_[0], i, t));
+      queue_.update(j, predict_from(lists_[shared ? 0 : 1], j, t));
+      predict_released();
+      return;
     } else {
       ++counters_.soft_overlap_fallbacks;  // exception A
     }
@@ -330,18 +357,20 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   if (env_.soft_collisions == SoftCollisions::kMapped && !overlapping) {
     Vec<D> x = h.pos;
     x[a] -= sgn * map.end_overlap * units.length_unit;  // into the wall by the end overlap
-    if (!placement_overlaps(i, x, kNone, x, t, face)) {
+    bool shared = true;
+    if (try_place(i, x, kNone, x, t, face, shared)) {
       Vec<D> frozen_velocity = h.vel;
       frozen_velocity[a] = wall_speed;
       counters_.soft_contact_energy += 0.5 * m * (norm2(after) - norm2(frozen_velocity));
-      h.pos = x;
       h.vel = frozen_velocity;
-      relocate(i);
       frozen_with_[i] = kFirstWall + static_cast<std::uint32_t>(face);
       release_time_[i] = t + map.eps_t * units.time_unit;
       release_velocity_[i] = after;
       ++counters_.soft_contacts;
-      placed = true;
+      ++counters_.wall_collisions;
+      ++h.collisions;
+      queue_.update(i, predict_from(lists_[0], i, t));
+      return;
     } else {
       ++counters_.soft_overlap_fallbacks;
     }
@@ -352,17 +381,17 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   queue_.update(i, predict(i, t));
 }
 
-#define KAIROS_SOFT_MEMBERS(D, Q)                                                                  \
-  template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                           \
-  template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&);                       \
-  template std::uint32_t EventEngine<D, Q>::frozen() const;                                        \
-  template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&);   \
-  template void EventEngine<D, Q>::relocate(std::uint32_t);                                        \
-  template bool EventEngine<D, Q>::placement_overlaps(std::uint32_t, const Vec<D>&, std::uint32_t, \
-                                                      const Vec<D>&, double, int);                 \
-  template std::uint32_t EventEngine<D, Q>::release(std::uint32_t, double, bool);                  \
-  template void EventEngine<D, Q>::release_event(std::uint32_t, double);                           \
-  template void EventEngine<D, Q>::collide_soft(std::uint32_t, std::uint32_t, double);             \
+#define KAIROS_SOFT_MEMBERS(D, Q)                                                                \
+  template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                         \
+  template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&);                     \
+  template std::uint32_t EventEngine<D, Q>::frozen() const;                                      \
+  template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&); \
+  template void EventEngine<D, Q>::relocate(std::uint32_t);                                      \
+  template bool EventEngine<D, Q>::try_place(std::uint32_t, const Vec<D>&, std::uint32_t,        \
+                                             const Vec<D>&, double, int, bool&);                 \
+  template std::uint32_t EventEngine<D, Q>::release(std::uint32_t, double, bool);                \
+  template void EventEngine<D, Q>::release_event(std::uint32_t, double);                         \
+  template void EventEngine<D, Q>::collide_soft(std::uint32_t, std::uint32_t, double);           \
   template void EventEngine<D, Q>::hit_wall_soft(std::uint32_t, int, double);
 
 KAIROS_SOFT_MEMBERS(2, BinaryHeapQueue)
