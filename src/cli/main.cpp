@@ -95,6 +95,16 @@ void print_summary(const kairos::RunOutcome& outcome) {
                st["core_collisions"].get<std::uint64_t>(),
                st["step_crossings"].get<std::uint64_t>(), st["step_bounces"].get<std::uint64_t>());
   }
+  if (s.contains("soft")) {
+    const auto& so = s["soft"];
+    fmt::print(
+        "  soft contacts        {} mapped, {} placed over a third body (A), {} released "
+        "early (B), {} maps integrated directly\n",
+        so["mapped_contacts"].get<std::uint64_t>(),
+        so["exception_a_overlap_fallbacks"].get<std::uint64_t>(),
+        so["exception_b_early_releases"].get<std::uint64_t>(),
+        so["direct_maps"].get<std::uint64_t>());
+  }
   fmt::print("  max overlap          {:.3g}\n", num("max_overlap"));
   fmt::print("  peak memory          {:.1f} MiB\n", num("peak_rss_bytes") / 1048576.0);
   fmt::print("  outputs              {}/ (summary.json, thermo.tsv, trajectory.gsd, restart.gsd)\n",
@@ -155,7 +165,8 @@ void print_step_tables(const kairos::Config& config, double kT, const std::strin
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Kairos: event-driven molecular dynamics of hard, granular and stepped-potential spheres "
+      "Kairos: event-driven molecular dynamics of hard, granular, stepped-potential and soft "
+      "spheres "
       "(3D) and disks (2D).\n"
       "Configuration keys are documented in docs/config.md."};
   app.set_version_flag("--version", std::string("kairos ") + KAIROS_VERSION);

@@ -164,6 +164,9 @@ constexpr KeySpec kSchema[] = {
     {"run.time_step", Kind::kFloat},
     {"soft", Kind::kTable},
     {"soft.collisions", Kind::kString},
+    {"soft.tables", Kind::kBoolean},
+    {"soft.table_tolerance", Kind::kFloat},
+    {"soft.table_cache", Kind::kString},
     {"soft.model", Kind::kString},
     {"soft.stiffness", Kind::kFloat},
     {"soft.damping", Kind::kFloat},
@@ -1433,6 +1436,15 @@ class Reader {
     read_soft_law(t, std::string(p), soft.law);
     const toml::node* n_collisions = get_string(t, p, "collisions", soft.collisions);
     require_choice(n_collisions, "soft.collisions", soft.collisions, kSoftCollisions);
+    get_bool(t, p, "tables", soft.tables);
+    const toml::node* n_tolerance = get_number(t, p, "table_tolerance", soft.table_tolerance);
+    require_positive(n_tolerance, "soft.table_tolerance", soft.table_tolerance);
+    if (n_tolerance != nullptr && !(soft.table_tolerance < 0.1)) {
+      fail(n_tolerance, "soft.table_tolerance",
+           fmt::format("soft.table_tolerance: must be below 0.1 (a relative error), got {}",
+                       soft.table_tolerance));
+    }
+    get_string(t, p, "table_cache", soft.table_cache);
     const std::vector<const toml::table*> tables = table_array(t, p, "pair");
     for (std::size_t i = 0; i < tables.size(); ++i) {
       const std::string prefix = fmt::format("soft.pair[{}]", i);
@@ -1860,6 +1872,9 @@ std::string to_toml(const Config& config) {
     out += "\n[soft]\n";
     out += soft_law_toml(soft.law);
     out += fmt::format("collisions = {}\n", toml_string(soft.collisions));
+    out += fmt::format("tables = {}\n", soft.tables);
+    out += fmt::format("table_tolerance = {}\n", toml_float(soft.table_tolerance));
+    out += fmt::format("table_cache = {}\n", toml_string(soft.table_cache));
     for (const SoftPairConfig& pair : soft.pairs) {
       out += "\n[[soft.pair]]\n";
       out += fmt::format("species = [{}, {}]\n", toml_string(pair.species[0]),

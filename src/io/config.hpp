@@ -195,6 +195,12 @@ struct SoftConfig {
   SoftLawConfig law;                  // every pair without an override, and the walls
   std::vector<SoftPairConfig> pairs;  // [[soft.pair]]
   std::string collisions = "mapped";  // event integrator: mapped | instantaneous
+  // Event integrator: lookup tables of the collision map (interactions/soft_map_table.hpp),
+  // accurate to table_tolerance (relative), cached in table_cache ("" = the default cache
+  // directory). false: every collision integrates the map directly (slow, exact).
+  bool tables = true;
+  double table_tolerance = 1e-6;
+  std::string table_cache;
 
   bool enabled() const { return !law.model.empty(); }
   bool operator==(const SoftConfig&) const = default;

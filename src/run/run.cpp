@@ -20,6 +20,7 @@
 #include "io/progress.hpp"
 #include "run/environment_setup.hpp"
 #include "run/run_support.hpp"
+#include "run/soft_tables_setup.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
 #include "scheduler/tournament_tree_queue.hpp"
@@ -235,12 +236,13 @@ class RunDriver {
     }
     thermo_stats_.emplace(D, n_, volume_);
     try {
-      const Environment<D> environment = make_environment<D>(config, start);
+      Environment<D> environment = make_environment<D>(config, start);
+      if (environment.soft_spheres() && config.soft.tables) attach_tables(environment, start);
       engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict,
                       EngineOptions{}, environment);
       driven_ = config.driving.kind != "none";
-      granular_ =
-          !environment.plain() || environment.has_gravity() || driven_ || environment.sheared();
+      granular_ = !environment.plain() || environment.has_gravity() || driven_ ||
+                  environment.sheared() || environment.soft_spheres();
       sheared_ = environment.sheared();
       for (int a = 0; a < D; ++a) granular_ = granular_ || !environment.periodic(a);
     } catch (const InputError& e) {
@@ -636,6 +638,7 @@ class RunDriver {
                             ke_start_
                       : 0.0;
     if (engine_->stepped()) j["stepped"] = stepped_summary(c);
+    if (engine_->soft()) j["soft"] = soft_summary(c);
     j["momentum_drift"] = pscale > 0 ? std::sqrt(dp2) / pscale : 0.0;
     j["max_overlap"] = overlap;
     j["peak_rss_bytes"] = peak_rss_bytes();
@@ -672,6 +675,67 @@ class RunDriver {
     j["granular"] = g;
     if (sheared_) j["shear"] = shear_summary(kT_prod);
     return j;
+  }
+
+  // Soft spheres: the lookup tables of the collision map (built now or read from the cache).
+  void attach_tables(Environment<D>& environment, const ParticleSystem<D>& start) {
+    SoftTableSettings settings;
+    settings.tolerance = config_.soft.table_tolerance;
+    settings.cache_dir = config_.soft.table_cache;
+    if (config_.driving.kind == "andersen")
+      settings.driving_temperature = config_.driving.temperature;
+    const bool tell = config_.output.progress != "never";
+    std::string building;
+    auto progress = [&](const std::string& contact, double) {
+      if (tell && contact != building) {
+        building = contact;
+        fmt::print(stderr, "building the soft-contact map table of {} ...\n", contact);
+      }
+    };
+    tables_ = attach_soft_tables(environment, start, settings, progress);
+  }
+
+  // Soft spheres: how the contacts were carried out in this invocation (mapped, or one of the
+  // two exceptions of formulas.md §1.6), where the maps came from, and the tables used.
+  nlohmann::json soft_summary(const EventCounters& c) const {
+    const std::uint64_t collisions = c.collisions - counters_start_.collisions;
+    auto fraction = [&](std::uint64_t k) {
+      return collisions > 0 ? static_cast<double>(k) / static_cast<double>(collisions) : 0.0;
+    };
+    const std::uint64_t a = c.soft_overlap_fallbacks - counters_start_.soft_overlap_fallbacks;
+    const std::uint64_t b = c.soft_early_releases - counters_start_.soft_early_releases;
+    const std::uint64_t direct = c.soft_direct_maps - counters_start_.soft_direct_maps;
+    nlohmann::json s;
+    s["collisions"] = config_.soft.collisions;
+    s["mapped_contacts"] = c.soft_contacts - counters_start_.soft_contacts;
+    s["exception_a_overlap_fallbacks"] = a;
+    s["exception_b_early_releases"] = b;
+    s["exception_a_fraction"] = fraction(a);
+    s["exception_b_fraction"] = fraction(b);
+    s["direct_maps"] = direct;
+    s["direct_map_fraction"] = fraction(direct);
+    s["frozen_now"] = engine_->frozen();
+    s["contact_energy"] = engine_->potential_energy();
+    nlohmann::json tables = nlohmann::json::array();
+    for (const SoftTableUse& use : tables_) {
+      nlohmann::json t;
+      t["contact"] = use.contact;
+      t["nodes"] = use.report.nodes;
+      t["min_normal_speed"] = use.spec.min_normal_speed;
+      t["max_normal_speed"] = use.spec.max_normal_speed;
+      t["max_tangential_ratio"] = use.spec.max_tangential_ratio;
+      t["tolerance"] = use.spec.tolerance;
+      t["max_error"] = {{"eps_t", use.report.max_error[0]},
+                        {"eps_rdot", use.report.max_error[1]},
+                        {"eps_phi", use.report.max_error[2]},
+                        {"end_overlap", use.report.max_error[3]}};
+      t["from_cache"] = use.report.from_cache;
+      t["build_seconds"] = use.report.build_seconds;
+      t["cache_file"] = use.report.cache_file.string();
+      tables.push_back(t);
+    }
+    s["tables"] = tables;
+    return s;
   }
 
   // Stepped potentials: the configurational energy over the production rows (blocked for its
@@ -714,6 +778,7 @@ class RunDriver {
   bool restart_;
   std::mt19937_64 rng_;
   std::optional<EventEngine<D, Queue>> engine_;
+  std::vector<SoftTableUse> tables_;  // soft spheres: the map tables in use
   std::size_t n_ = 0;
   double volume_ = 1.0, particle_volume_ = 0.0;
   fs::path dir_;

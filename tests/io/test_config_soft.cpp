@@ -43,7 +43,8 @@ void expect_error(std::string_view text, std::initializer_list<std::string_view>
 TEST(ConfigSoft, AbsentMeansHardSpheresAndTheEventIntegrator) {
   const Config c = parse_config(kBase, "test.toml");
   EXPECT_FALSE(c.soft.enabled());
-  EXPECT_EQ(c.soft, SoftConfig{});
+  const SoftConfig defaults;
+  EXPECT_EQ(c.soft, defaults);
   EXPECT_EQ(c.run.integrator, "event");
   EXPECT_EQ(c.run.time_step, 0.0);
 }
@@ -193,6 +194,25 @@ TEST(ConfigSoft, OverridesReachTheSoftKeys) {
   EXPECT_EQ(c.run.time_step, 0.002);
   expect_error(with(soft), {"override 'soft.restitution=2'", "soft.restitution"},
                {"soft.restitution=2"});
+}
+
+TEST(ConfigSoft, MapTableKeys) {
+  const std::string soft = "[soft]\nmodel = \"dashpot\"\nstiffness = 1e4\n";
+  const Config d = parse_config(with(soft), "test.toml");
+  EXPECT_TRUE(d.soft.tables);
+  EXPECT_EQ(d.soft.table_tolerance, 1e-6);
+  EXPECT_EQ(d.soft.table_cache, "");
+  const Config c = parse_config(
+      with(soft + "tables = false\ntable_tolerance = 1e-8\ntable_cache = \"/tmp/x\"\n"),
+      "test.toml");
+  EXPECT_FALSE(c.soft.tables);
+  EXPECT_EQ(c.soft.table_tolerance, 1e-8);
+  EXPECT_EQ(c.soft.table_cache, "/tmp/x");
+  EXPECT_EQ(parse_config(to_toml(c), "round trip"), c);
+  expect_error(with(soft + "table_tolerance = 0.0\n"), {"soft.table_tolerance", "> 0"});
+  expect_error(with(soft + "table_tolerance = 0.5\n"), {"soft.table_tolerance", "below 0.1"});
+  expect_error(with(soft + "tables = 1\n"), {"soft.tables"});
+  expect_error(with(soft + "table_cach = \"x\"\n"), {"soft.table_cach", "soft.table_cache"});
 }
 
 TEST(ConfigSoft, RoundTripIsExact) {
