@@ -395,6 +395,9 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     if (!s.asleep.empty()) w.write_chunk("kairos/state/asleep", n, 1, s.asleep.data());
     w.write_chunk("kairos/state/rng", rng_bytes.size(), 1, rng_bytes.data());
     w.write_chunk("kairos/run/equilibration_remaining", 1, 1, &progress.equilibration_remaining);
+    if (progress.soft_table_max_speed > 0.0) {
+      w.write_chunk("kairos/run/soft_table_max_speed", 1, 1, &progress.soft_table_max_speed);
+    }
     if (progress.integrator != "event") {
       const std::vector<std::int8_t> name(progress.integrator.begin(), progress.integrator.end());
       w.write_chunk("kairos/run/integrator", name.size(), 1, name.data());
@@ -561,6 +564,14 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
     }
     if (r.find(f, "kairos/run/next_kick_time"))
       progress->next_kick_time = require<double>(r, f, "kairos/run/next_kick_time", path, 1)[0];
+    if (r.find(f, "kairos/run/soft_table_max_speed")) {
+      const double v = require<double>(r, f, "kairos/run/soft_table_max_speed", path, 1)[0];
+      if (!(v > 0.0) || !std::isfinite(v)) {
+        throw InputError("'" + path.string() + "': kairos/run/soft_table_max_speed is " +
+                         std::to_string(v));
+      }
+      progress->soft_table_max_speed = v;
+    }
     if (r.find(f, "kairos/run/integrator")) {
       const auto name = r.read<std::int8_t>(f, "kairos/run/integrator");
       progress->integrator.assign(name.begin(), name.end());

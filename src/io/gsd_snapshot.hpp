@@ -48,6 +48,9 @@ struct RunProgress {
   // chunk are "event"), and the DEM's time step (0 for the event integrator).
   std::string integrator = "event";
   double dem_time_step = 0.0;
+  // Soft spheres: the fastest normal impact speed the run's map tables cover (0: no tables), so
+  // that a continued run uses the same tables (and stays bit-identical).
+  double soft_table_max_speed = 0.0;
 };
 
 // Writes the restart file atomically (temporary file + rename).

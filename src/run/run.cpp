@@ -344,6 +344,7 @@ class RunDriver {
       p.equilibration_remaining = per_particle(equilibration_target_ - c);
     }
     p.next_kick_time = driven_ ? next_kick_ : -1.0;
+    if (!tables_.empty()) p.soft_table_max_speed = tables_.front().spec.max_normal_speed;
     return p;
   }
 
@@ -682,6 +683,7 @@ class RunDriver {
     SoftTableSettings settings;
     settings.tolerance = config_.soft.table_tolerance;
     settings.cache_dir = config_.soft.table_cache;
+    if (restart_) settings.max_speed = resumed_.soft_table_max_speed;
     if (config_.driving.kind == "andersen")
       settings.driving_temperature = config_.driving.temperature;
     const bool tell = config_.output.progress != "never";

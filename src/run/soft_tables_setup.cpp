@@ -56,9 +56,10 @@ std::vector<SoftTableUse> attach_soft_tables(
     double lightest = *std::min_element(state.mass.begin(), state.mass.end());
     fastest = std::max(fastest, 6.0 * std::sqrt(settings.driving_temperature / lightest));
   }
-  if (!(fastest > 0.0)) return used;  // nothing moves: no collision to tabulate
+  if (!(fastest > 0.0) && !(settings.max_speed > 0.0)) return used;  // nothing moves
   // Relative speeds reach twice the fastest particle's speed.
-  const double max_speed = 2.0 * settings.speed_margin * fastest;
+  const double max_speed =
+      settings.max_speed > 0.0 ? settings.max_speed : 2.0 * settings.speed_margin * fastest;
   const double min_speed = max_speed * std::pow(10.0, -settings.speed_decades);
   const std::filesystem::path dir =
       settings.cache_dir.empty() ? default_soft_table_cache_dir() : settings.cache_dir;

@@ -22,6 +22,9 @@ struct SoftTableSettings {
   double speed_margin = 2.5;
   double speed_decades = 4.0;
   double driving_temperature = 0.0;  // > 0: an Andersen thermostat sets speeds too
+  // > 0: the fastest normal speed covered, as recorded by the run this one continues (the
+  // state's speeds are then not used: a continued run must use the same tables).
+  double max_speed = 0.0;
 };
 
 struct SoftTableUse {
