@@ -12,6 +12,10 @@
 #include "core/error.hpp"
 #include "interactions/soft_map_table.hpp"
 #include "io/atomic_file.hpp"
+#include "io/config.hpp"
+#include "run/environment_setup.hpp"
+#include "run/run_support.hpp"
+#include "run/soft_tables_setup.hpp"
 
 namespace kairos::cli {
 namespace {
@@ -216,6 +220,32 @@ void write_plot_files(const SoftMapTable& t, const std::filesystem::path& dir, i
   write_text_atomically(dir / "errors.tsv", errors);
 }
 
+// The tables `kairos run CONFIG` would use (same state, same speed range, same cache), built
+// now or read from the cache; one report each.
+template <int D>
+void build_config_tables(const Config& config) {
+  if (!config.soft.enabled()) throw InputError("the config has no [soft] table");
+  std::mt19937_64 rng(config.system.seed);
+  RunProgress progress;
+  const ParticleSystem<D> start =
+      run_detail::build_start_state<D>(config, std::nullopt, rng, progress);
+  Environment<D> env = make_environment<D>(config, start);
+  SoftTableSettings settings;
+  settings.tolerance = config.soft.table_tolerance;
+  settings.cache_dir = config.soft.table_cache;
+  if (config.driving.kind == "andersen") settings.driving_temperature = config.driving.temperature;
+  const std::vector<SoftTableUse> used =
+      attach_soft_tables(env, start, settings, [](const std::string& contact, double f) {
+        std::fprintf(stderr, "\rbuilding the table of %s: %5.1f %%", contact.c_str(), 100.0 * f);
+        std::fflush(stderr);
+      });
+  std::fprintf(stderr, "\r%60s\r", "");
+  for (const SoftTableUse& use : used) {
+    fmt::print("contact {}\n", use.contact);
+    fmt::print("{}", describe(SoftMapTable::read_file(use.report.cache_file)));
+  }
+}
+
 class TableCommandImpl final : public TableCommand {
  public:
   explicit TableCommandImpl(CLI::App& app) {
@@ -232,6 +262,11 @@ class TableCommandImpl final : public TableCommand {
                                     "Build (or load from the cache) the table "
                                     "of one contact and print its report.");
     build_flags_.add_to(build_);
+    build_->add_option("--config", config_file_,
+                       "Instead of the flags: the tables `kairos run CONFIG` would use (every "
+                       "species pair and wall of its [soft] laws, its state's speed range and "
+                       "soft.table_cache)");
+    build_->add_option("--set", overrides_, "key=value override of the config (repeatable)");
     build_->footer(
         "Example: kairos table build --model hertz --stiffness 1e5 "
         "--damping 1e-4 "
@@ -256,6 +291,17 @@ class TableCommandImpl final : public TableCommand {
   bool parsed() const override { return table_->parsed(); }
 
   int run() override {
+    if (build_->parsed() && !config_file_.empty()) {
+      if (build_flags_.model_option->count() > 0)
+        throw InputError("kairos table build: give either --config or the table flags");
+      const Config config = load_config(config_file_, overrides_);
+      if (config.system.dimension == 2) {
+        build_config_tables<2>(config);
+      } else {
+        build_config_tables<3>(config);
+      }
+      return 0;
+    }
     if (build_->parsed()) {
       const SoftMapTable t = build_flags_.load_or_build();
       fmt::print("{}", describe(t));
@@ -285,7 +331,8 @@ class TableCommandImpl final : public TableCommand {
   CLI::App* inspect_ = nullptr;
   CLI::App* plot_ = nullptr;
   SpecFlags build_flags_, plot_flags_;
-  std::string inspect_file_, plot_file_, plot_dir_;
+  std::string inspect_file_, plot_file_, plot_dir_, config_file_;
+  std::vector<std::string> overrides_;
   int error_points_ = 0;
 };
 

@@ -104,6 +104,25 @@ class SoftTableCli(kt.KairosTestCase):
         with open(png, "rb") as f:
             self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
 
+    def test_build_from_a_run_config_makes_the_tables_the_run_uses(self):
+        cache = self.path("cache")
+        config = kt.base_config(particles=200, packing_fraction=0.05, lattice="random",
+                                production=1.0, output={"trajectory": False},
+                                soft={"model": "dashpot", "stiffness": 1e4, "restitution": 0.9,
+                                      "table_tolerance": 1e-4, "table_cache": cache})
+        path = self.write_config(config)
+        built = self.run_ok("table", "build", "--config", path).stdout
+        self.assertIn("contact A-A", built)
+        self.run_ok("run", path, "-o", self.path("out"))
+        table = self.summary(self.path("out"))["soft"]["tables"][0]
+        self.assertTrue(table["from_cache"])  # the run read what `table build` wrote
+        self.assertEqual(report_value(built, "file"), table["cache_file"])
+        self.assert_user_error(self.kairos("table", "build", "--config", path, "--model", "hertz"),
+                               "--config")
+        del config["soft"]
+        self.assert_user_error(self.kairos("table", "build", "--config",
+                                           self.write_config(config, "hard.toml")), "[soft]")
+
     def test_user_errors(self):
         cache = ["--cache", self.path("cache")]
         self.assert_user_error(self.kairos("table", "build", "--model", "hertz", *cache),
