@@ -10,6 +10,8 @@
 //   kairos_bench --case gas --dimension 3 # one granular case (granular_cases.hpp)
 //   kairos_bench --suite stepped          # square well and stepped Lennard-Jones vs hard spheres
 //   kairos_bench --case sw --scan vector,scalar   # one stepped case (stepped_cases.hpp)
+//   kairos_bench --suite soft             # soft spheres: event-driven (mapped) vs DEM vs hard
+//   kairos_bench --case dashpot --eta 0.05 --contact-ratio 100   # one soft case (soft_cases.hpp)
 //
 // Cases given several queues are run interleaved (A B A B ...) so that machine noise hits
 // every variant alike; the best of the repeats is reported with the spread.
@@ -43,6 +45,7 @@
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
 #include "scheduler/tournament_tree_queue.hpp"
+#include "soft_cases.hpp"
 #include "stepped_cases.hpp"
 
 #ifndef KAIROS_BENCH_BUILD_TYPE
@@ -442,7 +445,7 @@ Plan suite_plan(const std::string& suite) {
     p.timed_large = 20;
   } else {
     throw UsageError(fmt::format(
-        "unknown --suite \"{}\"; use one of default, quick, full, granular, stepped", suite));
+        "unknown --suite \"{}\"; use one of default, quick, full, granular, stepped, soft", suite));
   }
   return p;
 }
@@ -610,6 +613,9 @@ int run(int argc, char** argv) {
   std::vector<int> dims;
   std::vector<std::string> queues, sizes, cases, scans;
   std::vector<int> lj_steps;
+  std::vector<double> contact_ratios;
+  std::int64_t dem_steps = 0;
+  std::string table_cache;
   double eq = 0, timed = 0;
   int repeat = 1;
   std::string format = "markdown", output;
@@ -622,10 +628,13 @@ int run(int argc, char** argv) {
       "20 + 100, but 10 + 20 at N > 32000); granular (--case gas,bed,pile: an inelastic gas "
       "and a vibrated bed against the elastic fluid, a pile settling with sleeping particles); "
       "stepped (--case sw,lj: the square-well fluid and stepped Lennard-Jones tables against "
-      "hard spheres). The options below override its parts");
+      "hard spheres); soft (--case dashpot,hertz: a dilute soft-sphere gas, event-driven with "
+      "the Müller–Pöschel map against Kairos's DEM and hard spheres). The options below "
+      "override its parts");
   auto* o_case = app.add_option("--case", cases,
                                 "granular cases: gas, bed, pile (imply --suite granular); "
-                                "stepped cases: sw, lj (imply --suite stepped)")
+                                "stepped cases: sw, lj (imply --suite stepped); soft cases: "
+                                "dashpot, hertz (imply --suite soft)")
                      ->delimiter(',');
   auto* o_steps =
       app.add_option("--steps", lj_steps,
@@ -636,6 +645,14 @@ int run(int argc, char** argv) {
                                 "stepped suite: candidate loops, run interleaved: vector "
                                 "(AVX-512 where available, the default) and/or scalar")
                      ->delimiter(',');
+  auto* o_ratios = app.add_option("--contact-ratio", contact_ratios,
+                                  "soft suite: mean free time / contact time (default 100,1000)")
+                       ->delimiter(',');
+  auto* o_dem_steps =
+      app.add_option("--dem-steps", dem_steps, "soft suite: DEM timed steps per sample (2000)");
+  auto* o_table_cache = app.add_option(
+      "--table-cache", table_cache,
+      "soft suite: lookup-table cache directory (default: a fresh temporary one, removed after)");
   auto* o_particles = app.add_option("--particles", particles, "particle numbers")->delimiter(',');
   auto* o_eta =
       app.add_option("--eta", etas, "packing fractions (area fractions in 2D)")->delimiter(',');
@@ -677,7 +694,45 @@ int run(int argc, char** argv) {
   if (o_case->count() > 0 && o_suite->count() == 0) {
     const bool stepped_cases = std::all_of(
         cases.begin(), cases.end(), [](const std::string& c) { return c == "sw" || c == "lj"; });
-    suite = stepped_cases ? "stepped" : "granular";
+    const bool soft_cases = std::all_of(cases.begin(), cases.end(), [](const std::string& c) {
+      return c == "dashpot" || c == "hertz";
+    });
+    suite = stepped_cases ? "stepped" : soft_cases ? "soft" : "granular";
+  }
+  if (suite != "soft" &&
+      (o_ratios->count() > 0 || o_dem_steps->count() > 0 || o_table_cache->count() > 0))
+    throw UsageError("--contact-ratio, --dem-steps and --table-cache need --suite soft");
+  if (suite == "soft") {
+    if (o_queue->count() > 0 || o_sizes->count() > 0 || o_ratio->count() > 0 ||
+        o_dim->count() > 0 || fmt_kind == Format::kTsv) {
+      throw UsageError("--suite soft takes no --queue, --sizes, --dimension or --format tsv");
+    }
+    if (particles.size() > 1) throw UsageError("--suite soft takes one --particles");
+    bench::SoftPlan sp;
+    if (o_case->count() > 0) sp.cases = cases;
+    if (!particles.empty()) {
+      if (particles[0] < 1) throw UsageError("--particles must be positive");
+      sp.particles = static_cast<std::uint64_t>(particles[0]);
+    }
+    if (o_eta->count() > 0) sp.etas = etas;
+    if (o_ratios->count() > 0) sp.contact_ratios = contact_ratios;
+    if (o_dem_steps->count() > 0) {
+      if (dem_steps < 1) throw UsageError("--dem-steps must be positive");
+      sp.dem_steps = static_cast<long>(dem_steps);
+    }
+    sp.table_cache = table_cache;
+    if (o_eq->count() > 0) sp.equilibrate = eq;
+    if (o_timed->count() > 0) sp.timed = timed;
+    if (o_repeat->count() > 0) sp.repeat = repeat;
+    try {
+      bench::validate(sp);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+    Output out(output);
+    out.add(preamble(argc, argv, bench::soft_protocol(sp), fmt_kind));
+    bench::run_soft(sp, [&](const std::string& text) { out.add(text); });
+    return 0;
   }
   if (suite != "stepped" && (o_steps->count() > 0 || o_scan->count() > 0))
     throw UsageError("--steps and --scan need --suite stepped");
@@ -738,7 +793,7 @@ int run(int argc, char** argv) {
     bench::run_granular(g, [&](const std::string& text) { out.add(text); });
     return 0;
   }
-  if (o_case->count() > 0) throw UsageError("--case needs --suite granular or stepped");
+  if (o_case->count() > 0) throw UsageError("--case needs --suite granular, stepped or soft");
 
   Plan plan = suite_plan(suite);
   if (o_particles->count() > 0) {
