@@ -121,6 +121,7 @@ void print_step_tables(const kairos::Config& config, double kT, const std::strin
     std::string label;
     const kairos::PotentialSpec* spec;
     double core;
+    double reduced_mass = std::nan("");  // spring_dashpot's restitution needs it
   };
   std::vector<Item> items;
   for (std::size_t p = 0; p < config.potentials.size(); ++p) {
@@ -132,18 +133,20 @@ void print_step_tables(const kairos::Config& config, double kT, const std::strin
                            (pc.species[0] == species[b].name && pc.species[1] == species[a].name);
         if (!named) continue;
         items.push_back({fmt::format("potential{}_{}_{}", p, species[a].name, species[b].name),
-                         &pc.potential, 0.5 * (species[a].diameter + species[b].diameter)});
+                         &pc.potential, 0.5 * (species[a].diameter + species[b].diameter),
+                         species[a].mass * species[b].mass / (species[a].mass + species[b].mass)});
       }
     }
   }
   double dmax = 0.0;
   for (const auto& sp : species) dmax = std::max(dmax, sp.diameter);
   for (std::size_t k = 0; k < config.bonds.size(); ++k)
-    items.push_back(
-        {fmt::format("bond{}_{}", k, config.bonds[k].type), &config.bonds[k].potential, dmax});
+    items.push_back({fmt::format("bond{}_{}", k, config.bonds[k].type), &config.bonds[k].potential,
+                     dmax, std::nan("")});
   if (items.empty()) throw kairos::InputError("the config has no [[potential]] and no [[bond]]");
   for (const Item& item : items) {
-    const kairos::StepTable table = kairos::make_step_table(*item.spec, item.core, dim);
+    const kairos::StepTable table =
+        kairos::make_step_table(*item.spec, item.core, dim, item.reduced_mass);
     const kairos::ContinuousPotential curve = kairos::continuous_potential(*item.spec);
     const bool has_curve = !curve.name.empty();
     const std::string report =

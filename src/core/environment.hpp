@@ -104,6 +104,12 @@ struct Environment {
       if (t >= 0) return true;
     return !bond_table.empty();
   }
+  // Some step table has a dashpot (spring_dashpot): energy is dissipated at steps.
+  bool dissipative_steps() const {
+    for (const StepTable& t : tables)
+      if (t.damping > 0.0) return true;
+    return false;
+  }
   bool periodic(int axis) const { return faces[2 * axis].kind == FaceKind::kPeriodic; }
   bool has_gravity() const {
     for (int a = 0; a < D; ++a)

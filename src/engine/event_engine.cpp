@@ -2001,7 +2001,8 @@ std::uint32_t EventEngine<D, Queue>::scan_stepped_loop(const CandidateList& list
 // A pair event under a stepped potential. Approaching, the pair meets its zone's inner boundary
 // (the hard core in the innermost zone: returns false, an ordinary collision); receding, the
 // outer one. It crosses into the next zone if its normal kinetic energy pays the step, else
-// bounces (formulas.md §4.2).
+// bounces (formulas.md §4.2); with a dashpot on the table the crossing also pays the dashpot's
+// work, which counts as dissipated (§4.3).
 template <int D, class Queue>
 bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t) {
   const PairSteps::Zone z = steps_.find(i, j, steps_.pair_table(species_of(i), species_of(j)));
@@ -2026,8 +2027,16 @@ bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t
   }
   const double distance = std::sqrt(r2);
   const double mi = mass_of(i), mj = mass_of(j);
-  const StepOutcome out =
-      step_event(mi * mj / (mi + mj), rg / distance, table.energy[next] - table.energy[z.zone]);
+  StepOutcome out;
+  if (table.damping > 0.0) [[unlikely]] {  // a dashpot by steps (formulas.md §4.3)
+    const DissipativeStepOutcome d = dissipative_step_event(
+        mi * mj / (mi + mj), rg / distance, table.energy[next] - table.energy[z.zone],
+        table.damping, table.width[std::max(next, z.zone)], table.force_zero);
+    out = {d.crosses, d.impulse};
+    counters_.dissipated_in_collisions += d.dissipated;
+  } else {
+    out = step_event(mi * mj / (mi + mj), rg / distance, table.energy[next] - table.energy[z.zone]);
+  }
   const Vec<D> impulse = (out.impulse / distance) * r;
   hi.vel = hi.vel + (1.0 / mi) * impulse;
   hj.vel = hj.vel - (1.0 / mj) * impulse;
@@ -2036,6 +2045,7 @@ bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t
   if (out.crosses) {
     steps_.set(i, j, {z.table, next});
     ++counters_.step_crossings;
+    step_captures_ += z.zone == 0 ? 1u : 0u;
   } else {
     ++counters_.step_bounces;
   }

@@ -131,6 +131,9 @@ class EventEngine {
   // How many particles sit in a frozen soft contact now.
   std::uint32_t frozen() const;
   bool stepped() const { return stepped_; }
+  // Pairs that crossed the outermost step of their potential inwards since this engine was
+  // built (not part of the state): the contacts of a stepped soft potential (spring_dashpot).
+  std::uint64_t step_captures() const { return step_captures_; }
   std::uint32_t sleeping() const { return sleeping_; }
   Vec<D> momentum() const;
   const Environment<D>& environment() const { return env_; }
@@ -348,6 +351,7 @@ class EventEngine {
   double next_image_shift_ = kNever;
   bool stepped_ = false;  // some pair has a step potential, or there are bonds
   PairSteps steps_;
+  std::uint64_t step_captures_ = 0;            // see step_captures()
   std::vector<std::uint16_t> step_row_table_;  // scan_stepped's scratch, per shape
   std::vector<double> step_row_reach2_;
   std::vector<double> step_held_;  // the vector loop's held candidates: r.r, r.g, g.g

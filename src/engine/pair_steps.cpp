@@ -13,6 +13,10 @@ ZoneTable::ZoneTable(const StepTable& t) {
   energy.push_back(t.beyond);
   energy.insert(energy.end(), t.energy.begin(), t.energy.end());
   core_zone = static_cast<std::uint16_t>(t.energy.size());
+  damping = t.damping;
+  force_zero = t.force_zero;
+  width.assign(t.boundary.size(), 0.0);
+  for (std::size_t z = 1; z < t.boundary.size(); ++z) width[z] = t.boundary[z - 1] - t.boundary[z];
 }
 
 PairSteps::PairSteps(const std::vector<StepTable>& tables, const std::vector<int>& pair_table,

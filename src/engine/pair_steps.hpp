@@ -35,6 +35,12 @@ struct ZoneTable {
   std::vector<double> r2;       // squared boundaries r_0^2 > ... > r_K^2
   std::vector<double> energy;   // energy of zone z = 0..K (zone 0: beyond the cut-off)
   std::uint16_t core_zone = 0;  // K: the zone next to the hard core
+  // A dashpot by steps (StepTable::damping; 0: none): a crossing between zones z and z +- 1
+  // costs damping |v_n| width[deeper of the two], width[z] = r_{z-1} - r_z (z >= 1; width[0]
+  // unused).
+  double damping = 0.0;
+  bool force_zero = true;
+  std::vector<double> width;
 
   explicit ZoneTable(const StepTable& t);
   // The zone of a pair at squared distance r2 (a pair on a boundary counts as outside it);

@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "interactions/soft_contact.hpp"
 
 namespace kairos {
 
@@ -17,7 +19,7 @@ bool is_bond(const std::string& kind) {
 
 bool is_continuous(const std::string& kind) {
   return kind == "lennard_jones" || kind == "wca" || kind == "yukawa" || kind == "morse" ||
-         kind == "tabulated" || kind == "spring";
+         kind == "tabulated" || kind == "spring" || kind == "spring_dashpot";
 }
 
 bool is_known(const std::string& kind) {
@@ -80,7 +82,7 @@ ContinuousPotential continuous_potential(const PotentialSpec& spec) {
   if (!is_known(spec.kind)) {
     throw InputError(fmt::format(
         "unknown potential kind '{}' (square_well, square_shoulder, steps, lennard_jones, wca, "
-        "yukawa, morse, tabulated, tether or spring)",
+        "yukawa, morse, tabulated, spring_dashpot, tether or spring)",
         spec.kind));
   }
   if (!is_continuous(spec.kind)) return {};
@@ -126,6 +128,11 @@ ContinuousPotential continuous_potential(const PotentialSpec& spec) {
       no_cutoff(spec, "the file's last r");
       return tabulated(spec.file, spec.shifted);
     }
+    if (spec.kind == "spring_dashpot") {
+      positive(spec, "stiffness", spec.stiffness);
+      positive(spec, "length", spec.length);
+      return repulsive_spring(spec.stiffness, spec.length);
+    }
     // spring
     positive(spec, "stiffness", spec.stiffness);
     positive(spec, "length", spec.length);
@@ -146,12 +153,56 @@ StepTable make_step_table(const PotentialSpec& spec, double core) {
   return make_step_table(spec, core, 3);
 }
 
-StepTable make_step_table(const PotentialSpec& spec, double core, int dimension) {
+namespace {
+
+// spring_dashpot: equal steps from `length` to the core, midpoint energies, the dashpot.
+StepTable spring_dashpot_table(const PotentialSpec& spec, const ContinuousPotential& p, double core,
+                               int dimension, double reduced_mass) {
+  if (!(spec.length > core)) {
+    fail(spec, fmt::format("length {} (where the contact begins) must exceed the contact "
+                           "distance (sum of the radii) {}, which is the hard core inside",
+                           spec.length, core));
+  }
+  if (spec.steps < 1) fail(spec, fmt::format("steps must be at least 1, not {}", spec.steps));
+  if (!(spec.damping >= 0.0) || !std::isfinite(spec.damping))
+    fail(spec, fmt::format("damping must be finite and at least 0, not {}", spec.damping));
+  double gamma = spec.damping;
+  if (spec.restitution != 0.0) {
+    if (spec.damping != 0.0) fail(spec, "give damping or restitution, not both");
+    if (!(spec.restitution > 0.0 && spec.restitution <= 1.0)) {
+      fail(spec, fmt::format("restitution must be in (0, 1], not {}", spec.restitution));
+    }
+    if (!(reduced_mass > 0.0) || !std::isfinite(reduced_mass)) {
+      fail(spec, "restitution needs the pair's masses (one mass per species); give damping");
+    }
+    gamma = dashpot_damping_for_restitution(reduced_mass, spec.stiffness, spec.restitution);
+  }
+  StepTable t = step_potential(p, StepPlacement::kDistance, spec.steps, core,
+                               StepEnergyRule::kMidpoint, 1.0, dimension);
+  t.damping = gamma;
+  t.force_zero = spec.force_zero;
+  t.check();
+  return t;
+}
+
+}  // namespace
+
+StepTable make_step_table(const PotentialSpec& spec, double core, int dimension,
+                          double reduced_mass) {
   const ContinuousPotential p = continuous_potential(spec);  // also rejects an unknown kind
   check_core(spec, core);
   if (dimension != 2 && dimension != 3)
     fail(spec, fmt::format("the dimension must be 2 or 3, not {}", dimension));
+  if (spec.kind != "spring_dashpot") {
+    for (const auto& [key, given] : {std::pair<const char*, bool>{"damping", spec.damping != 0.0},
+                                     {"restitution", spec.restitution != 0.0},
+                                     {"force_zero", !spec.force_zero}}) {
+      if (given) fail(spec, fmt::format("{} applies to kind spring_dashpot only", key));
+    }
+  }
   try {
+    if (spec.kind == "spring_dashpot")
+      return spring_dashpot_table(spec, p, core, dimension, reduced_mass);
     if (spec.kind == "square_well" || spec.kind == "square_shoulder") {
       if (!(spec.lambda > 1.0) || !std::isfinite(spec.lambda))
         fail(spec, fmt::format("lambda must be greater than 1, not {}", spec.lambda));

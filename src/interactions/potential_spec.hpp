@@ -3,6 +3,7 @@
 // whose hard core is at a given contact distance.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -11,8 +12,9 @@
 namespace kairos {
 
 struct PotentialSpec {
-  // square_well | square_shoulder | steps | lennard_jones | wca | yukawa | morse | tabulated
-  // (pair potentials); tether | spring (bonds: the pair can never part beyond the table).
+  // square_well | square_shoulder | steps | lennard_jones | wca | yukawa | morse | tabulated |
+  // spring_dashpot (pair potentials); tether | spring (bonds: the pair can never part beyond
+  // the table).
   std::string kind = "square_well";
   // square_well / square_shoulder: range lambda (in units of the contact distance) and depth
   // (well) or height (shoulder).
@@ -45,6 +47,13 @@ struct PotentialSpec {
   std::string placement = "energy";
   std::string shell_energy = "volume";
   double temperature = 1.0;
+  // spring_dashpot (formulas.md §4.3): a repulsive spring (stiffness, from `length` in) in
+  // `steps` equal steps with a dashpot per step: damping gamma, or the head-on restitution e of
+  // the continuous spring-dashpot (> 0: gamma from the closed form of §2.1 for the pair's
+  // reduced mass); force_zero: no net attraction while separating (false: the naive dashpot).
+  double damping = 0.0;
+  double restitution = 0.0;  // 0: not given
+  bool force_zero = true;
 
   bool operator==(const PotentialSpec&) const = default;
 };
@@ -66,13 +75,22 @@ struct PotentialSpec {
 //   tether (bond): max_length > core; boundaries {max_length, core}, energy {0}, beyond +inf.
 //   spring (bond): stiffness > 0, core < length < max_length; the harmonic spring stepped like
 //     a continuous potential (its well is at `length`), beyond +inf.
+//   spring_dashpot: stiffness > 0, length > core (the centre distance where the contact begins;
+//     the pair's contact distance `core` is the hard core inside, which the run must never
+//     reach), steps >= 1 shells of equal width from `length` to `core` with the spring's energy
+//     at each shell's middle radius (placement and shell_energy do not apply), damping >= 0 or
+//     restitution in (0, 1] (not both; restitution needs reduced_mass > 0), force_zero.
+// damping, restitution and force_zero belong to spring_dashpot only (an error elsewhere).
 // The continuous kinds and spring are stepped by step_potential with `steps` (>= 1),
 // `placement` (energy | distance | volume), `shell_energy` (midpoint | volume | mid_volume |
 // virial) and `temperature` (> 0, used by the virial rule). The two-argument form is 3D; the
 // dimension (2 or 3) matters for the volume placement and the volume, mid_volume and virial
 // energies.
+// reduced_mass: the pair's m_i m_j / (m_i + m_j), which only spring_dashpot's restitution needs
+// (NaN: unknown, an error if it is needed).
 StepTable make_step_table(const PotentialSpec& spec, double core);
-StepTable make_step_table(const PotentialSpec& spec, double core, int dimension);
+StepTable make_step_table(const PotentialSpec& spec, double core, int dimension,
+                          double reduced_mass = std::numeric_limits<double>::quiet_NaN());
 
 // The continuous potential of a spec, defaults filled in (empty name for square_well,
 // square_shoulder, steps, tether): what `kairos steps` draws next to the table. Throws

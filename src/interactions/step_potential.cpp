@@ -222,6 +222,10 @@ void StepTable::check() const {
     if (!std::isfinite(u)) throw InputError("step energies must be finite");
   if (beyond != 0.0 && beyond != kInfinity)
     throw InputError("the energy beyond a step table's cut-off must be 0 or infinite (a bond)");
+  if (!(damping >= 0.0) || !std::isfinite(damping)) {
+    throw InputError(
+        fmt::format("a step table's damping must be finite and at least 0, not {}", damping));
+  }
 }
 
 StepTable square_well(double sigma, double lambda, double eps) {
@@ -246,6 +250,17 @@ StepOutcome step_event(double mu, double v_n, double delta_u) {
   if (v_n * v_n < need) return {false, -2.0 * mu * v_n};  // bounce
   const double v_after = std::copysign(std::sqrt(v_n * v_n - need), v_n);
   return {true, -2.0 * delta_u / (v_n + v_after)};
+}
+
+DissipativeStepOutcome dissipative_step_event(double mu, double v_n, double delta_u, double damping,
+                                              double width, bool force_zero) {
+  const double work = damping * std::abs(v_n) * width;
+  // The kinetic energy the crossing takes: the step plus the dashpot's work, capped at 0 on the
+  // way down a step with the force-zero rule.
+  double charge = delta_u + work;
+  if (force_zero && delta_u < 0.0) charge = std::min(charge, 0.0);
+  const StepOutcome out = step_event(mu, v_n, charge);
+  return {out.crosses, out.impulse, out.crosses ? charge - delta_u : 0.0};
 }
 
 namespace {
@@ -323,6 +338,15 @@ ContinuousPotential harmonic_spring(double k, double length, double max_length) 
   return {"harmonic spring",
           [k, length](double r) { return 0.5 * k * (r - length) * (r - length); }, length,
           max_length, kInfinity};
+}
+
+ContinuousPotential repulsive_spring(double k, double length) {
+  require_positive("the stiffness k", k, "spring_dashpot");
+  require_positive("length", length, "spring_dashpot");
+  return {
+      "repulsive spring",
+      [k, length](double r) { return r < length ? 0.5 * k * (length - r) * (length - r) : 0.0; },
+      0.0, length, 0.0};
 }
 
 namespace {

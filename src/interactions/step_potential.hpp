@@ -22,6 +22,14 @@ struct StepTable {
   // Energy beyond the cut-off: 0 for a pair potential, +inf for a bond (the pair can never
   // separate further than r_0).
   double beyond = 0.0;
+  // A dashpot by steps (formulas.md §4.3): each crossing of a boundary removes gamma |v_n| dr
+  // from the pair's normal kinetic energy, dr the width of the deeper of the two shells and v_n
+  // the normal speed before the crossing (dissipative_step_event). 0: no dissipation (the
+  // conservative step rule, bit for bit). force_zero: while separating down a step the pair
+  // gains max(0, -delta_u - gamma |v_n| dr), never less (no net attraction: the force-zero end
+  // of contact); false: the naive dashpot, whose pair may be pulled back.
+  double damping = 0.0;
+  bool force_zero = true;
 
   double core() const { return boundary.back(); }
   double cutoff() const { return boundary.front(); }
@@ -29,7 +37,7 @@ struct StepTable {
   // value.
   double energy_at(double r) const;
   // Throws InputError naming the first problem (too few boundaries, not decreasing, not
-  // positive, energies not finite or of the wrong count).
+  // positive, energies not finite or of the wrong count, damping negative or not finite).
   void check() const;
 };
 
@@ -54,6 +62,22 @@ struct StepOutcome {
   double impulse = 0.0;  // J: v_i += J n / m_i, v_j -= J n / m_j
 };
 StepOutcome step_event(double mu, double v_n, double delta_u);
+
+// The same step with a dashpot (formulas.md §4.3): crossing a boundary costs the dashpot work
+// dE = gamma |v_n| width, with v_n the normal velocity before the crossing. Approaching (or
+// climbing, delta_u >= 0): the pair crosses if (1/2) mu v_n^2 >= delta_u + dE and then loses
+// delta_u + dE, else it bounces (elastically: no step is crossed, nothing is dissipated).
+// Separating down a step (delta_u < 0): with force_zero it gains max(0, -delta_u - dE) and always
+// crosses (the step never pulls it back: no net attraction); without, it is charged
+// delta_u + dE like a climb (and may bounce back inwards). `dissipated` = the kinetic energy lost
+// beyond delta_u (>= 0). damping = 0 gives step_event's outcome bit for bit.
+struct DissipativeStepOutcome {
+  bool crosses = false;
+  double impulse = 0.0;
+  double dissipated = 0.0;
+};
+DissipativeStepOutcome dissipative_step_event(double mu, double v_n, double delta_u, double damping,
+                                              double width, bool force_zero);
 
 // A continuous pair potential to be stepped: U(r) on (core, cutoff], and the shape of U, which
 // the equal-energy placement needs:
@@ -99,6 +123,11 @@ ContinuousPotential morse(double eps, double r_min, double alpha, double rc, boo
 // cut-off is max_length and beyond it the energy is +inf (beyond = +inf), so its step table is
 // a bond. r_min = length; requires k > 0 and 0 < length < max_length.
 ContinuousPotential harmonic_spring(double k, double length, double max_length);
+
+// The repulsive half of a spring, (k / 2) (length - r)^2 for r < length and 0 beyond (cut-off
+// `length`, r_min = 0: monotone, repulsive): the elastic part of a linear spring-dashpot contact
+// that begins at the centre distance `length` (formulas.md §4.3). Requires k > 0, length > 0.
+ContinuousPotential repulsive_spring(double k, double length);
 
 // A potential read from a text file of two whitespace-separated columns r U, one point per line
 // ('#' starts a comment; blank lines are skipped). r must be positive and strictly increasing,

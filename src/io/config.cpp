@@ -195,6 +195,10 @@ constexpr KeySpec kSchema[] = {
     {"output.progress", Kind::kString},
     {"output.profile_axis", Kind::kString},
     {"output.profile_bins", Kind::kInteger},
+    // After contact.* and soft.*: an unknown 'restitution' elsewhere is suggested those first.
+    {"potential[].damping", Kind::kFloat},
+    {"potential[].restitution", Kind::kFloat},
+    {"potential[].force_zero", Kind::kBoolean},
 };
 
 constexpr std::string_view kLattices3D[] = {"fcc", "sc", "bcc", "random"};
@@ -210,8 +214,8 @@ constexpr std::string_view kRestitutionModels[] = {"constant", "viscoelastic", "
 constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
 constexpr std::string_view kAxes[] = {"x", "y", "z"};
 constexpr std::string_view kPairPotentials[] = {
-    "square_well", "square_shoulder", "steps", "lennard_jones",
-    "wca",         "yukawa",          "morse", "tabulated"};
+    "square_well", "square_shoulder", "steps",     "lennard_jones", "wca",
+    "yukawa",      "morse",           "tabulated", "spring_dashpot"};
 constexpr std::string_view kBondPotentials[] = {"tether", "spring"};
 constexpr std::string_view kPlacements[] = {"energy", "distance", "volume"};
 constexpr std::string_view kShellEnergies[] = {"midpoint", "volume", "mid_volume", "virial"};
@@ -1287,6 +1291,41 @@ class Reader {
     const toml::node* n_shell = get_string(t, prefix, "shell_energy", spec.shell_energy);
     require_choice(n_shell, prefix + ".shell_energy", spec.shell_energy, kShellEnergies);
     require_positive(t.get("temperature"), prefix + ".temperature", spec.temperature);
+    if (spec.kind == "spring_dashpot") {
+      // Equal steps with midpoint energies always: the dashpot per step assumes them.
+      for (const auto& [node, key] :
+           {std::pair{n_placement, "placement"}, std::pair{n_shell, "shell_energy"}}) {
+        if (node != nullptr) {
+          fail(node, prefix + "." + key,
+               fmt::format("{}.{}: spring_dashpot steps are always of equal width with the "
+                           "spring's energy at each step's middle; remove the key",
+                           prefix, key));
+        }
+      }
+    }
+    const toml::node* n_damping = get_number(t, prefix, "damping", spec.damping);
+    const toml::node* n_restitution = get_number(t, prefix, "restitution", spec.restitution);
+    const toml::node* n_force_zero = get_bool(t, prefix, "force_zero", spec.force_zero);
+    for (const auto& [node, key] :
+         {std::pair{n_damping, "damping"}, std::pair{n_restitution, "restitution"},
+          std::pair{n_force_zero, "force_zero"}}) {
+      if (node != nullptr && spec.kind != "spring_dashpot") {
+        fail(node, prefix + "." + key,
+             fmt::format("{}.{}: applies to kind = \"spring_dashpot\" only", prefix, key));
+      }
+    }
+    if (n_damping != nullptr && n_restitution != nullptr) {
+      fail(n_restitution, prefix + ".restitution",
+           fmt::format("{}.restitution: give damping or restitution, not both", prefix));
+    }
+    if (n_damping != nullptr && !(spec.damping >= 0.0)) {
+      fail(n_damping, prefix + ".damping",
+           fmt::format("{}.damping: must be at least 0, got {}", prefix, spec.damping));
+    }
+    if (n_restitution != nullptr && !(spec.restitution > 0.0 && spec.restitution <= 1.0)) {
+      fail(n_restitution, prefix + ".restitution",
+           fmt::format("{}.restitution: must be in (0, 1], got {}", prefix, spec.restitution));
+    }
   }
 
   void read_potentials(const toml::table& root, const std::vector<SpeciesConfig>& species,
@@ -1733,8 +1772,14 @@ std::string potential_toml(const PotentialSpec& p) {
   out += fmt::format("shifted = {}\n", p.shifted);
   out += fmt::format("file = {}\n", toml_string(p.file));
   out += fmt::format("steps = {}\n", p.steps);
-  out += fmt::format("placement = {}\n", toml_string(p.placement));
-  out += fmt::format("shell_energy = {}\n", toml_string(p.shell_energy));
+  if (p.kind != "spring_dashpot") {
+    out += fmt::format("placement = {}\n", toml_string(p.placement));
+    out += fmt::format("shell_energy = {}\n", toml_string(p.shell_energy));
+  } else {
+    out += p.restitution > 0.0 ? fmt::format("restitution = {}\n", toml_float(p.restitution))
+                               : fmt::format("damping = {}\n", toml_float(p.damping));
+    out += fmt::format("force_zero = {}\n", p.force_zero);
+  }
   return out;
 }
 

@@ -39,10 +39,21 @@ std::vector<double> species_diameters(const ParticleSystem<D>& s, std::size_t sp
   return d;
 }
 
+// The mass of each species of the state (NaN for a species whose particles differ in mass).
+template <int D>
+std::vector<double> species_masses(const ParticleSystem<D>& s, std::size_t species) {
+  std::vector<double> m(species, 0.0);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    double& mi = m[s.species[i]];
+    mi = mi == 0.0 || mi == s.mass[i] ? s.mass[i] : std::nan("");
+  }
+  return m;
+}
+
 StepTable build_table(const PotentialSpec& spec, double core, int dimension,
-                      const std::string& where) {
+                      const std::string& where, double reduced_mass = std::nan("")) {
   try {
-    return make_step_table(spec, core, dimension);
+    return make_step_table(spec, core, dimension, reduced_mass);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", where, e.what()));
   }
@@ -55,6 +66,7 @@ void add_step_potentials(const Config& config, const ParticleSystem<D>& s, Envir
   const auto n = static_cast<std::uint32_t>(std::max<std::size_t>(1, names.size()));
   if (!config.potentials.empty()) {
     const std::vector<double> diameter = species_diameters(s, n);
+    const std::vector<double> mass = species_masses(s, n);
     env.pair_table.assign(static_cast<std::size_t>(n) * n, -1);
     // The entry without species first, so that named pairs override it.
     std::vector<std::size_t> order(config.potentials.size());
@@ -81,7 +93,9 @@ void add_step_potentials(const Config& config, const ParticleSystem<D>& s, Envir
               where, names[a], names[b]));
         }
         if (core == 0.0) continue;  // a species without particles
-        env.tables.push_back(build_table(pc.potential, core, D, where));
+        // The reduced mass (NaN if unknown): spring_dashpot's restitution needs it.
+        const double mu = mass[a] * mass[b] / (mass[a] + mass[b]);
+        env.tables.push_back(build_table(pc.potential, core, D, where, mu));
         const int t = static_cast<int>(env.tables.size()) - 1;
         env.pair_table[a * n + b] = t;
         env.pair_table[b * n + a] = t;

@@ -242,7 +242,8 @@ class RunDriver {
                       EngineOptions{}, environment);
       driven_ = config.driving.kind != "none";
       granular_ = !environment.plain() || environment.has_gravity() || driven_ ||
-                  environment.sheared() || environment.soft_spheres();
+                  environment.sheared() || environment.soft_spheres() ||
+                  environment.dissipative_steps();
       sheared_ = environment.sheared();
       for (int a = 0; a < D; ++a) granular_ = granular_ || !environment.periodic(a);
     } catch (const InputError& e) {

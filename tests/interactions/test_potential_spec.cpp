@@ -13,6 +13,7 @@
 
 #include "core/error.hpp"
 #include "input_error_matchers.hpp"
+#include "interactions/soft_contact.hpp"
 
 namespace kairos {
 namespace {
@@ -269,6 +270,59 @@ TEST(PotentialSpec, EveryBadValueIsNamed) {
   EXPECT_INPUT_ERROR(make_step_table(s, 1.0), "potential square_shoulder: depth must be positive");
   EXPECT_INPUT_ERROR(make_step_table(spec_of("soft"), 1.0), "unknown potential kind 'soft'");
   EXPECT_INPUT_ERROR(continuous_potential(spec_of("soft")), "unknown potential kind 'soft'");
+}
+
+// spring_dashpot (formulas.md §4.3): the repulsive spring from `length` in, N equal steps to the
+// core with midpoint energies, the dashpot on the table; its errors name the key.
+TEST(PotentialSpec, SpringDashpot) {
+  PotentialSpec s = spec_of("spring_dashpot");
+  s.stiffness = 100.0;
+  s.length = 1.2;
+  s.steps = 4;
+  s.damping = 0.5;
+  const StepTable t = make_step_table(s, 1.0);
+  EXPECT_EQ(t.boundary.size(), 5u);
+  EXPECT_DOUBLE_EQ(t.cutoff(), 1.2);
+  EXPECT_DOUBLE_EQ(t.core(), 1.0);
+  EXPECT_NEAR(t.energy[0], 50.0 * 0.025 * 0.025, 1e-13);
+  EXPECT_NEAR(t.energy[3], 50.0 * 0.175 * 0.175, 1e-13);
+  EXPECT_EQ(t.damping, 0.5);
+  EXPECT_TRUE(t.force_zero);
+  EXPECT_EQ(continuous_potential(s).u(1.3), 0.0);
+  EXPECT_NEAR(continuous_potential(s).u(1.1), 0.5, 1e-13);
+  s.force_zero = false;
+  EXPECT_FALSE(make_step_table(s, 1.0, 2).force_zero);
+  // gamma from the restitution for the pair's reduced mass.
+  s.damping = 0.0;
+  s.restitution = 0.7;
+  EXPECT_NEAR(make_step_table(s, 1.0, 3, 0.5).damping,
+              dashpot_damping_for_restitution(0.5, 100.0, 0.7), 1e-15);
+  EXPECT_INPUT_ERROR(make_step_table(s, 1.0),
+                     "potential spring_dashpot: restitution needs the pair's masses");
+  s.restitution = 0.0;
+  EXPECT_EQ(make_step_table(s, 1.0).damping, 0.0);  // an elastic stepped spring
+  s.restitution = 1.2;
+  EXPECT_INPUT_ERROR(make_step_table(s, 1.0, 3, 0.5),
+                     "potential spring_dashpot: restitution must be in (0, 1]");
+  s.restitution = 0.7;
+  s.damping = 1.0;
+  EXPECT_INPUT_ERROR(make_step_table(s, 1.0, 3, 0.5),
+                     "potential spring_dashpot: give damping or restitution, not both");
+  s.restitution = 0.0;
+  s.damping = -1.0;
+  EXPECT_INPUT_ERROR(make_step_table(s, 1.0), "potential spring_dashpot: damping must be");
+  s.damping = 0.0;
+  EXPECT_INPUT_ERROR(make_step_table(s, 1.2), "potential spring_dashpot: length 1.2");
+  s.stiffness = 0.0;
+  EXPECT_INPUT_ERROR(make_step_table(s, 1.0), "potential spring_dashpot: stiffness must be");
+  // The dashpot keys belong to spring_dashpot.
+  PotentialSpec w = spec_of("square_well");
+  w.damping = 1.0;
+  EXPECT_INPUT_ERROR(make_step_table(w, 1.0),
+                     "potential square_well: damping applies to kind spring_dashpot only");
+  w.damping = 0.0;
+  w.force_zero = false;
+  EXPECT_INPUT_ERROR(make_step_table(w, 1.0), "force_zero applies to kind spring_dashpot only");
 }
 
 }  // namespace

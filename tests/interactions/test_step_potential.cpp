@@ -572,5 +572,52 @@ TEST(Report, HeaderAndTableReadBack) {
                                p.u(1.5), p.u(2.0)));
 }
 
+// formulas.md §4.3: a crossing pays the dashpot's work gamma |v_n| width at the speed before
+// it. Approaching: cross if the energy pays step + work, else bounce with nothing dissipated.
+// Separating down a step: with the cap the pair gains max(0, -dU - work) and always crosses;
+// without, it is charged dU + work and may be pulled back. No damping: step_event bit for bit.
+TEST(DissipativeStepEvent, PaysTheDashpotWorkAndCapsTheGain) {
+  const double mu = 0.75, gamma = 2.0, width = 0.01;
+  for (const double v : {-3.0, -1.2, 0.7, 2.5}) {
+    for (const double du : {0.3, -0.2, 0.0}) {
+      const StepOutcome plain = step_event(mu, v, du);
+      const DissipativeStepOutcome none = dissipative_step_event(mu, v, du, 0.0, width, true);
+      EXPECT_EQ(none.crosses, plain.crosses);
+      EXPECT_EQ(none.impulse, plain.impulse);
+      EXPECT_EQ(none.dissipated, 0.0);
+      for (const bool cap : {true, false}) {
+        const DissipativeStepOutcome d = dissipative_step_event(mu, v, du, gamma, width, cap);
+        const double work = gamma * std::abs(v) * width;
+        const double k0 = 0.5 * mu * v * v;
+        const double after = v + d.impulse / mu;
+        const double k1 = 0.5 * mu * after * after;
+        if (!d.crosses) {  // a bounce: reversed, nothing lost
+          EXPECT_NEAR(after, -v, 1e-14);
+          EXPECT_EQ(d.dissipated, 0.0);
+          EXPECT_LT(k0, du + work);
+          continue;
+        }
+        EXPECT_GT(after * v, 0.0);  // same direction
+        EXPECT_NEAR(k0 - k1, du + d.dissipated, 1e-13) << v << " " << du;
+        if (cap && du < 0.0) {
+          EXPECT_NEAR(d.dissipated, std::min(work, -du), 1e-15);
+          EXPECT_GE(k1, k0 - 1e-15);  // never slower down a step: no net attraction
+        } else {
+          EXPECT_NEAR(d.dissipated, work, 1e-15);
+        }
+      }
+    }
+  }
+  // Slow, separating down a small step: the cap lets it leave unchanged; without the cap the
+  // dashpot's work exceeds the step and the pair is pulled back.
+  const DissipativeStepOutcome capped = dissipative_step_event(mu, 0.1, -0.001, 5.0, 0.01, true);
+  EXPECT_TRUE(capped.crosses);
+  EXPECT_EQ(capped.impulse, 0.0);
+  EXPECT_NEAR(capped.dissipated, 0.001, 1e-18);
+  const DissipativeStepOutcome naive = dissipative_step_event(mu, 0.1, -0.001, 5.0, 0.01, false);
+  EXPECT_FALSE(naive.crosses);
+  EXPECT_NEAR(naive.impulse, -2.0 * mu * 0.1, 1e-15);
+}
+
 }  // namespace
 }  // namespace kairos
