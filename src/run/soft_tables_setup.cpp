@@ -58,8 +58,13 @@ std::vector<SoftTableUse> attach_soft_tables(
   }
   if (!(fastest > 0.0) && !(settings.max_speed > 0.0)) return used;  // nothing moves
   // Relative speeds reach twice the fastest particle's speed.
+  // Rounded up to a quarter decade, so that states alike (other seeds, a cooler restart
+  // started afresh) share their tables through the cache.
   const double max_speed =
-      settings.max_speed > 0.0 ? settings.max_speed : 2.0 * settings.speed_margin * fastest;
+      settings.max_speed > 0.0
+          ? settings.max_speed
+          : std::pow(10.0, std::ceil(4.0 * std::log10(2.0 * settings.speed_margin * fastest)) /
+                               4.0);
   const double min_speed = max_speed * std::pow(10.0, -settings.speed_decades);
   const std::filesystem::path dir =
       settings.cache_dir.empty() ? default_soft_table_cache_dir() : settings.cache_dir;

@@ -17,8 +17,9 @@ namespace kairos {
 struct SoftTableSettings {
   double tolerance = 1e-6;          // relative, every component
   std::filesystem::path cache_dir;  // empty: default_soft_table_cache_dir()
-  // The fastest normal impact speed covered is this many times the state's largest particle
-  // speed (or the driving's thermal speed); the slowest is speed_decades below it.
+  // The fastest normal impact speed covered is this many times twice the state's largest
+  // particle speed (or the driving's thermal speed), rounded up to a quarter decade; the slowest
+  // is speed_decades below it.
   double speed_margin = 2.5;
   double speed_decades = 4.0;
   double driving_temperature = 0.0;  // > 0: an Andersen thermostat sets speeds too
