@@ -1097,46 +1097,56 @@ class Reader {
     const std::vector<const toml::table*> tables = table_array(t, p, "pair");
     for (std::size_t i = 0; i < tables.size(); ++i) {
       const std::string prefix = fmt::format("contact.pair[{}]", i);
-      const std::string species_key = prefix + ".species";
-      std::vector<std::string> names;
-      const toml::node* n_species = get_strings(*tables[i], prefix, "species", names);
-      if (n_species == nullptr) {
-        fail(tables[i], species_key,
-             fmt::format("missing required key '{}' (the pair's two species, e.g. species = "
-                         "[\"A\", \"B\"])",
-                         species_key));
-      }
-      if (names.size() != 2) {
-        fail(n_species, species_key,
-             fmt::format("{}: expected 2 species names, got {}", species_key, names.size()));
-      }
-      for (std::size_t k = 0; k < 2; ++k) {
-        const bool declared =
-            std::any_of(species.begin(), species.end(),
-                        [&](const SpeciesConfig& s) { return s.name == names[k]; });
-        if (!declared) {
-          std::vector<std::string_view> known;
-          for (const SpeciesConfig& s : species) known.push_back(s.name);
-          fail(element_of(n_species, k), species_key,
-               fmt::format("{}: unknown species '{}' (declared species: {})", species_key, names[k],
-                           join_words(known)));
-        }
-      }
-      for (std::size_t j = 0; j < in.pairs.size(); ++j) {
-        const auto& other = in.pairs[j].species;
-        if ((other[0] == names[0] && other[1] == names[1]) ||
-            (other[0] == names[1] && other[1] == names[0])) {
-          fail(n_species, species_key,
-               fmt::format("{}: the pair ({}, {}) is already given by contact.pair[{}]",
-                           species_key, names[0], names[1], j));
-        }
-      }
+      std::vector<std::array<std::string, 2>> given;
+      for (const PairContactConfig& other : in.pairs) given.push_back(other.species);
       PairContactConfig pair;
-      pair.species = {names[0], names[1]};
+      pair.species = read_species_pair(*tables[i], prefix, "contact.pair", species, given);
       pair.contact = in.contact;
       read_contact(*tables[i], prefix, pair.contact);
       in.pairs.push_back(std::move(pair));
     }
+  }
+
+  // The `species` key of a [[contact.pair]] / [[soft.pair]] table at `prefix`: two declared
+  // species names, a pair not already among `given` (the earlier tables of `list`).
+  std::array<std::string, 2> read_species_pair(
+      const toml::table& t, const std::string& prefix, std::string_view list,
+      const std::vector<SpeciesConfig>& species,
+      const std::vector<std::array<std::string, 2>>& given) const {
+    const std::string species_key = prefix + ".species";
+    std::vector<std::string> names;
+    const toml::node* n_species = get_strings(t, prefix, "species", names);
+    if (n_species == nullptr) {
+      fail(&t, species_key,
+           fmt::format("missing required key '{}' (the pair's two species, e.g. species = "
+                       "[\"A\", \"B\"])",
+                       species_key));
+    }
+    if (names.size() != 2) {
+      fail(n_species, species_key,
+           fmt::format("{}: expected 2 species names, got {}", species_key, names.size()));
+    }
+    for (std::size_t k = 0; k < 2; ++k) {
+      const bool declared = std::any_of(species.begin(), species.end(),
+                                        [&](const SpeciesConfig& s) { return s.name == names[k]; });
+      if (!declared) {
+        std::vector<std::string_view> known;
+        for (const SpeciesConfig& s : species) known.push_back(s.name);
+        fail(element_of(n_species, k), species_key,
+             fmt::format("{}: unknown species '{}' (declared species: {})", species_key, names[k],
+                         join_words(known)));
+      }
+    }
+    for (std::size_t j = 0; j < given.size(); ++j) {
+      const auto& other = given[j];
+      if ((other[0] == names[0] && other[1] == names[1]) ||
+          (other[0] == names[1] && other[1] == names[0])) {
+        fail(n_species, species_key,
+             fmt::format("{}: the pair ({}, {}) is already given by {}[{}]", species_key, names[0],
+                         names[1], list, j));
+      }
+    }
+    return {names[0], names[1]};
   }
 
   // The index in kFaces of a face name valid in `dimension`.
@@ -1487,42 +1497,10 @@ class Reader {
     const std::vector<const toml::table*> tables = table_array(t, p, "pair");
     for (std::size_t i = 0; i < tables.size(); ++i) {
       const std::string prefix = fmt::format("soft.pair[{}]", i);
-      const std::string species_key = prefix + ".species";
-      std::vector<std::string> names;
-      const toml::node* n_species = get_strings(*tables[i], prefix, "species", names);
-      if (n_species == nullptr) {
-        fail(tables[i], species_key,
-             fmt::format("missing required key '{}' (the pair's two species, e.g. species = "
-                         "[\"A\", \"B\"])",
-                         species_key));
-      }
-      if (names.size() != 2) {
-        fail(n_species, species_key,
-             fmt::format("{}: expected 2 species names, got {}", species_key, names.size()));
-      }
-      for (std::size_t k = 0; k < 2; ++k) {
-        const bool declared =
-            std::any_of(species.begin(), species.end(),
-                        [&](const SpeciesConfig& s) { return s.name == names[k]; });
-        if (!declared) {
-          std::vector<std::string_view> known;
-          for (const SpeciesConfig& s : species) known.push_back(s.name);
-          fail(element_of(n_species, k), species_key,
-               fmt::format("{}: unknown species '{}' (declared species: {})", species_key, names[k],
-                           join_words(known)));
-        }
-      }
-      for (std::size_t j = 0; j < soft.pairs.size(); ++j) {
-        const auto& other = soft.pairs[j].species;
-        if ((other[0] == names[0] && other[1] == names[1]) ||
-            (other[0] == names[1] && other[1] == names[0])) {
-          fail(n_species, species_key,
-               fmt::format("{}: the pair ({}, {}) is already given by soft.pair[{}]", species_key,
-                           names[0], names[1], j));
-        }
-      }
+      std::vector<std::array<std::string, 2>> given;
+      for (const SoftPairConfig& other : soft.pairs) given.push_back(other.species);
       SoftPairConfig pair;
-      pair.species = {names[0], names[1]};
+      pair.species = read_species_pair(*tables[i], prefix, "soft.pair", species, given);
       pair.law = soft.law;
       read_soft_law(*tables[i], prefix, pair.law);
       soft.pairs.push_back(std::move(pair));

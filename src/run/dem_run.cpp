@@ -84,28 +84,14 @@ class DemRunDriver {
       profile_.emplace(axis, static_cast<int>(config.output.profile_bins), 0.0, start.box[axis],
                        cross);
     }
-    dir_ = config.output.directory;
-    std::error_code ec;
-    fs::create_directories(dir_, ec);
-    if (ec || !fs::is_directory(dir_)) {
-      throw InputError("output.directory: cannot create '" + dir_.string() + "': " + ec.message());
-    }
-    write_text_atomically(dir_ / "config.toml", to_toml(config));
+    dir_ = prepare_output_directory(config);
   }
 
   RunOutcome run() {
     const auto wall_start = Clock::now();
     thermo_.emplace(dir_ / "thermo.tsv", restart_);
-    if (config_.output.trajectory) {
-      const fs::path traj = dir_ / "trajectory.gsd";
-      if (restart_ && fs::exists(traj)) {
-        check_same_trajectory(traj, n_, D, dir_);
-        trajectory_.emplace(gsd::Writer::open_append(traj));
-      } else {
-        trajectory_.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
-        append_trajectory_frame(*trajectory_, dem_->export_state());
-      }
-    }
+    if (config_.output.trajectory)
+      open_trajectory<D>(trajectory_, dir_, restart_, n_, [&] { return dem_->export_state(); });
     ke_start_ = dem_->kinetic_energy();
     energy_start_ = total_energy();
     dissipated_start_ = dem_->dissipated_energy();

@@ -258,27 +258,15 @@ class RunDriver {
         if (a != axis) cross *= box[a];
       profile_.emplace(axis, static_cast<int>(config.output.profile_bins), 0.0, box[axis], cross);
     }
-    dir_ = config.output.directory;
-    std::error_code ec;
-    fs::create_directories(dir_, ec);
-    if (ec || !fs::is_directory(dir_)) {
-      throw InputError("output.directory: cannot create '" + dir_.string() + "': " + ec.message());
-    }
-    write_text_atomically(dir_ / "config.toml", to_toml(config));
+    dir_ = run_detail::prepare_output_directory(config);
   }
 
   RunOutcome run() {
     const auto wall_start = Clock::now();
     thermo_.emplace(dir_ / "thermo.tsv", restart_);
     if (config_.output.trajectory) {
-      const fs::path traj = dir_ / "trajectory.gsd";
-      if (restart_ && fs::exists(traj)) {
-        check_same_system(traj);
-        trajectory_.emplace(gsd::Writer::open_append(traj));
-      } else {
-        trajectory_.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
-        append_trajectory_frame(*trajectory_, engine_->export_state(/*with_zones=*/false));
-      }
+      run_detail::open_trajectory<D>(trajectory_, dir_, restart_, n_,
+                                     [&] { return engine_->export_state(/*with_zones=*/false); });
     }
     ke_start_ = engine_->kinetic_energy();
     u_start_ = engine_->potential_energy();
@@ -332,11 +320,6 @@ class RunDriver {
   }
 
  private:
-  // Appending to another system's trajectory would corrupt it for every reader.
-  void check_same_system(const fs::path& traj) const {
-    run_detail::check_same_trajectory(traj, n_, D, dir_);
-  }
-
   // Equilibration still owed if the run stops now (a restart file records it).
   RunProgress progress_now() const {
     RunProgress p;

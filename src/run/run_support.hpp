@@ -19,6 +19,7 @@
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/particle_system.hpp"
+#include "io/atomic_file.hpp"
 #include "io/config.hpp"
 #include "io/gsd_file.hpp"
 #include "io/gsd_snapshot.hpp"
@@ -58,6 +59,33 @@ inline void check_same_trajectory(const fs::path& traj, std::size_t n, int dimen
         "this run has {} in {}D): write the continued run to another directory (-o)",
         dir.string(), stored_n.empty() ? 0u : stored_n[0], dims.empty() ? 0 : dims[0], n,
         dimension));
+  }
+}
+
+// Creates the output directory and writes the effective configuration into it.
+inline fs::path prepare_output_directory(const Config& config) {
+  const fs::path dir = config.output.directory;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) {
+    throw InputError("output.directory: cannot create '" + dir.string() + "': " + ec.message());
+  }
+  write_text_atomically(dir / "config.toml", to_toml(config));
+  return dir;
+}
+
+// trajectory.gsd of the run in `dir`: appended to when a restarted run finds its own system's
+// file there, else created with `first_frame` (a callable giving the state) as frame 0.
+template <int D, class FirstFrame>
+void open_trajectory(std::optional<gsd::Writer>& writer, const fs::path& dir, bool restarted,
+                     std::size_t n, FirstFrame&& first_frame) {
+  const fs::path traj = dir / "trajectory.gsd";
+  if (restarted && fs::exists(traj)) {
+    check_same_trajectory(traj, n, D, dir);
+    writer.emplace(gsd::Writer::open_append(traj));
+  } else {
+    writer.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
+    append_trajectory_frame(*writer, first_frame());
   }
 }
 
