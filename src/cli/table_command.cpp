@@ -20,8 +20,7 @@
 namespace kairos::cli {
 namespace {
 
-// The flags that describe one table (a species pair's law, mu and l, and the
-// ranges).
+// The flags that describe one table (a species pair's law, mu and l, and the ranges).
 struct SpecFlags {
   std::string model;
   double stiffness = 0.0, damping = 0.0, reduced_mass = 0.0, contact_distance = 0.0;
@@ -162,9 +161,8 @@ std::string describe(const SoftMapTable& t) {
   return out;
 }
 
-// The plot files: nodes.tsv (every node's map) and, with error points,
-// errors.tsv (lookup against direct integration at a regular grid of off-grid
-// points).
+// The plot files: nodes.tsv (every node's map) and, with error points, errors.tsv (lookup against
+// direct integration at a regular grid of off-grid points).
 void write_plot_files(const SoftMapTable& t, const std::filesystem::path& dir, int error_points) {
   std::filesystem::create_directories(dir);
   const SoftTableGrid& g = t.grid();
@@ -193,8 +191,7 @@ void write_plot_files(const SoftMapTable& t, const std::filesystem::path& dir, i
   write_text_atomically(dir / "nodes.tsv", nodes);
   write_text_atomically(dir / "report.txt", describe(t));
   if (error_points <= 0) return;
-  // Cell-centred points of an error_points^2 grid (error_points along w for
-  // head-on tables).
+  // Cell-centred points of an error_points^2 grid (error_points along w for head-on tables).
   std::string errors = header;
   errors += "u\tw\terr_eps_t\terr_eps_rdot\terr_eps_phi\terr_end_overlap\n";
   const double u_span = (g.nu - 1) * g.u_step, w_span = (g.nw - 1) * g.w_step;
@@ -220,8 +217,8 @@ void write_plot_files(const SoftMapTable& t, const std::filesystem::path& dir, i
   write_text_atomically(dir / "errors.tsv", errors);
 }
 
-// The tables `kairos run CONFIG` would use (same state, same speed range, same cache), built
-// now or read from the cache; one report each.
+// The tables `kairos run CONFIG` would use (same state, same speed range, same cache), built now or
+// read from the cache; one report each.
 template <int D>
 void build_config_tables(const Config& config) {
   if (!config.soft.enabled()) throw InputError("the config has no [soft] table");

@@ -25,8 +25,8 @@ namespace kairos {
 namespace {
 
 // ---------------------------------------------------------------------------------------------
-// Constants of the method. Any change to them (or to what is stored) changes
-// the tables: bump kFormatVersion so that cached files are rebuilt.
+// Constants of the method. Any change to them (or to what is stored) changes the tables: bump
+// kFormatVersion so that cached files are rebuilt.
 
 constexpr std::uint32_t kFormatVersion = 1;
 constexpr char kMagic[8] = {'K', 'A', 'I', 'R', 'O', 'S', 'M', 'T'};
@@ -35,8 +35,8 @@ constexpr double kLogMinRatio = -4.0;       // u_min: log10 of the smallest v_t/
 constexpr double kBelowLogMinRatio = -8.0;  // check points below the table: u in [-8, -4)
 constexpr double kNodeTolerance = 1e-13;    // collision_map's tolerance for nodes and check points
 constexpr double kInitialSpacing = 0.25;    // of u and w, before refinement
-// A hair of padding around the ranges, so that a collision exactly at a range's
-// end (whose log10 the caller computes with its own rounding) is inside.
+// A hair of padding around the ranges, so that a collision exactly at a range's end (whose log10
+// the caller computes with its own rounding) is inside.
 constexpr double kPad = 1e-9;
 constexpr long kMaxNodes = 1L << 21;  // 48 MiB of data
 constexpr int kStored = 3;            // ln eps_t, ln(-eps_rdot), ln eps_phi
@@ -52,10 +52,9 @@ void require_positive(double x, const char* field) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Cubic Lagrange interpolation on a uniform grid: the 4 nodes j..j+3 around
-// position s (in units of the spacing, 0 <= s <= n - 1, n >= 4), centred where
-// possible and shifted inwards at the ends; t = s - j lies in [1, 2] inside and
-// in [0, 1] or [2, 3] at the ends.
+// Cubic Lagrange interpolation on a uniform grid: the 4 nodes j..j+3 around position s (in units of
+// the spacing, 0 <= s <= n - 1, n >= 4), centred where possible and shifted inwards at the ends; t
+// = s - j lies in [1, 2] inside and in [0, 1] or [2, 3] at the ends.
 
 inline int stencil_start(double s, int n, double& t) {
   const int j = std::clamp(static_cast<int>(s) - 1, 0, n - 4);
@@ -72,8 +71,7 @@ inline void cubic_weights(double t, double w[4]) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Work spread over threads; the calling thread takes part and is the one that
-// reports progress.
+// Work spread over threads; the calling thread takes part and is the one that reports progress.
 
 template <class F>
 void parallel_for(std::size_t n, int threads, const F& f,
@@ -123,9 +121,8 @@ void component_errors(const CollisionMap& table, const CollisionMap& direct, dou
   err[3] = relative_error(table.end_overlap, direct.end_overlap);
 }
 
-// ---------------------------------------------------------------------------------------------
-// The file format: little helpers over a byte string, native byte order
-// (checked by a mark).
+// --------------------------------------------------------------------------------------------- The
+// file format: little helpers over a byte string, native byte order (checked by a mark).
 
 class Writer {
  public:
@@ -175,8 +172,8 @@ std::uint64_t fnv1a(const char* p, std::size_t n) {
   return h;
 }
 
-// The key: everything that determines a table's content. It opens the file, and
-// its hash names the file.
+// The key: everything that determines a table's content. It opens the file, and its hash names the
+// file.
 std::string key_bytes(const SoftTableSpec& s, int check_points, std::uint64_t seed) {
   Writer w;
   w.put_bytes(kMagic, sizeof kMagic);
@@ -259,15 +256,14 @@ void SoftMapTable::set_grid(const SoftTableGrid& grid) {
   grid_ = grid;
   inv_u_step_ = grid.nu > 1 ? 1.0 / grid.u_step : 0.0;
   inv_w_step_ = 1.0 / grid.w_step;
-  // (less a rounding, so that v_t/v_n computed as exactly 10^u_min is on the
-  // table)
+  // (less a rounding, so that v_t/v_n computed as exactly 10^u_min is on the table)
   min_ratio_ = grid.nu > 1 ? std::pow(10.0, grid.u_min) * (1.0 - 1e-12) : 0.0;
   report_.nodes = grid.nu > 1 ? std::vector<int>{grid.nu, grid.nw} : std::vector<int>{grid.nw};
 }
 
 // ---------------------------------------------------------------------------------------------
-// Lookup: the hot path (once per collision in the engine): two logarithms, 16
-// (or 4) nodes, three exponentials, no allocation.
+// Lookup: the hot path (once per collision in the engine): two logarithms, 16 (or 4) nodes, three
+// exponentials, no allocation.
 
 void SoftMapTable::interpolate(double su, double sw, double out[3]) const {
   double tw, ww[4];
@@ -314,8 +310,7 @@ void SoftMapTable::fill(const double logs[3], const CollisionUnits& units,
 
 bool SoftMapTable::lookup(const CollisionUnits& units, CollisionMap& map) const {
   const ReducedCollision& r = units.reduced;
-  // Units of another pair would give a wrong map silently: the check costs a
-  // few products.
+  // Units of another pair would give a wrong map silently: the check costs a few products.
   const bool same_pair = r.model == spec_.law.model &&
                          (r.model == SoftModel::LinearDashpot
                               ? std::abs(r.c_dis - c_dis_) <= 1e-9 * c_dis_
@@ -327,8 +322,7 @@ bool SoftMapTable::lookup(const CollisionUnits& units, CollisionMap& map) const 
                     "l~ {}) is not of this table's "
                     "pair",
                     static_cast<int>(r.model), r.c_dis, r.l_tilde));
-  // Positions a rounding beyond the end nodes (1e-9 of a spacing) count as on
-  // them.
+  // Positions a rounding beyond the end nodes (1e-9 of a spacing) count as on them.
   constexpr double kSlack = 1e-9;
   double sw = (std::log10(r.l_tilde) - grid_.w_min) * inv_w_step_;
   if (!(sw >= -kSlack && sw <= grid_.nw - 1 + kSlack)) return false;
@@ -395,8 +389,8 @@ struct SoftMapTableBuilder {
     out[2] = std::log(m.eps_phi);
   }
 
-  // Largest error per component over points (lookup against direct); +inf if
-  // one falls outside (it must not).
+  // Largest error per component over points (lookup against direct); +inf if one falls outside (it
+  // must not).
   static void max_errors(const SoftMapTable& t, const std::vector<Point>& points, double err[4]) {
     std::fill(err, err + 4, 0.0);
     for (const Point& p : points) {
@@ -411,9 +405,8 @@ struct SoftMapTableBuilder {
     }
   }
 
-  // The largest error (over the four components) of interpolating along one
-  // axis alone (axis 0: u, 1: w): points at random positions along it, on
-  // random node lines of the other.
+  // The largest error (over the four components) of interpolating along one axis alone (axis 0: u,
+  // 1: w): points at random positions along it, on random node lines of the other.
   static double axis_error(const SoftMapTable& t, int axis, const SoftTableBuildOptions& options,
                            int level, int threads) {
     const SoftTableGrid& g = t.grid_;
@@ -466,8 +459,7 @@ struct SoftMapTableBuilder {
                  std::sqrt(std::sqrt(spec.contact_distance));
       t.c_dis4_ = (t.c_dis_ * t.c_dis_) * (t.c_dis_ * t.c_dis_);
     }
-    // l~ falls with the impact speed: the fastest collision is at the low end
-    // of w.
+    // l~ falls with the impact speed: the fastest collision is at the low end of w.
     const double w_lo = std::log10(
         reduce_collision(law, spec.reduced_mass, spec.contact_distance, spec.max_normal_speed, 0.0)
             .reduced.l_tilde);
@@ -497,8 +489,7 @@ struct SoftMapTableBuilder {
       }
     }
 
-    // The check points and their direct maps (computed once, reused at every
-    // refinement).
+    // The check points and their direct maps (computed once, reused at every refinement).
     std::mt19937_64 rng(options.seed);
     const auto uniform = [&](double a, double b) {
       return a + (b - a) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
@@ -553,8 +544,7 @@ struct SoftMapTableBuilder {
         for (int i = 0; i < g.nu; ++i) {
           const std::size_t k = static_cast<std::size_t>(j) * static_cast<std::size_t>(g.nu) +
                                 static_cast<std::size_t>(i);
-          // After a halving, every other node along the halved axes is the
-          // previous level's.
+          // After a halving, every other node along the halved axes is the previous level's.
           if (level > 0 && j % w_factor == 0 && i % u_factor == 0) {
             const std::size_t k_old =
                 static_cast<std::size_t>(j / w_factor) * static_cast<std::size_t>(old_grid.nu) +
@@ -583,10 +573,9 @@ struct SoftMapTableBuilder {
       std::copy(err, err + 4, t.report_.max_error);
       t.report_.refinements = level;
       if (*std::max_element(err, err + 4) <= spec.tolerance) break;
-      // Which axis to halve: the error of interpolating along one axis alone,
-      // measured on the other axis's node lines (the map varies about twice as
-      // fast along u as along w where grazing sets in, so u usually needs the
-      // finer spacing).
+      // Which axis to halve: the error of interpolating along one axis alone, measured on the other
+      // axis's node lines (the map varies about twice as fast along u as along w where grazing sets
+      // in, so u usually needs the finer spacing).
       bool refine_u = false, refine_w = true;
       if (!spec.head_on) {
         const double e_u = axis_error(t, 0, options, level, threads);
@@ -759,9 +748,8 @@ SoftMapTable SoftMapTable::read_file(const std::filesystem::path& file) {
 
 void SoftMapTable::write_file(const std::filesystem::path& file) const {
   const std::string bytes = SoftMapTableBuilder::serialize(*this);
-  // A unique temporary name: two runs may build the same table at once; the
-  // last rename wins and either file is complete. (Not io/atomic_file:
-  // interactions stay below io.)
+  // A unique temporary name: two runs may build the same table at once; the last rename wins and
+  // either file is complete. (Not io/atomic_file: interactions stay below io.)
   static std::atomic<unsigned> counter{0};
   std::filesystem::path tmp = file;
   tmp += fmt::format(".tmp.{}.{}", static_cast<long>(::getpid()), counter.fetch_add(1));
@@ -799,8 +787,7 @@ SoftMapTable SoftMapTable::load_or_build(const SoftTableSpec& spec,
   if (std::filesystem::exists(file, ec)) {
     try {
       const std::string bytes = read_bytes(file);
-      // The whole key must match (a hash collision or a stale format is
-      // rebuilt).
+      // The whole key must match (a hash collision or a stale format is rebuilt).
       const std::string key = key_bytes(spec, options.check_points, options.seed);
       if (bytes.size() >= key.size() && bytes.compare(0, key.size(), key) == 0) {
         SoftMapTable t = SoftMapTableBuilder::parse(bytes, file);

@@ -1,9 +1,8 @@
-// Lookup tables of the soft-sphere collision map
-// (src/interactions/soft_map_table.hpp): lookups against direct integration
-// (collision_map) at random off-grid points, the ranges, head-on tables against
-// the closed forms of formulas.md §2, the cache file (round trip, damaged,
-// stale and other-spec files) and input validation. Small speed ranges keep the
-// builds short; one table is built at the default tolerance 1e-6.
+// Lookup tables of the soft-sphere collision map (src/interactions/soft_map_table.hpp): lookups
+// against direct integration (collision_map) at random off-grid points, the ranges, head-on tables
+// against the closed forms of formulas.md §2, the cache file (round trip, damaged, stale and
+// other-spec files) and input validation. Small speed ranges keep the builds short; one table is
+// built at the default tolerance 1e-6.
 #include "interactions/soft_map_table.hpp"
 
 #include <gtest/gtest.h>
@@ -39,8 +38,7 @@ SoftTableSpec dashpot_spec(double c_dis, double v_min, double v_max, double rati
   return s;
 }
 
-// Hertz with c_dis = c_at_1 at v_n = 1 (c_dis = A / T, T = (mu^2 / (rho^2
-// v))^(1/5)).
+// Hertz with c_dis = c_at_1 at v_n = 1 (c_dis = A / T, T = (mu^2 / (rho^2 v))^(1/5)).
 SoftTableSpec hertz_spec(double c_at_1, double v_min, double v_max, double ratio, double tol) {
   SoftTableSpec s;
   const double rho = 1e5;
@@ -65,9 +63,8 @@ double rel(double a, double b) {
   return a == b ? 0.0 : std::abs(a - b) / std::abs(b);
 }
 
-// Random impact velocities within the table's speeds and ratios: the largest
-// relative error of each component of lookup() against collision_map, and the
-// errors of the derived fields.
+// Random impact velocities within the table's speeds and ratios: the largest relative error of each
+// component of lookup() against collision_map, and the errors of the derived fields.
 struct Sample {
   double err[4] = {};
   double eps_r_err = 0.0, phidot_err = 0.0, phi_c_err = 0.0;
@@ -101,8 +98,8 @@ Sample sample_errors(const SoftMapTable& table, int n, std::uint64_t seed) {
   return out;
 }
 
-// A fresh sample's maximum may exceed the build's (another sample of the same
-// error field) a little: allow a factor 2.
+// A fresh sample's maximum may exceed the build's (another sample of the same error field) a
+// little: allow a factor 2.
 void expect_within_tolerance(const SoftMapTable& table, int n = 400, std::uint64_t seed = 99) {
   const double tol = table.spec().tolerance;
   for (int c = 0; c < 4; ++c)
@@ -115,8 +112,7 @@ void expect_within_tolerance(const SoftMapTable& table, int n = 400, std::uint64
   EXPECT_LE(s.phi_c_err, 2.0 * tol);
 }
 
-// A fresh directory under the system's temporary directory, removed at the end
-// of the test.
+// A fresh directory under the system's temporary directory, removed at the end of the test.
 class TempDir {
  public:
   explicit TempDir(const std::string& name)
@@ -264,15 +260,13 @@ TEST(SoftMapTable, DashpotHeadOnTableIsTheClosedForm) {
     ASSERT_EQ(table.report().nodes.size(), 1u);
     const HeadOn closed = dashpot_head_on_reduced(0.5 * c_dis);
     for (double v : {0.01, 0.3, 10.0}) {
-      // A wall: v_t plays no part (the caller passes 0; other values are
-      // ignored).
+      // A wall: v_t plays no part (the caller passes 0; other values are ignored).
       for (double v_t : {0.0, 5.0 * v}) {
         CollisionMap m;
         ASSERT_TRUE(table.lookup(reduce_collision(spec.law, kMu, kL, v, v_t), m));
         EXPECT_LE(rel(m.eps_t, closed.contact_time), 1e-6) << v;
         EXPECT_LE(rel(-m.eps_rdot, closed.restitution), 1e-6) << v;
-        // xi_c = (2 beta / omega_0^2) e v, in units of v T = v / omega_0: c_dis
-        // e.
+        // xi_c = (2 beta / omega_0^2) e v, in units of v T = v / omega_0: c_dis e.
         EXPECT_LE(rel(m.end_overlap, c_dis * closed.restitution), 1e-6) << v;
       }
     }
@@ -291,8 +285,8 @@ TEST(SoftMapTable, HertzHeadOnTableIsTheClosedForm) {
     EXPECT_LE(rel(m.eps_rdot, -1.0), 1e-6);
     EXPECT_EQ(m.end_overlap, 0.0);
   }
-  // Viscoelastic, c_dis = A / T from 0.0016 to 0.004 (grows as v^(1/5)): the
-  // restitution series to 7th order is exact to ~1e-8 there.
+  // Viscoelastic, c_dis = A / T from 0.0016 to 0.004 (grows as v^(1/5)): the restitution series to
+  // 7th order is exact to ~1e-8 there.
   SoftTableSpec visco = hertz_spec(0.0025, 0.1, 10.0, 1.0, 1e-6);
   visco.head_on = true;
   const SoftMapTable t1 = SoftMapTable::build(visco, few_checks());
@@ -306,8 +300,8 @@ TEST(SoftMapTable, HertzHeadOnTableIsTheClosedForm) {
   }
 }
 
-// ---------------------------------------------------------------------------------------------
-// The cache.
+// --------------------------------------------------------------------------------------------- The
+// cache.
 
 std::string read_all(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -423,8 +417,7 @@ TEST(SoftMapTable, EverySpecFieldAndCheckSettingNamesItsOwnFile) {
     for (std::size_t b = a + 1; b < names.size(); ++b)
       EXPECT_NE(names[a], names[b]) << a << " " << b;
 
-  // A file of another spec under this spec's name (a hash collision, a hand
-  // copy) is rebuilt.
+  // A file of another spec under this spec's name (a hash collision, a hand copy) is rebuilt.
   const TempDir dir("otherspec");
   SoftTableSpec other = base;
   other.max_normal_speed = 2.5;
