@@ -272,7 +272,6 @@ class DemRunDriver {
     const double kT_prod = production_temperatures_.empty()
                                ? th.temperature(prod_ke_)
                                : block_average(production_temperatures_).mean;
-    const BlockAverage z_blocks = th.compressibility_blocks();
     const double z_mean = th.compressibility(dem_->virial() - prod_start_.virial, kT_prod, t_prod);
     std::vector<Vec<D>> x(n_);
     std::vector<double> diameters(n_);
@@ -292,24 +291,11 @@ class DemRunDriver {
     j["number_density"] = static_cast<double>(n_) / volume_;
     j["restarted"] = restart_;
     j["stop_reason"] = stop_reason_;
-    j["events"] = steps;  // time steps
-    j["collisions"] = collisions;
-    j["sim_time"] = dem_->time();
-    j["production_time"] = t_prod;
-    j["production_collisions_per_particle"] = per_particle(coll_prod);
-    j["wall_seconds"] = wall;
-    j["events_per_second"] = wall > 0 ? static_cast<double>(steps) / wall : 0.0;
-    j["collisions_per_second"] = wall > 0 ? static_cast<double>(collisions) / wall : 0.0;
-    j["temperature"] = kT;
-    j["kinetic_energy"] = ke;
-    j["compressibility"] = {{"mean", z_mean},
-                            {"stderr", z_blocks.stderr_},
-                            {"blocks", z_blocks.samples},
-                            {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
-    j["pressure"] = th.pressure(z_mean, kT_prod);
-    j["production_temperature"] = kT_prod;
-    j["mean_free_time"] = th.mean_free_time(t_prod, coll_prod);
-    j["mean_free_time_stderr"] = th.mean_free_time_blocks().stderr_;
+    // "events" are time steps.
+    add_run_totals(j,
+                   {steps, collisions, coll_prod, dem_->time(), t_prod, wall,
+                    per_particle(coll_prod), kT, ke, kT_prod, z_mean},
+                   th);
     j["energy_drift_relative"] = ke_start_ > 0 ? std::abs(energy - energy_start_) / ke_start_ : 0.0;
     j["momentum_drift"] = pscale > 0 ? std::sqrt(dp2) / pscale : 0.0;
     j["max_overlap"] = max_overlap<D>(state.box, x, diameters);

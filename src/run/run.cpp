@@ -555,7 +555,6 @@ class RunDriver {
     if ((engine_->stepped() || driven_) && !production_temperatures_.empty()) {
       kT_prod = block_average(production_temperatures_).mean;
     }
-    const BlockAverage z_blocks = th.compressibility_blocks();
     const double z_mean = th.compressibility(c.virial - prod_start_.virial, kT_prod, t_prod);
     std::vector<double> diameters(n_);
     for (std::size_t i = 0; i < n_; ++i) diameters[i] = 2.0 * state.kinematics[i].radius;
@@ -577,27 +576,15 @@ class RunDriver {
     j["event_queue"] = engine_->queue_name();
     j["restarted"] = restart_;
     j["stop_reason"] = stop_reason_;
-    j["events"] = events;
-    j["collisions"] = collisions;
     j["event_counts"] = {{"collisions", collisions},
                          {"cell_crossings", c.cell_crossings},
                          {"stale", c.stale_events},
                          {"total_events_since_start", c.events},
                          {"total_collisions_since_start", c.collisions}};
-    j["sim_time"] = engine_->time();
-    j["production_time"] = t_prod;
-    j["production_collisions_per_particle"] = per_particle(coll_prod);
-    j["wall_seconds"] = wall;
-    j["events_per_second"] = wall > 0 ? static_cast<double>(events) / wall : 0.0;
-    j["collisions_per_second"] = wall > 0 ? static_cast<double>(collisions) / wall : 0.0;
-    j["temperature"] = kT;
-    j["kinetic_energy"] = ke;
-    j["compressibility"] = {{"mean", z_mean},
-                            {"stderr", z_blocks.stderr_},
-                            {"blocks", z_blocks.samples},
-                            {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
-    j["pressure"] = th.pressure(z_mean, kT_prod);
-    j["production_temperature"] = kT_prod;
+    run_detail::add_run_totals(j,
+                               {events, collisions, coll_prod, engine_->time(), t_prod, wall,
+                                per_particle(coll_prod), kT, ke, kT_prod, z_mean},
+                               th);
     if (kinetic_tensor_samples_ > 0 && t_prod > 0.0) {
       // Kinetic part averaged over the production rows, collisional part from the impulses
       // over the production time.
@@ -614,8 +601,6 @@ class RunDriver {
       }
       j["pressure_tensor"] = tensor;
     }
-    j["mean_free_time"] = th.mean_free_time(t_prod, coll_prod);
-    j["mean_free_time_stderr"] = th.mean_free_time_blocks().stderr_;
     // Kinetic plus stepped-potential energy against the starting kinetic energy.
     j["energy_drift_relative"] =
         ke_start_ > 0 ? std::abs(engine_->kinetic_energy() + engine_->potential_energy() -

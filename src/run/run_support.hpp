@@ -15,7 +15,9 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
+#include "analysis/block_average.hpp"
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/particle_system.hpp"
@@ -87,6 +89,41 @@ void open_trajectory(std::optional<gsd::Writer>& writer, const fs::path& dir, bo
     writer.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
     append_trajectory_frame(*writer, first_frame());
   }
+}
+
+// What summary.json holds alike for both integrators (docs/outputs.md): counts and rates, the
+// times, the temperature, Z with its blocked error, the pressure and the mean free time.
+struct RunTotals {
+  std::uint64_t events = 0;      // this invocation's (DEM: time steps)
+  std::uint64_t collisions = 0;  // this invocation's
+  std::uint64_t production_collisions = 0;
+  double sim_time = 0.0, production_time = 0.0, wall_seconds = 0.0;
+  double production_collisions_per_particle = 0.0;
+  double temperature = 0.0, kinetic_energy = 0.0, production_temperature = 0.0;
+  double compressibility = 0.0;  // the production mean
+};
+
+inline void add_run_totals(nlohmann::json& j, const RunTotals& r, const Thermodynamics& th) {
+  const BlockAverage z_blocks = th.compressibility_blocks();
+  const double wall = r.wall_seconds;
+  j["events"] = r.events;
+  j["collisions"] = r.collisions;
+  j["sim_time"] = r.sim_time;
+  j["production_time"] = r.production_time;
+  j["production_collisions_per_particle"] = r.production_collisions_per_particle;
+  j["wall_seconds"] = wall;
+  j["events_per_second"] = wall > 0 ? static_cast<double>(r.events) / wall : 0.0;
+  j["collisions_per_second"] = wall > 0 ? static_cast<double>(r.collisions) / wall : 0.0;
+  j["temperature"] = r.temperature;
+  j["kinetic_energy"] = r.kinetic_energy;
+  j["compressibility"] = {{"mean", r.compressibility},
+                          {"stderr", z_blocks.stderr_},
+                          {"blocks", z_blocks.samples},
+                          {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
+  j["pressure"] = th.pressure(r.compressibility, r.production_temperature);
+  j["production_temperature"] = r.production_temperature;
+  j["mean_free_time"] = th.mean_free_time(r.production_time, r.production_collisions);
+  j["mean_free_time_stderr"] = th.mean_free_time_blocks().stderr_;
 }
 
 inline std::uint64_t peak_rss_bytes() {
