@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
+#include <memory>
 #include "core/periodic.hpp"
 #include "core/vec.hpp"
-#include <memory>
 
 #include "interactions/granular_contact.hpp"
 #include "interactions/soft_contact.hpp"

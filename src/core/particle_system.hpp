@@ -105,10 +105,10 @@ struct PairZone {
 template <int D>
 struct FrozenContact {
   static constexpr std::uint32_t kWall = 0xffffffffu;
-  std::uint32_t i = 0;            // the caller's numbering
-  std::uint32_t j = kWall;        // the partner (caller's numbering), or kWall
-  std::uint32_t face = 0;         // the wall's face when j == kWall
-  double release_time = 0.0;      // absolute
+  std::uint32_t i = 0;                // the caller's numbering
+  std::uint32_t j = kWall;            // the partner (caller's numbering), or kWall
+  std::uint32_t face = 0;             // the wall's face when j == kWall
+  double release_time = 0.0;          // absolute
   Vec<D> velocity_i{}, velocity_j{};  // after the release (velocity_j unused for a wall)
   bool operator==(const FrozenContact&) const = default;
 };

@@ -1623,8 +1623,8 @@ void EventEngine<D, Queue>::validate() {
       if (gap >= radius_of(i) * (1.0 - 1e-9)) continue;
       // A soft contact overlaps its wall while frozen and after its release, leaving; turned
       // back towards the wall (by a third body), it meets the wall now.
-      const double leaving = (f % 2 == 0 ? 1.0 : -1.0) * (velocity_of(i, t)[f / 2] -
-                                                           env_.faces[f].wall.velocity[f / 2]);
+      const double leaving = (f % 2 == 0 ? 1.0 : -1.0) *
+                             (velocity_of(i, t)[f / 2] - env_.faces[f].wall.velocity[f / 2]);
       const bool soft_ok = soft_ && gap > 0.75 * radius_of(i) &&
                            (frozen_with_[i] == kFirstWall + static_cast<std::uint32_t>(f) ||
                             leaving >= 0.0 || queue_.time_of(i) <= t);

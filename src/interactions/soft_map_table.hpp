@@ -71,7 +71,7 @@ struct SoftTableReport {
   int check_points = 0;
   int refinements = 0;  // grid halvings needed to reach the tolerance
   bool from_cache = false;
-  std::filesystem::path cache_file;  // empty when not cached
+  std::filesystem::path cache_file;     // empty when not cached
   double recorded_build_seconds = 0.0;  // build_seconds of the build that made this table
   // Collisions with v_t/v_n below 10^-4 (head-on included) take the u = -4 row: allowed only when
   // points there (u in [-8, -4) and v_t = 0) met the tolerance at the build, with this largest

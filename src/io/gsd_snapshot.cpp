@@ -491,8 +491,7 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   if (const auto chunk = r.find(f, "kairos/state/frozen_contacts")) {
     const std::size_t nf = chunk->N;
     const auto who = require<std::uint32_t>(r, f, "kairos/state/frozen_contacts", path, 3 * nf);
-    const auto when =
-        require<double>(r, f, "kairos/state/frozen_release", path, nf * (1 + 2 * D));
+    const auto when = require<double>(r, f, "kairos/state/frozen_release", path, nf * (1 + 2 * D));
     s.frozen.resize(nf);
     for (std::size_t k = 0; k < nf; ++k) {
       FrozenContact<D>& c = s.frozen[k];

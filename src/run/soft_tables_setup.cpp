@@ -63,8 +63,8 @@ std::vector<SoftTableUse> attach_soft_tables(
   const double max_speed =
       settings.max_speed > 0.0
           ? settings.max_speed
-          : std::pow(10.0, std::ceil(4.0 * std::log10(2.0 * settings.speed_margin * fastest)) /
-                               4.0);
+          : std::pow(10.0,
+                     std::ceil(4.0 * std::log10(2.0 * settings.speed_margin * fastest)) / 4.0);
   const double min_speed = max_speed * std::pow(10.0, -settings.speed_decades);
   const std::filesystem::path dir =
       settings.cache_dir.empty() ? default_soft_table_cache_dir() : settings.cache_dir;
