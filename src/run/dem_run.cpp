@@ -46,13 +46,7 @@ class DemRunDriver {
   DemRunDriver(const Config& config, const std::optional<fs::path>& restart_file)
       : config_(config), restart_(restart_file.has_value()), rng_(config.system.seed) {
     ParticleSystem<D> start = build_start_state<D>(config, restart_file, rng_, resumed_);
-    if (restart_file && resumed_.integrator != "dem") {
-      throw InputError(fmt::format(
-          "restart file '{}' was written by run.integrator = \"{}\", this run uses \"dem\"; "
-          "continue it with the same integrator, or start a new run from its state with "
-          "system.initial_state",
-          restart_file->string(), resumed_.integrator));
-    }
+    check_restart_integrator(restart_file, resumed_, "dem");
     n_ = start.size();
     base_events_ = start.counters.events;
     volume_ = 1.0;

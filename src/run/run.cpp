@@ -219,13 +219,7 @@ class RunDriver {
   RunDriver(const Config& config, const std::optional<fs::path>& restart_file)
       : config_(config), restart_(restart_file.has_value()), rng_(config.system.seed) {
     ParticleSystem<D> start = build_start_state<D>(config, restart_file, rng_, resumed_);
-    if (restart_file && resumed_.integrator != "event") {
-      throw InputError(fmt::format(
-          "restart file '{}' was written by run.integrator = \"{}\", this run uses \"event\"; "
-          "continue it with the same integrator, or start a new run from its state with "
-          "system.initial_state",
-          restart_file->string(), resumed_.integrator));
-    }
+    run_detail::check_restart_integrator(restart_file, resumed_, "event");
     n_ = start.size();
     volume_ = 1.0;
     for (int a = 0; a < D; ++a) volume_ *= start.box[a];

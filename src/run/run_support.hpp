@@ -12,6 +12,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <fmt/format.h>
@@ -62,6 +63,17 @@ inline void check_same_trajectory(const fs::path& traj, std::size_t n, int dimen
         dir.string(), stored_n.empty() ? 0u : stored_n[0], dims.empty() ? 0 : dims[0], n,
         dimension));
   }
+}
+
+// A restart file continues only under the integrator that wrote it.
+inline void check_restart_integrator(const std::optional<fs::path>& restart_file,
+                                     const RunProgress& resumed, std::string_view integrator) {
+  if (!restart_file || resumed.integrator == integrator) return;
+  throw InputError(
+      fmt::format("restart file '{}' was written by run.integrator = \"{}\", this run uses \"{}\"; "
+                  "continue it with the same integrator, or start a new run from its state with "
+                  "system.initial_state",
+                  restart_file->string(), resumed.integrator, integrator));
 }
 
 // Creates the output directory and writes the effective configuration into it.
