@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <string>
 
@@ -31,6 +32,11 @@ inline double wrap_once(double x, double L) {
   return x;
 }
 
+// A neighbour cell beyond a wall (none).
+constexpr std::size_t kNoCell = std::numeric_limits<std::size_t>::max();
+constexpr std::uint32_t kNoCell32 = std::numeric_limits<std::uint32_t>::max();
+
+// With half_L infinite (an axis between walls) the difference is kept as it is.
 inline double min_image_once(double d, double half_L, double L) {
   if (d > half_L) return d - L;
   if (d < -half_L) return d + L;
@@ -43,6 +49,7 @@ template <int D>
 DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system, const SoftContactLaw& law,
                                 const DemOptions& options)
     : base_(system), laws_{law}, species_(1), box_(system.box), time_(system.time) {
+  set_walls(Environment<D>{});
   init(options);
 }
 
@@ -54,7 +61,86 @@ DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system,
   if (species == 0 || laws.size() != static_cast<std::size_t>(species) * species)
     throw InputError(fmt::format("DEM: {} contact laws for {} species (one per species pair)",
                                  laws.size(), species));
+  set_walls(Environment<D>{});
   init(options);
+}
+
+template <int D>
+DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system, const Environment<D>& env,
+                                const DemOptions& options)
+    : base_(system), laws_(env.soft), species_(env.species), box_(system.box), time_(system.time) {
+  if (env.soft.empty())
+    throw InputError("DEM: no soft contact laws (the DEM integrates the forces of [soft])");
+  if (species_ == 0 || laws_.size() != static_cast<std::size_t>(species_) * species_)
+    throw InputError(fmt::format("DEM: {} contact laws for {} species (one per species pair)",
+                                 laws_.size(), species_));
+  if (env.sheared()) throw InputError("DEM: Lees-Edwards shear is not supported");
+  if (env.stepped()) throw InputError("DEM: stepped potentials are not supported");
+  // The environment is the model (as for the event engine): its faces and field win over the
+  // flags the state carries.
+  for (int k = 0; k < D; ++k) base_.periodic[k] = env.periodic(k);
+  base_.gravity = env.gravity;
+  set_walls(env);
+  init(options);
+}
+
+template <int D>
+void DemIntegrator<D>::set_walls(const Environment<D>& env) {
+  for (int k = 0; k < D; ++k) {
+    periodic_[k] = env.periodic(k);
+    if (base_.periodic[k] != periodic_[k])
+      throw InputError(
+          fmt::format("DEM: axis {} is not periodic (walls need the environment constructor)", k));
+  }
+  for (int f = 0; f < 2 * D; ++f) {
+    const FaceKind kind = env.faces[static_cast<std::size_t>(f)].kind;
+    if (kind == FaceKind::kOpen)
+      throw InputError(fmt::format(
+          "DEM: face {} of the box is open (particles leaving the box are not supported)", f));
+    wall_on_[static_cast<std::size_t>(f)] = kind == FaceKind::kWall;
+    walls_[static_cast<std::size_t>(f)] = env.faces[static_cast<std::size_t>(f)].wall;
+    any_wall_ = any_wall_ || kind == FaceKind::kWall;
+  }
+  if (any_wall_) {
+    if (env.soft_wall.size() != species_)
+      throw InputError(fmt::format("DEM: {} particle-wall laws for {} species (one per species)",
+                                   env.soft_wall.size(), species_));
+    for (const SoftContactLaw& given : env.soft_wall) {
+      const SoftContactLaw law =
+          given.model == SoftModel::LinearDashpot
+              ? SoftContactLaw::linear_dashpot(given.stiffness, given.damping)
+              : SoftContactLaw::viscoelastic_hertz(given.stiffness, given.damping);
+      const bool hertz = law.model == SoftModel::ViscoelasticHertz;
+      wall_laws_.push_back(law);
+      wall_hertz_.push_back(hertz ? 1 : 0);
+      wall_stiffness_.push_back(law.stiffness);
+      wall_damping_.push_back(hertz ? 1.5 * law.damping * law.stiffness : law.damping);
+    }
+  }
+  for (int k = 0; k < D; ++k) {
+    if (!std::isfinite(env.gravity[k]))
+      throw InputError(fmt::format("DEM: gravity along axis {} is not finite", k));
+    gravity_[k] = env.gravity[k];
+    gravity_on_ = gravity_on_ || gravity_[k] != 0.0;
+  }
+}
+
+template <int D>
+double DemIntegrator<D>::plane(int face, double t) const {
+  const Wall<D>& w = walls_[static_cast<std::size_t>(face)];
+  const int k = face / 2;
+  double x = face % 2 == 0 ? 0.0 : box_[k];
+  if (w.velocity[k] != 0.0) x += w.velocity[k] * t;
+  return w.vibrates() ? x + w.amplitude * std::sin(w.angular_frequency * t + w.phase) : x;
+}
+
+template <int D>
+double DemIntegrator<D>::plane_velocity(int face, double t) const {
+  const Wall<D>& w = walls_[static_cast<std::size_t>(face)];
+  const double u = w.velocity[face / 2];
+  return w.vibrates()
+             ? u + w.amplitude * w.angular_frequency * std::cos(w.angular_frequency * t + w.phase)
+             : u;
 }
 
 template <int D>
@@ -91,6 +177,9 @@ void DemIntegrator<D>::init(const DemOptions& options) {
   collisions_ = system.counters.collisions;
   virial_ = system.counters.virial;
   dissipated_ = system.counters.dissipated_in_collisions;
+  wall_collisions_ = system.counters.wall_collisions;
+  dissipated_walls_ = system.counters.dissipated_at_walls;
+  work_by_walls_ = system.counters.work_by_walls;
 
   const std::size_t n = system.size();
   if (n == 0) throw InputError("DEM: the system has no particles");
@@ -101,9 +190,8 @@ void DemIntegrator<D>::init(const DemOptions& options) {
     if (!(box_[k] > 0.0) || !std::isfinite(box_[k]))
       throw InputError(
           fmt::format("DEM: box length {} along axis {} must be positive", box_[k], k));
-    if (!system.periodic[k])
-      throw InputError(fmt::format("DEM: axis {} is not periodic (only periodic boxes)", k));
-    if (system.gravity[k] != 0.0) throw InputError("DEM: gravity is not supported");
+    if (system.gravity[k] != gravity_[k])
+      throw InputError("DEM: gravity needs the environment constructor");
   }
   if (!system.bonds.empty()) throw InputError("DEM: bonds are not supported");
   for (std::size_t i = 0; i < n; ++i)
@@ -165,7 +253,7 @@ void DemIntegrator<D>::init(const DemOptions& options) {
         throw InputError(fmt::format("DEM: position of particle {} is not finite", i));
       if (!std::isfinite(v[k]))
         throw InputError(fmt::format("DEM: velocity of particle {} is not finite", i));
-      x_[k][i] = wrap_into_box(p[k], box_[k]);
+      x_[k][i] = periodic_[k] ? wrap_into_box(p[k], box_[k]) : p[k];
       v_[k][i] = v[k];
       vp_[k][i] = v[k];
       v2 += v[k] * v[k];
@@ -173,11 +261,16 @@ void DemIntegrator<D>::init(const DemOptions& options) {
     v_max = std::max(v_max, std::sqrt(v2));
   }
   skin_ = options.skin * max_diameter_;
-  for (int k = 0; k < D; ++k)
-    if (!(box_[k] > 2.0 * (max_diameter_ + skin_)))
+  for (int k = 0; k < D; ++k) {
+    if (periodic_[k] && !(box_[k] > 2.0 * (max_diameter_ + skin_)))
       throw InputError(
           fmt::format("DEM: box length {} along axis {} must exceed 2 (d_max + skin) = {}", box_[k],
                       k, 2.0 * (max_diameter_ + skin_)));
+    if (!periodic_[k] && !(box_[k] > max_diameter_))
+      throw InputError(fmt::format(
+          "DEM: box length {} along axis {} (between walls) must exceed the largest diameter {}",
+          box_[k], k, max_diameter_));
+  }
 
   if (options.dt > 0.0) {
     dt_ = options.dt;
@@ -185,7 +278,12 @@ void DemIntegrator<D>::init(const DemOptions& options) {
     double v_ref = options.reference_speed;
     if (!(v_ref >= 0.0) || !std::isfinite(v_ref))
       throw InputError(fmt::format("DEM: reference_speed must be >= 0, got {}", v_ref));
-    if (v_ref == 0.0) v_ref = v_max > 0.0 ? 2.0 * v_max : 1.0;
+    if (v_ref == 0.0) {
+      v_ref = v_max > 0.0 ? 2.0 * v_max : 1.0;
+      // Under gravity particles speed up: a fall across the box sets the impact speed.
+      for (int k = 0; k < D; ++k)
+        v_ref = std::max(v_ref, std::sqrt(2.0 * std::abs(gravity_[k]) * box_[k]));
+    }
     dt_ = std::numeric_limits<double>::infinity();
     for (std::size_t a = 0; a < species_; ++a) {
       for (std::size_t b = a; b < species_; ++b) {
@@ -194,6 +292,10 @@ void DemIntegrator<D>::init(const DemOptions& options) {
         dt_ = std::min(dt_, dem_default_time_step(laws_[a * species_ + b], mu, v_ref,
                                                   options.steps_per_contact));
       }
+      if (any_wall_ && std::isfinite(m_min[a])) {  // the wall's mass is infinite: mu = m
+        dt_ = std::min(
+            dt_, dem_default_time_step(wall_laws_[a], m_min[a], v_ref, options.steps_per_contact));
+      }
     }
   }
 
@@ -201,7 +303,7 @@ void DemIntegrator<D>::init(const DemOptions& options) {
   slot_.resize(n);
   for (std::size_t i = 0; i < n; ++i) id_[i] = slot_[i] = static_cast<std::uint32_t>(i);
   build_neighbours();
-  compute_forces(/*count_collisions=*/false);  // also rejects absurd initial overlaps
+  compute_forces(/*count_collisions=*/false, time_);  // also rejects absurd initial overlaps
 }
 
 template <int D>
@@ -262,12 +364,12 @@ void DemIntegrator<D>::build_neighbours() {
     for (std::size_t q = 0; q < n; ++q) cell_list[q] = static_cast<std::uint32_t>(q);
   }
 
-  Vec<D> half;
-  for (int k = 0; k < D; ++k) half[k] = 0.5 * box_[k];
+  const Vec<D> half = half_box();
   // Per axis, the distinct neighbouring cell coordinates of coordinate c (3 of them, fewer when
-  // the axis has fewer than 3 cells), as offsets into the flat index.
+  // a periodic axis has fewer than 3 cells), as offsets into the flat index; between walls a
+  // neighbour beyond the outer cells does not exist (kNoCell).
   bool all_three = true;
-  for (int k = 0; k < D; ++k) all_three = all_three && nc[k] >= 3;
+  for (int k = 0; k < D; ++k) all_three = all_three && (nc[k] >= 3 || !periodic_[k]);
   start_.assign(n + 1, 0);
   nbr_.clear();
   std::vector<std::uint32_t> around;
@@ -284,21 +386,33 @@ void DemIntegrator<D>::build_neighbours() {
     for (int k = 0; k < D; ++k) {
       for (int off = -1; off <= 1; ++off) {
         int ck = ci[k] + off;
+        std::size_t& out = axis[k][static_cast<std::size_t>(off + 1)];
+        if (!periodic_[k] && (ck < 0 || ck >= nc[k])) {
+          out = kNoCell;
+          continue;
+        }
         if (ck < 0) ck += nc[k];
         if (ck >= nc[k]) ck -= nc[k];
-        axis[k][static_cast<std::size_t>(off + 1)] = static_cast<std::size_t>(ck) * stride;
+        out = static_cast<std::size_t>(ck) * stride;
       }
       stride *= static_cast<std::size_t>(nc[k]);
     }
     around.clear();
+    const auto cell_at = [](std::initializer_list<std::size_t> parts) {
+      std::size_t flat = 0;
+      for (const std::size_t p : parts) {
+        if (p == kNoCell) return kNoCell32;
+        flat += p;
+      }
+      return static_cast<std::uint32_t>(flat);
+    };
     if constexpr (D == 3) {
       for (const std::size_t a : axis[2])
         for (const std::size_t b2 : axis[1])
-          for (const std::size_t c0 : axis[0])
-            around.push_back(static_cast<std::uint32_t>(a + b2 + c0));
+          for (const std::size_t c0 : axis[0]) around.push_back(cell_at({a, b2, c0}));
     } else {
       for (const std::size_t b2 : axis[1])
-        for (const std::size_t c0 : axis[0]) around.push_back(static_cast<std::uint32_t>(b2 + c0));
+        for (const std::size_t c0 : axis[0]) around.push_back(cell_at({b2, c0}));
     }
     Vec<D> xi;
     for (int k = 0; k < D; ++k) xi[k] = x_[k][i];
@@ -320,12 +434,13 @@ void DemIntegrator<D>::build_neighbours() {
       const std::size_t centre = around.size() / 2;
       scan(self + 1, cell_start[around[centre] + 1]);
       for (std::size_t m = centre + 1; m < around.size(); ++m)
-        scan(cell_start[around[m]], cell_start[around[m] + 1]);
+        if (around[m] != kNoCell32) scan(cell_start[around[m]], cell_start[around[m] + 1]);
     } else {  // some cells appear twice: keep one of each, pairs j > i
       std::sort(around.begin(), around.end());
       around.erase(std::unique(around.begin(), around.end()), around.end());
       for (const std::uint32_t cc : around)
-        scan(std::max(cell_start[cc], self + 1), std::max(cell_start[cc + 1], self + 1));
+        if (cc != kNoCell32)
+          scan(std::max(cell_start[cc], self + 1), std::max(cell_start[cc + 1], self + 1));
     }
     start_[i + 1] = static_cast<std::uint32_t>(nbr_.size());
   }
@@ -338,8 +453,7 @@ template <typename DemIntegrator<D>::Laws L>
 void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
   const std::size_t n = size();
   // f_ is zero here (cleared by the constructor or by step's kick pass).
-  Vec<D> half;
-  for (int k = 0; k < D; ++k) half[k] = 0.5 * box_[k];
+  const Vec<D> half = half_box();
   double potential = 0.0, power = 0.0, virial = 0.0;
   std::size_t contacts = 0;
   std::uint64_t entered = 0;
@@ -424,7 +538,67 @@ void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
 }
 
 template <int D>
-void DemIntegrator<D>::compute_forces(bool count_collisions) {
+Vec<D> DemIntegrator<D>::half_box() const {
+  Vec<D> half;
+  for (int k = 0; k < D; ++k)
+    half[k] = periodic_[k] ? 0.5 * box_[k] : std::numeric_limits<double>::infinity();
+  return half;
+}
+
+template <int D>
+void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
+  const std::size_t n = size();
+  double potential = 0.0, loss = 0.0, work = 0.0;
+  std::uint64_t entered = 0;
+  for (int f = 0; f < 2 * D; ++f) {
+    if (!wall_on_[static_cast<std::size_t>(f)]) continue;
+    const int k = f / 2;
+    const double sign = f % 2 == 0 ? 1.0 : -1.0;  // the wall's normal (into the box) along k
+    const double p = plane(f, t), w = plane_velocity(f, t);
+    const double p_before = plane(f, t - dt_);
+    const double* const x = x_[k].data();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double gap = sign * (x[i] - p);  // the centre's distance from the plane
+      const double R = radius_[i];
+      if (gap >= R) continue;
+      const double overlap = R - gap;
+      if (overlap > max_overlap_fraction_ * R)
+        throw InputError(fmt::format(
+            "DEM: particle {} overlaps the wall at face {} by {} (more than {} of its radius) at "
+            "t = {}: time step dt = {} too large, the wall too fast or the initial state outside",
+            id_[i], f, overlap, max_overlap_fraction_, t, dt_));
+      // Apart one step earlier (v_ holds the drift velocity)?
+      if (count_collisions && sign * (x[i] - dt_ * v_[k][i] - p_before) >= R) ++entered;
+      const double rdot = sign * (vp_[k][i] - w);  // the gap's rate of change
+      const std::size_t s = sp_[i];
+      const double kk = wall_stiffness_[s], c = wall_damping_[s];
+      double elastic, energy, F;
+      if (wall_hertz_[s] == 0) {
+        elastic = kk * overlap;
+        energy = 0.5 * elastic * overlap;
+        F = elastic - c * rdot;
+      } else {
+        const double root = std::sqrt(overlap);
+        elastic = kk * overlap * root;
+        energy = 0.4 * elastic * overlap;
+        F = elastic - c * rdot * root;
+      }
+      F = std::max(0.0, F);
+      potential += energy;
+      loss += (elastic - F) * rdot;
+      // d(KE + U)/dt = -(F_el - F) rdot + F w_n, w_n the plane's velocity along the normal.
+      work += F * sign * w;
+      f_[k][i] += sign * F;
+    }
+  }
+  potential_ += potential;
+  wall_loss_power_ = loss;
+  wall_work_power_ = work;
+  wall_collisions_ += count_collisions ? entered : 0;
+}
+
+template <int D>
+void DemIntegrator<D>::compute_forces(bool count_collisions, double t) {
   switch (kind_) {
     case Laws::kDashpot:
       compute_forces_for<Laws::kDashpot>(count_collisions);
@@ -435,6 +609,41 @@ void DemIntegrator<D>::compute_forces(bool count_collisions) {
     case Laws::kMixed:
       compute_forces_for<Laws::kMixed>(count_collisions);
       break;
+  }
+  if (any_wall_) compute_wall_forces(count_collisions, t);
+}
+
+// The fused kick (by `kick`) and drift of every particle; forces cleared for the next
+// evaluation, the predicted velocity v(t + dt) for the damping forces. Gravity adds to every
+// particle's acceleration; axes between walls are not wrapped.
+template <int D>
+template <bool Gravity>
+void DemIntegrator<D>::kick_drift(double kick, double& vmax2, double& vsum2) {
+  const std::size_t np = size();
+  const double h = 0.5 * dt_;
+  for (std::size_t i = 0; i < np; ++i) {
+    const double w = inv_mass_[i];
+    double v2 = 0.0;
+    for (int k = 0; k < D; ++k) {
+      const double f = f_[k][i];
+      f_[k][i] = 0.0;
+      double v, vp;
+      if constexpr (Gravity) {
+        const double a = w * f + gravity_[k];
+        v = v_[k][i] + kick * a;
+        vp = v + h * a;
+      } else {
+        v = v_[k][i] + kick * w * f;
+        vp = v + h * w * f;
+      }
+      v_[k][i] = v;
+      const double x = x_[k][i] + dt_ * v;
+      x_[k][i] = periodic_[k] ? wrap_once(x, box_[k]) : x;
+      vp_[k][i] = vp;
+      v2 += v * v;
+    }
+    vmax2 = std::max(vmax2, v2);
+    vsum2 += v2;
   }
 }
 
@@ -461,20 +670,10 @@ long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
   while (s < n && collisions_ < collisions) {
     const double kick = s == 0 ? h : dt_;
     double vmax2 = 0.0, vsum2 = 0.0;
-    for (std::size_t i = 0; i < np; ++i) {
-      const double w = inv_mass_[i];
-      double v2 = 0.0;
-      for (int k = 0; k < D; ++k) {
-        const double f = f_[k][i];
-        f_[k][i] = 0.0;
-        const double v = v_[k][i] + kick * w * f;
-        v_[k][i] = v;
-        x_[k][i] = wrap_once(x_[k][i] + dt_ * v, box_[k]);
-        vp_[k][i] = v + h * w * f;  // predicted v(t + dt) for the damping force
-        v2 += v * v;
-      }
-      vmax2 = std::max(vmax2, v2);
-      vsum2 += v2;
+    if (gravity_on_) {
+      kick_drift<true>(kick, vmax2, vsum2);
+    } else {
+      kick_drift<false>(kick, vmax2, vsum2);
     }
     if (!std::isfinite(vsum2))
       throw InputError(
@@ -482,9 +681,12 @@ long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
     moved_since_build_ += dt_ * std::sqrt(vmax2);
     if (2.0 * moved_since_build_ >= skin_) build_neighbours();
     const double power_before = power_, virial_before = virial_power_;
-    compute_forces();
+    const double loss_before = wall_loss_power_, work_before = wall_work_power_;
+    compute_forces(/*count_collisions=*/true, base_.time + static_cast<double>(steps_ + 1) * dt_);
     dissipated_ += h * (power_before + power_);
     virial_ += h * (virial_before + virial_power_);
+    dissipated_walls_ += h * (loss_before + wall_loss_power_);
+    work_by_walls_ += h * (work_before + wall_work_power_);
     ++steps_;
     ++s;
     time_ = base_.time + static_cast<double>(steps_) * dt_;
@@ -492,6 +694,8 @@ long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
   for (std::size_t i = 0; i < np; ++i) {  // the closing half kick of the last step
     const double hw = h * inv_mass_[i];
     for (int k = 0; k < D; ++k) v_[k][i] += hw * f_[k][i];
+    if (gravity_on_)
+      for (int k = 0; k < D; ++k) v_[k][i] += h * gravity_[k];
   }
   return s;
 }
@@ -504,6 +708,17 @@ double DemIntegrator<D>::kinetic_energy() const {
     for (int k = 0; k < D; ++k) v2 += v_[k][i] * v_[k][i];
     e += 0.5 * mass_[i] * v2;
   }
+  return e;
+}
+
+template <int D>
+double DemIntegrator<D>::field_energy() const {
+  if (!gravity_on_) return 0.0;
+  for (int k = 0; k < D; ++k)
+    if (periodic_[k] && gravity_[k] != 0.0) return std::numeric_limits<double>::quiet_NaN();
+  double e = 0.0;
+  for (std::size_t i = 0; i < size(); ++i)
+    for (int k = 0; k < D; ++k) e -= mass_[i] * gravity_[k] * x_[k][i];
   return e;
 }
 
@@ -538,7 +753,7 @@ ParticleSystem<D> DemIntegrator<D>::export_state() const {
   for (std::size_t i = 0; i < size(); ++i) {
     auto& kin = s.kinematics[id_[i]];
     for (int k = 0; k < D; ++k) {
-      kin.pos[k] = wrap_into_box(x_[k][i], box_[k]);
+      kin.pos[k] = periodic_[k] ? wrap_into_box(x_[k][i], box_[k]) : x_[k][i];
       kin.vel[k] = v_[k][i];
     }
     kin.time = time_;
@@ -551,6 +766,9 @@ ParticleSystem<D> DemIntegrator<D>::export_state() const {
   s.counters.collisions = collisions_;
   s.counters.events = base_.counters.events + static_cast<std::uint64_t>(steps_);
   s.counters.virial = virial_;
+  s.counters.wall_collisions = wall_collisions_;
+  s.counters.dissipated_at_walls = dissipated_walls_;
+  s.counters.work_by_walls = work_by_walls_;
   return s;
 }
 

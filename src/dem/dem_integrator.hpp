@@ -1,5 +1,6 @@
-// A force-based (time-stepped) DEM reference integrator for frictionless soft spheres in a
-// periodic box (issue 6): the yardstick the event-driven soft-sphere engine is checked against.
+// A force-based (time-stepped) DEM integrator for frictionless soft spheres, in a periodic box
+// or between walls, with or without gravity (issue 6): the yardstick the event-driven
+// soft-sphere engine is checked against, and an integrator for dense granular matter.
 //
 // Physics (formulas.md §1.2–1.3): the normal force of a pair is that of a SoftContactLaw
 // (interactions/soft_contact.hpp: linear dashpot or viscoelastic Hertz), clipped at zero,
@@ -27,15 +28,27 @@
 // per particle). The virial sum_pairs r F (time-integrated by the trapezoidal rule, like the
 // dissipation) gives the pressure as the collisional virial does for hard spheres.
 //
+// Walls and gravity (the Environment constructor): a face of the box may be a wall, a plane
+// that is fixed, slides in its plane (no effect: the contacts are frictionless) or moves along
+// its normal (a piston's constant speed, a vibration A sin(w t + phi): Environment's Wall). A
+// particle of species s closer to a wall than its radius feels the normal force of the law
+// soft_wall[s] with the reduced mass of the particle alone (the wall's mass is infinite), the
+// overlap R - d and the gap's rate of change, clipped at zero like a pair's. The wall's work on
+// the particles (force times the plane's normal velocity) and the energy the wall contacts
+// dissipate are accumulated by the same trapezoidal rule as the pairs'. Gravity is a constant
+// acceleration in the kicks; its potential energy is field_energy().
+//
 // Neighbours: a half neighbour list (pairs closer than d_max + skin), built from a linked-cell
 // grid (cells >= d_max + skin) and rebuilt when the particles may have moved skin/2.
 // Hot data are structure-of-arrays (x, y, z, vx, ... separately), renumbered into cell order at
 // every build.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
+#include "core/environment.hpp"
 #include "core/particle_system.hpp"
 #include "interactions/soft_contact.hpp"
 
@@ -62,9 +75,10 @@ template <int D>
 class DemIntegrator {
  public:
   // The system: periodic on every axis, no gravity, no bonds, nobody asleep, finite positions
-  // and velocities, masses and radii > 0, box > 2 (d_max + skin) on every axis, no pair
-  // overlapping by more than half the smaller radius. InputError naming the problem otherwise.
-  // Each particle's position is taken at system.time (position_at).
+  // and velocities, masses and radii > 0, box > 2 (d_max + skin) on every periodic axis (> d_max
+  // between walls), no pair or wall contact overlapping by more than half the smaller radius.
+  // InputError naming the problem otherwise. Each particle's position is taken at system.time
+  // (position_at).
   DemIntegrator(const ParticleSystem<D>& system, const SoftContactLaw& law,
                 const DemOptions& options = {});
   // One law per species pair: laws.size() == species * species, symmetric, every particle's
@@ -74,6 +88,14 @@ class DemIntegrator {
   // and handed back in (a restart) keeps counting.
   DemIntegrator(const ParticleSystem<D>& system, const std::vector<SoftContactLaw>& laws,
                 std::uint32_t species, const DemOptions& options = {});
+  // Laws, walls and gravity from an environment: env.soft and env.species as above, a wall at
+  // every face of kind kWall with the law env.soft_wall[s] for particles of species s, and
+  // env.gravity. The system's periodic axes and gravity must be the environment's. InputError
+  // for what the DEM does not integrate: open faces, shear, stepped potentials, no soft laws.
+  // The default time step also covers the wall contacts (reduced mass m_min) and, under
+  // gravity, impacts at the speed of a fall across the box.
+  DemIntegrator(const ParticleSystem<D>& system, const Environment<D>& env,
+                const DemOptions& options = {});
 
   // n velocity Verlet steps. InputError if a pair overlaps by more than half its smaller radius
   // (time step far too large) or a coordinate turns non-finite.
@@ -101,6 +123,15 @@ class DemIntegrator {
   std::size_t contact_count() const { return contacts_; }
   // Pairs that entered contact, including those counted in the constructor's system.
   std::uint64_t collisions() const { return collisions_; }
+  // Particle-wall contacts begun, the energy wall contacts dissipated and the work the walls
+  // did on the particles, each continuing the constructor's system's counters.
+  std::uint64_t wall_collisions() const { return wall_collisions_; }
+  double dissipated_at_walls() const { return dissipated_walls_; }
+  double work_by_walls() const { return work_by_walls_; }
+  // Potential energy in the gravity field, -sum m g.x: 0 without gravity, NaN when gravity has
+  // a component along a periodic axis (unbounded there). Then kinetic + potential + field +
+  // dissipated (pairs and walls) - work by walls is constant to O(dt^2).
+  double field_energy() const;
   // Time integral of sum over pairs of r_ij F_ij (F > 0 repulsive), including the system's.
   double virial() const { return virial_; }
   Vec<D> momentum() const;
@@ -112,11 +143,21 @@ class DemIntegrator {
 
  private:
   void init(const DemOptions& options);
+  void set_walls(const Environment<D>& env);
+  // The plane of wall face f along its axis at time t, and its velocity along the axis.
+  double plane(int face, double t) const;
+  double plane_velocity(int face, double t) const;
+  // Wall forces (added to f_) at positions x and predicted velocities vp at time t.
+  void compute_wall_forces(bool count_collisions, double t);
+  template <bool Gravity>
+  void kick_drift(double kick, double& vmax2, double& vsum2);
+  // Half the box on periodic axes (minimum image), infinite between walls (no image).
+  Vec<D> half_box() const;
   long advance(long n, std::uint64_t collisions);
   void build_neighbours();
   // Forces, potential_, power_, virial_power_, contacts_ at x with the predicted velocity;
   // counts pairs entering contact when count_collisions.
-  void compute_forces(bool count_collisions = true);
+  void compute_forces(bool count_collisions, double t);
   enum class Laws { kDashpot, kHertz, kMixed };
   template <Laws L>
   void compute_forces_for(bool count_collisions);
@@ -147,6 +188,21 @@ class DemIntegrator {
   std::vector<std::uint32_t> start_, nbr_;
   double moved_since_build_ = 0.0;  // upper bound on any displacement since the last build
   long builds_ = 0;
+
+  // Walls and gravity (set_walls): per face whether it is a wall and how its plane moves; per
+  // species the wall law (stiffness, damping coefficient as for the pairs, Hertz or not).
+  std::array<bool, D> periodic_{};
+  std::array<bool, 2 * D> wall_on_{};
+  std::array<Wall<D>, 2 * D> walls_{};
+  bool any_wall_ = false;
+  std::vector<SoftContactLaw> wall_laws_;
+  std::vector<double> wall_stiffness_, wall_damping_;
+  std::vector<std::uint8_t> wall_hertz_;
+  Vec<D> gravity_{};
+  bool gravity_on_ = false;
+  double wall_loss_power_ = 0.0, dissipated_walls_ = 0.0;
+  double wall_work_power_ = 0.0, work_by_walls_ = 0.0;
+  std::uint64_t wall_collisions_ = 0;
 
   double potential_ = 0.0, power_ = 0.0, dissipated_ = 0.0;
   double virial_power_ = 0.0, virial_ = 0.0;

@@ -1558,8 +1558,10 @@ class Reader {
         conflict("boundary.shear_rate",
                  "Lees-Edwards shear is not supported with soft spheres yet");
       }
-      if (!c.field.gravity.empty()) {
-        conflict("field.gravity", "gravity is not supported with soft spheres yet");
+      if (!c.field.gravity.empty() && c.run.integrator != "dem") {
+        conflict("field.gravity",
+                 "the collision mapping is not defined under gravity (a soft contact under a "
+                 "load does not end); use run.integrator = \"dem\"");
       }
     }
     if (c.run.integrator != "dem") return;
@@ -1575,7 +1577,6 @@ class Reader {
            "run.integrator: \"dem\" integrates soft contact forces and needs a [soft] table "
            "(model = \"dashpot\" or \"hertz\")");
     }
-    if (!c.boundary.walls.empty()) unsupported("boundary.wall", "walls are");
     if (!c.boundary.open.empty()) unsupported("boundary.open", "open faces are");
     if (c.driving.kind != "none") unsupported("driving.kind", "driving is");
     if (c.run.validate) unsupported("run.validate", "engine validation is");

@@ -63,9 +63,11 @@ class DemRunDriver {
                                             : 0.0;
     try {
       const Environment<D> env = make_environment<D>(config, start);
-      dissipative_ = std::any_of(env.soft.begin(), env.soft.end(),
-                                 [](const SoftContactLaw& law) { return law.damping > 0.0; });
-      dem_.emplace(start, env.soft, env.species, options);
+      const auto damped = [](const SoftContactLaw& law) { return law.damping > 0.0; };
+      // Walls and gravity, like damping, make the energy budget worth reporting.
+      granular_ = std::any_of(env.soft.begin(), env.soft.end(), damped) || env.has_walls() ||
+                  env.has_gravity();
+      dem_.emplace(start, env, options);
     } catch (const InputError& e) {
       if (!restart_file) throw;
       throw InputError("restart file '" + restart_file->string() + "': " + e.what());
@@ -89,6 +91,8 @@ class DemRunDriver {
     ke_start_ = dem_->kinetic_energy();
     energy_start_ = total_energy();
     dissipated_start_ = dem_->dissipated_energy();
+    dissipated_walls_start_ = dem_->dissipated_at_walls();
+    work_walls_start_ = dem_->work_by_walls();
     p_start_ = dem_->momentum();
     collisions_start_ = dem_->collisions();
     thermo_stats_->mark(point());
@@ -135,9 +139,11 @@ class DemRunDriver {
     return {dem_->time(), dem_->virial(), base_events_ + static_cast<std::uint64_t>(dem_->steps()),
             dem_->collisions()};
   }
-  // Kinetic plus elastic energy plus what the damping took: constant to O(dt^2).
+  // Kinetic plus elastic plus gravitational energy plus what the damping took, less what the
+  // walls gave: constant to O(dt^2) (NaN with gravity along a periodic axis).
   double total_energy() const {
-    return dem_->kinetic_energy() + dem_->potential_energy() + dem_->dissipated_energy();
+    return dem_->kinetic_energy() + dem_->potential_energy() + dem_->field_energy() +
+           dem_->dissipated_energy() + dem_->dissipated_at_walls() - dem_->work_by_walls();
   }
 
   RunProgress progress_now() const {
@@ -175,11 +181,20 @@ class DemRunDriver {
     while (dem_->collisions() < target) {
       const std::uint64_t stop_at =
           std::min({target, schedule.thermo.next, schedule.trajectory.next, schedule.restart.next});
-      const std::uint64_t before = dem_->collisions();
+      const std::uint64_t before = dem_->collisions(), wall_before = dem_->wall_collisions();
       dem_->step_until(chunk, stop_at);
       const std::uint64_t c = dem_->collisions();
-      if (c == before && dem_->contact_count() == 0 && dem_->kinetic_energy() == 0.0) {
+      const double ke = dem_->kinetic_energy();
+      ke_peak_ = std::max(ke_peak_, ke);
+      if (c == before && dem_->contact_count() == 0 && ke == 0.0) {
         stop_reason_ = "no_more_events";  // everything at rest and apart
+        break;
+      }
+      // A settled packing (under gravity, between walls) meets no new contacts: the collision
+      // target would never come. At rest: no contact began in this chunk and the kinetic energy
+      // fell below 1e-12 of its peak.
+      if (c == before && dem_->wall_collisions() == wall_before && ke <= 1e-12 * ke_peak_) {
+        stop_reason_ = "at_rest";
         break;
       }
       if (schedule.thermo.due(c)) write_thermo_row(phase);
@@ -211,7 +226,9 @@ class DemRunDriver {
       production_temperatures_.push_back(row.temperature);
       if (profile_) sample_profile();
     }
-    thermo_->write(phase, row, {0.0, dem_->dissipated_energy(), 0.0, dem_->potential_energy()});
+    thermo_->write(phase, row,
+                   {0.0, dem_->dissipated_energy() + dem_->dissipated_at_walls(),
+                    dem_->work_by_walls(), dem_->potential_energy()});
   }
 
   void sample_profile() {
@@ -305,20 +322,27 @@ class DemRunDriver {
     d["ns_per_particle_step"] =
         steps > 0 ? 1e9 * wall / (static_cast<double>(steps) * static_cast<double>(n_)) : 0.0;
     d["potential_energy"] = dem_->potential_energy();
+    d["field_energy"] = dem_->field_energy();
+    d["wall_collisions"] = dem_->wall_collisions();
     d["dissipated_energy"] = dem_->dissipated_energy() - dissipated_start_;
     d["energy_start"] = energy_start_;
     d["energy_end"] = energy;
     j["dem"] = d;
-    if (!dissipative_) return j;
-    // Dissipative laws: the energy budget, as the event engine reports it for granular runs.
+    if (!granular_) return j;
+    // Damping, walls or gravity: the energy budget, as the event engine reports it for
+    // granular runs.
     const double dissipated = dem_->dissipated_energy() - dissipated_start_;
-    const double scale = std::max(std::abs(energy_start_), dissipated);
+    const double at_walls = dem_->dissipated_at_walls() - dissipated_walls_start_;
+    const double by_walls = dem_->work_by_walls() - work_walls_start_;
+    const double scale =
+        std::max({std::abs(energy_start_), dissipated + at_walls, std::abs(by_walls)});
     nlohmann::json g;
     g["rotational_temperature"] = 0.0;
     g["sonine_a2"] = sonine_a2();
     g["dissipated_in_collisions"] = dissipated;
-    g["dissipated_at_walls"] = 0.0;
-    g["work_by_walls"] = 0.0;
+    g["dissipated_at_walls"] = at_walls;
+    g["work_by_walls"] = by_walls;
+    g["wall_collisions"] = dem_->wall_collisions();
     g["energy_start"] = energy_start_;
     g["energy_end"] = energy;
     g["energy_balance_relative"] = scale > 0.0 ? std::abs(energy - energy_start_) / scale : 0.0;
@@ -333,7 +357,7 @@ class DemRunDriver {
   std::optional<DemIntegrator<D>> dem_;
   std::size_t n_ = 0;
   double volume_ = 1.0, particle_volume_ = 0.0;
-  bool dissipative_ = false;
+  bool granular_ = false;  // damping, walls or gravity: report the energy budget
   fs::path dir_;
   std::optional<ThermoWriter> thermo_;
   std::optional<gsd::Writer> trajectory_;
@@ -341,6 +365,8 @@ class DemRunDriver {
   std::optional<AxisProfile<D>> profile_;
   ThermoPoint prod_start_;
   double ke_start_ = 0.0, prod_ke_ = 0.0, energy_start_ = 0.0, dissipated_start_ = 0.0;
+  double dissipated_walls_start_ = 0.0, work_walls_start_ = 0.0;
+  double ke_peak_ = 0.0;  // the largest kinetic energy seen (the scale of "at rest")
   Vec<D> p_start_{};
   long frame_steps_ = 0;
   // Time steps of the runs this one continues (the state's event counter at the start).

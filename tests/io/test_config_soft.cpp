@@ -156,7 +156,8 @@ TEST(ConfigSoft, ConflictsNameBothKeys) {
                {"contact.pair", "soft.model"});
   expect_error(with(soft + "[[potential]]\nkind = \"square_well\""), {"potential", "soft.model"});
   expect_error(with(soft + "[boundary]\nshear_rate = 0.1"), {"boundary.shear_rate", "soft.model"});
-  expect_error(with(soft + "[field]\ngravity = [0, 0, -1]"), {"field.gravity", "soft.model"});
+  expect_error(with(soft + "[field]\ngravity = [0, 0, -1]"),
+               {"field.gravity", "soft.model", "run.integrator = \"dem\""});
   expect_error(with(soft + "[[boundary.wall]]\nface = \"z-\"\nrestitution = 0.5\n"
                            "[[boundary.wall]]\nface = \"z+\""),
                {"boundary.wall[0].restitution", "[soft] material"});
@@ -173,9 +174,14 @@ TEST(ConfigSoft, IntegratorErrors) {
   expect_error(with(soft + "[run]\ntime_step = 0.01"), {"run.time_step", "DEM"});
   expect_error(with(soft + "[run]\nintegrator = \"dem\"\ntime_step = -0.01"),
                {"run.time_step", ">= 0"});
-  expect_error(with(soft + "[run]\nintegrator = \"dem\"\n[[boundary.wall]]\nface = \"z-\"\n"
-                           "[[boundary.wall]]\nface = \"z+\""),
-               {"boundary.wall", "not supported by the DEM integrator"});
+  expect_error(with(soft + "[run]\nintegrator = \"dem\"\n[boundary]\nopen = [\"z+\"]\n"
+                           "[[boundary.wall]]\nface = \"z-\""),
+               {"boundary.open", "not supported by the DEM integrator"});
+  // Walls and gravity are the DEM's (the event-driven mapping refuses gravity, above).
+  EXPECT_NO_THROW(parse_config(with(soft + "[run]\nintegrator = \"dem\"\n[[boundary.wall]]\n"
+                                           "face = \"z-\"\n[[boundary.wall]]\nface = \"z+\"\n"
+                                           "[field]\ngravity = [0, 0, -1]"),
+                               "test.toml"));
   expect_error(with(soft + "[run]\nintegrator = \"dem\"\n[driving]\nkind = \"andersen\""),
                {"driving.kind", "not supported by the DEM integrator"});
 }

@@ -1,6 +1,7 @@
 """The DEM integrator as a run choice (run.integrator = "dem", [soft]) end to end: energy of
 elastic soft gases conserved to O(dt^2), Haff cooling of a dashpot gas of constant restitution
-against formulas.md §6, the outputs, restarts that continue, and the errors.
+against formulas.md §6, a pile settling between walls under gravity (examples/dem_pile_3d.toml),
+the outputs, restarts that continue, and the errors.
 """
 
 import json
@@ -129,9 +130,41 @@ class DemRuns(kt.KairosTestCase):
         no_soft = kt.base_config(run={"integrator": "dem"})
         result = self.kairos("run", self.write_config(no_soft, "a.toml"), "-o", self.path("a"))
         self.assert_user_error(result, "run.integrator", "[soft]")
-        walls = dem_config(DASHPOT, boundary={"wall": [{"face": "z-"}, {"face": "z+"}]})
-        result = self.kairos("run", self.write_config(walls, "b.toml"), "-o", self.path("b"))
-        self.assert_user_error(result, "boundary.wall", "not supported by the DEM integrator")
+        # An open face lets particles leave: the DEM keeps its particles.
+        open_top = dem_config(DASHPOT, boundary={"open": ["z+"], "wall": [{"face": "z-"}]})
+        result = self.kairos("run", self.write_config(open_top, "b.toml"), "-o", self.path("b"))
+        self.assert_user_error(result, "boundary.open", "not supported by the DEM integrator")
+        # Gravity is the DEM's alone: the collision mapping has no contact that ends under load.
+        falling = dem_config(DASHPOT, field={"gravity": [0, 0, -1]}, run={"integrator": "event"})
+        result = self.kairos("run", self.write_config(falling, "c.toml"), "-o", self.path("c"))
+        self.assert_user_error(result, "field.gravity", "run.integrator = \"dem\"")
+
+    def test_pile_settles_between_walls_under_gravity(self):
+        # examples/dem_pile_3d.toml with 60 Hertz spheres (e = 0.1 at unit speed) dropped from a
+        # random gas onto the floor of a box with walls at z- and z+: the run ends by itself
+        # once the pile rests, with the energy budget (kinetic + elastic + gravitational +
+        # dissipated) closed to O(dt^2).
+        self.run_ok("run", kt.example("dem_pile_3d.toml"), "-o", self.path("pile"),
+                    "--set", "output.progress=never", "--set", "system.particles=60",
+                    "--set", "soft.restitution=0.1")
+        s = self.summary(self.path("pile"))
+        self.assertEqual(s["stop_reason"], "at_rest")
+        g = s["granular"]
+        self.assertLess(g["energy_balance_relative"], 3e-3)
+        self.assertGreater(g["wall_collisions"], 0)
+        self.assertGreater(g["dissipated_at_walls"], 0.0)
+        self.assertEqual(g["work_by_walls"], 0.0)  # fixed walls do no work
+        # The gravitational energy the pile lost went into heat: no kinetic energy is left.
+        self.assertLess(s["dem"]["energy_end"] - s["dem"]["field_energy"] -
+                        g["dissipated_in_collisions"] - g["dissipated_at_walls"] -
+                        s["dem"]["potential_energy"], 1e-6 * g["energy_start"])
+        frames = gsd.hoomd.open(self.path("pile", "trajectory.gsd"), "rb")
+        last = frames[len(frames) - 1]
+        lz = last.configuration.box[2]
+        z = last.particles.position[:, 2] + lz / 2  # GSD boxes are centred
+        self.assertTrue(np.all(z > 0.5 - 0.01) and np.all(z < lz - 0.5 + 0.01), (z.min(), z.max()))
+        # Random close packing of 60 unit spheres on a floor of area A rests far below its gas.
+        self.assertLess(np.mean(z), 0.3 * lz)
 
 
 if __name__ == "__main__":
