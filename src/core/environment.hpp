@@ -94,6 +94,10 @@ struct Environment {
   // of the map; collisions outside a table, or without one, integrate the map directly.
   std::vector<SoftContactLaw> soft;
   std::vector<SoftContactLaw> soft_wall;
+  // Coulomb friction of the soft contacts (same indices as soft / soft_wall; empty: smooth).
+  // The DEM integrates it; the event integrator's contacts are smooth.
+  std::vector<SoftFriction> soft_friction;
+  std::vector<SoftFriction> soft_wall_friction;
   std::vector<std::shared_ptr<const SoftMapTable>> soft_tables;
   std::vector<std::shared_ptr<const SoftMapTable>> soft_wall_tables;
   SoftCollisions soft_collisions = SoftCollisions::kMapped;

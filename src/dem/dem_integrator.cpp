@@ -5,6 +5,7 @@
 #include <initializer_list>
 #include <limits>
 #include <string>
+#include <unordered_map>
 
 #include <fmt/format.h>
 
@@ -35,6 +36,27 @@ inline double wrap_once(double x, double L) {
 // A neighbour cell beyond a wall (none).
 constexpr std::size_t kNoCell = std::numeric_limits<std::size_t>::max();
 constexpr std::uint32_t kNoCell32 = std::numeric_limits<std::uint32_t>::max();
+
+// The tangential force of a frictional contact (Cundall-Strack): the spring xi is turned into
+// the present tangent plane (normal n) and advanced by the slip velocity vt over `advance` (the
+// time step; 0 at the constructor's force evaluation), F_t = -(kt xi + gt vt) is cut to the
+// Coulomb limit |F_t| <= limit, and the spring's energy and the force's power on the slip are
+// added up. Sliding, the spring alone carries the Coulomb force (xi = -F_t / kt): it holds no
+// more than (mu F_n)^2 / 2 kt, and the force stays continuous when the slip stops (vt -> 0).
+template <int D>
+Vec<D> tangential_force(Vec<D>& xi, const Vec<D>& n, const Vec<D>& vt, double kt, double gt,
+                        double limit, double advance, double& spring, double& slip) {
+  if (advance > 0.0) xi = xi - dot(xi, n) * n + advance * vt;
+  Vec<D> ft = -1.0 * (kt * xi + gt * vt);
+  const double ft2 = norm2(ft);
+  if (ft2 > limit * limit) {  // sliding: the force at the Coulomb limit
+    ft = (limit / std::sqrt(ft2)) * ft;
+    xi = (-1.0 / kt) * ft;
+  }
+  spring += 0.5 * kt * norm2(xi);
+  slip += dot(ft, vt);
+  return ft;
+}
 
 // With half_L infinite (an axis between walls) the difference is kept as it is.
 inline double min_image_once(double d, double half_L, double L) {
@@ -81,7 +103,39 @@ DemIntegrator<D>::DemIntegrator(const ParticleSystem<D>& system, const Environme
   for (int k = 0; k < D; ++k) base_.periodic[k] = env.periodic(k);
   base_.gravity = env.gravity;
   set_walls(env);
+  set_friction(env);
   init(options);
+}
+
+template <int D>
+void DemIntegrator<D>::set_friction(const Environment<D>& env) {
+  const auto check = [](const std::vector<SoftFriction>& given, std::size_t size,
+                        const char* what) {
+    if (!given.empty() && given.size() != size)
+      throw InputError(fmt::format("DEM: {} friction laws for {} {}", given.size(), size, what));
+    for (const SoftFriction& f : given) {
+      if (!(f.coefficient >= 0.0) || !std::isfinite(f.coefficient) || !(f.stiffness_ratio > 0.0) ||
+          !std::isfinite(f.stiffness_ratio) || !(f.damping_ratio >= 0.0) ||
+          !std::isfinite(f.damping_ratio))
+        throw InputError(fmt::format(
+            "DEM: friction law (mu {}, k_t/k_n {}, gamma_t/gamma_n {}) of the {}: mu and "
+            "gamma_t/gamma_n must be >= 0, k_t/k_n > 0",
+            f.coefficient, f.stiffness_ratio, f.damping_ratio, what));
+    }
+  };
+  check(env.soft_friction, laws_.size(), "species pairs");
+  if (any_wall_) check(env.soft_wall_friction, species_, "species against the walls");
+  const auto rough = [](const std::vector<SoftFriction>& v) {
+    return std::any_of(v.begin(), v.end(), [](const SoftFriction& f) { return f.coefficient > 0; });
+  };
+  friction_ = rough(env.soft_friction) || (any_wall_ && rough(env.soft_wall_friction));
+  if (!friction_) return;
+  friction_pair_ = env.soft_friction;
+  friction_pair_.resize(laws_.size(), SoftFriction{});  // smooth where none is given
+  friction_wall_ = any_wall_ ? env.soft_wall_friction : std::vector<SoftFriction>{};
+  if (any_wall_) friction_wall_.resize(species_, SoftFriction{});
+  inertia_factor_.resize(species_);
+  for (std::uint32_t s = 0; s < species_; ++s) inertia_factor_[s] = env.inertia_factor_of(s);
 }
 
 template <int D>
@@ -260,6 +314,30 @@ void DemIntegrator<D>::init(const DemOptions& options) {
     }
     v_max = std::max(v_max, std::sqrt(v2));
   }
+  if (friction_) {
+    for (int c = 0; c < kSpin; ++c) {
+      w_[c].assign(n, 0.0);
+      wp_[c].assign(n, 0.0);
+      tq_[c].assign(n, 0.0);
+    }
+    inertia_.resize(n);
+    inv_inertia_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      inertia_[i] = inertia_factor_[sp_[i]] * mass_[i] * radius_[i] * radius_[i];
+      inv_inertia_[i] = 1.0 / inertia_[i];
+      if (!system.angular_velocity.empty()) {
+        for (int c = 0; c < kSpin; ++c) {
+          const double w = system.angular_velocity.at(i)[static_cast<std::size_t>(c)];
+          if (!std::isfinite(w))
+            throw InputError(fmt::format("DEM: angular velocity of particle {} is not finite", i));
+          w_[c][i] = wp_[c][i] = w;
+        }
+      }
+    }
+    for (int f = 0; f < 2 * D; ++f)
+      if (wall_on_[static_cast<std::size_t>(f)])
+        wall_shear_[static_cast<std::size_t>(f)].assign(n, Vec<D>{});
+  }
   skin_ = options.skin * max_diameter_;
   for (int k = 0; k < D; ++k) {
     if (periodic_[k] && !(box_[k] > 2.0 * (max_diameter_ + skin_)))
@@ -317,6 +395,20 @@ void DemIntegrator<D>::build_neighbours() {
     nc[k] = std::max(1, static_cast<int>(std::floor(box_[k] / cutoff)));
     ncells *= static_cast<std::size_t>(nc[k]);
   }
+  // The pairs' tangential springs, keyed by the caller's numbers (a < b; the spring of a
+  // relative to b), to be carried into the new list.
+  std::vector<std::uint64_t> carried_keys;
+  std::vector<Vec<D>> carried;
+  if (friction_ && !shear_.empty()) {
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::uint32_t q = start_[i]; q < start_[i + 1]; ++q) {
+        if (shear_[q] == Vec<D>{}) continue;
+        const std::uint64_t a = id_[i], b = id_[nbr_[q]];
+        carried_keys.push_back(a < b ? (a << 32) | b : (b << 32) | a);
+        carried.push_back(a < b ? shear_[q] : -1.0 * shear_[q]);
+      }
+    }
+  }
   std::vector<std::uint32_t> cell_of(n), cell_start(ncells + 1, 0), cell_list(n);
   for (std::size_t i = 0; i < n; ++i) {
     std::size_t c = 0;
@@ -351,6 +443,21 @@ void DemIntegrator<D>::build_neighbours() {
     permute(mass_);
     permute(inv_mass_);
     permute(radius_);
+    if (friction_) {
+      for (int c = 0; c < kSpin; ++c) {
+        permute(w_[c]);
+        permute(wp_[c]);
+        permute(tq_[c]);
+      }
+      permute(inertia_);
+      permute(inv_inertia_);
+      std::vector<Vec<D>> tmp_v(n);
+      for (std::vector<Vec<D>>& springs : wall_shear_) {
+        if (springs.empty()) continue;
+        for (std::size_t q = 0; q < n; ++q) tmp_v[q] = springs[cell_list[q]];
+        springs.swap(tmp_v);
+      }
+    }
     std::vector<std::uint32_t> tmp_u(n);
     for (std::size_t q = 0; q < n; ++q) tmp_u[q] = sp_[cell_list[q]];
     sp_.swap(tmp_u);
@@ -444,17 +551,53 @@ void DemIntegrator<D>::build_neighbours() {
     }
     start_[i + 1] = static_cast<std::uint32_t>(nbr_.size());
   }
+  if (friction_) carry_shear_over(carried_keys, carried);
   moved_since_build_ = 0.0;
   ++builds_;
 }
 
 template <int D>
-template <typename DemIntegrator<D>::Laws L>
+void DemIntegrator<D>::carry_shear_over(const std::vector<std::uint64_t>& keys,
+                                        const std::vector<Vec<D>>& values) {
+  shear_.assign(nbr_.size(), Vec<D>{});
+  if (keys.empty()) return;
+  std::unordered_map<std::uint64_t, Vec<D>> spring;
+  spring.reserve(keys.size());
+  for (std::size_t k = 0; k < keys.size(); ++k) spring.emplace(keys[k], values[k]);
+  for (std::size_t i = 0; i + 1 < start_.size(); ++i) {
+    for (std::uint32_t q = start_[i]; q < start_[i + 1]; ++q) {
+      const std::uint64_t a = id_[i], b = id_[nbr_[q]];
+      const auto it = spring.find(a < b ? (a << 32) | b : (b << 32) | a);
+      if (it != spring.end()) shear_[q] = a < b ? it->second : -1.0 * it->second;
+    }
+  }
+}
+
+template <int D>
+Spin<D> DemIntegrator<D>::spin(const std::vector<double> (&a)[kSpin], std::size_t i) const {
+  if constexpr (D == 3) {
+    return Vec<3>{a[0][i], a[1][i], a[2][i]};
+  } else {
+    return a[0][i];
+  }
+}
+
+template <int D>
+void DemIntegrator<D>::add_spin(std::vector<double> (&a)[kSpin], std::size_t i, const Spin<D>& s) {
+  if constexpr (D == 3) {
+    for (int c = 0; c < 3; ++c) a[c][i] += s[static_cast<std::size_t>(c)];
+  } else {
+    a[0][i] += s;
+  }
+}
+
+template <int D>
+template <typename DemIntegrator<D>::Laws L, bool Friction>
 void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
   const std::size_t n = size();
   // f_ is zero here (cleared by the constructor or by step's kick pass).
   const Vec<D> half = half_box();
-  double potential = 0.0, power = 0.0, virial = 0.0;
+  double potential = 0.0, power = 0.0, virial = 0.0, spring = 0.0, slip = 0.0;
   std::size_t contacts = 0;
   std::uint64_t entered = 0;
   const std::size_t ns = species_;
@@ -469,6 +612,8 @@ void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
       vi[k] = vp_[k][i];
     }
     const double Ri = radius_[i];
+    Spin<D> wi{}, ti{};  // predicted angular velocity and torque (friction)
+    if constexpr (Friction) wi = spin(wp_, i);
     const std::size_t row = ns == 1 ? 0 : sp_[i] * ns;
     for (std::uint32_t q = b; q < e; ++q) {
       const std::uint32_t j = nbr_[q];
@@ -479,7 +624,10 @@ void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
         r2 += d[k] * d[k];
       }
       const double l = Ri + radius_[j];
-      if (r2 >= l * l) continue;
+      if (r2 >= l * l) {
+        if constexpr (Friction) shear_[q] = Vec<D>{};  // apart: the spring is gone
+        continue;
+      }
       // Overlapping pair.
       const double r = std::sqrt(r2);
       const double overlap = l - r;
@@ -518,6 +666,34 @@ void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
       F = std::max(0.0, F);  // the force-zero end: no attraction
       potential += energy;
       power += (elastic - F) * rdot;
+      if constexpr (Friction) {
+        const SoftFriction& fr = friction_pair_[ab];
+        if (fr.coefficient > 0.0) {
+          Vec<D> unit, vc;
+          for (int k = 0; k < D; ++k) {
+            unit[k] = d[k] * inv_r;
+            vc[k] = vi[k] - vp_[k][j];
+          }
+          // The contact points' relative velocity: both at the middle of the overlap, i's at
+          // x_i - a_i unit and j's at x_j + a_j unit, a = R - overlap / 2, so a_i + a_j = r and
+          // the torques of the force pair cancel about any point (angular momentum kept).
+          const double ai = Ri - 0.5 * overlap, aj = radius_[j] - 0.5 * overlap;
+          vc = vc - cross(ai * wi + aj * spin(wp_, j), unit);
+          const Vec<D> vt = vc - dot(vc, unit) * unit;
+          const double root_t = hertz ? 1.5 * std::sqrt(overlap) : 1.0;
+          const double kt = fr.stiffness_ratio * kk * root_t;
+          const double gt = fr.damping_ratio * c * (hertz ? std::sqrt(overlap) : 1.0);
+          const Vec<D> ft = tangential_force<D>(shear_[q], unit, vt, kt, gt, fr.coefficient * F,
+                                                count_collisions ? dt_ : 0.0, spring, slip);
+          for (int k = 0; k < D; ++k) {
+            fi[k] += ft[k];
+            f_[k][j] -= ft[k];
+          }
+          const Spin<D> turn = cross(unit, ft);
+          ti = ti - ai * turn;
+          add_spin(tq_, j, -aj * turn);
+        }
+      }
       if (F > 0.0) {
         ++contacts;
         virial += F * r;
@@ -529,8 +705,11 @@ void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
       }
     }
     for (int k = 0; k < D; ++k) f_[k][i] += fi[k];
+    if constexpr (Friction) add_spin(tq_, i, ti);
   }
-  potential_ = potential;
+  potential_ = potential + spring;
+  spring_energy_ = spring;
+  slip_power_ = slip;
   power_ = power;
   virial_power_ = virial;
   contacts_ = contacts;
@@ -548,7 +727,7 @@ Vec<D> DemIntegrator<D>::half_box() const {
 template <int D>
 void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
   const std::size_t n = size();
-  double potential = 0.0, loss = 0.0, work = 0.0;
+  double potential = 0.0, loss = 0.0, work = 0.0, spring = 0.0, slip = 0.0;
   std::uint64_t entered = 0;
   for (int f = 0; f < 2 * D; ++f) {
     if (!wall_on_[static_cast<std::size_t>(f)]) continue;
@@ -557,10 +736,18 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
     const double p = plane(f, t), w = plane_velocity(f, t);
     const double p_before = plane(f, t - dt_);
     const double* const x = x_[k].data();
+    // Friction: the wall's velocity (sliding in its plane, moving along its normal) and normal.
+    Vec<D> wall_velocity = walls_[static_cast<std::size_t>(f)].velocity, normal{};
+    wall_velocity[k] = w;
+    normal[k] = sign;
+    std::vector<Vec<D>>& springs = wall_shear_[static_cast<std::size_t>(f)];
     for (std::size_t i = 0; i < n; ++i) {
       const double gap = sign * (x[i] - p);  // the centre's distance from the plane
       const double R = radius_[i];
-      if (gap >= R) continue;
+      if (gap >= R) {
+        if (friction_ && springs[i] != Vec<D>{}) springs[i] = Vec<D>{};
+        continue;
+      }
       const double overlap = R - gap;
       if (overlap > max_overlap_fraction_ * R)
         throw InputError(fmt::format(
@@ -589,9 +776,27 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
       // d(KE + U)/dt = -(F_el - F) rdot + F w_n, w_n the plane's velocity along the normal.
       work += F * sign * w;
       f_[k][i] += sign * F;
+      if (friction_ && friction_wall_[s].coefficient > 0.0) {
+        const SoftFriction& fr = friction_wall_[s];
+        Vec<D> v;
+        for (int a = 0; a < D; ++a) v[a] = vp_[a][i];
+        // The contact point (on the wall's plane, at x - gap n) relative to the wall.
+        const Vec<D> vc = v - gap * cross(spin(wp_, i), normal) - wall_velocity;
+        const Vec<D> vt = vc - dot(vc, normal) * normal;
+        const bool hertz = wall_hertz_[s] != 0;
+        const double kt = fr.stiffness_ratio * kk * (hertz ? 1.5 * std::sqrt(overlap) : 1.0);
+        const double gt = fr.damping_ratio * c * (hertz ? std::sqrt(overlap) : 1.0);
+        const Vec<D> ft = tangential_force<D>(springs[i], normal, vt, kt, gt, fr.coefficient * F,
+                                              count_collisions ? dt_ : 0.0, spring, slip);
+        for (int a = 0; a < D; ++a) f_[a][i] += ft[a];
+        add_spin(tq_, i, -gap * cross(normal, ft));
+        work += dot(ft, wall_velocity);  // a sliding wall drags (and heats) by friction
+      }
     }
   }
-  potential_ += potential;
+  potential_ += potential + spring;
+  wall_spring_energy_ = spring;
+  wall_slip_power_ = slip;
   wall_loss_power_ = loss;
   wall_work_power_ = work;
   wall_collisions_ += count_collisions ? entered : 0;
@@ -601,13 +806,16 @@ template <int D>
 void DemIntegrator<D>::compute_forces(bool count_collisions, double t) {
   switch (kind_) {
     case Laws::kDashpot:
-      compute_forces_for<Laws::kDashpot>(count_collisions);
+      friction_ ? compute_forces_for<Laws::kDashpot, true>(count_collisions)
+                : compute_forces_for<Laws::kDashpot, false>(count_collisions);
       break;
     case Laws::kHertz:
-      compute_forces_for<Laws::kHertz>(count_collisions);
+      friction_ ? compute_forces_for<Laws::kHertz, true>(count_collisions)
+                : compute_forces_for<Laws::kHertz, false>(count_collisions);
       break;
     case Laws::kMixed:
-      compute_forces_for<Laws::kMixed>(count_collisions);
+      friction_ ? compute_forces_for<Laws::kMixed, true>(count_collisions)
+                : compute_forces_for<Laws::kMixed, false>(count_collisions);
       break;
   }
   if (any_wall_) compute_wall_forces(count_collisions, t);
@@ -644,6 +852,17 @@ void DemIntegrator<D>::kick_drift(double kick, double& vmax2, double& vsum2) {
     }
     vmax2 = std::max(vmax2, v2);
     vsum2 += v2;
+  }
+  if (!friction_) return;
+  for (std::size_t i = 0; i < np; ++i) {  // the same for the rotation
+    const double w = inv_inertia_[i];
+    for (int c = 0; c < kSpin; ++c) {
+      const double tq = tq_[c][i];
+      tq_[c][i] = 0.0;
+      const double spin_now = w_[c][i] + kick * w * tq;
+      w_[c][i] = spin_now;
+      wp_[c][i] = spin_now + h * w * tq;
+    }
   }
 }
 
@@ -682,10 +901,17 @@ long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
     if (2.0 * moved_since_build_ >= skin_) build_neighbours();
     const double power_before = power_, virial_before = virial_power_;
     const double loss_before = wall_loss_power_, work_before = wall_work_power_;
+    const double slip_before = slip_power_, spring_before = spring_energy_;
+    const double wall_slip_before = wall_slip_power_, wall_spring_before = wall_spring_energy_;
     compute_forces(/*count_collisions=*/true, base_.time + static_cast<double>(steps_ + 1) * dt_);
     dissipated_ += h * (power_before + power_);
     virial_ += h * (virial_before + virial_power_);
     dissipated_walls_ += h * (loss_before + wall_loss_power_);
+    if (friction_) {  // what the tangential forces took from the slip beyond their springs
+      dissipated_ -= h * (slip_before + slip_power_) + (spring_energy_ - spring_before);
+      dissipated_walls_ -=
+          h * (wall_slip_before + wall_slip_power_) + (wall_spring_energy_ - wall_spring_before);
+    }
     work_by_walls_ += h * (work_before + wall_work_power_);
     ++steps_;
     ++s;
@@ -696,6 +922,8 @@ long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
     for (int k = 0; k < D; ++k) v_[k][i] += hw * f_[k][i];
     if (gravity_on_)
       for (int k = 0; k < D; ++k) v_[k][i] += h * gravity_[k];
+    if (friction_)
+      for (int c = 0; c < kSpin; ++c) w_[c][i] += h * inv_inertia_[i] * tq_[c][i];
   }
   return s;
 }
@@ -707,6 +935,18 @@ double DemIntegrator<D>::kinetic_energy() const {
     double v2 = 0.0;
     for (int k = 0; k < D; ++k) v2 += v_[k][i] * v_[k][i];
     e += 0.5 * mass_[i] * v2;
+  }
+  return e;
+}
+
+template <int D>
+double DemIntegrator<D>::rotational_energy() const {
+  double e = 0.0;
+  if (!friction_) return e;
+  for (std::size_t i = 0; i < size(); ++i) {
+    double w2 = 0.0;
+    for (int c = 0; c < kSpin; ++c) w2 += w_[c][i] * w_[c][i];
+    e += 0.5 * inertia_[i] * w2;
   }
   return e;
 }
@@ -766,6 +1006,12 @@ ParticleSystem<D> DemIntegrator<D>::export_state() const {
   s.counters.collisions = collisions_;
   s.counters.events = base_.counters.events + static_cast<std::uint64_t>(steps_);
   s.counters.virial = virial_;
+  if (friction_) {
+    s.angular_velocity.assign(size(), AngularVelocity<D>{});
+    for (std::size_t i = 0; i < size(); ++i)
+      for (int c = 0; c < kSpin; ++c)
+        s.angular_velocity[id_[i]][static_cast<std::size_t>(c)] = w_[c][i];
+  }
   s.counters.wall_collisions = wall_collisions_;
   s.counters.dissipated_at_walls = dissipated_walls_;
   s.counters.work_by_walls = work_by_walls_;

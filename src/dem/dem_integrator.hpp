@@ -38,6 +38,16 @@
 // dissipate are accumulated by the same trapezoidal rule as the pairs'. Gravity is a constant
 // acceleration in the kicks; its potential energy is field_energy().
 //
+// Friction (env.soft_friction / soft_wall_friction with a coefficient > 0; SoftFriction in
+// interactions/soft_contact.hpp): a tangential spring per contact on the slip of the contact
+// points (their relative velocity, rotation included, in the tangent plane), projected onto the
+// tangent plane as the contact turns, with a tangential dashpot and the Coulomb cut; torques
+// turn the particles (moment of inertia q m R^2, q = Environment::inertia_factor). The springs
+// of the pairs ride along with the neighbour list (carried over at every rebuild), those of the
+// walls per particle and face. Energy: the springs' energy counts as potential energy, and the
+// dissipation of a contact is what the tangential force took from the slip beyond what its
+// spring holds. Without friction the smooth loops run, unchanged.
+//
 // Neighbours: a half neighbour list (pairs closer than d_max + skin), built from a linked-cell
 // grid (cells >= d_max + skin) and rebuilt when the particles may have moved skin/2.
 // Hot data are structure-of-arrays (x, y, z, vx, ... separately), renumbered into cell order at
@@ -50,6 +60,7 @@
 
 #include "core/environment.hpp"
 #include "core/particle_system.hpp"
+#include "interactions/granular_contact.hpp"
 #include "interactions/soft_contact.hpp"
 
 namespace kairos {
@@ -114,7 +125,8 @@ class DemIntegrator {
   // set to dissipated_energy(). Everything else as given to the constructor.
   ParticleSystem<D> export_state() const;
 
-  double kinetic_energy() const;
+  double kinetic_energy() const;     // translational
+  double rotational_energy() const;  // 0 without friction
   // Elastic energy of every overlapping pair at the current positions.
   double potential_energy() const { return potential_; }
   // Accumulated work of the damping forces (see the header comment), >= 0 up to O(dt^2).
@@ -144,6 +156,7 @@ class DemIntegrator {
  private:
   void init(const DemOptions& options);
   void set_walls(const Environment<D>& env);
+  void set_friction(const Environment<D>& env);
   // The plane of wall face f along its axis at time t, and its velocity along the axis.
   double plane(int face, double t) const;
   double plane_velocity(int face, double t) const;
@@ -159,8 +172,12 @@ class DemIntegrator {
   // counts pairs entering contact when count_collisions.
   void compute_forces(bool count_collisions, double t);
   enum class Laws { kDashpot, kHertz, kMixed };
-  template <Laws L>
+  template <Laws L, bool Friction>
   void compute_forces_for(bool count_collisions);
+  void carry_shear_over(const std::vector<std::uint64_t>& keys, const std::vector<Vec<D>>& values);
+  static constexpr int kSpin = D == 3 ? 3 : 1;
+  Spin<D> spin(const std::vector<double> (&a)[kSpin], std::size_t i) const;
+  void add_spin(std::vector<double> (&a)[kSpin], std::size_t i, const Spin<D>& s);
 
   ParticleSystem<D> base_;
   // Per species pair a * species_ + b: the model, the stiffness (k or rho) and the damping
@@ -203,6 +220,21 @@ class DemIntegrator {
   double wall_loss_power_ = 0.0, dissipated_walls_ = 0.0;
   double wall_work_power_ = 0.0, work_by_walls_ = 0.0;
   std::uint64_t wall_collisions_ = 0;
+
+  // Friction (see the header comment): per species pair and per species against the walls
+  // mu, k_t / k_n and gamma_t / gamma_n; the springs of the list entries and, per wall face,
+  // of the particles; angular velocity, its predicted value, torque, 1/I and I per slot.
+  bool friction_ = false;
+  std::vector<SoftFriction> friction_pair_, friction_wall_;
+  std::vector<Vec<D>> shear_;
+  std::array<std::vector<Vec<D>>, 2 * D> wall_shear_;
+  std::vector<double> w_[kSpin], wp_[kSpin], tq_[kSpin];
+  std::vector<double> inertia_, inv_inertia_;
+  std::vector<double> inertia_factor_;  // q per species: I = q m R^2
+  // Sum over contacts of F_t . v_t (the tangential forces' power on the slip) and of the springs'
+  // energy, pairs and walls, at the last force evaluation.
+  double slip_power_ = 0.0, spring_energy_ = 0.0;
+  double wall_slip_power_ = 0.0, wall_spring_energy_ = 0.0;
 
   double potential_ = 0.0, power_ = 0.0, dissipated_ = 0.0;
   double virial_power_ = 0.0, virial_ = 0.0;

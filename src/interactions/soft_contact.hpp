@@ -54,6 +54,20 @@ struct SoftContactLaw {
   double end_overlap_per_speed() const;
 };
 
+// Coulomb friction of a soft contact, integrated by the DEM alone (the collision map is that of
+// smooth spheres): a tangential spring on the contact's accumulated tangential displacement
+// xi_t with a dashpot on the tangential slip velocity v_t (Cundall-Strack),
+// F_t = -(k_t xi_t + gamma_t v_t), cut to |F_t| <= mu F_n (the spring then reset to match).
+// k_t and gamma_t are fractions of the normal law's: k_t = stiffness_ratio k and gamma_t =
+// damping_ratio gamma (dashpot); for Hertz of the normal tangent stiffness (3/2) rho sqrt(xi)
+// and damping coefficient (3/2) A rho sqrt(xi), as LAMMPS's gran/hertz/history scales both.
+struct SoftFriction {
+  double coefficient = 0.0;            // mu >= 0; 0: smooth (no tangential force)
+  double stiffness_ratio = 2.0 / 7.0;  // k_t / k_n > 0
+  double damping_ratio = 0.5;          // gamma_t / gamma_n >= 0
+  bool operator==(const SoftFriction&) const = default;
+};
+
 // ---------------------------------------------------------------------------------------------
 // Reduced units (formulas.md §1.2). The two-body problem in the collision plane,
 //   x'' = c_phi^2 / x^3 + f(x, x'),  phi' = c_phi / x^2,  x(0) = l~, x'(0) = -1, phi(0) = 0,

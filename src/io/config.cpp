@@ -175,6 +175,9 @@ constexpr KeySpec kSchema[] = {
     {"soft.dissipation", Kind::kFloat},
     {"soft.restitution", Kind::kFloat},
     {"soft.restitution_speed", Kind::kFloat},
+    {"soft.friction", Kind::kFloat},
+    {"soft.tangential_stiffness", Kind::kFloat},
+    {"soft.tangential_damping", Kind::kFloat},
     {"soft.pair", Kind::kTableArray},
     {"soft.pair[]", Kind::kTable},
     {"soft.pair[].species", Kind::kArray},
@@ -186,6 +189,9 @@ constexpr KeySpec kSchema[] = {
     {"soft.pair[].dissipation", Kind::kFloat},
     {"soft.pair[].restitution", Kind::kFloat},
     {"soft.pair[].restitution_speed", Kind::kFloat},
+    {"soft.pair[].friction", Kind::kFloat},
+    {"soft.pair[].tangential_stiffness", Kind::kFloat},
+    {"soft.pair[].tangential_damping", Kind::kFloat},
     {"output", Kind::kTable},
     {"output.directory", Kind::kString},
     {"output.thermo_interval", Kind::kFloat},
@@ -1413,6 +1419,13 @@ class Reader {
     const toml::node* n_a = get_number(t, prefix, "dissipation", law.dissipation);
     const toml::node* n_e = get_number(t, prefix, "restitution", law.restitution);
     const toml::node* n_speed = get_number(t, prefix, "restitution_speed", law.restitution_speed);
+    const toml::node* n_mu = get_number(t, prefix, "friction", law.friction);
+    const toml::node* n_kt =
+        get_number(t, prefix, "tangential_stiffness", law.tangential_stiffness);
+    const toml::node* n_gt = get_number(t, prefix, "tangential_damping", law.tangential_damping);
+    require_non_negative(n_mu, path("friction"), law.friction);
+    require_positive(n_kt, path("tangential_stiffness"), law.tangential_stiffness);
+    require_non_negative(n_gt, path("tangential_damping"), law.tangential_damping);
     if (n_model == nullptr && law.model.empty()) {
       fail(&t, path("model"),
            fmt::format("missing required key '{}' (\"dashpot\" or \"hertz\"): [soft] makes every "
@@ -1557,6 +1570,22 @@ class Reader {
       if (c.boundary.shear_rate != 0.0) {
         conflict("boundary.shear_rate",
                  "Lees-Edwards shear is not supported with soft spheres yet");
+      }
+      if (c.run.integrator != "dem") {
+        const auto rough = [&](const SoftLawConfig& law, const std::string& prefix) {
+          if (law.friction > 0.0) {
+            const std::string key = prefix + ".friction";
+            const toml::node* n = node_at(root, key);
+            fail(n != nullptr ? n : n_model, key,
+                 fmt::format("{}: friction is integrated by the DEM alone (the collision map is "
+                             "that of smooth spheres); set run.integrator = \"dem\" or friction "
+                             "= 0",
+                             key));
+          }
+        };
+        rough(c.soft.law, "soft");
+        for (std::size_t p = 0; p < c.soft.pairs.size(); ++p)
+          rough(c.soft.pairs[p].law, fmt::format("soft.pair[{}]", p));
       }
       if (!c.field.gravity.empty() && c.run.integrator != "dem") {
         conflict("field.gravity",
@@ -1725,6 +1754,9 @@ std::string soft_law_toml(const SoftLawConfig& law) {
                                  : fmt::format("dissipation = {}\n", toml_float(law.dissipation));
     out += fmt::format("restitution_speed = {}\n", toml_float(law.restitution_speed));
   }
+  out += fmt::format("friction = {}\n", toml_float(law.friction));
+  out += fmt::format("tangential_stiffness = {}\n", toml_float(law.tangential_stiffness));
+  out += fmt::format("tangential_damping = {}\n", toml_float(law.tangential_damping));
   return out;
 }
 

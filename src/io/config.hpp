@@ -179,6 +179,11 @@ struct SoftLawConfig {
   double dissipation = 0.0;        // hertz: the dissipative time constant A >= 0
   double restitution = 0.0;        // head-on e in (0, 1] fixing gamma or A per pair; 0 = not given
   double restitution_speed = 1.0;  // hertz: the impact speed at which e = restitution
+  // Coulomb friction (DEM only; interactions/soft_contact.hpp SoftFriction): mu >= 0 (0:
+  // smooth), k_t / k_n > 0, gamma_t / gamma_n >= 0.
+  double friction = 0.0;
+  double tangential_stiffness = 2.0 / 7.0;
+  double tangential_damping = 0.5;
 
   bool operator==(const SoftLawConfig&) const = default;
 };

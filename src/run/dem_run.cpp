@@ -65,8 +65,10 @@ class DemRunDriver {
       const Environment<D> env = make_environment<D>(config, start);
       const auto damped = [](const SoftContactLaw& law) { return law.damping > 0.0; };
       // Walls and gravity, like damping, make the energy budget worth reporting.
-      granular_ = std::any_of(env.soft.begin(), env.soft.end(), damped) || env.has_walls() ||
-                  env.has_gravity();
+      const auto rough = [](const SoftFriction& f) { return f.coefficient > 0.0; };
+      granular_ = std::any_of(env.soft.begin(), env.soft.end(), damped) ||
+                  std::any_of(env.soft_friction.begin(), env.soft_friction.end(), rough) ||
+                  env.has_walls() || env.has_gravity();
       dem_.emplace(start, env, options);
     } catch (const InputError& e) {
       if (!restart_file) throw;
@@ -142,8 +144,9 @@ class DemRunDriver {
   // Kinetic plus elastic plus gravitational energy plus what the damping took, less what the
   // walls gave: constant to O(dt^2) (NaN with gravity along a periodic axis).
   double total_energy() const {
-    return dem_->kinetic_energy() + dem_->potential_energy() + dem_->field_energy() +
-           dem_->dissipated_energy() + dem_->dissipated_at_walls() - dem_->work_by_walls();
+    return dem_->kinetic_energy() + dem_->rotational_energy() + dem_->potential_energy() +
+           dem_->field_energy() + dem_->dissipated_energy() + dem_->dissipated_at_walls() -
+           dem_->work_by_walls();
   }
 
   RunProgress progress_now() const {
@@ -226,9 +229,10 @@ class DemRunDriver {
       production_temperatures_.push_back(row.temperature);
       if (profile_) sample_profile();
     }
-    thermo_->write(phase, row,
-                   {0.0, dem_->dissipated_energy() + dem_->dissipated_at_walls(),
-                    dem_->work_by_walls(), dem_->potential_energy()});
+    thermo_->write(
+        phase, row,
+        {rotational_temperature(), dem_->dissipated_energy() + dem_->dissipated_at_walls(),
+         dem_->work_by_walls(), dem_->potential_energy()});
   }
 
   void sample_profile() {
@@ -243,6 +247,11 @@ class DemRunDriver {
       volume[i] = D == 3 ? 4.0 / 3.0 * std::numbers::pi * r * r * r : std::numbers::pi * r * r;
     }
     profile_->sample(x, v, mass, volume);
+  }
+
+  // Per rotational degree of freedom (3 for spheres, 1 for disks); 0 without friction.
+  double rotational_temperature() const {
+    return 2.0 * dem_->rotational_energy() / ((D == 3 ? 3.0 : 1.0) * static_cast<double>(n_));
   }
 
   // Velocities relative to the centre of mass.
@@ -337,7 +346,7 @@ class DemRunDriver {
     const double scale =
         std::max({std::abs(energy_start_), dissipated + at_walls, std::abs(by_walls)});
     nlohmann::json g;
-    g["rotational_temperature"] = 0.0;
+    g["rotational_temperature"] = rotational_temperature();
     g["sonine_a2"] = sonine_a2();
     g["dissipated_in_collisions"] = dissipated;
     g["dissipated_at_walls"] = at_walls;

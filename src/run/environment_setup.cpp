@@ -194,6 +194,10 @@ SoftContactLaw make_soft_law(const SoftLawConfig& c, double mu, double r_eff,
   }
 }
 
+SoftFriction soft_friction(const SoftLawConfig& c) {
+  return {c.friction, c.tangential_stiffness, c.tangential_damping};
+}
+
 // [soft]: the law of every species pair (from [[soft.pair]] or [soft]) and, with walls, of
 // every species against a wall ([soft] with R_eff = R and mu = m: a wall of the same material
 // and infinite mass and radius).
@@ -214,6 +218,7 @@ void add_soft_laws(const Config& config, const ParticleSystem<D>& s, Environment
   }
   env.species = n;
   env.soft.assign(static_cast<std::size_t>(n) * n, SoftContactLaw{});
+  env.soft_friction.assign(static_cast<std::size_t>(n) * n, SoftFriction{});
   for (std::uint32_t a = 0; a < n; ++a) {
     for (std::uint32_t b = a; b < n; ++b) {
       const int p = pair_of[a * n + b];
@@ -228,10 +233,12 @@ void add_soft_laws(const Config& config, const ParticleSystem<D>& s, Environment
                                : std::nan("");
       env.soft[a * n + b] = env.soft[b * n + a] =
           make_soft_law(c, mu, r_eff, where, fmt::format("species {} and {}", name(a), name(b)));
+      env.soft_friction[a * n + b] = env.soft_friction[b * n + a] = soft_friction(c);
     }
   }
   if (!config.boundary.walls.empty()) {
     env.soft_wall.resize(n);
+    env.soft_wall_friction.assign(n, soft_friction(soft.law));
     for (std::uint32_t a = 0; a < n; ++a) {
       env.soft_wall[a] = make_soft_law(soft.law, shape[a].mass, shape[a].radius, "soft",
                                        fmt::format("species {} against a wall", name(a)));

@@ -221,6 +221,24 @@ TEST(ConfigSoft, MapTableKeys) {
   expect_error(with(soft + "table_cach = \"x\"\n"), {"soft.table_cach", "soft.table_cache"});
 }
 
+TEST(ConfigSoft, FrictionIsTheDems) {
+  const std::string soft = "[soft]\nmodel = \"dashpot\"\nstiffness = 1.0\nfriction = 0.5\n";
+  const Config c = parse_config(with(soft + "tangential_stiffness = 0.4\n[run]\n"
+                                            "integrator = \"dem\""),
+                                "test.toml");
+  EXPECT_EQ(c.soft.law.friction, 0.5);
+  EXPECT_EQ(c.soft.law.tangential_stiffness, 0.4);
+  EXPECT_EQ(c.soft.law.tangential_damping, 0.5);  // the default, LAMMPS's gamma_t / gamma_n
+  expect_error(with(soft), {"soft.friction", "run.integrator = \"dem\"", "smooth spheres"});
+  expect_error(with("[soft]\nmodel = \"dashpot\"\nstiffness = 1.0\n[[soft.pair]]\n"
+                    "species = [\"A\", \"B\"]\nfriction = 0.3\n"),
+               {"soft.pair[0].friction", "run.integrator"});
+  expect_error(with("[soft]\nmodel = \"dashpot\"\nstiffness = 1.0\nfriction = -1\n"),
+               {"soft.friction", ">= 0"});
+  expect_error(with("[soft]\nmodel = \"dashpot\"\nstiffness = 1.0\ntangential_stiffness = 0\n"),
+               {"soft.tangential_stiffness", "> 0"});
+}
+
 TEST(ConfigSoft, RoundTripIsExact) {
   for (const std::string_view text : {
            R"(
@@ -228,14 +246,18 @@ TEST(ConfigSoft, RoundTripIsExact) {
 model = "dashpot"
 stiffness = 2e4
 restitution = 0.9
+friction = 0.4
 [[soft.pair]]
 species = ["A", "B"]
 damping = 3.5
+tangential_stiffness = 0.5
 [[soft.pair]]
 species = ["B", "B"]
 model = "hertz"
 young = 1e6
 restitution_speed = 2.0
+friction = 0.0
+tangential_damping = 0.0
 [run]
 integrator = "dem"
 time_step = 1.25e-4
