@@ -117,6 +117,18 @@ struct FrozenContact {
 template <int D>
 using AngularVelocity = Vec<D == 3 ? 3 : 1>;
 
+// The DEM integrator's state beyond positions and velocities (DemIntegrator::checkpoint():
+// half-step velocities, forces, its numbering and neighbour list, the friction springs), kept
+// in restart files so that a continued DEM run is bit-identical. Empty for other states; the
+// layout is the DEM's (dem/dem_integrator.cpp).
+struct DemResume {
+  std::vector<double> scalars;
+  std::vector<double> particles;  // a fixed stride per particle, in the caller's numbering
+  std::vector<std::uint32_t> order, list_start, list;
+  std::vector<double> springs;
+  bool empty() const { return scalars.empty(); }
+};
+
 template <int D>
 struct ParticleSystem {
   Vec<D> box{};
@@ -153,6 +165,8 @@ struct ParticleSystem {
   std::optional<std::vector<PairZone>> zones;
   // Soft spheres: the contacts in progress (mapped contacts waiting for their release).
   std::vector<FrozenContact<D>> frozen;
+  // DEM runs: what a resumed DemIntegrator needs to continue bit for bit (empty: start afresh).
+  DemResume dem;
 
   std::size_t size() const { return kinematics.size(); }
   bool is_asleep(std::size_t i) const { return !asleep.empty() && asleep[i] != 0; }

@@ -259,6 +259,7 @@ void DemIntegrator<D>::init(const DemOptions& options) {
   for (int k = 0; k < D; ++k) {
     x_[k].resize(n);
     v_[k].resize(n);
+    u_[k].resize(n);
     f_[k].assign(n, 0.0);
     vp_[k].resize(n);
   }
@@ -317,6 +318,7 @@ void DemIntegrator<D>::init(const DemOptions& options) {
   if (friction_) {
     for (int c = 0; c < kSpin; ++c) {
       w_[c].assign(n, 0.0);
+      uw_[c].assign(n, 0.0);
       wp_[c].assign(n, 0.0);
       tq_[c].assign(n, 0.0);
     }
@@ -380,8 +382,186 @@ void DemIntegrator<D>::init(const DemOptions& options) {
   id_.resize(n);
   slot_.resize(n);
   for (std::size_t i = 0; i < n; ++i) id_[i] = slot_[i] = static_cast<std::uint32_t>(i);
+  time_origin_ = system.time;
+  step_base_ = 0;
+  if (!system.dem.empty() && resume(system.dem)) return;
   build_neighbours();
   compute_forces(/*count_collisions=*/false, time_);  // also rejects absurd initial overlaps
+  synchronise(/*from_half_step=*/false);              // u = v - (dt/2) a
+}
+
+// The layout of a DemResume: scalars in this order, per particle u (D), f (D) and with friction
+// the half-step spin and torque (kSpin each) and one spring (D) per wall face.
+namespace {
+enum DemScalar {
+  kLayout,  // kDemLayout
+  kTimeStep,
+  kTimeOrigin,
+  kStepsDone,
+  kMoved,
+  kPower,
+  kVirialPower,
+  kWallLoss,
+  kWallWork,
+  kSlip,
+  kSpring,
+  kWallSlip,
+  kWallSpring,
+  kPotential,
+  kContacts,
+  kFriction,
+  kScalars
+};
+constexpr double kDemLayout = 1.0;
+}  // namespace
+
+template <int D>
+DemResume DemIntegrator<D>::checkpoint() const {
+  DemResume r;
+  r.scalars.assign(kScalars, 0.0);
+  r.scalars[kLayout] = kDemLayout;
+  r.scalars[kTimeStep] = dt_;
+  r.scalars[kTimeOrigin] = time_origin_;
+  r.scalars[kStepsDone] = static_cast<double>(step_base_ + steps_);
+  r.scalars[kMoved] = moved_since_build_;
+  r.scalars[kPower] = power_;
+  r.scalars[kVirialPower] = virial_power_;
+  r.scalars[kWallLoss] = wall_loss_power_;
+  r.scalars[kWallWork] = wall_work_power_;
+  r.scalars[kSlip] = slip_power_;
+  r.scalars[kSpring] = spring_energy_;
+  r.scalars[kWallSlip] = wall_slip_power_;
+  r.scalars[kWallSpring] = wall_spring_energy_;
+  r.scalars[kPotential] = potential_;
+  r.scalars[kContacts] = static_cast<double>(contacts_);
+  r.scalars[kFriction] = friction_ ? 1.0 : 0.0;
+  const std::size_t n = size(), stride = resume_stride();
+  r.particles.resize(n * stride);
+  for (std::size_t i = 0; i < n; ++i) {
+    double* p = &r.particles[id_[i] * stride];
+    for (int k = 0; k < D; ++k) {
+      *p++ = u_[k][i];
+      *p++ = f_[k][i];
+    }
+    if (!friction_) continue;
+    for (int c = 0; c < kSpin; ++c) {
+      *p++ = uw_[c][i];
+      *p++ = tq_[c][i];
+    }
+    for (const std::vector<Vec<D>>& springs : wall_shear_)
+      if (!springs.empty())
+        for (int k = 0; k < D; ++k) *p++ = springs[i][static_cast<std::size_t>(k)];
+  }
+  r.order = id_;
+  r.list_start = start_;
+  r.list = nbr_;
+  if (friction_) {
+    r.springs.reserve(shear_.size() * D);
+    for (const Vec<D>& s : shear_) r.springs.insert(r.springs.end(), s.begin(), s.end());
+  }
+  return r;
+}
+
+template <int D>
+std::size_t DemIntegrator<D>::resume_stride() const {
+  std::size_t faces = 0;
+  for (const std::vector<Vec<D>>& springs : wall_shear_) faces += springs.empty() ? 0 : 1;
+  return 2 * D + (friction_ ? 2 * kSpin + faces * D : 0);
+}
+
+// Takes the state of checkpoint(): false (start afresh) when it was made with another time step;
+// InputError when it does not fit the system.
+template <int D>
+bool DemIntegrator<D>::resume(const DemResume& r) {
+  const std::size_t n = size();
+  if (r.scalars.size() != kScalars || r.scalars[kLayout] != kDemLayout)
+    throw InputError("DEM: the saved integrator state has an unknown layout");
+  if (r.scalars[kTimeStep] != dt_) return false;
+  const std::size_t stride = resume_stride();
+  const auto bad = [](const char* what) {
+    throw InputError(fmt::format("DEM: the saved integrator state is inconsistent ({})", what));
+  };
+  if ((r.scalars[kFriction] != 0.0) != friction_) bad("friction");
+  if (r.particles.size() != n * stride) bad("per-particle data");
+  if (r.order.size() != n || r.list_start.size() != n + 1 || r.list_start[0] != 0 ||
+      r.list_start[n] != r.list.size())
+    bad("numbering or neighbour list");
+  std::vector<std::uint8_t> seen(n, 0);
+  for (const std::uint32_t id : r.order) {
+    if (id >= n || seen[id]) bad("numbering");
+    seen[id] = 1;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (r.list_start[i] > r.list_start[i + 1]) bad("neighbour list");
+  for (const std::uint32_t j : r.list)
+    if (j >= n) bad("neighbour list");
+  if (friction_ && r.springs.size() != r.list.size() * D) bad("springs");
+  for (const double x : r.particles)
+    if (!std::isfinite(x)) bad("a value is not finite");
+  // The system's particles (slot = caller's number so far) into the saved order.
+  std::vector<std::uint32_t> order(r.order.begin(), r.order.end());
+  const auto permute = [&](std::vector<double>& a) {
+    std::vector<double> tmp(n);
+    for (std::size_t q = 0; q < n; ++q) tmp[q] = a[order[q]];
+    a.swap(tmp);
+  };
+  for (int k = 0; k < D; ++k) {
+    permute(x_[k]);
+    permute(v_[k]);
+  }
+  permute(mass_);
+  permute(inv_mass_);
+  permute(radius_);
+  if (friction_) {
+    for (int c = 0; c < kSpin; ++c) permute(w_[c]);
+    permute(inertia_);
+    permute(inv_inertia_);
+  }
+  std::vector<std::uint32_t> sp(n);
+  for (std::size_t q = 0; q < n; ++q) sp[q] = sp_[order[q]];
+  sp_.swap(sp);
+  id_ = order;
+  for (std::size_t q = 0; q < n; ++q) slot_[id_[q]] = static_cast<std::uint32_t>(q);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* p = &r.particles[id_[i] * stride];
+    for (int k = 0; k < D; ++k) {
+      u_[k][i] = *p++;
+      f_[k][i] = *p++;
+      vp_[k][i] = v_[k][i];
+    }
+    if (!friction_) continue;
+    for (int c = 0; c < kSpin; ++c) {
+      uw_[c][i] = *p++;
+      tq_[c][i] = *p++;
+      wp_[c][i] = w_[c][i];
+    }
+    for (std::vector<Vec<D>>& springs : wall_shear_)
+      if (!springs.empty())
+        for (int k = 0; k < D; ++k) springs[i][static_cast<std::size_t>(k)] = *p++;
+  }
+  start_ = r.list_start;
+  nbr_ = r.list;
+  if (friction_) {
+    shear_.resize(nbr_.size());
+    for (std::size_t q = 0; q < nbr_.size(); ++q)
+      for (int k = 0; k < D; ++k)
+        shear_[q][static_cast<std::size_t>(k)] = r.springs[q * D + static_cast<std::size_t>(k)];
+  }
+  time_origin_ = r.scalars[kTimeOrigin];
+  step_base_ = static_cast<long>(r.scalars[kStepsDone]);
+  moved_since_build_ = r.scalars[kMoved];
+  power_ = r.scalars[kPower];
+  virial_power_ = r.scalars[kVirialPower];
+  wall_loss_power_ = r.scalars[kWallLoss];
+  wall_work_power_ = r.scalars[kWallWork];
+  slip_power_ = r.scalars[kSlip];
+  spring_energy_ = r.scalars[kSpring];
+  wall_slip_power_ = r.scalars[kWallSlip];
+  wall_spring_energy_ = r.scalars[kWallSpring];
+  potential_ = r.scalars[kPotential];
+  contacts_ = static_cast<std::size_t>(r.scalars[kContacts]);
+  time_ = time_at(0);
+  return true;
 }
 
 template <int D>
@@ -437,6 +617,7 @@ void DemIntegrator<D>::build_neighbours() {
     for (int k = 0; k < D; ++k) {
       permute(x_[k]);
       permute(v_[k]);
+      permute(u_[k]);
       permute(vp_[k]);
       permute(f_[k]);
     }
@@ -446,6 +627,7 @@ void DemIntegrator<D>::build_neighbours() {
     if (friction_) {
       for (int c = 0; c < kSpin; ++c) {
         permute(w_[c]);
+        permute(uw_[c]);
         permute(wp_[c]);
         permute(tq_[c]);
       }
@@ -639,7 +821,7 @@ void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
       if (count_collisions) {  // apart one step earlier (v_ holds the drift velocity)?
         double r2_before = 0.0;
         for (int k = 0; k < D; ++k) {
-          const double dk = d[k] - dt_ * (v_[k][i] - v_[k][j]);
+          const double dk = d[k] - dt_ * (u_[k][i] - u_[k][j]);
           r2_before += dk * dk;
         }
         if (r2_before >= l * l) ++entered;
@@ -755,7 +937,7 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
             "t = {}: time step dt = {} too large, the wall too fast or the initial state outside",
             id_[i], f, overlap, max_overlap_fraction_, t, dt_));
       // Apart one step earlier (v_ holds the drift velocity)?
-      if (count_collisions && sign * (x[i] - dt_ * v_[k][i] - p_before) >= R) ++entered;
+      if (count_collisions && sign * (x[i] - dt_ * u_[k][i] - p_before) >= R) ++entered;
       const double rdot = sign * (vp_[k][i] - w);  // the gap's rate of change
       const std::size_t s = sp_[i];
       const double kk = wall_stiffness_[s], c = wall_damping_[s];
@@ -826,7 +1008,7 @@ void DemIntegrator<D>::compute_forces(bool count_collisions, double t) {
 // particle's acceleration; axes between walls are not wrapped.
 template <int D>
 template <bool Gravity>
-void DemIntegrator<D>::kick_drift(double kick, double& vmax2, double& vsum2) {
+void DemIntegrator<D>::kick_drift(double& vmax2, double& vsum2) {
   const std::size_t np = size();
   const double h = 0.5 * dt_;
   for (std::size_t i = 0; i < np; ++i) {
@@ -838,13 +1020,13 @@ void DemIntegrator<D>::kick_drift(double kick, double& vmax2, double& vsum2) {
       double v, vp;
       if constexpr (Gravity) {
         const double a = w * f + gravity_[k];
-        v = v_[k][i] + kick * a;
+        v = u_[k][i] + dt_ * a;
         vp = v + h * a;
       } else {
-        v = v_[k][i] + kick * w * f;
+        v = u_[k][i] + dt_ * w * f;
         vp = v + h * w * f;
       }
-      v_[k][i] = v;
+      u_[k][i] = v;
       const double x = x_[k][i] + dt_ * v;
       x_[k][i] = periodic_[k] ? wrap_once(x, box_[k]) : x;
       vp_[k][i] = vp;
@@ -859,10 +1041,29 @@ void DemIntegrator<D>::kick_drift(double kick, double& vmax2, double& vsum2) {
     for (int c = 0; c < kSpin; ++c) {
       const double tq = tq_[c][i];
       tq_[c][i] = 0.0;
-      const double spin_now = w_[c][i] + kick * w * tq;
-      w_[c][i] = spin_now;
+      const double spin_now = uw_[c][i] + dt_ * w * tq;
+      uw_[c][i] = spin_now;
       wp_[c][i] = spin_now + h * w * tq;
     }
+  }
+}
+
+// The velocities (and spins) at the present step from the half-step ones and the forces:
+// v = u + (dt/2) a. Only read by the outside: the stepping itself carries u, so where a run
+// splits its steps into calls does not change a bit.
+template <int D>
+void DemIntegrator<D>::synchronise(bool from_half_step) {
+  const double h = 0.5 * dt_;
+  const double sign = from_half_step ? 1.0 : -1.0;  // false: u = v - (dt/2) a instead
+  std::vector<double>(&from)[D] = from_half_step ? u_ : v_;
+  std::vector<double>(&to)[D] = from_half_step ? v_ : u_;
+  for (std::size_t i = 0; i < size(); ++i) {
+    const double hw = h * inv_mass_[i];
+    for (int k = 0; k < D; ++k) to[k][i] = from[k][i] + sign * (hw * f_[k][i] + h * gravity_[k]);
+    if (!friction_) continue;
+    const double hi = h * inv_inertia_[i];
+    for (int c = 0; c < kSpin; ++c)
+      (from_half_step ? w_ : uw_)[c][i] = (from_half_step ? uw_ : w_)[c][i] + sign * hi * tq_[c][i];
   }
 }
 
@@ -879,20 +1080,19 @@ long DemIntegrator<D>::step_until(long n, std::uint64_t collisions) {
 template <int D>
 long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
   if (n < 0) throw InputError(fmt::format("DEM: step count must be >= 0, got {}", n));
-  const std::size_t np = size();
   const double h = 0.5 * dt_;
   if (n == 0) return 0;
   long s = 0;
   // Velocity Verlet with the closing half kick of one step and the opening half kick of the
-  // next fused into one kick by dt (one pass over the arrays less); v_ holds v(t) only between
-  // calls. The same pass clears the forces for the next evaluation.
+  // next fused into one kick by dt on the half-step velocities u (one pass over the arrays
+  // less); v_ holds v(t), made from u, between calls. The same pass clears the forces for the
+  // next evaluation.
   while (s < n && collisions_ < collisions) {
-    const double kick = s == 0 ? h : dt_;
     double vmax2 = 0.0, vsum2 = 0.0;
     if (gravity_on_) {
-      kick_drift<true>(kick, vmax2, vsum2);
+      kick_drift<true>(vmax2, vsum2);
     } else {
-      kick_drift<false>(kick, vmax2, vsum2);
+      kick_drift<false>(vmax2, vsum2);
     }
     if (!std::isfinite(vsum2))
       throw InputError(
@@ -903,7 +1103,7 @@ long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
     const double loss_before = wall_loss_power_, work_before = wall_work_power_;
     const double slip_before = slip_power_, spring_before = spring_energy_;
     const double wall_slip_before = wall_slip_power_, wall_spring_before = wall_spring_energy_;
-    compute_forces(/*count_collisions=*/true, base_.time + static_cast<double>(steps_ + 1) * dt_);
+    compute_forces(/*count_collisions=*/true, time_at(steps_ + 1));
     dissipated_ += h * (power_before + power_);
     virial_ += h * (virial_before + virial_power_);
     dissipated_walls_ += h * (loss_before + wall_loss_power_);
@@ -915,17 +1115,15 @@ long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
     work_by_walls_ += h * (work_before + wall_work_power_);
     ++steps_;
     ++s;
-    time_ = base_.time + static_cast<double>(steps_) * dt_;
+    time_ = time_at(steps_);
   }
-  for (std::size_t i = 0; i < np; ++i) {  // the closing half kick of the last step
-    const double hw = h * inv_mass_[i];
-    for (int k = 0; k < D; ++k) v_[k][i] += hw * f_[k][i];
-    if (gravity_on_)
-      for (int k = 0; k < D; ++k) v_[k][i] += h * gravity_[k];
-    if (friction_)
-      for (int c = 0; c < kSpin; ++c) w_[c][i] += h * inv_inertia_[i] * tq_[c][i];
-  }
+  synchronise(/*from_half_step=*/true);
   return s;
+}
+
+template <int D>
+double DemIntegrator<D>::time_at(long steps) const {
+  return time_origin_ + static_cast<double>(step_base_ + steps) * dt_;
 }
 
 template <int D>
@@ -1002,6 +1200,7 @@ ParticleSystem<D> DemIntegrator<D>::export_state() const {
   s.cell.clear();
   s.order.clear();
   s.zones.reset();
+  s.dem = DemResume{};
   s.counters.dissipated_in_collisions = dissipated_;
   s.counters.collisions = collisions_;
   s.counters.events = base_.counters.events + static_cast<std::uint64_t>(steps_);

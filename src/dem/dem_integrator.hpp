@@ -28,6 +28,11 @@
 // per particle). The virial sum_pairs r F (time-integrated by the trapezoidal rule, like the
 // dissipation) gives the pressure as the collisional virial does for hard spheres.
 //
+// Exact continuation: the stepping carries the half-step velocities u = v(t - dt/2) (and
+// spins), from which v(t) is made for readers at the end of every call, so splitting the
+// steps into calls changes no bit; checkpoint() holds the rest of the integrator's state, with
+// which a new integrator continues bit for bit (restart files carry it).
+//
 // Walls and gravity (the Environment constructor): a face of the box may be a wall, a plane
 // that is fixed, slides in its plane (no effect: the contacts are frictionless) or moves along
 // its normal (a piston's constant speed, a vibration A sin(w t + phi): Environment's Wall). A
@@ -120,8 +125,14 @@ class DemIntegrator {
   long steps() const { return steps_; }
   std::size_t size() const { return mass_.size(); }
 
+  // What export_state() leaves out for a bit-identical continuation: handed back in the
+  // system's `dem` field (with export_state()'s positions and velocities and the same time
+  // step), the integrator continues exactly as this one would. A different time step, or a
+  // system without it, starts afresh (forces recomputed).
+  DemResume checkpoint() const;
+
   // Positions wrapped into [0, L), velocities, time set (every particle's local time too);
-  // scheduler state (events, cells, order, zones) cleared; counters.dissipated_in_collisions
+  // scheduler state (events, cells, order, zones, dem) cleared; counters.dissipated_in_collisions
   // set to dissipated_energy(). Everything else as given to the constructor.
   ParticleSystem<D> export_state() const;
 
@@ -155,6 +166,8 @@ class DemIntegrator {
 
  private:
   void init(const DemOptions& options);
+  bool resume(const DemResume& r);
+  std::size_t resume_stride() const;
   void set_walls(const Environment<D>& env);
   void set_friction(const Environment<D>& env);
   // The plane of wall face f along its axis at time t, and its velocity along the axis.
@@ -163,7 +176,9 @@ class DemIntegrator {
   // Wall forces (added to f_) at positions x and predicted velocities vp at time t.
   void compute_wall_forces(bool count_collisions, double t);
   template <bool Gravity>
-  void kick_drift(double kick, double& vmax2, double& vsum2);
+  void kick_drift(double& vmax2, double& vsum2);
+  void synchronise(bool from_half_step);
+  double time_at(long steps) const;
   // Half the box on periodic axes (minimum image), infinite between walls (no image).
   Vec<D> half_box() const;
   long advance(long n, std::uint64_t collisions);
@@ -191,8 +206,14 @@ class DemIntegrator {
   double dt_ = 0.0;
   double time_ = 0.0;
   long steps_ = 0;
+  // time = time_origin_ + (step_base_ + steps_) dt: the same bits whether or not a run went
+  // through a restart file in between.
+  double time_origin_ = 0.0;
+  long step_base_ = 0;
 
-  std::vector<double> x_[D], v_[D], f_[D], vp_[D];  // positions, velocities, forces, predicted
+  // Positions, velocities (at the present step, for readers), half-step velocities (what the
+  // stepping carries), forces, predicted velocities (for the damping forces).
+  std::vector<double> x_[D], v_[D], u_[D], f_[D], vp_[D];
   std::vector<double> mass_, inv_mass_, radius_;
   std::vector<std::uint32_t> sp_;  // species per slot
   // Internal numbering, cell order of the last neighbour-list build: id_[slot] = the caller's
@@ -228,7 +249,7 @@ class DemIntegrator {
   std::vector<SoftFriction> friction_pair_, friction_wall_;
   std::vector<Vec<D>> shear_;
   std::array<std::vector<Vec<D>>, 2 * D> wall_shear_;
-  std::vector<double> w_[kSpin], wp_[kSpin], tq_[kSpin];
+  std::vector<double> w_[kSpin], uw_[kSpin], wp_[kSpin], tq_[kSpin];
   std::vector<double> inertia_, inv_inertia_;
   std::vector<double> inertia_factor_;  // q per species: I = q m R^2
   // Sum over contacts of F_t . v_t (the tangential forces' power on the slip) and of the springs'

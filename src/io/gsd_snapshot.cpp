@@ -392,6 +392,18 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     }
     if (!s.last_collision_time.empty())
       w.write_chunk("kairos/state/last_collision_time", n, 1, s.last_collision_time.data());
+    if (!s.dem.empty()) {  // the DEM's own state (DemIntegrator::checkpoint), chunks when any
+      const DemResume& d = s.dem;
+      w.write_chunk("kairos/dem/scalars", d.scalars.size(), 1, d.scalars.data());
+      const auto put = [&](const char* name, const auto& v) {
+        if (!v.empty()) w.write_chunk(name, v.size(), 1, v.data());
+      };
+      put("kairos/dem/particles", d.particles);
+      put("kairos/dem/order", d.order);
+      put("kairos/dem/list_start", d.list_start);
+      put("kairos/dem/list", d.list);
+      put("kairos/dem/springs", d.springs);
+    }
     if (!s.asleep.empty()) w.write_chunk("kairos/state/asleep", n, 1, s.asleep.data());
     w.write_chunk("kairos/state/rng", rng_bytes.size(), 1, rng_bytes.data());
     w.write_chunk("kairos/run/equilibration_remaining", 1, 1, &progress.equilibration_remaining);
@@ -402,6 +414,7 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
       const std::vector<std::int8_t> name(progress.integrator.begin(), progress.integrator.end());
       w.write_chunk("kairos/run/integrator", name.size(), 1, name.data());
       w.write_chunk("kairos/run/dem_time_step", 1, 1, &progress.dem_time_step);
+      w.write_chunk("kairos/run/dem_collision_mark", 1, 1, &progress.dem_collision_mark);
     }
     w.end_frame();
     w.close();
@@ -533,6 +546,18 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   }
   if (r.find(f, "kairos/state/last_collision_time"))
     s.last_collision_time = require<double>(r, f, "kairos/state/last_collision_time", path, n);
+  if (r.find(f, "kairos/dem/scalars")) {  // checked by the DEM that resumes from it
+    s.dem.scalars = r.read<double>(f, "kairos/dem/scalars");
+    const auto get = [&](const char* name, auto& v) {
+      using T = typename std::decay_t<decltype(v)>::value_type;
+      if (r.find(f, name)) v = r.read<T>(f, name);
+    };
+    get("kairos/dem/particles", s.dem.particles);
+    get("kairos/dem/order", s.dem.order);
+    get("kairos/dem/list_start", s.dem.list_start);
+    get("kairos/dem/list", s.dem.list);
+    get("kairos/dem/springs", s.dem.springs);
+  }
   if (r.find(f, "kairos/state/asleep"))
     s.asleep = require<std::uint8_t>(r, f, "kairos/state/asleep", path, n);
   s.kinematics.resize(n);
@@ -575,6 +600,10 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
       const auto name = r.read<std::int8_t>(f, "kairos/run/integrator");
       progress->integrator.assign(name.begin(), name.end());
       progress->dem_time_step = require<double>(r, f, "kairos/run/dem_time_step", path, 1)[0];
+      if (r.find(f, "kairos/run/dem_collision_mark")) {
+        progress->dem_collision_mark =
+            require<std::uint64_t>(r, f, "kairos/run/dem_collision_mark", path, 1)[0];
+      }
       if (!(progress->dem_time_step > 0.0) || !std::isfinite(progress->dem_time_step)) {
         throw InputError("'" + path.string() + "': kairos/run/dem_time_step is " +
                          std::to_string(progress->dem_time_step));

@@ -48,6 +48,10 @@ struct RunProgress {
   // chunk are "event"), and the DEM's time step (0 for the event integrator).
   std::string integrator = "event";
   double dem_time_step = 0.0;
+  // DEM: the collision count the saved run had nominally reached (the target of the phase it
+  // completed; several pairs may enter contact in one step, so the count itself may be past
+  // it). A continued run counts its lengths from here, as one uninterrupted run would.
+  std::uint64_t dem_collision_mark = 0;
   // Soft spheres: the fastest normal impact speed the run's map tables cover (0: no tables), so
   // that a continued run uses the same tables (and stays bit-identical).
   double soft_table_max_speed = 0.0;

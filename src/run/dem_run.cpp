@@ -156,11 +156,14 @@ class DemRunDriver {
       p.equilibration_remaining = per_particle(equilibration_target_ - c);
     p.integrator = "dem";
     p.dem_time_step = dem_->dt();
+    // A completed phase ends at its target (the count may have passed it within the last step).
+    p.dem_collision_mark = c >= phase_target_ ? phase_target_ : c;
     return p;
   }
 
   void write_restart_file() const {
     ParticleSystem<D> s = dem_->export_state();
+    s.dem = dem_->checkpoint();        // for a bit-identical continuation
     s.events.assign(n_, EventSlot{});  // no scheduler state: the event fields are placeholders
     s.cell.assign(n_, 0);
     s.collision_count.resize(n_, 0);
@@ -171,9 +174,15 @@ class DemRunDriver {
   bool run_phase(const std::string& phase, double length, ProgressLine& progress,
                  Clock::time_point wall_start) {
     phase_ = phase;
-    const std::uint64_t begin = dem_->collisions();
+    // The first phase of a continued run starts where the saved run nominally stopped.
+    std::uint64_t begin = dem_->collisions();
+    if (restart_ && first_phase_ && resumed_.dem_collision_mark > 0 &&
+        resumed_.dem_collision_mark <= begin)
+      begin = resumed_.dem_collision_mark;
+    first_phase_ = false;
     const std::uint64_t target = begin + collisions_for(length);
     if (phase == "equilibration") equilibration_target_ = target;
+    phase_target_ = target;
     OutputSchedule schedule(config_.output, config_.run.collisions_per_particle, begin,
                             [&](double c) { return collisions_for(c); });
     // About 2^20 particle-steps between checks of the clock and the stop flag.
@@ -383,6 +392,8 @@ class DemRunDriver {
   std::vector<double> production_temperatures_;
   std::string phase_ = "production";
   std::uint64_t equilibration_target_ = 0;
+  std::uint64_t phase_target_ = 0;  // the collision count the present phase runs to
+  bool first_phase_ = true;
   std::string stop_reason_ = "completed";
 };
 
