@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <initializer_list>
 #include <limits>
 #include <string>
 #include <unordered_map>
@@ -687,21 +686,20 @@ void DemIntegrator<D>::build_neighbours() {
       stride *= static_cast<std::size_t>(nc[k]);
     }
     around.clear();
-    const auto cell_at = [](std::initializer_list<std::size_t> parts) {
-      std::size_t flat = 0;
-      for (const std::size_t p : parts) {
-        if (p == kNoCell) return kNoCell32;
-        flat += p;
-      }
-      return static_cast<std::uint32_t>(flat);
-    };
+    const bool walls = any_wall_;  // only then can a neighbour cell be missing
     if constexpr (D == 3) {
       for (const std::size_t a : axis[2])
         for (const std::size_t b2 : axis[1])
-          for (const std::size_t c0 : axis[0]) around.push_back(cell_at({a, b2, c0}));
+          for (const std::size_t c0 : axis[0])
+            around.push_back(walls && (a == kNoCell || b2 == kNoCell || c0 == kNoCell)
+                                 ? kNoCell32
+                                 : static_cast<std::uint32_t>(a + b2 + c0));
     } else {
       for (const std::size_t b2 : axis[1])
-        for (const std::size_t c0 : axis[0]) around.push_back(cell_at({b2, c0}));
+        for (const std::size_t c0 : axis[0])
+          around.push_back(walls && (b2 == kNoCell || c0 == kNoCell)
+                               ? kNoCell32
+                               : static_cast<std::uint32_t>(b2 + c0));
     }
     Vec<D> xi;
     for (int k = 0; k < D; ++k) xi[k] = x_[k][i];
@@ -1007,10 +1005,12 @@ void DemIntegrator<D>::compute_forces(bool count_collisions, double t) {
 // evaluation, the predicted velocity v(t + dt) for the damping forces. Gravity adds to every
 // particle's acceleration; axes between walls are not wrapped.
 template <int D>
-template <bool Gravity>
-void DemIntegrator<D>::kick_drift(double& vmax2, double& vsum2) {
+template <bool Gravity, bool Walls>
+void DemIntegrator<D>::kick_drift(double& vmax2_out, double& vsum2_out) {
   const std::size_t np = size();
   const double h = 0.5 * dt_;
+  const std::array<bool, D> periodic = periodic_;
+  double vmax2 = 0.0, vsum2 = 0.0;  // locals: the stores into the arrays could alias them
   for (std::size_t i = 0; i < np; ++i) {
     const double w = inv_mass_[i];
     double v2 = 0.0;
@@ -1028,13 +1028,15 @@ void DemIntegrator<D>::kick_drift(double& vmax2, double& vsum2) {
       }
       u_[k][i] = v;
       const double x = x_[k][i] + dt_ * v;
-      x_[k][i] = periodic_[k] ? wrap_once(x, box_[k]) : x;
+      x_[k][i] = !Walls || periodic[k] ? wrap_once(x, box_[k]) : x;
       vp_[k][i] = vp;
       v2 += v * v;
     }
     vmax2 = std::max(vmax2, v2);
     vsum2 += v2;
   }
+  vmax2_out = vmax2;
+  vsum2_out = vsum2;
   if (!friction_) return;
   for (std::size_t i = 0; i < np; ++i) {  // the same for the rotation
     const double w = inv_inertia_[i];
@@ -1090,9 +1092,9 @@ long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
   while (s < n && collisions_ < collisions) {
     double vmax2 = 0.0, vsum2 = 0.0;
     if (gravity_on_) {
-      kick_drift<true>(vmax2, vsum2);
+      any_wall_ ? kick_drift<true, true>(vmax2, vsum2) : kick_drift<true, false>(vmax2, vsum2);
     } else {
-      kick_drift<false>(vmax2, vsum2);
+      any_wall_ ? kick_drift<false, true>(vmax2, vsum2) : kick_drift<false, false>(vmax2, vsum2);
     }
     if (!std::isfinite(vsum2))
       throw InputError(

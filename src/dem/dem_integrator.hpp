@@ -175,7 +175,7 @@ class DemIntegrator {
   double plane_velocity(int face, double t) const;
   // Wall forces (added to f_) at positions x and predicted velocities vp at time t.
   void compute_wall_forces(bool count_collisions, double t);
-  template <bool Gravity>
+  template <bool Gravity, bool Walls>
   void kick_drift(double& vmax2, double& vsum2);
   void synchronise(bool from_half_step);
   double time_at(long steps) const;
