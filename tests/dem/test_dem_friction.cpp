@@ -3,7 +3,7 @@
 // launch speed (the textbook result for I = 2/5 m R^2, whatever mu and the springs), a
 // frictional pile closes its energy budget (rotation and tangential springs included) to
 // O(dt^2), an oblique frictional collision conserves angular momentum and turns both spheres,
-// and a frictionless law leaves everything as without friction.
+// and a frictionless law leaves everything as without friction; disks (2D) roll at 2/3.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -62,6 +62,34 @@ TEST(DemFriction, SlidingSphereEndsRollingAtFiveSevenths) {
   EXPECT_NEAR(heat, 0.5 * v0 * v0 * (1.0 - 5.0 / 7.0), 1e-4 * 0.5 * v0 * v0);
   EXPECT_NEAR(dem.kinetic_energy() + dem.rotational_energy(), 0.5 * v0 * v0 * 5.0 / 7.0,
               1e-4 * 0.5 * v0 * v0);
+}
+
+// The same in 2D: a disk (I = 1/2 m R^2) ends rolling at v0 / (1 + 1/2) = 2/3 v0, turning
+// clockwise (omega_z < 0) as it rolls along +x.
+TEST(DemFriction, SlidingDiskEndsRollingAtTwoThirds) {
+  const double g = 1.0, v0 = 1.5, mu = 0.4;
+  Environment<2> env;
+  env.species = 1;
+  env.soft = {SoftContactLaw::linear_dashpot(1e5, 50.0)};
+  env.soft_wall = env.soft;
+  env.soft_friction = {SoftFriction{mu, 2.0 / 7.0, 0.5}};
+  env.soft_wall_friction = env.soft_friction;
+  env.gravity = {0.0, -g};
+  env.faces[2].kind = FaceKind::kWall;
+  env.faces[3].kind = FaceKind::kWall;
+  ParticleSystem<2> s;
+  s.box = {20.0, 20.0};
+  s.periodic = {true, false};
+  s.kinematics.push_back({{10.0, 0.5 - g / 1e5}, {v0, 0.0}, 0.0, 0.5});
+  s.mass = {1.0};
+  DemIntegrator<2> dem(s, env);
+  const double t_roll = v0 / (3.0 * mu * g);  // sliding ends when v0 - mu g t = omega R = 2 mu g t
+  dem.step(static_cast<long>(std::llround(3.0 * t_roll / dem.dt())));
+  const ParticleSystem<2> end = dem.export_state();
+  const double vx = end.kinematics[0].vel[0], wz = end.angular_velocity[0][0];
+  EXPECT_NEAR(vx, 2.0 / 3.0 * v0, 1e-4 * v0);
+  EXPECT_NEAR(-wz * 0.5, vx, 1e-4 * v0);
+  EXPECT_NEAR(dem.dissipated_at_walls(), 0.5 * v0 * v0 / 3.0, 1e-4 * 0.5 * v0 * v0);
 }
 
 // A frictional pile settling between walls under gravity (Hertz, mu = 0.5 against particles
