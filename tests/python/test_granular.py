@@ -27,7 +27,9 @@ class Driving(kt.KairosTestCase):
         self.run_ok("run", self.write_config(config), "-o", self.path("andersen"))
         t, err = mean_temperature(self.path("andersen"))
         # The kinetic temperature counts D (N - 1) degrees of freedom; the bath acts on D N.
-        self.assertAlmostEqual(t, 2.0 * 2000 / 1999, delta=max(4 * err, 0.01))
+        # err treats the rows as independent; they are not (kicks every 2 time units), and over
+        # 20 seeds the mean scatters by 0.013-0.016 (sd), so the floor is 0.04, not 4 err.
+        self.assertAlmostEqual(t, 2.0 * 2000 / 1999, delta=max(4 * err, 0.04))
         summary = self.summary(self.path("andersen"))
         tensor = np.array(summary["pressure_tensor"])
         # Its trace is the scalar pressure (up to the temperature used: mean of rows vs start).
@@ -169,7 +171,8 @@ class Pistons(kt.KairosTestCase):
         self.assertGreater(g["work_by_walls"], 0.0)  # the lid pushes the gas
         self.assertGreater(g["dissipated_in_collisions"], 0.0)
         self.assertLess(g["energy_balance_relative"], 1e-9)
-        self.assertEqual(s["max_overlap"], 0.0)
+        # The run may end on a collision, whose pair touches to round-off.
+        self.assertLess(s["max_overlap"], 1e-12)
         # In every frame each particle is below the lid: z <= L_z / 2 - 0.02 t - 1/2 in HOOMD's
         # centred box (float32 positions).
         traj = kt.open_trajectory(self.path("whole", "trajectory.gsd"))
