@@ -63,9 +63,13 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
         "soft spheres replace the contact laws: [contact] restitution, roughness and tc must be "
         "left at their elastic defaults");
   }
+  // A piston (a wall at constant velocity) is an inertial frame: the map holds in it, and the
+  // frozen particle moves with the wall. A vibrated wall accelerates during the contact.
   for (int f = 0; f < 2 * D; ++f) {
-    if (env_.wall_moves(f))
-      throw InputError("soft spheres cannot meet walls that vibrate or move along their normal");
+    if (env_.faces[f].kind == FaceKind::kWall && env_.faces[f].wall.vibrates())
+      throw InputError(
+          "soft spheres cannot meet vibrating walls (the wall accelerates during a contact; "
+          "use run.integrator = \"dem\")");
   }
   const std::size_t n = s.size();
   frozen_with_.assign(n, kNone);
@@ -331,7 +335,9 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   HotRecord<D>& h = hot_[i];
   const int a = face / 2;
   const double sgn = face % 2 == 0 ? 1.0 : -1.0;
-  const double wall_speed = env_.faces[face].wall.velocity[a];  // 0: walls do not move (setup)
+  // The wall's normal velocity: constant (setup refuses vibrations), so the map holds in its
+  // frame; the frozen particle moves with the wall.
+  const double wall_speed = env_.faces[face].wall.velocity[a];
   const double vn = -sgn * (h.vel[a] - wall_speed);
   if (!(vn > 0.0)) {  // released early, it now leaves the wall
     ++h.collisions;
@@ -348,6 +354,7 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   Vec<D> after = h.vel;
   after[a] = wall_speed + sgn * e * vn;
   counters_.dissipated_at_walls += 0.5 * m * vn * vn * (1.0 - e * e);
+  counters_.work_by_walls += m * wall_speed * (after[a] - h.vel[a]);  // impulse . wall velocity
   // Already overlapping the wall (released from it, then turned back by a third body): no
   // first contact to start the map from, so the contact is instantaneous.
   const double gap = sgn * (h.pos[a] - wall_offset(face, t));

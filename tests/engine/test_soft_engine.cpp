@@ -349,6 +349,57 @@ TEST(SoftWalls, WallContactMatchesTheClosedFormDashpot) {
               0.5 * m * 1.3 * 1.3 * (1.0 - closed.restitution * closed.restitution), 1e-10);
 }
 
+// A sphere meeting a piston (the lid, coming down at constant speed): the map holds in the
+// wall's frame, so the particle leaves with the wall's velocity plus e v_n of the relative
+// approach, where the DEM (same Hertz law, same piston, dt = t_c / 20 000) puts it; the wall's
+// work is the impulse times its velocity, and the energy budget closes to round-off.
+TEST(SoftWalls, PistonContactIsTheMapInTheWallsFrame) {
+  const double m = 1.5, u = -0.4;
+  ParticleSystem<3> s;
+  s.box = {10.0, 10.0, 10.0};
+  const Vec<3> v{0.2, -0.1, 1.3};
+  s.kinematics = {{{5.0, 5.0, 8.5}, v, 0.0, 0.5}, {{2.0, 2.0, 3.0}, {}, 0.0, 0.5}};
+  s.mass = {m, m};
+  s.species = {0, 0};
+  s.species_names = {"A"};
+  const SoftContactLaw law = SoftContactLaw::viscoelastic_hertz(5e3, 1e-3);
+  Environment<3> env = soft_environment<3>(law, 1);
+  env.faces[4].kind = env.faces[5].kind = FaceKind::kWall;
+  env.faces[5].wall.velocity[2] = u;
+  Engine3 engine(s, StartMode::kPredict, {}, env);
+  const auto budget = [&] {
+    const EventCounters& c = engine.counters();
+    return engine.kinetic_energy() + engine.potential_energy() + c.dissipated_at_walls -
+           c.work_by_walls;
+  };
+  const double e0 = budget();
+  EventKind kind;
+  while ((kind = engine.step()) != EventKind::kSoftRelease) {
+    ASSERT_NE(kind, EventKind::kNone);
+    EXPECT_NEAR(budget(), e0, 1e-12);
+  }
+  EXPECT_NEAR(budget(), e0, 1e-12);
+  const double vn = v[2] - u;  // the approach speed in the wall's frame
+  const CollisionUnits units = reduce_collision(law, m, 0.5, vn, 0.0);
+  const CollisionMap map = collision_map(units.reduced);
+  const ParticleSystem<3> after = engine.export_state();
+  EXPECT_NEAR(after.kinematics[0].vel[2], u + map.eps_rdot * vn, 1e-12);
+  EXPECT_EQ(after.kinematics[0].vel[0], v[0]);
+  EXPECT_NEAR(after.counters.work_by_walls, m * u * (after.kinematics[0].vel[2] - v[2]), 1e-12);
+  EXPECT_GT(after.counters.work_by_walls, 0.0);  // the lid coming down hits the sphere back
+
+  DemOptions options;
+  options.dt = map.eps_t * units.time_unit / 20000.0;
+  DemIntegrator<3> dem(s, env, options);
+  dem.step(static_cast<long>((engine.time() + 0.05) / options.dt));
+  const Vec<3> x = after.position_at(0, dem.time());
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(dem.position(0)[a], x[a], 1e-6) << a;
+    EXPECT_NEAR(dem.velocity(0)[a], after.kinematics[0].vel[a], 1e-6) << a;
+  }
+  EXPECT_NEAR(dem.work_by_walls(), after.counters.work_by_walls, 1e-6);
+}
+
 TEST(SoftResume, ResumingFromARestartFileWithContactsInProgressIsBitIdentical) {
   const ParticleSystem<3> s = testing::lattice_system<3>(5, 0.15, 7, 1.4, 1.2);
   const Environment<3> env = soft_environment<3>(SoftContactLaw::viscoelastic_hertz(3.0e3, 4e-3));
@@ -404,6 +455,11 @@ TEST(SoftErrors, UnsupportedCombinationsAreRefusedByName) {
   env = soft_environment<3>(law);
   env.soft.resize(1);
   refused(env, "soft contact laws");
+  env = soft_environment<3>(law);
+  env.faces[4].kind = env.faces[5].kind = FaceKind::kWall;
+  env.faces[4].wall.amplitude = 0.01;
+  env.faces[4].wall.angular_frequency = 3.0;
+  refused(env, "vibrating walls");
 }
 
 }  // namespace
