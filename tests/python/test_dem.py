@@ -163,11 +163,11 @@ class DemRuns(kt.KairosTestCase):
         self.assert_user_error(result, "field.gravity", "run.integrator = \"dem\"")
 
     def test_friction_spins_the_spheres_up_and_closes_the_energy_budget(self):
-        # A dilute dashpot gas (e = 0.9) with Coulomb friction mu = 0.5, no spin at the start:
+        # A dilute dashpot gas (500 spheres, e = 0.9) with Coulomb friction mu = 0.5, no spin:
         # collisions pass translational energy to rotation, which heats up from 0, and the
         # budget (translational + rotational + elastic + springs + dissipated) closes.
         rough = dict(DASHPOT, restitution=0.9, friction=0.5)
-        s = self.run_dem("rough", dem_config(rough, production=2.0))
+        s = self.run_dem("rough", dem_config(rough, particles=500, production=2.0))
         g = s["granular"]
         self.assertGreater(g["rotational_temperature"], 0.05 * s["temperature"])
         self.assertLess(g["energy_balance_relative"], 1e-3)
@@ -175,7 +175,8 @@ class DemRuns(kt.KairosTestCase):
         rot = [r[header.index("rotational_temperature")] for r in rows]
         self.assertGreater(rot[-1], rot[0])
         # The smooth gas of the same law does not rotate at all.
-        smooth = self.run_dem("smooth", dem_config(dict(rough, friction=0.0), production=2.0))
+        smooth = self.run_dem("smooth", dem_config(dict(rough, friction=0.0), particles=500,
+                                                   production=2.0))
         self.assertEqual(smooth["granular"]["rotational_temperature"], 0.0)
 
     def test_pile_settles_between_walls_under_gravity(self):
