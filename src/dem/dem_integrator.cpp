@@ -1128,27 +1128,28 @@ double DemIntegrator<D>::time_at(long steps) const {
   return time_origin_ + static_cast<double>(step_base_ + steps) * dt_;
 }
 
-template <int D>
-double DemIntegrator<D>::kinetic_energy() const {
+namespace {
+// Sum over particles of w_i |a_i|^2 / 2, the C components of a stored apart (kinetic energies).
+template <int C>
+double half_weighted_squares(const std::vector<double> (&a)[C], const std::vector<double>& w) {
   double e = 0.0;
-  for (std::size_t i = 0; i < size(); ++i) {
-    double v2 = 0.0;
-    for (int k = 0; k < D; ++k) v2 += v_[k][i] * v_[k][i];
-    e += 0.5 * mass_[i] * v2;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    double a2 = 0.0;
+    for (int c = 0; c < C; ++c) a2 += a[c][i] * a[c][i];
+    e += 0.5 * w[i] * a2;
   }
   return e;
+}
+}  // namespace
+
+template <int D>
+double DemIntegrator<D>::kinetic_energy() const {
+  return half_weighted_squares(v_, mass_);
 }
 
 template <int D>
 double DemIntegrator<D>::rotational_energy() const {
-  double e = 0.0;
-  if (!friction_) return e;
-  for (std::size_t i = 0; i < size(); ++i) {
-    double w2 = 0.0;
-    for (int c = 0; c < kSpin; ++c) w2 += w_[c][i] * w_[c][i];
-    e += 0.5 * inertia_[i] * w2;
-  }
-  return e;
+  return friction_ ? half_weighted_squares(w_, inertia_) : 0.0;
 }
 
 template <int D>
