@@ -57,6 +57,35 @@ Vec<D> tangential_force(Vec<D>& xi, const Vec<D>& n, const Vec<D>& vt, double kt
   return ft;
 }
 
+// The normal force of a contact at `overlap` and gap rate `rdot` under a dashpot (k, gamma) or
+// Hertz law (rho, c = (3/2) A rho), clipped at zero (the force-zero end: no attraction), with
+// its elastic part and elastic energy; `root` is sqrt(overlap) for Hertz and 1 for a dashpot,
+// the factor the Hertz friction coefficients scale with. Pairs and walls alike.
+struct NormalForce {
+  double elastic, energy, force, root;
+};
+[[gnu::always_inline]] inline NormalForce normal_force(bool hertz, double k, double c,
+                                                       double overlap, double rdot) {
+  if (!hertz) {
+    const double elastic = k * overlap;
+    return {elastic, 0.5 * elastic * overlap, std::max(0.0, elastic - c * rdot), 1.0};
+  }
+  const double root = std::sqrt(overlap);
+  const double elastic = k * overlap * root;
+  return {elastic, 0.4 * elastic * overlap, std::max(0.0, elastic - c * rdot * root), root};
+}
+
+// The tangential spring and dashpot of a frictional contact: fractions of the normal law's
+// stiffness and damping, for Hertz of its tangent stiffness (3/2) rho sqrt(xi) and damping
+// coefficient (3/2) A rho sqrt(xi) (SoftFriction).
+struct TangentialLaw {
+  double kt, gt;
+};
+inline TangentialLaw tangential_law(const SoftFriction& fr, bool hertz, double k, double c,
+                                    double root) {
+  return {fr.stiffness_ratio * k * (hertz ? 1.5 * root : 1.0), fr.damping_ratio * c * root};
+}
+
 // With half_L infinite (an axis between walls) the difference is kept as it is.
 inline double min_image_once(double d, double half_L, double L) {
   if (d > half_L) return d - L;
@@ -617,8 +646,7 @@ void DemIntegrator<D>::build_neighbours() {
       permute(x_[k]);
       permute(v_[k]);
       permute(u_[k]);
-      permute(vp_[k]);
-      permute(f_[k]);
+      permute(vp_[k]);  // f_ and tq_ are zero here: the kick cleared them
     }
     permute(mass_);
     permute(inv_mass_);
@@ -628,7 +656,6 @@ void DemIntegrator<D>::build_neighbours() {
         permute(w_[c]);
         permute(uw_[c]);
         permute(wp_[c]);
-        permute(tq_[c]);
       }
       permute(inertia_);
       permute(inv_inertia_);
@@ -816,7 +843,7 @@ void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
             "DEM: particles {} and {} overlap by {} (more than {} of the smaller radius) at t = "
             "{}: time step dt = {} too large or the initial state overlapping",
             id_[i], id_[j], overlap, max_overlap_fraction_, time_, dt_));
-      if (count_collisions) {  // apart one step earlier (v_ holds the drift velocity)?
+      if (count_collisions) {  // apart one step earlier (u_ holds the drift velocity)?
         double r2_before = 0.0;
         for (int k = 0; k < D; ++k) {
           const double dk = d[k] - dt_ * (u_[k][i] - u_[k][j]);
@@ -832,20 +859,10 @@ void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
       const double kk = stiffness[ab], c = damping[ab];
       bool hertz = L == Laws::kHertz;
       if constexpr (L == Laws::kMixed) hertz = hertz_[ab] != 0;
-      double elastic, energy, F;
-      if (!hertz) {
-        elastic = kk * overlap;
-        energy = 0.5 * elastic * overlap;
-        F = elastic - c * rdot;
-      } else {
-        const double root = std::sqrt(overlap);
-        elastic = kk * overlap * root;
-        energy = 0.4 * elastic * overlap;
-        F = elastic - c * rdot * root;
-      }
-      F = std::max(0.0, F);  // the force-zero end: no attraction
-      potential += energy;
-      power += (elastic - F) * rdot;
+      const NormalForce nf = normal_force(hertz, kk, c, overlap, rdot);
+      const double F = nf.force;
+      potential += nf.energy;
+      power += (nf.elastic - F) * rdot;
       if constexpr (Friction) {
         const SoftFriction& fr = friction_pair_[ab];
         if (fr.coefficient > 0.0) {
@@ -860,9 +877,7 @@ void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
           const double ai = Ri - 0.5 * overlap, aj = radius_[j] - 0.5 * overlap;
           vc = vc - cross(ai * wi + aj * spin(wp_, j), unit);
           const Vec<D> vt = vc - dot(vc, unit) * unit;
-          const double root_t = hertz ? 1.5 * std::sqrt(overlap) : 1.0;
-          const double kt = fr.stiffness_ratio * kk * root_t;
-          const double gt = fr.damping_ratio * c * (hertz ? std::sqrt(overlap) : 1.0);
+          const auto [kt, gt] = tangential_law(fr, hertz, kk, c, nf.root);
           const Vec<D> ft = tangential_force<D>(shear_[q], unit, vt, kt, gt, fr.coefficient * F,
                                                 count_collisions ? dt_ : 0.0, spring, slip);
           for (int k = 0; k < D; ++k) {
@@ -934,25 +949,16 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
             "DEM: particle {} overlaps the wall at face {} by {} (more than {} of its radius) at "
             "t = {}: time step dt = {} too large, the wall too fast or the initial state outside",
             id_[i], f, overlap, max_overlap_fraction_, t, dt_));
-      // Apart one step earlier (v_ holds the drift velocity)?
+      // Apart one step earlier (u_ holds the drift velocity)?
       if (count_collisions && sign * (x[i] - dt_ * u_[k][i] - p_before) >= R) ++entered;
       const double rdot = sign * (vp_[k][i] - w);  // the gap's rate of change
       const std::size_t s = sp_[i];
       const double kk = wall_stiffness_[s], c = wall_damping_[s];
-      double elastic, energy, F;
-      if (wall_hertz_[s] == 0) {
-        elastic = kk * overlap;
-        energy = 0.5 * elastic * overlap;
-        F = elastic - c * rdot;
-      } else {
-        const double root = std::sqrt(overlap);
-        elastic = kk * overlap * root;
-        energy = 0.4 * elastic * overlap;
-        F = elastic - c * rdot * root;
-      }
-      F = std::max(0.0, F);
-      potential += energy;
-      loss += (elastic - F) * rdot;
+      const bool hertz = wall_hertz_[s] != 0;
+      const NormalForce nf = normal_force(hertz, kk, c, overlap, rdot);
+      const double F = nf.force;
+      potential += nf.energy;
+      loss += (nf.elastic - F) * rdot;
       // d(KE + U)/dt = -(F_el - F) rdot + F w_n, w_n the plane's velocity along the normal.
       work += F * sign * w;
       f_[k][i] += sign * F;
@@ -963,9 +969,7 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
         // The contact point (on the wall's plane, at x - gap n) relative to the wall.
         const Vec<D> vc = v - gap * cross(spin(wp_, i), normal) - wall_velocity;
         const Vec<D> vt = vc - dot(vc, normal) * normal;
-        const bool hertz = wall_hertz_[s] != 0;
-        const double kt = fr.stiffness_ratio * kk * (hertz ? 1.5 * std::sqrt(overlap) : 1.0);
-        const double gt = fr.damping_ratio * c * (hertz ? std::sqrt(overlap) : 1.0);
+        const auto [kt, gt] = tangential_law(fr, hertz, kk, c, nf.root);
         const Vec<D> ft = tangential_force<D>(springs[i], normal, vt, kt, gt, fr.coefficient * F,
                                               count_collisions ? dt_ : 0.0, spring, slip);
         for (int a = 0; a < D; ++a) f_[a][i] += ft[a];
