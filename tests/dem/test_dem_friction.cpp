@@ -7,10 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 
 #include "core/error.hpp"
 #include "dem/dem_integrator.hpp"
+#include "dem_fixtures.hpp"
 #include "interactions/soft_contact.hpp"
 
 namespace kairos {
@@ -99,16 +99,7 @@ double frictional_pile_error(double steps_per_contact, long contacts) {
   ParticleSystem<3> s;
   s.box = {6.0, 6.0, 10.0};
   s.periodic = {true, true, false};
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> jitter(-0.1, 0.1);
-  for (int ix = 0; ix < 4; ++ix)
-    for (int iy = 0; iy < 4; ++iy)
-      for (int iz = 0; iz < 5; ++iz) {
-        const Vec<3> x{0.75 + 1.5 * ix + jitter(rng), 0.75 + 1.5 * iy + jitter(rng),
-                       1.0 + 1.6 * iz + jitter(rng)};
-        s.kinematics.push_back({x, Vec<3>{jitter(rng), jitter(rng), jitter(rng)}, 0.0, 0.5});
-        s.mass.push_back(1.0);
-      }
+  testing::add_bed(s, {{4, 4, 5}, {0.75, 0.75, 1.0}, {1.5, 1.5, 1.6}, 0.1, 11});
   const SoftContactLaw law = SoftContactLaw::viscoelastic_hertz(2e4, 1e-3);
   DemOptions options;
   options.steps_per_contact = steps_per_contact;
@@ -185,16 +176,7 @@ TEST(DemFriction, SplitCallsAndCheckpointsContinueBitForBit) {
   ParticleSystem<3> s;
   s.box = {5.0, 5.0, 8.0};
   s.periodic = {true, true, false};
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> jitter(-0.1, 0.1);
-  for (int ix = 0; ix < 4; ++ix)
-    for (int iy = 0; iy < 4; ++iy)
-      for (int iz = 0; iz < 3; ++iz) {
-        const Vec<3> x{0.6 + 1.2 * ix + jitter(rng), 0.6 + 1.2 * iy + jitter(rng),
-                       0.7 + 1.2 * iz + jitter(rng)};
-        s.kinematics.push_back({x, Vec<3>{jitter(rng), jitter(rng), jitter(rng)}, 0.0, 0.5});
-        s.mass.push_back(1.0);
-      }
+  testing::add_bed(s, {{4, 4, 3}, {0.6, 0.6, 0.7}, {1.2, 1.2, 1.2}, 0.1, 5});
   Environment<3> env = rough_floor(SoftContactLaw::viscoelastic_hertz(2e4, 1e-3),
                                    SoftFriction{0.5, 2.0 / 7.0, 0.5}, 1.0);
   env.faces[4].wall.amplitude = 0.05;

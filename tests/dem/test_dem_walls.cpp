@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "dem/dem_integrator.hpp"
+#include "dem_fixtures.hpp"
 #include "interactions/soft_contact.hpp"
 
 namespace kairos {
@@ -82,16 +83,7 @@ double bed_budget_error(double steps_per_contact, long contacts) {
   const double g = 1.0, side = 8.0;
   const Vec<3> gravity{0.0, 0.0, -g};
   ParticleSystem<3> s = box_z(side, gravity);
-  std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
-  for (int ix = 0; ix < 6; ++ix)
-    for (int iy = 0; iy < 6; ++iy)
-      for (int iz = 0; iz < 4; ++iz) {
-        const Vec<3> x{0.7 + 1.2 * ix + jitter(rng), 0.7 + 1.2 * iy + jitter(rng),
-                       0.8 + 1.3 * iz + jitter(rng)};
-        s.kinematics.push_back({x, Vec<3>{jitter(rng), jitter(rng), jitter(rng)}, 0.0, 0.5});
-        s.mass.push_back(1.0);
-      }
+  testing::add_bed(s, {{6, 6, 4}, {0.7, 0.7, 0.8}, {1.2, 1.2, 1.3}, 0.05, 7});
   const SoftContactLaw law = SoftContactLaw::viscoelastic_hertz(1e4, 1e-3);
   Environment<3> env = walls_z(law, gravity);
   env.faces[4].wall.amplitude = 0.1;  // the floor shakes at 2.5 g
