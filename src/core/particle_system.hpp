@@ -77,7 +77,9 @@ struct EventCounters {
   std::uint64_t soft_early_releases = 0;
   std::uint64_t soft_direct_maps = 0;
   // The kinetic energy the frozen contacts give back at their release (part of the state:
-  // kinetic + this + dissipated energy is what a contact conserves).
+  // kinetic + this + dissipated energy is what a contact conserves). Deferred contacts
+  // (FrozenContact::deferred) are not in it: theirs follows from their velocities
+  // (EventEngine::potential_energy() adds it).
   double soft_contact_energy = 0.0;
 };
 
@@ -110,6 +112,10 @@ struct FrozenContact {
   std::uint32_t face = 0;             // the wall's face when j == kWall
   double release_time = 0.0;          // absolute
   Vec<D> velocity_i{}, velocity_j{};  // after the release (velocity_j unused for a wall)
+  // A deferred release (EngineOptions::defer_soft_releases): the engine already holds the
+  // motion after the release, as the positions at the release time (exact for a resume).
+  bool deferred = false;
+  Vec<D> release_position_i{}, release_position_j{};
   bool operator==(const FrozenContact&) const = default;
 };
 

@@ -8,8 +8,11 @@
 // 2a / (-b + sqrt(D)) avoids the cancellation of the textbook (-b - sqrt(D)) / 2c.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "core/vec.hpp"
 
 namespace kairos {
 
@@ -48,6 +51,30 @@ inline double interval_exit_time(double x, double v, double lo, double hi) {
   const double face = v > 0.0 ? hi : lo;
   const double t = (face - x) / v;  // +-inf or NaN for v = 0: replaced below
   return v != 0.0 ? (t > 0.0 ? t : 0.0) : kNever;
+}
+
+// The first contact at or after `from` and before `until` (absolute times) of a pair whose
+// separation is r at time t and whose relative velocity is g[p] until ends[p] (ascending, the
+// last may be kNever); kNever if none. Each piece follows the hard-sphere rule of
+// collision_time.hpp (an overlapping, receding pair does not collide). Soft spheres' deferred contacts.
+template <int D>
+inline double piecewise_contact_time(Vec<D> r, double t, const double* ends, const Vec<D>* g, int pieces,
+                              double from, double until, double sigma) {
+  double start = t;
+  for (int p = 0; p < pieces && start < until; ++p) {
+    const double end = std::min(ends[p], until);
+    if (end > from) {
+      const double s0 = std::max(start, from);
+      const Vec<D> r0 = r + (s0 - start) * g[p];
+      const double dt =
+          quadratic_contact_time(norm2(r0) - sigma * sigma, 2.0 * dot(r0, g[p]), norm2(g[p]));
+      if (s0 + dt < end) return s0 + dt;
+    }
+    if (!(ends[p] < kNever)) break;
+    r = r + (ends[p] - start) * g[p];
+    start = ends[p];
+  }
+  return kNever;
 }
 
 }  // namespace kairos

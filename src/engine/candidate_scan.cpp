@@ -42,9 +42,9 @@ template <int D, bool kAccelerated>
 [[gnu::always_inline]] inline void pair_terms(const CandidateScan<D>& s, std::uint32_t k,
                                               __m256i base, __mmask8 live, __m512d vt,
                                               const __m512d* vxi, const __m512d* vvi, __m512d& r2,
-                                              __m512d& rg, __m512d& g2) {
+                                              __m512d& rg, __m512d& g2, __m512d& dtj) {
   const __m512d zero = _mm512_setzero_pd();
-  const __m512d dtj = _mm512_sub_pd(vt, gather_field(s.records, base, live, 2 * D));
+  dtj = _mm512_sub_pd(vt, gather_field(s.records, base, live, 2 * D));
   r2 = zero;
   rg = zero;
   g2 = zero;
@@ -102,8 +102,16 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
     const __mmask8 live = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
     const __m256i ids = _mm256_maskz_loadu_epi32(live, s.candidates + k);
     const __m256i base = _mm256_mullo_epi32(ids, vstride);
-    __m512d r2, rg, g2;
-    pair_terms<D, kAccelerated>(s, k, base, live, vt, vxi, vvi, r2, rg, g2);
+    __m512d r2, rg, g2, dtj;
+    pair_terms<D, kAccelerated>(s, k, base, live, vt, vxi, vvi, r2, rg, g2, dtj);
+    // Candidates inside a deferred soft contact (local time after t) are left to the caller.
+    const __mmask8 future = _mm512_mask_cmp_pd_mask(live, dtj, zero, _CMP_LT_OQ);
+    if (future != 0 && s.delayed != nullptr) [[unlikely]] {
+      const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(k)),
+                                             _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+      _mm256_mask_compressstoreu_epi32(s.delayed + *s.delayed_count, future, index);
+      *s.delayed_count += static_cast<std::uint32_t>(__builtin_popcount(future));
+    }
     __m512d sigma2 = vsigma2;
     if (!s.uniform) {
       // Shape numbers are 16-bit: gather 32 bits at each and keep the low half (the array is
@@ -117,7 +125,7 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
     }
     const __m512d gap = _mm512_sub_pd(r2, sigma2);
     const __m512d bound = _mm512_mul_pd(_mm512_mul_pd(minus_two, rg), _mm512_set1_pd(best));
-    __mmask8 ok = _mm512_mask_cmp_pd_mask(live, rg, zero, _CMP_LT_OQ);
+    __mmask8 ok = _mm512_mask_cmp_pd_mask(live & ~future, rg, zero, _CMP_LT_OQ);
     ok = _mm512_mask_cmp_pd_mask(ok, gap, bound, _CMP_LE_OQ);
     if (ok == 0) continue;
     const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(rg, rg), _mm512_mul_pd(g2, gap));
@@ -136,6 +144,78 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
   }
   return found;
 }
+
+// Eight candidates per iteration, as scan_candidates_avx512 (no gravity).
+template <int D>
+PlacementCheck check_placement_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
+                                      const Vec<D>& vi, double span, std::uint32_t skip_a,
+                                      std::uint32_t skip_b) {
+  PlacementCheck out;
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512d vt = _mm512_set1_pd(t);
+  const __m512d vspan = _mm512_set1_pd(span);
+  const __m512d minus_two = _mm512_set1_pd(-2.0);
+  __m512d vxi[D], vvi[D];
+  for (int a = 0; a < D; ++a) {
+    vxi[a] = _mm512_set1_pd(xi[a]);
+    vvi[a] = _mm512_set1_pd(vi[a]);
+  }
+  const __m512d vsigma2 = _mm512_set1_pd(s.sigma * s.sigma);
+  const __m512d vradius_i = _mm512_set1_pd(s.radius_i);
+  const __m256i vstride = _mm256_set1_epi32(s.stride);
+  const __m256i va = _mm256_set1_epi32(static_cast<int>(skip_a));
+  const __m256i vb = _mm256_set1_epi32(static_cast<int>(skip_b));
+  __mmask8 met = 0;
+  for (std::uint32_t k = 0; k < s.count; k += 8) {
+    const std::uint32_t left = s.count - k;
+    __mmask8 live = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
+    const __m256i ids = _mm256_maskz_loadu_epi32(live, s.candidates + k);
+    live = _mm256_mask_cmpneq_epu32_mask(live, ids, va);
+    live = _mm256_mask_cmpneq_epu32_mask(live, ids, vb);
+    const __m256i base = _mm256_mullo_epi32(ids, vstride);
+    __m512d r2, rg, g2, dtj;
+    pair_terms<D, false>(s, k, base, live, vt, vxi, vvi, r2, rg, g2, dtj);
+    const __mmask8 future = _mm512_mask_cmp_pd_mask(live, dtj, zero, _CMP_LT_OQ);
+    if (future != 0 && s.delayed != nullptr) [[unlikely]] {
+      const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(k)),
+                                             _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+      _mm256_mask_compressstoreu_epi32(s.delayed + *s.delayed_count, future, index);
+      *s.delayed_count += static_cast<std::uint32_t>(__builtin_popcount(future));
+    }
+    live &= static_cast<__mmask8>(~future);
+    __m512d sigma2 = vsigma2;
+    if (!s.uniform) {
+      const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(live),
+                                                      _mm512_castsi256_si512(ids), s.shape, 2);
+      const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
+      const __m512d rj = _mm512_mask_i32gather_pd(zero, live, shp, s.shape_radius, 8);
+      const __m512d sigma = _mm512_add_pd(vradius_i, rj);
+      sigma2 = _mm512_mul_pd(sigma, sigma);
+    }
+    const __m512d gap = _mm512_sub_pd(r2, sigma2);
+    if (_mm512_mask_cmp_pd_mask(live, gap, zero, _CMP_LT_OQ) != 0) {
+      out.overlap = true;
+      return out;
+    }
+    const __m512d bound = _mm512_mul_pd(_mm512_mul_pd(minus_two, rg), vspan);
+    __mmask8 ok = _mm512_mask_cmp_pd_mask(live, rg, zero, _CMP_LT_OQ);
+    ok = _mm512_mask_cmp_pd_mask(ok, gap, bound, _CMP_LE_OQ);
+    if (ok == 0) continue;
+    const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(rg, rg), _mm512_mul_pd(g2, gap));
+    ok = _mm512_mask_cmp_pd_mask(ok, disc, zero, _CMP_GT_OQ);
+    const __m512d dt = _mm512_div_pd(gap, _mm512_sub_pd(_mm512_sqrt_pd(disc), rg));
+    met |= _mm512_mask_cmp_pd_mask(ok, dt, vspan, _CMP_LT_OQ);
+  }
+  out.met = met != 0;
+  return out;
+}
+
+template PlacementCheck check_placement_avx512<2>(const CandidateScan<2>&, double, const Vec<2>&,
+                                                  const Vec<2>&, double, std::uint32_t,
+                                                  std::uint32_t);
+template PlacementCheck check_placement_avx512<3>(const CandidateScan<3>&, double, const Vec<3>&,
+                                                  const Vec<3>&, double, std::uint32_t,
+                                                  std::uint32_t);
 
 // Instantiated here, inside the AVX-512 target region: an instantiation after the region
 // cannot inline the intrinsics (GCC: "target specific option mismatch"). The scalar stand-in
@@ -184,8 +264,8 @@ std::uint32_t scan_stepped_avx512(const SteppedScan<D>& s, double t, const Vec<D
     const __m256i ids = _mm256_maskz_loadu_epi32(live, c.candidates + k);
     live = _mm256_mask_cmpneq_epu32_mask(live, ids, vself);
     const __m256i base = _mm256_mullo_epi32(ids, vstride);
-    __m512d r2, rg, g2;
-    pair_terms<D, kAccelerated>(c, k, base, live, vt, vxi, vvi, r2, rg, g2);
+    __m512d r2, rg, g2, dtj;  // no deferred soft contacts under steps: dtj >= 0
+    pair_terms<D, kAccelerated>(c, k, base, live, vt, vxi, vvi, r2, rg, g2, dtj);
     // Zones from the capture map's stamps: listed lanes in zone >= 1 are held back.
     const __m512i stamp =
         _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), live, ids, s.stamps, 8);
@@ -356,6 +436,20 @@ template std::uint32_t scan_candidates_avx512<2, true>(const CandidateScan<2>&, 
                                                        const Vec<2>&, const Vec<2>&, double&);
 template std::uint32_t scan_candidates_avx512<3, true>(const CandidateScan<3>&, double,
                                                        const Vec<3>&, const Vec<3>&, double&);
+
+template <int D>
+PlacementCheck check_placement_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
+                                      const Vec<D>& vi, double span, std::uint32_t skip_a,
+                                      std::uint32_t skip_b) {
+  return check_placement_scalar<D>(s, t, xi, vi, span, skip_a, skip_b);
+}
+
+template PlacementCheck check_placement_avx512<2>(const CandidateScan<2>&, double, const Vec<2>&,
+                                                  const Vec<2>&, double, std::uint32_t,
+                                                  std::uint32_t);
+template PlacementCheck check_placement_avx512<3>(const CandidateScan<3>&, double, const Vec<3>&,
+                                                  const Vec<3>&, double, std::uint32_t,
+                                                  std::uint32_t);
 
 template <int D, bool kAccelerated>
 std::uint32_t scan_stepped_avx512(const SteppedScan<D>&, double, const Vec<D>&, const Vec<D>&,

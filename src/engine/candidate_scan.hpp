@@ -39,6 +39,12 @@ struct CandidateScan {
   // time t gain g dt^2/2 and g dt. The pair's relative motion stays a straight line.
   const double* accel = nullptr;       // g (kAccelerated loops only)
   const double* half_accel = nullptr;  // g / 2
+  // Soft spheres with deferred releases: a record whose local time lies after t belongs to a
+  // particle still inside a contact (its record already holds the motion after the release).
+  // Both loops skip such candidates and append their indices (into `candidates`) to
+  // delayed[0 .. *delayed_count) (room for count + 8 entries); the caller tests them.
+  std::uint32_t* delayed = nullptr;
+  std::uint32_t* delayed_count = nullptr;
 };
 
 inline constexpr std::uint32_t kNoCandidate = 0xffffffffu;
@@ -58,6 +64,10 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
         s.records + static_cast<std::size_t>(j) * static_cast<std::size_t>(s.stride);
     const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
     const double dtj = t - rec[2 * D];
+    if (dtj < 0.0) [[unlikely]] {
+      if (s.delayed != nullptr) s.delayed[(*s.delayed_count)++] = k;
+      continue;
+    }
     double r2 = 0.0, rg = 0.0, g2 = 0.0;
     for (int a = 0; a < D; ++a) {
       double xj = rec[a] + rec[D + a] * dtj;
@@ -89,6 +99,62 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
   }
   return found;
 }
+
+// Where a soft contact places a particle (EventEngine::try_place): whether particle i, placed at
+// xi and moving at vi from time t, overlaps a candidate now (overlap) or meets one before
+// t + span (met). Candidates skip_a and skip_b (the pair itself) are ignored; candidates in
+// deferred contacts are listed as by the scan loops (not after an overlap) and left to the
+// caller. The expressions are the scan loops'; the AVX-512 version gives the same answer.
+struct PlacementCheck {
+  bool overlap = false;
+  bool met = false;
+};
+
+template <int D>
+PlacementCheck check_placement_scalar(const CandidateScan<D>& s, double t, const Vec<D>& xi,
+                                      const Vec<D>& vi, double span, std::uint32_t skip_a,
+                                      std::uint32_t skip_b) {
+  PlacementCheck out;
+  const Vec<D> no_shift{};
+  for (std::uint32_t k = 0; k < s.count; ++k) {
+    const std::uint32_t j = s.candidates[k];
+    if (j == skip_a || j == skip_b) continue;
+    const double* rec =
+        s.records + static_cast<std::size_t>(j) * static_cast<std::size_t>(s.stride);
+    const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
+    const double dtj = t - rec[2 * D];
+    if (dtj < 0.0) [[unlikely]] {
+      if (s.delayed != nullptr) s.delayed[(*s.delayed_count)++] = k;
+      continue;
+    }
+    double r2 = 0.0, rg = 0.0, g2 = 0.0;
+    for (int a = 0; a < D; ++a) {
+      const double xj = rec[a] + rec[D + a] * dtj;
+      const double r = xi[a] - (xj + shift[a]);
+      const double g = vi[a] - rec[D + a];
+      r2 = r2 + r * r;
+      rg = rg + r * g;
+      g2 = g2 + g * g;
+    }
+    const double sigma = s.uniform ? s.sigma : s.radius_i + s.shape_radius[s.shape[j]];
+    const double gap = r2 - sigma * sigma;
+    if (gap < 0.0) {
+      out.overlap = true;
+      return out;
+    }
+    if (!(rg < 0.0) || gap > -2.0 * rg * span) continue;
+    const double disc = rg * rg - g2 * gap;
+    if (!(disc > 0.0)) continue;
+    if (gap / (-rg + std::sqrt(disc)) < span) out.met = true;
+  }
+  return out;
+}
+
+// AVX-512 version (candidate_scan.cpp); only called when cpu_has_avx512().
+template <int D>
+PlacementCheck check_placement_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
+                                      const Vec<D>& vi, double span, std::uint32_t skip_a,
+                                      std::uint32_t skip_b);
 
 // The cell lists of a neighbourhood: `cells` lists, the c-th starting at heads[cell[c]] and
 // linked through next[] to `end`; each list's members get the tag shift[c] (an index into the

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -72,6 +73,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
   for (CandidateList& list : lists_) {
     list.ids.resize(256);
     list.shift.resize(256);
+    list.delayed.resize(256 + 8);
   }
 
   // Internal numbering: the stored one when resuming, else the caller's (renumbered below).
@@ -102,7 +104,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
     const Kinematics<D>& kin = s.kinematics[id_[k]];
     hot_[k] = {kin.pos, kin.vel, kin.time, has_counts ? s.collision_count[id_[k]] : 0u, 0u};
   }
-  restore_frozen(s);
+  restore_frozen(s, mode);
   // Spins are tracked when contacts can change them, or when the state carries them.
   if (env_.rotates() || !s.angular_velocity.empty()) {
     if (!s.angular_velocity.empty() && s.angular_velocity.size() != n) {
@@ -457,6 +459,8 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(frozen_with_, n);
   permute(release_time_, n);
   permute(release_velocity_, n);
+  permute(deferred_, n);
+  permute(frozen_velocity_, n);
   for (std::uint32_t& p : frozen_with_)
     if (p < kFirstCode) p = new_index[p];
   if (stepped_) steps_.renumber(new_index);
@@ -559,6 +563,7 @@ template <int D, class Queue>
 std::uint32_t* EventEngine<D, Queue>::grow(CandidateList& list) {
   list.ids.resize(2 * list.ids.size());
   list.shift.resize(list.ids.size());
+  list.delayed.resize(list.ids.size() + 8);
   return list.ids.data();
 }
 
@@ -685,30 +690,41 @@ void EventEngine<D, Queue>::gather_vector(CellCode cell, CandidateList& list) {
   list.n_shifts = n_shifts;
 }
 
+// The candidate loops' view of a gathered list for particle i; candidates in deferred soft
+// contacts go to list.delayed, counted in *delayed.
+template <int D, class Queue>
+CandidateScan<D> EventEngine<D, Queue>::scan_of(const CandidateList& list, std::uint32_t i,
+                                                std::uint32_t* delayed) const {
+  // Every field written once (designated initialisers): a default-constructed scan would be
+  // zeroed first with a slow `rep stos`.
+  const double r = radius_of(i);
+  return CandidateScan<D>{.records = reinterpret_cast<const double*>(hot_.data()),
+                          .stride = static_cast<int>(sizeof(HotRecord<D>) / sizeof(double)),
+                          .candidates = list.ids.data(),
+                          .shift_index = list.shift.data(),
+                          .shifts = list.shifts,
+                          // else list.shift is stale and must not be read
+                          .any_shift = list.n_shifts > 1,
+                          .count = list.count,
+                          .uniform = uniform_radius_,
+                          .sigma = 2.0 * r,
+                          .radius_i = r,
+                          .shape = shape_.data(),
+                          .shape_radius = shape_radius_.data(),
+                          .accel = accelerated_ ? env_.gravity.data() : nullptr,
+                          .half_accel = accelerated_ ? half_gravity_.data() : nullptr,
+                          .delayed = soft_ ? list.delayed.data() : nullptr,
+                          .delayed_count = delayed};
+}
+
 // Tests particle i (at xi, time t) against a gathered candidate list; returns the partner of
 // the soonest contact earlier than t + best (kNoPartner if none) and lowers `best` to it.
 template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, std::uint32_t i,
                                                      double t, const Vec<D>& xi,
                                                      double& best) const {
-  // Every field written once (designated initialisers): a default-constructed scan would be
-  // zeroed first with a slow `rep stos`.
-  const double r = radius_of(i);
-  const CandidateScan<D> scan{
-      .records = reinterpret_cast<const double*>(hot_.data()),
-      .stride = static_cast<int>(sizeof(HotRecord<D>) / sizeof(double)),
-      .candidates = list.ids.data(),
-      .shift_index = list.shift.data(),
-      .shifts = list.shifts,
-      .any_shift = list.n_shifts > 1,  // else list.shift is stale and must not be read
-      .count = list.count,
-      .uniform = uniform_radius_,
-      .sigma = 2.0 * r,
-      .radius_i = r,
-      .shape = shape_.data(),
-      .shape_radius = shape_radius_.data(),
-      .accel = accelerated_ ? env_.gravity.data() : nullptr,
-      .half_accel = accelerated_ ? half_gravity_.data() : nullptr};
+  std::uint32_t delayed = 0;  // candidates in deferred soft contacts, listed in list.delayed
+  const CandidateScan<D> scan = scan_of(list, i, &delayed);
   std::uint32_t k;
   if (accelerated_) {
     const Vec<D> vi = velocity_at(hot_[i], t);
@@ -718,7 +734,12 @@ std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, 
     k = vector_scan_ ? scan_candidates_avx512<D>(scan, t, xi, hot_[i].vel, best)
                      : scan_candidates_scalar<D>(scan, t, xi, hot_[i].vel, best);
   }
-  return k == kNoCandidate ? kNoPartner : list.ids[k];
+  const std::uint32_t partner = k == kNoCandidate ? kNoPartner : list.ids[k];
+  if (delayed > 0) [[unlikely]] {
+    const std::uint32_t other = scan_deferred(list, delayed, i, t, xi, hot_[i].vel, best);
+    if (other != kNoPartner) return other;
+  }
+  return partner;
 }
 
 // Finds the particle's next event from time t: the soonest collision with a neighbour, if it
@@ -761,7 +782,8 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
       when = t + dt;
     }
   }
-  if (soft_ && frozen_with_[i] != kNoPartner && release_time_[i] <= when) [[unlikely]] {
+  if (soft_ && frozen_with_[i] != kNoPartner && release_time_[i] <= when &&
+      (deferred_.empty() || deferred_[i] == 0)) [[unlikely]] {
     pending_[i] = {kRelease, 0};
     when = release_time_[i];
   }
@@ -1304,13 +1326,17 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
   for (std::uint32_t k = 0; soft_ && k < n; ++k) {
     const std::uint32_t p = frozen_with_[k];
     if (p == kNoPartner || (p < kFirstCode && p < k)) continue;  // each pair once
+    if (!deferred_.empty() && deferred_[k] != 0 && !in_deferred_contact(k, time_)) continue;
     FrozenContact<D> c;
     c.i = id_[k];
     c.release_time = release_time_[k];
-    c.velocity_i = release_velocity_[k];
+    c.deferred = !deferred_.empty() && deferred_[k] != 0;
+    c.velocity_i = c.deferred ? hot_[k].vel : release_velocity_[k];
+    if (c.deferred) c.release_position_i = hot_[k].pos;
     if (p < kFirstCode) {
       c.j = id_[p];
-      c.velocity_j = release_velocity_[p];
+      c.velocity_j = c.deferred ? hot_[p].vel : release_velocity_[p];
+      if (c.deferred) c.release_position_j = hot_[p].pos;
     } else {
       c.face = p - kFirstWall;
     }
@@ -1321,6 +1347,8 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
     const HotRecord<D>& h = hot_[k];
     const Shape& sh = shapes_[shape_.empty() ? 0 : shape_[k]];
     out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};
+    if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
+      out.kinematics[c] = {position_of(k, time_), frozen_velocity_[k], time_, sh.radius};
     out.mass[c] = sh.mass;
     out.species[c] = sh.species;
     out.collision_count[c] = h.collisions;
@@ -1338,7 +1366,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
 template <int D, class Queue>
 double EventEngine<D, Queue>::kinetic_energy() const {
   double ke = 0.0;
-  if (accelerated_) {
+  if (accelerated_ || !deferred_.empty()) {
     for (std::uint32_t i = 0; i < size(); ++i)
       ke += 0.5 * mass_of(i) * norm2(velocity_of(i, time_));
     return ke;
@@ -1647,6 +1675,22 @@ void EventEngine<D, Queue>::validate() {
   // Wall contacts, brute force over all particles: none comes before the particle's event.
   for (std::uint32_t i = 0; walls_ && i < n; ++i) {
     if (is_asleep(i)) continue;
+    if (in_deferred_contact(i, t)) {  // frozen until the release, then as its record says
+      const HotRecord<D>& h = hot_[i];
+      for (int f = 0; f < 2 * D; ++f) {
+        if (env_.faces[f].kind != FaceKind::kWall) continue;
+        if (wall_event_time(f, position_of(i, t), frozen_velocity_[i], radius_of(i), t,
+                            h.time - t) < h.time - t)
+          fail("particle " + name(i) + " meets wall " + std::to_string(f) +
+               " inside its deferred soft contact");
+        const double due = h.time + wall_event_time(f, h.pos, h.vel, radius_of(i), h.time, kNever);
+        const double speed = std::abs(h.vel[f / 2] - env_.faces[f].wall.velocity[f / 2]);
+        if (std::isfinite(due) && late(queue_.time_of(i), due, speed))
+          fail("particle " + name(i) + " meets wall " + std::to_string(f) +
+               " after its deferred release before its pending event");
+      }
+      continue;
+    }
     const Vec<D> x = position_of(i, t), v = velocity_of(i, t);
     for (int f = 0; f < 2 * D; ++f) {
       if (env_.faces[f].kind != FaceKind::kWall) continue;
@@ -1709,6 +1753,51 @@ void EventEngine<D, Queue>::validate() {
       fail(os.str());
     }
   };
+  // A pair with a member in a deferred soft contact: piecewise straight lines (frozen, then
+  // released), no gravity, no shear.
+  auto check_deferred_covered = [&](std::uint32_t i, std::uint32_t j, Vec<D> r, double sigma,
+                                    const char* which) {
+    const std::uint32_t both[2] = {i, j};
+    double ends[3];
+    int pieces = 0;
+    for (const std::uint32_t k : both)
+      if (in_deferred_contact(k, t)) ends[pieces++] = hot_[k].time;
+    if (pieces == 2 && ends[1] < ends[0]) std::swap(ends[0], ends[1]);
+    ends[pieces++] = kNever;
+    auto velocity = [&](std::uint32_t k, double when) {
+      return in_deferred_contact(k, when) ? frozen_velocity_[k] : hot_[k].vel;
+    };
+    Vec<D> g[3];
+    double start = t;
+    for (int p = 0; p < pieces; ++p) {
+      g[p] = velocity(i, start) - velocity(j, start);
+      start = ends[p];
+    }
+    const double due = piecewise_contact_time<D>(r, t, ends, g, pieces, t, kNever, sigma);
+    if (!std::isfinite(due)) return;
+    start = t;
+    int p = 0;
+    for (; ends[p] <= due; ++p) {  // r and g at the contact
+      r = r + (ends[p] - start) * g[p];
+      start = ends[p];
+    }
+    if (norm2(g[p]) > 0.0) {  // a graze at round-off level may be a hit or a miss
+      const double rg = std::min(0.0, dot(r, g[p]));
+      const double closest = std::sqrt(std::max(0.0, norm2(r) - rg * rg / norm2(g[p])));
+      if (sigma - closest < 1e-9 * sigma) return;
+    }
+    const Vec<D> r_contact = r + (due - start) * g[p];
+    const double normal_speed = std::abs(dot(r_contact, g[p])) / sigma;
+    const double bound = std::min(queue_.time_of(i), queue_.time_of(j));
+    if (late(bound, due, normal_speed)) {
+      std::ostringstream os;
+      os.precision(17);
+      os << "pair " << name(i) << "," << name(j) << " (" << which << ", deferred soft contact) "
+         << "collides at " << due << " but no pending event comes first (theirs: "
+         << queue_.time_of(i) << ", " << queue_.time_of(j) << ")";
+      fail(os.str());
+    }
+  };
   auto check_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, const char* which,
                            const Vec<D>& image_velocity = Vec<D>{}) {
     if (is_asleep(i) && is_asleep(j)) return;  // neither moves
@@ -1726,6 +1815,10 @@ void EventEngine<D, Queue>::validate() {
       }
     }
     const double sigma = radius_of(i) + radius_of(j);
+    if (in_deferred_contact(i, t) || in_deferred_contact(j, t)) {
+      if (!frozen_pair(i, j)) check_deferred_covered(i, j, r, sigma, which);
+      return;
+    }
     const double due =
         t + pair_contact_time_accelerated<D>(r.data(), g.data(), accel.data(), sigma);
     double bound = std::min(queue_.time_of(i), queue_.time_of(j));

@@ -33,6 +33,7 @@
 #include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
 #include "dynamics/collision_time.hpp"
+#include "engine/candidate_scan.hpp"
 #include "engine/pair_steps.hpp"
 #include "scheduler/cell_grid.hpp"
 
@@ -80,6 +81,10 @@ struct EngineOptions {
   double max_cells_per_particle = CellGrid<3>::kDefaultCellsPerParticle;
   // Test candidates eight at a time with AVX-512 when the CPU has it (same results either way).
   bool vector_scan = true;
+  // Soft spheres: when a mapped contact can meet nothing before its end, give the pair its
+  // post-contact motion at once (deferred release, see soft_contacts.cpp) instead of freezing
+  // it until a release event. Same physics; false keeps every contact frozen (for comparison).
+  bool defer_soft_releases = true;
 };
 
 template <int D, class Queue>
@@ -125,7 +130,9 @@ class EventEngine {
   // contacts will give back at their release (what the contacts hold, so that kinetic +
   // potential + dissipated energy stays constant through a contact).
   double potential_energy() const {
-    return stepped_ ? steps_.energy() : counters_.soft_contact_energy;
+    if (stepped_) return steps_.energy();
+    return deferred_.empty() ? counters_.soft_contact_energy
+                             : counters_.soft_contact_energy + deferred_contact_energy();
   }
   bool soft() const { return soft_; }
   // How many particles sit in a frozen soft contact now.
@@ -161,6 +168,8 @@ class EventEngine {
   struct CandidateList {
     std::vector<std::uint32_t> ids;
     std::vector<std::uint32_t> shift;  // per candidate, into shifts; read only if n_shifts > 1
+    // Scratch of the candidate loops: which candidates sit in deferred soft contacts.
+    mutable std::vector<std::uint32_t> delayed;
     Vec<D> shifts[kMaxShifts] = {};
     Vec<D> velocity_shifts[kMaxShifts] = {};  // read only if sheared
     std::uint32_t count = 0, n_shifts = 1;
@@ -203,10 +212,16 @@ class EventEngine {
   [[noreturn]] void throw_squeezed(double t) const;
   // Sleeping particles (gravity with walls): see Environment::sleep_speed.
   bool is_asleep(std::uint32_t i) const { return !asleep_.empty() && asleep_[i] != 0; }
+  // Where particle i is and how it moves at time t (not before its local time, unless it sits
+  // in a deferred soft contact: then the frozen motion until the release).
   Vec<D> position_of(std::uint32_t i, double t) const {
+    if (in_deferred_contact(i, t)) [[unlikely]]
+      return hot_[i].pos - (hot_[i].time - t) * frozen_velocity_[i];
     return is_asleep(i) ? hot_[i].pos : position_at(hot_[i], t);
   }
   Vec<D> velocity_of(std::uint32_t i, double t) const {
+    if (in_deferred_contact(i, t)) [[unlikely]]
+      return frozen_velocity_[i];
     return is_asleep(i) ? Vec<D>{} : velocity_at(hot_[i], t);
   }
   void add_virial_tensor(const Vec<D>& r, const Vec<D>& impulse);
@@ -256,6 +271,8 @@ class EventEngine {
   static constexpr std::uint32_t kCandidateSlack = 4;
   std::uint32_t test_candidates(const CandidateList& list, std::uint32_t i, double t,
                                 const Vec<D>& xi, double& best) const;
+  CandidateScan<D> scan_of(const CandidateList& list, std::uint32_t i,
+                           std::uint32_t* delayed) const;
   void collide(std::uint32_t i, std::uint32_t j, double t);
   // Stepped potentials: the zones of all pairs at the start, the candidate loop, and a pair
   // event at a step (false: the pair meets its hard core, an ordinary collision).
@@ -291,7 +308,7 @@ class EventEngine {
   void cross(std::uint32_t i, double t);
   // Soft spheres (formulas.md §1.6; engine/soft_contacts.cpp).
   void setup_soft(const ParticleSystem<D>& s);
-  void restore_frozen(const ParticleSystem<D>& s);
+  void restore_frozen(const ParticleSystem<D>& s, StartMode mode);
   void collide_soft(std::uint32_t i, std::uint32_t j, double t);
   void hit_wall_soft(std::uint32_t i, int face, double t);
   // Gives the contact particle i is frozen in its post-contact velocities at time t (early:
@@ -299,17 +316,52 @@ class EventEngine {
   // is now the caller's business, or a wall code), kNoPartner if i is not frozen.
   std::uint32_t release(std::uint32_t i, double t, bool early);
   void release_event(std::uint32_t i, double t);
+  // Deferred releases: the pair (or particle and wall) already moves as after the contact in its
+  // record, whose local time is the release time; until then it is frozen (frozen_velocity_).
+  // Only such a record has a local time after the present.
+  bool in_deferred_contact(std::uint32_t i, double t) const {
+    return !deferred_.empty() && t < hot_[i].time;
+  }
+  // Tries to defer the release of the placed pair i, j (frozen at velocity V from time t until
+  // `until`, then at vi, vj; try_place found no third body meeting it): true when its frozen
+  // path stays in its cells, meets no wall and both post-contact predictions come after the
+  // release; then both are predicted.
+  bool try_defer(std::uint32_t i, const Vec<D>& vi, std::uint32_t j, const Vec<D>& vj,
+                 const Vec<D>& V, double t, double until, bool shared);
+  // The exact event time of particle i (at xi, vi at time t) with candidates in deferred
+  // contacts (skipped by the loops): the contact while frozen, else after the release.
+  // `count` of them, listed in list.delayed by the loop.
+  std::uint32_t scan_deferred(const CandidateList& list, std::uint32_t count, std::uint32_t i,
+                              double t, const Vec<D>& xi, const Vec<D>& vi, double& best) const;
+  // A deferred contact keeps its flags after its release (nothing needs to happen then); they
+  // are cleared when the particle next meets something.
+  void forget_contact(std::uint32_t k) {
+    if (!deferred_.empty()) deferred_[k] = 0;
+    frozen_with_[k] = EventSlot::kNoPartner;
+    release_time_[k] = kNever;
+  }
+  double deferred_contact_energy() const;
   // The map from the table, or integrated directly outside it (counted).
   CollisionMap soft_map(const SoftMapTable* table, const CollisionUnits& units);
   // Places i at xi (and j at xj, unless j is kNoPartner) at time t unless that overlaps a third
   // particle or a wall (other than face skip_face; exception A): then nothing changes and the
   // result is false. Placed, the neighbourhoods of i and j are left gathered in lists_[0] and
   // (unless `shared`, one cell) lists_[1].
+  // With a window, also sets window->met if a third particle meets the pair, frozen at
+  // window->velocity, before window->until.
+  struct FrozenWindow {
+    Vec<D> velocity;
+    double until;
+    bool met;
+  };
   bool try_place(std::uint32_t i, const Vec<D>& xi, std::uint32_t j, const Vec<D>& xj, double t,
-                 int skip_face, bool& shared);
+                 int skip_face, bool& shared, FrozenWindow* window = nullptr);
   // Moves particle i into the cell of its (changed) position.
   void relocate(std::uint32_t i);
-  bool frozen_pair(std::uint32_t i, std::uint32_t j) const { return soft_ && frozen_with_[i] == j; }
+  bool frozen_pair(std::uint32_t i, std::uint32_t j) const {
+    return soft_ && frozen_with_[i] == j && frozen_with_[j] == i &&
+           (deferred_.empty() || deferred_[i] == 0 || in_deferred_contact(i, time_));
+  }
   void renumber(bool queue_filled);
   void insert_all_into_grid();
   void check_restored_cell(std::uint32_t i) const;
@@ -366,6 +418,11 @@ class EventEngine {
   HugeVector<std::uint32_t> frozen_with_;
   HugeVector<double> release_time_;
   HugeVector<Vec<D>> release_velocity_;
+  // Deferred releases: per particle 1 while its contact is deferred (its record holds the motion
+  // after the release) and the frozen velocity until then. The energy a deferred contact holds
+  // is not in counters_.soft_contact_energy (see potential_energy()).
+  HugeVector<std::uint8_t> deferred_;
+  HugeVector<Vec<D>> frozen_velocity_;
 
   CandidateList lists_[2];
   Environment<D> env_;  // last: the hot members above share fewer cache lines

@@ -15,11 +15,14 @@
 // the force-zero end of formulas.md §1.3. Wall contacts are the head-on map with mu = m and
 // l = R: the particle is pushed into the wall by the end overlap and keeps only its tangential
 // velocity until its release.
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "core/error.hpp"
 #include "core/periodic.hpp"
+#include "engine/candidate_scan.hpp"
 #include "engine/event_engine.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -29,7 +32,7 @@ namespace kairos {
 
 namespace {
 constexpr std::uint32_t kNone = EventSlot::kNoPartner;
-}
+}  // namespace
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
@@ -75,12 +78,17 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
   frozen_with_.assign(n, kNone);
   release_time_.assign(n, kNever);
   release_velocity_.assign(n, Vec<D>{});
+  if (options_.defer_soft_releases) {
+    deferred_.assign(n, 0);
+    frozen_velocity_.assign(n, Vec<D>{});
+  }
 }
 
 // The contacts in progress of the state, in the engine's numbering (id_ is set, the hot
-// records hold the frozen velocities).
+// records hold the frozen velocities). A deferred release resumes deferred, from the stored
+// release positions (bit for bit); otherwise it continues as a frozen contact.
 template <int D, class Queue>
-void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s) {
+void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s, StartMode mode) {
   if (!soft_) return;
   const auto n = static_cast<std::uint32_t>(size());
   std::vector<std::uint32_t> internal(n);
@@ -112,13 +120,29 @@ void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s) {
     }
     release_time_[i] = c.release_time;
     release_velocity_[i] = c.velocity_i;
+    if (c.deferred && !wall && mode == StartMode::kResume && !deferred_.empty() &&
+        c.release_time > s.time) {
+      const std::uint32_t j = internal[c.j];
+      const std::pair<std::uint32_t, Vec<D>> both[2] = {{i, c.release_position_i},
+                                                        {j, c.release_position_j}};
+      for (const auto& [k, x] : both) {
+        frozen_velocity_[k] = hot_[k].vel;
+        hot_[k].pos = x;
+        hot_[k].vel = release_velocity_[k];
+        hot_[k].time = c.release_time;
+        deferred_[k] = 1;
+      }
+    }
   }
 }
 
 template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::frozen() const {
   std::uint32_t count = 0;
-  for (const std::uint32_t p : frozen_with_) count += p != kNone ? 1u : 0u;
+  for (std::uint32_t k = 0; k < frozen_with_.size(); ++k) {
+    const bool stale = !deferred_.empty() && deferred_[k] != 0 && !in_deferred_contact(k, time_);
+    count += frozen_with_[k] != kNone && !stale ? 1u : 0u;
+  }
   return count;
 }
 
@@ -144,10 +168,13 @@ void EventEngine<D, Queue>::relocate(std::uint32_t i) {
 }
 
 // The placed particles are moved first and their neighbourhoods gathered from their new cells:
-// the same lists serve the overlap test and, when the placement stands, the predictions.
+// the same lists serve the overlap test and, when the placement stands, the predictions. With a
+// window (a pair contact that may be deferred), the same loop also asks whether a third particle
+// meets the frozen pair before the release (cheap rejection first, as in the candidate loops).
 template <int D, class Queue>
 bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::uint32_t j,
-                                      const Vec<D>& xj, double t, int skip_face, bool& shared) {
+                                      const Vec<D>& xj, double t, int skip_face, bool& shared,
+                                      FrozenWindow* window) {
   const std::uint32_t both[2] = {i, j};
   const Vec<D> to[2] = {xi, xj};
   Vec<D> from[2];
@@ -163,6 +190,8 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
   gather(hot_[i].cell, lists_[0]);
   shared = count == 1 || hot_[j].cell == hot_[i].cell;
   if (!shared) gather(hot_[j].cell, lists_[1]);
+  const double span = window != nullptr ? window->until - t : 0.0;
+  const Vec<D> velocity = window != nullptr ? window->velocity : Vec<D>{};
   auto overlaps = [&](std::uint32_t p, const CandidateList& list) {
     const Vec<D>& x = hot_[p].pos;
     const double radius = radius_of(p);
@@ -171,14 +200,26 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
       const double gap = f % 2 == 0 ? x[f / 2] - wall_offset(f, t) : wall_offset(f, t) - x[f / 2];
       if (gap < radius) return true;
     }
-    for (std::uint32_t k = 0; k < list.count; ++k) {
-      const std::uint32_t q = list.ids[k];
-      if (q == i || q == j) continue;
-      Vec<D> d = x - position_of(q, t);
-      for (int a = 0; a < D; ++a)
-        if (grid_.periodic(a)) d[a] = minimum_image(d[a], box_[a]);
-      const double sigma = radius + radius_of(q);
+    std::uint32_t delayed = 0;
+    const CandidateScan<D> scan = scan_of(list, p, &delayed);
+    const PlacementCheck check =
+        vector_scan_ ? check_placement_avx512<D>(scan, t, x, velocity, span, i, j)
+                     : check_placement_scalar<D>(scan, t, x, velocity, span, i, j);
+    if (check.overlap) return true;
+    if (window != nullptr && check.met) window->met = true;
+    // Candidates in deferred contacts of their own: frozen until their release.
+    for (std::uint32_t n = 0; n < delayed; ++n) {
+      const std::uint32_t k = list.delayed[n];
+      const HotRecord<D>& h = hot_[list.ids[k]];
+      Vec<D> d = x - (h.pos - (h.time - t) * frozen_velocity_[list.ids[k]]);
+      if (list.n_shifts > 1) d = d - list.shifts[list.shift[k]];
+      const double sigma = radius + radius_of(list.ids[k]);
       if (norm2(d) < sigma * sigma) return true;
+      if (window == nullptr || window->met) continue;
+      const double ends[2] = {h.time, kNever};
+      const Vec<D> g[2] = {velocity - frozen_velocity_[list.ids[k]], velocity - h.vel};
+      window->met =
+          piecewise_contact_time<D>(d, t, ends, g, 2, t, window->until, sigma) < window->until;
     }
     return false;
   };
@@ -199,6 +240,25 @@ template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool early) {
   const std::uint32_t p = frozen_with_[i];
   if (p == kNone) return kNone;
+  if (!deferred_.empty() && deferred_[i] != 0) [[unlikely]] {
+    if (!(t < hot_[i].time)) {  // released already: only the flags were left
+      forget_contact(i);
+      if (p < kFirstCode && frozen_with_[p] == i) forget_contact(p);
+      return kNone;
+    }
+    // Early: from where the frozen pair is now, with the post-contact velocities.
+    auto give_back = [&](std::uint32_t k) {
+      HotRecord<D>& h = hot_[k];
+      h.pos = h.pos - (h.time - t) * frozen_velocity_[k];
+      h.time = t;
+      ++h.collisions;
+      forget_contact(k);
+    };
+    give_back(i);
+    if (p < kFirstCode) give_back(p);
+    if (early) ++counters_.soft_early_releases;
+    return p;
+  }
   auto give_back = [&](std::uint32_t k) {
     advance_to(k, t);
     HotRecord<D>& h = hot_[k];
@@ -213,6 +273,97 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
   if (p < kFirstCode) give_back(p);
   if (early) ++counters_.soft_early_releases;
   return p;
+}
+
+// The kinetic energy the deferred contacts in progress will give back (their records already
+// move as after the release; the frozen motion is the physical one until then).
+template <int D, class Queue>
+double EventEngine<D, Queue>::deferred_contact_energy() const {
+  double e = 0.0;
+  for (std::uint32_t k = 0; k < deferred_.size(); ++k) {
+    if (in_deferred_contact(k, time_))
+      e += 0.5 * mass_of(k) * (norm2(hot_[k].vel) - norm2(frozen_velocity_[k]));
+  }
+  return e;
+}
+
+template <int D, class Queue>
+std::uint32_t EventEngine<D, Queue>::scan_deferred(const CandidateList& list, std::uint32_t count,
+                                                   std::uint32_t i, double t, const Vec<D>& xi,
+                                                   const Vec<D>& vi, double& best) const {
+  // A particle predicted inside its own deferred contact (at its start, see try_defer) moves as
+  // its record says only from its release on; what comes before was checked by try_defer.
+  const double from = in_deferred_contact(i, t) ? hot_[i].time : t;
+  std::uint32_t found = kNone;
+  for (std::uint32_t n = 0; n < count; ++n) {
+    const std::uint32_t k = list.delayed[n];
+    const std::uint32_t q = list.ids[k];
+    const HotRecord<D>& h = hot_[q];
+    if (q == i || (frozen_with_[i] == q && frozen_with_[q] == i)) continue;  // its own pair
+    Vec<D> xq = h.pos - (h.time - t) * frozen_velocity_[q];
+    if (list.n_shifts > 1) xq = xq + list.shifts[list.shift[k]];
+    const double ends[2] = {h.time, kNever};
+    const Vec<D> g[2] = {vi - frozen_velocity_[q], vi - h.vel};
+    const double when = piecewise_contact_time<D>(xi - xq, t, ends, g, 2, from, t + best,
+                                                  radius_of(i) + radius_of(q));
+    if (when - t < best) {
+      best = when - t;
+      found = q;
+    }
+  }
+  return found;
+}
+
+// The pair's frozen path is checked first (cells and walls; try_place has checked the third
+// bodies: nothing may happen to it before `until`), then both are predicted from their
+// post-contact motion. A prediction before
+// the release would be a contact of that motion extended backwards, which never happens.
+template <int D, class Queue>
+bool EventEngine<D, Queue>::try_defer(std::uint32_t i, const Vec<D>& vi, std::uint32_t j,
+                                      const Vec<D>& vj, const Vec<D>& V, double t, double until,
+                                      bool shared) {
+  const std::uint32_t both[2] = {i, j};
+  Vec<D> start[2], end[2];
+  for (int k = 0; k < 2; ++k) {
+    const HotRecord<D>& h = hot_[both[k]];
+    start[k] = h.pos;
+    for (int a = 0; a < D; ++a) {
+      end[k][a] = h.pos[a] + V[a] * (until - t);  // as advance_to() would move it
+      if (!(grid_.lower_bound(h.cell, a) < end[k][a] && end[k][a] < grid_.upper_bound(h.cell, a)))
+        return false;
+    }
+    for (int f = 0; walls_ && f < 2 * D; ++f) {
+      if (env_.faces[f].kind == FaceKind::kWall &&
+          wall_event_time(f, h.pos, V, radius_of(both[k]), t, until - t) < until - t)
+        return false;
+    }
+  }
+  const CandidateList& list_i = lists_[0];
+  const CandidateList& list_j = lists_[shared ? 0 : 1];
+  const Vec<D> after[2] = {vi, vj};
+  for (int k = 0; k < 2; ++k) {
+    HotRecord<D>& h = hot_[both[k]];
+    h.pos = end[k];
+    h.vel = after[k];
+    h.time = until;
+    deferred_[both[k]] = 1;
+    frozen_velocity_[both[k]] = V;
+  }
+  const double ti = predict_from(list_i, i, t);
+  const double tj = predict_from(list_j, j, t);
+  if (ti >= until && tj >= until) {
+    queue_.update(i, ti);
+    queue_.update(j, tj);
+    return true;
+  }
+  for (int k = 0; k < 2; ++k) {  // back to the frozen pair at time t
+    HotRecord<D>& h = hot_[both[k]];
+    h.pos = start[k];
+    h.vel = V;
+    h.time = t;
+    deferred_[both[k]] = 0;
+  }
+  return false;
 }
 
 template <int D, class Queue>
@@ -277,7 +428,9 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
     // Each particle's displacement from its place at first contact (R stays): no images.
     const Vec<D> xi = hi.pos + (mj / total) * (rc - r), xj = hj.pos - (mi / total) * (rc - r);
     bool shared = false;
-    if (try_place(i, xi, j, xj, t, -1, shared)) {
+    const double until = t + map.eps_t * units.time_unit;
+    FrozenWindow window{V, until, false};
+    if (try_place(i, xi, j, xj, t, -1, shared, deferred_.empty() ? nullptr : &window)) {
       const Vec<D> gc = (-map.eps_rdot * vn) * nc + (vt / map.eps_r) * tc;
       release_velocity_[i] = V + (mj / total) * gc;
       release_velocity_[j] = V - (mi / total) * gc;
@@ -289,16 +442,21 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
       const double ke_after =
           0.5 * (mi * norm2(release_velocity_[i]) + mj * norm2(release_velocity_[j]));
       counters_.dissipated_in_collisions += ke_before - ke_after;
-      counters_.soft_contact_energy += ke_after - 0.5 * total * norm2(V);
       hi.vel = V;
       hj.vel = V;
       frozen_with_[i] = j;
       frozen_with_[j] = i;
-      release_time_[i] = release_time_[j] = t + map.eps_t * units.time_unit;
+      release_time_[i] = release_time_[j] = until;
       ++counters_.soft_contacts;
       ++counters_.collisions;
       ++hi.collisions;
       ++hj.collisions;
+      if (!deferred_.empty() && !window.met &&
+          try_defer(i, release_velocity_[i], j, release_velocity_[j], V, t, until, shared)) {
+        predict_released();  // deferred: what the contact holds is in its records
+        return;
+      }
+      counters_.soft_contact_energy += ke_after - 0.5 * total * norm2(V);
       queue_.update(i, predict_from(lists_[0], i, t));
       queue_.update(j, predict_from(lists_[shared ? 0 : 1], j, t));
       predict_released();
@@ -390,15 +548,22 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
 
 #define KAIROS_SOFT_MEMBERS(D, Q)                                                                \
   template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                         \
-  template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&);                     \
+  template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&, StartMode);                     \
   template std::uint32_t EventEngine<D, Q>::frozen() const;                                      \
   template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&); \
   template void EventEngine<D, Q>::relocate(std::uint32_t);                                      \
   template bool EventEngine<D, Q>::try_place(std::uint32_t, const Vec<D>&, std::uint32_t,        \
-                                             const Vec<D>&, double, int, bool&);                 \
+                                             const Vec<D>&, double, int, bool&,                  \
+                                             FrozenWindow*);                               \
   template std::uint32_t EventEngine<D, Q>::release(std::uint32_t, double, bool);                \
   template void EventEngine<D, Q>::release_event(std::uint32_t, double);                         \
   template void EventEngine<D, Q>::collide_soft(std::uint32_t, std::uint32_t, double);           \
+  template double EventEngine<D, Q>::deferred_contact_energy() const;                            \
+  template std::uint32_t EventEngine<D, Q>::scan_deferred(const CandidateList&, std::uint32_t,    \
+                                                         std::uint32_t, double, const Vec<D>&,   \
+                                                         const Vec<D>&, double&) const;          \
+  template bool EventEngine<D, Q>::try_defer(std::uint32_t, const Vec<D>&, std::uint32_t,        \
+                                             const Vec<D>&, const Vec<D>&, double, double, bool); \
   template void EventEngine<D, Q>::hit_wall_soft(std::uint32_t, int, double);
 
 KAIROS_SOFT_MEMBERS(2, BinaryHeapQueue)

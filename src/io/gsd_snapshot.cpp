@@ -381,6 +381,21 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
       }
       w.write_chunk("kairos/state/frozen_contacts", nf, 3, who.data());
       w.write_chunk("kairos/state/frozen_release", nf, 1 + 2 * D, when.data());
+      bool any_deferred = false;
+      for (const FrozenContact<D>& c : s.frozen) any_deferred = any_deferred || c.deferred;
+      if (any_deferred) {
+        std::vector<double> deferred(nf * (1 + 2 * D), 0.0);
+        for (std::size_t k = 0; k < nf; ++k) {
+          const FrozenContact<D>& c = s.frozen[k];
+          double* row = &deferred[k * (1 + 2 * D)];
+          row[0] = c.deferred ? 1.0 : 0.0;
+          for (int a = 0; a < D; ++a) {
+            row[1 + a] = c.release_position_i[a];
+            row[1 + D + a] = c.release_position_j[a];
+          }
+        }
+        w.write_chunk("kairos/state/frozen_deferred", nf, 1 + 2 * D, deferred.data());
+      }
     }
     w.write_chunk("kairos/run/next_kick_time", 1, 1, &progress.next_kick_time);
     if (!s.angular_velocity.empty()) {
@@ -516,6 +531,19 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
       for (int a = 0; a < D; ++a) {
         c.velocity_i[a] = row[1 + a];
         c.velocity_j[a] = row[1 + D + a];
+      }
+    }
+    if (r.find(f, "kairos/state/frozen_deferred")) {
+      const auto deferred =
+          require<double>(r, f, "kairos/state/frozen_deferred", path, nf * (1 + 2 * D));
+      for (std::size_t k = 0; k < nf; ++k) {
+        FrozenContact<D>& c = s.frozen[k];
+        const double* row = &deferred[k * (1 + 2 * D)];
+        c.deferred = row[0] != 0.0;
+        for (int a = 0; a < D; ++a) {
+          c.release_position_i[a] = row[1 + a];
+          c.release_position_j[a] = row[1 + D + a];
+        }
       }
     }
   }

@@ -20,6 +20,9 @@
 //   kairos/state/frozen_contacts      uint32 F x 3 (i, j, face) of ParticleSystem::frozen, and
 //   kairos/state/frozen_release       float64 F x (1 + 2D): release time, velocity_i, velocity_j
 //                                     (both only when some soft contact is in progress)
+//   kairos/state/frozen_deferred      float64 F x (1 + 2D): deferred (1 or 0), the release
+//                                     positions i and j (only when some release is deferred;
+//                                     absent: none is)
 // Format 4 files are read with no soft contacts.
 #pragma once
 

@@ -57,11 +57,25 @@ ParticleSystem<3> oblique_pair() {
   return s;
 }
 
-// Runs until the first release has been processed; returns the state then.
+// The state at the end of the first soft contact: after its release event, or, for a deferred
+// release (no event), built from the exported contact's release positions and velocities.
 ParticleSystem<3> through_first_release(Engine3& engine) {
   for (int k = 0; k < 100000; ++k) {
     const EventKind kind = engine.step();
     if (kind == EventKind::kSoftRelease) return engine.export_state();
+    if (kind == EventKind::kCollision && engine.counters().soft_contacts > 0) {
+      ParticleSystem<3> s = engine.export_state();
+      if (s.frozen.size() == 1 && s.frozen[0].deferred) {
+        const FrozenContact<3> c = s.frozen[0];
+        s.time = c.release_time;
+        s.kinematics[c.i] = {c.release_position_i, c.velocity_i, c.release_time,
+                             s.kinematics[c.i].radius};
+        s.kinematics[c.j] = {c.release_position_j, c.velocity_j, c.release_time,
+                             s.kinematics[c.j].radius};
+        s.frozen.clear();
+        return s;
+      }
+    }
     if (kind == EventKind::kNone) break;
   }
   ADD_FAILURE() << "no release";
@@ -275,7 +289,7 @@ TEST(SoftExceptions, ThirdBodyDuringTheContactReleasesThePairEarly) {
   s.species_names = {"A"};
   Engine3 engine(s, StartMode::kPredict, {}, soft_environment<3>(law, 1));
   const Vec<3> p0 = engine.momentum();
-  while (engine.time() < th + 0.5 * tc) {
+  while (engine.next_event_time() < th + 0.5 * tc) {
     ASSERT_NE(engine.step(), EventKind::kNone);
     ASSERT_NO_THROW(engine.validate());
   }
