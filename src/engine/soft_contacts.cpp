@@ -132,6 +132,13 @@ void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s, StartMode
         hot_[k].time = c.release_time;
         deferred_[k] = 1;
       }
+    } else if (c.deferred) {  // continues frozen: the counter now holds what it will give back
+      const std::uint32_t j = wall ? kNone : internal[c.j];
+      for (const std::uint32_t k : {i, j}) {
+        if (k != kNone)
+          counters_.soft_contact_energy +=
+              0.5 * mass_of(k) * (norm2(release_velocity_[k]) - norm2(hot_[k].vel));
+      }
     }
   }
 }

@@ -490,6 +490,11 @@ TEST(SoftResume, ResumingFromARestartFileWithContactsInProgressIsBitIdentical) {
   EXPECT_EQ(mid.frozen, a.export_state().frozen);
   EXPECT_EQ(mid.counters.soft_contacts, a.counters().soft_contacts);
   EXPECT_EQ(mid.counters.soft_contact_energy, a.counters().soft_contact_energy);
+  // Started afresh (predicting), the deferred contacts continue frozen, holding the same energy.
+  const Engine3 fresh(mid, StartMode::kPredict, {}, env);
+  EXPECT_NEAR(fresh.potential_energy(), a.potential_energy(), 1e-12 * a.kinetic_energy());
+  EXPECT_NEAR(fresh.kinetic_energy(), a.kinetic_energy(), 1e-12 * a.kinetic_energy());
+  EXPECT_GT(a.potential_energy(), 0.0);
   Engine3 b(mid, StartMode::kResume, {}, env);
   for (int k = 0; k < 3000; ++k) {
     ASSERT_NE(a.step(), EventKind::kNone);
