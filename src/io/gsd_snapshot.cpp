@@ -15,9 +15,10 @@ namespace {
 
 // 2: one event time per particle, order; 3: granular counters, spins, TC times, sleepers;
 // 4: bonds, pair zones, step counters; 5: soft contacts in progress and soft counters (a
-// format-4 reader would drop the contacts in progress silently, hence the new number).
-// Versions 3 and 4 are still read: the chunks added since are optional.
-constexpr std::uint32_t kRestartFormat = 5;
+// format-4 reader would drop the contacts in progress silently, hence the new number); 6:
+// deferred soft contacts (frozen_deferred: a format-5 reader would continue them frozen, not
+// bit-identically). Versions 3 to 5 are still read: the chunks added since are optional.
+constexpr std::uint32_t kRestartFormat = 6;
 constexpr std::uint32_t kOldestRestartFormat = 3;
 
 // HOOMD stores type names as an N_types x M int8 array of 0-padded strings.

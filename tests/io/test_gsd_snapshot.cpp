@@ -124,7 +124,7 @@ TEST_F(GsdSnapshot, RestartRoundTripsBondsZonesAndStepCounters3D) {
   s.zones = std::vector<PairZone>{{0, 1, 1}, {3, 17, 2}, {5, 59, 7}};
   expect_round_trip<3>(file("restart.gsd"), s);
   const gsd::Reader r(file("restart.gsd"));
-  EXPECT_EQ(r.read<std::uint32_t>(0, "kairos/format"), std::vector<std::uint32_t>{5});
+  EXPECT_EQ(r.read<std::uint32_t>(0, "kairos/format"), std::vector<std::uint32_t>{6});
   EXPECT_EQ(r.read<std::uint64_t>(0, "kairos/state/zone_count"), std::vector<std::uint64_t>{3});
   const auto zones = r.find(0, "kairos/state/zones");
   ASSERT_TRUE(zones);
@@ -191,7 +191,7 @@ TEST_F(GsdSnapshot, ReadsFormat3RestartsWithoutTheNewChunks) {
   EXPECT_TRUE(r.bond_types.empty());
   EXPECT_EQ(r.size(), s.size());
 
-  for (const std::uint32_t bad : {2u, 6u}) {
+  for (const std::uint32_t bad : {2u, 7u}) {
     copy_frame(file("v4.gsd"), file("bad.gsd"), {}, bad);
     try {
       (void)read_restart<3>(file("bad.gsd"), rng);
