@@ -56,10 +56,11 @@ inline double interval_exit_time(double x, double v, double lo, double hi) {
 // The first contact at or after `from` and before `until` (absolute times) of a pair whose
 // separation is r at time t and whose relative velocity is g[p] until ends[p] (ascending, the
 // last may be kNever); kNever if none. Each piece follows the hard-sphere rule of
-// collision_time.hpp (an overlapping, receding pair does not collide). Soft spheres' deferred contacts.
+// collision_time.hpp (an overlapping, receding pair does not collide). Soft spheres' deferred
+// contacts.
 template <int D>
-inline double piecewise_contact_time(Vec<D> r, double t, const double* ends, const Vec<D>* g, int pieces,
-                              double from, double until, double sigma) {
+inline double piecewise_contact_time(Vec<D> r, double t, const double* ends, const Vec<D>* g,
+                                     int pieces, double from, double until, double sigma) {
   double start = t;
   for (int p = 0; p < pieces && start < until; ++p) {
     const double end = std::min(ends[p], until);

@@ -1793,8 +1793,9 @@ void EventEngine<D, Queue>::validate() {
       std::ostringstream os;
       os.precision(17);
       os << "pair " << name(i) << "," << name(j) << " (" << which << ", deferred soft contact) "
-         << "collides at " << due << " but no pending event comes first (theirs: "
-         << queue_.time_of(i) << ", " << queue_.time_of(j) << ")";
+         << "collides at " << due
+         << " but no pending event comes first (theirs: " << queue_.time_of(i) << ", "
+         << queue_.time_of(j) << ")";
       fail(os.str());
     }
   };

@@ -209,9 +209,9 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
     }
     std::uint32_t delayed = 0;
     const CandidateScan<D> scan = scan_of(list, p, &delayed);
-    const PlacementCheck check =
-        vector_scan_ ? check_placement_avx512<D>(scan, t, x, velocity, span, i, j)
-                     : check_placement_scalar<D>(scan, t, x, velocity, span, i, j);
+    const PlacementCheck check = vector_scan_
+                                     ? check_placement_avx512<D>(scan, t, x, velocity, span, i, j)
+                                     : check_placement_scalar<D>(scan, t, x, velocity, span, i, j);
     if (check.overlap) return true;
     if (window != nullptr && check.met) window->met = true;
     // Candidates in deferred contacts of their own: frozen until their release.
@@ -553,23 +553,22 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   queue_.update(i, predict(i, t));
 }
 
-#define KAIROS_SOFT_MEMBERS(D, Q)                                                                \
-  template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                         \
-  template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&, StartMode);                     \
-  template std::uint32_t EventEngine<D, Q>::frozen() const;                                      \
-  template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&); \
-  template void EventEngine<D, Q>::relocate(std::uint32_t);                                      \
-  template bool EventEngine<D, Q>::try_place(std::uint32_t, const Vec<D>&, std::uint32_t,        \
-                                             const Vec<D>&, double, int, bool&,                  \
-                                             FrozenWindow*);                               \
-  template std::uint32_t EventEngine<D, Q>::release(std::uint32_t, double, bool);                \
-  template void EventEngine<D, Q>::release_event(std::uint32_t, double);                         \
-  template void EventEngine<D, Q>::collide_soft(std::uint32_t, std::uint32_t, double);           \
-  template double EventEngine<D, Q>::deferred_contact_energy() const;                            \
+#define KAIROS_SOFT_MEMBERS(D, Q)                                                                 \
+  template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                          \
+  template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&, StartMode);           \
+  template std::uint32_t EventEngine<D, Q>::frozen() const;                                       \
+  template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&);  \
+  template void EventEngine<D, Q>::relocate(std::uint32_t);                                       \
+  template bool EventEngine<D, Q>::try_place(std::uint32_t, const Vec<D>&, std::uint32_t,         \
+                                             const Vec<D>&, double, int, bool&, FrozenWindow*);   \
+  template std::uint32_t EventEngine<D, Q>::release(std::uint32_t, double, bool);                 \
+  template void EventEngine<D, Q>::release_event(std::uint32_t, double);                          \
+  template void EventEngine<D, Q>::collide_soft(std::uint32_t, std::uint32_t, double);            \
+  template double EventEngine<D, Q>::deferred_contact_energy() const;                             \
   template std::uint32_t EventEngine<D, Q>::scan_deferred(const CandidateList&, std::uint32_t,    \
-                                                         std::uint32_t, double, const Vec<D>&,   \
-                                                         const Vec<D>&, double&) const;          \
-  template bool EventEngine<D, Q>::try_defer(std::uint32_t, const Vec<D>&, std::uint32_t,        \
+                                                          std::uint32_t, double, const Vec<D>&,   \
+                                                          const Vec<D>&, double&) const;          \
+  template bool EventEngine<D, Q>::try_defer(std::uint32_t, const Vec<D>&, std::uint32_t,         \
                                              const Vec<D>&, const Vec<D>&, double, double, bool); \
   template void EventEngine<D, Q>::hit_wall_soft(std::uint32_t, int, double);
 
