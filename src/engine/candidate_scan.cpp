@@ -145,26 +145,30 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
   return found;
 }
 
-// Eight candidates per iteration, as scan_candidates_avx512 (no gravity).
+// Eight candidates per iteration, as scan_candidates_avx512 (no gravity): the record fields are
+// gathered once and serve both the placed particle's tests and the prediction.
 template <int D>
-PlacementCheck check_placement_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
-                                      const Vec<D>& vi, double span, std::uint32_t skip_a,
-                                      std::uint32_t skip_b) {
-  PlacementCheck out;
+ContactProbeResult probe_contact_avx512(const CandidateScan<D>& s, double t,
+                                        const ContactProbe<D>& probe, const Vec<D>& xi,
+                                        const Vec<D>& vi, double& best) {
+  ContactProbeResult out;
+  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
   const __m512d zero = _mm512_setzero_pd();
   const __m512d vt = _mm512_set1_pd(t);
-  const __m512d vspan = _mm512_set1_pd(span);
+  const __m512d vspan = _mm512_set1_pd(probe.span);
   const __m512d minus_two = _mm512_set1_pd(-2.0);
-  __m512d vxi[D], vvi[D];
+  __m512d vxp[D], vvp[D], vxi[D], vvi[D];
   for (int a = 0; a < D; ++a) {
+    vxp[a] = _mm512_set1_pd(probe.placed[a]);
+    vvp[a] = _mm512_set1_pd(probe.frozen_velocity[a]);
     vxi[a] = _mm512_set1_pd(xi[a]);
     vvi[a] = _mm512_set1_pd(vi[a]);
   }
   const __m512d vsigma2 = _mm512_set1_pd(s.sigma * s.sigma);
   const __m512d vradius_i = _mm512_set1_pd(s.radius_i);
   const __m256i vstride = _mm256_set1_epi32(s.stride);
-  const __m256i va = _mm256_set1_epi32(static_cast<int>(skip_a));
-  const __m256i vb = _mm256_set1_epi32(static_cast<int>(skip_b));
+  const __m256i va = _mm256_set1_epi32(static_cast<int>(probe.skip_a));
+  const __m256i vb = _mm256_set1_epi32(static_cast<int>(probe.skip_b));
   __mmask8 met = 0;
   for (std::uint32_t k = 0; k < s.count; k += 8) {
     const std::uint32_t left = s.count - k;
@@ -173,8 +177,7 @@ PlacementCheck check_placement_avx512(const CandidateScan<D>& s, double t, const
     live = _mm256_mask_cmpneq_epu32_mask(live, ids, va);
     live = _mm256_mask_cmpneq_epu32_mask(live, ids, vb);
     const __m256i base = _mm256_mullo_epi32(ids, vstride);
-    __m512d r2, rg, g2, dtj;
-    pair_terms<D, false>(s, k, base, live, vt, vxi, vvi, r2, rg, g2, dtj);
+    const __m512d dtj = _mm512_sub_pd(vt, gather_field(s.records, base, live, 2 * D));
     const __mmask8 future = _mm512_mask_cmp_pd_mask(live, dtj, zero, _CMP_LT_OQ);
     if (future != 0 && s.delayed != nullptr) [[unlikely]] {
       const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(k)),
@@ -183,6 +186,29 @@ PlacementCheck check_placement_avx512(const CandidateScan<D>& s, double t, const
       *s.delayed_count += static_cast<std::uint32_t>(__builtin_popcount(future));
     }
     live &= static_cast<__mmask8>(~future);
+    __m256i shift_base = _mm256_setzero_si256();
+    if (s.any_shift) {
+      const __m256i sidx = _mm256_maskz_loadu_epi32(live, s.shift_index + k);
+      shift_base = _mm256_mullo_epi32(sidx, _mm256_set1_epi32(D));
+    }
+    __m512d p2 = zero, pg = zero, q2 = zero, r2 = zero, rg = zero, g2 = zero;
+    for (int a = 0; a < D; ++a) {
+      const __m512d vel = gather_field(s.records, base, live, D + a);
+      __m512d xj = _mm512_add_pd(gather_field(s.records, base, live, a), _mm512_mul_pd(vel, dtj));
+      if (s.any_shift) {
+        xj = _mm512_add_pd(xj, _mm512_mask_i32gather_pd(
+                                   zero, live, _mm256_add_epi32(shift_base, _mm256_set1_epi32(a)),
+                                   reinterpret_cast<const double*>(s.shifts), 8));
+      }
+      const __m512d rp = _mm512_sub_pd(vxp[a], xj), gp = _mm512_sub_pd(vvp[a], vel);
+      p2 = _mm512_add_pd(p2, _mm512_mul_pd(rp, rp));
+      pg = _mm512_add_pd(pg, _mm512_mul_pd(rp, gp));
+      q2 = _mm512_add_pd(q2, _mm512_mul_pd(gp, gp));
+      const __m512d r = _mm512_sub_pd(vxi[a], xj), g = _mm512_sub_pd(vvi[a], vel);
+      r2 = _mm512_add_pd(r2, _mm512_mul_pd(r, r));
+      rg = _mm512_add_pd(rg, _mm512_mul_pd(r, g));
+      g2 = _mm512_add_pd(g2, _mm512_mul_pd(g, g));
+    }
     __m512d sigma2 = vsigma2;
     if (!s.uniform) {
       const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(live),
@@ -192,30 +218,51 @@ PlacementCheck check_placement_avx512(const CandidateScan<D>& s, double t, const
       const __m512d sigma = _mm512_add_pd(vradius_i, rj);
       sigma2 = _mm512_mul_pd(sigma, sigma);
     }
-    const __m512d gap = _mm512_sub_pd(r2, sigma2);
-    if (_mm512_mask_cmp_pd_mask(live, gap, zero, _CMP_LT_OQ) != 0) {
+    // The placed particle: an overlap now, a meeting while frozen.
+    const __m512d gap_placed = _mm512_sub_pd(p2, sigma2);
+    if (_mm512_mask_cmp_pd_mask(live, gap_placed, zero, _CMP_LT_OQ) != 0) {
       out.overlap = true;
       return out;
     }
-    const __m512d bound = _mm512_mul_pd(_mm512_mul_pd(minus_two, rg), vspan);
+    __mmask8 near = _mm512_mask_cmp_pd_mask(live, pg, zero, _CMP_LT_OQ);
+    near = _mm512_mask_cmp_pd_mask(near, gap_placed,
+                                   _mm512_mul_pd(_mm512_mul_pd(minus_two, pg), vspan), _CMP_LE_OQ);
+    if (near != 0) {
+      const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(pg, pg), _mm512_mul_pd(q2, gap_placed));
+      near = _mm512_mask_cmp_pd_mask(near, disc, zero, _CMP_GT_OQ);
+      const __m512d dt = _mm512_div_pd(gap_placed, _mm512_sub_pd(_mm512_sqrt_pd(disc), pg));
+      met |= _mm512_mask_cmp_pd_mask(near, dt, vspan, _CMP_LT_OQ);
+    }
+    if (!probe.predict) continue;
+    // The motion after the release: scan_candidates_avx512's test.
+    const __m512d gap = _mm512_sub_pd(r2, sigma2);
+    const __m512d bound = _mm512_mul_pd(_mm512_mul_pd(minus_two, rg), _mm512_set1_pd(best));
     __mmask8 ok = _mm512_mask_cmp_pd_mask(live, rg, zero, _CMP_LT_OQ);
     ok = _mm512_mask_cmp_pd_mask(ok, gap, bound, _CMP_LE_OQ);
     if (ok == 0) continue;
     const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(rg, rg), _mm512_mul_pd(g2, gap));
     ok = _mm512_mask_cmp_pd_mask(ok, disc, zero, _CMP_GT_OQ);
-    const __m512d dt = _mm512_div_pd(gap, _mm512_sub_pd(_mm512_sqrt_pd(disc), rg));
-    met |= _mm512_mask_cmp_pd_mask(ok, dt, vspan, _CMP_LT_OQ);
+    if (ok == 0) continue;
+    __m512d dt = _mm512_div_pd(gap, _mm512_sub_pd(_mm512_sqrt_pd(disc), rg));
+    dt = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(dt, zero, _CMP_GT_OQ), zero, dt);
+    dt = _mm512_mask_blend_pd(ok, inf, dt);
+    const double m = _mm512_reduce_min_pd(dt);
+    if (m < best) {
+      const __mmask8 at = _mm512_mask_cmp_pd_mask(ok, dt, _mm512_set1_pd(m), _CMP_EQ_OQ);
+      best = m;
+      out.found = k + static_cast<std::uint32_t>(__builtin_ctz(at));
+    }
   }
   out.met = met != 0;
   return out;
 }
 
-template PlacementCheck check_placement_avx512<2>(const CandidateScan<2>&, double, const Vec<2>&,
-                                                  const Vec<2>&, double, std::uint32_t,
-                                                  std::uint32_t);
-template PlacementCheck check_placement_avx512<3>(const CandidateScan<3>&, double, const Vec<3>&,
-                                                  const Vec<3>&, double, std::uint32_t,
-                                                  std::uint32_t);
+template ContactProbeResult probe_contact_avx512<2>(const CandidateScan<2>&, double,
+                                                    const ContactProbe<2>&, const Vec<2>&,
+                                                    const Vec<2>&, double&);
+template ContactProbeResult probe_contact_avx512<3>(const CandidateScan<3>&, double,
+                                                    const ContactProbe<3>&, const Vec<3>&,
+                                                    const Vec<3>&, double&);
 
 // Instantiated here, inside the AVX-512 target region: an instantiation after the region
 // cannot inline the intrinsics (GCC: "target specific option mismatch"). The scalar stand-in
@@ -438,18 +485,18 @@ template std::uint32_t scan_candidates_avx512<3, true>(const CandidateScan<3>&, 
                                                        const Vec<3>&, const Vec<3>&, double&);
 
 template <int D>
-PlacementCheck check_placement_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
-                                      const Vec<D>& vi, double span, std::uint32_t skip_a,
-                                      std::uint32_t skip_b) {
-  return check_placement_scalar<D>(s, t, xi, vi, span, skip_a, skip_b);
+ContactProbeResult probe_contact_avx512(const CandidateScan<D>& s, double t,
+                                        const ContactProbe<D>& probe, const Vec<D>& xi,
+                                        const Vec<D>& vi, double& best) {
+  return probe_contact_scalar<D>(s, t, probe, xi, vi, best);
 }
 
-template PlacementCheck check_placement_avx512<2>(const CandidateScan<2>&, double, const Vec<2>&,
-                                                  const Vec<2>&, double, std::uint32_t,
-                                                  std::uint32_t);
-template PlacementCheck check_placement_avx512<3>(const CandidateScan<3>&, double, const Vec<3>&,
-                                                  const Vec<3>&, double, std::uint32_t,
-                                                  std::uint32_t);
+template ContactProbeResult probe_contact_avx512<2>(const CandidateScan<2>&, double,
+                                                    const ContactProbe<2>&, const Vec<2>&,
+                                                    const Vec<2>&, double&);
+template ContactProbeResult probe_contact_avx512<3>(const CandidateScan<3>&, double,
+                                                    const ContactProbe<3>&, const Vec<3>&,
+                                                    const Vec<3>&, double&);
 
 template <int D, bool kAccelerated>
 std::uint32_t scan_stepped_avx512(const SteppedScan<D>&, double, const Vec<D>&, const Vec<D>&,

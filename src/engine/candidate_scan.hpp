@@ -100,25 +100,37 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
   return found;
 }
 
-// Where a soft contact places a particle (EventEngine::try_place): whether particle i, placed at
-// xi and moving at vi from time t, overlaps a candidate now (overlap) or meets one before
-// t + span (met). Candidates skip_a and skip_b (the pair itself) are ignored; candidates in
-// deferred contacts are listed as by the scan loops (not after an overlap) and left to the
-// caller. The expressions are the scan loops'; the AVX-512 version gives the same answer.
-struct PlacementCheck {
+// The start of a soft contact (EventEngine::try_place), in one pass over the candidates: does
+// the placed particle (at `placed`, frozen at `frozen_velocity` for `span` from time t) overlap a
+// candidate now (overlap), or meet one while frozen (met)? With `predict`, also the soonest
+// contact of its motion after the release (at xi with velocity vi at time t, earlier than
+// t + best, lowering best) exactly as the scan loops find it: the same expressions in the same
+// order, the lowest index among equal times. Candidates skip_a and skip_b (the pair itself) are
+// ignored; candidates in deferred contacts are listed as by the scan loops (not after an
+// overlap) and left to the caller. The AVX-512 version gives the same answer.
+template <int D>
+struct ContactProbe {
+  Vec<D> placed{}, frozen_velocity{};
+  double span = 0.0;
+  std::uint32_t skip_a = 0, skip_b = 0;
+  bool predict = false;
+};
+
+struct ContactProbeResult {
   bool overlap = false;
   bool met = false;
+  std::uint32_t found = kNoCandidate;  // index into candidates (predict only)
 };
 
 template <int D>
-PlacementCheck check_placement_scalar(const CandidateScan<D>& s, double t, const Vec<D>& xi,
-                                      const Vec<D>& vi, double span, std::uint32_t skip_a,
-                                      std::uint32_t skip_b) {
-  PlacementCheck out;
+ContactProbeResult probe_contact_scalar(const CandidateScan<D>& s, double t,
+                                        const ContactProbe<D>& probe, const Vec<D>& xi,
+                                        const Vec<D>& vi, double& best) {
+  ContactProbeResult out;
   const Vec<D> no_shift{};
   for (std::uint32_t k = 0; k < s.count; ++k) {
     const std::uint32_t j = s.candidates[k];
-    if (j == skip_a || j == skip_b) continue;
+    if (j == probe.skip_a || j == probe.skip_b) continue;
     const double* rec =
         s.records + static_cast<std::size_t>(j) * static_cast<std::size_t>(s.stride);
     const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
@@ -127,34 +139,51 @@ PlacementCheck check_placement_scalar(const CandidateScan<D>& s, double t, const
       if (s.delayed != nullptr) s.delayed[(*s.delayed_count)++] = k;
       continue;
     }
-    double r2 = 0.0, rg = 0.0, g2 = 0.0;
+    double p2 = 0.0, pg = 0.0, q2 = 0.0;  // the placed particle's r.r, r.g, g.g
+    double r2 = 0.0, rg = 0.0, g2 = 0.0;  // the released motion's
     for (int a = 0; a < D; ++a) {
-      const double xj = rec[a] + rec[D + a] * dtj;
-      const double r = xi[a] - (xj + shift[a]);
-      const double g = vi[a] - rec[D + a];
+      const double xj = rec[a] + rec[D + a] * dtj + shift[a];
+      const double vj = rec[D + a];
+      const double rp = probe.placed[a] - xj, gp = probe.frozen_velocity[a] - vj;
+      p2 = p2 + rp * rp;
+      pg = pg + rp * gp;
+      q2 = q2 + gp * gp;
+      const double r = xi[a] - xj, g = vi[a] - vj;
       r2 = r2 + r * r;
       rg = rg + r * g;
       g2 = g2 + g * g;
     }
     const double sigma = s.uniform ? s.sigma : s.radius_i + s.shape_radius[s.shape[j]];
-    const double gap = r2 - sigma * sigma;
-    if (gap < 0.0) {
+    const double sigma2 = sigma * sigma;
+    const double gap_placed = p2 - sigma2;
+    if (gap_placed < 0.0) {
       out.overlap = true;
       return out;
     }
-    if (!(rg < 0.0) || gap > -2.0 * rg * span) continue;
+    if (pg < 0.0 && gap_placed <= -2.0 * pg * probe.span) {
+      const double disc = pg * pg - q2 * gap_placed;
+      if (disc > 0.0 && gap_placed / (-pg + std::sqrt(disc)) < probe.span) out.met = true;
+    }
+    if (!probe.predict) continue;
+    const double gap = r2 - sigma2;
+    if (!(rg < 0.0) || gap > -2.0 * rg * best) continue;
     const double disc = rg * rg - g2 * gap;
     if (!(disc > 0.0)) continue;
-    if (gap / (-rg + std::sqrt(disc)) < span) out.met = true;
+    double dt = gap / (-rg + std::sqrt(disc));
+    if (!(dt > 0.0)) dt = 0.0;
+    if (dt < best) {
+      best = dt;
+      out.found = k;
+    }
   }
   return out;
 }
 
 // AVX-512 version (candidate_scan.cpp); only called when cpu_has_avx512().
 template <int D>
-PlacementCheck check_placement_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
-                                      const Vec<D>& vi, double span, std::uint32_t skip_a,
-                                      std::uint32_t skip_b);
+ContactProbeResult probe_contact_avx512(const CandidateScan<D>& s, double t,
+                                        const ContactProbe<D>& probe, const Vec<D>& xi,
+                                        const Vec<D>& vi, double& best);
 
 // The cell lists of a neighbourhood: `cells` lists, the c-th starting at heads[cell[c]] and
 // linked through next[] to `end`; each list's members get the tag shift[c] (an index into the

@@ -736,7 +736,7 @@ std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, 
   }
   const std::uint32_t partner = k == kNoCandidate ? kNoPartner : list.ids[k];
   if (delayed > 0) [[unlikely]] {
-    const std::uint32_t other = scan_deferred(list, delayed, i, t, xi, hot_[i].vel, best);
+    const std::uint32_t other = scan_deferred(list, delayed, i, t, xi, hot_[i].vel, t, best);
     if (other != kNoPartner) return other;
   }
   return partner;
@@ -768,6 +768,15 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
   } else {
     partner = test_candidates(list, i, t, xi, best);
   }
+  return conclude_prediction(i, t, crossing, partner, best);
+}
+
+// Stores particle i's next event from time t: the contact with `partner` at t + best if there
+// is one (else the crossing), unless a wall or a frozen contact's release comes first.
+template <int D, class Queue>
+double EventEngine<D, Queue>::conclude_prediction(std::uint32_t i, double t,
+                                                  const Crossing& crossing, std::uint32_t partner,
+                                                  double best) {
   double when = crossing.time;
   if (partner != kNoPartner) {
     pending_[i] = {partner, hot_[partner].collisions};

@@ -255,6 +255,8 @@ class EventEngine {
   [[gnu::noinline]] void advance_accelerated(HotRecord<D>& h, double t) const;
   double predict(std::uint32_t i, double t);
   double predict_from(const CandidateList& list, std::uint32_t i, double t);
+  double conclude_prediction(std::uint32_t i, double t, const Crossing& crossing,
+                             std::uint32_t partner, double best);
   double predict_asleep(const CandidateList& list, std::uint32_t i, double t);
   bool sleeper_among(const CandidateList& list) const;
   void gather(CellCode cell, CandidateList& list);
@@ -322,17 +324,32 @@ class EventEngine {
   bool in_deferred_contact(std::uint32_t i, double t) const {
     return !deferred_.empty() && t < hot_[i].time;
   }
-  // Tries to defer the release of the placed pair i, j (frozen at velocity V from time t until
-  // `until`, then at vi, vj; try_place found no third body meeting it): true when its frozen
-  // path stays in its cells, meets no wall and both post-contact predictions come after the
-  // release; then both are predicted.
-  bool try_defer(std::uint32_t i, const Vec<D>& vi, std::uint32_t j, const Vec<D>& vj,
-                 const Vec<D>& V, double t, double until, bool shared);
+  // A pair contact frozen at `velocity` until `until` (see try_place). With `predict` (a contact
+  // that may be deferred), try_place also finds each particle's soonest event after the release
+  // (post-contact velocity after[k], k = 0 for i, 1 for j): partner and time from t.
+  struct FrozenWindow {
+    Vec<D> velocity{};
+    double until = 0.0;
+    bool met = false;
+    bool predict = false;
+    Vec<D> after[2] = {};
+    Crossing crossing[2] = {};
+    std::uint32_t partner[2] = {EventSlot::kNoPartner, EventSlot::kNoPartner};
+    double best[2] = {};
+  };
+  // Tries to defer the release of the placed pair i, j (frozen at window.velocity from time t
+  // until window.until, then at window.after; try_place found no third body meeting it and
+  // predicted both): true when the frozen path stays in its cells, meets no wall and both
+  // events come after the release; then both are scheduled.
+  bool try_defer(std::uint32_t i, std::uint32_t j, double t, const FrozenWindow& window);
   // The exact event time of particle i (at xi, vi at time t) with candidates in deferred
   // contacts (skipped by the loops): the contact while frozen, else after the release.
   // `count` of them, listed in list.delayed by the loop.
+  // Events before `from` are not looked for (a particle at the start of its own deferred
+  // contact moves as xi, vi say only from its release on).
   std::uint32_t scan_deferred(const CandidateList& list, std::uint32_t count, std::uint32_t i,
-                              double t, const Vec<D>& xi, const Vec<D>& vi, double& best) const;
+                              double t, const Vec<D>& xi, const Vec<D>& vi, double from,
+                              double& best) const;
   // A deferred contact keeps its flags after its release (nothing needs to happen then); they
   // are cleared when the particle next meets something.
   void forget_contact(std::uint32_t k) {
@@ -348,12 +365,7 @@ class EventEngine {
   // result is false. Placed, the neighbourhoods of i and j are left gathered in lists_[0] and
   // (unless `shared`, one cell) lists_[1].
   // With a window, also sets window->met if a third particle meets the pair, frozen at
-  // window->velocity, before window->until.
-  struct FrozenWindow {
-    Vec<D> velocity;
-    double until;
-    bool met;
-  };
+  // window->velocity, before window->until (and predicts, see FrozenWindow).
   bool try_place(std::uint32_t i, const Vec<D>& xi, std::uint32_t j, const Vec<D>& xj, double t,
                  int skip_face, bool& shared, FrozenWindow* window = nullptr);
   // Moves particle i into the cell of its (changed) position.

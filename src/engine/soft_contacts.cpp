@@ -199,7 +199,7 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
   if (!shared) gather(hot_[j].cell, lists_[1]);
   const double span = window != nullptr ? window->until - t : 0.0;
   const Vec<D> velocity = window != nullptr ? window->velocity : Vec<D>{};
-  auto overlaps = [&](std::uint32_t p, const CandidateList& list) {
+  auto overlaps = [&](std::uint32_t p, const CandidateList& list, int slot) {
     const Vec<D>& x = hot_[p].pos;
     const double radius = radius_of(p);
     for (int f = 0; f < 2 * D; ++f) {
@@ -209,9 +209,24 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
     }
     std::uint32_t delayed = 0;
     const CandidateScan<D> scan = scan_of(list, p, &delayed);
-    const PlacementCheck check = vector_scan_
-                                     ? check_placement_avx512<D>(scan, t, x, velocity, span, i, j)
-                                     : check_placement_scalar<D>(scan, t, x, velocity, span, i, j);
+    ContactProbe<D> probe{x, velocity, span, i, j, false};
+    // With `predict`, the particle's motion after the release as its record will hold it.
+    Vec<D> x_after{}, v_after{};
+    double best = 0.0;
+    if (window != nullptr && window->predict) {
+      HotRecord<D> after = hot_[p];
+      for (int a = 0; a < D; ++a) after.pos[a] = x[a] + velocity[a] * (window->until - t);
+      after.vel = window->after[slot];
+      after.time = window->until;
+      window->crossing[slot] = next_crossing(after);
+      best = window->crossing[slot].time - t;
+      x_after = after.pos + (t - after.time) * after.vel;
+      v_after = after.vel;
+      probe.predict = true;
+    }
+    const ContactProbeResult check =
+        vector_scan_ ? probe_contact_avx512<D>(scan, t, probe, x_after, v_after, best)
+                     : probe_contact_scalar<D>(scan, t, probe, x_after, v_after, best);
     if (check.overlap) return true;
     if (window != nullptr && check.met) window->met = true;
     // Candidates in deferred contacts of their own: frozen until their release.
@@ -228,9 +243,20 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
       window->met =
           piecewise_contact_time<D>(d, t, ends, g, 2, t, window->until, sigma) < window->until;
     }
+    if (probe.predict && !window->met) {
+      std::uint32_t partner = check.found == kNoCandidate ? kNone : list.ids[check.found];
+      if (delayed > 0) {
+        const std::uint32_t other =
+            scan_deferred(list, delayed, p, t, x_after, v_after, window->until, best);
+        if (other != kNone) partner = other;
+      }
+      window->partner[slot] = partner;
+      window->best[slot] = best;
+    }
     return false;
   };
-  if (!overlaps(i, lists_[0]) && (count == 1 || !overlaps(j, lists_[shared ? 0 : 1]))) return true;
+  if (!overlaps(i, lists_[0], 0) && (count == 1 || !overlaps(j, lists_[shared ? 0 : 1], 1)))
+    return true;
   for (int k = 0; k < count; ++k) {  // put back, cells included
     HotRecord<D>& h = hot_[both[k]];
     h.pos = from[k];
@@ -297,10 +323,8 @@ double EventEngine<D, Queue>::deferred_contact_energy() const {
 template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::scan_deferred(const CandidateList& list, std::uint32_t count,
                                                    std::uint32_t i, double t, const Vec<D>& xi,
-                                                   const Vec<D>& vi, double& best) const {
-  // A particle predicted inside its own deferred contact (at its start, see try_defer) moves as
-  // its record says only from its release on; what comes before was checked by try_defer.
-  const double from = in_deferred_contact(i, t) ? hot_[i].time : t;
+                                                   const Vec<D>& vi, double from,
+                                                   double& best) const {
   std::uint32_t found = kNone;
   for (std::uint32_t n = 0; n < count; ++n) {
     const std::uint32_t k = list.delayed[n];
@@ -321,52 +345,51 @@ std::uint32_t EventEngine<D, Queue>::scan_deferred(const CandidateList& list, st
   return found;
 }
 
-// The pair's frozen path is checked first (cells and walls; try_place has checked the third
-// bodies: nothing may happen to it before `until`), then both are predicted from their
-// post-contact motion. A prediction before
-// the release would be a contact of that motion extended backwards, which never happens.
+// try_place has checked the third bodies and predicted both particles' motion after the
+// release; here the frozen path must stay inside both cells and meet no wall, and both events
+// after the release must come after it (an earlier one would be the post-contact motion extended
+// backwards, which is not where the particle is).
 template <int D, class Queue>
-bool EventEngine<D, Queue>::try_defer(std::uint32_t i, const Vec<D>& vi, std::uint32_t j,
-                                      const Vec<D>& vj, const Vec<D>& V, double t, double until,
-                                      bool shared) {
+bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t,
+                                      const FrozenWindow& window) {
   const std::uint32_t both[2] = {i, j};
+  const double until = window.until;
   Vec<D> start[2], end[2];
   for (int k = 0; k < 2; ++k) {
     const HotRecord<D>& h = hot_[both[k]];
     start[k] = h.pos;
     for (int a = 0; a < D; ++a) {
-      end[k][a] = h.pos[a] + V[a] * (until - t);  // as advance_to() would move it
+      end[k][a] = h.pos[a] + window.velocity[a] * (until - t);  // as advance_to() would move it
       if (!(grid_.lower_bound(h.cell, a) < end[k][a] && end[k][a] < grid_.upper_bound(h.cell, a)))
         return false;
     }
     for (int f = 0; walls_ && f < 2 * D; ++f) {
       if (env_.faces[f].kind == FaceKind::kWall &&
-          wall_event_time(f, h.pos, V, radius_of(both[k]), t, until - t) < until - t)
+          wall_event_time(f, h.pos, window.velocity, radius_of(both[k]), t, until - t) < until - t)
         return false;
     }
   }
-  const CandidateList& list_i = lists_[0];
-  const CandidateList& list_j = lists_[shared ? 0 : 1];
-  const Vec<D> after[2] = {vi, vj};
   for (int k = 0; k < 2; ++k) {
     HotRecord<D>& h = hot_[both[k]];
     h.pos = end[k];
-    h.vel = after[k];
+    h.vel = window.after[k];
     h.time = until;
     deferred_[both[k]] = 1;
-    frozen_velocity_[both[k]] = V;
+    frozen_velocity_[both[k]] = window.velocity;
   }
-  const double ti = predict_from(list_i, i, t);
-  const double tj = predict_from(list_j, j, t);
-  if (ti >= until && tj >= until) {
-    queue_.update(i, ti);
-    queue_.update(j, tj);
+  double when[2];
+  for (int k = 0; k < 2; ++k)
+    when[k] =
+        conclude_prediction(both[k], t, window.crossing[k], window.partner[k], window.best[k]);
+  if (when[0] >= until && when[1] >= until) {
+    queue_.update(i, when[0]);
+    queue_.update(j, when[1]);
     return true;
   }
   for (int k = 0; k < 2; ++k) {  // back to the frozen pair at time t
     HotRecord<D>& h = hot_[both[k]];
     h.pos = start[k];
-    h.vel = V;
+    h.vel = window.velocity;
     h.time = t;
     deferred_[both[k]] = 0;
   }
@@ -435,12 +458,18 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
     // Each particle's displacement from its place at first contact (R stays): no images.
     const Vec<D> xi = hi.pos + (mj / total) * (rc - r), xj = hj.pos - (mi / total) * (rc - r);
     bool shared = false;
-    const double until = t + map.eps_t * units.time_unit;
-    FrozenWindow window{V, until, false};
+    const Vec<D> gc = (-map.eps_rdot * vn) * nc + (vt / map.eps_r) * tc;
+    const Vec<D> after_i = V + (mj / total) * gc, after_j = V - (mi / total) * gc;
+    FrozenWindow window;
+    window.velocity = V;
+    window.until = t + map.eps_t * units.time_unit;
+    window.predict = !deferred_.empty();
+    window.after[0] = after_i;
+    window.after[1] = after_j;
     if (try_place(i, xi, j, xj, t, -1, shared, deferred_.empty() ? nullptr : &window)) {
-      const Vec<D> gc = (-map.eps_rdot * vn) * nc + (vt / map.eps_r) * tc;
-      release_velocity_[i] = V + (mj / total) * gc;
-      release_velocity_[j] = V - (mi / total) * gc;
+      const double until = window.until;
+      release_velocity_[i] = after_i;
+      release_velocity_[j] = after_j;
       const Vec<D> impulse = mi * (release_velocity_[i] - hi.vel);
       // The impulse acts while the line of centres turns from r to rc: the mean lever arm.
       const Vec<D> arm = 0.5 * (r + rc);
@@ -458,8 +487,7 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
       ++counters_.collisions;
       ++hi.collisions;
       ++hj.collisions;
-      if (!deferred_.empty() && !window.met &&
-          try_defer(i, release_velocity_[i], j, release_velocity_[j], V, t, until, shared)) {
+      if (!deferred_.empty() && !window.met && try_defer(i, j, t, window)) {
         predict_released();  // deferred: what the contact holds is in its records
         return;
       }
@@ -553,23 +581,23 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   queue_.update(i, predict(i, t));
 }
 
-#define KAIROS_SOFT_MEMBERS(D, Q)                                                                 \
-  template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                          \
-  template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&, StartMode);           \
-  template std::uint32_t EventEngine<D, Q>::frozen() const;                                       \
-  template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&);  \
-  template void EventEngine<D, Q>::relocate(std::uint32_t);                                       \
-  template bool EventEngine<D, Q>::try_place(std::uint32_t, const Vec<D>&, std::uint32_t,         \
-                                             const Vec<D>&, double, int, bool&, FrozenWindow*);   \
-  template std::uint32_t EventEngine<D, Q>::release(std::uint32_t, double, bool);                 \
-  template void EventEngine<D, Q>::release_event(std::uint32_t, double);                          \
-  template void EventEngine<D, Q>::collide_soft(std::uint32_t, std::uint32_t, double);            \
-  template double EventEngine<D, Q>::deferred_contact_energy() const;                             \
-  template std::uint32_t EventEngine<D, Q>::scan_deferred(const CandidateList&, std::uint32_t,    \
-                                                          std::uint32_t, double, const Vec<D>&,   \
-                                                          const Vec<D>&, double&) const;          \
-  template bool EventEngine<D, Q>::try_defer(std::uint32_t, const Vec<D>&, std::uint32_t,         \
-                                             const Vec<D>&, const Vec<D>&, double, double, bool); \
+#define KAIROS_SOFT_MEMBERS(D, Q)                                                                \
+  template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                         \
+  template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&, StartMode);          \
+  template std::uint32_t EventEngine<D, Q>::frozen() const;                                      \
+  template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&); \
+  template void EventEngine<D, Q>::relocate(std::uint32_t);                                      \
+  template bool EventEngine<D, Q>::try_place(std::uint32_t, const Vec<D>&, std::uint32_t,        \
+                                             const Vec<D>&, double, int, bool&, FrozenWindow*);  \
+  template std::uint32_t EventEngine<D, Q>::release(std::uint32_t, double, bool);                \
+  template void EventEngine<D, Q>::release_event(std::uint32_t, double);                         \
+  template void EventEngine<D, Q>::collide_soft(std::uint32_t, std::uint32_t, double);           \
+  template double EventEngine<D, Q>::deferred_contact_energy() const;                            \
+  template std::uint32_t EventEngine<D, Q>::scan_deferred(const CandidateList&, std::uint32_t,   \
+                                                          std::uint32_t, double, const Vec<D>&,  \
+                                                          const Vec<D>&, double, double&) const; \
+  template bool EventEngine<D, Q>::try_defer(std::uint32_t, std::uint32_t, double,               \
+                                             const FrozenWindow&);                               \
   template void EventEngine<D, Q>::hit_wall_soft(std::uint32_t, int, double);
 
 KAIROS_SOFT_MEMBERS(2, BinaryHeapQueue)
