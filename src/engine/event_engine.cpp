@@ -460,7 +460,6 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(release_time_, n);
   permute(release_velocity_, n);
   permute(deferred_, n);
-  permute(frozen_velocity_, n);
   for (std::uint32_t& p : frozen_with_)
     if (p < kFirstCode) p = new_index[p];
   if (stepped_) steps_.renumber(new_index);
@@ -1338,8 +1337,8 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
     if (!deferred_.empty() && deferred_[k] != 0 && !in_deferred_contact(k, time_)) continue;
     FrozenContact<D> c;
     c.i = id_[k];
-    c.release_time = release_time_[k];
     c.deferred = !deferred_.empty() && deferred_[k] != 0;
+    c.release_time = c.deferred ? hot_[k].time : release_time_[k];
     c.velocity_i = c.deferred ? hot_[k].vel : release_velocity_[k];
     if (c.deferred) c.release_position_i = hot_[k].pos;
     if (p < kFirstCode) {
@@ -1357,7 +1356,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
     const Shape& sh = shapes_[shape_.empty() ? 0 : shape_[k]];
     out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};
     if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
-      out.kinematics[c] = {position_of(k, time_), frozen_velocity_[k], time_, sh.radius};
+      out.kinematics[c] = {position_of(k, time_), frozen_velocity_of(k), time_, sh.radius};
     out.mass[c] = sh.mass;
     out.species[c] = sh.species;
     out.collision_count[c] = h.collisions;
@@ -1688,7 +1687,7 @@ void EventEngine<D, Queue>::validate() {
       const HotRecord<D>& h = hot_[i];
       for (int f = 0; f < 2 * D; ++f) {
         if (env_.faces[f].kind != FaceKind::kWall) continue;
-        if (wall_event_time(f, position_of(i, t), frozen_velocity_[i], radius_of(i), t,
+        if (wall_event_time(f, position_of(i, t), frozen_velocity_of(i), radius_of(i), t,
                             h.time - t) < h.time - t)
           fail("particle " + name(i) + " meets wall " + std::to_string(f) +
                " inside its deferred soft contact");
@@ -1774,7 +1773,7 @@ void EventEngine<D, Queue>::validate() {
     if (pieces == 2 && ends[1] < ends[0]) std::swap(ends[0], ends[1]);
     ends[pieces++] = kNever;
     auto velocity = [&](std::uint32_t k, double when) {
-      return in_deferred_contact(k, when) ? frozen_velocity_[k] : hot_[k].vel;
+      return in_deferred_contact(k, when) ? frozen_velocity_of(k) : hot_[k].vel;
     };
     Vec<D> g[3];
     double start = t;

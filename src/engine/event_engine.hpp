@@ -216,12 +216,12 @@ class EventEngine {
   // in a deferred soft contact: then the frozen motion until the release).
   Vec<D> position_of(std::uint32_t i, double t) const {
     if (in_deferred_contact(i, t)) [[unlikely]]
-      return hot_[i].pos - (hot_[i].time - t) * frozen_velocity_[i];
+      return hot_[i].pos - (hot_[i].time - t) * frozen_velocity_of(i);
     return is_asleep(i) ? hot_[i].pos : position_at(hot_[i], t);
   }
   Vec<D> velocity_of(std::uint32_t i, double t) const {
     if (in_deferred_contact(i, t)) [[unlikely]]
-      return frozen_velocity_[i];
+      return frozen_velocity_of(i);
     return is_asleep(i) ? Vec<D>{} : velocity_at(hot_[i], t);
   }
   void add_virial_tensor(const Vec<D>& r, const Vec<D>& impulse);
@@ -319,7 +319,9 @@ class EventEngine {
   std::uint32_t release(std::uint32_t i, double t, bool early);
   void release_event(std::uint32_t i, double t);
   // Deferred releases: the pair (or particle and wall) already moves as after the contact in its
-  // record, whose local time is the release time; until then it is frozen (frozen_velocity_).
+  // record, whose local time is the release time; until then it is frozen (frozen_velocity_of).
+  // Only frozen_with_ and deferred_ are written for it (release_time_ and release_velocity_
+  // belong to frozen contacts with release events).
   // Only such a record has a local time after the present.
   bool in_deferred_contact(std::uint32_t i, double t) const {
     return !deferred_.empty() && t < hot_[i].time;
@@ -353,9 +355,16 @@ class EventEngine {
   // A deferred contact keeps its flags after its release (nothing needs to happen then); they
   // are cleared when the particle next meets something.
   void forget_contact(std::uint32_t k) {
-    if (!deferred_.empty()) deferred_[k] = 0;
+    deferred_[k] = 0;
     frozen_with_[k] = EventSlot::kNoPartner;
-    release_time_[k] = kNever;
+  }
+  // The centre-of-mass velocity of a deferred pair (its frozen motion), from the records after
+  // the release: the same bits for both particles (summed in index order).
+  Vec<D> frozen_velocity_of(std::uint32_t k) const {
+    const std::uint32_t p = frozen_with_[k];
+    const std::uint32_t a = std::min(k, p), b = std::max(k, p);
+    const double ma = mass_of(a), mb = mass_of(b);
+    return (1.0 / (ma + mb)) * (ma * hot_[a].vel + mb * hot_[b].vel);
   }
   double deferred_contact_energy() const;
   // The map from the table, or integrated directly outside it (counted).
@@ -434,7 +443,6 @@ class EventEngine {
   // after the release) and the frozen velocity until then. The energy a deferred contact holds
   // is not in counters_.soft_contact_energy (see potential_energy()).
   HugeVector<std::uint8_t> deferred_;
-  HugeVector<Vec<D>> frozen_velocity_;
 
   CandidateList lists_[2];
   Environment<D> env_;  // last: the hot members above share fewer cache lines

@@ -80,7 +80,6 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
   release_velocity_.assign(n, Vec<D>{});
   if (options_.defer_soft_releases) {
     deferred_.assign(n, 0);
-    frozen_velocity_.assign(n, Vec<D>{});
   }
 }
 
@@ -126,7 +125,6 @@ void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s, StartMode
       const std::pair<std::uint32_t, Vec<D>> both[2] = {{i, c.release_position_i},
                                                         {j, c.release_position_j}};
       for (const auto& [k, x] : both) {
-        frozen_velocity_[k] = hot_[k].vel;
         hot_[k].pos = x;
         hot_[k].vel = release_velocity_[k];
         hot_[k].time = c.release_time;
@@ -233,13 +231,13 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
     for (std::uint32_t n = 0; n < delayed; ++n) {
       const std::uint32_t k = list.delayed[n];
       const HotRecord<D>& h = hot_[list.ids[k]];
-      Vec<D> d = x - (h.pos - (h.time - t) * frozen_velocity_[list.ids[k]]);
+      Vec<D> d = x - (h.pos - (h.time - t) * frozen_velocity_of(list.ids[k]));
       if (list.n_shifts > 1) d = d - list.shifts[list.shift[k]];
       const double sigma = radius + radius_of(list.ids[k]);
       if (norm2(d) < sigma * sigma) return true;
       if (window == nullptr || window->met) continue;
       const double ends[2] = {h.time, kNever};
-      const Vec<D> g[2] = {velocity - frozen_velocity_[list.ids[k]], velocity - h.vel};
+      const Vec<D> g[2] = {velocity - frozen_velocity_of(list.ids[k]), velocity - h.vel};
       window->met =
           piecewise_contact_time<D>(d, t, ends, g, 2, t, window->until, sigma) < window->until;
     }
@@ -282,7 +280,7 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
     // Early: from where the frozen pair is now, with the post-contact velocities.
     auto give_back = [&](std::uint32_t k) {
       HotRecord<D>& h = hot_[k];
-      h.pos = h.pos - (h.time - t) * frozen_velocity_[k];
+      h.pos = h.pos - (h.time - t) * frozen_velocity_of(k);
       h.time = t;
       ++h.collisions;
       forget_contact(k);
@@ -315,7 +313,7 @@ double EventEngine<D, Queue>::deferred_contact_energy() const {
   double e = 0.0;
   for (std::uint32_t k = 0; k < deferred_.size(); ++k) {
     if (in_deferred_contact(k, time_))
-      e += 0.5 * mass_of(k) * (norm2(hot_[k].vel) - norm2(frozen_velocity_[k]));
+      e += 0.5 * mass_of(k) * (norm2(hot_[k].vel) - norm2(frozen_velocity_of(k)));
   }
   return e;
 }
@@ -331,10 +329,10 @@ std::uint32_t EventEngine<D, Queue>::scan_deferred(const CandidateList& list, st
     const std::uint32_t q = list.ids[k];
     const HotRecord<D>& h = hot_[q];
     if (q == i || (frozen_with_[i] == q && frozen_with_[q] == i)) continue;  // its own pair
-    Vec<D> xq = h.pos - (h.time - t) * frozen_velocity_[q];
+    Vec<D> xq = h.pos - (h.time - t) * frozen_velocity_of(q);
     if (list.n_shifts > 1) xq = xq + list.shifts[list.shift[k]];
     const double ends[2] = {h.time, kNever};
-    const Vec<D> g[2] = {vi - frozen_velocity_[q], vi - h.vel};
+    const Vec<D> g[2] = {vi - frozen_velocity_of(q), vi - h.vel};
     const double when = piecewise_contact_time<D>(xi - xq, t, ends, g, 2, from, t + best,
                                                   radius_of(i) + radius_of(q));
     if (when - t < best) {
@@ -375,7 +373,6 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
     h.vel = window.after[k];
     h.time = until;
     deferred_[both[k]] = 1;
-    frozen_velocity_[both[k]] = window.velocity;
   }
   double when[2];
   for (int k = 0; k < 2; ++k)
@@ -468,21 +465,17 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
     window.after[1] = after_j;
     if (try_place(i, xi, j, xj, t, -1, shared, deferred_.empty() ? nullptr : &window)) {
       const double until = window.until;
-      release_velocity_[i] = after_i;
-      release_velocity_[j] = after_j;
-      const Vec<D> impulse = mi * (release_velocity_[i] - hi.vel);
+      const Vec<D> impulse = mi * (after_i - hi.vel);
       // The impulse acts while the line of centres turns from r to rc: the mean lever arm.
       const Vec<D> arm = 0.5 * (r + rc);
       counters_.virial += dot(arm, impulse);
       add_virial_tensor(arm, impulse);
-      const double ke_after =
-          0.5 * (mi * norm2(release_velocity_[i]) + mj * norm2(release_velocity_[j]));
+      const double ke_after = 0.5 * (mi * norm2(after_i) + mj * norm2(after_j));
       counters_.dissipated_in_collisions += ke_before - ke_after;
       hi.vel = V;
       hj.vel = V;
       frozen_with_[i] = j;
       frozen_with_[j] = i;
-      release_time_[i] = release_time_[j] = until;
       ++counters_.soft_contacts;
       ++counters_.collisions;
       ++hi.collisions;
@@ -491,6 +484,9 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
         predict_released();  // deferred: what the contact holds is in its records
         return;
       }
+      release_time_[i] = release_time_[j] = until;
+      release_velocity_[i] = after_i;
+      release_velocity_[j] = after_j;
       counters_.soft_contact_energy += ke_after - 0.5 * total * norm2(V);
       queue_.update(i, predict_from(lists_[0], i, t));
       queue_.update(j, predict_from(lists_[shared ? 0 : 1], j, t));
