@@ -462,6 +462,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(deferred_, n);
   for (std::uint32_t& p : frozen_with_)
     if (p < kFirstCode) p = new_index[p];
+  if (soft_) rebuild_awaiting_release();
   if (stepped_) steps_.renumber(new_index);
   insert_all_into_grid();
   if (queue_filled) queue_.reset(times);
@@ -790,8 +791,7 @@ double EventEngine<D, Queue>::conclude_prediction(std::uint32_t i, double t,
       when = t + dt;
     }
   }
-  if (soft_ && frozen_with_[i] != kNoPartner && release_time_[i] <= when &&
-      (deferred_.empty() || deferred_[i] == 0)) [[unlikely]] {
+  if (soft_ && awaits_release(i) && release_time_[i] <= when) [[unlikely]] {
     pending_[i] = {kRelease, 0};
     when = release_time_[i];
   }

@@ -367,6 +367,17 @@ class EventEngine {
     return (1.0 / (ma + mb)) * (ma * hot_[a].vel + mb * hot_[b].vel);
   }
   double deferred_contact_energy() const;
+  // Particles frozen until a release event, one bit each: every prediction asks, and the bits
+  // stay in the first-level cache where the per-particle arrays would not.
+  bool awaits_release(std::uint32_t i) const {
+    return ((awaiting_release_[i >> 6] >> (i & 63u)) & 1u) != 0;
+  }
+  void set_awaits_release(std::uint32_t i, bool on) {
+    const std::uint64_t bit = std::uint64_t{1} << (i & 63u);
+    awaiting_release_[i >> 6] =
+        on ? awaiting_release_[i >> 6] | bit : awaiting_release_[i >> 6] & ~bit;
+  }
+  void rebuild_awaiting_release();
   // The map from the table, or integrated directly outside it (counted).
   CollisionMap soft_map(const SoftMapTable* table, const CollisionUnits& units);
   // Places i at xi (and j at xj, unless j is kNoPartner) at time t unless that overlaps a third
@@ -443,6 +454,7 @@ class EventEngine {
   // after the release) and the frozen velocity until then. The energy a deferred contact holds
   // is not in counters_.soft_contact_energy (see potential_energy()).
   HugeVector<std::uint8_t> deferred_;
+  std::vector<std::uint64_t> awaiting_release_;  // see awaits_release()
 
   CandidateList lists_[2];
   Environment<D> env_;  // last: the hot members above share fewer cache lines

@@ -76,6 +76,7 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
   }
   const std::size_t n = s.size();
   frozen_with_.assign(n, kNone);
+  awaiting_release_.assign((n + 63) / 64, 0);
   release_time_.assign(n, kNever);
   release_velocity_.assign(n, Vec<D>{});
   if (options_.defer_soft_releases) {
@@ -139,6 +140,15 @@ void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s, StartMode
       }
     }
   }
+  rebuild_awaiting_release();
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::rebuild_awaiting_release() {
+  std::fill(awaiting_release_.begin(), awaiting_release_.end(), 0);
+  for (std::uint32_t k = 0; k < frozen_with_.size(); ++k)
+    if (frozen_with_[k] != kNone && (deferred_.empty() || deferred_[k] == 0))
+      set_awaits_release(k, true);
 }
 
 template <int D, class Queue>
@@ -298,6 +308,7 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
     h.vel = release_velocity_[k];
     ++h.collisions;
     frozen_with_[k] = kNone;
+    set_awaits_release(k, false);
     release_time_[k] = kNever;
   };
   give_back(i);
@@ -487,6 +498,8 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
       release_time_[i] = release_time_[j] = until;
       release_velocity_[i] = after_i;
       release_velocity_[j] = after_j;
+      set_awaits_release(i, true);
+      set_awaits_release(j, true);
       counters_.soft_contact_energy += ke_after - 0.5 * total * norm2(V);
       queue_.update(i, predict_from(lists_[0], i, t));
       queue_.update(j, predict_from(lists_[shared ? 0 : 1], j, t));
@@ -560,6 +573,7 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
       counters_.soft_contact_energy += 0.5 * m * (norm2(after) - norm2(frozen_velocity));
       h.vel = frozen_velocity;
       frozen_with_[i] = kFirstWall + static_cast<std::uint32_t>(face);
+      set_awaits_release(i, true);
       release_time_[i] = t + map.eps_t * units.time_unit;
       release_velocity_[i] = after;
       ++counters_.soft_contacts;
@@ -581,6 +595,7 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                         \
   template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&, StartMode);          \
   template std::uint32_t EventEngine<D, Q>::frozen() const;                                      \
+  template void EventEngine<D, Q>::rebuild_awaiting_release();                                   \
   template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&); \
   template void EventEngine<D, Q>::relocate(std::uint32_t);                                      \
   template bool EventEngine<D, Q>::try_place(std::uint32_t, const Vec<D>&, std::uint32_t,        \
