@@ -75,6 +75,32 @@ template <int D, bool kAccelerated>
   }
 }
 
+// The pair test of the scan loops for the lanes `lanes`: the contact time gap/(-rg + sqrt(disc))
+// of approaching lanes that the cheap bound (at least gap/(-2 rg)) does not rule out; lowers best
+// to the soonest and sets found to the lowest lane holding it (k: the first lane's index).
+[[gnu::always_inline]] inline void keep_soonest(__mmask8 lanes, __m512d gap, __m512d rg, __m512d g2,
+                                                std::uint32_t k, double& best,
+                                                std::uint32_t& found) {
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512d bound =
+      _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(-2.0), rg), _mm512_set1_pd(best));
+  __mmask8 ok = _mm512_mask_cmp_pd_mask(lanes, rg, zero, _CMP_LT_OQ);
+  ok = _mm512_mask_cmp_pd_mask(ok, gap, bound, _CMP_LE_OQ);
+  if (ok == 0) return;
+  const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(rg, rg), _mm512_mul_pd(g2, gap));
+  ok = _mm512_mask_cmp_pd_mask(ok, disc, zero, _CMP_GT_OQ);
+  if (ok == 0) return;
+  __m512d dt = _mm512_div_pd(gap, _mm512_sub_pd(_mm512_sqrt_pd(disc), rg));
+  dt = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(dt, zero, _CMP_GT_OQ), zero, dt);
+  dt = _mm512_mask_blend_pd(ok, _mm512_set1_pd(std::numeric_limits<double>::infinity()), dt);
+  const double m = _mm512_reduce_min_pd(dt);
+  if (m < best) {
+    const __mmask8 at = _mm512_mask_cmp_pd_mask(ok, dt, _mm512_set1_pd(m), _CMP_EQ_OQ);
+    best = m;
+    found = k + static_cast<std::uint32_t>(__builtin_ctz(at));
+  }
+}
+
 }  // namespace
 
 // Eight candidates per iteration. Record fields come in by gathers (the records were prefetched
@@ -84,10 +110,8 @@ template <int D, bool kAccelerated>
 template <int D, bool kAccelerated>
 std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
                                      const Vec<D>& vi, double& best) {
-  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
   const __m512d zero = _mm512_setzero_pd();
   const __m512d vt = _mm512_set1_pd(t);
-  const __m512d minus_two = _mm512_set1_pd(-2.0);
   __m512d vxi[D], vvi[D];
   for (int a = 0; a < D; ++a) {
     vxi[a] = _mm512_set1_pd(xi[a]);
@@ -123,24 +147,8 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
       const __m512d sigma = _mm512_add_pd(vradius_i, rj);
       sigma2 = _mm512_mul_pd(sigma, sigma);
     }
-    const __m512d gap = _mm512_sub_pd(r2, sigma2);
-    const __m512d bound = _mm512_mul_pd(_mm512_mul_pd(minus_two, rg), _mm512_set1_pd(best));
-    __mmask8 ok = _mm512_mask_cmp_pd_mask(live & ~future, rg, zero, _CMP_LT_OQ);
-    ok = _mm512_mask_cmp_pd_mask(ok, gap, bound, _CMP_LE_OQ);
-    if (ok == 0) continue;
-    const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(rg, rg), _mm512_mul_pd(g2, gap));
-    ok = _mm512_mask_cmp_pd_mask(ok, disc, zero, _CMP_GT_OQ);
-    if (ok == 0) continue;
-    const __m512d root = _mm512_sqrt_pd(disc);
-    __m512d dt = _mm512_div_pd(gap, _mm512_sub_pd(root, rg));
-    dt = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(dt, zero, _CMP_GT_OQ), zero, dt);
-    dt = _mm512_mask_blend_pd(ok, inf, dt);
-    const double m = _mm512_reduce_min_pd(dt);
-    if (m < best) {
-      const __mmask8 at = _mm512_mask_cmp_pd_mask(ok, dt, _mm512_set1_pd(m), _CMP_EQ_OQ);
-      best = m;
-      found = k + static_cast<std::uint32_t>(__builtin_ctz(at));
-    }
+    keep_soonest(static_cast<__mmask8>(live & ~future), _mm512_sub_pd(r2, sigma2), rg, g2, k, best,
+                 found);
   }
   return found;
 }
@@ -152,7 +160,6 @@ ContactProbeResult probe_contact_avx512(const CandidateScan<D>& s, double t,
                                         const ContactProbe<D>& probe, const Vec<D>& xi,
                                         const Vec<D>& vi, double& best) {
   ContactProbeResult out;
-  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
   const __m512d zero = _mm512_setzero_pd();
   const __m512d vt = _mm512_set1_pd(t);
   const __m512d vspan = _mm512_set1_pd(probe.span);
@@ -236,22 +243,7 @@ ContactProbeResult probe_contact_avx512(const CandidateScan<D>& s, double t,
     if (!probe.predict) continue;
     // The motion after the release: scan_candidates_avx512's test.
     const __m512d gap = _mm512_sub_pd(r2, sigma2);
-    const __m512d bound = _mm512_mul_pd(_mm512_mul_pd(minus_two, rg), _mm512_set1_pd(best));
-    __mmask8 ok = _mm512_mask_cmp_pd_mask(live, rg, zero, _CMP_LT_OQ);
-    ok = _mm512_mask_cmp_pd_mask(ok, gap, bound, _CMP_LE_OQ);
-    if (ok == 0) continue;
-    const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(rg, rg), _mm512_mul_pd(g2, gap));
-    ok = _mm512_mask_cmp_pd_mask(ok, disc, zero, _CMP_GT_OQ);
-    if (ok == 0) continue;
-    __m512d dt = _mm512_div_pd(gap, _mm512_sub_pd(_mm512_sqrt_pd(disc), rg));
-    dt = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(dt, zero, _CMP_GT_OQ), zero, dt);
-    dt = _mm512_mask_blend_pd(ok, inf, dt);
-    const double m = _mm512_reduce_min_pd(dt);
-    if (m < best) {
-      const __mmask8 at = _mm512_mask_cmp_pd_mask(ok, dt, _mm512_set1_pd(m), _CMP_EQ_OQ);
-      best = m;
-      out.found = k + static_cast<std::uint32_t>(__builtin_ctz(at));
-    }
+    keep_soonest(live, gap, rg, g2, k, best, out.found);
   }
   out.met = met != 0;
   return out;
@@ -291,7 +283,6 @@ std::uint32_t scan_stepped_avx512(const SteppedScan<D>& s, double t, const Vec<D
   const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
   const __m512d zero = _mm512_setzero_pd();
   const __m512d vt = _mm512_set1_pd(t);
-  const __m512d minus_two = _mm512_set1_pd(-2.0);
   __m512d vxi[D], vvi[D];
   for (int a = 0; a < D; ++a) {
     vxi[a] = _mm512_set1_pd(xi[a]);
@@ -339,22 +330,7 @@ std::uint32_t scan_stepped_avx512(const SteppedScan<D>& s, double t, const Vec<D
       reach2 = _mm512_mask_i32gather_pd(zero, outside, shp, s.row_reach2, 8);
     }
     const __m512d gap = _mm512_sub_pd(r2, reach2);
-    const __m512d bound = _mm512_mul_pd(_mm512_mul_pd(minus_two, rg), _mm512_set1_pd(best));
-    __mmask8 ok = _mm512_mask_cmp_pd_mask(outside, rg, zero, _CMP_LT_OQ);
-    ok = _mm512_mask_cmp_pd_mask(ok, gap, bound, _CMP_LE_OQ);
-    if (ok == 0) continue;
-    const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(rg, rg), _mm512_mul_pd(g2, gap));
-    ok = _mm512_mask_cmp_pd_mask(ok, disc, zero, _CMP_GT_OQ);
-    if (ok == 0) continue;
-    __m512d dt = _mm512_div_pd(gap, _mm512_sub_pd(_mm512_sqrt_pd(disc), rg));
-    dt = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(dt, zero, _CMP_GT_OQ), zero, dt);
-    dt = _mm512_mask_blend_pd(ok, inf, dt);
-    const double m = _mm512_reduce_min_pd(dt);
-    if (m < best) {
-      const __mmask8 at = _mm512_mask_cmp_pd_mask(ok, dt, _mm512_set1_pd(m), _CMP_EQ_OQ);
-      best = m;
-      found = k + static_cast<std::uint32_t>(__builtin_ctz(at));
-    }
+    keep_soonest(outside, gap, rg, g2, k, best, found);
   }
   // The held (listed) candidates, in list order: ZoneTable::event_time.
   const __m512i sign = _mm512_set1_epi64(static_cast<long long>(0x8000000000000000ull));
