@@ -75,6 +75,31 @@ template <int D, bool kAccelerated>
   }
 }
 
+// Appends the indices of the lanes `lanes` of the block starting at k to s.delayed (candidates
+// in deferred soft contacts, left to the caller).
+template <int D>
+[[gnu::always_inline]] inline void list_lanes(const CandidateScan<D>& s, std::uint32_t k,
+                                              __mmask8 lanes) {
+  const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(k)),
+                                         _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  _mm256_mask_compressstoreu_epi32(s.delayed + *s.delayed_count, lanes, index);
+  *s.delayed_count += static_cast<std::uint32_t>(__builtin_popcount(lanes));
+}
+
+// The squared contact distances (radius_i + the candidate's radius)^2 of mixed sizes. Shape
+// numbers are 16-bit: gather 32 bits at each and keep the low half (the array is padded by the
+// engine so the last read stays inside it).
+template <int D>
+[[gnu::always_inline]] inline __m512d contact_distance2(const CandidateScan<D>& s, __m256i ids,
+                                                        __mmask8 live, __m512d vradius_i) {
+  const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(live),
+                                                  _mm512_castsi256_si512(ids), s.shape, 2);
+  const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
+  const __m512d rj = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live, shp, s.shape_radius, 8);
+  const __m512d sigma = _mm512_add_pd(vradius_i, rj);
+  return _mm512_mul_pd(sigma, sigma);
+}
+
 // The pair test of the scan loops for the lanes `lanes`: the contact time gap/(-rg + sqrt(disc))
 // of approaching lanes that the cheap bound (at least gap/(-2 rg)) does not rule out; lowers best
 // to the soonest and sets found to the lowest lane holding it (k: the first lane's index).
@@ -130,23 +155,9 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
     pair_terms<D, kAccelerated>(s, k, base, live, vt, vxi, vvi, r2, rg, g2, dtj);
     // Candidates inside a deferred soft contact (local time after t) are left to the caller.
     const __mmask8 future = _mm512_mask_cmp_pd_mask(live, dtj, zero, _CMP_LT_OQ);
-    if (future != 0 && s.delayed != nullptr) [[unlikely]] {
-      const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(k)),
-                                             _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-      _mm256_mask_compressstoreu_epi32(s.delayed + *s.delayed_count, future, index);
-      *s.delayed_count += static_cast<std::uint32_t>(__builtin_popcount(future));
-    }
-    __m512d sigma2 = vsigma2;
-    if (!s.uniform) {
-      // Shape numbers are 16-bit: gather 32 bits at each and keep the low half (the array is
-      // padded by the engine so the last read stays inside it).
-      const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(live),
-                                                      _mm512_castsi256_si512(ids), s.shape, 2);
-      const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
-      const __m512d rj = _mm512_mask_i32gather_pd(zero, live, shp, s.shape_radius, 8);
-      const __m512d sigma = _mm512_add_pd(vradius_i, rj);
-      sigma2 = _mm512_mul_pd(sigma, sigma);
-    }
+    if (future != 0 && s.delayed != nullptr) [[unlikely]]
+      list_lanes<D>(s, k, future);
+    const __m512d sigma2 = s.uniform ? vsigma2 : contact_distance2<D>(s, ids, live, vradius_i);
     keep_soonest(static_cast<__mmask8>(live & ~future), _mm512_sub_pd(r2, sigma2), rg, g2, k, best,
                  found);
   }
@@ -186,12 +197,8 @@ ContactProbeResult probe_contact_avx512(const CandidateScan<D>& s, double t,
     const __m256i base = _mm256_mullo_epi32(ids, vstride);
     const __m512d dtj = _mm512_sub_pd(vt, gather_field(s.records, base, live, 2 * D));
     const __mmask8 future = _mm512_mask_cmp_pd_mask(live, dtj, zero, _CMP_LT_OQ);
-    if (future != 0 && s.delayed != nullptr) [[unlikely]] {
-      const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(k)),
-                                             _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-      _mm256_mask_compressstoreu_epi32(s.delayed + *s.delayed_count, future, index);
-      *s.delayed_count += static_cast<std::uint32_t>(__builtin_popcount(future));
-    }
+    if (future != 0 && s.delayed != nullptr) [[unlikely]]
+      list_lanes<D>(s, k, future);
     live &= static_cast<__mmask8>(~future);
     __m256i shift_base = _mm256_setzero_si256();
     if (s.any_shift) {
@@ -216,15 +223,7 @@ ContactProbeResult probe_contact_avx512(const CandidateScan<D>& s, double t,
       rg = _mm512_add_pd(rg, _mm512_mul_pd(r, g));
       g2 = _mm512_add_pd(g2, _mm512_mul_pd(g, g));
     }
-    __m512d sigma2 = vsigma2;
-    if (!s.uniform) {
-      const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(live),
-                                                      _mm512_castsi256_si512(ids), s.shape, 2);
-      const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
-      const __m512d rj = _mm512_mask_i32gather_pd(zero, live, shp, s.shape_radius, 8);
-      const __m512d sigma = _mm512_add_pd(vradius_i, rj);
-      sigma2 = _mm512_mul_pd(sigma, sigma);
-    }
+    const __m512d sigma2 = s.uniform ? vsigma2 : contact_distance2<D>(s, ids, live, vradius_i);
     // The placed particle: an overlap now, a meeting while frozen.
     const __m512d gap_placed = _mm512_sub_pd(p2, sigma2);
     if (_mm512_mask_cmp_pd_mask(live, gap_placed, zero, _CMP_LT_OQ) != 0) {
