@@ -2015,20 +2015,7 @@ std::uint32_t EventEngine<D, Queue>::scan_stepped(const CandidateList& list, std
   }
   const HotRecord<D>& h = hot_[i];
   const SteppedScan<D> scan{
-      .base = {.records = reinterpret_cast<const double*>(hot_.data()),
-               .stride = static_cast<int>(sizeof(HotRecord<D>) / sizeof(double)),
-               .candidates = list.ids.data(),
-               .shift_index = list.shift.data(),
-               .shifts = list.shifts,
-               .any_shift = list.n_shifts > 1,
-               .count = list.count,
-               .uniform = true,
-               .sigma = 0.0,
-               .radius_i = 0.0,
-               .shape = nullptr,
-               .shape_radius = nullptr,
-               .accel = accelerated_ ? env_.gravity.data() : nullptr,
-               .half_accel = accelerated_ ? half_gravity_.data() : nullptr},
+      .base = scan_of(list, i, nullptr),  // its contact distances are not read
       .self = i,
       .stamps = steps_.stamps(),
       .epoch = steps_.epoch(),
