@@ -1,6 +1,6 @@
 # Kairos convenience targets. Everything goes through CMake; these only chain the steps.
 #   make demo    install missing Debian packages, build (Release), run the default example
-#   make test    install missing Debian packages, build, run the whole test suite
+#   make test    install missing Debian packages, build the tests and the CLI, run the whole test suite
 #   make bench   build and run the benchmark driver (see bench/README.md)
 #   make asan    build and test with AddressSanitizer + UBSan
 
@@ -25,7 +25,10 @@ demo: configure
 	cmake --build $(BUILD) -j $(JOBS) --target kairos
 	$(BUILD)/kairos run examples/hard_spheres_3d.toml -o demo-output
 
-test: build
+# The tests need the test binary and the kairos CLI only (kairos_tests depends on it); `make
+# build` or `make bench` compiles the benchmark and validation programs.
+test: configure
+	cmake --build $(BUILD) -j $(JOBS) --target kairos_tests
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 bench: configure
