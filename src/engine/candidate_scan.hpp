@@ -49,6 +49,20 @@ struct CandidateScan {
 
 inline constexpr std::uint32_t kNoCandidate = 0xffffffffu;
 
+// Candidate k's record and its time to t (dtj); null for a record whose local time lies after t
+// (a deferred soft contact), which is listed in s.delayed instead.
+template <int D>
+inline const double* record_at(const CandidateScan<D>& s, std::uint32_t k, double t, double& dtj) {
+  const double* rec =
+      s.records + static_cast<std::size_t>(s.candidates[k]) * static_cast<std::size_t>(s.stride);
+  dtj = t - rec[2 * D];
+  if (dtj < 0.0) [[unlikely]] {
+    if (s.delayed != nullptr) s.delayed[(*s.delayed_count)++] = k;
+    return nullptr;
+  }
+  return rec;
+}
+
 // Scalar reference. Returns the index (into `candidates`) of the soonest contact earlier than
 // t + best and lowers best to it; kNoCandidate if none.
 // kAccelerated: the loop with gravity's terms (s.accel must be set); a separate
@@ -60,14 +74,11 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
   const Vec<D> no_shift{};
   for (std::uint32_t k = 0; k < s.count; ++k) {
     const std::uint32_t j = s.candidates[k];
-    const double* rec =
-        s.records + static_cast<std::size_t>(j) * static_cast<std::size_t>(s.stride);
-    const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
-    const double dtj = t - rec[2 * D];
-    if (dtj < 0.0) [[unlikely]] {
-      if (s.delayed != nullptr) s.delayed[(*s.delayed_count)++] = k;
+    double dtj;
+    const double* rec = record_at(s, k, t, dtj);
+    if (rec == nullptr) [[unlikely]]
       continue;
-    }
+    const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
     double r2 = 0.0, rg = 0.0, g2 = 0.0;
     for (int a = 0; a < D; ++a) {
       double xj = rec[a] + rec[D + a] * dtj;
@@ -131,14 +142,11 @@ ContactProbeResult probe_contact_scalar(const CandidateScan<D>& s, double t,
   for (std::uint32_t k = 0; k < s.count; ++k) {
     const std::uint32_t j = s.candidates[k];
     if (j == probe.skip_a || j == probe.skip_b) continue;
-    const double* rec =
-        s.records + static_cast<std::size_t>(j) * static_cast<std::size_t>(s.stride);
-    const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
-    const double dtj = t - rec[2 * D];
-    if (dtj < 0.0) [[unlikely]] {
-      if (s.delayed != nullptr) s.delayed[(*s.delayed_count)++] = k;
+    double dtj;
+    const double* rec = record_at(s, k, t, dtj);
+    if (rec == nullptr) [[unlikely]]
       continue;
-    }
+    const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
     double p2 = 0.0, pg = 0.0, q2 = 0.0;  // the placed particle's r.r, r.g, g.g
     double r2 = 0.0, rg = 0.0, g2 = 0.0;  // the released motion's
     for (int a = 0; a < D; ++a) {
