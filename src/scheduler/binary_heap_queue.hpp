@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "scheduler/indexed_min_heap.hpp"
@@ -24,8 +25,11 @@ class BinaryHeapQueue {
     heap_.fill_all();
   }
 
-  std::uint32_t top() const { return heap_.top(); }
-  double top_time() const { return key_[heap_.top()]; }
+  std::uint32_t top() const { return heap_.empty() ? 0 : heap_.top(); }
+  // +inf when empty, as the other queues.
+  double top_time() const {
+    return heap_.empty() ? std::numeric_limits<double>::infinity() : key_[heap_.top()];
+  }
   double time_of(std::uint32_t i) const { return key_[i]; }
 
   void update(std::uint32_t i, double t) {
