@@ -616,6 +616,7 @@ int run(int argc, char** argv) {
   std::vector<double> contact_ratios;
   std::int64_t dem_steps = 0;
   std::string table_cache;
+  std::string lammps_dir;
   double eq = 0, timed = 0;
   int repeat = 1;
   std::string format = "markdown", output;
@@ -653,6 +654,10 @@ int run(int argc, char** argv) {
   auto* o_table_cache = app.add_option(
       "--table-cache", table_cache,
       "soft suite: lookup-table cache directory (default: a fresh temporary one, removed after)");
+  auto* o_lammps = app.add_option(
+      "--lammps-dir", lammps_dir,
+      "soft suite: also write every case for LAMMPS into this directory (start state, input, "
+      "Kairos's figures in cases.tsv; bench/lammps_soft.sh runs them)");
   auto* o_particles = app.add_option("--particles", particles, "particle numbers")->delimiter(',');
   auto* o_eta =
       app.add_option("--eta", etas, "packing fractions (area fractions in 2D)")->delimiter(',');
@@ -699,9 +704,10 @@ int run(int argc, char** argv) {
     });
     suite = stepped_cases ? "stepped" : soft_cases ? "soft" : "granular";
   }
-  if (suite != "soft" &&
-      (o_ratios->count() > 0 || o_dem_steps->count() > 0 || o_table_cache->count() > 0))
-    throw UsageError("--contact-ratio, --dem-steps and --table-cache need --suite soft");
+  if (suite != "soft" && (o_ratios->count() > 0 || o_dem_steps->count() > 0 ||
+                          o_table_cache->count() > 0 || o_lammps->count() > 0))
+    throw UsageError(
+        "--contact-ratio, --dem-steps, --table-cache and --lammps-dir need --suite soft");
   if (suite == "soft") {
     if (o_queue->count() > 0 || o_sizes->count() > 0 || o_ratio->count() > 0 ||
         o_dim->count() > 0 || fmt_kind == Format::kTsv) {
@@ -721,6 +727,7 @@ int run(int argc, char** argv) {
       sp.dem_steps = static_cast<long>(dem_steps);
     }
     sp.table_cache = table_cache;
+    sp.lammps_dir = lammps_dir;
     if (o_eq->count() > 0) sp.equilibrate = eq;
     if (o_timed->count() > 0) sp.timed = timed;
     if (o_repeat->count() > 0) sp.repeat = repeat;

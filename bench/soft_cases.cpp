@@ -42,10 +42,12 @@
 
 #include "analysis/granular_theory.hpp"
 #include "core/environment.hpp"
+#include "core/periodic.hpp"
 #include "dem/dem_integrator.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
 #include "interactions/soft_contact.hpp"
+#include "io/atomic_file.hpp"
 #include "run/soft_tables_setup.hpp"
 #include "scheduler/calendar_queue.hpp"
 
@@ -359,6 +361,59 @@ struct TempDir {
   TempDir& operator=(const TempDir&) = delete;
 };
 
+// The start state as a LAMMPS data file (atom_style sphere: diameter and density, so that the
+// mass is m; angular velocities zero), for bench/lammps_soft.sh.
+void write_lammps_data(const std::filesystem::path& file, const ParticleSystem<3>& s) {
+  std::string text = fmt::format(
+      "LAMMPS data file: kairos_bench --suite soft start state ({} spheres, d = {:g}, m = {:g})\n\n"
+      "{} atoms\n1 atom types\n\n",
+      s.size(), kDiameter, kMass, s.size());
+  const char* axes[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a)
+    text += fmt::format("0 {:.17g} {}lo {}hi\n", s.box[a], axes[a], axes[a]);
+  const double density = kMass / (std::numbers::pi / 6.0 * kDiameter * kDiameter * kDiameter);
+  text += "\nAtoms # sphere\n\n";
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    Vec<3> x = s.position_at(i, s.time);
+    for (int a = 0; a < 3; ++a) x[a] = wrap_into_box(x[a], s.box[a]);
+    text += fmt::format("{} 1 {:g} {:.17g} {:.17g} {:.17g} {:.17g}\n", i + 1, kDiameter, density,
+                        x[0], x[1], x[2]);
+  }
+  text += "\nVelocities\n\n";
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const Vec<3>& v = s.kinematics[i].vel;
+    text += fmt::format("{} {:.17g} {:.17g} {:.17g} 0 0 0\n", i + 1, v[0], v[1], v[2]);
+  }
+  write_text_atomically(file, text);
+}
+
+// The same case for LAMMPS: the same contact law in its pair style's parameters (gran/hooke:
+// F = kn d - m_eff gn v_n; gran/hertz/history: F = sqrt(d R_eff) (kn d - m_eff gn v_n), with
+// R_eff = d/4, so kn = rho / sqrt(R_eff) and gn = 1.5 A rho / (m_eff sqrt(R_eff))), frictionless,
+// DEM's time step, warm-up and timed steps.
+void write_lammps_input(const std::filesystem::path& file, const std::string& data, const Case& c,
+                        double dt, long steps) {
+  std::string pair;
+  const SoftContactLaw& law = c.law.law;
+  if (c.law.name == "dashpot") {
+    pair =
+        fmt::format("gran/hooke {:.17g} 0.0 {:.17g} 0.0 0.0 0", law.stiffness, law.damping / kMu);
+  } else {
+    const double sqrt_r = std::sqrt(kDiameter / 4.0);
+    pair = fmt::format("gran/hertz/history {:.17g} NULL {:.17g} NULL 0.0 0", law.stiffness / sqrt_r,
+                       1.5 * law.damping * law.stiffness / (kMu * sqrt_r));
+  }
+  const std::string text = fmt::format(
+      "# kairos_bench --suite soft, eta {:g}, {}, tau/t_c {:g}: DEM cost in LAMMPS "
+      "(bench/lammps_soft.sh)\n"
+      "units lj\natom_style sphere\ndimension 3\nboundary p p p\nnewton off\n"
+      "comm_modify vel yes\nread_data {}\npair_style {}\npair_coeff * *\n"
+      "neighbor 0.3 bin\nneigh_modify delay 0 every 1 check yes\ntimestep {:.17g}\n"
+      "fix nve all nve/sphere\nthermo_modify norm no\nthermo 1000000\nrun {}\nrun {}\n",
+      c.eta, c.law.name, c.ratio, data, pair, dt, kDemWarmup, steps);
+  write_text_atomically(file, text);
+}
+
 }  // namespace
 
 void validate(const SoftPlan& p) {
@@ -420,6 +475,9 @@ void run_soft(const SoftPlan& plan, const std::function<void(const std::string&)
     cache = temp->path;
   }
   std::vector<std::string> notes, summary;
+  std::string lammps_cases =
+      "input\teta\tlaw\tratio\tparticles\tsteps\tenskog_collisions\tmapped_coll_per_s\t"
+      "dem_coll_per_s\tdem_ns_per_particle_step\n";
   emit("\n" + detail_header());
   for (double eta : plan.etas) {
     const auto w0 = Clock::now();
@@ -429,6 +487,12 @@ void run_soft(const SoftPlan& plan, const std::function<void(const std::string&)
         "τ = {:.4f}; start state in {:.1f} s",
         eta, gas.start.box[0], gas.density, gas.temperature, contact_value(3, eta), gas.frequency,
         gas.tau(), seconds_since(w0)));
+    std::string data_name;
+    if (!plan.lammps_dir.empty()) {
+      std::filesystem::create_directories(plan.lammps_dir);
+      data_name = fmt::format("eta{:g}.data", eta);
+      write_lammps_data(std::filesystem::path(plan.lammps_dir) / data_name, gas.start);
+    }
     for (const std::string& name : plan.cases) {
       for (double r : plan.contact_ratios) {
         Case c;
@@ -472,12 +536,25 @@ void run_soft(const SoftPlan& plan, const std::function<void(const std::string&)
         const double dem_dt = vs[2].best().sim / static_cast<double>(dem_steps);
         c.dem_expected =
             0.5 * static_cast<double>(n) * gas.frequency * dem_dt * static_cast<double>(dem_steps);
+        if (!plan.lammps_dir.empty()) {
+          const std::string input = fmt::format("eta{:g}-{}-R{:g}.in", eta, name, r);
+          const double dt = dem_default_time_step(c.law.law, kMu, c.law.reference_speed);
+          write_lammps_input(std::filesystem::path(plan.lammps_dir) / input, data_name, c, dt,
+                             dem_steps);
+          const Sample& dem_best = vs[2].best();
+          lammps_cases += fmt::format(
+              "{}\t{:g}\t{}\t{:g}\t{}\t{}\t{:.6g}\t{:.6g}\t{:.6g}\t{:.6g}\n", input, eta, name, r,
+              n, dem_steps, c.dem_expected, vs[1].best().rate(), dem_best.rate(),
+              1e9 * dem_best.wall / (static_cast<double>(n) * static_cast<double>(dem_steps)));
+        }
         emit(detail_row(c, vs[0], &vs[2], nullptr) + detail_row(c, vs[1], &vs[2], &vs[0]) +
              detail_row(c, vs[3], &vs[2], &vs[0]) + detail_row(c, vs[2], nullptr, &vs[0]));
         summary.push_back(summary_row(c, vs[0], vs[1], vs[2], n));
       }
     }
   }
+  if (!plan.lammps_dir.empty())
+    write_text_atomically(std::filesystem::path(plan.lammps_dir) / "cases.tsv", lammps_cases);
   emit("\n" + summary_header());
   for (const std::string& row : summary) emit(row);
   emit("\n");

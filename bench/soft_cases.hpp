@@ -23,6 +23,9 @@ struct SoftPlan {
   long dem_steps = 0;         // DEM timed steps per sample; 0: 2000
   int repeat = 3;             // interleaved repeats
   std::string table_cache;    // empty: a fresh temporary directory (tables built, then removed)
+  // Non-empty: also write each case for LAMMPS here (start state, input, Kairos's figures in
+  // cases.tsv), for bench/lammps_soft.sh.
+  std::string lammps_dir;
 };
 
 // Throws std::invalid_argument naming the first bad field.
