@@ -27,18 +27,24 @@ fi
 "$BUILD/bench/kairos_bench" --suite soft --lammps-dir "$dir" "$@"
 
 echo
-echo "| η | law | τ/t_c | LAMMPS pair style | LAMMPS ns/particle-step | Kairos DEM ns/particle-step | LAMMPS coll/s | mapped coll/s | **mapped / LAMMPS** | mapped / Kairos DEM |"
-echo "|---|---|---|---|---|---|---|---|---|---|"
-tail -n +2 "$dir/cases.tsv" | while IFS=$'\t' read -r input eta law ratio n steps enskog mapped dem dem_ns; do
+echo "| η | law | τ/t_c | LAMMPS pair style | LAMMPS ns/particle-step | Kairos DEM ns/particle-step | LAMMPS coll/s | mapped coll/s | **mapped / LAMMPS** | mapped / Kairos DEM | energy end/start: LAMMPS, Kairos DEM |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
+tail -n +2 "$dir/cases.tsv" | while IFS=$'\t' read -r input eta law ratio n steps enskog mapped dem dem_ns dem_energy; do
   log="$dir/${input%.in}.log"
   (cd "$dir" && OMP_NUM_THREADS=1 "$LMP" -in "$input" -log none -screen "$log" >/dev/null)
   # "Loop time of 12.3 on 1 procs for 2000 steps with 32000 atoms": the timed (last) run.
   loop=$(grep "^Loop time of" "$log" | tail -n 1 | awk '{print $4}')
   style=$(awk '/^pair_style/ {print $2}' "$dir/$input")
+  # The timed run's first and last thermo rows (Step Temp E_pair E_mol TotEng Press): the same
+  # law cools the gas by the same fraction as Kairos's DEM sample (a check of the translation).
+  energy=$(awk '/^ *Step / {rows = 0; next} /^Loop time/ {if (rows) {r = last / first}} \
+    rows == 0 && $1 ~ /^[0-9]+$/ {first = $5; rows = 1; next} rows && $1 ~ /^[0-9]+$/ {last = $5} \
+    END {printf "%.4f", r}' "$log")
   awk -v eta="$eta" -v law="$law" -v ratio="$ratio" -v style="$style" -v loop="$loop" \
     -v n="$n" -v steps="$steps" -v enskog="$enskog" -v mapped="$mapped" -v dem="$dem" \
-    -v dem_ns="$dem_ns" 'BEGIN {
+    -v dem_ns="$dem_ns" -v energy="$energy" -v dem_energy="$dem_energy" 'BEGIN {
       lns = 1e9 * loop / (n * steps); lrate = enskog / loop;
-      printf "| %s | %s | %s | %s | %.1f | %.1f | %.0f | %.3g M | **%.0f** | %.0f |\n",
-        eta, law, ratio, style, lns, dem_ns, lrate, mapped / 1e6, mapped / lrate, mapped / dem }'
+      printf "| %s | %s | %s | %s | %.1f | %.1f | %.0f | %.3g M | **%.0f** | %.0f | %s, %.4f |\n",
+        eta, law, ratio, style, lns, dem_ns, lrate, mapped / 1e6, mapped / lrate, mapped / dem,
+        energy, dem_energy }'
 done

@@ -477,7 +477,7 @@ void run_soft(const SoftPlan& plan, const std::function<void(const std::string&)
   std::vector<std::string> notes, summary;
   std::string lammps_cases =
       "input\teta\tlaw\tratio\tparticles\tsteps\tenskog_collisions\tmapped_coll_per_s\t"
-      "dem_coll_per_s\tdem_ns_per_particle_step\n";
+      "dem_coll_per_s\tdem_ns_per_particle_step\tdem_energy_ratio\n";
   emit("\n" + detail_header());
   for (double eta : plan.etas) {
     const auto w0 = Clock::now();
@@ -543,9 +543,10 @@ void run_soft(const SoftPlan& plan, const std::function<void(const std::string&)
                              dem_steps);
           const Sample& dem_best = vs[2].best();
           lammps_cases += fmt::format(
-              "{}\t{:g}\t{}\t{:g}\t{}\t{}\t{:.6g}\t{:.6g}\t{:.6g}\t{:.6g}\n", input, eta, name, r,
-              n, dem_steps, c.dem_expected, vs[1].best().rate(), dem_best.rate(),
-              1e9 * dem_best.wall / (static_cast<double>(n) * static_cast<double>(dem_steps)));
+              "{}\t{:g}\t{}\t{:g}\t{}\t{}\t{:.6g}\t{:.6g}\t{:.6g}\t{:.6g}\t{:.6f}\n", input, eta,
+              name, r, n, dem_steps, c.dem_expected, vs[1].best().rate(), dem_best.rate(),
+              1e9 * dem_best.wall / (static_cast<double>(n) * static_cast<double>(dem_steps)),
+              dem_best.energy_ratio);
         }
         emit(detail_row(c, vs[0], &vs[2], nullptr) + detail_row(c, vs[1], &vs[2], &vs[0]) +
              detail_row(c, vs[3], &vs[2], &vs[0]) + detail_row(c, vs[2], nullptr, &vs[0]));
