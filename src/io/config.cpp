@@ -167,6 +167,7 @@ constexpr KeySpec kSchema[] = {
     {"soft.tables", Kind::kBoolean},
     {"soft.table_tolerance", Kind::kFloat},
     {"soft.table_cache", Kind::kString},
+    {"soft.defer_releases", Kind::kBoolean},
     {"soft.model", Kind::kString},
     {"soft.stiffness", Kind::kFloat},
     {"soft.damping", Kind::kFloat},
@@ -1507,6 +1508,7 @@ class Reader {
                        soft.table_tolerance));
     }
     get_string(t, p, "table_cache", soft.table_cache);
+    get_bool(t, p, "defer_releases", soft.defer_releases);
     const std::vector<const toml::table*> tables = table_array(t, p, "pair");
     for (std::size_t i = 0; i < tables.size(); ++i) {
       const std::string prefix = fmt::format("soft.pair[{}]", i);
@@ -1931,6 +1933,7 @@ std::string to_toml(const Config& config) {
     out += fmt::format("tables = {}\n", soft.tables);
     out += fmt::format("table_tolerance = {}\n", toml_float(soft.table_tolerance));
     out += fmt::format("table_cache = {}\n", toml_string(soft.table_cache));
+    out += fmt::format("defer_releases = {}\n", soft.defer_releases);
     for (const SoftPairConfig& pair : soft.pairs) {
       out += "\n[[soft.pair]]\n";
       out += fmt::format("species = [{}, {}]\n", toml_string(pair.species[0]),

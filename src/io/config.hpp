@@ -206,6 +206,10 @@ struct SoftConfig {
   bool tables = true;
   double table_tolerance = 1e-6;
   std::string table_cache;
+  // Event integrator, mapped contacts: a contact that can meet nothing before its end gets its
+  // post-contact motion at once (EngineOptions::defer_soft_releases). false: every contact
+  // waits for a release event (same physics, slower; for comparison).
+  bool defer_releases = true;
 
   bool enabled() const { return !law.model.empty(); }
   bool operator==(const SoftConfig&) const = default;

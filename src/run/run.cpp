@@ -232,8 +232,10 @@ class RunDriver {
     try {
       Environment<D> environment = make_environment<D>(config, start);
       if (environment.soft_spheres() && config.soft.tables) attach_tables(environment, start);
+      EngineOptions options;
+      options.defer_soft_releases = config.soft.defer_releases;
       engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict,
-                      EngineOptions{}, environment);
+                      options, environment);
       driven_ = config.driving.kind != "none";
       granular_ = !environment.plain() || environment.has_gravity() || driven_ ||
                   environment.sheared() || environment.soft_spheres() ||
@@ -672,6 +674,7 @@ class RunDriver {
     const std::uint64_t direct = c.soft_direct_maps - counters_start_.soft_direct_maps;
     nlohmann::json s;
     s["collisions"] = config_.soft.collisions;
+    s["defer_releases"] = config_.soft.defer_releases;
     s["mapped_contacts"] = c.soft_contacts - counters_start_.soft_contacts;
     s["exception_a_overlap_fallbacks"] = a;
     s["exception_b_early_releases"] = b;

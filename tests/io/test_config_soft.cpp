@@ -208,9 +208,11 @@ TEST(ConfigSoft, MapTableKeys) {
   EXPECT_TRUE(d.soft.tables);
   EXPECT_EQ(d.soft.table_tolerance, 1e-6);
   EXPECT_EQ(d.soft.table_cache, "");
-  const Config c = parse_config(
-      with(soft + "tables = false\ntable_tolerance = 1e-8\ntable_cache = \"/tmp/x\"\n"),
-      "test.toml");
+  EXPECT_TRUE(d.soft.defer_releases);
+  const Config c = parse_config(with(soft + "tables = false\ntable_tolerance = 1e-8\ntable_cache = "
+                                            "\"/tmp/x\"\ndefer_releases = false\n"),
+                                "test.toml");
+  EXPECT_FALSE(c.soft.defer_releases);
   EXPECT_FALSE(c.soft.tables);
   EXPECT_EQ(c.soft.table_tolerance, 1e-8);
   EXPECT_EQ(c.soft.table_cache, "/tmp/x");
@@ -218,6 +220,7 @@ TEST(ConfigSoft, MapTableKeys) {
   expect_error(with(soft + "table_tolerance = 0.0\n"), {"soft.table_tolerance", "> 0"});
   expect_error(with(soft + "table_tolerance = 0.5\n"), {"soft.table_tolerance", "below 0.1"});
   expect_error(with(soft + "tables = 1\n"), {"soft.tables"});
+  expect_error(with(soft + "defer_releases = \"no\"\n"), {"soft.defer_releases"});
   expect_error(with(soft + "table_cach = \"x\"\n"), {"soft.table_cach", "soft.table_cache"});
 }
 

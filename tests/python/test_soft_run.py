@@ -77,6 +77,30 @@ class SoftRuns(kt.KairosTestCase):
         self.assertLess(np.max(np.abs(a["kairos/velocity"] - b["kairos/velocity"])), 1e-3)
         self.assertEqual(tabulated["collisions"], direct["collisions"])
 
+    def test_every_release_an_event_is_the_same_run(self):
+        # defer_releases = false freezes every contact until a release event: more events, the
+        # same trajectories (to round-off over half a collision per particle).
+        cache = self.shared_cache
+        deferred = self.run_soft("deferred", soft_config(cache, production=0.5))
+        frozen = self.run_soft("frozen", soft_config(cache, production=0.5,
+                                                     defer_releases=False))
+        self.assertTrue(deferred["soft"]["defer_releases"])
+        self.assertFalse(frozen["soft"]["defer_releases"])
+        self.assertEqual(deferred["collisions"], frozen["collisions"])
+        events = [s["event_counts"]["total_events_since_start"] for s in (deferred, frozen)]
+        self.assertGreater(events[1], events[0] + deferred["soft"]["mapped_contacts"] // 2)
+        # Every thermo row (time, temperature, pressure, energies): the physical state, whatever
+        # each run's records hold for contacts in progress.
+        header, rows_a, _ = kt.read_thermo(self.path("deferred", "thermo.tsv"))
+        _, rows_b, _ = kt.read_thermo(self.path("frozen", "thermo.tsv"))
+        self.assertEqual(len(rows_a), len(rows_b))
+        self.assertGreater(len(rows_a), 5)
+        for ra, rb in zip(rows_a, rows_b):
+            self.assertEqual(ra[0], rb[0])
+            for name, x, y in zip(header[1:], ra[1:], rb[1:]):
+                if name != "events":  # fewer with deferral: that is its point
+                    self.assertLessEqual(abs(x - y), 1e-9 * max(1.0, abs(x)), name)
+
     def test_split_run_equals_whole_run_with_contacts_in_progress(self):
         # The continued run uses the tables of the first (their speed range is in the restart
         # file), not tables for its own, cooler start.
