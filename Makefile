@@ -36,7 +36,7 @@ bench: configure
 	$(BUILD)/bench/kairos_bench
 
 # -O1 with line tables: half the compile time of -O2 -g, file:line still in every report; the
-# engine's hot files keep -O2 (CMakeLists.txt, KAIROS_SANITIZE_HOT_SOURCES).
+# engine's hot files keep -O2 (CMakeLists.txt).
 asan: deps
 	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" -DKAIROS_SANITIZE=ON -DKAIROS_BUILD_BENCH=OFF -DKAIROS_BUILD_VALIDATION=OFF
 	cmake --build build-asan -j $(JOBS)

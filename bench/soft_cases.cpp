@@ -169,6 +169,7 @@ struct Sample {
   double energy_ratio = 1;
   std::uint64_t collisions = 0, events = 0, contacts = 0, fallbacks = 0, early = 0, direct = 0;
   long steps = 0;  // DEM
+  double dt = 0;   // DEM's time step
 
   double rate() const { return static_cast<double>(collisions) / wall; }
   double per_collision(std::uint64_t k) const {
@@ -228,6 +229,7 @@ Sample dem(const ParticleSystem<3>& start, const Law& law, long steps) {
   s.energy_ratio = (d.kinetic_energy() + d.potential_energy()) / ke0;
   s.collisions = d.collisions() - c0;
   s.steps = steps;
+  s.dt = d.dt();
   return s;
 }
 
@@ -533,13 +535,12 @@ void run_soft(const SoftPlan& plan, const std::function<void(const std::string&)
                       {}});
         for (int k = 0; k < plan.repeat; ++k)
           for (Variant& v : vs) v.samples.push_back(v.measure());
-        const double dem_dt = vs[2].best().sim / static_cast<double>(dem_steps);
+        const double dem_dt = vs[2].best().dt;
         c.dem_expected =
             0.5 * static_cast<double>(n) * gas.frequency * dem_dt * static_cast<double>(dem_steps);
         if (!plan.lammps_dir.empty()) {
           const std::string input = fmt::format("eta{:g}-{}-R{:g}.in", eta, name, r);
-          const double dt = dem_default_time_step(c.law.law, kMu, c.law.reference_speed);
-          write_lammps_input(std::filesystem::path(plan.lammps_dir) / input, data_name, c, dt,
+          write_lammps_input(std::filesystem::path(plan.lammps_dir) / input, data_name, c, dem_dt,
                              dem_steps);
           const Sample& dem_best = vs[2].best();
           lammps_cases += fmt::format(
