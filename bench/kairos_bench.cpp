@@ -32,6 +32,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -124,9 +125,10 @@ std::uint64_t collisions_for(double per_particle, std::size_t n) {
 }
 
 template <int D, class Queue>
-Run measure(const ParticleSystem<D>& start, double equilibrate, double timed) {
+Run measure(const ParticleSystem<D>& start, double equilibrate, double timed,
+            EngineOptions options) {
   const auto t_begin = Clock::now();
-  EventEngine<D, Queue> engine(start);
+  EventEngine<D, Queue> engine(start, StartMode::kPredict, options);
   run_until(engine, collisions_for(equilibrate, engine.size()));
   const Counts c0 = counts_of(engine.counters());
   const auto t0 = Clock::now();
@@ -141,11 +143,20 @@ Run measure(const ParticleSystem<D>& start, double equilibrate, double timed) {
   return r;
 }
 
+// A queue name, with the suffix kFullScans when every crossing rescans all neighbours
+// (--crossings full).
+constexpr std::string_view kFullScans = " full-scan";
+
 template <int D>
-Run measure_queue(const std::string& queue, const ParticleSystem<D>& s, const Case& c) {
-  if (queue == "heap") return measure<D, BinaryHeapQueue>(s, c.equilibrate, c.timed);
-  if (queue == "tree") return measure<D, TournamentTreeQueue>(s, c.equilibrate, c.timed);
-  return measure<D, CalendarQueue>(s, c.equilibrate, c.timed);
+Run measure_queue(std::string_view queue, const ParticleSystem<D>& s, const Case& c) {
+  EngineOptions options;
+  if (queue.ends_with(kFullScans)) {
+    options.incremental_crossings = false;
+    queue.remove_suffix(kFullScans.size());
+  }
+  if (queue == "heap") return measure<D, BinaryHeapQueue>(s, c.equilibrate, c.timed, options);
+  if (queue == "tree") return measure<D, TournamentTreeQueue>(s, c.equilibrate, c.timed, options);
+  return measure<D, CalendarQueue>(s, c.equilibrate, c.timed, options);
 }
 
 std::string default_lattice(int dimension) {
@@ -482,7 +493,8 @@ void validate(const Plan& p) {
   for (std::uint64_t n : p.particles) {
     if (n < 2) throw UsageError(fmt::format("--particles {} is invalid: must be >= 2", n));
   }
-  for (const auto& q : p.queues) {
+  for (std::string_view q : p.queues) {
+    if (q.ends_with(kFullScans)) q.remove_suffix(kFullScans.size());
     if (q != "calendar" && q != "heap" && q != "tree") {
       throw UsageError(fmt::format("--queue \"{}\" is unknown; use calendar, heap or tree", q));
     }
@@ -611,7 +623,7 @@ int run(int argc, char** argv) {
   std::vector<std::int64_t> particles;  // signed: "-5" is an error, not 2^64 - 5
   std::vector<double> etas, ratios;
   std::vector<int> dims;
-  std::vector<std::string> queues, sizes, cases, scans;
+  std::vector<std::string> queues, sizes, cases, scans, crossings;
   std::vector<int> lj_steps;
   std::vector<double> contact_ratios;
   std::int64_t dem_steps = 0;
@@ -646,6 +658,13 @@ int run(int argc, char** argv) {
                                 "stepped suite: candidate loops, run interleaved: vector "
                                 "(AVX-512 where available, the default) and/or scalar")
                      ->delimiter(',');
+  auto* o_crossings =
+      app.add_option("--crossings", crossings,
+                     "cell crossings: incremental (the default: a crossing scans only the cells "
+                     "new to the neighbourhood) and/or full (every crossing rescans all "
+                     "neighbours, as before); run interleaved with the queues (default and soft "
+                     "suites; the soft suite takes one)")
+          ->delimiter(',');
   auto* o_ratios = app.add_option("--contact-ratio", contact_ratios,
                                   "soft suite: mean free time / contact time (default 100,1000)")
                        ->delimiter(',');
@@ -708,7 +727,15 @@ int run(int argc, char** argv) {
                           o_table_cache->count() > 0 || o_lammps->count() > 0))
     throw UsageError(
         "--contact-ratio, --dem-steps, --table-cache and --lammps-dir need --suite soft");
+  for (const std::string& c : crossings) {
+    if (c != "incremental" && c != "full")
+      throw UsageError(fmt::format("--crossings \"{}\" is unknown; use incremental or full", c));
+  }
+  if (o_crossings->count() > 0 && suite != "soft" && suite != "default" && suite != "quick" &&
+      suite != "full")
+    throw UsageError("--crossings needs the default, quick, full or soft suite");
   if (suite == "soft") {
+    if (crossings.size() > 1) throw UsageError("--suite soft takes one --crossings");
     if (o_queue->count() > 0 || o_sizes->count() > 0 || o_ratio->count() > 0 ||
         o_dim->count() > 0 || fmt_kind == Format::kTsv) {
       throw UsageError("--suite soft takes no --queue, --sizes, --dimension or --format tsv");
@@ -728,6 +755,7 @@ int run(int argc, char** argv) {
     }
     sp.table_cache = table_cache;
     sp.lammps_dir = lammps_dir;
+    sp.full_crossing_scans = !crossings.empty() && crossings[0] == "full";
     if (o_eq->count() > 0) sp.equilibrate = eq;
     if (o_timed->count() > 0) sp.timed = timed;
     if (o_repeat->count() > 0) sp.repeat = repeat;
@@ -813,6 +841,13 @@ int run(int argc, char** argv) {
   if (o_eta->count() > 0) plan.etas = etas;
   if (o_dim->count() > 0) plan.dims = dims;
   if (o_queue->count() > 0) plan.queues = queues;
+  if (o_crossings->count() > 0) {
+    std::vector<std::string> variants;
+    for (const std::string& q : plan.queues)
+      for (const std::string& c : crossings)
+        variants.push_back(c == "full" ? q + std::string(kFullScans) : q);
+    plan.queues = variants;
+  }
   if (o_sizes->count() > 0 || o_ratio->count() > 0) {
     plan.size_ratios.clear();
     for (const auto& s : sizes) plan.size_ratios.push_back(parse_size(s));

@@ -26,6 +26,9 @@ struct SoftPlan {
   // Non-empty: also write each case for LAMMPS here (start state, input, Kairos's figures in
   // cases.tsv), for bench/lammps_soft.sh.
   std::string lammps_dir;
+  // Every cell crossing rescans all neighbours (EngineOptions::incremental_crossings = false)
+  // in the event-driven samples, for comparison with the default.
+  bool full_crossing_scans = false;
 };
 
 // Throws std::invalid_argument naming the first bad field.

@@ -35,6 +35,12 @@ struct EventSlot {
   double time = std::numeric_limits<double>::infinity();
   std::uint32_t partner = kNoPartner;
   std::uint32_t partner_count = 0;
+  // Partner values from kKeptBase on are not particles. A cell crossing is kNoPartner, or
+  // kKeptBase + p when its prediction found the contact with particle p (counter in
+  // partner_count) as the soonest after the crossing, or kNoneKept (2 * D + 2 below kNoPartner)
+  // when it found none (incremental crossings, see EventEngine::cross). Walls and a soft
+  // contact's release use the codes just below kNoPartner.
+  static constexpr std::uint32_t kKeptBase = 0x80000000u;
 };
 
 struct EventCounters {

@@ -16,6 +16,15 @@ bool cpu_has_avx512() {
 #endif
 }
 
+bool cpu_gathers_lists_fast() {
+#if defined(__x86_64__) && defined(__GNUC__)
+  static const bool fast = cpu_has_avx512() && __builtin_cpu_is("intel");
+  return fast;
+#else
+  return false;
+#endif
+}
+
 #if defined(__x86_64__) && defined(__GNUC__)
 
 // Everything up to the matching pop_options is compiled for AVX-512 (and only ever called

@@ -216,6 +216,12 @@ std::uint32_t gather_lists_avx512(const Neighbourhood& nb, std::uint32_t* out,
 
 // Whether this CPU runs the AVX-512 loop.
 bool cpu_has_avx512();
+// Whether gather_lists_avx512 beats walking the cell lists one by one on this CPU: on Intel's
+// cores it does; on AMD's Zen 4 the 16-lane 32-bit gathers are slow enough that the scalar walk
+// made a dilute hard-sphere run 1.4x faster (measured on an AMD EPYC; docs/performance.md).
+// Either walk lists the same candidates; only their order differs (which decides only exact
+// ties of contact times).
+bool cpu_gathers_lists_fast();
 
 // AVX-512 loop (defined in candidate_scan.cpp); same contract and result as the scalar loop.
 template <int D, bool kAccelerated = false>

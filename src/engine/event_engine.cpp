@@ -61,7 +61,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
       env_(environment) {
   const std::size_t n = s.size();
   if (n < 2) throw InputError("a simulation needs at least 2 particles");
-  if (n >= kFirstCode) throw InputError("too many particles (at most 2^32 - 16)");
+  if (n >= kFirstCode - 16) throw InputError("too many particles (at most 2^31 - 16)");
   if (s.mass.size() != n || s.species.size() != n) {
     throw InputError("the state needs a mass and a species for every particle");
   }
@@ -98,6 +98,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
   // The vector loop indexes records with 32-bit offsets.
   vector_scan_ = options_.vector_scan && cpu_has_avx512() &&
                  static_cast<double>(n) * sizeof(HotRecord<D>) < 2e9;
+  vector_gather_ = vector_scan_ && cpu_gathers_lists_fast();
   const bool has_counts = s.collision_count.size() == n;
   hot_.resize(n);
   for (std::uint32_t k = 0; k < n; ++k) {
@@ -160,11 +161,18 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
                          " is not at or after the state's time");
       }
       const bool particle = e.partner < n;
-      if (!particle && e.partner < kFirstCode) {
+      const bool kept = e.partner >= kKeptBase && e.partner - kKeptBase < n;
+      if (!particle && !kept && e.partner < kNoneKept) {
         throw InputError("cannot resume: particle " + std::to_string(id_[k]) +
                          " has an event partner code out of range");
       }
-      pending_[k] = {particle ? internal[e.partner] : e.partner, e.partner_count};
+      pending_[k] = {particle ? internal[e.partner]
+                     : kept   ? kKeptBase + internal[e.partner - kKeptBase]
+                              : e.partner,
+                     e.partner_count};
+      // Files written with incremental crossings resumed without them: full scans.
+      if (!incremental_crossings_ && is_crossing(pending_[k].partner))
+        pending_[k] = {kNoPartner, 0};
       times[k] = e.time;
       hot_[k].cell = s.cell[id_[k]];
       check_restored_cell(k);
@@ -300,6 +308,8 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   }
   find_squeeze_time(rmax);
   if (time_ >= squeeze_time_) throw_squeezed(time_);
+  // Walls, open faces and sleepers (which come with them), shear and steps keep full scans.
+  incremental_crossings_ = options_.incremental_crossings && !bounded_ && !stepped_ && !sheared_;
 }
 
 // Relative margin of find_squeeze_time: a lone particle squeezed between approaching walls
@@ -438,7 +448,9 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
       const std::uint32_t old = rank[k].second;
       hot[k] = hot_[old];
       pending[k] = pending_[old];
-      if (pending[k].partner < kFirstCode) pending[k].partner = new_index[pending[k].partner];
+      std::uint32_t& p = pending[k].partner;
+      if (p < kFirstCode) p = new_index[p];
+      if (p >= kKeptBase && p < kNoneKept) p = kKeptBase + new_index[p - kKeptBase];
       id[k] = id_[old];
       if (queue_filled) times[k] = queue_.time_of(old);
     }
@@ -605,11 +617,18 @@ void EventEngine<D, Queue>::gather(CellCode cell, CandidateList& list) {
       return;
     }
   }
-  if (vector_scan_) {
-    gather_vector(cell, list);
+  gather_cells(cell, all_neighbours_.data(), CellGrid<D>::kNeighbourCells, list);
+}
+
+// gather() for the cells numbered which[0 .. count) among the 3^D around `cell` (see
+// CellGrid::for_each_neighbour's numbering), in that order.
+template <int D, class Queue>
+void EventEngine<D, Queue>::gather_cells(CellCode cell, const std::uint8_t* which, int count,
+                                         CandidateList& list) {
+  if (vector_gather_) {
+    gather_vector(cell, which, count, list);
     return;
   }
-  constexpr auto kCells = static_cast<std::uint32_t>(CellGrid<D>::kNeighbourCells);
   std::uint32_t n = 0;
   auto cap = static_cast<std::uint32_t>(list.ids.size());
   std::uint32_t* cand = list.ids.data();
@@ -619,18 +638,19 @@ void EventEngine<D, Queue>::gather(CellCode cell, CandidateList& list) {
   if (grid_.interior(cell)) {
     const std::uint32_t centre = grid_.index(cell);
     const std::int32_t* delta = grid_.neighbour_deltas();
-    for (std::uint32_t c = 0; c < kCells; ++c) {
+    for (int c = 0; c < count; ++c) {
       if (cap - n < kCandidateSlack) [[unlikely]] {
         cand = grow(list);
         cap = static_cast<std::uint32_t>(list.ids.size());
       }
-      append_members(heads[centre + static_cast<std::uint32_t>(delta[c])], links, list, n, cand,
-                     cap);
+      append_members(heads[centre + static_cast<std::uint32_t>(delta[which[c]])], links, list, n,
+                     cand, cap);
     }
     list.n_shifts = 1;
   } else {
     std::uint32_t n_shifts = 1;  // shifts[0] is the zero shift
-    grid_.for_each_neighbour(cell, [&](const typename CellGrid<D>::Neighbour& nb) {
+    for (int c = 0; c < count; ++c) {
+      const typename CellGrid<D>::Neighbour nb = grid_.neighbour(cell, which[c]);
       if (cap - n < kCandidateSlack) [[unlikely]] {
         cand = grow(list);
         cap = static_cast<std::uint32_t>(list.ids.size());
@@ -640,16 +660,17 @@ void EventEngine<D, Queue>::gather(CellCode cell, CandidateList& list) {
       const std::uint32_t shift = nb.shifted ? n_shifts : 0;
       for (std::uint32_t k = from; k < n; ++k) list.shift[k] = shift;
       if (nb.shifted) list.shifts[n_shifts++] = nb.shift;
-    });
+    }
     list.n_shifts = n_shifts;
   }
   list.count = n;
 }
 
-// gather() with AVX-512: the neighbourhood's list heads and their successors are fetched and
+// gather_cells() with AVX-512: the cells' list heads and their successors are fetched and
 // compressed sixteen lists at a time; the rare third and later members follow by links.
 template <int D, class Queue>
-void EventEngine<D, Queue>::gather_vector(CellCode cell, CandidateList& list) {
+void EventEngine<D, Queue>::gather_vector(CellCode cell, const std::uint8_t* which, int count,
+                                          CandidateList& list) {
   constexpr auto kCells = static_cast<std::uint32_t>(CellGrid<D>::kNeighbourCells);
   while (list.ids.size() < 2 * kCells + kCandidateSlack) grow(list);
   std::uint32_t cells[kCells], tags[kCells];
@@ -658,19 +679,17 @@ void EventEngine<D, Queue>::gather_vector(CellCode cell, CandidateList& list) {
   if (interior) {
     const std::uint32_t centre = grid_.index(cell);
     const std::int32_t* delta = grid_.neighbour_deltas();
-    for (std::uint32_t c = 0; c < kCells; ++c)
-      cells[c] = centre + static_cast<std::uint32_t>(delta[c]);
+    for (int c = 0; c < count; ++c) cells[c] = centre + static_cast<std::uint32_t>(delta[which[c]]);
   } else {
-    std::uint32_t c = 0;
-    grid_.for_each_neighbour(cell, [&](const typename CellGrid<D>::Neighbour& nb) {
+    for (int c = 0; c < count; ++c) {
+      const typename CellGrid<D>::Neighbour nb = grid_.neighbour(cell, which[c]);
       cells[c] = nb.cell;
-      tags[c++] = nb.shifted ? n_shifts : 0;
+      tags[c] = nb.shifted ? n_shifts : 0;
       if (nb.shifted) list.shifts[n_shifts++] = nb.shift;
-    });
+    }
   }
   const Neighbourhood nb{
-      grid_.heads(),           grid_.links(), grid_.end(), cells, interior ? nullptr : tags,
-      static_cast<int>(kCells)};
+      grid_.heads(), grid_.links(), grid_.end(), cells, interior ? nullptr : tags, count};
   std::uint32_t third[kCells], third_tag[kCells];
   std::uint32_t n_third = 0;
   std::uint32_t n =
@@ -765,6 +784,11 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
     partner = stepped_       ? scan_stepped(list, i, t, best)
               : list.sheared ? scan_sheared(list, i, t, best)
                              : scan_with_sleepers(list, i, t, best);
+  } else if (incremental_crossings_) {
+    // Unbounded: a contact after the crossing is kept for the crossing's own prediction.
+    double soonest = kNever;
+    partner = test_candidates(list, i, t, xi, soonest);
+    return conclude_unbounded(i, t, crossing, partner, soonest);
   } else {
     partner = test_candidates(list, i, t, xi, best);
   }
@@ -796,6 +820,74 @@ double EventEngine<D, Queue>::conclude_prediction(std::uint32_t i, double t,
     when = release_time_[i];
   }
   return when > t ? when : t;  // never in the past, whatever the round-off
+}
+
+template <int D, class Queue>
+double EventEngine<D, Queue>::conclude_unbounded(std::uint32_t i, double t,
+                                                 const Crossing& crossing, std::uint32_t partner,
+                                                 double soonest) {
+  // The same choice as a scan bounded by the crossing: a contact strictly before it.
+  if (partner != kNoPartner && soonest < crossing.time - t)
+    return conclude_prediction(i, t, crossing, partner, soonest);
+  const double when = conclude_prediction(i, t, crossing, kNoPartner, 0.0);
+  if (pending_[i].partner == kNoPartner) {  // the crossing (no wall or release came first)
+    pending_[i] = partner == kNoPartner
+                      ? PendingEvent{kNoneKept, 0}
+                      : PendingEvent{kKeptBase + partner, hot_[partner].collisions};
+  }
+  return when;
+}
+
+// After crossing `crossed` at time t (already in its new cell): the particle's old neighbours
+// were all tested by the prediction that scheduled the crossing, and the soonest contact among
+// them came after it (`kept`, due in kept_dt; kNoPartner: none). A neighbour whose motion
+// changed since was predicted again then, against this particle's unchanged motion, so that
+// pair is in the neighbour's own event; only the layer of cells new to the neighbourhood needs
+// a scan.
+template <int D, class Queue>
+double EventEngine<D, Queue>::predict_after_crossing(std::uint32_t i, double t,
+                                                     const Crossing& crossed, std::uint32_t kept,
+                                                     double kept_dt) {
+  const HotRecord<D>& h = hot_[i];
+  CandidateList& list = lists_[0];
+  gather_cells(h.cell, grid_.layer(crossed.axis, crossed.sign), CellGrid<D>::kLayerCells, list);
+  const Crossing crossing = next_crossing(h);
+  const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
+  double soonest = kNever;
+  std::uint32_t partner = test_candidates(list, i, t, xi, soonest);
+  if (kept != kNoPartner && kept_dt < soonest) {
+    soonest = kept_dt;
+    partner = kept;
+  }
+  ++incremental_scans_;
+  return conclude_unbounded(i, t, crossing, partner, soonest);
+}
+
+// The kept pair's contact time from its present state, computed as the candidate loops do,
+// with the periodic image of the cell offset (the pair's time does not change while neither
+// motion does; recomputing it costs one record and keeps the pending event at 8 bytes).
+template <int D, class Queue>
+bool EventEngine<D, Queue>::kept_contact_time(std::uint32_t i, std::uint32_t p, double t,
+                                              double& dt) const {
+  const HotRecord<D>& hi = hot_[i];
+  const HotRecord<D>& hp = hot_[p];
+  std::array<int, D> d;
+  if (!grid_.neighbour_offset(hi.cell, hp.cell, d)) return false;
+  if (in_deferred_contact(p, t)) [[unlikely]]
+    return false;
+  const Vec<D> xi = accelerated_ ? position_at(hi, t) : hi.pos + (t - hi.time) * hi.vel;
+  const Vec<D> xp = accelerated_ ? position_at(hp, t) : hp.pos + (t - hp.time) * hp.vel;
+  const Vec<D> vi = accelerated_ ? velocity_at(hi, t) : hi.vel;
+  const Vec<D> vp = accelerated_ ? velocity_at(hp, t) : hp.vel;
+  Vec<D> r, g;
+  for (int a = 0; a < D; ++a) {
+    const int c = grid_.coordinate(hi.cell, a) + d[a];
+    const double shift = c < 0 ? -box_[a] : c >= grid_.cells_along(a) ? box_[a] : 0.0;
+    r[a] = xi[a] - (xp[a] + shift);
+    g[a] = vi[a] - vp[a];
+  }
+  dt = pair_contact_time<D>(r.data(), g.data(), radius_of(i) + radius_of(p));
+  return true;
 }
 
 // Whether some candidate sleeps: only then does a pair need the quartic of scan_with_sleepers;
@@ -1242,6 +1334,15 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   HotRecord<D>& h = hot_[i];
   const Crossing x = next_crossing(h);
+  const PendingEvent e = pending_[i];
+  // Whether the prediction that scheduled this crossing kept the contact beyond it, and whether
+  // that is still good: its partner's motion unchanged (counter), read before i moves.
+  std::uint32_t kept = kNoPartner;
+  bool incremental = e.partner == kNoneKept;
+  if (e.partner >= kKeptBase && e.partner < kNoneKept) {
+    kept = e.partner - kKeptBase;
+    incremental = hot_[kept].collisions == e.partner_count;
+  }
   advance_to(i, t);
   std::array<int, D> c;
   for (int a = 0; a < D; ++a) c[a] = grid_.coordinate(h.cell, a);
@@ -1262,7 +1363,9 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   h.cell = grid_.code_at(c);
   grid_.insert(i, h.cell);
   ++counters_.cell_crossings;
-  queue_.update(i, predict(i, t));
+  double kept_dt = kNever;
+  if (incremental && kept != kNoPartner) incremental = kept_contact_time(i, kept, t, kept_dt);
+  queue_.update(i, incremental ? predict_after_crossing(i, t, x, kept, kept_dt) : predict(i, t));
 }
 
 template <int D, class Queue>
@@ -1283,11 +1386,11 @@ EventKind EventEngine<D, Queue>::step() {
     __builtin_prefetch(&pending_[k]);
   }
   const PendingEvent e = pending_[i];
-  if (e.partner == kNoPartner) {
-    cross(i, t);
-    return EventKind::kCellCrossing;
-  }
-  if (e.partner >= kFirstCode) [[unlikely]] {
+  if (e.partner >= kFirstCode) {
+    if (is_crossing(e.partner)) [[likely]] {
+      cross(i, t);
+      return EventKind::kCellCrossing;
+    }
     if (e.partner == kRelease) {
       release_event(i, t);
       return EventKind::kSoftRelease;
@@ -1365,8 +1468,10 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
     if (sleeping_ > 0) out.asleep[c] = asleep_[k];
     if (!last_collision_.empty()) out.last_collision_time[c] = last_collision_[k];
     const PendingEvent& e = pending_[k];
-    out.events[c] = {queue_.time_of(k), e.partner >= kFirstCode ? e.partner : id_[e.partner],
-                     e.partner_count};
+    std::uint32_t partner = e.partner < kFirstCode ? id_[e.partner] : e.partner;
+    if (e.partner >= kKeptBase && e.partner < kNoneKept)
+      partner = kKeptBase + id_[e.partner - kKeptBase];
+    out.events[c] = {queue_.time_of(k), partner, e.partner_count};
   }
   return out;
 }
@@ -1673,6 +1778,11 @@ void EventEngine<D, Queue>::validate() {
     }
     if (pending_[i].partner < kFirstCode && pending_[i].partner >= n)
       fail("particle " + name(i) + " has a partner out of range");
+    const std::uint32_t code = pending_[i].partner;
+    if (code != kNoPartner && is_crossing(code) && !incremental_crossings_)
+      fail("particle " + name(i) + " keeps a contact beyond its crossing with full scans");
+    if (code >= kKeptBase && code < kNoneKept && code - kKeptBase >= n)
+      fail("particle " + name(i) + " keeps a contact partner out of range");
   }
   // Whether a pending event lies after a contact due at `due`, beyond round-off: positions are
   // exact to ~1e-12 of the box, which a slow approach (speed) turns into a longer time.

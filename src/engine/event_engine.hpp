@@ -7,9 +7,11 @@
 // local clocks), applies the elastic impulse, bumps both collision counters and re-predicts
 // both. A crossing moves the particle to the next cell and re-predicts it.
 //
-// Every prediction scans the particle's 3^D neighbouring cells, bounded by its next cell
-// crossing: a collision later than the crossing is found again by the full scan the crossing
-// triggers, so only the soonest of the two is stored (no second time per particle).
+// Every prediction scans the particle's 3^D neighbouring cells. When the crossing comes first,
+// the soonest contact after it is kept, named by the crossing's pending event, and the crossing
+// then scans only the layer of cells new to the neighbourhood (incremental crossings, see
+// cross()); where that does not apply (walls, shear, steps) the crossing bounds the scan and
+// rescans everything.
 //
 // Invariant (checked by validate()): for every pair in neighbouring cells, the sooner of the
 // two particles' pending events is no later than the pair's true next contact; so the queue
@@ -85,6 +87,10 @@ struct EngineOptions {
   // post-contact motion at once (deferred release, see soft_contacts.cpp) instead of freezing
   // it until a release event. Same physics; false keeps every contact frozen (for comparison).
   bool defer_soft_releases = true;
+  // After a cell crossing, scan only the layer of cells new to the particle's neighbourhood and
+  // keep the soonest contact its last prediction found beyond the crossing (periodic boxes
+  // without shear or steps). Same physics; false rescans every neighbour (for comparison).
+  bool incremental_crossings = true;
 };
 
 template <int D, class Queue>
@@ -142,6 +148,10 @@ class EventEngine {
   // built (not part of the state): the contacts of a stepped soft potential (spring_dashpot).
   std::uint64_t step_captures() const { return step_captures_; }
   std::uint32_t sleeping() const { return sleeping_; }
+  // Cell crossings since this engine was built (not part of the state) that scanned only the
+  // cells new to the particle's neighbourhood (EngineOptions::incremental_crossings).
+  std::uint64_t incremental_crossing_scans() const { return incremental_scans_; }
+  bool incremental_crossings() const { return incremental_crossings_; }
   Vec<D> momentum() const;
   const Environment<D>& environment() const { return env_; }
   // Positions at the current time, wrapped into the box, in the caller's numbering.
@@ -157,8 +167,8 @@ class EventEngine {
 
  private:
   struct PendingEvent {
-    std::uint32_t partner;        // EventSlot::kNoPartner: the event is a cell crossing
-    std::uint32_t partner_count;  // the partner's collision counter when predicted
+    std::uint32_t partner;        // a particle, or a code from kFirstCode on (see below)
+    std::uint32_t partner_count;  // the partner's (or kept partner's) collision counter
   };
   // Scratch of a prediction: candidate partners and the periodic shift of each one's cell. Two,
   // so that both partners of a collision gather (and prefetch) before either is tested.
@@ -181,13 +191,26 @@ class EventEngine {
     int sign;     // +1 up, -1 down
   };
 
-  // Partner codes of a PendingEvent beyond the particle indices: a wall (one per box face),
-  // and kNoPartner for a cell crossing.
+  // Partner codes of a PendingEvent above the particle indices: a wall (one per box face),
+  // and kNoPartner (or one of the codes of is_crossing) for a cell crossing.
   static constexpr std::uint32_t kFirstWall = EventSlot::kNoPartner - 2 * D;
-  // Soft spheres: the release of the frozen contact the particle sits in. Codes from
-  // kFirstCode on are not particles.
+  // Soft spheres: the release of the frozen contact the particle sits in.
   static constexpr std::uint32_t kRelease = kFirstWall - 1;
-  static constexpr std::uint32_t kFirstCode = kRelease;
+  // Incremental crossings (see cross()): a crossing whose prediction found no contact at all,
+  // and a crossing that keeps the soonest contact after it, with particle p: kKeptBase + p
+  // (partner_count: p's counter). kNoPartner is a crossing that kept nothing (a full scan next).
+  static constexpr std::uint32_t kNoneKept = kRelease - 1;
+  static constexpr std::uint32_t kKeptBase = EventSlot::kKeptBase;
+  // Codes from kFirstCode on are not particles; particle indices stay below it.
+  static constexpr std::uint32_t kFirstCode = kKeptBase;
+  static bool is_crossing(std::uint32_t code) {
+    return code == EventSlot::kNoPartner || (code >= kKeptBase && code <= kNoneKept);
+  }
+  static constexpr auto all_neighbours_ = [] {
+    std::array<std::uint8_t, CellGrid<D>::kNeighbourCells> all{};
+    for (int n = 0; n < CellGrid<D>::kNeighbourCells; ++n) all[n] = static_cast<std::uint8_t>(n);
+    return all;
+  }();
   // Cells per particle allowed when some axis has walls or open faces (see setup_environment).
   static constexpr double kBoundedCellsPerParticle = 8.0;
 
@@ -259,8 +282,23 @@ class EventEngine {
                              std::uint32_t partner, double best);
   double predict_asleep(const CandidateList& list, std::uint32_t i, double t);
   bool sleeper_among(const CandidateList& list) const;
+  // Incremental crossings: after a crossing, only the new layer of cells is scanned and the
+  // result is merged with the contact the last prediction kept beyond the crossing (see
+  // cross()).
+  // The contact kept with particle p, from time t (kNever if the pair now misses); false if
+  // the kept contact cannot be used (p has moved out of the neighbourhood or sits in a
+  // deferred soft contact): then the crossing scans every neighbour.
+  bool kept_contact_time(std::uint32_t i, std::uint32_t p, double t, double& dt) const;
+  double predict_after_crossing(std::uint32_t i, double t, const Crossing& crossed,
+                                std::uint32_t kept, double kept_dt);
+  // The end of a prediction that looked at every contact (`soonest`, from t, with `partner`,
+  // kNoPartner if none): the contact if it comes before the crossing, else the crossing with
+  // the contact kept as the one beyond it.
+  double conclude_unbounded(std::uint32_t i, double t, const Crossing& crossing,
+                            std::uint32_t partner, double soonest);
   void gather(CellCode cell, CandidateList& list);
-  void gather_vector(CellCode cell, CandidateList& list);
+  void gather_cells(CellCode cell, const std::uint8_t* which, int count, CandidateList& list);
+  void gather_vector(CellCode cell, const std::uint8_t* which, int count, CandidateList& list);
   struct Links {
     const std::uint32_t* next;
     std::uint32_t end;
@@ -407,11 +445,14 @@ class EventEngine {
 
   HugeVector<HotRecord<D>> hot_;
   HugeVector<PendingEvent> pending_;
+  // Incremental crossings (see cross()): on unless a feature needs every crossing's full scan.
+  bool incremental_crossings_ = false;
   HugeVector<std::uint16_t> shape_;  // per particle; empty when there is a single shape
   std::vector<Shape> shapes_;
   bool uniform_radius_ = true;
   std::vector<double> shape_radius_;  // radius per shape, for the candidate loops
   bool vector_scan_ = false;
+  bool vector_gather_ = false;    // gather_lists_avx512 for the cell lists (cpu_gathers_lists_fast)
   HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
   bool accelerated_ = false;      // uniform gravity
   Vec<D> half_gravity_{};
@@ -436,6 +477,7 @@ class EventEngine {
   bool stepped_ = false;  // some pair has a step potential, or there are bonds
   PairSteps steps_;
   std::uint64_t step_captures_ = 0;            // see step_captures()
+  std::uint64_t incremental_scans_ = 0;        // see incremental_crossing_scans()
   std::vector<std::uint16_t> step_row_table_;  // scan_stepped's scratch, per shape
   std::vector<double> step_row_reach2_;
   std::vector<double> step_held_;  // the vector loop's held candidates: r.r, r.g, g.g

@@ -227,7 +227,8 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
       after.vel = window->after[slot];
       after.time = window->until;
       window->crossing[slot] = next_crossing(after);
-      best = window->crossing[slot].time - t;
+      // Unbounded with incremental crossings: a contact after the crossing is kept for it.
+      best = incremental_crossings_ ? kNever : window->crossing[slot].time - t;
       x_after = after.pos + (t - after.time) * after.vel;
       v_after = after.vel;
       probe.predict = true;
@@ -387,8 +388,10 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
   }
   double when[2];
   for (int k = 0; k < 2; ++k)
-    when[k] =
-        conclude_prediction(both[k], t, window.crossing[k], window.partner[k], window.best[k]);
+    when[k] = incremental_crossings_ ? conclude_unbounded(both[k], t, window.crossing[k],
+                                                          window.partner[k], window.best[k])
+                                     : conclude_prediction(both[k], t, window.crossing[k],
+                                                           window.partner[k], window.best[k]);
   if (when[0] >= until && when[1] >= until) {
     queue_.update(i, when[0]);
     queue_.update(j, when[1]);

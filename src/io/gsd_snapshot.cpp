@@ -235,10 +235,12 @@ void validate_restart(const ParticleSystem<D>& s, const std::filesystem::path& p
       throw bad("mass" + who + " is not positive");
     if (s.species[i] >= s.species_names.size()) throw bad("typeid" + who + " out of range");
     if (std::isnan(e.time)) throw bad("pending event time" + who + " is NaN");
-    // Codes above the particle indices name walls (the 2D faces below kNoPartner) and, just
-    // below those, a soft contact's release.
-    if (e.partner < EventSlot::kNoPartner - 2 * D - 1 && e.partner >= n)
-      throw bad("collision partner" + who + " out of range");
+    // Codes above the particle indices name walls (the 2D faces below kNoPartner), just below
+    // those a soft contact's release, below that a crossing that kept no contact; from
+    // kKeptBase on, a crossing that kept the contact with particle partner - kKeptBase.
+    const bool code = e.partner >= EventSlot::kNoPartner - 2 * D - 2;
+    const bool kept = e.partner >= EventSlot::kKeptBase && e.partner - EventSlot::kKeptBase < n;
+    if (!code && !kept && e.partner >= n) throw bad("collision partner" + who + " out of range");
   }
   std::vector<char> seen(n, 0);
   for (std::uint32_t k : s.order) {

@@ -572,11 +572,13 @@ class RunDriver {
     j["event_queue"] = engine_->queue_name();
     j["restarted"] = restart_;
     j["stop_reason"] = stop_reason_;
-    j["event_counts"] = {{"collisions", collisions},
-                         {"cell_crossings", c.cell_crossings},
-                         {"stale", c.stale_events},
-                         {"total_events_since_start", c.events},
-                         {"total_collisions_since_start", c.collisions}};
+    j["event_counts"] = {
+        {"collisions", collisions},
+        {"cell_crossings", c.cell_crossings},
+        {"incremental_crossings_this_invocation", engine_->incremental_crossing_scans()},
+        {"stale", c.stale_events},
+        {"total_events_since_start", c.events},
+        {"total_collisions_since_start", c.collisions}};
     run_detail::add_run_totals(j,
                                {events, collisions, coll_prod, engine_->time(), t_prod, wall,
                                 per_particle(coll_prod), kT, ke, kT_prod, z_mean},

@@ -38,6 +38,8 @@ template <int D>
 class CellGrid {
  public:
   static constexpr int kNeighbourCells = D == 3 ? 27 : 9;
+  // The cells a crossing adds to a particle's neighbourhood: one layer of 3^(D-1).
+  static constexpr int kLayerCells = D == 3 ? 9 : 3;
   static constexpr int kBits = D == 3 ? 10 : 16;  // bits per coordinate in a CellCode
   static constexpr int kMaxCellsAlong = 1 << kBits;
   // Bounds the grid's memory (4 bytes per cell) at 5 bytes per particle; speed is flat between
@@ -89,7 +91,14 @@ class CellGrid {
     }
     std::array<int, D> off;
     off.fill(-1);
+    int in_layer[D][2] = {};
     for (int n = 0; n < kNeighbourCells; ++n) {
+      for (int k = 0; k < D; ++k) {
+        if (off[k] != 0) {
+          const int side = off[k] > 0 ? 1 : 0;
+          layer_[k][side][in_layer[k][side]++] = static_cast<std::uint8_t>(n);
+        }
+      }
       std::int64_t delta = 0;
       for (int k = 0; k < D; ++k) delta += static_cast<std::int64_t>(off[k]) * stride_[k];
       neighbour_delta_[n] = static_cast<std::int32_t>(delta);
@@ -207,6 +216,21 @@ class CellGrid {
     return in;
   }
   const std::int32_t* neighbour_deltas() const { return neighbour_delta_; }
+  // The neighbour numbers n (as for_each_neighbour and neighbour_deltas() count them, in
+  // increasing order) of the kLayerCells cells one step along axis k on the side `sign` (+1, -1):
+  // after a crossing, the layer that is new to the particle's neighbourhood.
+  const std::uint8_t* layer(int k, int sign) const { return layer_[k][sign > 0 ? 1 : 0]; }
+  // Neighbour number n of cell c: its linear index and periodic shift (as for_each_neighbour
+  // gives it).
+  Neighbour neighbour(CellCode c, int n) const {
+    std::array<int, D> base, off;
+    for (int k = 0; k < D; ++k) {
+      base[k] = coordinate(c, k);
+      off[k] = n % 3 - 1;
+      n /= 3;
+    }
+    return bounded() ? offset_cell<true>(base, off) : offset_cell<false>(base, off);
+  }
 
   // Visits the 3^D cells around `c` (itself included). Cells away from the box faces take a
   // fast path: fixed index offsets, no wrapping, no shift.
@@ -320,6 +344,7 @@ class CellGrid {
   std::uint32_t total_ = 0;
   std::uint32_t end_ = 0;  // the list end marker: the number of particles
   std::int32_t neighbour_delta_[kNeighbourCells] = {};  // index offsets of an interior cell
+  std::uint8_t layer_[D][2][kLayerCells] = {};          // see layer()
   HugeVector<std::uint32_t> head_;                      // per cell: first member or end_
   HugeVector<std::uint32_t> next_;                      // per particle (+ end_): next or end_
 };

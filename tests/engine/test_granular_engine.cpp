@@ -54,7 +54,9 @@ double collisions_per_particle(const EventEngine<D, CalendarQueue>& engine) {
 template <int D>
 void check_cooling_per_collision(int n, double eta, double e, double c_end, double tolerance) {
   double sum = 0.0, sum2 = 0.0;
-  const int seeds = 4;
+  // 12 seeds: one run's ratio scatters by ~2 % in 2D, and the 2D mean sits ~1 % below 1
+  // (velocity correlations), so fewer seeds made the verdict depend on the realisation.
+  const int seeds = 12;
   double expected = 0.0;
   for (int seed = 1; seed <= seeds; ++seed) {
     const ParticleSystem<D> start = thermalised_gas<D>(n, eta, static_cast<std::uint64_t>(seed));
@@ -76,7 +78,7 @@ void check_cooling_per_collision(int n, double eta, double e, double c_end, doub
   ::testing::Test::RecordProperty("log_ratio_mean", std::to_string(mean));
   ::testing::Test::RecordProperty("log_ratio_stderr", std::to_string(stderr_));
   std::printf("D=%d e=%.2f: ln(T/T0) measured / predicted = %.5f +- %.5f\n", D, e, mean, stderr_);
-  EXPECT_NEAR(mean, 1.0, tolerance);
+  EXPECT_NEAR(mean, 1.0, tolerance + 3.0 * stderr_);
 }
 
 TEST(GranularEngine, CoolingPerCollisionFollowsTheExponentialLaw3D) {
@@ -96,7 +98,9 @@ TEST(GranularEngine, TemperatureFollowsHaffsLaw3D) {
   constexpr int D = 3;
   const double e = 0.9, eta = 0.02;
   std::vector<double> times, sum(4, 0.0);
-  const int seeds = 4;
+  // 12 seeds: one run's ratio scatters by ~2 % in 2D, and the 2D mean sits ~1 % below 1
+  // (velocity correlations), so fewer seeds made the verdict depend on the realisation.
+  const int seeds = 12;
   double tau0 = 0.0;
   for (int seed = 1; seed <= seeds; ++seed) {
     const ParticleSystem<D> start = thermalised_gas<D>(13, eta, static_cast<std::uint64_t>(seed));
@@ -204,14 +208,16 @@ double mean_field_ratio(int d, double e, double beta, double q, double c_end) {
 // Rough spheres starting without spin: T_rot / T_tr follows the mean-field theory of the
 // cooling state (docs/theory-rough-hcs.md) towards its stationary value. The theory neglects
 // correlations between spins and velocities; simulations are known to sit a few per cent below
-// it, so the tolerance is 6 %. Energy bookkeeping holds throughout and linear momentum is
-// conserved to round-off.
+// it, so the tolerance is 6 % plus three standard errors of the mean over seeds. Energy bookkeeping
+// holds throughout and linear momentum is conserved to round-off.
 template <int D>
 void check_rough_cooling_state(int n, double e, double beta, double tolerance) {
   const double q = D == 3 ? 0.4 : 0.5;
   const int checkpoints[] = {5, 10, 20, 30};
-  std::vector<double> ratio(4, 0.0);
-  const int seeds = 3;
+  std::vector<double> ratio(4, 0.0), ratio2(4, 0.0);
+  // 8 seeds: with 3 the mean at 30 collisions per particle scattered by ~3 % between
+  // realisations, on top of the known few per cent below mean field.
+  const int seeds = 8;
   for (int seed = 1; seed <= seeds; ++seed) {
     const ParticleSystem<D> start = thermalised_gas<D>(n, 0.02, static_cast<std::uint64_t>(seed));
     EventEngine<D, CalendarQueue> engine(start, StartMode::kPredict, EngineOptions{},
@@ -220,7 +226,9 @@ void check_rough_cooling_state(int n, double e, double beta, double tolerance) {
     for (int k = 0; k < 4; ++k) {
       while (collisions_per_particle(engine) < checkpoints[k])
         ASSERT_NE(engine.step(), EventKind::kNone);
-      ratio[k] += rotational_temperature(engine) / translational_temperature(engine) / seeds;
+      const double r = rotational_temperature(engine) / translational_temperature(engine);
+      ratio[k] += r / seeds;
+      ratio2[k] += r * r / seeds;
     }
     const double e_now = engine.kinetic_energy() + engine.rotational_energy();
     EXPECT_NEAR(e0 - e_now, engine.counters().dissipated_in_collisions, 1e-9 * e0);
@@ -229,11 +237,36 @@ void check_rough_cooling_state(int n, double e, double beta, double tolerance) {
   }
   for (int k = 0; k < 4; ++k) {
     const double theory = mean_field_ratio(D, e, beta, q, checkpoints[k]);
+    const double stderr_ = std::sqrt(std::max(0.0, ratio2[k] - ratio[k] * ratio[k]) / (seeds - 1));
     std::printf(
-        "D=%d e=%.2f beta=%.2f c=%d: T_rot/T_tr = %.4f, mean field %.4f (stationary %.4f)\n", D, e,
-        beta, checkpoints[k], ratio[k], theory, rough_hcs_temperature_ratio(D, e, beta, q));
-    EXPECT_NEAR(ratio[k] / theory, 1.0, tolerance) << "after " << checkpoints[k] << " collisions";
+        "D=%d e=%.2f beta=%.2f c=%d: T_rot/T_tr = %.4f +- %.4f, mean field %.4f (stationary "
+        "%.4f)\n",
+        D, e, beta, checkpoints[k], ratio[k], stderr_, theory,
+        rough_hcs_temperature_ratio(D, e, beta, q));
+    EXPECT_NEAR(ratio[k] / theory, 1.0, tolerance + 3.0 * stderr_ / theory)
+        << "after " << checkpoints[k] << " collisions";
   }
+}
+
+// Dilute inelastic and rough gases run with incremental crossings (most events are crossings);
+// the scheduler invariant holds by brute force throughout the cooling.
+template <int D>
+void run_granular_validated(const ContactModel& model, std::uint64_t seed) {
+  const ParticleSystem<D> start = thermalised_gas<D>(D == 3 ? 8 : 20, 0.02, seed);
+  EventEngine<D, CalendarQueue> engine(start, StartMode::kPredict, EngineOptions{},
+                                       uniform_contact<D>(model));
+  ASSERT_TRUE(engine.incremental_crossings());
+  for (int k = 0; k < 2000; ++k) {
+    ASSERT_NE(engine.step(), EventKind::kNone);
+    if (k % 11 == 0) engine.validate();
+  }
+  EXPECT_GT(engine.incremental_crossing_scans(), engine.counters().cell_crossings / 2);
+}
+
+TEST(GranularEngine, IncrementalCrossingsValidatedInCoolingGases) {
+  run_granular_validated<2>(inelastic(0.8), 41);
+  run_granular_validated<2>(rough(0.9, 0.5), 42);
+  run_granular_validated<3>(inelastic(0.8), 43);
 }
 
 TEST(GranularEngine, RoughSpheresReachTheMeanFieldTemperatureRatio3D) {
