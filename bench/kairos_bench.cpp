@@ -40,6 +40,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/error.hpp"
+#include "engine/candidate_scan.hpp"
 #include "engine/event_engine.hpp"
 #include "granular_cases.hpp"
 #include "init/initial_state.hpp"
@@ -144,16 +145,31 @@ Run measure(const ParticleSystem<D>& start, double equilibrate, double timed,
 }
 
 // A queue name, with the suffix kFullScans when every crossing rescans all neighbours
-// (--crossings full).
+// (--crossings full) and a list-walk suffix (--list-gather).
 constexpr std::string_view kFullScans = " full-scan";
+constexpr std::string_view kScalarWalk = " scalar-walk";
+constexpr std::string_view kVectorGather = " vector-gather";
 
-template <int D>
-Run measure_queue(std::string_view queue, const ParticleSystem<D>& s, const Case& c) {
-  EngineOptions options;
+// Strips the variant suffixes off a queue name into options.
+std::string_view strip_variants(std::string_view queue, EngineOptions& options) {
+  if (queue.ends_with(kScalarWalk)) {
+    options.list_gather = ListGather::kScalar;
+    queue.remove_suffix(kScalarWalk.size());
+  } else if (queue.ends_with(kVectorGather)) {
+    options.list_gather = ListGather::kVector;
+    queue.remove_suffix(kVectorGather.size());
+  }
   if (queue.ends_with(kFullScans)) {
     options.incremental_crossings = false;
     queue.remove_suffix(kFullScans.size());
   }
+  return queue;
+}
+
+template <int D>
+Run measure_queue(std::string_view queue, const ParticleSystem<D>& s, const Case& c) {
+  EngineOptions options;
+  queue = strip_variants(queue, options);
   if (queue == "heap") return measure<D, BinaryHeapQueue>(s, c.equilibrate, c.timed, options);
   if (queue == "tree") return measure<D, TournamentTreeQueue>(s, c.equilibrate, c.timed, options);
   return measure<D, CalendarQueue>(s, c.equilibrate, c.timed, options);
@@ -494,7 +510,8 @@ void validate(const Plan& p) {
     if (n < 2) throw UsageError(fmt::format("--particles {} is invalid: must be >= 2", n));
   }
   for (std::string_view q : p.queues) {
-    if (q.ends_with(kFullScans)) q.remove_suffix(kFullScans.size());
+    EngineOptions unused;
+    q = strip_variants(q, unused);
     if (q != "calendar" && q != "heap" && q != "tree") {
       throw UsageError(fmt::format("--queue \"{}\" is unknown; use calendar, heap or tree", q));
     }
@@ -623,7 +640,7 @@ int run(int argc, char** argv) {
   std::vector<std::int64_t> particles;  // signed: "-5" is an error, not 2^64 - 5
   std::vector<double> etas, ratios;
   std::vector<int> dims;
-  std::vector<std::string> queues, sizes, cases, scans, crossings;
+  std::vector<std::string> queues, sizes, cases, scans, crossings, gathers;
   std::vector<int> lj_steps;
   std::vector<double> contact_ratios;
   std::int64_t dem_steps = 0;
@@ -664,6 +681,12 @@ int run(int argc, char** argv) {
                      "new to the neighbourhood) and/or full (every crossing rescans all "
                      "neighbours, as before); run interleaved with the queues (default and soft "
                      "suites; the soft suite takes one)")
+          ->delimiter(',');
+  auto* o_gathers =
+      app.add_option("--list-gather", gathers,
+                     "how cell lists are walked: auto (the default: AVX-512 gathers on Intel, "
+                     "one by one elsewhere), scalar and/or vector (AVX-512 gathers); run "
+                     "interleaved with the queues (default, quick and full suites)")
           ->delimiter(',');
   auto* o_ratios = app.add_option("--contact-ratio", contact_ratios,
                                   "soft suite: mean free time / contact time (default 100,1000)")
@@ -734,6 +757,15 @@ int run(int argc, char** argv) {
   if (o_crossings->count() > 0 && suite != "soft" && suite != "default" && suite != "quick" &&
       suite != "full")
     throw UsageError("--crossings needs the default, quick, full or soft suite");
+  for (const std::string& g : gathers) {
+    if (g != "auto" && g != "scalar" && g != "vector")
+      throw UsageError(
+          fmt::format("--list-gather \"{}\" is unknown; use auto, scalar or vector", g));
+    if (g == "vector" && !cpu_has_avx512())
+      throw UsageError("--list-gather vector needs a CPU with AVX-512");
+  }
+  if (o_gathers->count() > 0 && suite != "default" && suite != "quick" && suite != "full")
+    throw UsageError("--list-gather needs the default, quick or full suite");
   if (suite == "soft") {
     if (crossings.size() > 1) throw UsageError("--suite soft takes one --crossings");
     if (o_queue->count() > 0 || o_sizes->count() > 0 || o_ratio->count() > 0 ||
@@ -846,6 +878,15 @@ int run(int argc, char** argv) {
     for (const std::string& q : plan.queues)
       for (const std::string& c : crossings)
         variants.push_back(c == "full" ? q + std::string(kFullScans) : q);
+    plan.queues = variants;
+  }
+  if (o_gathers->count() > 0) {
+    std::vector<std::string> variants;
+    for (const std::string& q : plan.queues)
+      for (const std::string& g : gathers)
+        variants.push_back(g == "scalar"   ? q + std::string(kScalarWalk)
+                           : g == "vector" ? q + std::string(kVectorGather)
+                                           : q);
     plan.queues = variants;
   }
   if (o_sizes->count() > 0 || o_ratio->count() > 0) {

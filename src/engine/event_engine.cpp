@@ -98,7 +98,9 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
   // The vector loop indexes records with 32-bit offsets.
   vector_scan_ = options_.vector_scan && cpu_has_avx512() &&
                  static_cast<double>(n) * sizeof(HotRecord<D>) < 2e9;
-  vector_gather_ = vector_scan_ && cpu_gathers_lists_fast();
+  vector_gather_ =
+      vector_scan_ && (options_.list_gather == ListGather::kVector ||
+                       (options_.list_gather == ListGather::kAuto && cpu_gathers_lists_fast()));
   const bool has_counts = s.collision_count.size() == n;
   hot_.resize(n);
   for (std::uint32_t k = 0; k < n; ++k) {

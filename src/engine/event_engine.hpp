@@ -76,6 +76,11 @@ struct Shape {
   std::uint32_t species;
 };
 
+// How the cell lists of a neighbourhood are walked: kVector gathers sixteen list heads at a time
+// with AVX-512 (fast on Intel's cores, slow on AMD's Zen 4), kScalar follows them one by one,
+// kAuto picks by CPU (cpu_gathers_lists_fast). Either lists the same candidates.
+enum class ListGather { kAuto, kScalar, kVector };
+
 struct EngineOptions {
   // Renumber particles along a Morton curve at the start and every this many collisions per
   // particle (0: never, the caller's order is kept).
@@ -91,6 +96,8 @@ struct EngineOptions {
   // keep the soonest contact its last prediction found beyond the crossing (periodic boxes
   // without shear or steps). Same physics; false rescans every neighbour (for comparison).
   bool incremental_crossings = true;
+  // Needs vector_scan (and AVX-512) for kVector.
+  ListGather list_gather = ListGather::kAuto;
 };
 
 template <int D, class Queue>
