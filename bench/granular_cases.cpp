@@ -149,10 +149,18 @@ Sample timed_collisions(Engine<D>& e, double per_particle) {
   return s;
 }
 
+// The engine options of the timed samples (--crossings full: every crossing rescans).
+EngineOptions options_of(const GranularPlan& p) {
+  EngineOptions options;
+  options.incremental_crossings = !p.full_crossing_scans;
+  return options;
+}
+
 // A fresh engine from `start`, warmed up, then timed.
 template <int D>
-Sample sample(const ParticleSystem<D>& start, const Environment<D>& env, double timed) {
-  Engine<D> e(start, StartMode::kPredict, EngineOptions{}, env);
+Sample sample(const ParticleSystem<D>& start, const Environment<D>& env, double timed,
+              const EngineOptions& options) {
+  Engine<D> e(start, StartMode::kPredict, options, env);
   advance_collisions(e, kWarmup);
   return timed_collisions(e, timed);
 }
@@ -342,11 +350,12 @@ void run_gas(const GranularPlan& p, const Emit& emit, Notes& notes) {
   const ParticleSystem<D> start = equilibrated_fluid<D>(n, eta, p.equilibrate);
   const double setup = seconds_since(w0);
   const Environment<D> elastic{}, inelastic = inelastic_gas<D>();
-  std::vector<Variant> vs = {
-      {fmt::format("elastic, η = {:g}", eta), [&] { return sample<D>(start, elastic, timed); }, {}},
-      {fmt::format("e = {:g}, η = {:g}", kRestitution, eta),
-       [&] { return sample<D>(start, inelastic, timed); },
-       {}}};
+  std::vector<Variant> vs = {{fmt::format("elastic, η = {:g}", eta),
+                              [&] { return sample<D>(start, elastic, timed, options_of(p)); },
+                              {}},
+                             {fmt::format("e = {:g}, η = {:g}", kRestitution, eta),
+                              [&] { return sample<D>(start, inelastic, timed, options_of(p)); },
+                              {}}};
   interleave(vs, p.repeat);
   for (const Variant& v : vs) emit(steady_row("gas", D, n, v, vs[0], timed));
   notes.push_back(fmt::format("gas {}D: the shared elastic start took {:.1f} s", D, setup));
@@ -393,10 +402,10 @@ void run_bed(const GranularPlan& p, const Emit& emit, Notes& notes) {
   const Environment<D> elastic{}, driven = bed_environment<D>();
   std::vector<Variant> vs = {
       {fmt::format("elastic, η = {:g}", kBedEta),
-       [&] { return sample<D>(fluid, elastic, timed); },
+       [&] { return sample<D>(fluid, elastic, timed, options_of(p)); },
        {}},
       {fmt::format("vibrated bed, e = {:g}, Γ = {:g}", kRestitution, kBedGamma),
-       [&] { return sample<D>(bed, driven, timed); },
+       [&] { return sample<D>(bed, driven, timed, options_of(p)); },
        {}}};
   interleave(vs, p.repeat);
   for (const Variant& v : vs) emit(steady_row("bed", D, n, v, vs[0], timed));
@@ -433,7 +442,7 @@ void run_pile(const GranularPlan& p, const Emit& emit, Notes& notes) {
   const auto w0 = Clock::now();
   Environment<D> env = floor_environment<D>(kPileRestitution, 0.0, 0.0, kPileTc);
   env.sleep_speed = kPileSleepSpeed;
-  Engine<D> e(column_state<D>(c), StartMode::kPredict, EngineOptions{}, env);
+  Engine<D> e(column_state<D>(c), StartMode::kPredict, options_of(p), env);
   notes.push_back(fmt::format("pile {}D: engine built in {:.2f} s", D, seconds_since(w0)));
   // Settling rows share one wall-clock budget; the last row (after settling) gets its own.
   const auto budget =
@@ -499,8 +508,9 @@ void validate(const GranularPlan& p) {
 
 std::string granular_protocol(const GranularPlan& p) {
   return fmt::format(
-      "Protocol (granular): calendar queue; each engine warmed up {:g} collision per particle "
-      "before it is timed; variants of a case interleaved, best of {} (events/s) with the "
+      "Protocol (granular): calendar queue, {} cell crossings; each engine warmed up {:g} "
+      "collision per particle before it is timed; variants of a case interleaved, best of {} "
+      "(events/s) with the "
       "spread; ratios best/best and (in brackets) the range over the interleaved pairs. gas: "
       "e = {:g}, start equilibrated elastically {:g} collisions per particle; bed: gravity "
       "{:g}, periodic sides, open top, floor amplitude {:g}, Γ = {:g}, e = {:g}, tc = {:g}, {} "
@@ -508,10 +518,11 @@ std::string granular_protocol(const GranularPlan& p) {
       "body-centred layers (3D; 2D: {}), spacing {:g}, gap {:g}, e = {:g}, tc = {:g}, sleep "
       "speed {:g}, rows every {:g} time units until all sleep (or t = {:g}, or {:g} wall "
       "seconds), then one of {:g}.",
-      kWarmup, p.repeat, kRestitution, p.equilibrate, kGravity, kBedAmplitude, kBedGamma,
-      kRestitution, kBedTc, kBedLayers, 2 * kBedLayers, kBedEta, kBedPeriods, kPileLayers,
-      2 * kPileLayers, kPileSpacing, kPileGap, kPileRestitution, kPileTc, kPileSleepSpeed,
-      kPileInterval, kPileMaxTime, kPileWallBudget, kPileAfter);
+      p.full_crossing_scans ? "full-scan" : "incremental", kWarmup, p.repeat, kRestitution,
+      p.equilibrate, kGravity, kBedAmplitude, kBedGamma, kRestitution, kBedTc, kBedLayers,
+      2 * kBedLayers, kBedEta, kBedPeriods, kPileLayers, 2 * kPileLayers, kPileSpacing, kPileGap,
+      kPileRestitution, kPileTc, kPileSleepSpeed, kPileInterval, kPileMaxTime, kPileWallBudget,
+      kPileAfter);
 }
 
 void run_granular(const GranularPlan& plan, const std::function<void(const std::string&)>& emit) {

@@ -18,6 +18,9 @@ struct GranularPlan {
   double equilibrate = 20.0;    // elastic collisions per particle before the gas is timed
   double timed = 0.0;           // timed collisions per particle (gas, bed); 0: the defaults
   int repeat = 3;               // interleaved repeats (gas, bed)
+  // Every cell crossing rescans all neighbours (EngineOptions::incremental_crossings = false),
+  // for comparison with the default.
+  bool full_crossing_scans = false;
 };
 
 // Throws std::invalid_argument naming the first bad field.

@@ -679,8 +679,8 @@ int run(int argc, char** argv) {
       app.add_option("--crossings", crossings,
                      "cell crossings: incremental (the default: a crossing scans only the cells "
                      "new to the neighbourhood) and/or full (every crossing rescans all "
-                     "neighbours, as before); run interleaved with the queues (default and soft "
-                     "suites; the soft suite takes one)")
+                     "neighbours, as before); run interleaved with the queues (default, quick "
+                     "and full suites; the soft and granular suites take one)")
           ->delimiter(',');
   auto* o_gathers =
       app.add_option("--list-gather", gathers,
@@ -754,9 +754,10 @@ int run(int argc, char** argv) {
     if (c != "incremental" && c != "full")
       throw UsageError(fmt::format("--crossings \"{}\" is unknown; use incremental or full", c));
   }
-  if (o_crossings->count() > 0 && suite != "soft" && suite != "default" && suite != "quick" &&
-      suite != "full")
-    throw UsageError("--crossings needs the default, quick, full or soft suite");
+  if (o_crossings->count() > 0 && suite == "stepped")
+    throw UsageError("--crossings does not apply to the stepped suite (steps keep full scans)");
+  if ((suite == "soft" || suite == "granular") && crossings.size() > 1)
+    throw UsageError("--suite " + suite + " takes one --crossings");
   for (const std::string& g : gathers) {
     if (g != "auto" && g != "scalar" && g != "vector")
       throw UsageError(
@@ -767,7 +768,6 @@ int run(int argc, char** argv) {
   if (o_gathers->count() > 0 && suite != "default" && suite != "quick" && suite != "full")
     throw UsageError("--list-gather needs the default, quick or full suite");
   if (suite == "soft") {
-    if (crossings.size() > 1) throw UsageError("--suite soft takes one --crossings");
     if (o_queue->count() > 0 || o_sizes->count() > 0 || o_ratio->count() > 0 ||
         o_dim->count() > 0 || fmt_kind == Format::kTsv) {
       throw UsageError("--suite soft takes no --queue, --sizes, --dimension or --format tsv");
@@ -850,6 +850,7 @@ int run(int argc, char** argv) {
     if (o_eq->count() > 0) g.equilibrate = eq;
     if (o_timed->count() > 0) g.timed = timed;
     if (o_repeat->count() > 0) g.repeat = repeat;
+    g.full_crossing_scans = !crossings.empty() && crossings[0] == "full";
     try {
       bench::validate(g);
     } catch (const std::invalid_argument& e) {

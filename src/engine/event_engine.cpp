@@ -310,8 +310,8 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   }
   find_squeeze_time(rmax);
   if (time_ >= squeeze_time_) throw_squeezed(time_);
-  // Walls, open faces and sleepers (which come with them), shear and steps keep full scans.
-  incremental_crossings_ = options_.incremental_crossings && !bounded_ && !stepped_ && !sheared_;
+  // Shear (sliding images) and steps (zones) keep full scans.
+  incremental_crossings_ = options_.incremental_crossings && !stepped_ && !sheared_;
 }
 
 // Relative margin of find_squeeze_time: a lone particle squeezed between approaching walls
@@ -853,6 +853,9 @@ double EventEngine<D, Queue>::predict_after_crossing(std::uint32_t i, double t,
   const HotRecord<D>& h = hot_[i];
   CandidateList& list = lists_[0];
   gather_cells(h.cell, grid_.layer(crossed.axis, crossed.sign), CellGrid<D>::kLayerCells, list);
+  // A sleeper in the new layer needs the loop of scan_with_sleepers: the full prediction.
+  if (sleeping_ > 0 && sleeper_among(list)) [[unlikely]]
+    return predict(i, t);
   const Crossing crossing = next_crossing(h);
   const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
   double soonest = kNever;
@@ -875,7 +878,7 @@ bool EventEngine<D, Queue>::kept_contact_time(std::uint32_t i, std::uint32_t p, 
   const HotRecord<D>& hp = hot_[p];
   std::array<int, D> d;
   if (!grid_.neighbour_offset(hi.cell, hp.cell, d)) return false;
-  if (in_deferred_contact(p, t)) [[unlikely]]
+  if (in_deferred_contact(p, t) || is_asleep(p)) [[unlikely]]
     return false;
   const Vec<D> xi = accelerated_ ? position_at(hi, t) : hi.pos + (t - hi.time) * hi.vel;
   const Vec<D> xp = accelerated_ ? position_at(hp, t) : hp.pos + (t - hp.time) * hp.vel;

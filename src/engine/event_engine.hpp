@@ -10,7 +10,7 @@
 // Every prediction scans the particle's 3^D neighbouring cells. When the crossing comes first,
 // the soonest contact after it is kept, named by the crossing's pending event, and the crossing
 // then scans only the layer of cells new to the neighbourhood (incremental crossings, see
-// cross()); where that does not apply (walls, shear, steps) the crossing bounds the scan and
+// cross()); where that does not apply (shear, steps) the crossing bounds the scan and
 // rescans everything.
 //
 // Invariant (checked by validate()): for every pair in neighbouring cells, the sooner of the
@@ -93,8 +93,8 @@ struct EngineOptions {
   // it until a release event. Same physics; false keeps every contact frozen (for comparison).
   bool defer_soft_releases = true;
   // After a cell crossing, scan only the layer of cells new to the particle's neighbourhood and
-  // keep the soonest contact its last prediction found beyond the crossing (periodic boxes
-  // without shear or steps). Same physics; false rescans every neighbour (for comparison).
+  // keep the soonest contact its last prediction found beyond the crossing (not under shear or
+  // with steps). Same physics; false rescans every neighbour (for comparison).
   bool incremental_crossings = true;
   // Needs vector_scan (and AVX-512) for kVector.
   ListGather list_gather = ListGather::kAuto;

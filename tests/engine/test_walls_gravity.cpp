@@ -124,6 +124,39 @@ TEST(WallsAndGravity, ElasticGasUnderGravityConservesEnergyAndKeepsInvariants) {
   EXPECT_NEAR(energy() - work_x, e0, 1e-9 * e0);
 }
 
+// Incremental crossings between walls and under gravity: a dilute inelastic gas falling onto a
+// floor (walls on z, periodic x and y) keeps the scheduler invariant, by brute force, while
+// most crossings scan only their new layer of cells.
+TEST(WallsAndGravity, IncrementalCrossingsValidatedBetweenWalls) {
+  ParticleSystem<D> s;
+  s.box = {12.0, 12.0, 20.0};
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j)
+      for (int k = 0; k < 6; ++k) {
+        s.kinematics.push_back(
+            {{1.0 + 2.0 * i, 1.0 + 2.0 * j, 1.0 + 3.0 * k}, {u(rng), u(rng), u(rng)}, 0.0, 0.5});
+        s.mass.push_back(1.0);
+        s.species.push_back(0);
+      }
+  s.species_names = {"A"};
+  Environment<D> env = box_with_floor(0.9, 0.2);
+  ContactModel law;
+  law.normal = NormalRestitution::constant(0.95);
+  env.species = 1;
+  env.contact.assign(1, law);
+  Engine engine(s, StartMode::kPredict, EngineOptions{}, env);
+  ASSERT_TRUE(engine.incremental_crossings());
+  for (int k = 0; k < 4000; ++k) {
+    ASSERT_NE(engine.step(), EventKind::kNone);
+    if (k % 7 == 0) engine.validate();
+  }
+  EXPECT_GT(engine.counters().wall_collisions, 20u);
+  EXPECT_GT(engine.counters().collisions, 200u);
+  EXPECT_GT(engine.incremental_crossing_scans(), engine.counters().cell_crossings / 2);
+}
+
 // A resting ball (on the floor, at rest) stays at rest: no events, no motion.
 TEST(WallsAndGravity, BallAtRestStaysAtRest) {
   ParticleSystem<D> s = two_balls(0.0);
