@@ -623,7 +623,7 @@ void EventEngine<D, Queue>::gather(CellCode cell, CandidateList& list) {
 }
 
 // gather() for the cells numbered which[0 .. count) among the 3^D around `cell` (see
-// CellGrid::for_each_neighbour's numbering), in that order.
+// CellGrid::neighbour's numbering), in that order.
 template <int D, class Queue>
 void EventEngine<D, Queue>::gather_cells(CellCode cell, const std::uint8_t* which, int count,
                                          CandidateList& list) {

@@ -293,8 +293,8 @@ class EventEngine {
   // result is merged with the contact the last prediction kept beyond the crossing (see
   // cross()).
   // The contact kept with particle p, from time t (kNever if the pair now misses); false if
-  // the kept contact cannot be used (p has moved out of the neighbourhood or sits in a
-  // deferred soft contact): then the crossing scans every neighbour.
+  // the kept contact cannot be used (p has moved out of the neighbourhood, sits in a deferred
+  // soft contact or sleeps): then the crossing scans every neighbour.
   bool kept_contact_time(std::uint32_t i, std::uint32_t p, double t, double& dt) const;
   double predict_after_crossing(std::uint32_t i, double t, const Crossing& crossed,
                                 std::uint32_t kept, double kept_dt);

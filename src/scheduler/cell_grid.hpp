@@ -216,12 +216,13 @@ class CellGrid {
     return in;
   }
   const std::int32_t* neighbour_deltas() const { return neighbour_delta_; }
-  // The neighbour numbers n (as for_each_neighbour and neighbour_deltas() count them, in
-  // increasing order) of the kLayerCells cells one step along axis k on the side `sign` (+1, -1):
-  // after a crossing, the layer that is new to the particle's neighbourhood.
+  // The neighbour numbers n (as neighbour() and neighbour_deltas() count them, in increasing
+  // order) of the kLayerCells cells one step along axis k on the side `sign` (+1, -1): after a
+  // crossing, the layer that is new to the particle's neighbourhood.
   const std::uint8_t* layer(int k, int sign) const { return layer_[k][sign > 0 ? 1 : 0]; }
-  // Neighbour number n of cell c: its linear index and periodic shift (as for_each_neighbour
-  // gives it).
+  // Neighbour number n (0 .. 3^D - 1, axis 0 fastest: n = sum (off_k + 1) 3^k) of cell c, itself
+  // included: its linear index and periodic shift; beyond a wall or open face the empty sentinel
+  // cell.
   Neighbour neighbour(CellCode c, int n) const {
     std::array<int, D> base, off;
     for (int k = 0; k < D; ++k) {
@@ -230,37 +231,6 @@ class CellGrid {
       n /= 3;
     }
     return bounded() ? offset_cell<true>(base, off) : offset_cell<false>(base, off);
-  }
-
-  // Visits the 3^D cells around `c` (itself included). Cells away from the box faces take a
-  // fast path: fixed index offsets, no wrapping, no shift.
-  template <class F>
-  void for_each_neighbour(CellCode c, F&& f) const {
-    std::array<int, D> base;
-    bool interior = true;
-    for (int k = 0; k < D; ++k) {
-      base[k] = coordinate(c, k);
-      interior = interior && base[k] > 0 && base[k] < n_[k] - 1;
-    }
-    if (interior) {
-      const std::uint32_t centre = index(c);
-      Neighbour nb{0, false, {}};
-      for (int n = 0; n < kNeighbourCells; ++n) {
-        nb.cell = centre + static_cast<std::uint32_t>(neighbour_delta_[n]);
-        f(nb);
-      }
-      return;
-    }
-    std::array<int, D> off;
-    off.fill(-1);
-    const bool bounded = this->bounded();
-    for (int n = 0; n < kNeighbourCells; ++n) {
-      f(bounded ? offset_cell<true>(base, off) : offset_cell<false>(base, off));
-      for (int k = 0; k < D; ++k) {
-        if (++off[k] <= 1) break;
-        off[k] = -1;
-      }
-    }
   }
 
   // Offset of cell b from cell a, each component wrapped into {-1, 0, 1} (periodic axes);
