@@ -28,6 +28,29 @@ ParticleSystem<D> two_balls(double drop_height) {
   return s;
 }
 
+// Unit spheres on a count[0] x count[1] x count[2] lattice (first centre `first`, spacing
+// `pitch`) with velocity components uniform in [-1, 1].
+ParticleSystem<D> ball_lattice(const Vec<D>& box, const std::array<int, D>& count,
+                               const Vec<D>& first, const Vec<D>& pitch, std::uint64_t seed) {
+  ParticleSystem<D> s;
+  s.box = box;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < count[0]; ++i)
+    for (int j = 0; j < count[1]; ++j)
+      for (int k = 0; k < count[2]; ++k) {
+        s.kinematics.push_back(
+            {{first[0] + pitch[0] * i, first[1] + pitch[1] * j, first[2] + pitch[2] * k},
+             {u(rng), u(rng), u(rng)},
+             0.0,
+             0.5});
+        s.mass.push_back(1.0);
+        s.species.push_back(0);
+      }
+  s.species_names = {"A"};
+  return s;
+}
+
 Environment<D> box_with_floor(double e_floor, double g) {
   Environment<D> env;
   env.gravity = {0.0, 0.0, -g};
@@ -80,19 +103,8 @@ TEST(WallsAndGravity, BouncingBallFollowsTheAnalyticSequenceAndComesToRest) {
 // With elastic walls and collisions, kinetic plus potential energy is conserved to round-off
 // by a gas under gravity in a closed box; the engine's invariants hold after every event.
 TEST(WallsAndGravity, ElasticGasUnderGravityConservesEnergyAndKeepsInvariants) {
-  ParticleSystem<D> s;
-  s.box = {6.0, 6.0, 9.0};
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j)
-      for (int k = 0; k < 5; ++k) {
-        s.kinematics.push_back(
-            {{0.75 + 1.5 * i, 0.75 + 1.5 * j, 0.9 + 1.6 * k}, {u(rng), u(rng), u(rng)}, 0.0, 0.5});
-        s.mass.push_back(1.0);
-        s.species.push_back(0);
-      }
-  s.species_names = {"A"};
+  const ParticleSystem<D> s =
+      ball_lattice({6.0, 6.0, 9.0}, {4, 4, 5}, {0.75, 0.75, 0.9}, {1.5, 1.5, 1.6}, 3);
   Environment<D> env;
   env.gravity = {0.3, 0.0, -1.0};  // tilted: a component along a periodic axis too
   env.faces[4].kind = FaceKind::kWall;
@@ -128,19 +140,8 @@ TEST(WallsAndGravity, ElasticGasUnderGravityConservesEnergyAndKeepsInvariants) {
 // floor (walls on z, periodic x and y) keeps the scheduler invariant, by brute force, while
 // most crossings scan only their new layer of cells.
 TEST(WallsAndGravity, IncrementalCrossingsValidatedBetweenWalls) {
-  ParticleSystem<D> s;
-  s.box = {12.0, 12.0, 20.0};
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int i = 0; i < 6; ++i)
-    for (int j = 0; j < 6; ++j)
-      for (int k = 0; k < 6; ++k) {
-        s.kinematics.push_back(
-            {{1.0 + 2.0 * i, 1.0 + 2.0 * j, 1.0 + 3.0 * k}, {u(rng), u(rng), u(rng)}, 0.0, 0.5});
-        s.mass.push_back(1.0);
-        s.species.push_back(0);
-      }
-  s.species_names = {"A"};
+  const ParticleSystem<D> s =
+      ball_lattice({12.0, 12.0, 20.0}, {6, 6, 6}, {1.0, 1.0, 1.0}, {2.0, 2.0, 3.0}, 5);
   Environment<D> env = box_with_floor(0.9, 0.2);
   ContactModel law;
   law.normal = NormalRestitution::constant(0.95);
