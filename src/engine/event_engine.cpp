@@ -61,7 +61,7 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
       env_(environment) {
   const std::size_t n = s.size();
   if (n < 2) throw InputError("a simulation needs at least 2 particles");
-  if (n >= kFirstCode - 16) throw InputError("too many particles (at most 2^31 - 16)");
+  if (n > kFirstCode - 16) throw InputError("too many particles (at most 2^31 - 16)");
   if (s.mass.size() != n || s.species.size() != n) {
     throw InputError("the state needs a mass and a species for every particle");
   }
@@ -873,11 +873,16 @@ double EventEngine<D, Queue>::predict_after_crossing(std::uint32_t i, double t,
 // motion does; recomputing it costs one record and keeps the pending event at 8 bytes).
 template <int D, class Queue>
 bool EventEngine<D, Queue>::kept_contact_time(std::uint32_t i, std::uint32_t p, double t,
-                                              double& dt) const {
+                                              const Crossing& crossed, double& dt) const {
   const HotRecord<D>& hi = hot_[i];
   const HotRecord<D>& hp = hot_[p];
   std::array<int, D> d;
   if (!grid_.neighbour_offset(hi.cell, hp.cell, d)) return false;
+  // On a periodic axis only 3 cells wide the new layer is the old far layer through the other
+  // image: a partner there was kept for its contact through the old image, which the new image
+  // does not give back, and that contact bounded the old neighbours' ones. Scan everything.
+  const int axis = crossed.axis;
+  if (grid_.periodic(axis) && grid_.cells_along(axis) == 3 && d[axis] == crossed.sign) return false;
   if (in_deferred_contact(p, t) || is_asleep(p)) [[unlikely]]
     return false;
   const Vec<D> xi = accelerated_ ? position_at(hi, t) : hi.pos + (t - hi.time) * hi.vel;
@@ -1369,7 +1374,7 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   grid_.insert(i, h.cell);
   ++counters_.cell_crossings;
   double kept_dt = kNever;
-  if (incremental && kept != kNoPartner) incremental = kept_contact_time(i, kept, t, kept_dt);
+  if (incremental && kept != kNoPartner) incremental = kept_contact_time(i, kept, t, x, kept_dt);
   queue_.update(i, incremental ? predict_after_crossing(i, t, x, kept, kept_dt) : predict(i, t));
 }
 
