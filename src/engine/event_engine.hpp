@@ -292,12 +292,11 @@ class EventEngine {
   // Incremental crossings: after a crossing, only the new layer of cells is scanned and the
   // result is merged with the contact the last prediction kept beyond the crossing (see
   // cross()).
-  // The contact kept with particle p, from time t after `crossed` (kNever if the pair now
-  // misses); false if the kept contact cannot be used (p has moved out of the neighbourhood,
-  // sits in a deferred soft contact or sleeps, or is seen through another image after a
-  // crossing of a periodic axis 3 cells wide): then the crossing scans every neighbour.
-  bool kept_contact_time(std::uint32_t i, std::uint32_t p, double t, const Crossing& crossed,
-                         double& dt) const;
+  // The contact kept with particle p, from time t (kNever if the pair now misses); false if
+  // the kept contact cannot be used (p has moved out of the neighbourhood, sits in a deferred
+  // soft contact or sleeps, or some periodic axis is only 3 cells wide): then the crossing
+  // scans every neighbour.
+  bool kept_contact_time(std::uint32_t i, std::uint32_t p, double t, double& dt) const;
   double predict_after_crossing(std::uint32_t i, double t, const Crossing& crossed,
                                 std::uint32_t kept, double kept_dt);
   // The end of a prediction that looked at every contact (`soonest`, from t, with `partner`,
@@ -456,6 +455,7 @@ class EventEngine {
   HugeVector<PendingEvent> pending_;
   // Incremental crossings (see cross()): on unless a feature needs every crossing's full scan.
   bool incremental_crossings_ = false;
+  bool three_cell_axis_ = false;     // some periodic axis is 3 cells wide: kept contacts unused
   HugeVector<std::uint16_t> shape_;  // per particle; empty when there is a single shape
   std::vector<Shape> shapes_;
   bool uniform_radius_ = true;
