@@ -647,39 +647,74 @@ void EventEngine<D, Queue>::gather_cells(CellCode cell, const std::uint8_t* whic
     gather_vector(cell, which, count, list);
     return;
   }
-  std::uint32_t n = 0;
-  auto cap = static_cast<std::uint32_t>(list.ids.size());
-  std::uint32_t* cand = list.ids.data();
-  const std::uint32_t* heads = grid_.heads();
-  // Read once: the stores into the candidate list could alias them for the compiler.
-  const Links links{grid_.links(), grid_.end(), hot_.data()};
+  constexpr int kMost = CellGrid<D>::kNeighbourCells;
+  std::uint32_t cells[kMost], tags[kMost];
   if (grid_.interior(cell)) {
     const std::uint32_t centre = grid_.index(cell);
     const std::int32_t* delta = grid_.neighbour_deltas();
-    for (int c = 0; c < count; ++c) {
-      if (cap - n < kCandidateSlack) [[unlikely]] {
-        cand = grow(list);
-        cap = static_cast<std::uint32_t>(list.ids.size());
-      }
-      append_members(heads[centre + static_cast<std::uint32_t>(delta[which[c]])], links, list, n,
-                     cand, cap);
-    }
+    for (int c = 0; c < count; ++c) cells[c] = centre + static_cast<std::uint32_t>(delta[which[c]]);
     list.n_shifts = 1;
+    walk_lists<false>(cells, tags, count, list);
   } else {
     std::uint32_t n_shifts = 1;  // shifts[0] is the zero shift
     for (int c = 0; c < count; ++c) {
       const typename CellGrid<D>::Neighbour nb = grid_.neighbour(cell, which[c]);
-      if (cap - n < kCandidateSlack) [[unlikely]] {
-        cand = grow(list);
-        cap = static_cast<std::uint32_t>(list.ids.size());
-      }
-      const std::uint32_t from = n;
-      append_members(heads[nb.cell], links, list, n, cand, cap);
-      const std::uint32_t shift = nb.shifted ? n_shifts : 0;
-      for (std::uint32_t k = from; k < n; ++k) list.shift[k] = shift;
+      cells[c] = nb.cell;
+      tags[c] = nb.shifted ? n_shifts : 0;
       if (nb.shifted) list.shifts[n_shifts++] = nb.shift;
     }
     list.n_shifts = n_shifts;
+    walk_lists<true>(cells, tags, count, list);
+  }
+}
+
+// The members of the lists of cells[0 .. count), in list order, as candidates (with their
+// cells' shift numbers tags[] when kTagged). The first three links of every list are loaded in
+// three waves of independent loads (heads, second members, third links), not in a chain per
+// cell, so that each wave's cache misses overlap; only crowded cells follow links further.
+template <int D, class Queue>
+template <bool kTagged>
+void EventEngine<D, Queue>::walk_lists(const std::uint32_t* cells, const std::uint32_t* tags,
+                                       int count, CandidateList& list) {
+  const std::uint32_t* heads = grid_.heads();
+  // Read once: the stores into the candidate list could alias them for the compiler.
+  const Links links{grid_.links(), grid_.end(), hot_.data()};
+  const std::uint32_t* next = links.next;
+  const std::uint32_t end = links.end;
+  constexpr int kMost = CellGrid<D>::kNeighbourCells;
+  std::uint32_t first[kMost], second[kMost], third[kMost];
+  for (int c = 0; c < count; ++c) first[c] = heads[cells[c]];
+  for (int c = 0; c < count; ++c) second[c] = next[first[c]];  // next[end] is end
+  for (int c = 0; c < count; ++c) third[c] = next[second[c]];
+  // Two slots per cell are written unchecked (an empty one is overwritten).
+  const auto room = [&](int cells_left) {
+    return kCandidateSlack + 2 * static_cast<std::uint32_t>(cells_left);
+  };
+  std::uint32_t n = 0;
+  auto cap = static_cast<std::uint32_t>(list.ids.size());
+  std::uint32_t* cand = list.ids.data();
+  while (cap < room(count)) [[unlikely]] {
+      cand = grow(list);
+      cap = static_cast<std::uint32_t>(list.ids.size());
+    }
+  for (int c = 0; c < count; ++c) {
+    const std::uint32_t from = n;
+    __builtin_prefetch(links.hot + first[c]);
+    cand[n] = first[c];
+    n += first[c] != end ? 1u : 0u;
+    __builtin_prefetch(links.hot + second[c]);
+    cand[n] = second[c];
+    n += second[c] != end ? 1u : 0u;
+    if (third[c] != end) [[unlikely]] {  // a crowded cell: the rest by links
+      append_members(third[c], links, list, n, cand, cap);
+      while (cap - n < room(count - c - 1)) {
+        cand = grow(list);
+        cap = static_cast<std::uint32_t>(list.ids.size());
+      }
+    }
+    if constexpr (kTagged) {
+      for (std::uint32_t k = from; k < n; ++k) list.shift[k] = tags[c];
+    }
   }
   list.count = n;
 }

@@ -307,6 +307,9 @@ class EventEngine {
   void gather(CellCode cell, CandidateList& list);
   void gather_cells(CellCode cell, const std::uint8_t* which, int count, CandidateList& list);
   void gather_vector(CellCode cell, const std::uint8_t* which, int count, CandidateList& list);
+  template <bool kTagged>
+  void walk_lists(const std::uint32_t* cells, const std::uint32_t* tags, int count,
+                  CandidateList& list);
   struct Links {
     const std::uint32_t* next;
     std::uint32_t end;
