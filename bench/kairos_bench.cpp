@@ -149,9 +149,18 @@ Run measure(const ParticleSystem<D>& start, double equilibrate, double timed,
 constexpr std::string_view kFullScans = " full-scan";
 constexpr std::string_view kScalarWalk = " scalar-walk";
 constexpr std::string_view kVectorGather = " vector-gather";
+constexpr std::string_view kGatherLoads = " gather-loads";
+constexpr std::string_view kRowLoads = " row-loads";
 
 // Strips the variant suffixes off a queue name into options.
 std::string_view strip_variants(std::string_view queue, EngineOptions& options) {
+  if (queue.ends_with(kGatherLoads)) {
+    options.record_loads = RecordLoads::kGather;
+    queue.remove_suffix(kGatherLoads.size());
+  } else if (queue.ends_with(kRowLoads)) {
+    options.record_loads = RecordLoads::kRows;
+    queue.remove_suffix(kRowLoads.size());
+  }
   if (queue.ends_with(kScalarWalk)) {
     options.list_gather = ListGather::kScalar;
     queue.remove_suffix(kScalarWalk.size());
@@ -640,7 +649,7 @@ int run(int argc, char** argv) {
   std::vector<std::int64_t> particles;  // signed: "-5" is an error, not 2^64 - 5
   std::vector<double> etas, ratios;
   std::vector<int> dims;
-  std::vector<std::string> queues, sizes, cases, scans, crossings, gathers;
+  std::vector<std::string> queues, sizes, cases, scans, crossings, gathers, record_loads;
   std::vector<int> lj_steps;
   std::vector<double> contact_ratios;
   std::int64_t dem_steps = 0;
@@ -687,6 +696,13 @@ int run(int argc, char** argv) {
                      "how cell lists are walked: auto (the default: AVX-512 gathers on Intel, "
                      "one by one elsewhere), scalar and/or vector (AVX-512 gathers); run "
                      "interleaved with the queues (default, quick and full suites)")
+          ->delimiter(',');
+  auto* o_record_loads =
+      app.add_option("--record-loads", record_loads,
+                     "how the AVX-512 loops read candidates' records: auto (the default: "
+                     "gathers on Intel, row loads elsewhere), gather and/or rows (one load per "
+                     "record and a transpose); run interleaved with the queues (default, quick "
+                     "and full suites)")
           ->delimiter(',');
   auto* o_ratios = app.add_option("--contact-ratio", contact_ratios,
                                   "soft suite: mean free time / contact time (default 100,1000)")
@@ -767,6 +783,15 @@ int run(int argc, char** argv) {
   }
   if (o_gathers->count() > 0 && suite != "default" && suite != "quick" && suite != "full")
     throw UsageError("--list-gather needs the default, quick or full suite");
+  for (const std::string& r : record_loads) {
+    if (r != "auto" && r != "gather" && r != "rows")
+      throw UsageError(
+          fmt::format("--record-loads \"{}\" is unknown; use auto, gather or rows", r));
+    if (r != "auto" && !cpu_has_avx512())
+      throw UsageError("--record-loads gather and rows need a CPU with AVX-512");
+  }
+  if (o_record_loads->count() > 0 && suite != "default" && suite != "quick" && suite != "full")
+    throw UsageError("--record-loads needs the default, quick or full suite");
   if (suite == "soft") {
     if (o_queue->count() > 0 || o_sizes->count() > 0 || o_ratio->count() > 0 ||
         o_dim->count() > 0 || fmt_kind == Format::kTsv) {
@@ -888,6 +913,15 @@ int run(int argc, char** argv) {
         variants.push_back(g == "scalar"   ? q + std::string(kScalarWalk)
                            : g == "vector" ? q + std::string(kVectorGather)
                                            : q);
+    plan.queues = variants;
+  }
+  if (o_record_loads->count() > 0) {
+    std::vector<std::string> variants;
+    for (const std::string& q : plan.queues)
+      for (const std::string& r : record_loads)
+        variants.push_back(r == "gather" ? q + std::string(kGatherLoads)
+                           : r == "rows" ? q + std::string(kRowLoads)
+                                         : q);
     plan.queues = variants;
   }
   if (o_sizes->count() > 0 || o_ratio->count() > 0) {

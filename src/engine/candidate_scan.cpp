@@ -16,7 +16,7 @@ bool cpu_has_avx512() {
 #endif
 }
 
-bool cpu_gathers_lists_fast() {
+bool cpu_gathers_fast() {
 #if defined(__x86_64__) && defined(__GNUC__)
   static const bool fast = cpu_has_avx512() && __builtin_cpu_is("intel");
   return fast;
@@ -44,16 +44,91 @@ inline __m512d gather_field(const double* records, __m256i base, __mmask8 live, 
                                   _mm256_add_epi32(base, _mm256_set1_epi32(f)), records, 8);
 }
 
-// r.r, r.g and g.g of the eight candidates k..k+7 (lanes `live`, records at offsets `base`)
-// against particle i (position vxi, velocity vvi, broadcast): the part both AVX-512 loops share,
-// in the scalar loop's order of operations.
+// The position, velocity and local time of eight candidates' records, one vector per field.
+template <int D>
+struct RecordColumns {
+  __m512d pos[D], vel[D], time;
+};
+
+// By one gather per field (masked lanes: 0).
+template <int D>
+[[gnu::always_inline]] inline RecordColumns<D> gather_columns(const double* records, __m256i base,
+                                                              __mmask8 live) {
+  RecordColumns<D> c;
+  c.time = gather_field(records, base, live, 2 * D);
+  for (int a = 0; a < D; ++a) {
+    c.pos[a] = gather_field(records, base, live, a);
+    c.vel[a] = gather_field(records, base, live, D + a);
+  }
+  return c;
+}
+
+// 128-bit lanes 0 and 2 of a, then of b; odd(): lanes 1 and 3.
+[[gnu::always_inline]] inline __m512d even(__m512d a, __m512d b) {
+  return _mm512_shuffle_f64x2(a, b, 0x88);
+}
+[[gnu::always_inline]] inline __m512d odd(__m512d a, __m512d b) {
+  return _mm512_shuffle_f64x2(a, b, 0xdd);
+}
+
+// By one load per record (its 2D + 1 fields: most of a cache line) and an 8 x 8 transpose, for
+// CPUs whose gathers are slow. Lanes whose ids are 0 (masked) read record 0.
+template <int D>
+[[gnu::always_inline]] inline RecordColumns<D> load_columns(const double* records, int stride,
+                                                            __m256i ids) {
+  alignas(32) std::uint32_t id[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(id), ids);
+  constexpr __mmask8 kFields = static_cast<__mmask8>((1u << (2 * D + 1)) - 1u);
+  __m512d r[8];
+  for (int l = 0; l < 8; ++l)
+    r[l] = _mm512_maskz_loadu_pd(kFields, records + static_cast<std::size_t>(id[l]) * stride);
+  // Pairs of rows interleaved: 128-bit lane q of lo[p] holds field 2q of rows 2p and 2p + 1,
+  // of hi[p] field 2q + 1.
+  __m512d lo[4], hi[4];
+  for (int p = 0; p < 4; ++p) {
+    lo[p] = _mm512_unpacklo_pd(r[2 * p], r[2 * p + 1]);
+    hi[p] = _mm512_unpackhi_pd(r[2 * p], r[2 * p + 1]);
+  }
+  // 128-bit lanes (0, 2) or (1, 3) of two such vectors, twice: eight rows of one field.
+  __m512d field[8];
+  const __m512d e0 = even(lo[0], lo[1]), e1 = odd(lo[0], lo[1]);
+  const __m512d e2 = even(lo[2], lo[3]), e3 = odd(lo[2], lo[3]);
+  const __m512d o0 = even(hi[0], hi[1]), o1 = odd(hi[0], hi[1]);
+  const __m512d o2 = even(hi[2], hi[3]), o3 = odd(hi[2], hi[3]);
+  field[0] = even(e0, e2);
+  field[4] = odd(e0, e2);
+  field[2] = even(e1, e3);
+  field[6] = odd(e1, e3);
+  field[1] = even(o0, o2);
+  field[5] = odd(o0, o2);
+  field[3] = even(o1, o3);
+  RecordColumns<D> c;
+  c.time = field[2 * D];
+  for (int a = 0; a < D; ++a) {
+    c.pos[a] = field[a];
+    c.vel[a] = field[D + a];
+  }
+  return c;
+}
+
+template <int D>
+[[gnu::always_inline]] inline RecordColumns<D> record_columns(const CandidateScan<D>& s,
+                                                              __m256i ids, __m256i base,
+                                                              __mmask8 live) {
+  return s.row_loads ? load_columns<D>(s.records, s.stride, ids)
+                     : gather_columns<D>(s.records, base, live);
+}
+
+// r.r, r.g and g.g of the eight candidates k..k+7 (lanes `live`, record fields `c`) against
+// particle i (position vxi, velocity vvi, broadcast): the part both AVX-512 loops share, in the
+// scalar loop's order of operations.
 template <int D, bool kAccelerated>
 [[gnu::always_inline]] inline void pair_terms(const CandidateScan<D>& s, std::uint32_t k,
-                                              __m256i base, __mmask8 live, __m512d vt,
+                                              const RecordColumns<D>& c, __mmask8 live, __m512d vt,
                                               const __m512d* vxi, const __m512d* vvi, __m512d& r2,
                                               __m512d& rg, __m512d& g2, __m512d& dtj) {
   const __m512d zero = _mm512_setzero_pd();
-  dtj = _mm512_sub_pd(vt, gather_field(s.records, base, live, 2 * D));
+  dtj = _mm512_sub_pd(vt, c.time);
   r2 = zero;
   rg = zero;
   g2 = zero;
@@ -63,8 +138,8 @@ template <int D, bool kAccelerated>
     shift_base = _mm256_mullo_epi32(sidx, _mm256_set1_epi32(D));
   }
   for (int a = 0; a < D; ++a) {
-    __m512d vel = gather_field(s.records, base, live, D + a);
-    __m512d xj = _mm512_add_pd(gather_field(s.records, base, live, a), _mm512_mul_pd(vel, dtj));
+    __m512d vel = c.vel[a];
+    __m512d xj = _mm512_add_pd(c.pos[a], _mm512_mul_pd(vel, dtj));
     if constexpr (kAccelerated) {
       xj = _mm512_add_pd(xj,
                          _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(s.half_accel[a]), dtj), dtj));
@@ -161,7 +236,8 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
     const __m256i ids = _mm256_maskz_loadu_epi32(live, s.candidates + k);
     const __m256i base = _mm256_mullo_epi32(ids, vstride);
     __m512d r2, rg, g2, dtj;
-    pair_terms<D, kAccelerated>(s, k, base, live, vt, vxi, vvi, r2, rg, g2, dtj);
+    pair_terms<D, kAccelerated>(s, k, record_columns(s, ids, base, live), live, vt, vxi, vvi, r2,
+                                rg, g2, dtj);
     // Candidates inside a deferred soft contact (local time after t) are left to the caller.
     const __mmask8 future = _mm512_mask_cmp_pd_mask(live, dtj, zero, _CMP_LT_OQ);
     if (future != 0 && s.delayed != nullptr) [[unlikely]]
@@ -204,7 +280,8 @@ ContactProbeResult probe_contact_avx512(const CandidateScan<D>& s, double t,
     live = _mm256_mask_cmpneq_epu32_mask(live, ids, va);
     live = _mm256_mask_cmpneq_epu32_mask(live, ids, vb);
     const __m256i base = _mm256_mullo_epi32(ids, vstride);
-    const __m512d dtj = _mm512_sub_pd(vt, gather_field(s.records, base, live, 2 * D));
+    const RecordColumns<D> rec = record_columns(s, ids, base, live);
+    const __m512d dtj = _mm512_sub_pd(vt, rec.time);
     const __mmask8 future = _mm512_mask_cmp_pd_mask(live, dtj, zero, _CMP_LT_OQ);
     if (future != 0 && s.delayed != nullptr) [[unlikely]]
       list_lanes<D>(s, k, future);
@@ -216,8 +293,8 @@ ContactProbeResult probe_contact_avx512(const CandidateScan<D>& s, double t,
     }
     __m512d p2 = zero, pg = zero, q2 = zero, r2 = zero, rg = zero, g2 = zero;
     for (int a = 0; a < D; ++a) {
-      const __m512d vel = gather_field(s.records, base, live, D + a);
-      __m512d xj = _mm512_add_pd(gather_field(s.records, base, live, a), _mm512_mul_pd(vel, dtj));
+      const __m512d vel = rec.vel[a];
+      __m512d xj = _mm512_add_pd(rec.pos[a], _mm512_mul_pd(vel, dtj));
       if (s.any_shift) {
         xj = _mm512_add_pd(xj, _mm512_mask_i32gather_pd(
                                    zero, live, _mm256_add_epi32(shift_base, _mm256_set1_epi32(a)),
@@ -311,7 +388,8 @@ std::uint32_t scan_stepped_avx512(const SteppedScan<D>& s, double t, const Vec<D
     live = _mm256_mask_cmpneq_epu32_mask(live, ids, vself);
     const __m256i base = _mm256_mullo_epi32(ids, vstride);
     __m512d r2, rg, g2, dtj;  // no deferred soft contacts under steps: dtj >= 0
-    pair_terms<D, kAccelerated>(c, k, base, live, vt, vxi, vvi, r2, rg, g2, dtj);
+    pair_terms<D, kAccelerated>(c, k, record_columns(c, ids, base, live), live, vt, vxi, vvi, r2,
+                                rg, g2, dtj);
     // Zones from the capture map's stamps: listed lanes in zone >= 1 are held back.
     const __m512i stamp =
         _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), live, ids, s.stamps, 8);

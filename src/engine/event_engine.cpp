@@ -102,7 +102,10 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
                  static_cast<double>(n) * sizeof(HotRecord<D>) < 2e9;
   vector_gather_ =
       vector_scan_ && (options_.list_gather == ListGather::kVector ||
-                       (options_.list_gather == ListGather::kAuto && cpu_gathers_lists_fast()));
+                       (options_.list_gather == ListGather::kAuto && cpu_gathers_fast()));
+  row_loads_ =
+      vector_scan_ && (options_.record_loads == RecordLoads::kRows ||
+                       (options_.record_loads == RecordLoads::kAuto && !cpu_gathers_fast()));
   const bool has_counts = s.collision_count.size() == n;
   hot_.resize(n);
   for (std::uint32_t k = 0; k < n; ++k) {
@@ -772,6 +775,7 @@ CandidateScan<D> EventEngine<D, Queue>::scan_of(const CandidateList& list, std::
   const double r = radius_of(i);
   return CandidateScan<D>{.records = reinterpret_cast<const double*>(hot_.data()),
                           .stride = static_cast<int>(sizeof(HotRecord<D>) / sizeof(double)),
+                          .row_loads = row_loads_,
                           .candidates = list.ids.data(),
                           .shift_index = list.shift.data(),
                           .shifts = list.shifts,

@@ -78,8 +78,13 @@ struct Shape {
 
 // How the cell lists of a neighbourhood are walked: kVector gathers sixteen list heads at a time
 // with AVX-512 (fast on Intel's cores, slow on AMD's Zen 4), kScalar follows them one by one,
-// kAuto picks by CPU (cpu_gathers_lists_fast). Either lists the same candidates.
+// kAuto picks by CPU (cpu_gathers_fast). Either lists the same candidates.
 enum class ListGather { kAuto, kScalar, kVector };
+
+// How the AVX-512 loops read eight candidates' records: kGather with one gather per field (fast
+// on Intel's cores), kRows with one load per record and a transpose (faster on AMD's Zen 4),
+// kAuto by CPU (cpu_gathers_fast). The same values either way.
+enum class RecordLoads { kAuto, kGather, kRows };
 
 struct EngineOptions {
   // Renumber particles along a Morton curve at the start and every this many collisions per
@@ -98,6 +103,8 @@ struct EngineOptions {
   bool incremental_crossings = true;
   // Needs vector_scan (and AVX-512) for kVector.
   ListGather list_gather = ListGather::kAuto;
+  // Used by the AVX-512 loops only.
+  RecordLoads record_loads = RecordLoads::kAuto;
 };
 
 template <int D, class Queue>
@@ -159,6 +166,8 @@ class EventEngine {
   // cells new to the particle's neighbourhood (EngineOptions::incremental_crossings).
   std::uint64_t incremental_crossing_scans() const { return incremental_scans_; }
   bool incremental_crossings() const { return incremental_crossings_; }
+  // Whether the AVX-512 loops read candidates' records by rows (EngineOptions::record_loads).
+  bool candidate_row_loads() const { return row_loads_; }
   Vec<D> momentum() const;
   const Environment<D>& environment() const { return env_; }
   // Positions at the current time, wrapped into the box, in the caller's numbering.
@@ -464,7 +473,8 @@ class EventEngine {
   bool uniform_radius_ = true;
   std::vector<double> shape_radius_;  // radius per shape, for the candidate loops
   bool vector_scan_ = false;
-  bool vector_gather_ = false;    // gather_lists_avx512 for the cell lists (cpu_gathers_lists_fast)
+  bool vector_gather_ = false;    // gather_lists_avx512 for the cell lists (cpu_gathers_fast)
+  bool row_loads_ = false;        // CandidateScan::row_loads (RecordLoads, cpu_gathers_fast)
   HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
   bool accelerated_ = false;      // uniform gravity
   Vec<D> half_gravity_{};
