@@ -895,19 +895,18 @@ double EventEngine<D, Queue>::conclude_unbounded(std::uint32_t i, double t,
   return when;
 }
 
-// After crossing `crossed` at time t (already in its new cell): the particle's old neighbours
+// After a crossing at time t (already in its new cell, the new layer of cells gathered
+// into lists_[0] by cross()): the particle's old neighbours
 // were all tested by the prediction that scheduled the crossing, and the soonest contact among
 // them came after it (`kept`, due in kept_dt; kNoPartner: none). A neighbour whose motion
 // changed since was predicted again then, against this particle's unchanged motion, so that
 // pair is in the neighbour's own event; only the layer of cells new to the neighbourhood needs
 // a scan.
 template <int D, class Queue>
-double EventEngine<D, Queue>::predict_after_crossing(std::uint32_t i, double t,
-                                                     const Crossing& crossed, std::uint32_t kept,
+double EventEngine<D, Queue>::predict_after_crossing(std::uint32_t i, double t, std::uint32_t kept,
                                                      double kept_dt) {
   const HotRecord<D>& h = hot_[i];
-  CandidateList& list = lists_[0];
-  gather_cells(h.cell, grid_.layer(crossed.axis, crossed.sign), CellGrid<D>::kLayerCells, list);
+  const CandidateList& list = lists_[0];
   // A sleeper in the new layer needs the loop of scan_with_sleepers: the full prediction.
   if (sleeping_ > 0 && sleeper_among(list)) [[unlikely]]
     return predict(i, t);
@@ -1425,13 +1424,18 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
     h.pos[x.axis] -= box_[x.axis];
     if (sheared_ && x.axis == 1) cross_shear_face(i, 1, t, c);
   }
+  const CellCode entered = grid_.code_at(c);
+  // The layer new to the neighbourhood, gathered first so that the misses on its records overlap
+  // the list surgery and the kept contact's time (its cells are neither the old nor the new one).
+  if (incremental)
+    gather_cells(entered, grid_.layer(x.axis, x.sign), CellGrid<D>::kLayerCells, lists_[0]);
   grid_.erase(i, h.cell);
-  h.cell = grid_.code_at(c);
+  h.cell = entered;
   grid_.insert(i, h.cell);
   ++counters_.cell_crossings;
   double kept_dt = kNever;
   if (incremental && kept != kNoPartner) incremental = kept_contact_time(i, kept, t, kept_dt);
-  queue_.update(i, incremental ? predict_after_crossing(i, t, x, kept, kept_dt) : predict(i, t));
+  queue_.update(i, incremental ? predict_after_crossing(i, t, kept, kept_dt) : predict(i, t));
 }
 
 template <int D, class Queue>

@@ -306,8 +306,7 @@ class EventEngine {
   // soft contact or sleeps, or some periodic axis is only 3 cells wide): then the crossing
   // scans every neighbour.
   bool kept_contact_time(std::uint32_t i, std::uint32_t p, double t, double& dt) const;
-  double predict_after_crossing(std::uint32_t i, double t, const Crossing& crossed,
-                                std::uint32_t kept, double kept_dt);
+  double predict_after_crossing(std::uint32_t i, double t, std::uint32_t kept, double kept_dt);
   // The end of a prediction that looked at every contact (`soonest`, from t, with `partner`,
   // kNoPartner if none): the contact if it comes before the crossing, else the crossing with
   // the contact kept as the one beyond it.
