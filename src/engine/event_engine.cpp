@@ -1599,6 +1599,13 @@ std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
 }
 
 template <int D, class Queue>
+std::vector<Vec<D>> EventEngine<D, Queue>::current_velocities() const {
+  std::vector<Vec<D>> out(size());
+  for (std::uint32_t i = 0; i < size(); ++i) out[id_[i]] = velocity_of(i, time_);
+  return out;
+}
+
+template <int D, class Queue>
 double EventEngine<D, Queue>::bytes_per_particle() const {
   // Per-particle arrays plus the grid's and the queue's own (cells and buckets included,
   // divided by N); the shape table is a few bytes in all.

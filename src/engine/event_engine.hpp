@@ -172,6 +172,9 @@ class EventEngine {
   const Environment<D>& environment() const { return env_; }
   // Positions at the current time, wrapped into the box, in the caller's numbering.
   std::vector<Vec<D>> current_positions() const;
+  // Velocities at the current time, in the caller's numbering: export_state()'s
+  // velocity_at(i, time()) to the bit, without copying the rest of the state.
+  std::vector<Vec<D>> current_velocities() const;
 
   // Debug: checks cell membership, queue order and the prediction invariant against brute
   // force; throws std::logic_error describing the first violation. O(N^2).
