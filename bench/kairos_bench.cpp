@@ -152,27 +152,38 @@ constexpr std::string_view kVectorGather = " vector-gather";
 constexpr std::string_view kGatherLoads = " gather-loads";
 constexpr std::string_view kRowLoads = " row-loads";
 
-// Strips the variant suffixes off a queue name into options.
+// Whether name ends with suffix; if so, takes it off.
+bool strip_suffix(std::string_view& name, std::string_view suffix) {
+  if (!name.ends_with(suffix)) return false;
+  name.remove_suffix(suffix.size());
+  return true;
+}
+
+// Strips the variant suffixes off a queue name into options (the reverse order of with_variants).
 std::string_view strip_variants(std::string_view queue, EngineOptions& options) {
-  if (queue.ends_with(kGatherLoads)) {
-    options.record_loads = RecordLoads::kGather;
-    queue.remove_suffix(kGatherLoads.size());
-  } else if (queue.ends_with(kRowLoads)) {
-    options.record_loads = RecordLoads::kRows;
-    queue.remove_suffix(kRowLoads.size());
-  }
-  if (queue.ends_with(kScalarWalk)) {
-    options.list_gather = ListGather::kScalar;
-    queue.remove_suffix(kScalarWalk.size());
-  } else if (queue.ends_with(kVectorGather)) {
-    options.list_gather = ListGather::kVector;
-    queue.remove_suffix(kVectorGather.size());
-  }
-  if (queue.ends_with(kFullScans)) {
-    options.incremental_crossings = false;
-    queue.remove_suffix(kFullScans.size());
-  }
+  if (strip_suffix(queue, kGatherLoads)) options.record_loads = RecordLoads::kGather;
+  if (strip_suffix(queue, kRowLoads)) options.record_loads = RecordLoads::kRows;
+  if (strip_suffix(queue, kScalarWalk)) options.list_gather = ListGather::kScalar;
+  if (strip_suffix(queue, kVectorGather)) options.list_gather = ListGather::kVector;
+  if (strip_suffix(queue, kFullScans)) options.incremental_crossings = false;
   return queue;
+}
+
+// Every queue name with every value of a variant option: the name plus the value's suffix (none
+// for a value without one: the default).
+std::vector<std::string> with_variants(
+    const std::vector<std::string>& queues, const std::vector<std::string>& values,
+    const std::vector<std::pair<std::string_view, std::string_view>>& suffixes) {
+  std::vector<std::string> out;
+  for (const std::string& q : queues) {
+    for (const std::string& v : values) {
+      std::string name = q;
+      for (const auto& [value, suffix] : suffixes)
+        if (v == value) name += suffix;
+      out.push_back(name);
+    }
+  }
+  return out;
 }
 
 template <int D>
@@ -899,30 +910,15 @@ int run(int argc, char** argv) {
   if (o_eta->count() > 0) plan.etas = etas;
   if (o_dim->count() > 0) plan.dims = dims;
   if (o_queue->count() > 0) plan.queues = queues;
-  if (o_crossings->count() > 0) {
-    std::vector<std::string> variants;
-    for (const std::string& q : plan.queues)
-      for (const std::string& c : crossings)
-        variants.push_back(c == "full" ? q + std::string(kFullScans) : q);
-    plan.queues = variants;
-  }
+  if (o_crossings->count() > 0)
+    plan.queues = with_variants(plan.queues, crossings, {{"full", kFullScans}});
   if (o_gathers->count() > 0) {
-    std::vector<std::string> variants;
-    for (const std::string& q : plan.queues)
-      for (const std::string& g : gathers)
-        variants.push_back(g == "scalar"   ? q + std::string(kScalarWalk)
-                           : g == "vector" ? q + std::string(kVectorGather)
-                                           : q);
-    plan.queues = variants;
+    plan.queues =
+        with_variants(plan.queues, gathers, {{"scalar", kScalarWalk}, {"vector", kVectorGather}});
   }
   if (o_record_loads->count() > 0) {
-    std::vector<std::string> variants;
-    for (const std::string& q : plan.queues)
-      for (const std::string& r : record_loads)
-        variants.push_back(r == "gather" ? q + std::string(kGatherLoads)
-                           : r == "rows" ? q + std::string(kRowLoads)
-                                         : q);
-    plan.queues = variants;
+    plan.queues =
+        with_variants(plan.queues, record_loads, {{"gather", kGatherLoads}, {"rows", kRowLoads}});
   }
   if (o_sizes->count() > 0 || o_ratio->count() > 0) {
     plan.size_ratios.clear();
