@@ -212,7 +212,8 @@ template <int D>
 
 }  // namespace
 
-// Eight candidates per iteration. Record fields come in by gathers (the records were prefetched
+// Eight candidates per iteration. Record fields come in by gathers or row loads
+// (record_columns; the records were prefetched
 // while the candidate list was built); lanes past the end read record 0 and are masked out.
 // Every lane computes the full contact time; invalid lanes (receding, near miss, beaten by the
 // cheap bound) become +inf, and the lowest lane holding the minimum wins, as in list order.
@@ -250,7 +251,7 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
 }
 
 // Eight candidates per iteration, as scan_candidates_avx512 (no gravity): the record fields are
-// gathered once and serve both the placed particle's tests and the prediction.
+// read once and serve both the placed particle's tests and the prediction.
 template <int D>
 ContactProbeResult probe_contact_avx512(const CandidateScan<D>& s, double t,
                                         const ContactProbe<D>& probe, const Vec<D>& xi,
