@@ -212,9 +212,9 @@ template <int D>
 
 }  // namespace
 
-// Eight candidates per iteration. Record fields come in by gathers or row loads
-// (record_columns; the records were prefetched
-// while the candidate list was built); lanes past the end read record 0 and are masked out.
+// Eight candidates per iteration. Record fields come in by gathers or row loads (record_columns;
+// the records were prefetched while the candidate list was built); lanes past the end read
+// record 0 and are masked out.
 // Every lane computes the full contact time; invalid lanes (receding, near miss, beaten by the
 // cheap bound) become +inf, and the lowest lane holding the minimum wins, as in list order.
 template <int D, bool kAccelerated>
