@@ -600,10 +600,10 @@ std::uint32_t* EventEngine<D, Queue>::grow(CandidateList& list) {
   return list.ids.data();
 }
 
-// Appends the members of the list starting at p to cand[n...]. Cells hold about one particle,
-// so the first two links are followed without a branch (an empty slot is written but not
-// counted); only a third member takes the loop. Records are prefetched so that the cache
-// misses of a whole prediction overlap instead of queueing one after another.
+// Appends the members of the list starting at p to cand[n...]: walk_lists' rest of a crowded
+// cell (from its third member on). The first two links are followed without a branch (an empty
+// slot is written but not counted); only a further member takes the loop. Records are
+// prefetched so that the cache misses of a whole prediction overlap.
 template <int D, class Queue>
 [[gnu::always_inline]] inline void EventEngine<D, Queue>::append_members(
     std::uint32_t p, const Links& links, CandidateList& list, std::uint32_t& n,
