@@ -412,11 +412,17 @@ class EventEngine {
   std::uint32_t scan_deferred(const CandidateList& list, std::uint32_t count, std::uint32_t i,
                               double t, const Vec<D>& xi, const Vec<D>& vi, double from,
                               double& best) const;
-  // A deferred contact keeps its flags after its release (nothing needs to happen then); they
-  // are cleared when the particle next meets something.
+  // A deferred contact keeps its flags after its release (nothing needs to happen then) until
+  // the particle's next contact overwrites them: readers of frozen_with_ take a particle with
+  // deferred_ set and a record time not after the present as in no contact.
   void forget_contact(std::uint32_t k) {
     deferred_[k] = 0;
     frozen_with_[k] = EventSlot::kNoPartner;
+  }
+  // Particle k frozen with `partner` (a particle or a wall code), not (yet) deferred.
+  void begin_contact(std::uint32_t k, std::uint32_t partner) {
+    frozen_with_[k] = partner;
+    if (!deferred_.empty()) deferred_[k] = 0;
   }
   // The centre-of-mass velocity of a deferred pair (its frozen motion), from the records after
   // the release: the same bits for both particles (summed in index order).

@@ -56,6 +56,9 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
     throw InputError("soft spheres: walls need a soft contact law for every species");
   if (!env_.soft_wall_tables.empty() && env_.soft_wall_tables.size() != env_.soft_wall.size())
     throw InputError("soft spheres: one wall lookup table (or none) per species is needed");
+  // Once here: collisions reduce their units unchecked (reduce_collision_unchecked).
+  for (const SoftContactLaw& law : env_.soft) kairos::validate(law);
+  for (const SoftContactLaw& law : env_.soft_wall) kairos::validate(law);
   // The map is exact for a free pair: the uniform field, steps, shear and instantaneous laws
   // would all act during the contact, where the algorithm has nothing to say.
   if (stepped_) throw InputError("soft spheres cannot be combined with stepped potentials");
@@ -280,14 +283,13 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
 
 template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool early) {
+  // Most particles are in no contact: the bit and the record (already read) say so, without a
+  // (cache-missing) look at frozen_with_. A deferred contact that is over keeps its flags.
+  const bool deferred = in_deferred_contact(i, t);
+  if (!awaits_release(i) && !deferred) [[likely]]
+    return kNone;
   const std::uint32_t p = frozen_with_[i];
-  if (p == kNone) return kNone;
-  if (!deferred_.empty() && deferred_[i] != 0) [[unlikely]] {
-    if (!(t < hot_[i].time)) {  // released already: only the flags were left
-      forget_contact(i);
-      if (p < kFirstCode && frozen_with_[p] == i) forget_contact(p);
-      return kNone;
-    }
+  if (deferred) [[unlikely]] {
     // Early: from where the frozen pair is now, with the post-contact velocities.
     auto give_back = [&](std::uint32_t k) {
       HotRecord<D>& h = hot_[k];
@@ -455,7 +457,7 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
   // first contact to start the map from: it collides instantaneously.
   const bool overlapping = distance < l * (1.0 - 1e-9);
   const bool mapped = env_.soft_collisions == SoftCollisions::kMapped && !overlapping;
-  const CollisionUnits units = reduce_collision(law, mu, l, vn, mapped ? vt : 0.0);
+  const CollisionUnits units = reduce_collision_unchecked(law, mu, l, vn, mapped ? vt : 0.0);
   const CollisionMap map = soft_map(table, units);
   const Vec<D> V = (1.0 / total) * (mi * hi.vel + mj * hj.vel);
   const double ke_before = 0.5 * (mi * norm2(hi.vel) + mj * norm2(hj.vel));
@@ -488,8 +490,8 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
       counters_.dissipated_in_collisions += ke_before - ke_after;
       hi.vel = V;
       hj.vel = V;
-      frozen_with_[i] = j;
-      frozen_with_[j] = i;
+      begin_contact(i, j);
+      begin_contact(j, i);
       ++counters_.soft_contacts;
       ++counters_.collisions;
       ++hi.collisions;
@@ -553,7 +555,7 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   const double m = mass_of(i), radius = radius_of(i);
   const SoftMapTable* table =
       env_.soft_wall_tables.empty() ? nullptr : env_.soft_wall_tables[s].get();
-  const CollisionUnits units = reduce_collision(env_.soft_wall[s], m, radius, vn, 0.0);
+  const CollisionUnits units = reduce_collision_unchecked(env_.soft_wall[s], m, radius, vn, 0.0);
   const CollisionMap map = soft_map(table, units);
   const double e = -map.eps_rdot;
   Vec<D> after = h.vel;
@@ -575,7 +577,7 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
       frozen_velocity[a] = wall_speed;
       counters_.soft_contact_energy += 0.5 * m * (norm2(after) - norm2(frozen_velocity));
       h.vel = frozen_velocity;
-      frozen_with_[i] = kFirstWall + static_cast<std::uint32_t>(face);
+      begin_contact(i, kFirstWall + static_cast<std::uint32_t>(face));
       set_awaits_release(i, true);
       release_time_[i] = t + map.eps_t * units.time_unit;
       release_velocity_[i] = after;

@@ -40,6 +40,8 @@ void require_finite(const Vec<3>& a, const char* what) {
           fmt::format("soft contact: {} must be finite, got ({}, {}, {})", what, a[0], a[1], a[2]));
 }
 
+}  // namespace
+
 void validate(const SoftContactLaw& law) {
   if (law.model == SoftModel::LinearDashpot) {
     require_positive(law.stiffness, "the spring constant k");
@@ -51,6 +53,8 @@ void validate(const SoftContactLaw& law) {
     throw InputError("soft contact: unknown contact model");
   }
 }
+
+namespace {
 
 void validate(const ReducedCollision& reduced) {
   if (reduced.model != SoftModel::LinearDashpot && reduced.model != SoftModel::ViscoelasticHertz)
@@ -290,6 +294,11 @@ CollisionUnits reduce_collision(const SoftContactLaw& law, double reduced_mass,
   require_positive(contact_distance, "the contact distance l");
   require_positive(v_n, "the normal impact speed v_n");
   require_non_negative(v_t, "the tangential speed v_t");
+  return reduce_collision_unchecked(law, reduced_mass, contact_distance, v_n, v_t);
+}
+
+CollisionUnits reduce_collision_unchecked(const SoftContactLaw& law, double reduced_mass,
+                                          double contact_distance, double v_n, double v_t) {
   CollisionUnits u;
   u.reduced.model = law.model;
   if (law.model == SoftModel::LinearDashpot) {

@@ -643,6 +643,13 @@ TEST(SoftErrors, UnsupportedCombinationsAreRefusedByName) {
   env.faces[4].wall.amplitude = 0.01;
   env.faces[4].wall.angular_frequency = 3.0;
   refused(env, "vibrating walls");
+  // Collisions reduce their units unchecked: a bad law is refused when the engine starts.
+  env = soft_environment<3>(law);
+  env.soft[1].stiffness = 0.0;
+  refused(env, "spring constant");
+  env = soft_environment<3>(law);
+  env.soft_wall[0].damping = std::nan("");
+  refused(env, "dashpot coefficient");
 }
 
 }  // namespace
