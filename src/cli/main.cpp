@@ -199,7 +199,8 @@ int main(int argc, char** argv) {
       "--restart", restart,
       "Continue from a restart file (OUTDIR/restart.gsd) bit-identically: a finished "
       "equilibration is not repeated (an interrupted one is completed), then "
-      "run.collisions_per_particle more collisions per particle are simulated");
+      "run.collisions_per_particle more collisions per particle (or run.time more simulated "
+      "time) are simulated");
   run->footer(
       "Outputs in OUTDIR: config.toml, thermo.tsv, trajectory.gsd, restart.gsd, summary.json.\n"
       "SIGINT/SIGTERM stop after the current event and still write every output.");

@@ -157,6 +157,8 @@ constexpr KeySpec kSchema[] = {
     {"run", Kind::kTable},
     {"run.equilibration_collisions_per_particle", Kind::kFloat},
     {"run.collisions_per_particle", Kind::kFloat},
+    {"run.time", Kind::kFloat},
+    {"run.equilibration_time", Kind::kFloat},
     {"run.event_queue", Kind::kString},
     {"run.max_wall_seconds", Kind::kFloat},
     {"run.validate", Kind::kBoolean},
@@ -198,6 +200,7 @@ constexpr KeySpec kSchema[] = {
     {"output.thermo_interval", Kind::kFloat},
     {"output.trajectory_interval", Kind::kFloat},
     {"output.restart_interval", Kind::kFloat},
+    {"output.interval_unit", Kind::kString},
     {"output.trajectory", Kind::kBoolean},
     {"output.progress", Kind::kString},
     {"output.profile_axis", Kind::kString},
@@ -212,6 +215,7 @@ constexpr std::string_view kLattices3D[] = {"fcc", "sc", "bcc", "random"};
 constexpr std::string_view kLattices2D[] = {"hex", "square", "random"};
 constexpr std::string_view kEventQueues[] = {"calendar", "heap", "tree"};
 constexpr std::string_view kProgressModes[] = {"auto", "always", "never"};
+constexpr std::string_view kIntervalUnits[] = {"collisions", "time"};
 constexpr std::string_view kDrivingKinds[] = {"none", "andersen", "white_noise"};
 constexpr std::string_view kIntegrators[] = {"event", "dem"};
 constexpr std::string_view kSoftModels[] = {"dashpot", "hertz"};
@@ -605,6 +609,7 @@ class Reader {
     read_driving(section(root, "driving", empty), config.driving);
     read_run(section(root, "run", empty), config.run);
     read_output(section(root, "output", empty), config.system.dimension, config.output);
+    resolve_interval_unit(section(root, "output", empty), config.run, config.output);
     read_potentials(root, config.system.species, config.potentials);
     read_bonds(root, config.bonds);
     if (root.contains("soft")) {
@@ -1649,9 +1654,25 @@ class Reader {
     const toml::node* n_wall = get_number(t, p, "max_wall_seconds", r.max_wall_seconds);
     get_bool(t, p, "validate", r.validate);
 
+    const toml::node* n_time = get_number(t, p, "time", r.time);
+    const toml::node* n_equilibration_time =
+        get_number(t, p, "equilibration_time", r.equilibration_time);
     require_non_negative(n_equilibration, "run.equilibration_collisions_per_particle",
                          r.equilibration_collisions_per_particle);
     require_positive(n_production, "run.collisions_per_particle", r.collisions_per_particle);
+    if (n_time != nullptr) require_positive(n_time, "run.time", r.time);
+    if (n_equilibration_time != nullptr)
+      require_non_negative(n_equilibration_time, "run.equilibration_time", r.equilibration_time);
+    // One length per phase: in collisions per particle or in simulated time, not both.
+    if (n_time != nullptr && n_production != nullptr) {
+      fail(n_time, "run.time",
+           "run.time and run.collisions_per_particle both give the production length: keep one");
+    }
+    if (n_equilibration_time != nullptr && n_equilibration != nullptr) {
+      fail(n_equilibration_time, "run.equilibration_time",
+           "run.equilibration_time and run.equilibration_collisions_per_particle both give the "
+           "equilibration length: keep one");
+    }
     require_choice(n_queue, "run.event_queue", r.event_queue, kEventQueues);
     require_non_negative(n_wall, "run.max_wall_seconds", r.max_wall_seconds);
     const toml::node* n_integrator = get_string(t, p, "integrator", r.integrator);
@@ -1672,6 +1693,9 @@ class Reader {
     const toml::node* n_thermo = get_number(t, p, "thermo_interval", o.thermo_interval);
     const toml::node* n_trajectory = get_number(t, p, "trajectory_interval", o.trajectory_interval);
     const toml::node* n_restart = get_number(t, p, "restart_interval", o.restart_interval);
+    const toml::node* n_unit = get_string(t, p, "interval_unit", o.interval_unit);
+    if (n_unit != nullptr)
+      require_choice(n_unit, "output.interval_unit", o.interval_unit, kIntervalUnits);
     get_bool(t, p, "trajectory", o.trajectory);
     const toml::node* n_progress = get_string(t, p, "progress", o.progress);
     const toml::node* n_axis = get_string(t, p, "profile_axis", o.profile_axis);
@@ -1695,6 +1719,25 @@ class Reader {
     require_non_negative(n_trajectory, "output.trajectory_interval", o.trajectory_interval);
     require_non_negative(n_restart, "output.restart_interval", o.restart_interval);
     require_choice(n_progress, "output.progress", o.progress, kProgressModes);
+  }
+
+  // The intervals' unit defaults to the production length's; automatic intervals (0) are
+  // fractions of the production length, so they need the same unit.
+  void resolve_interval_unit(const toml::table& t, const RunConfig& r, OutputConfig& o) const {
+    const std::string length_unit = r.time > 0.0 ? "time" : "collisions";
+    if (o.interval_unit.empty()) o.interval_unit = length_unit;
+    if (o.interval_unit == length_unit) return;
+    const char* automatic = !(o.thermo_interval > 0.0)       ? "thermo_interval"
+                            : !(o.trajectory_interval > 0.0) ? "trajectory_interval"
+                                                             : nullptr;
+    if (automatic != nullptr) {
+      fail(t.get("interval_unit"), "output.interval_unit",
+           fmt::format("output.interval_unit = \"{}\" but the production length is in {} "
+                       "(run.{}): the automatic output.{} (a fraction of that length) cannot be "
+                       "converted; give it explicitly",
+                       o.interval_unit, length_unit == "time" ? "simulated time" : "collisions",
+                       length_unit == "time" ? "time" : "collisions_per_particle", automatic));
+    }
   }
 
   std::string source_;
@@ -1942,9 +1985,18 @@ std::string to_toml(const Config& config) {
     }
   }
   out += "\n[run]\n";
-  out += fmt::format("equilibration_collisions_per_particle = {}\n",
-                     toml_float(r.equilibration_collisions_per_particle));
-  out += fmt::format("collisions_per_particle = {}\n", toml_float(r.collisions_per_particle));
+  // Each phase's length in its one unit (both would be refused when the file is read back).
+  if (r.equilibration_time >= 0.0) {
+    out += fmt::format("equilibration_time = {}\n", toml_float(r.equilibration_time));
+  } else {
+    out += fmt::format("equilibration_collisions_per_particle = {}\n",
+                       toml_float(r.equilibration_collisions_per_particle));
+  }
+  if (r.time > 0.0) {
+    out += fmt::format("time = {}\n", toml_float(r.time));
+  } else {
+    out += fmt::format("collisions_per_particle = {}\n", toml_float(r.collisions_per_particle));
+  }
   out += fmt::format("event_queue = {}\n", toml_string(r.event_queue));
   out += fmt::format("max_wall_seconds = {}\n", toml_float(r.max_wall_seconds));
   out += fmt::format("validate = {}\n", r.validate);
@@ -1955,6 +2007,8 @@ std::string to_toml(const Config& config) {
   out += fmt::format("thermo_interval = {}\n", toml_float(o.thermo_interval));
   out += fmt::format("trajectory_interval = {}\n", toml_float(o.trajectory_interval));
   out += fmt::format("restart_interval = {}\n", toml_float(o.restart_interval));
+  if (!o.interval_unit.empty())  // "" (a config built in code): the reader's default
+    out += fmt::format("interval_unit = {}\n", toml_string(o.interval_unit));
   out += fmt::format("trajectory = {}\n", o.trajectory);
   out += fmt::format("progress = {}\n", toml_string(o.progress));
   out += fmt::format("profile_axis = {}\n", toml_string(o.profile_axis));

@@ -111,8 +111,12 @@ struct FieldConfig {
 struct RunConfig {
   double equilibration_collisions_per_particle = 20.0;
   double collisions_per_particle = 100.0;  // production length
-  std::string event_queue = "calendar";    // calendar | heap
-  double max_wall_seconds = 0.0;           // 0 = no limit; stop cleanly when exceeded
+  // Lengths in simulated time instead: production `time` (> 0; 0 = in collisions per particle)
+  // and equilibration `equilibration_time` (>= 0; < 0 = in collisions per particle).
+  double time = 0.0;
+  double equilibration_time = -1.0;
+  std::string event_queue = "calendar";  // calendar | heap
+  double max_wall_seconds = 0.0;         // 0 = no limit; stop cleanly when exceeded
   bool validate = false;  // debug: check neighbour structure and queue against brute force
   // event: the event-driven engine; dem: the force-based velocity Verlet integrator (needs
   // [soft], periodic boxes only).
@@ -127,8 +131,12 @@ struct OutputConfig {
   double thermo_interval = 0.0;      // collisions per particle between thermo rows; 0 = auto
   double trajectory_interval = 0.0;  // collisions per particle between GSD frames; 0 = auto
   double restart_interval = 0.0;     // collisions per particle between restart files; 0 = end
-  bool trajectory = true;            // write trajectory.gsd at all
-  std::string progress = "auto";     // auto (when stderr is a terminal) | always | never
+  // The unit of the three intervals: "collisions" (per particle) or "time" (simulated time;
+  // outputs at the multiples of the interval). The reader resolves "" to the production
+  // length's unit.
+  std::string interval_unit;
+  bool trajectory = true;         // write trajectory.gsd at all
+  std::string progress = "auto";  // auto (when stderr is a terminal) | always | never
   // Profiles along an axis (profile.tsv), sampled at every production thermo row: "" = none,
   // else x, y or z, in profile_bins slabs.
   std::string profile_axis;

@@ -433,6 +433,8 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
       w.write_chunk("kairos/run/integrator", name.size(), 1, name.data());
       w.write_chunk("kairos/run/dem_time_step", 1, 1, &progress.dem_time_step);
       w.write_chunk("kairos/run/dem_collision_mark", 1, 1, &progress.dem_collision_mark);
+      if (std::isfinite(progress.dem_time_mark))
+        w.write_chunk("kairos/run/dem_time_mark", 1, 1, &progress.dem_time_mark);
     }
     w.end_frame();
     w.close();
@@ -634,6 +636,11 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
       if (r.find(f, "kairos/run/dem_collision_mark")) {
         progress->dem_collision_mark =
             require<std::uint64_t>(r, f, "kairos/run/dem_collision_mark", path, 1)[0];
+      }
+      if (r.find(f, "kairos/run/dem_time_mark")) {
+        progress->dem_time_mark = require<double>(r, f, "kairos/run/dem_time_mark", path, 1)[0];
+        if (!std::isfinite(progress->dem_time_mark))
+          throw InputError("'" + path.string() + "': kairos/run/dem_time_mark is not finite");
       }
       if (!(progress->dem_time_step > 0.0) || !std::isfinite(progress->dem_time_step)) {
         throw InputError("'" + path.string() + "': kairos/run/dem_time_step is " +

@@ -28,6 +28,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -55,6 +56,9 @@ struct RunProgress {
   // completed; several pairs may enter contact in one step, so the count itself may be past
   // it). A continued run counts its lengths from here, as one uninterrupted run would.
   std::uint64_t dem_collision_mark = 0;
+  // The same in simulated time, for lengths in time (run.time, run.equilibration_time): the
+  // end time of the phase it completed (a step may end past it). NaN: none recorded.
+  double dem_time_mark = std::numeric_limits<double>::quiet_NaN();
   // Soft spheres: the fastest normal impact speed the run's map tables cover (0: no tables), so
   // that a continued run uses the same tables (and stays bit-identical).
   double soft_table_max_speed = 0.0;

@@ -40,10 +40,12 @@ void ProgressLine::update(const ProgressInfo& info, bool force) {
   const double frac = info.total > 0 ? std::min(1.0, info.done / info.total) : 1.0;
   const double elapsed = std::chrono::duration<double>(now - phase_start_).count();
   const double eta = frac > 1e-9 ? elapsed * (1.0 - frac) / frac : -1.0;
-  const std::string line = fmt::format(
-      "[{:<13} {:5.1f}%] {:.1f}/{:.0f} coll/particle | t = {:.6g} | {:.3g} M events/s | ETA {}",
-      info.phase, 100.0 * frac, info.done, info.total, info.sim_time, rate_ / 1e6,
-      format_duration(eta));
+  const std::string done = info.in_time
+                               ? fmt::format("{:.4g}/{:.4g} time", info.done, info.total)
+                               : fmt::format("{:.1f}/{:.0f} coll/particle", info.done, info.total);
+  const std::string line =
+      fmt::format("[{:<13} {:5.1f}%] {} | t = {:.6g} | {:.3g} M events/s | ETA {}", info.phase,
+                  100.0 * frac, done, info.sim_time, rate_ / 1e6, format_duration(eta));
   if (tty_) {
     std::fprintf(stderr, "\r%-100s", line.c_str());
   } else {

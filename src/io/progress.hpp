@@ -12,10 +12,11 @@ namespace kairos {
 
 struct ProgressInfo {
   std::string phase;   // "equilibration" / "production"
-  double done = 0.0;   // collisions per particle done in this phase
-  double total = 0.0;  // collisions per particle in this phase
+  double done = 0.0;   // collisions per particle (or time) done in this phase
+  double total = 0.0;  // collisions per particle (or time) in this phase
   double sim_time = 0.0;
   std::uint64_t events = 0;  // cumulative; the line shows the rate since the previous draw
+  bool in_time = false;      // done and total are simulated time (run.time), not collisions
 };
 
 class ProgressLine {

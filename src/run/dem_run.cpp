@@ -82,6 +82,8 @@ class DemRunDriver {
       profile_.emplace(axis, static_cast<int>(config.output.profile_bins), 0.0, start.box[axis],
                        cross);
     }
+    timed_ =
+        config.run.time > 0.0 || config.run.equilibration_time >= 0.0 || intervals_in_time(config);
     dir_ = prepare_output_directory(config);
   }
 
@@ -100,19 +102,19 @@ class DemRunDriver {
     thermo_stats_->mark(point());
     ProgressLine progress(config_.output.progress);
 
-    const double eq = restart_ ? resumed_.equilibration_remaining
-                               : config_.run.equilibration_collisions_per_particle;
+    PhaseLength eq = equilibration_length(config_.run);
+    if (restart_) eq.value = resumed_.equilibration_remaining;
     bool stopped = false;
-    if (eq > 0.0) {
+    if (eq.value > 0.0) {
       stopped = run_phase("equilibration", eq, progress, wall_start);
-      if (dem_->collisions() > thermo_stats_->last().collisions) write_thermo_row("equilibration");
+      if (row_pending()) write_thermo_row("equilibration");
     }
     prod_start_ = point();
     prod_ke_ = dem_->kinetic_energy();
     if (!stopped)
-      stopped = run_phase("production", config_.run.collisions_per_particle, progress, wall_start);
+      stopped = run_phase("production", production_length(config_.run), progress, wall_start);
     progress.finish();
-    if (dem_->collisions() > thermo_stats_->last().collisions) write_thermo_row(phase_);
+    if (row_pending()) write_thermo_row(phase_);
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
 
     if (trajectory_) {
@@ -152,12 +154,19 @@ class DemRunDriver {
   RunProgress progress_now() const {
     RunProgress p;
     const std::uint64_t c = dem_->collisions();
-    if (phase_ == "equilibration" && c < equilibration_target_)
+    const double t = dem_->time();
+    if (phase_ == "equilibration" && config_.run.equilibration_time >= 0.0) {
+      p.equilibration_remaining =
+          reached(equilibration_end_time_) ? 0.0 : equilibration_end_time_ - t;
+    } else if (phase_ == "equilibration" && c < equilibration_target_) {
       p.equilibration_remaining = per_particle(equilibration_target_ - c);
+    }
     p.integrator = "dem";
     p.dem_time_step = dem_->dt();
     // A completed phase ends at its target (the count may have passed it within the last step).
     p.dem_collision_mark = c >= phase_target_ ? phase_target_ : c;
+    if (std::isfinite(phase_end_time_))
+      p.dem_time_mark = reached(phase_end_time_) ? phase_end_time_ : t;
     return p;
   }
 
@@ -170,56 +179,104 @@ class DemRunDriver {
     write_restart(dir_ / "restart.gsd", s, rng_, progress_now());
   }
 
-  // Steps until `length` more collisions per particle; true if stopped early.
-  bool run_phase(const std::string& phase, double length, ProgressLine& progress,
+  // Whether the clock has reached time t: at the first step at or after it (round-off aside:
+  // time_at(steps) need not hit a multiple of dt exactly).
+  bool reached(double t) const { return dem_->time() >= t - 1e-9 * dem_->dt(); }
+  // Steps until the first step at or after time t (at least one).
+  long steps_to(double t) const {
+    const double steps = std::ceil((t - dem_->time()) / dem_->dt() - 1e-9);
+    return steps < 1.0    ? 1l
+           : steps > 1e15 ? std::numeric_limits<long>::max()
+                          : static_cast<long>(steps);
+  }
+  bool row_pending() const {
+    return dem_->collisions() > thermo_stats_->last().collisions ||
+           (timed_ && dem_->time() > thermo_stats_->last().time);
+  }
+  void write_trajectory_frame() {
+    append_trajectory_frame(*trajectory_, dem_->export_state());
+    frame_steps_ = dem_->steps();
+  }
+
+  // Steps until `length` more collisions per particle or simulated time (then to the first
+  // step at or after its end); true if stopped early. Outputs in time come at the first step at
+  // or after each multiple of their interval.
+  bool run_phase(const std::string& phase, PhaseLength length, ProgressLine& progress,
                  Clock::time_point wall_start) {
     phase_ = phase;
     // The first phase of a continued run starts where the saved run nominally stopped.
     std::uint64_t begin = dem_->collisions();
+    double begin_time = dem_->time();
     if (restart_ && first_phase_ && resumed_.dem_collision_mark > 0 &&
         resumed_.dem_collision_mark <= begin)
       begin = resumed_.dem_collision_mark;
+    if (restart_ && first_phase_ && resumed_.dem_time_mark <= begin_time &&
+        resumed_.dem_time_mark > begin_time - dem_->dt())
+      begin_time = resumed_.dem_time_mark;
     first_phase_ = false;
-    const std::uint64_t target = begin + collisions_for(length);
-    if (phase == "equilibration") equilibration_target_ = target;
+    const std::uint64_t target =
+        length.in_time ? ~std::uint64_t{0} : begin + collisions_for(length.value);
+    const double end_time =
+        length.in_time ? begin_time + length.value : std::numeric_limits<double>::quiet_NaN();
+    if (phase == "equilibration") {
+      equilibration_target_ = target;
+      equilibration_end_time_ = end_time;
+    }
     phase_target_ = target;
-    OutputSchedule schedule(config_.output, config_.run.collisions_per_particle, begin,
-                            [&](double c) { return collisions_for(c); });
+    phase_end_time_ = end_time;
+    const double production = production_length(config_.run).value;
+    const bool time_outputs = intervals_in_time(config_);
+    OutputSchedule schedule;  // one of the two; the other is never due
+    TimeSchedule timed;
+    if (time_outputs) {
+      timed = TimeSchedule(config_.output, production, begin_time);
+    } else {
+      schedule = OutputSchedule(config_.output, production, begin,
+                                [&](double c) { return collisions_for(c); });
+    }
     // About 2^20 particle-steps between checks of the clock and the stop flag.
     const long chunk =
         std::max<long>(1, (1l << 20) / static_cast<long>(std::max<std::size_t>(1, n_)));
     const auto steps = [&] { return base_events_ + static_cast<std::uint64_t>(dem_->steps()); };
-    progress.update({phase, 0.0, length, dem_->time(), steps()});
-    while (dem_->collisions() < target) {
+    const auto done = [&] {
+      return length.in_time ? dem_->time() - begin_time : per_particle(dem_->collisions() - begin);
+    };
+    progress.update({phase, 0.0, length.value, dem_->time(), steps(), length.in_time});
+    while (length.in_time ? !reached(end_time) : dem_->collisions() < target) {
       const std::uint64_t stop_at =
           std::min({target, schedule.thermo.next, schedule.trajectory.next, schedule.restart.next});
+      long n = chunk;
+      if (length.in_time) n = std::min(n, steps_to(end_time));
+      if (time_outputs) n = std::min(n, steps_to(timed.next()));
       const std::uint64_t before = dem_->collisions(), wall_before = dem_->wall_collisions();
-      dem_->step_until(chunk, stop_at);
+      dem_->step_until(n, stop_at);
       const std::uint64_t c = dem_->collisions();
       const double ke = dem_->kinetic_energy();
       ke_peak_ = std::max(ke_peak_, ke);
-      if (c == before && dem_->contact_count() == 0 && ke == 0.0) {
+      // A length in collisions would never end once nothing moves or meets any more; a length
+      // in time does.
+      if (!length.in_time && c == before && dem_->contact_count() == 0 && ke == 0.0) {
         stop_reason_ = "no_more_events";  // everything at rest and apart
         break;
       }
       // A settled packing (under gravity, between walls) meets no new contacts: the collision
       // target would never come. At rest: no contact began in this chunk and the kinetic energy
       // fell below 1e-12 of its peak.
-      if (c == before && dem_->wall_collisions() == wall_before && ke <= 1e-12 * ke_peak_) {
+      if (!length.in_time && c == before && dem_->wall_collisions() == wall_before &&
+          ke <= 1e-12 * ke_peak_) {
         stop_reason_ = "at_rest";
         break;
       }
-      if (schedule.thermo.due(c)) write_thermo_row(phase);
-      if (schedule.trajectory.due(c) && trajectory_) {
-        append_trajectory_frame(*trajectory_, dem_->export_state());
-        frame_steps_ = dem_->steps();
-      }
-      if (schedule.restart.due(c)) write_restart_file();
+      const double t = dem_->time() + 1e-9 * dem_->dt();  // as reached()
+      if (schedule.thermo.due(c) || timed.thermo.due(t)) write_thermo_row(phase);
+      if ((schedule.trajectory.due(c) || timed.trajectory.due(t)) && trajectory_)
+        write_trajectory_frame();
+      if (schedule.restart.due(c) || timed.restart.due(t)) write_restart_file();
       if (stop_requested()) {
         stop_reason_ = "signal";
         return true;
       }
-      progress.update({phase, per_particle(c - begin), length, dem_->time(), steps()});
+      progress.update({phase, done(), length.value, dem_->time(), steps(), length.in_time});
       if (config_.run.max_wall_seconds > 0 &&
           std::chrono::duration<double>(Clock::now() - wall_start).count() >
               config_.run.max_wall_seconds) {
@@ -227,7 +284,8 @@ class DemRunDriver {
         return true;
       }
     }
-    progress.update({phase, length, length, dem_->time(), steps()}, true);
+    progress.update({phase, length.value, length.value, dem_->time(), steps(), length.in_time},
+                    true);
     return false;
   }
 
@@ -393,6 +451,10 @@ class DemRunDriver {
   std::string phase_ = "production";
   std::uint64_t equilibration_target_ = 0;
   std::uint64_t phase_target_ = 0;  // the collision count the present phase runs to
+  // Lengths in time: the present phase's end time (NaN: in collisions), the equilibration's.
+  double phase_end_time_ = std::numeric_limits<double>::quiet_NaN();
+  double equilibration_end_time_ = 0.0;
+  bool timed_ = false;  // some length or the intervals in time (see RunDriver)
   bool first_phase_ = true;
   std::string stop_reason_ = "completed";
 };

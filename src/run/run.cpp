@@ -211,7 +211,9 @@ using run_detail::build_start_state;
 
 using run_detail::OutputSchedule;
 using run_detail::peak_rss_bytes;
+using run_detail::PhaseLength;
 using run_detail::ThermoWriter;
+using run_detail::TimeSchedule;
 
 template <int D, class Queue>
 class RunDriver {
@@ -238,6 +240,8 @@ class RunDriver {
       engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict,
                       options, environment);
       driven_ = config.driving.kind != "none";
+      timed_ = config.run.time > 0.0 || config.run.equilibration_time >= 0.0 ||
+               run_detail::intervals_in_time(config);
       granular_ = !environment.plain() || environment.has_gravity() || driven_ ||
                   environment.sheared() || environment.soft_spheres() ||
                   environment.dissipative_steps();
@@ -281,28 +285,28 @@ class RunDriver {
     ProgressLine progress(config_.output.progress);
 
     // A restart continues an interrupted equilibration, otherwise goes straight to production.
-    const double eq = restart_ ? resumed_.equilibration_remaining
-                               : config_.run.equilibration_collisions_per_particle;
+    PhaseLength eq = run_detail::equilibration_length(config_.run);
+    if (restart_) eq.value = resumed_.equilibration_remaining;
     bool stopped = false;
-    if (eq > 0.0) {
+    if (eq.value > 0.0) {
       stopped = run_phase("equilibration", eq, progress, wall_start);
       // Close the equilibration rows so no production row spans both phases.
-      if (engine_->counters().collisions > thermo_stats_->last().collisions) {
-        write_thermo_row("equilibration");
-      }
+      if (row_pending()) write_thermo_row("equilibration");
     }
     prod_start_ = point();
     virial_tensor_start_ = engine_->counters().virial_tensor;
     prod_ke_ = thermal_energy();
     shear_row_start_ = {engine_->time(), engine_->counters().virial_tensor[1]};
     if (!stopped)
-      stopped = run_phase("production", config_.run.collisions_per_particle, progress, wall_start);
+      stopped =
+          run_phase("production", run_detail::production_length(config_.run), progress, wall_start);
     progress.finish();
-    if (engine_->counters().collisions > thermo_stats_->last().collisions) write_thermo_row(phase_);
+    if (row_pending()) write_thermo_row(phase_);
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
 
     if (trajectory_) {
-      if (frame_collisions_ != engine_->counters().collisions)
+      if (frame_collisions_ != engine_->counters().collisions ||
+          (timed_ && frame_time_ != engine_->time()))
         append_trajectory_frame(*trajectory_, engine_->export_state(/*with_zones=*/false));
       trajectory_->close();
     }
@@ -321,7 +325,10 @@ class RunDriver {
   RunProgress progress_now() const {
     RunProgress p;
     const std::uint64_t c = engine_->counters().collisions;
-    if (phase_ == "equilibration" && c < equilibration_target_) {
+    // In the unit of the config's equilibration length.
+    if (phase_ == "equilibration" && config_.run.equilibration_time >= 0.0) {
+      p.equilibration_remaining = std::max(0.0, equilibration_end_time_ - engine_->time());
+    } else if (phase_ == "equilibration" && c < equilibration_target_) {
       p.equilibration_remaining = per_particle(equilibration_target_ - c);
     }
     p.next_kick_time = driven_ ? next_kick_ : -1.0;
@@ -336,8 +343,9 @@ class RunDriver {
     std::exponential_distribution<double> wait(config_.driving.rate * static_cast<double>(n_));
     return wait(rng_);
   }
-  void apply_due_kicks() {
-    while (next_kick_ <= engine_->next_event_time()) {
+  // The kicks due up to the next event, and not after `limit`.
+  void apply_due_kicks(double limit = std::numeric_limits<double>::infinity()) {
+    while (next_kick_ <= std::min(engine_->next_event_time(), limit)) {
       std::uniform_int_distribution<std::uint32_t> pick(0, static_cast<std::uint32_t>(n_ - 1));
       const std::uint32_t k = pick(rng_);
       const DrivingConfig& d = config_.driving;
@@ -371,18 +379,72 @@ class RunDriver {
     return thermo_stats_->per_particle(collisions);
   }
 
-  // Runs until `length` more collisions per particle; returns true if stopped early.
-  bool run_phase(const std::string& phase, double length, ProgressLine& progress,
+  // A thermo row not yet written for the present: new collisions, or (with lengths or
+  // intervals in time) time gone by.
+  bool row_pending() const {
+    return engine_->counters().collisions > thermo_stats_->last().collisions ||
+           (timed_ && engine_->time() > thermo_stats_->last().time);
+  }
+
+  void write_trajectory_frame() {
+    append_trajectory_frame(*trajectory_, engine_->export_state(/*with_zones=*/false));
+    frame_collisions_ = engine_->counters().collisions;
+    frame_time_ = engine_->time();
+  }
+
+  // Runs until `length` more collisions per particle or simulated time; returns true if stopped
+  // early. Outputs come every so many collisions per particle, or (interval_unit = "time") at
+  // the multiples of their intervals in time, for which the engine's clock is stopped there
+  // between two events.
+  bool run_phase(const std::string& phase, PhaseLength length, ProgressLine& progress,
                  Clock::time_point wall_start) {
     phase_ = phase;
     const std::uint64_t begin = engine_->counters().collisions;
-    const std::uint64_t target = begin + collisions_for(length);
-    if (phase == "equilibration") equilibration_target_ = target;
-    OutputSchedule schedule(config_.output, config_.run.collisions_per_particle, begin,
-                            [&](double c) { return collisions_for(c); });
-    progress.update({phase, 0.0, length, engine_->time(), engine_->counters().events});
-    while (engine_->counters().collisions < target) {
-      if (driven_) apply_due_kicks();
+    const double begin_time = engine_->time();
+    const std::uint64_t target = begin + (length.in_time ? 0 : collisions_for(length.value));
+    const double end_time = length.in_time ? begin_time + length.value : kNever;
+    if (phase == "equilibration") {
+      equilibration_target_ = target;
+      equilibration_end_time_ = end_time;
+    }
+    const double production = run_detail::production_length(config_.run).value;
+    const bool time_outputs = run_detail::intervals_in_time(config_);
+    // One of the two schedules; the other stays empty (never due).
+    OutputSchedule schedule;
+    TimeSchedule timed;
+    if (time_outputs) {
+      timed = TimeSchedule(config_.output, production, begin_time);
+    } else {
+      schedule = OutputSchedule(config_.output, production, begin,
+                                [&](double c) { return collisions_for(c); });
+    }
+    const auto done = [&] {
+      return length.in_time ? engine_->time() - begin_time
+                            : per_particle(engine_->counters().collisions - begin);
+    };
+    progress.update(
+        {phase, 0.0, length.value, engine_->time(), engine_->counters().events, length.in_time});
+    while (length.in_time ? engine_->time() < end_time : engine_->counters().collisions < target) {
+      if (length.in_time || time_outputs) {
+        // Outputs due, and the phase's end, before the next event: the clock stops there.
+        const double stop = std::min(timed.next(), end_time);
+        if (driven_) apply_due_kicks(stop);
+        if (!length.in_time && !driven_ && !(engine_->next_event_time() < kNever)) {
+          stop_reason_ = "no_more_events";  // the collision target would never come
+          break;
+        }
+        if (engine_->next_event_time() > stop) {
+          engine_->advance_clock(stop);
+          const double t = engine_->time();
+          if (timed.thermo.due(t)) write_thermo_row(phase);
+          if (timed.trajectory.due(t) && trajectory_) write_trajectory_frame();
+          if (timed.restart.due(t))
+            write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
+          continue;
+        }
+      } else if (driven_) {
+        apply_due_kicks();
+      }
       if (engine_->step() == EventKind::kNone) {
         stop_reason_ = "no_more_events";  // every particle at rest, or alone
         break;
@@ -390,10 +452,7 @@ class RunDriver {
       if (config_.run.validate) engine_->validate();
       const std::uint64_t c = engine_->counters().collisions;
       if (schedule.thermo.due(c)) write_thermo_row(phase);
-      if (schedule.trajectory.due(c) && trajectory_) {
-        append_trajectory_frame(*trajectory_, engine_->export_state(/*with_zones=*/false));
-        frame_collisions_ = c;
-      }
+      if (schedule.trajectory.due(c) && trajectory_) write_trajectory_frame();
       if (schedule.restart.due(c)) {
         write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
       }
@@ -403,8 +462,8 @@ class RunDriver {
       }
       if ((engine_->counters().events & 0x3fffu) == 0) {
         const auto now = Clock::now();
-        progress.update(
-            {phase, per_particle(c - begin), length, engine_->time(), engine_->counters().events});
+        progress.update({phase, done(), length.value, engine_->time(), engine_->counters().events,
+                         length.in_time});
         if (config_.run.max_wall_seconds > 0 &&
             std::chrono::duration<double>(now - wall_start).count() >
                 config_.run.max_wall_seconds) {
@@ -413,7 +472,9 @@ class RunDriver {
         }
       }
     }
-    progress.update({phase, length, length, engine_->time(), engine_->counters().events}, true);
+    progress.update({phase, length.value, length.value, engine_->time(), engine_->counters().events,
+                     length.in_time},
+                    true);
     return false;
   }
 
@@ -756,6 +817,10 @@ class RunDriver {
   std::optional<ThermoWriter> thermo_;
   std::optional<gsd::Writer> trajectory_;
   std::uint64_t frame_collisions_ = 0;
+  double frame_time_ = 0.0;
+  // Some length or the output intervals in simulated time: rows and frames also when no
+  // collision happened since the last.
+  bool timed_ = false;
   std::optional<Thermodynamics> thermo_stats_;
   ThermoPoint prod_start_;
   double ke_start_ = 0.0, prod_ke_ = 0.0, energy_start_ = 0.0, u_start_ = 0.0;
@@ -778,7 +843,8 @@ class RunDriver {
   std::uint64_t events_start_ = 0, collisions_start_ = 0;
   std::string phase_ = "production";
   std::uint64_t equilibration_target_ = 0;
-  RunProgress resumed_;  // progress recorded in the restart file this run continues
+  double equilibration_end_time_ = 0.0;  // with run.equilibration_time
+  RunProgress resumed_;                  // progress recorded in the restart file this run continues
   std::string stop_reason_ = "completed";
 };
 

@@ -6,9 +6,11 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <optional>
 #include <random>
 #include <string>
@@ -199,6 +201,7 @@ struct OutputSchedule {
   };
   Every thermo, trajectory, restart;
 
+  OutputSchedule() = default;  // nothing ever due
   template <class ToCollisions>
   OutputSchedule(const OutputConfig& out, double production, std::uint64_t begin,
                  ToCollisions&& collisions_for) {
@@ -214,6 +217,67 @@ struct OutputSchedule {
     trajectory = every(out.trajectory_interval > 0 ? out.trajectory_interval : production / 10.0);
     restart = every(out.restart_interval);
   }
+};
+
+// A phase's length: collisions per particle, or simulated time (run.time,
+// run.equilibration_time).
+struct PhaseLength {
+  double value = 0.0;
+  bool in_time = false;
+};
+
+// Whether the output intervals are in simulated time (the reader resolves the unit; a config
+// built in code may leave it "", the production length's unit).
+inline bool intervals_in_time(const Config& c) {
+  return c.output.interval_unit == "time" || (c.output.interval_unit.empty() && c.run.time > 0.0);
+}
+
+inline PhaseLength production_length(const RunConfig& r) {
+  return r.time > 0.0 ? PhaseLength{r.time, true} : PhaseLength{r.collisions_per_particle, false};
+}
+inline PhaseLength equilibration_length(const RunConfig& r) {
+  return r.equilibration_time >= 0.0 ? PhaseLength{r.equilibration_time, true}
+                                     : PhaseLength{r.equilibration_collisions_per_particle, false};
+}
+
+// When the periodic outputs are due with output.interval_unit = "time": at the multiples of
+// each interval (k * step, k an integer), not at offsets from the phase's start, so that a
+// continued run writes at the times one uninterrupted run would, and a vibrated wall is seen at
+// the same phases in every frame. Intervals of 0: as OutputSchedule.
+struct TimeSchedule {
+  struct Every {
+    double step = 0.0, next = std::numeric_limits<double>::infinity();  // step 0: never
+    // The first multiple of step after t.
+    double after(double t) const {
+      double k = std::floor(t / step) + 1.0;
+      while (k * step <= t) k += 1.0;
+      return k * step;
+    }
+    // True (once) when t has reached the next multiple.
+    bool due(double t) {
+      if (!(t >= next)) return false;
+      next = after(t);
+      return true;
+    }
+  };
+  Every thermo, trajectory, restart;
+
+  TimeSchedule() = default;  // nothing ever due
+  TimeSchedule(const OutputConfig& out, double production_time, double begin) {
+    auto every = [&](double interval) {
+      Every e;
+      if (interval > 0.0) {
+        e.step = interval;
+        e.next = e.after(begin);
+      }
+      return e;
+    };
+    thermo = every(out.thermo_interval > 0 ? out.thermo_interval : production_time / 100.0);
+    trajectory =
+        every(out.trajectory_interval > 0 ? out.trajectory_interval : production_time / 10.0);
+    restart = every(out.restart_interval);
+  }
+  double next() const { return std::min({thermo.next, trajectory.next, restart.next}); }
 };
 
 }  // namespace kairos::run_detail

@@ -69,7 +69,9 @@ TEST(Config, MinimalConfigGetsDefaults) {
   EXPECT_EQ(c.run.event_queue, "calendar");
   EXPECT_EQ(c.run.max_wall_seconds, 0.0);
   EXPECT_FALSE(c.run.validate);
-  EXPECT_EQ(c.output, OutputConfig{});
+  OutputConfig defaults;
+  defaults.interval_unit = "collisions";  // resolved: the production length's unit
+  EXPECT_EQ(c.output, defaults);
   EXPECT_EQ(c.output.directory, "kairos-output");
   EXPECT_EQ(c.output.progress, "auto");
   EXPECT_TRUE(c.output.trajectory);
@@ -1067,6 +1069,7 @@ TEST(ConfigToToml, RoundTripIsExact) {
   c.output.restart_interval = 0.1;
   c.output.trajectory = false;
   c.output.progress = "never";
+  c.output.interval_unit = "collisions";
 
   const std::string text = to_toml(c);
   const Config back = parse_config(text, "config.toml");
@@ -1117,6 +1120,7 @@ TEST(ConfigToToml, RoundTripWithEveryGranularKey) {
   c.boundary.walls = {floor, left, right};
   c.boundary.open = {"z+"};
   c.field.gravity = {0.0, 1e-3, -9.81};
+  c.output.interval_unit = "collisions";
 
   const std::string text = to_toml(c);
   const Config back = parse_config(text, "config.toml");
@@ -1209,6 +1213,22 @@ TEST(ConfigToToml, ResolvesDefaultsOfHandBuiltConfig) {
   EXPECT_EQ(back.system.lattice, "hex");
   ASSERT_EQ(back.system.species.size(), 1u);
   EXPECT_EQ(back.system.species[0], SpeciesConfig{});
+}
+
+TEST(ConfigToToml, RoundTripWithLengthsAndIntervalsInTime) {
+  Config c = parse_config(kMinimal, "t.toml");
+  c.run.time = 2.5;
+  c.run.equilibration_time = 0.0;  // in time, and none
+  c.output.interval_unit = "time";
+  c.output.thermo_interval = 0.1;
+  const std::string text = to_toml(c);
+  EXPECT_EQ(text.find("collisions_per_particle"), std::string::npos) << text;
+  const Config back = parse_config(text, "config.toml");
+  EXPECT_EQ(back, c) << text;
+  // Without an explicit unit the intervals follow the production length's.
+  c.output.interval_unit.clear();
+  c.output.trajectory_interval = 0.0;  // automatic: a tenth of run.time
+  EXPECT_EQ(parse_config(to_toml(c), "config.toml").output.interval_unit, "time");
 }
 
 TEST(ConfigToToml, SeedBeyondTomlRangeThrows) {
