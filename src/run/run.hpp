@@ -1,7 +1,7 @@
 // One invocation of `kairos run`: configuration -> initial state -> engine -> outputs.
 //
-// Phases: equilibration (skipped on restart), then production, both measured in collisions per
-// particle c = 2 N_coll / N. Outputs in the output directory: config.toml (the effective
+// Phases: equilibration (skipped on restart), then production, each measured in collisions per
+// particle c = 2 N_coll / N or in simulated time (run.time, run.equilibration_time). Outputs in the output directory: config.toml (the effective
 // configuration), thermo.tsv, trajectory.gsd, restart.gsd, summary.json (see docs/outputs.md).
 #pragma once
 

@@ -1,0 +1,202 @@
+// The Python module `kairos` (pybind11): kairos.run, the CLI's `kairos run` as a function, and
+// kairos.Simulation, an event-driven simulation held in memory (run/simulation.hpp) whose state
+// comes back as NumPy arrays. docs/python.md is its user guide.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "core/error.hpp"
+#include "io/config.hpp"
+#include "run/run.hpp"
+#include "run/simulation.hpp"
+
+namespace py = pybind11;
+namespace fs = std::filesystem;
+
+namespace kairos {
+namespace {
+
+// Ctrl-C in Python: a long advance checks for signals every 16 384 events.
+bool python_keeps_going() {
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  return true;
+}
+
+// A config file, or TOML text when the argument holds a newline (a path never does here).
+Config config_from(const std::string& config, const std::vector<std::string>& overrides) {
+  if (config.find('\n') != std::string::npos) return parse_config(config, "<text>", overrides);
+  return load_config(config, overrides);
+}
+
+py::array_t<double> as_array(const auto& rows, int dimension) {
+  py::array_t<double> out({static_cast<py::ssize_t>(rows.size()), py::ssize_t{dimension}});
+  auto view = out.template mutable_unchecked<2>();
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (int a = 0; a < dimension; ++a) view(static_cast<py::ssize_t>(i), a) = rows[i][a];
+  return out;
+}
+
+// kairos.Simulation: one of the two dimensions behind one Python class.
+class PySimulation {
+ public:
+  PySimulation(const std::string& config, const std::vector<std::string>& overrides,
+               const std::optional<fs::path>& restart) {
+    const Config c = config_from(config, overrides);
+    if (c.system.dimension == 2) {
+      sim_ = std::make_unique<Simulation<2>>(c, restart);
+    } else {
+      sim_ = std::make_unique<Simulation<3>>(c, restart);
+    }
+  }
+
+  template <class F>
+  auto visit(F&& f) const {
+    return std::visit([&](const auto& s) { return f(std::as_const(*s)); }, sim_);
+  }
+  template <class F>
+  auto visit(F&& f) {
+    return std::visit([&](auto& s) { return f(*s); }, sim_);
+  }
+
+  int dimension() const {
+    return visit([](const auto& s) { return dimension_of(s); });
+  }
+  bool advance(std::optional<double> time, std::optional<std::uint64_t> events,
+               std::optional<std::uint64_t> collisions) {
+    const int given = (time ? 1 : 0) + (events ? 1 : 0) + (collisions ? 1 : 0);
+    if (given != 1) throw InputError("advance: give exactly one of time=, events= or collisions=");
+    return visit([&](auto& s) {
+      if (time) return s.advance_to_time(*time, python_keeps_going);
+      if (events) return s.advance_events(*events, python_keeps_going);
+      return s.advance_collisions(*collisions, python_keeps_going);
+    });
+  }
+  py::array_t<double> positions() const {
+    return visit([](const auto& s) { return as_array(s.positions(), dimension_of(s)); });
+  }
+  py::array_t<double> velocities() const {
+    return visit([](const auto& s) { return as_array(s.velocities(), dimension_of(s)); });
+  }
+  py::array_t<double> box() const {
+    return visit([](const auto& s) {
+      const auto& b = s.box();
+      return py::array_t<double>(static_cast<py::ssize_t>(b.size()), b.data());
+    });
+  }
+  py::array_t<double> masses() const {
+    return visit([](const auto& s) { return py::array_t<double>(py::cast(s.masses())); });
+  }
+  py::array_t<double> radii() const {
+    return visit([](const auto& s) { return py::array_t<double>(py::cast(s.radii())); });
+  }
+  py::array_t<std::uint32_t> species() const {
+    return visit([](const auto& s) { return py::array_t<std::uint32_t>(py::cast(s.species())); });
+  }
+  std::vector<std::string> species_names() const {
+    return visit([](const auto& s) { return s.species_names(); });
+  }
+  double time() const {
+    return visit([](const auto& s) { return s.time(); });
+  }
+  std::uint64_t events() const {
+    return visit([](const auto& s) { return s.events(); });
+  }
+  std::uint64_t collisions() const {
+    return visit([](const auto& s) { return s.collisions(); });
+  }
+  std::size_t size() const {
+    return visit([](const auto& s) { return s.size(); });
+  }
+  double kinetic_energy() const {
+    return visit([](const auto& s) { return s.kinetic_energy(); });
+  }
+  // kT = 2 KE / (D N): every particle's translational degrees of freedom.
+  double temperature() const {
+    return visit([](const auto& s) {
+      return 2.0 * s.kinetic_energy() / (dimension_of(s) * static_cast<double>(s.size()));
+    });
+  }
+  void save(const fs::path& path) const {
+    visit([&](const auto& s) { s.save(path); });
+  }
+
+ private:
+  template <int D>
+  static int dimension_of(const Simulation<D>&) {
+    return D;
+  }
+  std::variant<std::unique_ptr<Simulation<2>>, std::unique_ptr<Simulation<3>>> sim_;
+};
+
+}  // namespace
+}  // namespace kairos
+
+PYBIND11_MODULE(kairos, m) {
+  using kairos::PySimulation;
+  m.doc() =
+      "Kairos, event-driven particle dynamics: kairos.run (the `kairos run` command) and "
+      "kairos.Simulation (a simulation in memory, its state as NumPy arrays). docs/python.md.";
+  m.attr("__version__") = KAIROS_VERSION;
+  // A configuration or state the user must fix; Python's ValueError family.
+  py::register_exception<kairos::InputError>(m, "InputError", PyExc_ValueError);
+
+  m.def(
+      "run",
+      [](const std::string& config, std::optional<fs::path> output,
+         const std::vector<std::string>& overrides, std::optional<fs::path> restart) {
+        kairos::Config c = kairos::config_from(config, overrides);
+        if (output) c.output.directory = output->string();
+        const kairos::RunOutcome outcome = [&] {
+          py::gil_scoped_release release;  // the run is C++ throughout
+          return kairos::run_simulation(c, restart);
+        }();
+        return py::module_::import("json").attr("loads")(outcome.summary.dump());
+      },
+      py::arg("config"), py::arg("output") = py::none(),
+      py::arg("set") = std::vector<std::string>{}, py::arg("restart") = py::none(),
+      "Runs a simulation as `kairos run` does (config: a TOML file's path, or TOML text; set: "
+      "'key=value' overrides; output: the output directory; restart: a restart file to "
+      "continue). Writes the usual output files and returns summary.json as a dict.");
+
+  py::class_<PySimulation>(m, "Simulation",
+                           "An event-driven simulation in memory: the engine of `kairos run` "
+                           "started from the same configuration (bit-identical trajectory), "
+                           "advanced on request, without output files.")
+      .def(py::init<const std::string&, const std::vector<std::string>&,
+                    const std::optional<fs::path>&>(),
+           py::arg("config"), py::arg("set") = std::vector<std::string>{},
+           py::arg("restart") = py::none(),
+           "config: a TOML file's path, or TOML text; set: 'key=value' overrides; restart: a "
+           "restart file to continue from.")
+      .def("advance", &PySimulation::advance, py::arg("time") = py::none(),
+           py::arg("events") = py::none(), py::arg("collisions") = py::none(),
+           "Advances to simulated time `time` (exactly; no event needs to happen then), or by "
+           "`events` events, or by `collisions` collisions (one of the three). Returns False if "
+           "no event was left before the target.")
+      .def("positions", &PySimulation::positions,
+           "Positions at the present time, an (N, D) array, wrapped into the periodic box.")
+      .def("velocities", &PySimulation::velocities, "Velocities at the present time, (N, D).")
+      .def("masses", &PySimulation::masses)
+      .def("radii", &PySimulation::radii)
+      .def("species", &PySimulation::species, "Species index of each particle.")
+      .def_property_readonly("species_names", &PySimulation::species_names)
+      .def_property_readonly("box", &PySimulation::box, "Box edges, (D,).")
+      .def_property_readonly("dimension", &PySimulation::dimension)
+      .def_property_readonly("time", &PySimulation::time)
+      .def_property_readonly("events", &PySimulation::events)
+      .def_property_readonly("collisions", &PySimulation::collisions)
+      .def("__len__", &PySimulation::size)
+      .def("kinetic_energy", &PySimulation::kinetic_energy)
+      .def("temperature", &PySimulation::temperature, "kT = 2 KE / (D N).")
+      .def("save", &PySimulation::save, py::arg("path"),
+           "Writes a restart file (atomically) that `kairos run --restart` continues.");
+}

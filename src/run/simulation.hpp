@@ -1,0 +1,81 @@
+// An event-driven simulation held in memory and advanced on request: the engine of `kairos run`
+// without its output files, for scripts (the Python module, python/kairos_module.cpp) and
+// tests. It starts as `kairos run` does (the same start state, contact laws, soft-sphere tables
+// and engine), so its trajectory is the CLI's bit for bit, and save() writes a restart file that
+// `kairos run --restart` continues.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/particle_system.hpp"
+#include "core/vec.hpp"
+#include "io/config.hpp"
+#include "io/gsd_snapshot.hpp"
+
+namespace kairos {
+
+template <int D, class Queue>
+class EventEngine;
+class CalendarQueue;
+
+template <int D>
+class Simulation {
+ public:
+  // From a configuration (run.integrator "event"; [driving] is refused: its kicks belong to
+  // `kairos run`), or from a restart file with it. InputError for anything the user must fix.
+  explicit Simulation(const Config& config,
+                      const std::optional<std::filesystem::path>& restart_file = {});
+  ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  // Events until the clock reaches t (>= time()), which it then shows exactly (no event needs
+  // to happen at t). Returns false if stopped early by `keep_going` returning false (asked
+  // every 16 384 events, e.g. to let Python handle Ctrl-C).
+  using KeepGoing = std::function<bool()>;
+  bool advance_to_time(double t, const KeepGoing& keep_going = {});
+  // Until `count` more events / collisions have happened (or no event is left: then false).
+  bool advance_events(std::uint64_t count, const KeepGoing& keep_going = {});
+  bool advance_collisions(std::uint64_t count, const KeepGoing& keep_going = {});
+
+  double time() const;
+  std::uint64_t events() const;
+  std::uint64_t collisions() const;
+  std::size_t size() const { return n_; }
+  const Vec<D>& box() const;
+  // Per particle, in the numbering of the configuration (or the start file), at time():
+  // positions wrapped into the periodic box, velocities.
+  std::vector<Vec<D>> positions() const;
+  std::vector<Vec<D>> velocities() const;
+  const std::vector<double>& masses() const { return mass_; }
+  const std::vector<double>& radii() const { return radius_; }
+  const std::vector<std::uint32_t>& species() const { return species_; }
+  const std::vector<std::string>& species_names() const { return species_names_; }
+  double kinetic_energy() const;
+  // The complete state (what a restart file holds).
+  ParticleSystem<D> state() const;
+  // A restart file (atomically) that `kairos run --restart` continues bit-identically.
+  void save(const std::filesystem::path& path) const;
+
+ private:
+  // Events while `more` holds; false if none was left or keep_going said stop.
+  bool run_while(const std::function<bool()>& more, const KeepGoing& keep_going);
+
+  Config config_;
+  std::unique_ptr<EventEngine<D, CalendarQueue>> engine_;
+  std::mt19937_64 rng_;
+  RunProgress progress_;
+  std::size_t n_ = 0;
+  std::vector<double> mass_, radius_;
+  std::vector<std::uint32_t> species_;
+  std::vector<std::string> species_names_;
+};
+
+}  // namespace kairos

@@ -1,0 +1,149 @@
+"""The Python module `kairos` (docs/python.md).
+
+kairos.Simulation starts as `kairos run` does and follows the same trajectory bit for bit (hard
+spheres in 3D and 2D, soft spheres with their map tables); its saved state is a restart file the
+CLI continues exactly; its arrays obey the physics (no overlap, energy conserved, positions in
+the box, the clock exactly at the time asked). kairos.run returns summary.json. Mistakes raise
+kairos.InputError naming the problem.
+
+Run by ctest with the module's directory on PYTHONPATH (tests/CMakeLists.txt).
+"""
+
+import json
+import os
+
+import numpy as np
+
+import kairos_testlib as kt
+import kairos
+
+
+def hard_config(dimension=3, time=1.5, **sections):
+    config = kt.base_config(dimension=dimension, particles=200, packing_fraction=0.35,
+                            lattice="random", seed=31, **sections)
+    del config["run"]["equilibration_collisions_per_particle"]
+    del config["run"]["collisions_per_particle"]
+    config["run"].update({"equilibration_time": 0.0, "time": float(time)})
+    return config
+
+
+def soft_config(time=2.0):
+    config = hard_config(time=time)
+    config["system"]["packing_fraction"] = 0.1
+    config["soft"] = {"model": "dashpot", "stiffness": 1e4, "restitution": 0.8}
+    return config
+
+
+def min_gap(x, radii, box):
+    """The smallest r_ij - (R_i + R_j) over all pairs (minimum image in a periodic box)."""
+    d = x[:, None, :] - x[None, :, :]
+    d -= box * np.round(d / box)
+    r = np.sqrt((d ** 2).sum(axis=-1))
+    sigma = radii[:, None] + radii[None, :]
+    np.fill_diagonal(r, np.inf)
+    return (r - sigma).min()
+
+
+class Module(kt.KairosTestCase):
+    def cli_and_module_agree(self, config, time):
+        cfg = self.write_config(config)
+        self.run_ok("run", cfg, "-o", self.path("cli"))
+        sim = kairos.Simulation(cfg)
+        self.assertTrue(sim.advance(time=time))
+        self.assertEqual(sim.time, time)
+        sim.save(self.path("module.gsd"))
+        a = kt.read_exact_state(self.path("cli", "restart.gsd"))
+        b = kt.read_exact_state(self.path("module.gsd"))
+        for name in kt.EXACT_CHUNKS:
+            self.assertTrue(np.array_equal(a[name], b[name]), name)
+        summary = self.summary(self.path("cli"))
+        self.assertEqual(sim.collisions, summary["event_counts"]["total_collisions_since_start"])
+        return sim, cfg
+
+    def test_the_same_trajectory_as_the_cli_in_3d_and_2d(self):
+        for dimension in (3, 2):
+            with self.subTest(dimension=dimension):
+                sim, _ = self.cli_and_module_agree(hard_config(dimension), 1.5)
+                self.assertEqual(sim.dimension, dimension)
+                self.assertEqual(sim.positions().shape, (200, dimension))
+
+    def test_soft_spheres_with_their_tables(self):
+        config = soft_config()
+        config["soft"]["table_cache"] = self.path("tables")
+        sim, _ = self.cli_and_module_agree(config, 2.0)
+        self.assertLess(sim.temperature(), 1.0)  # inelastic: the gas cooled
+
+    def test_the_cli_continues_a_saved_simulation_exactly(self):
+        cfg = self.write_config(hard_config(time=1.0))
+        sim = kairos.Simulation(cfg)
+        sim.advance(time=1.0)
+        sim.save(self.path("saved.gsd"))
+        self.run_ok("run", cfg, "--restart", self.path("saved.gsd"), "-o", self.path("continued"))
+        whole = self.write_config(hard_config(time=2.0), "whole.toml")
+        self.run_ok("run", whole, "-o", self.path("whole"))
+        a = kt.read_exact_state(self.path("continued", "restart.gsd"))
+        b = kt.read_exact_state(self.path("whole", "restart.gsd"))
+        for name in kt.EXACT_CHUNKS:
+            self.assertTrue(np.array_equal(a[name], b[name]), name)
+        # And a Simulation continues a restart file as well.
+        again = kairos.Simulation(cfg, restart=self.path("saved.gsd"))
+        self.assertEqual(again.time, 1.0)
+        self.assertTrue(np.array_equal(again.positions(), sim.positions()))
+
+    def test_arrays_obey_the_physics(self):
+        sim = kairos.Simulation(self.write_config(hard_config()))
+        box = sim.box
+        radii = sim.radii()
+        e0 = sim.kinetic_energy()
+        self.assertEqual(len(sim), 200)
+        self.assertTrue(np.all(sim.masses() == 1.0))
+        self.assertEqual(list(sim.species_names), ["A"])
+        self.assertTrue(np.all(sim.species() == 0))
+        self.assertAlmostEqual(sim.temperature(), 2.0 * e0 / (3 * 200), places=14)
+        p0 = sim.masses() @ sim.velocities()
+        for t in (0.1, 0.35, 0.8, 2.0, 5.0):
+            sim.advance(time=t)
+            self.assertEqual(sim.time, t)
+            x = sim.positions()
+            self.assertTrue(np.all((x >= 0) & (x < box)))
+            self.assertGreater(min_gap(x, radii, box), -1e-9)
+            self.assertLess(abs(sim.kinetic_energy() - e0), 1e-12 * e0)
+            self.assertTrue(np.allclose(sim.masses() @ sim.velocities(), p0, atol=1e-12))
+        before = sim.events
+        self.assertTrue(sim.advance(events=1000))
+        self.assertEqual(sim.events, before + 1000)
+        before = sim.collisions
+        self.assertTrue(sim.advance(collisions=500))
+        self.assertEqual(sim.collisions, before + 500)
+
+    def test_run_returns_the_summary(self):
+        out = self.path("out")
+        summary = kairos.run(self.write_config(hard_config()), output=out,
+                             set=["run.time=0.5"])
+        with open(os.path.join(out, "summary.json")) as f:
+            self.assertEqual(summary, json.load(f))
+        self.assertEqual(summary["sim_time"], 0.5)
+
+    def test_mistakes_raise_input_errors_naming_the_problem(self):
+        cfg = self.write_config(hard_config())
+        sim = kairos.Simulation(cfg)
+        cases = [
+            (lambda: sim.advance(), "exactly one"),
+            (lambda: sim.advance(time=1.0, events=3), "exactly one"),
+            (lambda: (sim.advance(time=1.0), sim.advance(time=0.5)), "at time 1"),
+            (lambda: kairos.Simulation(cfg, set=["run.integrator=dem"]), "integrator"),
+            (lambda: kairos.Simulation(cfg, set=["driving.kind=andersen"]), "[driving]"),
+            (lambda: kairos.Simulation(cfg, set=["system.packing_fraction=1.5"]),
+             "packing_fraction"),
+            (lambda: kairos.Simulation("[system]\nparticles = 10\nbogus = 1\n"), "bogus"),
+            (lambda: kairos.run(self.path("missing.toml")), "missing.toml"),
+        ]
+        for call, needle in cases:
+            with self.assertRaises(kairos.InputError) as caught:
+                call()
+            self.assertIn(needle, str(caught.exception))
+        self.assertTrue(issubclass(kairos.InputError, ValueError))
+
+
+if __name__ == "__main__":
+    kt.main()
