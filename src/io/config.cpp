@@ -449,6 +449,16 @@ struct PathToken {
   bool is_index = false;
 };
 
+// run.time and run.collisions_per_particle (and the equilibration pair) give one length in two
+// units: the key an override of one of them replaces, else nullptr.
+const char* other_unit_key(std::string_view path) {
+  if (path == "run.time") return "collisions_per_particle";
+  if (path == "run.collisions_per_particle") return "time";
+  if (path == "run.equilibration_time") return "equilibration_collisions_per_particle";
+  if (path == "run.equilibration_collisions_per_particle") return "equilibration_time";
+  return nullptr;
+}
+
 AppliedOverride apply_override(toml::table& root, const std::string& text) {
   const std::string label = fmt::format("override '{}'", text);
   const auto error = [&](const std::string& message) {
@@ -542,6 +552,8 @@ AppliedOverride apply_override(toml::table& root, const std::string& text) {
       }
       if (last) {
         with_value([&](auto&& v) { table->insert_or_assign(token.key, std::move(v)); });
+        // A phase's length set in one unit replaces the file's length in the other.
+        if (const char* other = other_unit_key(canonical)) table->erase(other);
       } else {
         if (table->get(token.key) == nullptr) {
           if (tokens[k + 1].is_index) {

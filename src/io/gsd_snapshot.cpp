@@ -425,6 +425,9 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     if (!s.asleep.empty()) w.write_chunk("kairos/state/asleep", n, 1, s.asleep.data());
     w.write_chunk("kairos/state/rng", rng_bytes.size(), 1, rng_bytes.data());
     w.write_chunk("kairos/run/equilibration_remaining", 1, 1, &progress.equilibration_remaining);
+    if (std::isfinite(progress.equilibration_end_time)) {
+      w.write_chunk("kairos/run/equilibration_end_time", 1, 1, &progress.equilibration_end_time);
+    }
     if (progress.soft_table_max_speed > 0.0) {
       w.write_chunk("kairos/run/soft_table_max_speed", 1, 1, &progress.soft_table_max_speed);
     }
@@ -618,6 +621,13 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
                          std::to_string(left));
       }
       progress->equilibration_remaining = left;
+    }
+    if (r.find(f, "kairos/run/equilibration_end_time")) {
+      const double end = require<double>(r, f, "kairos/run/equilibration_end_time", path, 1)[0];
+      if (!std::isfinite(end))
+        throw InputError("'" + path.string() +
+                         "': kairos/run/equilibration_end_time is not finite");
+      progress->equilibration_end_time = end;
     }
     if (r.find(f, "kairos/run/next_kick_time"))
       progress->next_kick_time = require<double>(r, f, "kairos/run/next_kick_time", path, 1)[0];

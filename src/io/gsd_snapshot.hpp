@@ -46,8 +46,10 @@ void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& syste
 
 // Where the run that wrote a restart file stood, beyond the physical state.
 struct RunProgress {
-  double equilibration_remaining = 0.0;  // collisions per particle still to equilibrate
-  double next_kick_time = -1.0;          // driving: when the next random event is due (< 0: draw)
+  double equilibration_remaining = 0.0;  // collisions per particle (or time) still to equilibrate
+  // An unfinished equilibration in time (run.equilibration_time): when it ends. NaN otherwise.
+  double equilibration_end_time = std::numeric_limits<double>::quiet_NaN();
+  double next_kick_time = -1.0;  // driving: when the next random event is due (< 0: draw)
   // The integrator that wrote the state (run.integrator: "event" or "dem"; files without the
   // chunk are "event"), and the DEM's time step (0 for the event integrator).
   std::string integrator = "event";

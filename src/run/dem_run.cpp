@@ -44,7 +44,10 @@ template <int D>
 class DemRunDriver {
  public:
   DemRunDriver(const Config& config, const std::optional<fs::path>& restart_file)
-      : config_(config), restart_(restart_file.has_value()), rng_(config.system.seed) {
+      : config_(config),
+        restart_(restart_file.has_value()),
+        restart_name_(restart_file ? restart_file->string() : ""),
+        rng_(config.system.seed) {
     ParticleSystem<D> start = build_start_state<D>(config, restart_file, rng_, resumed_);
     check_restart_integrator(restart_file, resumed_, "dem");
     n_ = start.size();
@@ -102,8 +105,8 @@ class DemRunDriver {
     thermo_stats_->mark(point());
     ProgressLine progress(config_.output.progress);
 
-    PhaseLength eq = equilibration_length(config_.run);
-    if (restart_) eq.value = resumed_.equilibration_remaining;
+    const PhaseLength eq = restart_ ? resumed_equilibration(config_.run, resumed_, restart_name_)
+                                    : equilibration_length(config_.run);
     bool stopped = false;
     if (eq.value > 0.0) {
       stopped = run_phase("equilibration", eq, progress, wall_start);
@@ -156,8 +159,10 @@ class DemRunDriver {
     const std::uint64_t c = dem_->collisions();
     const double t = dem_->time();
     if (phase_ == "equilibration" && config_.run.equilibration_time >= 0.0) {
-      p.equilibration_remaining =
-          reached(equilibration_end_time_) ? 0.0 : equilibration_end_time_ - t;
+      if (!reached(equilibration_end_time_)) {
+        p.equilibration_remaining = equilibration_end_time_ - t;
+        p.equilibration_end_time = equilibration_end_time_;
+      }
     } else if (phase_ == "equilibration" && c < equilibration_target_) {
       p.equilibration_remaining = per_particle(equilibration_target_ - c);
     }
@@ -207,6 +212,10 @@ class DemRunDriver {
     // The first phase of a continued run starts where the saved run nominally stopped.
     std::uint64_t begin = dem_->collisions();
     double begin_time = dem_->time();
+    // After a phase in time: from its nominal end (its last step may have passed it).
+    if (!first_phase_ && std::isfinite(phase_end_time_) && reached(phase_end_time_) &&
+        phase_end_time_ > begin_time - dem_->dt())
+      begin_time = phase_end_time_;
     if (restart_ && first_phase_ && resumed_.dem_collision_mark > 0 &&
         resumed_.dem_collision_mark <= begin)
       begin = resumed_.dem_collision_mark;
@@ -216,8 +225,9 @@ class DemRunDriver {
     first_phase_ = false;
     const std::uint64_t target =
         length.in_time ? ~std::uint64_t{0} : begin + collisions_for(length.value);
-    const double end_time =
-        length.in_time ? begin_time + length.value : std::numeric_limits<double>::quiet_NaN();
+    const double end_time = !length.in_time             ? std::numeric_limits<double>::quiet_NaN()
+                            : std::isfinite(length.end) ? length.end
+                                                        : begin_time + length.value;
     if (phase == "equilibration") {
       equilibration_target_ = target;
       equilibration_end_time_ = end_time;
@@ -284,6 +294,7 @@ class DemRunDriver {
         return true;
       }
     }
+    if (length.in_time) stop_reason_ = "completed";  // ran to its end, whatever came before
     progress.update({phase, length.value, length.value, dem_->time(), steps(), length.in_time},
                     true);
     return false;
@@ -428,6 +439,7 @@ class DemRunDriver {
 
   Config config_;
   bool restart_;
+  std::string restart_name_;  // the restart file continued, for messages
   std::mt19937_64 rng_;
   RunProgress resumed_;
   std::optional<DemIntegrator<D>> dem_;

@@ -219,7 +219,10 @@ template <int D, class Queue>
 class RunDriver {
  public:
   RunDriver(const Config& config, const std::optional<fs::path>& restart_file)
-      : config_(config), restart_(restart_file.has_value()), rng_(config.system.seed) {
+      : config_(config),
+        restart_(restart_file.has_value()),
+        restart_name_(restart_file ? restart_file->string() : ""),
+        rng_(config.system.seed) {
     ParticleSystem<D> start = build_start_state<D>(config, restart_file, rng_, resumed_);
     run_detail::check_restart_integrator(restart_file, resumed_, "event");
     n_ = start.size();
@@ -285,8 +288,9 @@ class RunDriver {
     ProgressLine progress(config_.output.progress);
 
     // A restart continues an interrupted equilibration, otherwise goes straight to production.
-    PhaseLength eq = run_detail::equilibration_length(config_.run);
-    if (restart_) eq.value = resumed_.equilibration_remaining;
+    const PhaseLength eq =
+        restart_ ? run_detail::resumed_equilibration(config_.run, resumed_, restart_name_)
+                 : run_detail::equilibration_length(config_.run);
     bool stopped = false;
     if (eq.value > 0.0) {
       stopped = run_phase("equilibration", eq, progress, wall_start);
@@ -327,7 +331,10 @@ class RunDriver {
     const std::uint64_t c = engine_->counters().collisions;
     // In the unit of the config's equilibration length.
     if (phase_ == "equilibration" && config_.run.equilibration_time >= 0.0) {
-      p.equilibration_remaining = std::max(0.0, equilibration_end_time_ - engine_->time());
+      if (engine_->time() < equilibration_end_time_) {
+        p.equilibration_remaining = equilibration_end_time_ - engine_->time();
+        p.equilibration_end_time = equilibration_end_time_;
+      }
     } else if (phase_ == "equilibration" && c < equilibration_target_) {
       p.equilibration_remaining = per_particle(equilibration_target_ - c);
     }
@@ -392,6 +399,21 @@ class RunDriver {
     frame_time_ = engine_->time();
   }
 
+  // A stop asked by a signal or by run.max_wall_seconds (stop_reason_ set).
+  bool interrupted(Clock::time_point wall_start) {
+    if (g_stop.load(std::memory_order_relaxed)) {
+      stop_reason_ = "signal";
+      return true;
+    }
+    if (config_.run.max_wall_seconds > 0 &&
+        std::chrono::duration<double>(Clock::now() - wall_start).count() >
+            config_.run.max_wall_seconds) {
+      stop_reason_ = "wall_time_limit";
+      return true;
+    }
+    return false;
+  }
+
   // Runs until `length` more collisions per particle or simulated time; returns true if stopped
   // early. Outputs come every so many collisions per particle, or (interval_unit = "time") at
   // the multiples of their intervals in time, for which the engine's clock is stopped there
@@ -402,7 +424,9 @@ class RunDriver {
     const std::uint64_t begin = engine_->counters().collisions;
     const double begin_time = engine_->time();
     const std::uint64_t target = begin + (length.in_time ? 0 : collisions_for(length.value));
-    const double end_time = length.in_time ? begin_time + length.value : kNever;
+    const double end_time = !length.in_time             ? kNever
+                            : std::isfinite(length.end) ? length.end
+                                                        : begin_time + length.value;
     if (phase == "equilibration") {
       equilibration_target_ = target;
       equilibration_end_time_ = end_time;
@@ -427,7 +451,10 @@ class RunDriver {
     while (length.in_time ? engine_->time() < end_time : engine_->counters().collisions < target) {
       if (length.in_time || time_outputs) {
         // Outputs due, and the phase's end, before the next event: the clock stops there.
-        const double stop = std::min(timed.next(), end_time);
+        double stop = std::min(timed.next(), end_time);
+        // An output within round-off of the phase's end comes at the end (one row, not two).
+        if (length.in_time && stop >= end_time - TimeSchedule::Every::slack(end_time))
+          stop = end_time;
         if (driven_) apply_due_kicks(stop);
         if (!length.in_time && !driven_ && !(engine_->next_event_time() < kNever)) {
           stop_reason_ = "no_more_events";  // the collision target would never come
@@ -440,6 +467,12 @@ class RunDriver {
           if (timed.trajectory.due(t) && trajectory_) write_trajectory_frame();
           if (timed.restart.due(t))
             write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
+          // A system at rest passes its output times without events: the stop checks too.
+          if (interrupted(wall_start)) return true;
+          if ((++clock_stops_ & 0x3ffu) == 0) {
+            progress.update({phase, done(), length.value, engine_->time(),
+                             engine_->counters().events, length.in_time});
+          }
           continue;
         }
       } else if (driven_) {
@@ -461,17 +494,12 @@ class RunDriver {
         return true;
       }
       if ((engine_->counters().events & 0x3fffu) == 0) {
-        const auto now = Clock::now();
         progress.update({phase, done(), length.value, engine_->time(), engine_->counters().events,
                          length.in_time});
-        if (config_.run.max_wall_seconds > 0 &&
-            std::chrono::duration<double>(now - wall_start).count() >
-                config_.run.max_wall_seconds) {
-          stop_reason_ = "wall_time_limit";
-          return true;
-        }
+        if (interrupted(wall_start)) return true;
       }
     }
+    if (length.in_time) stop_reason_ = "completed";  // ran to its end, whatever came before
     progress.update({phase, length.value, length.value, engine_->time(), engine_->counters().events,
                      length.in_time},
                     true);
@@ -807,6 +835,7 @@ class RunDriver {
 
   Config config_;
   bool restart_;
+  std::string restart_name_;  // the restart file continued, for messages
   std::mt19937_64 rng_;
   std::optional<EventEngine<D, Queue>> engine_;
   std::vector<SoftTableUse> tables_;  // soft spheres: the map tables in use
@@ -844,6 +873,7 @@ class RunDriver {
   std::string phase_ = "production";
   std::uint64_t equilibration_target_ = 0;
   double equilibration_end_time_ = 0.0;  // with run.equilibration_time
+  std::uint64_t clock_stops_ = 0;        // outputs in time passed without an event
   RunProgress resumed_;                  // progress recorded in the restart file this run continues
   std::string stop_reason_ = "completed";
 };

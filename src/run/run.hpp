@@ -1,8 +1,9 @@
 // One invocation of `kairos run`: configuration -> initial state -> engine -> outputs.
 //
 // Phases: equilibration (skipped on restart), then production, each measured in collisions per
-// particle c = 2 N_coll / N or in simulated time (run.time, run.equilibration_time). Outputs in the output directory: config.toml (the effective
-// configuration), thermo.tsv, trajectory.gsd, restart.gsd, summary.json (see docs/outputs.md).
+// particle c = 2 N_coll / N or in simulated time (run.time, run.equilibration_time). Outputs in the
+// output directory: config.toml (the effective configuration), thermo.tsv, trajectory.gsd,
+// restart.gsd, summary.json (see docs/outputs.md).
 #pragma once
 
 #include <filesystem>

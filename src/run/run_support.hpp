@@ -224,7 +224,26 @@ struct OutputSchedule {
 struct PhaseLength {
   double value = 0.0;
   bool in_time = false;
+  // A phase in time resumed from a restart file: its end as recorded (value is then what was
+  // left), so that it ends where the interrupted run would have, bit for bit.
+  double end = std::numeric_limits<double>::quiet_NaN();
 };
+
+// The equilibration a restart file leaves to do, in the unit it was started in (its recorded end
+// time says: time); a config that gives it in the other unit is refused.
+inline PhaseLength resumed_equilibration(const RunConfig& r, const RunProgress& resumed,
+                                         const std::string& restart_file) {
+  const bool in_time = std::isfinite(resumed.equilibration_end_time);
+  const bool config_in_time = r.equilibration_time >= 0.0;
+  if (resumed.equilibration_remaining > 0.0 && in_time != config_in_time) {
+    throw InputError(fmt::format(
+        "restart file '{}' has an unfinished equilibration measured in {}, but the config gives "
+        "run.{}: continue it with the same unit",
+        restart_file, in_time ? "simulated time" : "collisions per particle",
+        config_in_time ? "equilibration_time" : "equilibration_collisions_per_particle"));
+  }
+  return {resumed.equilibration_remaining, in_time, resumed.equilibration_end_time};
+}
 
 // Whether the output intervals are in simulated time (the reader resolves the unit; a config
 // built in code may leave it "", the production length's unit).
@@ -247,18 +266,23 @@ inline PhaseLength equilibration_length(const RunConfig& r) {
 struct TimeSchedule {
   struct Every {
     double step = 0.0, next = std::numeric_limits<double>::infinity();  // step 0: never
-    // The first multiple of step after t.
+    // k * step is not the decimal multiple (3 * 0.1 = 0.30000000000000004): a multiple within
+    // this of t counts as t, so that no output follows another (or a phase's end) by 1e-16.
+    static double slack(double t) { return 1e-12 * std::abs(t); }
+    // The first multiple of step after t (beyond the slack).
     double after(double t) const {
       double k = std::floor(t / step) + 1.0;
-      while (k * step <= t) k += 1.0;
-      return k * step;
+      // A step below t's resolution (t / step > 2^53) would never move k: a few tries only.
+      for (int tries = 0; tries < 4 && k * step <= t + slack(t); ++tries) k += 1.0;
+      return std::max(k * step, std::nextafter(t + slack(t), kInfinity));
     }
     // True (once) when t has reached the next multiple.
     bool due(double t) {
-      if (!(t >= next)) return false;
+      if (!(t >= next - slack(next))) return false;
       next = after(t);
       return true;
     }
+    static constexpr double kInfinity = std::numeric_limits<double>::infinity();
   };
   Every thermo, trajectory, restart;
 

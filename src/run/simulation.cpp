@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
@@ -51,7 +52,9 @@ Simulation<D>::Simulation(const Config& config,
   engine_ = std::make_unique<EventEngine<D, CalendarQueue>>(
       std::move(start), restart_file ? StartMode::kResume : StartMode::kPredict, options,
       environment);
-  progress_.equilibration_remaining = 0.0;  // a saved state continues with production
+  // A saved state continues with production.
+  progress_.equilibration_remaining = 0.0;
+  progress_.equilibration_end_time = std::numeric_limits<double>::quiet_NaN();
 }
 
 template <int D>

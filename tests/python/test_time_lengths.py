@@ -114,6 +114,62 @@ class TimeLengths(kt.KairosTestCase):
             matched += 1
         self.assertEqual(matched, 6)  # 0, 0.4, 0.8, 1.2, 1.6 and the end, 1.9
 
+    def test_no_output_within_round_off_of_another(self):
+        # 3 * 0.1 = 0.30000000000000004 is the end of the equilibration (0.3) to round-off, and
+        # 9 * 0.1 that of the run: one row there each, not a second 1e-16 later.
+        cfg = self.write_config(timed_config(0.6, 0.3, output={"thermo_interval": 0.1,
+                                                                "trajectory_interval": 0.3}))
+        out = self.path("out")
+        self.run_ok("run", cfg, "-o", out)
+        header, rows, _ = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        times = [r[header.index("time")] for r in rows]
+        self.assertEqual(len(times), 9, times)
+        self.assertTrue(all(b - a > 0.09 for a, b in zip(times, times[1:])), times)
+        self.assertEqual(len(frame_times(out)), 4)  # 0, 0.3, 0.6 and 0.9
+
+    def test_an_interrupted_equilibration_in_time_resumes_exactly(self):
+        # Stopped at its first output (wall-time limit), continued, against one run: the end of
+        # the equilibration is recorded, not recomputed as time + remaining (1 ulp off here).
+        for integrator in ("event", "dem"):
+            with self.subTest(integrator=integrator):
+                if integrator == "event":
+                    # Stopped at 0.7: 0.7 + (2.72 - 0.7) is not 2.72 in doubles.
+                    config = timed_config(1.3, 2.72, output={"thermo_interval": 0.7,
+                                                             "trajectory_interval": 1.4})
+                else:
+                    config = soft_dem_config(0.5, output={"thermo_interval": 0.25,
+                                                          "trajectory_interval": 0.25})
+                    config["run"]["equilibration_time"] = 0.5
+                cfg = self.write_config(config, integrator + ".toml")
+                first, second, whole = (self.path(integrator + x) for x in ("1", "2", "w"))
+                self.run_ok("run", cfg, "-o", first, "--set", "run.max_wall_seconds=1e-9")
+                self.assertEqual(self.summary(first)["stop_reason"], "wall_time_limit")
+                self.run_ok("run", cfg, "--restart", os.path.join(first, "restart.gsd"),
+                            "-o", second)
+                self.run_ok("run", cfg, "-o", whole)
+                a = kt.read_exact_state(os.path.join(second, "restart.gsd"))
+                b = kt.read_exact_state(os.path.join(whole, "restart.gsd"))
+                for name in ("kairos/state/position", "kairos/velocity", "kairos/time"):
+                    self.assertTrue(np.array_equal(a[name], b[name]), name)
+                # The same rows from the end of the equilibration on (its last row included).
+                rows = []
+                for out in (second, whole):
+                    header, r, _ = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+                    t = header.index("time")
+                    last_eq = max(k for k, row in enumerate(r) if row[0] == "equilibration")
+                    rows.append([(row[0], row[t]) for row in r[last_eq:]])
+                self.assertEqual(rows[0], rows[1])
+
+    def test_an_unfinished_equilibration_continues_in_its_own_unit(self):
+        config = kt.base_config(equilibration=50.0, production=10.0)
+        cfg = self.write_config(config)
+        first = self.path("first")
+        self.run_ok("run", cfg, "-o", first, "--set", "run.max_wall_seconds=1e-9")
+        result = self.kairos("run", cfg, "--restart", os.path.join(first, "restart.gsd"),
+                             "-o", self.path("second"), "--set", "run.equilibration_time=1.0")
+        self.assert_user_error(result, "restart.gsd", "collisions per particle",
+                               "run.equilibration_time")
+
     def test_collision_lengths_with_outputs_in_time(self):
         config = kt.base_config(dimension=2, particles=400, packing_fraction=0.4, seed=5,
                                 production=30.0,
@@ -152,6 +208,13 @@ class TimeLengths(kt.KairosTestCase):
         frames = frame_times(self.path("b"))
         self.assertEqual(frames[:-1], [10.0 * k for k in range(len(frames) - 1)])
         self.assertEqual(frames[-1], rest + 25.0)
+        # An equilibration in collisions that ends at rest, then production in time (given with
+        # --set, which replaces the file's length in collisions): the run completes.
+        self.run_ok("run", self.write_config(text, "c.toml"), "-o", self.path("c"), *out,
+                    "--set", "run.equilibration_collisions_per_particle=2000",
+                    "--set", "run.time=5.0")
+        s = self.summary(self.path("c"))
+        self.assertEqual((s["stop_reason"], s["sim_time"]), ("completed", rest + 5.0))
 
     def test_dem_lengths_in_time_and_an_exact_continuation(self):
         out = {"thermo_interval": 0.1, "trajectory_interval": 0.25}
