@@ -234,16 +234,9 @@ class DemRunDriver {
     }
     phase_target_ = target;
     phase_end_time_ = end_time;
-    const double production = production_length(config_.run).value;
     const bool time_outputs = intervals_in_time(config_);
-    OutputSchedule schedule;  // one of the two; the other is never due
-    TimeSchedule timed;
-    if (time_outputs) {
-      timed = TimeSchedule(config_.output, production, begin_time);
-    } else {
-      schedule = OutputSchedule(config_.output, production, begin,
-                                [&](double c) { return collisions_for(c); });
-    }
+    auto [schedule, timed] =
+        phase_schedules(config_, begin, begin_time, [&](double c) { return collisions_for(c); });
     // About 2^20 particle-steps between checks of the clock and the stop flag.
     const long chunk =
         std::max<long>(1, (1l << 20) / static_cast<long>(std::max<std::size_t>(1, n_)));

@@ -431,17 +431,9 @@ class RunDriver {
       equilibration_target_ = target;
       equilibration_end_time_ = end_time;
     }
-    const double production = run_detail::production_length(config_.run).value;
     const bool time_outputs = run_detail::intervals_in_time(config_);
-    // One of the two schedules; the other stays empty (never due).
-    OutputSchedule schedule;
-    TimeSchedule timed;
-    if (time_outputs) {
-      timed = TimeSchedule(config_.output, production, begin_time);
-    } else {
-      schedule = OutputSchedule(config_.output, production, begin,
-                                [&](double c) { return collisions_for(c); });
-    }
+    auto [schedule, timed] = run_detail::phase_schedules(
+        config_, begin, begin_time, [&](double c) { return collisions_for(c); });
     const auto done = [&] {
       return length.in_time ? engine_->time() - begin_time
                             : per_particle(engine_->counters().collisions - begin);

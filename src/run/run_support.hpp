@@ -15,6 +15,7 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -303,5 +304,17 @@ struct TimeSchedule {
   }
   double next() const { return std::min({thermo.next, trajectory.next, restart.next}); }
 };
+
+// A phase's output schedule, in collisions or in time (intervals_in_time): the other part of
+// the pair is empty, never due. begin, begin_time: where the phase starts.
+template <class ToCollisions>
+std::pair<OutputSchedule, TimeSchedule> phase_schedules(const Config& c, std::uint64_t begin,
+                                                        double begin_time,
+                                                        ToCollisions&& collisions_for) {
+  const double production = production_length(c.run).value;
+  if (intervals_in_time(c))
+    return {OutputSchedule{}, TimeSchedule(c.output, production, begin_time)};
+  return {OutputSchedule(c.output, production, begin, collisions_for), TimeSchedule{}};
+}
 
 }  // namespace kairos::run_detail
