@@ -36,7 +36,8 @@ void replace_file_atomically(const std::filesystem::path& target,
   std::error_code ec;
   std::filesystem::rename(tmp, target, ec);
   if (ec) {
-    std::filesystem::remove(tmp, ec);
+    std::error_code ignored;  // the rename's error is the one to report
+    std::filesystem::remove(tmp, ignored);
     throw InputError("cannot replace '" + target.string() + "': " + ec.message());
   }
   const auto dir = target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");

@@ -6,6 +6,10 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <fmt/format.h>
+#include <signal.h>
+
+#include <atomic>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -25,17 +29,56 @@ namespace fs = std::filesystem;
 namespace kairos {
 namespace {
 
-// Ctrl-C in Python: a long advance checks for signals every 16 384 events.
+// Ctrl-C in Python: a long advance (run without the GIL) takes it back every 16 384 events to
+// let Python see pending signals.
 bool python_keeps_going() {
+  py::gil_scoped_acquire gil;
   if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   return true;
 }
 
-// A config file, or TOML text when the argument holds a newline (a path never does here).
-Config config_from(const std::string& config, const std::vector<std::string>& overrides) {
-  if (config.find('\n') != std::string::npos) return parse_config(config, "<text>", overrides);
-  return load_config(config, overrides);
+// A config file (str or path-like), or TOML text when the string holds a newline (a path here
+// never does); `set`: one "key=value" override or a sequence of them.
+Config config_from(const py::object& config, const py::object& set) {
+  std::vector<std::string> overrides;
+  if (py::isinstance<py::str>(set)) {
+    overrides.push_back(set.cast<std::string>());
+  } else if (!set.is_none()) {
+    overrides = set.cast<std::vector<std::string>>();
+  }
+  if (py::isinstance<py::str>(config)) {
+    const auto text = config.cast<std::string>();
+    if (text.find('\n') != std::string::npos) return parse_config(text, "<text>", overrides);
+    return load_config(text, overrides);
+  }
+  const auto path = py::module_::import("os").attr("fspath")(config).cast<std::string>();
+  return load_config(path, overrides);
 }
+
+// SIGINT during kairos.run: the run stops cleanly after the current event (request_stop(), as
+// in the CLI) and writes every output; Python's handler is back afterwards.
+extern "C" void stop_on_sigint(int) {
+  request_stop();
+}
+class SigintStopsRun {
+ public:
+  SigintStopsRun() {
+    clear_stop_request();
+    struct sigaction sa {};
+    sa.sa_handler = stop_on_sigint;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &previous_);
+  }
+  ~SigintStopsRun() {
+    sigaction(SIGINT, &previous_, nullptr);
+    clear_stop_request();
+  }
+  SigintStopsRun(const SigintStopsRun&) = delete;
+  SigintStopsRun& operator=(const SigintStopsRun&) = delete;
+
+ private:
+  struct sigaction previous_ {};
+};
 
 py::array_t<double> as_array(const auto& rows, int dimension) {
   py::array_t<double> out({static_cast<py::ssize_t>(rows.size()), py::ssize_t{dimension}});
@@ -48,9 +91,9 @@ py::array_t<double> as_array(const auto& rows, int dimension) {
 // kairos.Simulation: one of the two dimensions behind one Python class.
 class PySimulation {
  public:
-  PySimulation(const std::string& config, const std::vector<std::string>& overrides,
+  PySimulation(const py::object& config, const py::object& set,
                const std::optional<fs::path>& restart) {
-    const Config c = config_from(config, overrides);
+    const Config c = config_from(config, set);
     if (c.system.dimension == 2) {
       sim_ = std::make_unique<Simulation<2>>(c, restart);
     } else {
@@ -58,12 +101,16 @@ class PySimulation {
     }
   }
 
+  // Every access goes through visit(): refused while another thread advances this simulation
+  // (advance() runs without the GIL).
   template <class F>
   auto visit(F&& f) const {
+    if (busy_) throw InputError("this Simulation is advancing in another thread");
     return std::visit([&](const auto& s) { return f(std::as_const(*s)); }, sim_);
   }
   template <class F>
   auto visit(F&& f) {
+    if (busy_) throw InputError("this Simulation is advancing in another thread");
     return std::visit([&](auto& s) { return f(*s); }, sim_);
   }
 
@@ -75,6 +122,12 @@ class PySimulation {
     const int given = (time ? 1 : 0) + (events ? 1 : 0) + (collisions ? 1 : 0);
     if (given != 1) throw InputError("advance: give exactly one of time=, events= or collisions=");
     return visit([&](auto& s) {
+      busy_ = true;
+      struct Idle {
+        std::atomic<bool>& busy;
+        ~Idle() { busy = false; }
+      } idle{busy_};
+      py::gil_scoped_release release;
       if (time) return s.advance_to_time(*time, python_keeps_going);
       if (events) return s.advance_events(*events, python_keeps_going);
       return s.advance_collisions(*collisions, python_keeps_going);
@@ -119,10 +172,16 @@ class PySimulation {
   double kinetic_energy() const {
     return visit([](const auto& s) { return s.kinetic_energy(); });
   }
-  // kT = 2 KE / (D N): every particle's translational degrees of freedom.
   double temperature() const {
+    return visit([](const auto& s) { return s.temperature(); });
+  }
+  double potential_energy() const {
+    return visit([](const auto& s) { return s.potential_energy(); });
+  }
+  std::string repr() const {
     return visit([](const auto& s) {
-      return 2.0 * s.kinetic_energy() / (dimension_of(s) * static_cast<double>(s.size()));
+      return fmt::format("<kairos.Simulation: {} particles in {}D, t = {:.6g}, {} collisions>",
+                         s.size(), dimension_of(s), s.time(), s.collisions());
     });
   }
   void save(const fs::path& path) const {
@@ -135,6 +194,7 @@ class PySimulation {
     return D;
   }
   std::variant<std::unique_ptr<Simulation<2>>, std::unique_ptr<Simulation<3>>> sim_;
+  std::atomic<bool> busy_{false};
 };
 
 }  // namespace
@@ -151,30 +211,35 @@ PYBIND11_MODULE(kairos, m) {
 
   m.def(
       "run",
-      [](const std::string& config, std::optional<fs::path> output,
-         const std::vector<std::string>& overrides, std::optional<fs::path> restart) {
-        kairos::Config c = kairos::config_from(config, overrides);
+      [](const py::object& config, std::optional<fs::path> output, const py::object& set,
+         std::optional<fs::path> restart) {
+        kairos::Config c = kairos::config_from(config, set);
         if (output) c.output.directory = output->string();
         const kairos::RunOutcome outcome = [&] {
+          kairos::SigintStopsRun sigint;
           py::gil_scoped_release release;  // the run is C++ throughout
           return kairos::run_simulation(c, restart);
         }();
+        if (outcome.summary.value("stop_reason", "") == "signal") {
+          // Ctrl-C: the outputs are written (summary.json says "signal"); Python's way is this.
+          PyErr_SetNone(PyExc_KeyboardInterrupt);
+          throw py::error_already_set();
+        }
         return py::module_::import("json").attr("loads")(outcome.summary.dump());
       },
-      py::arg("config"), py::arg("output") = py::none(),
-      py::arg("set") = std::vector<std::string>{}, py::arg("restart") = py::none(),
+      py::arg("config"), py::arg("output") = py::none(), py::arg("set") = py::none(),
+      py::arg("restart") = py::none(),
       "Runs a simulation as `kairos run` does (config: a TOML file's path, or TOML text; set: "
       "'key=value' overrides; output: the output directory; restart: a restart file to "
-      "continue). Writes the usual output files and returns summary.json as a dict.");
+      "continue). Writes the usual output files and returns summary.json as a dict. Ctrl-C "
+      "stops the run cleanly (every output written) and raises KeyboardInterrupt.");
 
   py::class_<PySimulation>(m, "Simulation",
                            "An event-driven simulation in memory: the engine of `kairos run` "
                            "started from the same configuration (bit-identical trajectory), "
                            "advanced on request, without output files.")
-      .def(py::init<const std::string&, const std::vector<std::string>&,
-                    const std::optional<fs::path>&>(),
-           py::arg("config"), py::arg("set") = std::vector<std::string>{},
-           py::arg("restart") = py::none(),
+      .def(py::init<const py::object&, const py::object&, const std::optional<fs::path>&>(),
+           py::arg("config"), py::arg("set") = py::none(), py::arg("restart") = py::none(),
            "config: a TOML file's path, or TOML text; set: 'key=value' overrides; restart: a "
            "restart file to continue from.")
       .def("advance", &PySimulation::advance, py::arg("time") = py::none(),
@@ -196,7 +261,12 @@ PYBIND11_MODULE(kairos, m) {
       .def_property_readonly("collisions", &PySimulation::collisions)
       .def("__len__", &PySimulation::size)
       .def("kinetic_energy", &PySimulation::kinetic_energy)
-      .def("temperature", &PySimulation::temperature, "kT = 2 KE / (D N).")
+      .def("temperature", &PySimulation::temperature,
+           "kT as thermo.tsv gives it: D (N - 1) degrees of freedom; under shear, of the "
+           "velocities relative to the flow.")
+      .def("potential_energy", &PySimulation::potential_energy,
+           "Of the stepped potentials, or the elastic energy of soft contacts in progress.")
+      .def("__repr__", &PySimulation::repr)
       .def("save", &PySimulation::save, py::arg("path"),
            "Writes a restart file (atomically) that `kairos run --restart` continues.");
 }

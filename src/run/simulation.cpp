@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "run/environment_setup.hpp"
@@ -37,6 +38,7 @@ Simulation<D>::Simulation(const Config& config,
   for (std::size_t i = 0; i < n_; ++i) radius_[i] = start.kinematics[i].radius;
   species_ = start.species;
   species_names_ = start.species_names;
+  for (int a = 0; a < D; ++a) volume_ *= start.box[a];
   Environment<D> environment = make_environment<D>(config, start);
   if (environment.soft_spheres() && config.soft.tables) {
     // The tables `kairos run` would use (the same speeds covered: the same maps, bit for bit).
@@ -84,15 +86,22 @@ bool Simulation<D>::advance_to_time(double t, const KeepGoing& keep_going) {
   return true;
 }
 
+namespace {
+// now + count, at most the largest count (no wrap-around).
+std::uint64_t target_after(std::uint64_t now, std::uint64_t count) {
+  return count > ~std::uint64_t{0} - now ? ~std::uint64_t{0} : now + count;
+}
+}  // namespace
+
 template <int D>
 bool Simulation<D>::advance_events(std::uint64_t count, const KeepGoing& keep_going) {
-  const std::uint64_t target = engine_->counters().events + count;
+  const std::uint64_t target = target_after(engine_->counters().events, count);
   return run_while([&] { return engine_->counters().events < target; }, keep_going);
 }
 
 template <int D>
 bool Simulation<D>::advance_collisions(std::uint64_t count, const KeepGoing& keep_going) {
-  const std::uint64_t target = engine_->counters().collisions + count;
+  const std::uint64_t target = target_after(engine_->counters().collisions, count);
   return run_while([&] { return engine_->counters().collisions < target; }, keep_going);
 }
 
@@ -123,6 +132,16 @@ std::vector<Vec<D>> Simulation<D>::velocities() const {
 template <int D>
 double Simulation<D>::kinetic_energy() const {
   return engine_->kinetic_energy();
+}
+template <int D>
+double Simulation<D>::temperature() const {
+  const double ke = engine_->environment().sheared() ? engine_->peculiar_kinetic_energy()
+                                                     : engine_->kinetic_energy();
+  return Thermodynamics(D, n_, volume_).temperature(ke);
+}
+template <int D>
+double Simulation<D>::potential_energy() const {
+  return engine_->potential_energy();
 }
 template <int D>
 ParticleSystem<D> Simulation<D>::state() const {

@@ -59,6 +59,11 @@ class Simulation {
   const std::vector<std::uint32_t>& species() const { return species_; }
   const std::vector<std::string>& species_names() const { return species_names_; }
   double kinetic_energy() const;
+  // kT as thermo.tsv gives it (analysis/thermodynamics: D (N - 1) degrees of freedom; under
+  // shear, of the velocities relative to the flow).
+  double temperature() const;
+  // Of the stepped potentials, or the elastic energy of soft contacts in progress.
+  double potential_energy() const;
   // The complete state (what a restart file holds).
   ParticleSystem<D> state() const;
   // A restart file (atomically) that `kairos run --restart` continues bit-identically.
@@ -76,6 +81,7 @@ class Simulation {
   std::vector<double> mass_, radius_;
   std::vector<std::uint32_t> species_;
   std::vector<std::string> species_names_;
+  double volume_ = 1.0;
 };
 
 }  // namespace kairos

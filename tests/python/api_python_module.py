@@ -11,6 +11,10 @@ Run by ctest with the module's directory on PYTHONPATH (tests/CMakeLists.txt).
 
 import json
 import os
+import pathlib
+import signal
+import threading
+import time
 
 import numpy as np
 
@@ -58,7 +62,33 @@ class Module(kt.KairosTestCase):
             self.assertTrue(np.array_equal(a[name], b[name]), name)
         summary = self.summary(self.path("cli"))
         self.assertEqual(sim.collisions, summary["event_counts"]["total_collisions_since_start"])
+        # The temperature of summary.json (D (N - 1) degrees of freedom, peculiar under shear).
+        self.assertAlmostEqual(sim.temperature(), summary["temperature"],
+                               delta=1e-12 * summary["temperature"])
         return sim, cfg
+
+    def test_examples_with_mixtures_walls_gravity_and_shear(self):
+        for name in ("binary_mixture.toml", "vibrated_bed_2d.toml", "shear_flow_2d.toml"):
+            with self.subTest(example=name):
+                with open(kt.example(name)) as f:
+                    text = f.read()
+                cfg = self.write_config(text, name)
+                t = 0.7
+                out = self.path(name + "-out")
+                self.run_ok("run", cfg, "-o", out, "--set", "run.time=%r" % t,
+                            "--set", "run.equilibration_time=0", "--set",
+                            'output.progress="never"')
+                sim = kairos.Simulation(pathlib.Path(cfg), set=["run.time=1.0"])
+                sim.advance(time=t)
+                sim.save(self.path(name + ".gsd"))
+                a = kt.read_exact_state(os.path.join(out, "restart.gsd"))
+                b = kt.read_exact_state(self.path(name + ".gsd"))
+                for chunk in ("kairos/state/position", "kairos/velocity", "kairos/time"):
+                    self.assertTrue(np.array_equal(a[chunk], b[chunk]), chunk)
+                summary = self.summary(out)
+                self.assertAlmostEqual(sim.temperature(), summary["temperature"],
+                                       delta=1e-12 * summary["temperature"])
+                self.assertIn("particles in", repr(sim))
 
     def test_the_same_trajectory_as_the_cli_in_3d_and_2d(self):
         for dimension in (3, 2):
@@ -99,7 +129,7 @@ class Module(kt.KairosTestCase):
         self.assertTrue(np.all(sim.masses() == 1.0))
         self.assertEqual(list(sim.species_names), ["A"])
         self.assertTrue(np.all(sim.species() == 0))
-        self.assertAlmostEqual(sim.temperature(), 2.0 * e0 / (3 * 200), places=14)
+        self.assertAlmostEqual(sim.temperature(), 2.0 * e0 / (3 * (200 - 1)), places=14)
         p0 = sim.masses() @ sim.velocities()
         for t in (0.1, 0.35, 0.8, 2.0, 5.0):
             sim.advance(time=t)
@@ -115,6 +145,50 @@ class Module(kt.KairosTestCase):
         before = sim.collisions
         self.assertTrue(sim.advance(collisions=500))
         self.assertEqual(sim.collisions, before + 500)
+
+    def test_ctrl_c_stops_a_run_and_an_advance_cleanly(self):
+        # SIGINT half a second in: kairos.run stops after the current event, writes every
+        # output (summary.json: "signal") and raises KeyboardInterrupt; an advance raises it
+        # too and leaves the simulation usable.
+        config = hard_config(time=1e6)
+        config["system"]["particles"] = 4000
+        cfg = self.write_config(config)
+        timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+        timer.start()
+        started = time.monotonic()
+        with self.assertRaises(KeyboardInterrupt):
+            kairos.run(cfg, output=self.path("out"))
+        timer.join()
+        self.assertLess(time.monotonic() - started, 30.0)
+        self.assertEqual(self.summary(self.path("out"))["stop_reason"], "signal")
+        self.assertIsNotNone(kt.read_exact_state(self.path("out", "restart.gsd")))
+        sim = kairos.Simulation(cfg)
+        timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+        timer.start()
+        with self.assertRaises(KeyboardInterrupt):
+            sim.advance(time=1e6)
+        timer.join()
+        t = sim.time
+        self.assertGreater(t, 0.0)
+        self.assertTrue(sim.advance(time=t + 0.1))
+        self.assertEqual(sim.time, t + 0.1)
+
+    def test_advance_lets_other_threads_run_and_guards_the_object(self):
+        sim = kairos.Simulation(self.write_config(hard_config()), set="system.particles=4000")
+        worker = threading.Thread(target=sim.advance, kwargs={"events": 3_000_000})
+        worker.start()
+        refused = 0
+        while worker.is_alive():  # this thread runs while the other advances (no GIL held)
+            try:
+                sim.positions()
+            except kairos.InputError as e:
+                self.assertIn("another thread", str(e))
+                refused += 1
+            time.sleep(0.01)
+        worker.join()
+        self.assertGreater(refused, 0)
+        self.assertEqual(sim.events, 3_000_000)
+        self.assertEqual(sim.positions().shape, (4000, 3))
 
     def test_run_returns_the_summary(self):
         out = self.path("out")
