@@ -176,24 +176,11 @@ class DemRunDriver {
   }
 
   void write_restart_file() const {
-    ParticleSystem<D> s = dem_->export_state();
-    s.dem = dem_->checkpoint();        // for a bit-identical continuation
-    s.events.assign(n_, EventSlot{});  // no scheduler state: the event fields are placeholders
-    s.cell.assign(n_, 0);
-    s.collision_count.resize(n_, 0);
-    write_restart(dir_ / "restart.gsd", s, rng_, progress_now());
+    write_dem_restart(dir_ / "restart.gsd", *dem_, rng_, progress_now());
   }
 
-  // Whether the clock has reached time t: at the first step at or after it (round-off aside:
-  // time_at(steps) need not hit a multiple of dt exactly).
-  bool reached(double t) const { return dem_->time() >= t - 1e-9 * dem_->dt(); }
-  // Steps until the first step at or after time t (at least one).
-  long steps_to(double t) const {
-    const double steps = std::ceil((t - dem_->time()) / dem_->dt() - 1e-9);
-    return steps < 1.0    ? 1l
-           : steps > 1e15 ? std::numeric_limits<long>::max()
-                          : static_cast<long>(steps);
-  }
+  bool reached(double t) const { return dem_reached(*dem_, t); }
+  long steps_to(double t) const { return dem_steps_to(*dem_, t); }
   bool row_pending() const {
     return dem_->collisions() > thermo_stats_->last().collisions ||
            (timed_ && dem_->time() > thermo_stats_->last().time);

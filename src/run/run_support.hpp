@@ -25,6 +25,7 @@
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/particle_system.hpp"
+#include "dem/dem_integrator.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
 #include "io/gsd_file.hpp"
@@ -304,6 +305,34 @@ struct TimeSchedule {
   }
   double next() const { return std::min({thermo.next, trajectory.next, restart.next}); }
 };
+
+// The DEM's clock against times its steps (dt apart) cannot hit exactly: a time is reached at
+// the first step at or after it (round-off aside: time_at(steps) need not hit a multiple of dt).
+template <int D>
+bool dem_reached(const DemIntegrator<D>& dem, double t) {
+  return dem.time() >= t - 1e-9 * dem.dt();
+}
+// Steps until the first step at or after time t (at least one).
+template <int D>
+long dem_steps_to(const DemIntegrator<D>& dem, double t) {
+  const double steps = std::ceil((t - dem.time()) / dem.dt() - 1e-9);
+  return steps < 1.0 ? 1l
+         : steps > static_cast<double>(std::numeric_limits<long>::max() / 2)
+             ? std::numeric_limits<long>::max() / 2
+             : static_cast<long>(steps);
+}
+// A DEM state's restart file, with the integrator's checkpoint (bit-identical continuation).
+template <int D>
+void write_dem_restart(const fs::path& path, const DemIntegrator<D>& dem,
+                       const std::mt19937_64& rng, const RunProgress& progress) {
+  ParticleSystem<D> s = dem.export_state();
+  s.dem = dem.checkpoint();
+  const std::size_t n = s.size();
+  s.events.assign(n, EventSlot{});  // no scheduler state: the event fields are placeholders
+  s.cell.assign(n, 0);
+  s.collision_count.resize(n, 0);
+  write_restart(path, s, rng, progress);
+}
 
 // A phase's output schedule, in collisions or in time (intervals_in_time): the other part of
 // the pair is empty, never due. begin, begin_time: where the phase starts.
