@@ -328,7 +328,7 @@ void write_dem_restart(const fs::path& path, const DemIntegrator<D>& dem,
   ParticleSystem<D> s = dem.export_state();
   s.dem = dem.checkpoint();
   const std::size_t n = s.size();
-  s.events.assign(n, EventSlot{});  // no scheduler state: the event fields are placeholders
+  s.events.assign(n, EventSlot{});  // a DEM state has no scheduler: empty event slots, never read
   s.cell.assign(n, 0);
   s.collision_count.resize(n, 0);
   write_restart(path, s, rng, progress);
