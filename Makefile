@@ -23,7 +23,7 @@ build: configure
 
 demo: configure
 	cmake --build $(BUILD) -j $(JOBS) --target kairos
-	$(BUILD)/kairos run examples/hard_spheres_3d.toml -o demo-output
+	$(BUILD)/kairos run examples/hard_spheres_3d.toml -o demo-output --overwrite
 
 # The tests need the test binary and the kairos CLI only (kairos_tests depends on it); `make
 # build` or `make bench` compiles the benchmark and validation programs.

@@ -1,6 +1,6 @@
 // The `kairos` command line.
 //
-//   kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE]
+//   kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE] [--overwrite]
 //   kairos steps CONFIG.toml [--set key=value ...] [--temperature KT] [-o DIR]
 //   kairos table build|inspect|plot ...   (cli/table_command.hpp)
 //
@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include <fmt/format.h>
@@ -44,44 +45,73 @@ void install_signal_handlers() {
 
 void print_summary(const kairos::RunOutcome& outcome) {
   const auto& s = outcome.summary;
-  auto num = [&](const char* key) {
-    return s.contains(key) && s[key].is_number() ? s[key].get<double>() : std::nan("");
+  auto number = [](const nlohmann::json& where, const char* key) -> std::optional<double> {
+    if (!where.contains(key) || !where[key].is_number()) return std::nullopt;
+    return where[key].get<double>();
   };
-  const auto& z = s["compressibility"];
-  const double zm = z["mean"].is_number() ? z["mean"].get<double>() : std::nan("");
-  const double ze = z["stderr"].is_number() ? z["stderr"].get<double>() : std::nan("");
-  fmt::print("\nKairos run {} ({})\n", outcome.interrupted ? "stopped early" : "finished",
+  auto num = [&](const char* key) { return number(s, key).value_or(std::nan("")); };
+  // Undefined in this run (null in summary.json): "n/a" and the reason.
+  auto why = [&](const std::string& name) {
+    const auto& u = s.contains("undefined") ? s["undefined"] : nlohmann::json::object();
+    return u.contains(name) ? fmt::format("n/a ({})", u[name].get<std::string>())
+                            : std::string("n/a");
+  };
+  const bool dem = s.value("integrator", "event") == "dem";
+  const bool early = outcome.interrupted || !outcome.error.empty();
+  fmt::print("\nKairos run {} ({})\n", early ? "stopped early" : "finished",
              s["stop_reason"].get<std::string>());
   fmt::print("  particles            {} in {}D, packing fraction {:.6g}\n",
              s["particles"].get<std::uint64_t>(), s["dimension"].get<int>(),
              num("packing_fraction"));
-  fmt::print("  events               {} ({} collisions) in {} wall\n",
+  fmt::print("  {:<20} {} ({} collisions) in {} wall\n", dem ? "time steps" : "events",
              s["events"].get<std::uint64_t>(), s["collisions"].get<std::uint64_t>(),
              kairos::format_duration(num("wall_seconds")));
-  fmt::print("  speed                {:.3g} M events/s, {:.3g} M collisions/s\n",
-             num("events_per_second") / 1e6, num("collisions_per_second") / 1e6);
+  fmt::print("  speed                {:.3g} M {}/s, {:.3g} M collisions/s\n",
+             num("events_per_second") / 1e6, dem ? "steps" : "events",
+             num("collisions_per_second") / 1e6);
   fmt::print("  simulated time       {:.6g}\n", num("sim_time"));
   fmt::print("  temperature          {:.10g}\n", num("temperature"));
-  fmt::print("  compressibility Z    {:.5f} +- {:.5f}\n", zm, ze);
-  fmt::print("  mean free time       {:.6g}\n", num("mean_free_time"));
+  const auto& z = s["compressibility"];
+  if (const auto zm = number(z, "mean")) {
+    const auto ze = number(z, "stderr");
+    fmt::print("  compressibility Z    {:.5f} +- {}\n", *zm,
+               ze ? fmt::format("{:.5f}", *ze) : std::string("n/a"));
+  } else {
+    fmt::print("  compressibility Z    {}\n", why("compressibility"));
+  }
+  if (const auto mft = number(s, "mean_free_time"))
+    fmt::print("  mean free time       {:.6g}\n", *mft);
+  else
+    fmt::print("  mean free time       {}\n", why("mean_free_time"));
   if (s.contains("granular")) {
     const auto& g = s["granular"];
-    auto gnum = [&](const char* key) {
-      return g.contains(key) && g[key].is_number() ? g[key].get<double>() : std::nan("");
-    };
-    fmt::print("  rotational temp.     {:.6g}\n", gnum("rotational_temperature"));
-    fmt::print("  Sonine a2            {:.4f}\n", gnum("sonine_a2"));
-    fmt::print("  dissipated           {:.6g} in collisions, {:.6g} at walls\n",
-               gnum("dissipated_in_collisions"), gnum("dissipated_at_walls"));
-    fmt::print("  work by walls        {:.6g}\n", gnum("work_by_walls"));
-    fmt::print("  energy balance       {:.3g} (rel.)\n", gnum("energy_balance_relative"));
+    auto gnum = [&](const char* key) { return number(g, key).value_or(std::nan("")); };
+    auto flag = [&](const char* key) { return !g.contains(key) || g[key].get<bool>(); };
+    if (flag("rotating"))
+      fmt::print("  rotational temp.     {:.6g}\n", gnum("rotational_temperature"));
+    if (flag("dissipative")) {
+      if (const auto a2 = number(g, "sonine_a2"))
+        fmt::print("  Sonine a2            {:.4f}\n", *a2);
+      fmt::print("  dissipated           {:.6g} in collisions, {:.6g} at walls\n",
+                 gnum("dissipated_in_collisions"), gnum("dissipated_at_walls"));
+    }
+    if (flag("moving_walls")) fmt::print("  work by walls        {:.6g}\n", gnum("work_by_walls"));
+    if (g.value("driven", false))
+      fmt::print("  work by driving      {:.6g} ({} kicks)\n", gnum("work_by_driving"),
+                 g.value("driving_kicks", std::uint64_t{0}));
+    if (const auto balance = number(g, "energy_balance_relative"))
+      fmt::print("  energy balance       {:.3g} (rel.)\n", *balance);
+    else
+      fmt::print("  energy balance       {}\n", why("granular.energy_balance_relative"));
     if (s.contains("shear")) {
       const auto& sh = s["shear"];
       fmt::print("  shear stress P_xy    {:.6g} +- {:.2g} at shear rate {:.6g}\n",
-                 sh["shear_stress"].get<double>(), sh["shear_stress_stderr"].get<double>(),
-                 sh["shear_rate"].get<double>());
-      fmt::print("  viscosity            {:.6g} +- {:.2g}\n", sh["viscosity"].get<double>(),
-                 sh["viscosity_stderr"].get<double>());
+                 number(sh, "shear_stress").value_or(std::nan("")),
+                 number(sh, "shear_stress_stderr").value_or(std::nan("")),
+                 number(sh, "shear_rate").value_or(std::nan("")));
+      fmt::print("  viscosity            {:.6g} +- {:.2g}\n",
+                 number(sh, "viscosity").value_or(std::nan("")),
+                 number(sh, "viscosity_stderr").value_or(std::nan("")));
     }
   } else {
     fmt::print("  energy drift (rel.)  {:.3g}\n", num("energy_drift_relative"));
@@ -89,8 +119,8 @@ void print_summary(const kairos::RunOutcome& outcome) {
   if (s.contains("stepped")) {
     const auto& st = s["stepped"];
     fmt::print("  potential energy/N   {:.6g} +- {:.2g}\n",
-               st["potential_energy_per_particle_mean"].get<double>(),
-               st["potential_energy_per_particle_stderr"].get<double>());
+               number(st, "potential_energy_per_particle_mean").value_or(std::nan("")),
+               number(st, "potential_energy_per_particle_stderr").value_or(std::nan("")));
     fmt::print("  pair events          {} core, {} step crossings, {} step bounces\n",
                st["core_collisions"].get<std::uint64_t>(),
                st["step_crossings"].get<std::uint64_t>(), st["step_bounces"].get<std::uint64_t>());
@@ -107,8 +137,10 @@ void print_summary(const kairos::RunOutcome& outcome) {
   }
   fmt::print("  max overlap          {:.3g}\n", num("max_overlap"));
   fmt::print("  peak memory          {:.1f} MiB\n", num("peak_rss_bytes") / 1048576.0);
-  fmt::print("  outputs              {}/ (summary.json, thermo.tsv, trajectory.gsd, restart.gsd)\n",
-             outcome.directory.string());
+  std::string files;
+  if (s.contains("outputs"))
+    for (const auto& f : s["outputs"]) files += (files.empty() ? "" : ", ") + f.get<std::string>();
+  fmt::print("  outputs              {}/ ({})\n", outcome.directory.string(), files);
 }
 
 // `kairos steps`: the step table of every [[potential]] (per species pair) and [[bond]] of the
@@ -175,7 +207,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("kairos ") + KAIROS_VERSION);
   app.require_subcommand(1);
   app.footer(
-      "Usage of run: kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE]\n"
+      "Usage of run: kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE] "
+      "[--overwrite]\n"
       "Usage of steps: kairos steps CONFIG.toml [--set key=value ...] [--temperature KT] [-o DIR]\n"
       "Usage of table: kairos table build|inspect|plot ... (soft-sphere collision map tables)\n"
       "  -o,--output OUTDIR   output directory (overrides output.directory)\n"
@@ -201,6 +234,10 @@ int main(int argc, char** argv) {
       "equilibration is not repeated (an interrupted one is completed), then "
       "run.collisions_per_particle more collisions per particle (or run.time more simulated "
       "time) are simulated");
+  bool overwrite = false;
+  run->add_flag("--overwrite", overwrite,
+                "A new run (no --restart) may replace the outputs an earlier run left in OUTDIR "
+                "(refused otherwise)");
   run->footer(
       "Outputs in OUTDIR: config.toml, thermo.tsv, trajectory.gsd, restart.gsd, summary.json.\n"
       "SIGINT/SIGTERM stop after the current event and still write every output.");
@@ -264,8 +301,14 @@ int main(int argc, char** argv) {
     install_signal_handlers();
     const std::optional<std::filesystem::path> restart_file =
         restart.empty() ? std::nullopt : std::optional<std::filesystem::path>(restart);
-    const kairos::RunOutcome outcome = kairos::run_simulation(config, restart_file);
+    kairos::RunOptions options;
+    options.overwrite = overwrite;
+    const kairos::RunOutcome outcome = kairos::run_simulation(config, restart_file, options);
     print_summary(outcome);
+    if (!outcome.error.empty()) {
+      std::fprintf(stderr, "kairos: error: %s\n", outcome.error.c_str());
+      return 2;
+    }
     if (outcome.interrupted && g_signal != 0) return 128 + g_signal;
     return 0;
   } catch (const kairos::InputError& e) {

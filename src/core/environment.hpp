@@ -12,6 +12,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -132,6 +133,14 @@ struct Environment {
   bool wall_moves(int f) const {
     const Wall<D>& w = faces[f].wall;
     return faces[f].kind == FaceKind::kWall && (w.velocity[f / 2] != 0.0 || w.vibrates());
+  }
+  // Where the plane of wall face f lies along its axis at time t (box: the box's edges): the
+  // plane of the header comment. The event engine and the outputs read walls through this.
+  double wall_position(int f, const Vec<D>& box, double t) const {
+    const Wall<D>& w = faces[f].wall;
+    double x = f % 2 == 0 ? 0.0 : box[f / 2];
+    if (w.velocity[f / 2] != 0.0) x += w.velocity[f / 2] * t;
+    return w.vibrates() ? x + w.amplitude * std::sin(w.angular_frequency * t + w.phase) : x;
   }
   bool has_walls() const {
     for (const Face<D>& f : faces)

@@ -313,7 +313,11 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
     image_step_ = image_step_at(time_);
     next_image_shift_ = image_shift_time(image_step_);
   }
-  find_squeeze_time(rmax);
+  double particle_volume = 0.0;
+  for (const Kinematics<D>& k : s.kinematics)
+    particle_volume +=
+        D == 3 ? 4.0 / 3.0 * M_PI * k.radius * k.radius * k.radius : M_PI * k.radius * k.radius;
+  find_squeeze_time(rmax, particle_volume);
   if (time_ >= squeeze_time_) throw_squeezed(time_);
   // Shear (sliding images) and steps (zones) keep full scans.
   incremental_crossings_ = options_.incremental_crossings && !stepped_ && !sheared_;
@@ -323,26 +327,40 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
 
 // Relative margin of find_squeeze_time: a lone particle squeezed between approaching walls
 // bounces ever faster (speed times gap is an adiabatic invariant), so the exact limit would take
-// without end to reach; this one is reached after some 1e6 bounces.
-constexpr double kSqueezeMargin = 1e-6;
+// without end to reach; this one is reached after some 1e5 bounces, while its events are still
+// 1e5 ulps of the clock apart (at a margin of 1e-6 the clock froze first, 1e-5 short of it).
+constexpr double kSqueezeMargin = 1e-4;
 
 // The first time at which the walls of an axis, moving towards each other, are no more than the
-// largest diameter (times 1 + kSqueezeMargin) apart, vibration amplitudes counted as if both
-// walls were at their innermost: from then on the largest particle has no room between them.
+// largest diameter (times 1 + kSqueezeMargin) apart, or leave less room between them than the
+// particles' volume at the densest packing, vibration amplitudes counted as if both walls were
+// at their innermost: from then on the particles have no room between them (a gas compressed by
+// a piston jams before that, which the run drivers' frozen-clock watch reports). The densest
+// packing: pi / sqrt 18 for equal spheres (Kepler's conjecture, Hales, Ann. Math. 162, 1065
+// (2005)), pi / sqrt 12 for equal disks (Thue); particles of several sizes can pack denser,
+// so for them the bound is 1 (no room at all).
 template <int D, class Queue>
-void EventEngine<D, Queue>::find_squeeze_time(double rmax) {
+void EventEngine<D, Queue>::find_squeeze_time(double rmax, double particle_volume) {
   squeeze_time_ = kNever;
+  const double densest = !uniform_radius_ ? 1.0
+                         : D == 3         ? M_PI / std::sqrt(18.0)
+                                          : M_PI / std::sqrt(12.0);
   for (int a = 0; a < D; ++a) {
     const Face<D>& lo = env_.faces[2 * a];
     const Face<D>& hi = env_.faces[2 * a + 1];
     if (lo.kind != FaceKind::kWall || hi.kind != FaceKind::kWall) continue;
     const double approach = lo.wall.velocity[a] - hi.wall.velocity[a];
     if (!(approach > 0.0)) continue;
-    const double room =
-        box_[a] - lo.wall.amplitude - hi.wall.amplitude - 2.0 * rmax * (1.0 + kSqueezeMargin);
+    double cross_section = 1.0;
+    for (int b = 0; b < D; ++b)
+      if (b != a) cross_section *= box_[b];
+    const double needed =
+        std::max(2.0 * rmax * (1.0 + kSqueezeMargin), particle_volume / (densest * cross_section));
+    const double room = box_[a] - lo.wall.amplitude - hi.wall.amplitude - needed;
     if (room / approach < squeeze_time_) {
       squeeze_time_ = room / approach;
       squeeze_axis_ = a;
+      squeeze_needed_ = needed;
     }
   }
 }
@@ -362,8 +380,15 @@ void EventEngine<D, Queue>::throw_squeezed(double t) const {
   if (wl.vibrates() || wh.vibrates()) {
     msg << " (their vibrations take up to " << wl.amplitude + wh.amplitude << " of that)";
   }
-  msg << ", no more than the largest particle diameter " << dmax
-      << ": there is no room left between them (";
+  if (squeeze_needed_ > dmax * (1.0 + 2.0 * kSqueezeMargin)) {
+    msg << ", less than the " << squeeze_needed_
+        << " the particles need between them at the densest packing"
+        << (uniform_radius_ ? (D == 3 ? " of equal spheres" : " of equal disks") : "")
+        << ": there is no room left between them (";
+  } else {
+    msg << ", no more than the largest particle diameter " << dmax
+        << ": there is no room left between them (";
+  }
   if (wl.velocity[a] != 0.0 && wh.velocity[a] != 0.0) {
     msg << "the walls " << lo << " and " << hi << " move towards each other";
   } else {
@@ -379,10 +404,7 @@ void EventEngine<D, Queue>::throw_squeezed(double t) const {
 // Position of a wall's plane along its axis at time t.
 template <int D, class Queue>
 double EventEngine<D, Queue>::wall_offset(int face, double t) const {
-  const Wall<D>& w = env_.faces[face].wall;
-  double x = face % 2 == 0 ? 0.0 : box_[face / 2];
-  if (w.velocity[face / 2] != 0.0) x += w.velocity[face / 2] * t;
-  return w.vibrates() ? x + w.amplitude * std::sin(w.angular_frequency * t + w.phase) : x;
+  return env_.wall_position(face, box_, t);
 }
 
 // Along the wall's normal n (into the box: +e_a at the low face, -e_a at the high one) the

@@ -184,6 +184,13 @@ class EventEngine {
   // Velocities at the current time, in the caller's numbering: export_state()'s
   // velocity_at(i, time()) to the bit, without copying the rest of the state.
   std::vector<Vec<D>> current_velocities() const;
+  // Each particle's collision counter (particle and wall collisions; it wraps at 2^32), in the
+  // caller's numbering: which particles took part in the events between two calls.
+  std::vector<std::uint32_t> collision_counts() const {
+    std::vector<std::uint32_t> out(size());
+    for (std::uint32_t i = 0; i < size(); ++i) out[id_[i]] = hot_[i].collisions;
+    return out;
+  }
 
   // Debug: checks cell membership, queue order and the prediction invariant against brute
   // force; throws std::logic_error describing the first violation. O(N^2).
@@ -259,7 +266,7 @@ class EventEngine {
   bool near_face(CellCode c, int f) const;
   void hit_wall(std::uint32_t i, int face, double t);
   // Walls moving towards each other: when they leave no room for the largest particle.
-  void find_squeeze_time(double rmax);
+  void find_squeeze_time(double rmax, double particle_volume);
   [[noreturn]] void throw_squeezed(double t) const;
   // Sleeping particles (gravity with walls): see Environment::sleep_speed.
   bool is_asleep(std::uint32_t i) const { return !asleep_.empty() && asleep_[i] != 0; }
@@ -498,6 +505,7 @@ class EventEngine {
   bool walls_ = false;
   double squeeze_time_ = 0.0;  // see find_squeeze_time: kNever unless walls approach
   int squeeze_axis_ = -1;
+  double squeeze_needed_ = 0.0;          // the room the particles need along squeeze_axis_
   bool bounded_ = false;                 // some axis has walls or open faces
   bool granular_contacts_ = false;       // some contact law is not elastic and smooth
   HugeVector<AngularVelocity<D>> spin_;  // rough particles only

@@ -107,11 +107,12 @@ double box_volume(const std::array<double, D>& box) {
 // and the brute-force search so that both give bit-identical values.
 template <int D>
 double pair_overlap(const std::array<double, D>& box, const std::array<double, D>& a,
-                    const std::array<double, D>& b, double da, double db) {
+                    const std::array<double, D>& b, double da, double db,
+                    const std::array<bool, D>* periodic = nullptr) {
   double r2 = 0.0;
   for (int k = 0; k < D; ++k) {
     double dx = a[k] - b[k];
-    dx = minimum_image(dx, box[k]);
+    if (periodic == nullptr || (*periodic)[k]) dx = minimum_image(dx, box[k]);
     r2 += dx * dx;
   }
   const double sigma = 0.5 * (da + db);
@@ -1140,8 +1141,37 @@ double max_overlap(const std::array<double, D>& box, const std::vector<std::arra
   return worst;
 }
 
+// Along the bounded axes the positions are moved into a box padded by three largest diameters
+// beyond their extent, so that the periodic search sees no pair through the wrap-around (the
+// distance through it is at least 3 d_max): the same pairs and distances as without images.
 template <int D>
-double max_overlap_bruteforce(const std::array<double, D>& box,
+double max_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
+                   const std::vector<std::array<double, D>>& pos,
+                   const std::vector<double>& diameter, std::uint32_t* worst_i,
+                   std::uint32_t* worst_j) {
+  if (std::all_of(periodic.begin(), periodic.end(), [](bool p) { return p; }) || pos.empty())
+    return max_overlap<D>(box, pos, diameter, worst_i, worst_j);
+  double dmax = 0.0;
+  for (const double d : diameter) dmax = std::max(dmax, std::isfinite(d) ? d : 0.0);
+  std::array<double, D> padded = box;
+  std::vector<std::array<double, D>> moved = pos;
+  for (int k = 0; k < D; ++k) {
+    if (periodic[k]) continue;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& x : pos) {
+      lo = std::min(lo, x[k]);
+      hi = std::max(hi, x[k]);
+    }
+    if (!std::isfinite(lo) || !std::isfinite(hi))
+      throw std::invalid_argument("max_overlap: non-finite position");
+    for (auto& x : moved) x[k] = x[k] - lo + dmax;
+    padded[k] = (hi - lo) + 3.0 * dmax + (dmax > 0.0 ? 0.0 : 1.0);
+  }
+  return max_overlap<D>(padded, moved, diameter, worst_i, worst_j);
+}
+
+template <int D>
+double max_overlap_bruteforce(const std::array<double, D>& box, const std::array<bool, D>& periodic,
                               const std::vector<std::array<double, D>>& pos,
                               const std::vector<double>& diameter) {
   if (pos.size() != diameter.size()) {
@@ -1150,10 +1180,20 @@ double max_overlap_bruteforce(const std::array<double, D>& box,
   double worst = 0.0;
   for (std::size_t i = 0; i < pos.size(); ++i) {
     for (std::size_t j = i + 1; j < pos.size(); ++j) {
-      worst = std::max(worst, pair_overlap<D>(box, pos[i], pos[j], diameter[i], diameter[j]));
+      worst = std::max(worst,
+                       pair_overlap<D>(box, pos[i], pos[j], diameter[i], diameter[j], &periodic));
     }
   }
   return worst;
+}
+
+template <int D>
+double max_overlap_bruteforce(const std::array<double, D>& box,
+                              const std::vector<std::array<double, D>>& pos,
+                              const std::vector<double>& diameter) {
+  std::array<bool, D> periodic;
+  periodic.fill(true);
+  return max_overlap_bruteforce<D>(box, periodic, pos, diameter);
 }
 
 #define KAIROS_INSTANTIATE(D)                                                                 \
@@ -1164,9 +1204,15 @@ double max_overlap_bruteforce(const std::array<double, D>& box,
   template double max_overlap<D>(const std::array<double, D>&,                                \
                                  const std::vector<std::array<double, D>>&,                   \
                                  const std::vector<double>&, std::uint32_t*, std::uint32_t*); \
+  template double max_overlap<D>(const std::array<double, D>&, const std::array<bool, D>&,    \
+                                 const std::vector<std::array<double, D>>&,                   \
+                                 const std::vector<double>&, std::uint32_t*, std::uint32_t*); \
   template double max_overlap_bruteforce<D>(const std::array<double, D>&,                     \
                                             const std::vector<std::array<double, D>>&,        \
-                                            const std::vector<double>&);
+                                            const std::vector<double>&);                      \
+  template double max_overlap_bruteforce<D>(                                                  \
+      const std::array<double, D>&, const std::array<bool, D>&,                               \
+      const std::vector<std::array<double, D>>&, const std::vector<double>&);
 
 KAIROS_INSTANTIATE(2)
 KAIROS_INSTANTIATE(3)

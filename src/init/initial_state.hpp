@@ -134,9 +134,23 @@ double max_overlap(const std::array<double, D>& box, const std::vector<std::arra
                    const std::vector<double>& diameter, std::uint32_t* worst_i = nullptr,
                    std::uint32_t* worst_j = nullptr);
 
-// The same by an O(N^2) loop over all pairs: the reference for tests.
+// The same in a box whose axes need not all be periodic (walls or open faces): along an axis
+// with periodic[k] false no minimum image is taken (two particles at opposite faces are far
+// apart), and positions are not wrapped (a grain thrown out of an open top stays where it is).
+template <int D>
+double max_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
+                   const std::vector<std::array<double, D>>& pos,
+                   const std::vector<double>& diameter, std::uint32_t* worst_i = nullptr,
+                   std::uint32_t* worst_j = nullptr);
+
+// The same by an O(N^2) loop over all pairs: the reference for tests (all axes periodic unless
+// `periodic` says otherwise).
 template <int D>
 double max_overlap_bruteforce(const std::array<double, D>& box,
+                              const std::vector<std::array<double, D>>& pos,
+                              const std::vector<double>& diameter);
+template <int D>
+double max_overlap_bruteforce(const std::array<double, D>& box, const std::array<bool, D>& periodic,
                               const std::vector<std::array<double, D>>& pos,
                               const std::vector<double>& diameter);
 

@@ -271,7 +271,7 @@ Writer Writer::create(const std::filesystem::path& path, std::string_view applic
   return Writer(std::move(s));
 }
 
-Writer Writer::open_append(const std::filesystem::path& path) {
+Writer Writer::open_append(const std::filesystem::path& path, std::uint64_t keep_frames) {
   const int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
   if (fd < 0) fail(path, std::string("cannot open for appending: ") + std::strerror(errno));
   auto s = std::make_unique<State>(path, fd);
@@ -283,6 +283,13 @@ Writer Writer::open_append(const std::filesystem::path& path) {
     s->ids.emplace(c.names[i], static_cast<std::uint16_t>(i));
   s->entries = c.index.size();
   s->frames = c.index.empty() ? 0 : c.index.back().frame + 1;
+  if (keep_frames < s->frames) {  // entries are sorted by frame: drop a tail of them
+    s->entries = static_cast<std::uint64_t>(
+        std::find_if(c.index.begin(), c.index.end(),
+                     [&](const Entry& e) { return e.frame >= keep_frames; }) -
+        c.index.begin());
+    s->frames = keep_frames;
+  }
   s->end = c.file_size;
   if (c.used_slots > s->entries) {  // clear the entries of a dropped (torn) frame
     const std::vector<Entry> zeros(c.used_slots - s->entries, Entry{});

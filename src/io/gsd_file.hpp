@@ -76,8 +76,11 @@ class Writer {
   static Writer create(const std::filesystem::path& path, std::string_view application,
                        std::string_view schema = "hoomd",
                        std::uint32_t schema_version = (1u << 16) | 4u);
-  // Opens an existing GSD 2.x file to append frames; InputError if it is not one.
-  static Writer open_append(const std::filesystem::path& path);
+  // Opens an existing GSD 2.x file to append frames; InputError if it is not one. Frames from
+  // `keep_frames` on are dropped first (a run continued from an earlier state: the frames it
+  // had written after that state), their bytes left unreferenced.
+  static Writer open_append(const std::filesystem::path& path,
+                            std::uint64_t keep_frames = ~std::uint64_t{0});
 
   Writer(Writer&&) noexcept;
   Writer& operator=(Writer&&) noexcept;

@@ -431,6 +431,33 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     if (progress.soft_table_max_speed > 0.0) {
       w.write_chunk("kairos/run/soft_table_max_speed", 1, 1, &progress.soft_table_max_speed);
     }
+    if (!progress.config.empty()) {
+      const std::vector<std::int8_t> text(progress.config.begin(), progress.config.end());
+      w.write_chunk("kairos/run/config", text.size(), 1, text.data());
+    }
+    if (progress.thermo_rows >= 0 || progress.trajectory_frames >= 0) {
+      const std::int64_t outputs[2] = {progress.thermo_rows, progress.trajectory_frames};
+      w.write_chunk("kairos/run/outputs", 2, 1, outputs);
+    }
+    if (progress.has_thermo_mark) {
+      const double mark[2] = {progress.mark_time, progress.mark_virial};
+      const std::uint64_t counts[2] = {progress.mark_events, progress.mark_collisions};
+      w.write_chunk("kairos/run/thermo_mark", 2, 1, mark);
+      w.write_chunk("kairos/run/thermo_mark_counts", 2, 1, counts);
+    }
+    if (progress.schedule_phase >= 0) {
+      std::uint64_t schedule[7];
+      schedule[0] = static_cast<std::uint64_t>(progress.schedule_phase);
+      for (int k = 0; k < 3; ++k) {
+        schedule[1 + k] = progress.schedule_step[k];
+        schedule[4 + k] = progress.schedule_next[k];
+      }
+      w.write_chunk("kairos/run/schedule", 7, 1, schedule);
+    }
+    if (progress.production_target > 0)
+      w.write_chunk("kairos/run/production_target", 1, 1, &progress.production_target);
+    if (std::isfinite(progress.production_end_time))
+      w.write_chunk("kairos/run/production_end_time", 1, 1, &progress.production_end_time);
     if (progress.integrator != "event") {
       const std::vector<std::int8_t> name(progress.integrator.begin(), progress.integrator.end());
       w.write_chunk("kairos/run/integrator", name.size(), 1, name.data());
@@ -638,6 +665,45 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
                          std::to_string(v));
       }
       progress->soft_table_max_speed = v;
+    }
+    if (r.find(f, "kairos/run/config")) {
+      const auto text = r.read<std::int8_t>(f, "kairos/run/config");
+      progress->config.assign(text.begin(), text.end());
+    }
+    if (r.find(f, "kairos/run/outputs")) {
+      const auto outputs = require<std::int64_t>(r, f, "kairos/run/outputs", path, 2);
+      progress->thermo_rows = std::max<std::int64_t>(-1, outputs[0]);
+      progress->trajectory_frames = std::max<std::int64_t>(-1, outputs[1]);
+    }
+    if (r.find(f, "kairos/run/thermo_mark")) {
+      const auto mark = require<double>(r, f, "kairos/run/thermo_mark", path, 2);
+      const auto counts = require<std::uint64_t>(r, f, "kairos/run/thermo_mark_counts", path, 2);
+      if (!std::isfinite(mark[0]) || !std::isfinite(mark[1]) || mark[0] > s.time ||
+          counts[1] > s.counters.collisions)
+        throw InputError("'" + path.string() + "': kairos/run/thermo_mark lies after the state");
+      progress->has_thermo_mark = true;
+      progress->mark_time = mark[0];
+      progress->mark_virial = mark[1];
+      progress->mark_events = counts[0];
+      progress->mark_collisions = counts[1];
+    }
+    if (r.find(f, "kairos/run/schedule")) {
+      const auto schedule = require<std::uint64_t>(r, f, "kairos/run/schedule", path, 7);
+      if (schedule[0] > 1) throw InputError("'" + path.string() + "': corrupt kairos/run/schedule");
+      progress->schedule_phase = static_cast<int>(schedule[0]);
+      for (int k = 0; k < 3; ++k) {
+        progress->schedule_step[k] = schedule[1 + k];
+        progress->schedule_next[k] = schedule[4 + k];
+      }
+    }
+    if (r.find(f, "kairos/run/production_target"))
+      progress->production_target =
+          require<std::uint64_t>(r, f, "kairos/run/production_target", path, 1)[0];
+    if (r.find(f, "kairos/run/production_end_time")) {
+      progress->production_end_time =
+          require<double>(r, f, "kairos/run/production_end_time", path, 1)[0];
+      if (!std::isfinite(progress->production_end_time))
+        throw InputError("'" + path.string() + "': kairos/run/production_end_time is not finite");
     }
     if (r.find(f, "kairos/run/integrator")) {
       const auto name = r.read<std::int8_t>(f, "kairos/run/integrator");

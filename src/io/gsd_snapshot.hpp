@@ -26,6 +26,7 @@
 // Format 4 files are read with no soft contacts.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -64,6 +65,26 @@ struct RunProgress {
   // Soft spheres: the fastest normal impact speed the run's map tables cover (0: no tables), so
   // that a continued run uses the same tables (and stays bit-identical).
   double soft_table_max_speed = 0.0;
+  // The configuration the state was run under (to_toml; kairos/run/config), so that a continued
+  // run knows which of its keys changed (run/restart_plan.hpp). Empty: not recorded (older files).
+  std::string config;
+  // The run's outputs up to this state (kairos/run/outputs), so that a run continued into the
+  // same directory leaves them as one uninterrupted run would: rows and frames written after
+  // this state (before an interruption) are dropped. -1: not recorded.
+  std::int64_t thermo_rows = -1, trajectory_frames = -1;
+  // The point the next thermo row is measured from (the last kept row's; kairos/run/thermo_mark).
+  bool has_thermo_mark = false;
+  double mark_time = 0.0, mark_virial = 0.0;
+  std::uint64_t mark_events = 0, mark_collisions = 0;
+  // Output schedules in collisions (kairos/run/schedule) of the phase the state is in (0:
+  // equilibration, 1: production, -1: not recorded): thermo, trajectory, restart; a step of 0:
+  // not scheduled. A continued run in that phase with the same steps keeps them.
+  int schedule_phase = -1;
+  std::array<std::uint64_t, 3> schedule_step{}, schedule_next{};
+  // An unfinished production (kairos/run/production_end): the collision count (0: none) or
+  // the time (NaN: none) it was to end at; a continued run completes it.
+  std::uint64_t production_target = 0;
+  double production_end_time = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Writes the restart file atomically (temporary file + rename).

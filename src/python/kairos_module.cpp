@@ -212,26 +212,31 @@ PYBIND11_MODULE(kairos, m) {
   m.def(
       "run",
       [](const py::object& config, std::optional<fs::path> output, const py::object& set,
-         std::optional<fs::path> restart) {
+         std::optional<fs::path> restart, bool overwrite) {
         kairos::Config c = kairos::config_from(config, set);
         if (output) c.output.directory = output->string();
         const kairos::RunOutcome outcome = [&] {
           kairos::SigintStopsRun sigint;
           py::gil_scoped_release release;  // the run is C++ throughout
-          return kairos::run_simulation(c, restart);
+          kairos::RunOptions options;
+          options.overwrite = overwrite;
+          return kairos::run_simulation(c, restart, options);
         }();
         if (outcome.summary.value("stop_reason", "") == "signal") {
           // Ctrl-C: the outputs are written (summary.json says "signal"); Python's way is this.
           PyErr_SetNone(PyExc_KeyboardInterrupt);
           throw py::error_already_set();
         }
+        // A run that could not go on (a frozen clock...): outputs written, the reason raised.
+        if (!outcome.error.empty()) throw kairos::InputError(outcome.error);
         return py::module_::import("json").attr("loads")(outcome.summary.dump());
       },
       py::arg("config"), py::arg("output") = py::none(), py::arg("set") = py::none(),
-      py::arg("restart") = py::none(),
+      py::arg("restart") = py::none(), py::arg("overwrite") = false,
       "Runs a simulation as `kairos run` does (config: a TOML file's path, or TOML text; set: "
       "'key=value' overrides; output: the output directory; restart: a restart file to "
-      "continue). Writes the usual output files and returns summary.json as a dict. Ctrl-C "
+      "continue; overwrite: replace an earlier run's outputs in the directory). Writes the usual "
+      "output files and returns summary.json as a dict. Ctrl-C "
       "stops the run cleanly (every output written) and raises KeyboardInterrupt.");
 
   py::class_<PySimulation>(m, "Simulation",

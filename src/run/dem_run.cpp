@@ -43,13 +43,21 @@ using Clock = std::chrono::steady_clock;
 template <int D>
 class DemRunDriver {
  public:
-  DemRunDriver(const Config& config, const std::optional<fs::path>& restart_file)
+  DemRunDriver(const Config& config, const std::optional<fs::path>& restart_file,
+               const RunOptions& run_options)
       : config_(config),
         restart_(restart_file.has_value()),
         restart_name_(restart_file ? restart_file->string() : ""),
-        rng_(config.system.seed) {
+        rng_(config.system.seed),
+        restart_file_(restart_file) {
     ParticleSystem<D> start = build_start_state<D>(config, restart_file, rng_, resumed_);
     check_restart_integrator(restart_file, resumed_, "dem");
+    if (restart_file) {
+      // New physics: the integrator starts afresh from the restored state (its lists and
+      // tangential springs dropped).
+      plan_ = plan_continuation<D>(config, start, resumed_, restart_name_);
+      config_ = plan_->used;
+    }
     n_ = start.size();
     base_events_ = start.counters.events;
     volume_ = 1.0;
@@ -61,40 +69,76 @@ class DemRunDriver {
     thermo_stats_.emplace(D, n_, volume_);
     DemOptions options;
     // A continued run keeps its time step unless run.time_step sets one.
-    options.dt = config.run.time_step > 0.0 ? config.run.time_step
-                 : restart_                 ? resumed_.dem_time_step
-                                            : 0.0;
+    options.dt = config_.run.time_step > 0.0 ? config_.run.time_step
+                 : restart_                  ? resumed_.dem_time_step
+                                             : 0.0;
     try {
-      const Environment<D> env = make_environment<D>(config, start);
+      const Environment<D> env = make_environment<D>(config_, start);
       const auto damped = [](const SoftContactLaw& law) { return law.damping > 0.0; };
       // Walls and gravity, like damping, make the energy budget worth reporting.
       const auto rough = [](const SoftFriction& f) { return f.coefficient > 0.0; };
       granular_ = std::any_of(env.soft.begin(), env.soft.end(), damped) ||
                   std::any_of(env.soft_friction.begin(), env.soft_friction.end(), rough) ||
                   env.has_walls() || env.has_gravity();
+      gravity_ = env.has_gravity();
+      bulk_ = !gravity_ && !env.has_walls();
+      dissipative_ = std::any_of(env.soft.begin(), env.soft.end(), damped);
+      rotating_ = std::any_of(env.soft_friction.begin(), env.soft_friction.end(), rough);
+      for (int f = 0; f < 2 * D; ++f)
+        moving_walls_ =
+            moving_walls_ || (env.faces[f].kind == FaceKind::kWall &&
+                              (env.wall_moves(f) || norm2(env.faces[f].wall.velocity) > 0.0));
       dem_.emplace(start, env, options);
     } catch (const InputError& e) {
       if (!restart_file) throw;
       throw InputError("restart file '" + restart_file->string() + "': " + e.what());
     }
-    if (!config.output.profile_axis.empty()) {
-      const int axis = config.output.profile_axis[0] - 'x';
+    if (!config_.output.profile_axis.empty()) {
+      const int axis = config_.output.profile_axis[0] - 'x';
       double cross = 1.0;
       for (int a = 0; a < D; ++a)
         if (a != axis) cross *= start.box[a];
-      profile_.emplace(axis, static_cast<int>(config.output.profile_bins), 0.0, start.box[axis],
+      profile_.emplace(axis, static_cast<int>(config_.output.profile_bins), 0.0, start.box[axis],
                        cross);
     }
-    timed_ =
-        config.run.time > 0.0 || config.run.equilibration_time >= 0.0 || intervals_in_time(config);
-    dir_ = prepare_output_directory(config);
+    timed_ = config_.run.time > 0.0 || config_.run.equilibration_time >= 0.0 ||
+             intervals_in_time(config_);
+    double mass = 0.0;
+    for (const double m : start.mass) mass += m;
+    check_collisions_happen(mass);
+    if (plan_) print_restart_note(*plan_, restart_name_);
+    out_dir_.emplace(prepare_output_directory(config_, restart_, run_options));
+    dir_ = out_dir_->path();
+  }
+
+  // As the event driver's: phases in collisions in a system that hardly collides refused, here
+  // by the time steps a collision would take.
+  void check_collisions_happen(double total_mass) const {
+    if (gravity_) return;
+    const PhaseLength eq = restart_ ? resumed_equilibration(config_.run, resumed_, restart_name_)
+                                    : equilibration_length(config_.run);
+    double collisions = 0.0;
+    for (const PhaseLength& p : {eq, production_length(config_.run)})
+      if (!p.in_time && p.value > 0.0) collisions += static_cast<double>(collisions_for(p.value));
+    if (collisions == 0.0) return;
+    const auto n = static_cast<double>(n_);
+    const FlightEstimate flight =
+        estimate_flight<D>(n, volume_, mean_volume_diameter<D>(particle_volume_, n),
+                           std::sqrt(2.0 * dem_->kinetic_energy() / total_mass));
+    check_collisions_can_happen(1.0 + flight.mean_free_time / dem_->dt(), collisions, flight,
+                                "time steps");
   }
 
   RunOutcome run() {
     const auto wall_start = Clock::now();
-    thermo_.emplace(dir_ / "thermo.tsv", restart_);
-    if (config_.output.trajectory)
-      open_trajectory<D>(trajectory_, dir_, restart_, n_, [&] { return dem_->export_state(); });
+    continuation_ = output_continuation(restart_file_, dir_, resumed_);
+    thermo_.emplace(dir_ / "thermo.tsv", restart_, continuation_.thermo_rows);
+    rows_kept_ = thermo_->rows();
+    if (config_.output.trajectory) {
+      open_trajectory<D>(trajectory_, dir_, restart_, n_, continuation_.trajectory_frames,
+                         [&] { return dem_->export_state(); });
+      frames_kept_ = trajectory_->frame_count();
+    }
     ke_start_ = dem_->kinetic_energy();
     energy_start_ = total_energy();
     dissipated_start_ = dem_->dissipated_energy();
@@ -102,7 +146,11 @@ class DemRunDriver {
     work_walls_start_ = dem_->work_by_walls();
     p_start_ = dem_->momentum();
     collisions_start_ = dem_->collisions();
-    thermo_stats_->mark(point());
+    kept_mark_ = continuation_.same_directory && resumed_.has_thermo_mark
+                     ? ThermoPoint{resumed_.mark_time, resumed_.mark_virial, resumed_.mark_events,
+                                   resumed_.mark_collisions}
+                     : point();
+    thermo_stats_->mark(kept_mark_);
     ProgressLine progress(config_.output.progress);
 
     const PhaseLength eq = restart_ ? resumed_equilibration(config_.run, resumed_, restart_name_)
@@ -110,28 +158,43 @@ class DemRunDriver {
     bool stopped = false;
     if (eq.value > 0.0) {
       stopped = run_phase("equilibration", eq, progress, wall_start);
-      if (row_pending()) write_thermo_row("equilibration");
+      if (row_pending())
+        outputs_.attempt("thermo.tsv", [&] { write_thermo_row("equilibration", !stopped); });
     }
     prod_start_ = point();
     prod_ke_ = dem_->kinetic_energy();
-    if (!stopped)
-      stopped = run_phase("production", production_length(config_.run), progress, wall_start);
-    progress.finish();
-    if (row_pending()) write_thermo_row(phase_);
-    const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
-
-    if (trajectory_) {
-      if (frame_steps_ != dem_->steps())
-        append_trajectory_frame(*trajectory_, dem_->export_state());
-      trajectory_->close();
+    if (!stopped) {
+      const PhaseLength production =
+          restart_
+              ? continued_production(config_.run, resumed_, plan_, dem_->time(), dem_->collisions())
+              : production_length(config_.run);
+      stopped = run_phase("production", production, progress, wall_start);
+      production_done_ = !stopped;
     }
+    progress.finish();
+    const bool kept = !stopped;
+    if (row_pending()) outputs_.attempt("thermo.tsv", [&] { write_thermo_row(phase_, kept); });
+    if (trajectory_) {
+      outputs_.attempt("trajectory.gsd", [&] {
+        if (frame_steps_ != dem_->steps()) write_trajectory_frame(kept);
+        trajectory_->close();
+      });
+    }
+    outputs_.attempt("restart.gsd", [&] { write_restart_file(); });
+    if (profile_) outputs_.attempt("profile.tsv", [&] { profile_->write(dir_ / "profile.tsv"); });
+    const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
+    if (outputs_.any() && (stop_reason_ == "completed" || stop_reason_ == "signal"))
+      stop_reason_ = "write_failed";
     RunOutcome outcome;
     outcome.directory = dir_;
-    outcome.interrupted = stopped;
+    outcome.interrupted = stopped && !outputs_.any();
+    outcome.error = outputs_.error;
     outcome.summary = summary(wall);
-    write_restart_file();
-    if (profile_) profile_->write(dir_ / "profile.tsv");
-    write_text_atomically(dir_ / "summary.json", outcome.summary.dump(2) + "\n");
+    outcome.summary["outputs"] = outputs_present(dir_);
+    outputs_.attempt("summary.json", [&] {
+      write_text_atomically(dir_ / "summary.json", outcome.summary.dump(2) + "\n");
+    });
+    outcome.error = outputs_.error;
     return outcome;
   }
 
@@ -167,6 +230,29 @@ class DemRunDriver {
       p.equilibration_remaining = per_particle(equilibration_target_ - c);
     }
     p.integrator = "dem";
+    p.config = to_toml(config_);
+    p.thermo_rows = static_cast<std::int64_t>(rows_kept_);
+    p.trajectory_frames = trajectory_ ? static_cast<std::int64_t>(frames_kept_) : -1;
+    p.has_thermo_mark = true;
+    p.mark_time = kept_mark_.time;
+    p.mark_virial = kept_mark_.virial;
+    p.mark_events = kept_mark_.events;
+    p.mark_collisions = kept_mark_.collisions;
+    if (schedule_ != nullptr) {
+      p.schedule_phase = phase_ == "production" ? 1 : 0;
+      const OutputSchedule::Every* e[3] = {&schedule_->thermo, &schedule_->trajectory,
+                                           &schedule_->restart};
+      for (int k = 0; k < 3; ++k) {
+        p.schedule_step[k] = e[k]->step;
+        p.schedule_next[k] = e[k]->next;
+      }
+    }
+    if (phase_ == "production" && !production_done_) {
+      if (std::isfinite(phase_end_time_))
+        p.production_end_time = phase_end_time_;
+      else
+        p.production_target = phase_target_;
+    }
     p.dem_time_step = dem_->dt();
     // A completed phase ends at its target (the count may have passed it within the last step).
     p.dem_collision_mark = c >= phase_target_ ? phase_target_ : c;
@@ -185,9 +271,12 @@ class DemRunDriver {
     return dem_->collisions() > thermo_stats_->last().collisions ||
            (timed_ && dem_->time() > thermo_stats_->last().time);
   }
-  void write_trajectory_frame() {
+  // kept: the frame (row) belongs to the run as an uninterrupted one writes it (not the last
+  // of a run stopped early).
+  void write_trajectory_frame(bool kept = true) {
     append_trajectory_frame(*trajectory_, dem_->export_state());
     frame_steps_ = dem_->steps();
+    if (kept) frames_kept_ = trajectory_->frame_count();
   }
 
   // Steps until `length` more collisions per particle or simulated time (then to the first
@@ -209,9 +298,12 @@ class DemRunDriver {
     if (restart_ && first_phase_ && resumed_.dem_time_mark <= begin_time &&
         resumed_.dem_time_mark > begin_time - dem_->dt())
       begin_time = resumed_.dem_time_mark;
+    const bool first = first_phase_;
     first_phase_ = false;
-    const std::uint64_t target =
-        length.in_time ? ~std::uint64_t{0} : begin + collisions_for(length.value);
+    const std::uint64_t target = length.in_time      ? ~std::uint64_t{0}
+                                 : length.target > 0 ? length.target
+                                                     : begin + collisions_for(length.value);
+    if (length.target > 0) length.value = per_particle(target > begin ? target - begin : 0);
     const double end_time = !length.in_time             ? std::numeric_limits<double>::quiet_NaN()
                             : std::isfinite(length.end) ? length.end
                                                         : begin_time + length.value;
@@ -224,6 +316,18 @@ class DemRunDriver {
     const bool time_outputs = intervals_in_time(config_);
     auto [schedule, timed] =
         phase_schedules(config_, begin, begin_time, [&](double c) { return collisions_for(c); });
+    if (restart_ && first && resumed_.schedule_phase == (phase == "production" ? 1 : 0)) {
+      OutputSchedule::Every* e[3] = {&schedule.thermo, &schedule.trajectory, &schedule.restart};
+      for (int k = 0; k < 3; ++k)
+        if (e[k]->step > 0 && e[k]->step == resumed_.schedule_step[k] &&
+            resumed_.schedule_next[k] > begin)
+          e[k]->next = resumed_.schedule_next[k];
+    }
+    schedule_ = &schedule;
+    struct Forget {  // the schedule lives in this phase only
+      const OutputSchedule*& s;
+      ~Forget() { s = nullptr; }
+    } forget{schedule_};
     // About 2^20 particle-steps between checks of the clock and the stop flag.
     const long chunk =
         std::max<long>(1, (1l << 20) / static_cast<long>(std::max<std::size_t>(1, n_)));
@@ -258,10 +362,19 @@ class DemRunDriver {
         break;
       }
       const double t = dem_->time() + 1e-9 * dem_->dt();  // as reached()
-      if (schedule.thermo.due(c) || timed.thermo.due(t)) write_thermo_row(phase);
-      if ((schedule.trajectory.due(c) || timed.trajectory.due(t)) && trajectory_)
-        write_trajectory_frame();
-      if (schedule.restart.due(c) || timed.restart.due(t)) write_restart_file();
+      const auto failed = [&] {
+        stop_reason_ = "write_failed";
+        return true;
+      };
+      if ((schedule.thermo.due(c) || timed.thermo.due(t)) &&
+          !outputs_.attempt("thermo.tsv", [&] { write_thermo_row(phase); }))
+        return failed();
+      if ((schedule.trajectory.due(c) || timed.trajectory.due(t)) && trajectory_ &&
+          !outputs_.attempt("trajectory.gsd", [&] { write_trajectory_frame(); }))
+        return failed();
+      if ((schedule.restart.due(c) || timed.restart.due(t)) &&
+          !outputs_.attempt("restart.gsd", [&] { write_restart_file(); }))
+        return failed();
       if (stop_requested()) {
         stop_reason_ = "signal";
         return true;
@@ -280,7 +393,7 @@ class DemRunDriver {
     return false;
   }
 
-  void write_thermo_row(const std::string& phase) {
+  void write_thermo_row(const std::string& phase, bool kept = true) {
     const double ke = dem_->kinetic_energy();
     const ThermoRow row = thermo_stats_->row(point(), ke, phase == "production");
     if (phase == "production") {
@@ -291,6 +404,10 @@ class DemRunDriver {
         phase, row,
         {rotational_temperature(), dem_->dissipated_energy() + dem_->dissipated_at_walls(),
          dem_->work_by_walls(), dem_->potential_energy()});
+    if (kept) {
+      rows_kept_ = thermo_->rows();
+      kept_mark_ = row.at;
+    }
   }
 
   void sample_profile() {
@@ -368,15 +485,17 @@ class DemRunDriver {
     j["packing_fraction"] = particle_volume_ / volume_;
     j["number_density"] = static_cast<double>(n_) / volume_;
     j["restarted"] = restart_;
+    if (plan_) j["restart"] = restart_summary(*plan_);
     j["stop_reason"] = stop_reason_;
+    if (outputs_.any()) j["error"] = outputs_.error;
     // "events" are time steps.
     add_run_totals(j,
                    {steps, collisions, coll_prod, dem_->time(), t_prod, wall,
                     per_particle(coll_prod), kT, ke, kT_prod, z_mean},
-                   th);
+                   th, bulk_);
     j["energy_drift_relative"] = ke_start_ > 0 ? std::abs(energy - energy_start_) / ke_start_ : 0.0;
     j["momentum_drift"] = pscale > 0 ? std::sqrt(dp2) / pscale : 0.0;
-    j["max_overlap"] = max_overlap<D>(state.box, x, diameters);
+    j["max_overlap"] = max_overlap<D>(state.box, state.periodic, x, diameters);
     j["peak_rss_bytes"] = peak_rss_bytes();
     nlohmann::json d;
     d["time_step"] = dem_->dt();
@@ -404,15 +523,29 @@ class DemRunDriver {
     const double scale =
         std::max({std::abs(energy_start_), dissipated + at_walls, std::abs(by_walls)});
     nlohmann::json g;
+    g["rotating"] = rotating_;
+    g["dissipative"] = dissipative_;
+    g["moving_walls"] = moving_walls_;
+    g["driven"] = false;
     g["rotational_temperature"] = rotational_temperature();
-    g["sonine_a2"] = sonine_a2();
+    const double a2 = sonine_a2();
+    set_or_explain(j, g, "sonine_a2", a2,
+                   !bulk_               ? "walls, open faces or a field: the gas is not homogeneous"
+                   : !std::isfinite(a2) ? "every particle at rest"
+                                        : "",
+                   "granular.sonine_a2");
     g["dissipated_in_collisions"] = dissipated;
     g["dissipated_at_walls"] = at_walls;
     g["work_by_walls"] = by_walls;
     g["wall_collisions"] = dem_->wall_collisions();
     g["energy_start"] = energy_start_;
     g["energy_end"] = energy;
-    g["energy_balance_relative"] = scale > 0.0 ? std::abs(energy - energy_start_) / scale : 0.0;
+    set_or_explain(j, g, "energy_balance_relative",
+                   scale > 0.0 ? std::abs(energy - energy_start_) / scale : 0.0,
+                   std::isfinite(energy)
+                       ? ""
+                       : "gravity along a periodic axis: the potential energy is unbounded",
+                   "granular.energy_balance_relative");
     j["granular"] = g;
     return j;
   }
@@ -422,10 +555,23 @@ class DemRunDriver {
   std::string restart_name_;  // the restart file continued, for messages
   std::mt19937_64 rng_;
   RunProgress resumed_;
+  std::optional<RestartPlan> plan_;  // a restart: how it used the changed configuration
+  std::optional<fs::path> restart_file_;
+  std::optional<OutputDirectory> out_dir_;  // claimed (locked) while the run lasts
+  OutputContinuation continuation_;
+  OutputFailures outputs_;
+  // As the event driver's (run/run.cpp).
+  std::uint64_t rows_kept_ = 0, frames_kept_ = 0;
+  ThermoPoint kept_mark_;
+  const OutputSchedule* schedule_ = nullptr;
+  bool production_done_ = false;
   std::optional<DemIntegrator<D>> dem_;
   std::size_t n_ = 0;
   double volume_ = 1.0, particle_volume_ = 0.0;
   bool granular_ = false;  // damping, walls or gravity: report the energy budget
+  bool gravity_ = false;
+  bool bulk_ = true;  // periodic without a field: Z, P and a2 are bulk values
+  bool rotating_ = false, dissipative_ = false, moving_walls_ = false;  // granular lines shown
   fs::path dir_;
   std::optional<ThermoWriter> thermo_;
   std::optional<gsd::Writer> trajectory_;
@@ -454,11 +600,12 @@ class DemRunDriver {
 }  // namespace
 
 template <int D>
-RunOutcome run_dem(const Config& config, const std::optional<fs::path>& restart_file) {
-  return DemRunDriver<D>(config, restart_file).run();
+RunOutcome run_dem(const Config& config, const std::optional<fs::path>& restart_file,
+                   const RunOptions& options) {
+  return DemRunDriver<D>(config, restart_file, options).run();
 }
 
-template RunOutcome run_dem<2>(const Config&, const std::optional<fs::path>&);
-template RunOutcome run_dem<3>(const Config&, const std::optional<fs::path>&);
+template RunOutcome run_dem<2>(const Config&, const std::optional<fs::path>&, const RunOptions&);
+template RunOutcome run_dem<3>(const Config&, const std::optional<fs::path>&, const RunOptions&);
 
 }  // namespace kairos::run_detail

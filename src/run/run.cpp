@@ -19,6 +19,7 @@
 #include "io/gsd_snapshot.hpp"
 #include "io/progress.hpp"
 #include "run/environment_setup.hpp"
+#include "run/frozen_clock.hpp"
 #include "run/run_support.hpp"
 #include "run/soft_tables_setup.hpp"
 #include "scheduler/binary_heap_queue.hpp"
@@ -35,8 +36,25 @@ static_assert(std::atomic<bool>::is_always_lock_free);
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+// The axes with a wall or an open face (not periodic) in the config.
 template <int D>
-void check_no_overlap(const InitialState<D>& init, const std::string& source) {
+std::array<bool, D> periodic_axes(const Config& config) {
+  std::array<bool, D> periodic;
+  periodic.fill(true);
+  const auto bound = [&](const std::string& face) {
+    if (face.size() == 2 && face[0] - 'x' < D) periodic[face[0] - 'x'] = false;
+  };
+  for (const WallConfig& w : config.boundary.walls) bound(w.face);
+  for (const std::string& f : config.boundary.open) bound(f);
+  return periodic;
+}
+
+// No pair overlaps by more than round-off. `exact`: float64 positions from a Kairos file, whose
+// last event may have left a pair in contact to within round-off (relative 1e-12 of the contact
+// distance): a contact, not an overlap.
+template <int D>
+void check_no_overlap(const InitialState<D>& init, const std::array<bool, D>& periodic,
+                      const std::string& source, bool exact = false) {
   for (int a = 0; a < D; ++a) {
     if (!std::isfinite(init.box[a]) || !(init.box[a] > 0.0)) {
       throw InputError(
@@ -46,8 +64,11 @@ void check_no_overlap(const InitialState<D>& init, const std::string& source) {
     }
   }
   std::uint32_t i = 0, j = 0;
-  const double worst = max_overlap<D>(init.box, init.position, init.diameter, &i, &j);
-  if (worst > 0.0) {
+  const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, &i, &j);
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const double d : init.diameter) smallest = std::min(smallest, d);
+  const double round_off = exact ? 1e-12 * smallest : 0.0;
+  if (worst > round_off) {
     throw InputError(
         fmt::format("{}: particles {} and {} overlap by {:.6g} (hard particles must "
                     "not overlap)",
@@ -62,7 +83,7 @@ void check_no_overlap(const InitialState<D>& init, const std::string& source) {
 // them: every distance grows by that factor, the packing fraction shrinks by ~1e-7 relative, less
 // than the file's precision. Larger overlaps are left for check_no_overlap to report.
 template <int D>
-void expand_away_rounding_overlaps(InitialState<D>& init) {
+void expand_away_rounding_overlaps(InitialState<D>& init, const std::array<bool, D>& periodic) {
   double edge = 0.0;
   for (int a = 0; a < D; ++a) edge = std::max(edge, init.box[a]);
   double smallest = std::numeric_limits<double>::infinity();
@@ -70,7 +91,7 @@ void expand_away_rounding_overlaps(InitialState<D>& init) {
   const double tolerance =
       std::min(8.0 * std::numeric_limits<float>::epsilon() * edge, 1e-3 * smallest);
   for (int attempt = 0; attempt < 8; ++attempt) {
-    const double worst = max_overlap<D>(init.box, init.position, init.diameter);
+    const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter);
     if (worst == 0.0 || worst > tolerance) return;
     // Every overlapping pair has r >= sigma - worst with sigma >= smallest.
     const double factor =
@@ -109,40 +130,14 @@ template <int D>
 void make_room_for_walls(const Config& config, InitialState<D>& init) {
   double dmax = 0.0;
   for (const double d : init.diameter) dmax = std::max(dmax, d);
-  std::array<bool, D> bounded{};
-  for (const WallConfig& w : config.boundary.walls)
-    if (w.face.size() == 2 && w.face[0] - 'x' < D) bounded[w.face[0] - 'x'] = true;
-  for (const std::string& f : config.boundary.open)
-    if (f.size() == 2 && f[0] - 'x' < D) bounded[f[0] - 'x'] = true;
+  const std::array<bool, D> periodic = periodic_axes<D>(config);
   for (int a = 0; a < D; ++a) {
-    if (!bounded[a]) continue;
+    if (periodic[a]) continue;
     init.box[a] += dmax;
     for (auto& x : init.position) x[a] += 0.5 * dmax;
   }
   for (int a = 0; a < D && a < static_cast<int>(config.system.box_scale.size()); ++a)
     init.box[a] *= config.system.box_scale[a];
-}
-
-// max_overlap() under Lees-Edwards shear: the particles within the largest diameter of the low
-// y face are copied above the box as their images (displaced along x by `offset`), in a box
-// tall enough that nothing else wraps around along y.
-template <int D>
-double max_overlap_sheared(const Vec<D>& box, std::vector<Vec<D>> x, std::vector<double> diameter,
-                           double offset) {
-  const double dmax = *std::max_element(diameter.begin(), diameter.end());
-  const std::size_t n = x.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    x[i][1] = wrap_into_box(x[i][1], box[1]);
-    if (x[i][1] >= dmax) continue;
-    Vec<D> image = x[i];
-    image[0] = wrap_into_box(image[0] + offset, box[0]);
-    image[1] += box[1];
-    x.push_back(image);
-    diameter.push_back(diameter[i]);
-  }
-  Vec<D> tall = box;
-  tall[1] += 3.0 * dmax;
-  return max_overlap<D>(tall, x, diameter);
 }
 
 // Velocities drawn from the temperature are peculiar: under Lees-Edwards shear the mean flow
@@ -171,9 +166,7 @@ ParticleSystem<D> build_start_state(const Config& config,
     if (!fs::exists(*restart_file)) {
       throw InputError("restart file '" + restart_file->string() + "' does not exist");
     }
-    ParticleSystem<D> s = read_restart<D>(*restart_file, rng, &progress);
-    note_ignored_system_keys(config, s.size(), "the restart file");
-    return s;
+    return read_restart<D>(*restart_file, rng, &progress);  // plan_continuation says the rest
   }
   if (!config.system.initial_state.empty()) {
     const fs::path path = config.system.initial_state;
@@ -182,8 +175,10 @@ ParticleSystem<D> build_start_state(const Config& config,
     }
     bool has_velocities = false;
     InitialState<D> init = read_initial_state<D>(path, has_velocities);
-    if (!holds_exact_positions(path)) expand_away_rounding_overlaps(init);
-    check_no_overlap(init, "system.initial_state '" + path.string() + "'");
+    const std::array<bool, D> periodic = periodic_axes<D>(config);
+    const bool exact = holds_exact_positions(path);
+    if (!exact) expand_away_rounding_overlaps<D>(init, periodic);
+    check_no_overlap<D>(init, periodic, "system.initial_state '" + path.string() + "'", exact);
     note_ignored_system_keys(config, init.position.size(), "system.initial_state");
     if (!has_velocities) {
       assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
@@ -192,7 +187,9 @@ ParticleSystem<D> build_start_state(const Config& config,
     return to_particle_system<D>(init);
   }
   InitialState<D> init = make_initial_state<D>(config.system, rng);
-  check_no_overlap(init, "generated initial state");
+  std::array<bool, D> periodic;
+  periodic.fill(true);  // generated in a periodic box; make_room_for_walls then adds the gaps
+  check_no_overlap<D>(init, periodic, "generated initial state");
   make_room_for_walls(config, init);
   add_shear_flow(config, init);
   return to_particle_system<D>(init);
@@ -218,13 +215,20 @@ using run_detail::TimeSchedule;
 template <int D, class Queue>
 class RunDriver {
  public:
-  RunDriver(const Config& config, const std::optional<fs::path>& restart_file)
+  RunDriver(const Config& config, const std::optional<fs::path>& restart_file,
+            const RunOptions& run_options)
       : config_(config),
         restart_(restart_file.has_value()),
         restart_name_(restart_file ? restart_file->string() : ""),
-        rng_(config.system.seed) {
+        rng_(config.system.seed),
+        restart_file_(restart_file) {
     ParticleSystem<D> start = build_start_state<D>(config, restart_file, rng_, resumed_);
     run_detail::check_restart_integrator(restart_file, resumed_, "event");
+    if (restart_file) {
+      plan_ = run_detail::plan_continuation<D>(config, start, resumed_, restart_name_);
+      config_ = plan_->used;
+    }
+    const bool resume = restart_ && !plan_->repredict;
     n_ = start.size();
     mass_ = start.mass;
     volume_ = 1.0;
@@ -236,41 +240,67 @@ class RunDriver {
     }
     thermo_stats_.emplace(D, n_, volume_);
     try {
-      Environment<D> environment = make_environment<D>(config, start);
-      if (environment.soft_spheres() && config.soft.tables) attach_tables(environment, start);
+      Environment<D> environment = make_environment<D>(config_, start);
+      if (environment.soft_spheres() && config_.soft.tables) attach_tables(environment, start);
       EngineOptions options;
-      options.defer_soft_releases = config.soft.defer_releases;
-      engine_.emplace(std::move(start), restart_ ? StartMode::kResume : StartMode::kPredict,
-                      options, environment);
-      driven_ = config.driving.kind != "none";
-      timed_ = config.run.time > 0.0 || config.run.equilibration_time >= 0.0 ||
-               run_detail::intervals_in_time(config);
+      options.defer_soft_releases = config_.soft.defer_releases;
+      engine_.emplace(std::move(start), resume ? StartMode::kResume : StartMode::kPredict, options,
+                      environment);
+      if (restart_ && !resume) run_detail::check_no_overlap_after_new_physics(*engine_);
+      driven_ = config_.driving.kind != "none";
+      timed_ = config_.run.time > 0.0 || config_.run.equilibration_time >= 0.0 ||
+               run_detail::intervals_in_time(config_);
       granular_ = !environment.plain() || environment.has_gravity() || driven_ ||
                   environment.sheared() || environment.soft_spheres() ||
                   environment.dissipative_steps();
       sheared_ = environment.sheared();
       for (int a = 0; a < D; ++a) granular_ = granular_ || !environment.periodic(a);
+      bulk_ = !environment.has_gravity();
+      for (int a = 0; a < D; ++a) bulk_ = bulk_ && environment.periodic(a);
+      rotating_ = environment.rotates() || engine_->rotational_energy() > 0.0;
+      dissipative_ = environment.tc > 0.0 || environment.dissipative_steps() ||
+                     environment.soft_spheres() || !environment.plain();
+      for (int f = 0; f < 2 * D; ++f)
+        moving_walls_ =
+            moving_walls_ ||
+            (environment.faces[f].kind == FaceKind::kWall &&
+             (environment.wall_moves(f) || norm2(environment.faces[f].wall.velocity) > 0.0));
     } catch (const InputError& e) {
       if (!restart_file) throw;
+      if (restart_ && !resume && plan_->stored_config) {
+        throw InputError(fmt::format("restart file '{}' continued with new physics ({}): {}",
+                                     restart_file->string(), fmt::join(plan_->changed, ", "),
+                                     e.what()));
+      }
       throw InputError("restart file '" + restart_file->string() + "': " + e.what());
     }
-    if (!config.output.profile_axis.empty()) {
-      const int axis = config.output.profile_axis[0] - 'x';
+    if (!config_.output.profile_axis.empty()) {
+      const int axis = config_.output.profile_axis[0] - 'x';
       const Vec<D>& box = engine_->box();
       double cross = 1.0;
       for (int a = 0; a < D; ++a)
         if (a != axis) cross *= box[a];
-      profile_.emplace(axis, static_cast<int>(config.output.profile_bins), 0.0, box[axis], cross);
+      profile_.emplace(axis, static_cast<int>(config_.output.profile_bins), 0.0, box[axis], cross);
     }
-    dir_ = run_detail::prepare_output_directory(config);
+    check_collisions_can_happen(
+        {restart_ ? run_detail::resumed_equilibration(config_.run, resumed_, restart_name_)
+                  : run_detail::equilibration_length(config_.run),
+         run_detail::production_length(config_.run)});
+    if (plan_) run_detail::print_restart_note(*plan_, restart_name_);
+    out_dir_.emplace(run_detail::prepare_output_directory(config_, restart_, run_options));
+    dir_ = out_dir_->path();
   }
 
   RunOutcome run() {
     const auto wall_start = Clock::now();
-    thermo_.emplace(dir_ / "thermo.tsv", restart_);
+    continuation_ = run_detail::output_continuation(restart_file_, dir_, resumed_);
+    thermo_.emplace(dir_ / "thermo.tsv", restart_, continuation_.thermo_rows);
+    rows_kept_ = thermo_->rows();
     if (config_.output.trajectory) {
       run_detail::open_trajectory<D>(trajectory_, dir_, restart_, n_,
+                                     continuation_.trajectory_frames,
                                      [&] { return engine_->export_state(/*with_zones=*/false); });
+      frames_kept_ = trajectory_->frame_count();
     }
     ke_start_ = engine_->kinetic_energy();
     u_start_ = engine_->potential_energy();
@@ -284,7 +314,13 @@ class RunDriver {
     p_start_ = engine_->momentum();
     events_start_ = engine_->counters().events;
     collisions_start_ = engine_->counters().collisions;
-    thermo_stats_->mark(point());
+    // Continued in its own directory: the next row covers the interval from the last kept one.
+    kept_mark_ = continuation_.same_directory && resumed_.has_thermo_mark
+                     ? ThermoPoint{resumed_.mark_time, resumed_.mark_virial, resumed_.mark_events,
+                                   resumed_.mark_collisions}
+                     : point();
+    thermo_stats_->mark(kept_mark_);
+    clock_watch_.emplace(*engine_);
     ProgressLine progress(config_.output.progress);
 
     // A restart continues an interrupted equilibration, otherwise goes straight to production.
@@ -294,40 +330,91 @@ class RunDriver {
     bool stopped = false;
     if (eq.value > 0.0) {
       stopped = run_phase("equilibration", eq, progress, wall_start);
-      // Close the equilibration rows so no production row spans both phases.
-      if (row_pending()) write_thermo_row("equilibration");
+      // Close the equilibration rows so no production row spans both phases (a stopped run's
+      // last row is not kept: a continued run writes the rows an uninterrupted one would).
+      if (row_pending())
+        outputs_.attempt("thermo.tsv", [&] { write_thermo_row("equilibration", !stopped); });
     }
     prod_start_ = point();
     virial_tensor_start_ = engine_->counters().virial_tensor;
     prod_ke_ = thermal_energy();
     shear_row_start_ = {engine_->time(), engine_->counters().virial_tensor[1]};
-    if (!stopped)
-      stopped =
-          run_phase("production", run_detail::production_length(config_.run), progress, wall_start);
+    if (!stopped) {
+      const PhaseLength production =
+          restart_ ? run_detail::continued_production(config_.run, resumed_, plan_, engine_->time(),
+                                                      engine_->counters().collisions)
+                   : run_detail::production_length(config_.run);
+      stopped = run_phase("production", production, progress, wall_start);
+      production_done_ = !stopped;
+    }
     progress.finish();
-    if (row_pending()) write_thermo_row(phase_);
+    finish_outputs(stopped);
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
-
-    if (trajectory_) {
-      if (frame_collisions_ != engine_->counters().collisions ||
-          (timed_ && frame_time_ != engine_->time()))
-        append_trajectory_frame(*trajectory_, engine_->export_state(/*with_zones=*/false));
-      trajectory_->close();
+    if (outputs_.any()) {
+      error_ = error_.empty() ? outputs_.error : error_ + "; " + outputs_.error;
+      if (stop_reason_ == "completed" || stop_reason_ == "signal") stop_reason_ = "write_failed";
     }
     RunOutcome outcome;
     outcome.directory = dir_;
-    outcome.interrupted = stopped;
-    outcome.summary = summary(wall);  // before the restart copy inflates the peak memory
-    write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
-    if (profile_) profile_->write(dir_ / "profile.tsv");
-    write_text_atomically(dir_ / "summary.json", outcome.summary.dump(2) + "\n");
+    outcome.interrupted = stopped && error_.empty();
+    outcome.error = error_;
+    outcome.summary = summary(wall);
+    outcome.summary["outputs"] = run_detail::outputs_present(dir_);
+    outputs_.attempt("summary.json", [&] {
+      write_text_atomically(dir_ / "summary.json", outcome.summary.dump(2) + "\n");
+    });
+    if (outputs_.failed_file("summary.json")) outcome.error = error_ + "; " + outputs_.error;
     return outcome;
   }
 
  private:
+  // The last row and frame (kept unless the run stopped early: a continued run writes the
+  // ones an uninterrupted run would), the restart file, the profile. Each write is tried even
+  // if another failed; failures go into outputs_.
+  void finish_outputs(bool stopped) {
+    const bool kept = !stopped;
+    if (row_pending()) outputs_.attempt("thermo.tsv", [&] { write_thermo_row(phase_, kept); });
+    if (trajectory_) {
+      outputs_.attempt("trajectory.gsd", [&] {
+        if (frame_collisions_ != engine_->counters().collisions ||
+            (timed_ && frame_time_ != engine_->time()))
+          write_trajectory_frame(kept);
+        trajectory_->close();
+      });
+    }
+    outputs_.attempt("restart.gsd", [&] { write_restart_file(); });
+    if (profile_) outputs_.attempt("profile.tsv", [&] { profile_->write(dir_ / "profile.tsv"); });
+  }
+
+  void write_restart_file() const {
+    write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
+  }
+
   // Equilibration still owed if the run stops now (a restart file records it).
   RunProgress progress_now() const {
     RunProgress p;
+    p.thermo_rows = static_cast<std::int64_t>(rows_kept_);
+    p.trajectory_frames = trajectory_ ? static_cast<std::int64_t>(frames_kept_) : -1;
+    p.has_thermo_mark = true;
+    p.mark_time = kept_mark_.time;
+    p.mark_virial = kept_mark_.virial;
+    p.mark_events = kept_mark_.events;
+    p.mark_collisions = kept_mark_.collisions;
+    if (schedule_ != nullptr) {
+      p.schedule_phase = phase_ == "production" ? 1 : 0;
+      const OutputSchedule::Every* e[3] = {&schedule_->thermo, &schedule_->trajectory,
+                                           &schedule_->restart};
+      for (int k = 0; k < 3; ++k) {
+        p.schedule_step[k] = e[k]->step;
+        p.schedule_next[k] = e[k]->next;
+      }
+    }
+    if (phase_ == "production" && !production_done_) {
+      if (std::isfinite(production_end_time_))
+        p.production_end_time = production_end_time_;
+      else
+        p.production_target = production_target_;
+    }
     const std::uint64_t c = engine_->counters().collisions;
     // In the unit of the config's equilibration length.
     if (phase_ == "equilibration" && config_.run.equilibration_time >= 0.0) {
@@ -340,7 +427,30 @@ class RunDriver {
     }
     p.next_kick_time = driven_ ? next_kick_ : -1.0;
     if (!tables_.empty()) p.soft_table_max_speed = tables_.front().spec.max_normal_speed;
+    p.config = to_toml(config_);
     return p;
+  }
+
+  // Phases measured in collisions need a system that collides: InputError if the ideal-gas
+  // estimate says they would take practically for ever (without a field: with gravity grains
+  // gather far denser than the mean).
+  void check_collisions_can_happen(std::initializer_list<PhaseLength> phases) const {
+    if (engine_->environment().has_gravity()) return;
+    double collisions = 0.0;
+    for (const PhaseLength& p : phases)
+      if (!p.in_time && p.value > 0.0) collisions += static_cast<double>(collisions_for(p.value));
+    if (collisions == 0.0) return;
+    double mass = 0.0;
+    for (const double m : mass_) mass += m;
+    const auto n = static_cast<double>(n_);
+    const run_detail::FlightEstimate flight = run_detail::estimate_flight<D>(
+        n, volume_, run_detail::mean_volume_diameter<D>(particle_volume_, n),
+        std::sqrt(2.0 * engine_->kinetic_energy() / mass));
+    double width = 0.0;
+    for (int a = 0; a < D; ++a) width += engine_->grid().width(a) / D;
+    run_detail::check_collisions_can_happen(
+        1.0 + 2.0 * std::sqrt(static_cast<double>(D)) * flight.mean_free_path / width, collisions,
+        flight, "events");
   }
 
   // Stochastic driving ([driving]): Poisson events at rate N * rate, each on one random
@@ -393,10 +503,19 @@ class RunDriver {
            (timed_ && engine_->time() > thermo_stats_->last().time);
   }
 
-  void write_trajectory_frame() {
+  // kept: the frame belongs to the run as an uninterrupted one writes it (not the last frame
+  // of a run stopped early).
+  void write_trajectory_frame(bool kept = true) {
     append_trajectory_frame(*trajectory_, engine_->export_state(/*with_zones=*/false));
     frame_collisions_ = engine_->counters().collisions;
     frame_time_ = engine_->time();
+    if (kept) frames_kept_ = trajectory_->frame_count();
+  }
+
+  // A periodic output could not be written: the run stops (outputs_ holds the error).
+  bool write_failed() {
+    stop_reason_ = "write_failed";
+    return true;
   }
 
   // A stop asked by a signal or by run.max_wall_seconds (stop_reason_ set).
@@ -423,17 +542,38 @@ class RunDriver {
     phase_ = phase;
     const std::uint64_t begin = engine_->counters().collisions;
     const double begin_time = engine_->time();
-    const std::uint64_t target = begin + (length.in_time ? 0 : collisions_for(length.value));
+    const std::uint64_t target = length.in_time      ? begin
+                                 : length.target > 0 ? length.target
+                                                     : begin + collisions_for(length.value);
+    if (length.target > 0) length.value = per_particle(target - begin);
     const double end_time = !length.in_time             ? kNever
                             : std::isfinite(length.end) ? length.end
                                                         : begin_time + length.value;
     if (phase == "equilibration") {
       equilibration_target_ = target;
       equilibration_end_time_ = end_time;
+    } else {
+      production_target_ = target;
+      production_end_time_ = length.in_time ? end_time : kNever;
     }
     const bool time_outputs = run_detail::intervals_in_time(config_);
     auto [schedule, timed] = run_detail::phase_schedules(
         config_, begin, begin_time, [&](double c) { return collisions_for(c); });
+    // The first phase of a continued run keeps the stored schedule of the same phase (the rows
+    // an uninterrupted run would write), if its steps are unchanged.
+    if (restart_ && first_phase_ && resumed_.schedule_phase == (phase == "production" ? 1 : 0)) {
+      OutputSchedule::Every* e[3] = {&schedule.thermo, &schedule.trajectory, &schedule.restart};
+      for (int k = 0; k < 3; ++k)
+        if (e[k]->step > 0 && e[k]->step == resumed_.schedule_step[k] &&
+            resumed_.schedule_next[k] > begin)
+          e[k]->next = resumed_.schedule_next[k];
+    }
+    first_phase_ = false;
+    schedule_ = &schedule;
+    struct Forget {  // the schedule lives in this phase only
+      const OutputSchedule*& s;
+      ~Forget() { s = nullptr; }
+    } forget{schedule_};
     const auto done = [&] {
       return length.in_time ? engine_->time() - begin_time
                             : per_particle(engine_->counters().collisions - begin);
@@ -455,10 +595,15 @@ class RunDriver {
         if (engine_->next_event_time() > stop) {
           engine_->advance_clock(stop);
           const double t = engine_->time();
-          if (timed.thermo.due(t)) write_thermo_row(phase);
-          if (timed.trajectory.due(t) && trajectory_) write_trajectory_frame();
-          if (timed.restart.due(t))
-            write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
+          if (timed.thermo.due(t) &&
+              !outputs_.attempt("thermo.tsv", [&] { write_thermo_row(phase); }))
+            return write_failed();
+          if (timed.trajectory.due(t) && trajectory_ &&
+              !outputs_.attempt("trajectory.gsd", [&] { write_trajectory_frame(); }))
+            return write_failed();
+          if (timed.restart.due(t) &&
+              !outputs_.attempt("restart.gsd", [&] { write_restart_file(); }))
+            return write_failed();
           // A system at rest passes its output times without events: the stop checks too.
           if (interrupted(wall_start)) return true;
           if ((++clock_stops_ & 0x3ffu) == 0) {
@@ -470,17 +615,36 @@ class RunDriver {
       } else if (driven_) {
         apply_due_kicks();
       }
-      if (engine_->step() == EventKind::kNone) {
+      EventKind kind{};
+      try {
+        kind = engine_->step();
+      } catch (const InputError& e) {
+        // The event cannot happen (walls leave the particles no room): the state is that of
+        // the moment before it, every output is written, the message is the run's error.
+        error_ = e.what();
+        stop_reason_ = "error";
+        return true;
+      }
+      if (kind == EventKind::kNone) {
         stop_reason_ = "no_more_events";  // every particle at rest, or alone
         break;
       }
       if (config_.run.validate) engine_->validate();
-      const std::uint64_t c = engine_->counters().collisions;
-      if (schedule.thermo.due(c)) write_thermo_row(phase);
-      if (schedule.trajectory.due(c) && trajectory_) write_trajectory_frame();
-      if (schedule.restart.due(c)) {
-        write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
+      if (clock_watch_->frozen(*engine_)) {
+        error_ = clock_watch_->describe(*engine_);
+        stop_reason_ = "frozen_clock";
+        return true;
       }
+      const std::uint64_t c = engine_->counters().collisions;
+      if (schedule.thermo.due(c) &&
+          !outputs_.attempt("thermo.tsv", [&] { write_thermo_row(phase); }))
+        return write_failed();
+      if (schedule.trajectory.due(c) && trajectory_ &&
+          !outputs_.attempt("trajectory.gsd", [&] { write_trajectory_frame(); }))
+        return write_failed();
+      if (schedule.restart.due(c) &&
+          !outputs_.attempt("restart.gsd", [&] { write_restart_file(); }))
+        return write_failed();
       if (g_stop.load(std::memory_order_relaxed)) {
         stop_reason_ = "signal";
         return true;
@@ -562,7 +726,8 @@ class RunDriver {
     return sheared_ ? engine_->peculiar_kinetic_energy() : engine_->kinetic_energy();
   }
 
-  void write_thermo_row(const std::string& phase) {
+  // kept: as write_trajectory_frame.
+  void write_thermo_row(const std::string& phase, bool kept = true) {
     if (phase == "production") {
       if (profile_) sample_profile(engine_->export_state(/*with_zones=*/false));
       sample_kinetic_tensor(peculiar_velocities());
@@ -575,6 +740,10 @@ class RunDriver {
     thermo_->write(phase, row,
                    {rotational_temperature(), c.dissipated_in_collisions + c.dissipated_at_walls,
                     c.work_by_walls, u});
+    if (kept) {
+      rows_kept_ = thermo_->rows();
+      kept_mark_ = row.at;
+    }
   }
 
   // Per rotational degree of freedom (3 for spheres, 1 for disks); 0 without spins.
@@ -635,12 +804,7 @@ class RunDriver {
     const double z_mean = th.compressibility(c.virial - prod_start_.virial, kT_prod, t_prod);
     std::vector<double> diameters(n_);
     for (std::size_t i = 0; i < n_; ++i) diameters[i] = 2.0 * state.kinematics[i].radius;
-    const double overlap =
-        sheared_ ? max_overlap_sheared<D>(
-                       state.box, engine_->current_positions(), diameters,
-                       std::fmod(engine_->environment().shear_rate * state.box[1] * state.time,
-                                 state.box[0]))
-                 : max_overlap<D>(state.box, engine_->current_positions(), diameters);
+    const double overlap = run_detail::current_max_overlap(*engine_, state, diameters);
     const std::uint64_t events = c.events - events_start_;
     const std::uint64_t collisions = c.collisions - collisions_start_;
     nlohmann::json j;
@@ -652,7 +816,9 @@ class RunDriver {
     j["integrator"] = "event";
     j["event_queue"] = engine_->queue_name();
     j["restarted"] = restart_;
+    if (plan_) j["restart"] = run_detail::restart_summary(*plan_);
     j["stop_reason"] = stop_reason_;
+    if (!error_.empty()) j["error"] = error_;
     j["event_counts"] = {
         {"collisions", collisions},
         {"cell_crossings", c.cell_crossings},
@@ -663,7 +829,7 @@ class RunDriver {
     run_detail::add_run_totals(j,
                                {events, collisions, coll_prod, engine_->time(), t_prod, wall,
                                 per_particle(coll_prod), kT, ke, kT_prod, z_mean},
-                               th);
+                               th, bulk_);
     if (kinetic_tensor_samples_ > 0 && t_prod > 0.0) {
       // Kinetic part averaged over the production rows, collisional part from the impulses
       // over the production time.
@@ -704,8 +870,19 @@ class RunDriver {
     const double balance = energy - energy_start_ + dissipated - work;
     const double scale = std::max({std::abs(energy_start_), dissipated, std::abs(work)});
     nlohmann::json g;
+    // What this run's granular lines mean (the CLI prints only those): spins, dissipation,
+    // moving walls, driving.
+    g["rotating"] = rotating_;
+    g["dissipative"] = dissipative_;
+    g["moving_walls"] = moving_walls_;
+    g["driven"] = driven_;
     g["rotational_temperature"] = rotational_temperature();
-    g["sonine_a2"] = sonine_a2_now();
+    const double a2 = sonine_a2_now();
+    run_detail::set_or_explain(j, g, "sonine_a2", a2,
+                               !bulk_ ? "walls, open faces or a field: the gas is not homogeneous"
+                               : !std::isfinite(a2) ? "every particle at rest"
+                                                    : "",
+                               "granular.sonine_a2");
     g["wall_collisions"] = c.wall_collisions - counters_start_.wall_collisions;
     g["elastic_by_rule"] = c.elastic_by_rule - counters_start_.elastic_by_rule;
     g["sliding_collisions"] = c.sliding_collisions - counters_start_.sliding_collisions;
@@ -720,7 +897,11 @@ class RunDriver {
     g["work_by_shear"] = c.work_by_shear - counters_start_.work_by_shear;
     g["energy_start"] = energy_start_;
     g["energy_end"] = energy;
-    g["energy_balance_relative"] = scale > 0.0 ? std::abs(balance) / scale : 0.0;
+    run_detail::set_or_explain(
+        j, g, "energy_balance_relative", scale > 0.0 ? std::abs(balance) / scale : 0.0,
+        std::isfinite(energy) ? ""
+                              : "gravity along a periodic axis: the potential energy is unbounded",
+        "granular.energy_balance_relative");
     j["granular"] = g;
     if (sheared_) j["shear"] = shear_summary(kT_prod);
     return j;
@@ -850,8 +1031,10 @@ class RunDriver {
                                                  // potentials: U at each production thermo row
   EventCounters counters_start_;
   bool granular_ = false;  // walls, gravity or contact laws: report the energy budget
-  bool driven_ = false;    // [driving]: thermostat or random kicks
-  bool sheared_ = false;   // Lees-Edwards boundaries
+  bool bulk_ = true;       // periodic without a field: Z, P and a2 are bulk values
+  bool rotating_ = false, dissipative_ = false, moving_walls_ = false;  // granular lines shown
+  bool driven_ = false;   // [driving]: thermostat or random kicks
+  bool sheared_ = false;  // Lees-Edwards boundaries
   struct ShearRowStart {
     double time = 0.0, virial_xy = 0.0;
   } shear_row_start_;
@@ -868,16 +1051,33 @@ class RunDriver {
   std::uint64_t clock_stops_ = 0;        // outputs in time passed without an event
   RunProgress resumed_;                  // progress recorded in the restart file this run continues
   std::string stop_reason_ = "completed";
+  std::optional<FrozenClockWatch> clock_watch_;
+  std::optional<RestartPlan> plan_;  // a restart: how it used the changed configuration
+  std::optional<fs::path> restart_file_;
+  std::optional<OutputDirectory> out_dir_;  // claimed (locked) while the run lasts
+  run_detail::OutputContinuation continuation_;
+  run_detail::OutputFailures outputs_;
+  // Rows and frames of this directory's files that an uninterrupted run also writes, and the
+  // point the last kept row ended at (what a restart file records for a continued run).
+  std::uint64_t rows_kept_ = 0, frames_kept_ = 0;
+  ThermoPoint kept_mark_;
+  const OutputSchedule* schedule_ = nullptr;  // the running phase's schedule in collisions
+  bool first_phase_ = true;
+  bool production_done_ = false;
+  std::uint64_t production_target_ = 0;
+  double production_end_time_ = kNever;
+  std::string error_;  // why the run could not go on (RunOutcome::error)
 };
 
 template <int D>
-RunOutcome run_with_dimension(const Config& config, const std::optional<fs::path>& restart) {
-  if (config.run.integrator == "dem") return run_detail::run_dem<D>(config, restart);
-  if (config.run.event_queue == "heap") return RunDriver<D, BinaryHeapQueue>(config, restart).run();
-  if (config.run.event_queue == "tree") {
-    return RunDriver<D, TournamentTreeQueue>(config, restart).run();
-  }
-  return RunDriver<D, CalendarQueue>(config, restart).run();
+RunOutcome run_with_dimension(const Config& config, const std::optional<fs::path>& restart,
+                              const RunOptions& options) {
+  if (config.run.integrator == "dem") return run_detail::run_dem<D>(config, restart, options);
+  if (config.run.event_queue == "heap")
+    return RunDriver<D, BinaryHeapQueue>(config, restart, options).run();
+  if (config.run.event_queue == "tree")
+    return RunDriver<D, TournamentTreeQueue>(config, restart, options).run();
+  return RunDriver<D, CalendarQueue>(config, restart, options).run();
 }
 
 }  // namespace
@@ -889,7 +1089,8 @@ void clear_stop_request() noexcept {
   g_stop.store(false, std::memory_order_relaxed);
 }
 
-RunOutcome run_simulation(const Config& config, const std::optional<fs::path>& restart_file) {
+RunOutcome run_simulation(const Config& config, const std::optional<fs::path>& restart_file,
+                          const RunOptions& options) {
   int dimension = config.system.dimension;
   if (restart_file && fs::exists(*restart_file)) {
     const int stored = gsd_dimension(*restart_file);
@@ -898,8 +1099,8 @@ RunOutcome run_simulation(const Config& config, const std::optional<fs::path>& r
                                    restart_file->string(), stored, dimension));
     }
   }
-  return dimension == 2 ? run_with_dimension<2>(config, restart_file)
-                        : run_with_dimension<3>(config, restart_file);
+  return dimension == 2 ? run_with_dimension<2>(config, restart_file, options)
+                        : run_with_dimension<3>(config, restart_file, options);
 }
 
 }  // namespace kairos

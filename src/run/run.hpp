@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -19,11 +20,20 @@ struct RunOutcome {
   nlohmann::json summary;
   std::filesystem::path directory;
   bool interrupted = false;  // stopped by a signal or the wall-time limit (outputs still written)
+  // Non-empty: the run stopped because it could not go on (a frozen clock, ...); every output is
+  // written, and the message says why and what to change. The CLI prints it as an error.
+  std::string error;
+};
+
+// How one invocation treats its output directory (run/output_directory.hpp).
+struct RunOptions {
+  bool overwrite = false;  // a new run may replace the outputs an earlier run left there
 };
 
 // Runs the whole simulation. Throws InputError for anything the user must fix.
 RunOutcome run_simulation(const Config& config,
-                          const std::optional<std::filesystem::path>& restart_file = {});
+                          const std::optional<std::filesystem::path>& restart_file = {},
+                          const RunOptions& options = {});
 
 // Asks a running simulation to stop after the current event (async-signal-safe).
 void request_stop() noexcept;

@@ -25,16 +25,23 @@
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/particle_system.hpp"
+#include "core/periodic.hpp"
 #include "dem/dem_integrator.hpp"
+#include "init/initial_state.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
 #include "io/gsd_file.hpp"
 #include "io/gsd_snapshot.hpp"
+#include "io/line_file.hpp"
+#include "run/output_directory.hpp"
+#include "run/restart_plan.hpp"
 #include "run/run.hpp"
 
 namespace kairos::run_detail {
 
 namespace fs = std::filesystem;
+
+inline constexpr double kNeverTime = std::numeric_limits<double>::infinity();
 
 // The state a run starts from: the restart file (its progress into `progress`), else
 // system.initial_state, else a generated one (run/run.cpp).
@@ -43,12 +50,113 @@ ParticleSystem<D> build_start_state(const Config& config,
                                     const std::optional<fs::path>& restart_file,
                                     std::mt19937_64& rng, RunProgress& progress);
 
+// max_overlap() under Lees-Edwards shear: the particles within the largest diameter of the low
+// y face are copied above the box as their images (displaced along x by `offset`), in a box
+// tall enough that nothing else wraps around along y.
+template <int D>
+inline double max_overlap_sheared(const Vec<D>& box, std::vector<Vec<D>> x,
+                                  std::vector<double> diameter, double offset) {
+  const double dmax = *std::max_element(diameter.begin(), diameter.end());
+  const std::size_t n = x.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i][1] = wrap_into_box(x[i][1], box[1]);
+    if (x[i][1] >= dmax) continue;
+    Vec<D> image = x[i];
+    image[0] = wrap_into_box(image[0] + offset, box[0]);
+    image[1] += box[1];
+    x.push_back(image);
+    diameter.push_back(diameter[i]);
+  }
+  Vec<D> tall = box;
+  tall[1] += 3.0 * dmax;
+  return max_overlap<D>(tall, x, diameter);
+}
+
+// max_overlap of an engine's present positions: no image along bounded axes, Lees-Edwards
+// images displaced by the shear's offset. `state`: its export, `diameters` per particle.
+template <class Engine, int D>
+double current_max_overlap(const Engine& engine, const ParticleSystem<D>& state,
+                           const std::vector<double>& diameters) {
+  if (engine.environment().sheared()) {
+    return max_overlap_sheared<D>(
+        state.box, engine.current_positions(), diameters,
+        std::fmod(engine.environment().shear_rate * state.box[1] * state.time, state.box[0]));
+  }
+  return max_overlap<D>(state.box, state.periodic, engine.current_positions(), diameters);
+}
+
+// A state continued under new physics may hold pairs that now overlap (a new potential's core,
+// new images): InputError (the driver names the keys).
+template <class Engine>
+void check_no_overlap_after_new_physics(const Engine& engine) {
+  const auto state = engine.export_state(/*with_zones=*/false);
+  std::vector<double> diameters(state.size());
+  for (std::size_t i = 0; i < state.size(); ++i) diameters[i] = 2.0 * state.kinematics[i].radius;
+  const double smallest = *std::min_element(diameters.begin(), diameters.end());
+  const double overlap = current_max_overlap(engine, state, diameters);
+  if (overlap > 1e-12 * smallest) {
+    throw InputError(fmt::format(
+        "particles overlap by up to {:.6g} under the new physics; start a new run from the "
+        "state with system.initial_state instead",
+        overlap));
+  }
+}
+
+// A restart under a configuration that changed (run/restart_plan.hpp): the plan, and, when the
+// run re-predicts, the restored state made ready for a fresh prediction: sleepers woken where
+// they rest (their rest was decided under the old physics), the stepped potentials' zones
+// recomputed from the distances if a potential or bond changed, the DEM's own state dropped.
+// InputError for a refused change.
+template <int D>
+RestartPlan plan_continuation(const Config& config, ParticleSystem<D>& state,
+                              const RunProgress& resumed, const std::string& restart_file) {
+  RestartPlan plan =
+      plan_restart(config, resumed.config, !state.frozen.empty(), state.time, restart_file);
+  if (plan.repredict) {
+    // Every particle brought to the present on its old trajectory (the old field's parabola),
+    // so that the new physics starts from where the particles are now.
+    state.gravity = Vec<D>{};
+    for (int a = 0; a < D && a < static_cast<int>(plan.stored_gravity.size()); ++a)
+      state.gravity[a] = plan.stored_gravity[a];
+    for (std::size_t i = 0; i < state.size(); ++i) {
+      const Vec<D> x = state.position_at(i, state.time), v = state.velocity_at(i, state.time);
+      state.kinematics[i].pos = x;
+      state.kinematics[i].vel = v;  // a sleeper's is zero
+      state.kinematics[i].time = state.time;
+    }
+    state.asleep.clear();
+    const bool potentials = std::any_of(
+        plan.changed.begin(), plan.changed.end(),
+        [](const std::string& k) { return k.starts_with("potential") || k.starts_with("bond"); });
+    if (potentials || !plan.stored_config) state.zones.reset();
+    state.dem = {};
+  }
+  return plan;
+}
+
+// The note on stderr about a restart whose configuration changed (once it is set up).
+inline void print_restart_note(const RestartPlan& plan, const std::string& restart_file) {
+  const std::string note = describe_restart(plan, restart_file);
+  if (!note.empty())
+    fmt::print(stderr, "kairos: note: restart from '{}': {}\n", restart_file, note);
+}
+
+// summary.json's "restart" part: how the restart used the changed configuration.
+inline nlohmann::json restart_summary(const RestartPlan& plan) {
+  return {{"mode", plan.repredict ? "new_physics" : "resumed"},
+          {"stored_config", plan.stored_config},
+          {"repredicted_keys", plan.changed},
+          {"resumed_keys", plan.resumed},
+          {"ignored_keys", plan.ignored}};
+}
+
 // Whether SIGINT/SIGTERM asked the run to stop (request_stop()).
 bool stop_requested() noexcept;
 
 // run.integrator = "dem" (run/dem_run.cpp).
 template <int D>
-RunOutcome run_dem(const Config& config, const std::optional<fs::path>& restart_file);
+RunOutcome run_dem(const Config& config, const std::optional<fs::path>& restart_file,
+                   const RunOptions& options);
 
 // Appending to another system's trajectory would corrupt it for every reader: InputError unless
 // `traj` holds n particles in `dimension` D (the run's output directory `dir` named).
@@ -80,32 +188,79 @@ inline void check_restart_integrator(const std::optional<fs::path>& restart_file
                   restart_file->string(), resumed.integrator, integrator));
 }
 
-// Creates the output directory and writes the effective configuration into it.
-inline fs::path prepare_output_directory(const Config& config) {
-  const fs::path dir = config.output.directory;
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) {
-    throw InputError("output.directory: cannot create '" + dir.string() + "': " + ec.message());
-  }
-  write_text_atomically(dir / "config.toml", to_toml(config));
+// Claims the output directory (run/output_directory.hpp) and writes the effective
+// configuration into it (after a restart: the configuration as run, RestartPlan::used).
+inline OutputDirectory prepare_output_directory(const Config& config, bool continuing,
+                                                const RunOptions& options) {
+  OutputDirectory dir(config.output.directory, continuing, options.overwrite);
+  write_text_atomically(dir.path() / "config.toml", to_toml(config));
   return dir;
 }
 
+// Where a run continued from a restart file picks up its outputs: in the directory that holds
+// the restart file (its own run's), thermo.tsv and trajectory.gsd are cut back to the rows and
+// frames the state had written (those after it came from a run interrupted later: a continued
+// run leaves the files as one uninterrupted run would), and the next row is measured from the
+// last kept one; in another directory they continue as they are.
+struct OutputContinuation {
+  bool same_directory = false;
+  std::optional<std::uint64_t> thermo_rows, trajectory_frames;
+};
+inline OutputContinuation output_continuation(const std::optional<fs::path>& restart_file,
+                                              const fs::path& dir, const RunProgress& resumed) {
+  OutputContinuation c;
+  if (!restart_file) return c;
+  std::error_code ec;
+  const fs::path home = restart_file->has_parent_path() ? restart_file->parent_path() : ".";
+  c.same_directory = fs::exists(dir, ec) && fs::equivalent(home, dir, ec) && !ec;
+  if (!c.same_directory) return c;
+  if (resumed.thermo_rows >= 0) c.thermo_rows = static_cast<std::uint64_t>(resumed.thermo_rows);
+  if (resumed.trajectory_frames >= 0)
+    c.trajectory_frames = static_cast<std::uint64_t>(resumed.trajectory_frames);
+  return c;
+}
+
 // trajectory.gsd of the run in `dir`: appended to when a restarted run finds its own system's
-// file there, else created with `first_frame` (a callable giving the state) as frame 0.
+// file there (keeping its first `keep_frames` frames when given), else created with
+// `first_frame` (a callable giving the state) as frame 0.
 template <int D, class FirstFrame>
 void open_trajectory(std::optional<gsd::Writer>& writer, const fs::path& dir, bool restarted,
-                     std::size_t n, FirstFrame&& first_frame) {
+                     std::size_t n, std::optional<std::uint64_t> keep_frames,
+                     FirstFrame&& first_frame) {
   const fs::path traj = dir / "trajectory.gsd";
   if (restarted && fs::exists(traj)) {
     check_same_trajectory(traj, n, D, dir);
-    writer.emplace(gsd::Writer::open_append(traj));
+    writer.emplace(gsd::Writer::open_append(traj, keep_frames.value_or(~std::uint64_t{0})));
   } else {
     writer.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
     append_trajectory_frame(*writer, first_frame());
   }
 }
+
+// The outputs of a run whose writing failed (a full disk, a size limit): a failed write stops
+// the run; the file that failed is not written again (no torn or partial record follows), the
+// others still are (the restart file first of all), and the run ends with the error.
+struct OutputFailures {
+  std::string error;                // the first failure, then any later ones
+  std::vector<std::string> failed;  // the files that failed
+  bool failed_file(const std::string& file) const {
+    return std::find(failed.begin(), failed.end(), file) != failed.end();
+  }
+  // Runs `write` for `file` unless that file failed before; false if it failed now or before.
+  template <class Write>
+  bool attempt(const std::string& file, Write&& write) {
+    if (failed_file(file)) return false;
+    try {
+      write();
+      return true;
+    } catch (const InputError& e) {
+      failed.push_back(file);
+      error += (error.empty() ? "" : "; then ") + std::string(e.what());
+      return false;
+    }
+  }
+  bool any() const { return !failed.empty(); }
+};
 
 // What summary.json holds alike for both integrators (docs/outputs.md): counts and rates, the
 // times, the temperature, Z with its blocked error, the pressure and the mean free time.
@@ -119,7 +274,22 @@ struct RunTotals {
   double compressibility = 0.0;  // the production mean
 };
 
-inline void add_run_totals(nlohmann::json& j, const RunTotals& r, const Thermodynamics& th) {
+// A quantity a run defines only sometimes: its value, or null and, in summary["undefined"], the
+// reason (never NaN as a number: docs/outputs.md).
+inline void set_or_explain(nlohmann::json& summary, nlohmann::json& where, const std::string& key,
+                           double value, std::string reason, const std::string& name) {
+  if (reason.empty() && !std::isfinite(value)) reason = "not finite in this run";
+  if (reason.empty()) {
+    where[key] = value;
+    return;
+  }
+  where[key] = nullptr;
+  summary["undefined"][name] = reason;
+}
+
+// bulk: a periodic box without a field, where Z and the pressure are the uniform bulk values.
+inline void add_run_totals(nlohmann::json& j, const RunTotals& r, const Thermodynamics& th,
+                           bool bulk) {
   const BlockAverage z_blocks = th.compressibility_blocks();
   const double wall = r.wall_seconds;
   j["events"] = r.events;
@@ -132,14 +302,46 @@ inline void add_run_totals(nlohmann::json& j, const RunTotals& r, const Thermody
   j["collisions_per_second"] = wall > 0 ? static_cast<double>(r.collisions) / wall : 0.0;
   j["temperature"] = r.temperature;
   j["kinetic_energy"] = r.kinetic_energy;
-  j["compressibility"] = {{"mean", r.compressibility},
-                          {"stderr", z_blocks.stderr_},
-                          {"blocks", z_blocks.samples},
-                          {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
-  j["pressure"] = th.pressure(r.compressibility, r.production_temperature);
+  std::string why;
+  if (!bulk)
+    why = "walls, open faces or a field: the pressure is not uniform in the box";
+  else if (!(r.production_time > 0.0))
+    why = "no production time elapsed";
+  else if (!(r.production_temperature > 0.0))
+    why = "the particles are at rest (kT = 0)";
+  nlohmann::json z = {{"blocks", z_blocks.samples},
+                      {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
+  set_or_explain(j, z, "mean", r.compressibility, why, "compressibility");
+  set_or_explain(j, z, "stderr", z_blocks.stderr_,
+                 !why.empty()           ? why
+                 : z_blocks.samples < 2 ? "fewer than 2 production thermo rows"
+                                        : "",
+                 "compressibility_stderr");
+  j["compressibility"] = z;
+  set_or_explain(j, j, "pressure", th.pressure(r.compressibility, r.production_temperature), why,
+                 "pressure");
   j["production_temperature"] = r.production_temperature;
-  j["mean_free_time"] = th.mean_free_time(r.production_time, r.production_collisions);
-  j["mean_free_time_stderr"] = th.mean_free_time_blocks().stderr_;
+  const std::string no_collision =
+      r.production_collisions == 0 ? "no collision in the production" : "";
+  set_or_explain(j, j, "mean_free_time",
+                 th.mean_free_time(r.production_time, r.production_collisions), no_collision,
+                 "mean_free_time");
+  set_or_explain(j, j, "mean_free_time_stderr", th.mean_free_time_blocks().stderr_,
+                 !no_collision.empty()                    ? no_collision
+                 : th.mean_free_time_blocks().samples < 2 ? "fewer than 2 production thermo rows"
+                                                          : "",
+                 "mean_free_time_stderr");
+}
+
+// The output files in `dir` after the run, summary.json (about to be written) first
+// (summary.json's "outputs").
+inline nlohmann::json outputs_present(const fs::path& dir) {
+  nlohmann::json list = nlohmann::json::array({"summary.json"});
+  std::error_code ec;
+  for (const char* name :
+       {"thermo.tsv", "trajectory.gsd", "restart.gsd", "profile.tsv", "config.toml"})
+    if (fs::exists(dir / name, ec)) list.push_back(name);
+  return list;
 }
 
 inline std::uint64_t peak_rss_bytes() {
@@ -150,18 +352,16 @@ inline std::uint64_t peak_rss_bytes() {
 
 class ThermoWriter {
  public:
-  ThermoWriter(const fs::path& path, bool append) {
-    const bool header = !append || !fs::exists(path) || fs::file_size(path) == 0;
-    out_.open(path, append ? std::ios::app : std::ios::trunc);
-    if (!out_) throw InputError("cannot write '" + path.string() + "'");
-    if (header) {
-      write_line(
-          "phase\ttime\tevents\tcollisions\tcollisions_per_particle\ttemperature\tpressure\t"
-          "compressibility\tkinetic_energy\tmean_free_time\trotational_temperature\t"
-          "dissipated_energy\twall_work\tpotential_energy\n");
-    }
-  }
-  // One row per line, each flushed at once: an interrupted run keeps every earlier row.
+  static constexpr const char* kHeader =
+      "phase\ttime\tevents\tcollisions\tcollisions_per_particle\ttemperature\tpressure\t"
+      "compressibility\tkinetic_energy\tmean_free_time\trotational_temperature\t"
+      "dissipated_energy\twall_work\tpotential_energy\n";
+  // A new file, or (a continued run) the existing one cut to the `keep_rows` rows the
+  // continued state had written (all complete rows when not recorded).
+  ThermoWriter(const fs::path& path, bool append, std::optional<std::uint64_t> keep_rows)
+      : file_(append ? LineFile(path, kHeader, keep_rows) : LineFile::create(path, kHeader)) {}
+  // One row per line, each written whole or not at all (io/line_file.hpp): an interrupted run
+  // keeps every earlier row, a failed write (InputError) leaves none torn.
   // Granular columns: rotational temperature, and the energy dissipated and the work done by
   // moving walls since the start of the simulation (zero for elastic hard spheres).
   // potential_energy: of the stepped potentials (0 for hard spheres), or the elastic energy of
@@ -171,21 +371,17 @@ class ThermoWriter {
     double potential_energy = 0.0;
   };
   void write(const std::string& phase, const ThermoRow& r, const Granular& g) {
-    write_line(fmt::format(
+    file_.append(fmt::format(
         "{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t"
         "{:.17g}\t{:.17g}\t{:.17g}\n",
         phase, r.at.time, r.at.events, r.at.collisions, r.collisions_per_particle, r.temperature,
         r.pressure, r.compressibility, r.kinetic_energy, r.mean_free_time, g.rotational_temperature,
         g.dissipated, g.wall_work, g.potential_energy));
   }
+  std::uint64_t rows() const { return file_.rows(); }
 
  private:
-  void write_line(const std::string& line) {
-    out_ << line;
-    out_.flush();
-  }
-
-  std::ofstream out_;
+  LineFile file_;
 };
 
 // When the periodic outputs of a phase are due, in collisions (not time: the same schedule at
@@ -229,6 +425,8 @@ struct PhaseLength {
   // A phase in time resumed from a restart file: its end as recorded (value is then what was
   // left), so that it ends where the interrupted run would have, bit for bit.
   double end = std::numeric_limits<double>::quiet_NaN();
+  // The same for a phase in collisions: the collision count it ends at (0: value from now).
+  std::uint64_t target = 0;
 };
 
 // The equilibration a restart file leaves to do, in the unit it was started in (its recorded end
@@ -259,6 +457,31 @@ inline PhaseLength production_length(const RunConfig& r) {
 inline PhaseLength equilibration_length(const RunConfig& r) {
   return r.equilibration_time >= 0.0 ? PhaseLength{r.equilibration_time, true}
                                      : PhaseLength{r.equilibration_collisions_per_particle, false};
+}
+
+// Whether the run-length keys changed at a restart (then a new length counts from now).
+inline bool length_given_anew(const std::optional<RestartPlan>& plan) {
+  if (!plan) return false;
+  for (const std::string& k : plan->resumed)
+    if (k == "run.collisions_per_particle" || k == "run.time") return true;
+  return false;
+}
+
+// The production of a continued run: an unfinished one (the restart file records its end) is
+// completed, as one uninterrupted run would be, unless the config gives the length anew; a
+// finished one is extended by the config's length.
+inline PhaseLength continued_production(const RunConfig& r, const RunProgress& resumed,
+                                        const std::optional<RestartPlan>& plan, double now,
+                                        std::uint64_t collisions) {
+  PhaseLength length = production_length(r);
+  if (length_given_anew(plan)) return length;
+  if (length.in_time && std::isfinite(resumed.production_end_time)) {
+    length.end = resumed.production_end_time;
+    length.value = std::max(0.0, length.end - now);
+  } else if (!length.in_time && resumed.production_target > collisions) {
+    length.target = resumed.production_target;
+  }
+  return length;
 }
 
 // When the periodic outputs are due with output.interval_unit = "time": at the multiples of
@@ -332,6 +555,49 @@ void write_dem_restart(const fs::path& path, const DemIntegrator<D>& dem,
   s.cell.assign(n, 0);
   s.collision_count.resize(n, 0);
   write_restart(path, s, rng, progress);
+}
+
+// The ideal-gas estimate of how far and how long a particle flies between collisions, from the
+// mean density, the mean diameter and the rms speed (the Boltzmann mean free path
+// 1 / (sqrt 2 n pi sigma^2) in 3D, 1 / (2 sqrt 2 n sigma) in 2D: Chapman and Cowling, The
+// Mathematical Theory of Non-uniform Gases, 3rd ed. 1970, ch. 5). Without a field the
+// density is never lower than the mean, so the estimate never makes a possible run look
+// impossible by more than the estimate's own factor of order one.
+struct FlightEstimate {
+  double mean_free_path = 0.0, mean_free_time = 0.0;
+};
+// n particles in a volume, sigma: their mean diameter (or one of the same volume), v_rms.
+template <int D>
+FlightEstimate estimate_flight(double n, double volume, double sigma, double v_rms) {
+  const double density = n / volume;
+  FlightEstimate e;
+  e.mean_free_path = D == 3 ? 1.0 / (std::sqrt(2.0) * density * M_PI * sigma * sigma)
+                            : 1.0 / (2.0 * std::sqrt(2.0) * density * sigma);
+  e.mean_free_time = v_rms > 0.0 ? e.mean_free_path / v_rms : kNeverTime;
+  return e;
+}
+
+// The diameter of the sphere (disk) of the mean particle volume (area).
+template <int D>
+double mean_volume_diameter(double particle_volume, double n) {
+  const double v = particle_volume / n;
+  return D == 3 ? std::cbrt(6.0 * v / M_PI) : std::sqrt(4.0 * v / M_PI);
+}
+
+// A run measured in collisions in a system that can hardly collide (two particles in a box of
+// 1e9, diameters of 1e-30) would run for ever: InputError when a phase of `collisions` (its
+// target collision count) would take more than 1e15 units of work, given the work one
+// collision takes (events per collision, or DEM steps per collision).
+inline void check_collisions_can_happen(double work_per_collision, double collisions,
+                                        const FlightEstimate& flight, const char* unit) {
+  if (!(work_per_collision * collisions > 1e15)) return;
+  throw InputError(fmt::format(
+      "the run is measured in collisions, but this system hardly ever collides: the mean free "
+      "path is about {:.3g} (mean free time {:.3g}), so each collision takes some {:.3g} {} and "
+      "the run some {:.3g}; give its length in simulated time instead (run.time, "
+      "run.equilibration_time), or check the box and the diameters",
+      flight.mean_free_path, flight.mean_free_time, work_per_collision, unit,
+      work_per_collision * collisions));
 }
 
 // A phase's output schedule, in collisions or in time (intervals_in_time): the other part of

@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "run/environment_setup.hpp"
+#include "run/frozen_clock.hpp"
 #include "run/run_support.hpp"
 #include "run/soft_tables_setup.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -32,6 +33,12 @@ Simulation<D>::Simulation(const Config& config,
   }
   ParticleSystem<D> start = run_detail::build_start_state<D>(config, restart_file, rng_, progress_);
   run_detail::check_restart_integrator(restart_file, progress_, "event");
+  std::optional<RestartPlan> plan;
+  if (restart_file) {
+    plan = run_detail::plan_continuation<D>(config, start, progress_, restart_file->string());
+    config_ = plan->used;
+  }
+  const bool resume = plan && !plan->repredict;
   n_ = start.size();
   mass_ = start.mass;
   radius_.resize(n_);
@@ -39,21 +46,24 @@ Simulation<D>::Simulation(const Config& config,
   species_ = start.species;
   species_names_ = start.species_names;
   for (int a = 0; a < D; ++a) volume_ *= start.box[a];
-  Environment<D> environment = make_environment<D>(config, start);
-  if (environment.soft_spheres() && config.soft.tables) {
+  Environment<D> environment = make_environment<D>(config_, start);
+  if (environment.soft_spheres() && config_.soft.tables) {
     // The tables `kairos run` would use (the same speeds covered: the same maps, bit for bit).
     SoftTableSettings settings;
-    settings.tolerance = config.soft.table_tolerance;
-    settings.cache_dir = config.soft.table_cache;
+    settings.tolerance = config_.soft.table_tolerance;
+    settings.cache_dir = config_.soft.table_cache;
     settings.max_speed = progress_.soft_table_max_speed;
     const std::vector<SoftTableUse> tables = attach_soft_tables(environment, start, settings);
     if (!tables.empty()) progress_.soft_table_max_speed = tables.front().spec.max_normal_speed;
   }
   EngineOptions options;
-  options.defer_soft_releases = config.soft.defer_releases;
+  options.defer_soft_releases = config_.soft.defer_releases;
   engine_ = std::make_unique<EventEngine<D, CalendarQueue>>(
-      std::move(start), restart_file ? StartMode::kResume : StartMode::kPredict, options,
-      environment);
+      std::move(start), resume ? StartMode::kResume : StartMode::kPredict, options, environment);
+  progress_.config = to_toml(config_);
+  if (plan && plan->repredict) run_detail::check_no_overlap_after_new_physics(*engine_);
+  if (plan) run_detail::print_restart_note(*plan, restart_file->string());
+  clock_watch_ = std::make_unique<FrozenClockWatch>(*engine_);
   // A saved state continues with production.
   progress_.equilibration_remaining = 0.0;
   progress_.equilibration_end_time = std::numeric_limits<double>::quiet_NaN();
@@ -66,6 +76,7 @@ template <int D>
 bool Simulation<D>::run_while(const std::function<bool()>& more, const KeepGoing& keep_going) {
   while (more()) {
     if (engine_->step() == EventKind::kNone) return false;
+    if (clock_watch_->frozen(*engine_)) throw InputError(clock_watch_->describe(*engine_));
     if ((engine_->counters().events & 0x3fffu) == 0 && keep_going && !keep_going()) return false;
   }
   return true;

@@ -24,6 +24,7 @@ namespace kairos {
 template <int D, class Queue>
 class EventEngine;
 class CalendarQueue;
+class FrozenClockWatch;
 
 template <int D>
 class Simulation {
@@ -38,7 +39,8 @@ class Simulation {
 
   // Events until the clock reaches t (>= time()), which it then shows exactly (no event needs
   // to happen at t). Returns false if stopped early by `keep_going` returning false (asked
-  // every 16 384 events, e.g. to let Python handle Ctrl-C).
+  // every 16 384 events, e.g. to let Python handle Ctrl-C). A frozen clock (run/frozen_clock.hpp)
+  // throws InputError saying who collides and what to change; the state stays readable.
   using KeepGoing = std::function<bool()>;
   bool advance_to_time(double t, const KeepGoing& keep_going = {});
   // Until `count` more events / collisions have happened (or no event is left: then false).
@@ -75,6 +77,7 @@ class Simulation {
 
   Config config_;
   std::unique_ptr<EventEngine<D, CalendarQueue>> engine_;
+  std::unique_ptr<FrozenClockWatch> clock_watch_;
   std::mt19937_64 rng_;
   RunProgress progress_;
   std::size_t n_ = 0;

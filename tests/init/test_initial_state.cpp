@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -448,6 +449,48 @@ TEST(InitMaxOverlap, KnownPairAcrossTheBoundary) {
   EXPECT_EQ(wj, kNoParticle);
   EXPECT_EQ(max_overlap<3>(box, {}, {}), 0.0);
   EXPECT_THROW((void)max_overlap<3>(box, pos, {1.0}), std::invalid_argument);
+}
+
+// Along an axis with walls or an open face there is no periodic image: particles at opposite
+// faces are far apart (a pile's fcc start has its bottom and top layers a box height apart, and
+// a minimum image on that axis reported them overlapping). The cell search must agree with
+// the brute force in random boxes with every combination of bounded axes, positions beyond the
+// box on the bounded axes included (grains thrown out of an open top).
+TEST(MaxOverlap, BoundedAxesTakeNoMinimumImage) {
+  const std::array<double, 3> box{4.0, 4.0, 6.0};
+  std::vector<std::array<double, 3>> pos{{1.0, 1.0, 0.1}, {1.0, 1.0, 5.9}};
+  const std::vector<double> d{1.0, 1.0};
+  EXPECT_NEAR(max_overlap<3>(box, pos, d), 0.8, 1e-12);  // periodic z: 0.2 apart through it
+  const std::array<bool, 3> open_z{true, true, false};
+  EXPECT_EQ(max_overlap<3>(box, open_z, pos, d), 0.0);
+  EXPECT_EQ(max_overlap_bruteforce<3>(box, open_z, pos, d), 0.0);
+  pos[1][2] = 0.6;
+  std::uint32_t i = 7, j = 7;
+  EXPECT_NEAR(max_overlap<3>(box, open_z, pos, d, &i, &j), 0.5, 1e-12);
+  EXPECT_EQ(i, 0u);
+  EXPECT_EQ(j, 1u);
+}
+
+TEST(MaxOverlap, BoundedAxesAgreeWithBruteForce) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int trial = 0; trial < 64; ++trial) {
+    std::array<bool, 3> periodic{(trial & 1) != 0, (trial & 2) != 0, (trial & 4) != 0};
+    const std::array<double, 3> box{5.0 + 3.0 * u(rng), 4.0 + 2.0 * u(rng), 6.0 + 4.0 * u(rng)};
+    std::vector<std::array<double, 3>> pos(60);
+    std::vector<double> d(60);
+    for (std::size_t k = 0; k < pos.size(); ++k) {
+      for (int a = 0; a < 3; ++a) {
+        // Bounded axes: some positions outside [0, L).
+        pos[k][a] = periodic[a] ? u(rng) * box[a] : (1.4 * u(rng) - 0.2) * box[a];
+      }
+      d[k] = 0.3 + 0.5 * u(rng);
+    }
+    // The cell search shifts bounded axes (round-off in the differences only).
+    EXPECT_NEAR(max_overlap<3>(box, periodic, pos, d),
+                max_overlap_bruteforce<3>(box, periodic, pos, d), 1e-12)
+        << "trial " << trial;
+  }
 }
 
 }  // namespace

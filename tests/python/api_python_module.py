@@ -51,16 +51,19 @@ def min_gap(x, radii, box):
 class Module(kt.KairosTestCase):
     def cli_and_module_agree(self, config, time):
         cfg = self.write_config(config)
-        self.run_ok("run", cfg, "-o", self.path("cli"))
+        # One directory per call: a new run never overwrites an earlier one's outputs.
+        self.runs = getattr(self, "runs", 0) + 1
+        cli = "cli-%d" % self.runs
+        self.run_ok("run", cfg, "-o", self.path(cli))
         sim = kairos.Simulation(cfg)
         self.assertTrue(sim.advance(time=time))
         self.assertEqual(sim.time, time)
         sim.save(self.path("module.gsd"))
-        a = kt.read_exact_state(self.path("cli", "restart.gsd"))
+        a = kt.read_exact_state(self.path(cli, "restart.gsd"))
         b = kt.read_exact_state(self.path("module.gsd"))
         for name in kt.EXACT_CHUNKS:
             self.assertTrue(np.array_equal(a[name], b[name]), name)
-        summary = self.summary(self.path("cli"))
+        summary = self.summary(self.path(cli))
         self.assertEqual(sim.collisions, summary["event_counts"]["total_collisions_since_start"])
         # The temperature of summary.json (D (N - 1) degrees of freedom, peculiar under shear).
         self.assertAlmostEqual(sim.temperature(), summary["temperature"],

@@ -43,7 +43,7 @@ class DemRuns(kt.KairosTestCase):
         # One collision per particle: the runs at dt and dt/2 meet the same collisions, whose
         # energy errors shrink as dt^2 (a factor ~4; asserted > 2.5).
         for soft in (DASHPOT, HERTZ):
-            base = self.run_dem("auto", dem_config(soft, production=1.0))
+            base = self.run_dem("auto-" + soft["model"], dem_config(soft, production=1.0))
             dt = 2.0 * base["dem"]["time_step"]  # t_c / 25
             errors = []
             for f in (1.0, 0.5):

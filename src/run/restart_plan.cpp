@@ -1,0 +1,198 @@
+#include "run/restart_plan.hpp"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string_view>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "core/error.hpp"
+
+namespace kairos {
+
+namespace {
+
+using Flat = std::map<std::string, std::string>;
+
+// Every leaf of a TOML tree under its dotted path, arrays of tables by index (wall[2].face),
+// other arrays as one value.
+void flatten(const toml::node& node, const std::string& path, Flat& out) {
+  if (const toml::table* t = node.as_table()) {
+    for (auto&& [key, value] : *t)
+      flatten(value, path.empty() ? std::string(key.str()) : path + "." + std::string(key.str()),
+              out);
+    return;
+  }
+  if (const toml::array* a = node.as_array();
+      a != nullptr && !a->empty() && a->is_array_of_tables()) {
+    for (std::size_t k = 0; k < a->size(); ++k)
+      flatten(*a->get(k), fmt::format("{}[{}]", path, k), out);
+    return;
+  }
+  std::ostringstream text;
+  node.visit([&](auto&& leaf) { text << leaf; });
+  out[path] = text.str();
+}
+
+Flat flat_config(const Config& config) {
+  Flat out;
+  flatten(toml::parse(to_toml(config)), "", out);
+  return out;
+}
+
+enum class Effect { kResume, kRepredict, kIgnore, kRefuse };
+
+// The key without its array indices: boundary.wall[2].restitution -> boundary.wall.restitution.
+std::string generic(const std::string& key) {
+  static const std::regex index(R"(\[[0-9]+\])");
+  return std::regex_replace(key, index, "");
+}
+
+bool starts_with(std::string_view s, std::string_view prefix) {
+  return s.substr(0, prefix.size()) == prefix;
+}
+
+// The contact law of a wall: how a collision ends, never when it happens.
+constexpr std::array<std::string_view, 7> kWallLaw = {
+    "restitution",        "restitution_model",      "restitution_speed",
+    "restitution_table",  "tangential_restitution", "friction",
+    "elastic_below_speed"};
+
+Effect effect_of(const std::string& key) {
+  const std::string k = generic(key);
+  if (k == "system.dimension") return Effect::kRefuse;
+  if (starts_with(k, "system.species.")) {
+    if (k == "system.species.inertia_factor") return Effect::kResume;  // a contact law's
+    if (k == "system.species.fraction") return Effect::kIgnore;
+    return Effect::kRefuse;  // name, diameter, mass: the particles as stored
+  }
+  if (starts_with(k, "system.")) return Effect::kIgnore;
+  if (starts_with(k, "run.") || starts_with(k, "output.") || starts_with(k, "driving."))
+    return Effect::kResume;
+  if (k == "contact.sleep_speed") return Effect::kRepredict;  // sleepers predict nothing
+  if (starts_with(k, "contact.")) return Effect::kResume;
+  if (starts_with(k, "boundary.wall.")) {
+    const std::string_view leaf =
+        std::string_view(k).substr(std::string_view("boundary.wall.").size());
+    if (std::find(kWallLaw.begin(), kWallLaw.end(), leaf) != kWallLaw.end()) return Effect::kResume;
+    return Effect::kRepredict;
+  }
+  // The maps' tables and their cache decide how a future contact ends, not when.
+  if (k == "soft.table_cache" || k == "soft.tables" || k == "soft.table_tolerance")
+    return Effect::kResume;
+  return Effect::kRepredict;  // field, boundary, potential, bond, soft laws; anything new
+}
+
+}  // namespace
+
+RestartPlan plan_restart(const Config& now, const std::string& stored, bool contacts_in_progress,
+                         double before_time, const std::string& restart_file) {
+  RestartPlan plan;
+  plan.used = now;
+  if (stored.empty()) return plan;  // an older file: what it was run with is unknown
+  Config before;
+  try {
+    before = parse_config(stored, restart_file + " (its kairos/run/config)");
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("restart file '{}': its stored configuration does not read: {}",
+                                 restart_file, e.what()));
+  }
+  plan.stored_config = true;
+  plan.stored_gravity = before.field.gravity;
+  plan.used.system = before.system;  // the values that made the state
+  const Flat a = flat_config(before), b = flat_config(now);
+  std::vector<std::string> keys;
+  for (const auto& [key, value] : a)
+    if (auto it = b.find(key); it == b.end() || it->second != value) keys.push_back(key);
+  for (const auto& [key, value] : b)
+    if (!a.contains(key)) keys.push_back(key);
+  std::sort(keys.begin(), keys.end());
+  for (const std::string& key : keys) {
+    const auto was = a.find(key), is = b.find(key);
+    const std::string from = was == a.end() ? "absent" : was->second;
+    const std::string to = is == b.end() ? "absent" : is->second;
+    // The Lees-Edwards offset runs from t = 0 (shear_rate * L_y * t): another rate would
+    // displace the images at once by the difference.
+    if (generic(key) == "boundary.shear_rate" && before_time > 0.0) {
+      throw InputError(fmt::format(
+          "restart file '{}': boundary.shear_rate was {} and is now {}: the Lees-Edwards images "
+          "are displaced by shear_rate * L_y * t from t = 0, so a new rate at t = {} would move "
+          "them at once; start a new run from the state with system.initial_state = \"{}\" "
+          "(its clock starts at 0)",
+          restart_file, from, to, before_time, restart_file));
+    }
+    switch (effect_of(key)) {
+      case Effect::kRefuse:
+        throw InputError(fmt::format(
+            "restart file '{}': {} was {} and is now {}: a restart continues the particles as "
+            "they are stored (sizes, masses, species); to change them start a new run from the "
+            "state with system.initial_state = \"{}\"",
+            restart_file, key, from, to, restart_file));
+      case Effect::kIgnore:
+        plan.ignored.push_back(key);
+        break;
+      case Effect::kResume:
+        plan.resumed.push_back(key);
+        break;
+      case Effect::kRepredict:
+        if (contacts_in_progress) {
+          throw InputError(fmt::format(
+              "restart file '{}': {} was {} and is now {}, but the state holds soft contacts "
+              "in progress whose end was computed under the old physics; continue it "
+              "unchanged, or start a new run from its state with system.initial_state",
+              restart_file, key, from, to));
+        }
+        // A table added or removed (a wall, a potential) is named once, not key by key.
+        if (was == a.end() || is == b.end()) {
+          const std::string element = key.substr(0, key.rfind(']') + 1);
+          if (!element.empty() && element.back() == ']') {
+            if (std::find(plan.changed.begin(), plan.changed.end(), element) == plan.changed.end())
+              plan.changed.push_back(element);
+            plan.repredict = true;
+            break;
+          }
+        }
+        plan.changed.push_back(key);
+        plan.repredict = true;
+        break;
+    }
+  }
+  return plan;
+}
+
+std::string describe_restart(const RestartPlan& plan, const std::string& restart_file) {
+  const auto list = [](const std::vector<std::string>& keys) {
+    std::string out;
+    for (std::size_t k = 0; k < keys.size() && k < 8; ++k) out += (k ? ", " : "") + keys[k];
+    if (keys.size() > 8) out += fmt::format(" and {} more", keys.size() - 8);
+    return out;
+  };
+  std::string text;
+  if (!plan.stored_config) {
+    return fmt::format(
+        "'{}' was written by an older Kairos and does not record its configuration: its "
+        "predictions are resumed as they are, which is right only if gravity, shear, walls, "
+        "potentials, bonds and soft laws are unchanged (to change them, start a new run from "
+        "its state with system.initial_state)",
+        restart_file);
+  }
+  if (plan.repredict) {
+    text = fmt::format(
+        "continued with new physics ({} changed): every event is predicted afresh from the "
+        "restored state; not bit-identical to a run that had it from the start",
+        list(plan.changed));
+  }
+  if (!plan.ignored.empty()) {
+    text += fmt::format(
+        "{}{} not used: a restart continues the stored state (config.toml records "
+        "the values that made it)",
+        text.empty() ? "" : "; ", list(plan.ignored));
+  }
+  return text;
+}
+
+}  // namespace kairos

@@ -1,0 +1,167 @@
+"""Outputs that an interrupted or failed run never loses, tears or duplicates:
+
+- kill -9 (or SIGINT) and then --restart into the same directory leaves thermo.tsv,
+  trajectory.gsd and the final state exactly as one uninterrupted run writes them, row for row
+  and frame for frame (the rows and frames written after the restart point are dropped, the
+  unfinished production is completed);
+- a failed write (a file size limit: RLIMIT_FSIZE) stops the run with an error naming the file,
+  a non-zero exit, no torn row, and the restart file still written;
+- two runs never share an output directory, and a new run never overwrites an earlier run's
+  outputs unless asked (--overwrite).
+"""
+
+import os
+import resource
+import signal
+import subprocess
+import time
+
+import numpy as np
+
+import kairos_testlib as kt
+
+
+def timed_config():
+    # Outputs at multiples of their intervals in time; the restart file every 1.0.
+    config = kt.base_config(particles=2000, packing_fraction=0.3, seed=11)
+    config["run"] = {"equilibration_time": 0.0, "time": 40.0}
+    config["output"].update({"thermo_interval": 0.05, "trajectory_interval": 0.5,
+                             "restart_interval": 1.0})
+    return config
+
+
+def collision_config():
+    # Intervals in collisions per particle that do not divide each other: the continued run
+    # must keep the stored schedule to write the rows an uninterrupted run writes.
+    config = kt.base_config(particles=2000, packing_fraction=0.3, seed=12, equilibration=0.5,
+                            production=2000.0)
+    config["output"].update({"thermo_interval": 0.3, "trajectory_interval": 70.0,
+                             "restart_interval": 1.1})
+    return config
+
+
+def frames(path):
+    traj = kt.open_trajectory(path)
+    return [np.asarray(f.particles.position) for f in traj], [float(f.log["time"][0]) for f in traj]
+
+
+class ContinuedRunsLeaveOneRunsOutputs(kt.KairosTestCase):
+    def start(self, config, out):
+        cfg = self.write_config(config, "config.toml")
+        proc = subprocess.Popen([kt.KAIROS, "run", cfg, "-o", out], cwd=self.tmp,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.addCleanup(lambda: proc.poll() is None and proc.kill())
+        return cfg, proc
+
+    def interrupt_and_continue(self, config, sig):
+        whole = self.path("whole")
+        self.run_ok("run", self.write_config(config, "whole.toml"), "-o", whole, timeout=600)
+        out = self.path("out")
+        cfg, proc = self.start(config, out)
+        restart = os.path.join(out, "restart.gsd")
+        deadline = time.monotonic() + 120
+        while not os.path.exists(restart):  # the first periodic restart file
+            self.assertIsNone(proc.poll(), "the run ended before it was interrupted")
+            self.assertLess(time.monotonic(), deadline)
+            time.sleep(0.01)
+        time.sleep(0.2)
+        proc.send_signal(sig)
+        proc.communicate(timeout=60)
+        self.assertNotEqual(proc.returncode, 0)
+        self.run_ok("run", cfg, "--restart", restart, "-o", out, timeout=600)
+        with open(os.path.join(out, "thermo.tsv")) as f, \
+                open(os.path.join(whole, "thermo.tsv")) as g:
+            self.assertEqual(f.read(), g.read(), "thermo.tsv differs from one uninterrupted run's")
+        a, ta = frames(os.path.join(out, "trajectory.gsd"))
+        b, tb = frames(os.path.join(whole, "trajectory.gsd"))
+        self.assertEqual(ta, tb)
+        for x, y in zip(a, b):
+            self.assertTrue(np.array_equal(x, y))
+        s = kt.read_exact_state(os.path.join(out, "restart.gsd"))
+        w = kt.read_exact_state(os.path.join(whole, "restart.gsd"))
+        for name in kt.EXACT_CHUNKS:
+            self.assertTrue(np.array_equal(s[name], w[name]), name)
+
+    def test_kill_9_then_restart_in_time(self):
+        self.interrupt_and_continue(timed_config(), signal.SIGKILL)
+
+    def test_kill_9_then_restart_in_collisions(self):
+        self.interrupt_and_continue(collision_config(), signal.SIGKILL)
+
+    def test_sigint_then_restart(self):
+        # The rows and frame written at the stop are the interrupted run's, not the whole's.
+        self.interrupt_and_continue(timed_config(), signal.SIGINT)
+
+
+class FailedWrites(kt.KairosTestCase):
+    def test_a_file_size_limit_stops_the_run_without_a_torn_row(self):
+        # thermo.tsv grows past the limit long before the run ends; the restart file is
+        # smaller than the limit and is still written.
+        config = kt.base_config(particles=2000, packing_fraction=0.3, seed=3, production=1500.0)
+        config["output"].update({"thermo_interval": 0.1, "trajectory": False})
+        cfg = self.write_config(config)
+        limit = 400000
+
+        def limit_file_size():
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # write() then fails with EFBIG
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+        out = self.path("out")
+        result = subprocess.run([kt.KAIROS, "run", cfg, "-o", out], cwd=self.tmp,
+                                capture_output=True, text=True, timeout=300,
+                                preexec_fn=limit_file_size)
+        line = self.assert_user_error(result, "thermo.tsv", "File too large")
+        self.assertIn("stopped early (write_failed)", result.stdout)
+        with open(os.path.join(out, "thermo.tsv")) as f:
+            text = f.read()
+        self.assertTrue(text.endswith("\n"), "a torn last row")
+        self.assertLessEqual(len(text), limit)
+        header, rows, _ = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        for row in rows:
+            self.assertEqual(len(row), len(header))
+        s = self.summary(out)
+        self.assertEqual(s["stop_reason"], "write_failed")
+        self.assertIn("thermo.tsv", s["error"])
+        state = kt.read_exact_state(os.path.join(out, "restart.gsd"))
+        self.assertEqual(float(state["kairos/time"][0]), s["sim_time"])
+        # The run stopped at the failure, far short of its length.
+        self.assertLess(s["production_collisions_per_particle"], 1500.0)
+        self.assertNotIn("trajectory.gsd", s["outputs"])
+        del line
+
+
+class OutputDirectories(kt.KairosTestCase):
+    def test_a_directory_in_use_is_refused(self):
+        config = kt.base_config(particles=4000, packing_fraction=0.4, production=100000.0)
+        cfg = self.write_config(config)
+        out = self.path("out")
+        proc = subprocess.Popen([kt.KAIROS, "run", cfg, "-o", out], cwd=self.tmp,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.addCleanup(lambda: proc.poll() is None and proc.kill())
+        deadline = time.monotonic() + 60
+        while not os.path.exists(os.path.join(out, "config.toml")):
+            self.assertLess(time.monotonic(), deadline)
+            time.sleep(0.02)
+        result = self.kairos("run", cfg, "-o", out, "--overwrite")
+        self.assert_user_error(result, "is in use by another run", "process %d" % proc.pid)
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=60)
+
+    def test_earlier_outputs_are_kept_unless_overwrite(self):
+        config = kt.base_config(production=2.0)
+        cfg = self.write_config(config)
+        out = self.path("out")
+        self.run_ok("run", cfg, "-o", out)
+        before = self.summary(out)
+        result = self.kairos("run", cfg, "-o", out)
+        self.assert_user_error(result, "holds the outputs of an earlier run", "--restart",
+                               "--overwrite")
+        self.assertEqual(self.summary(out), before)
+        # Continuing it is allowed; so is replacing it when asked.
+        self.run_ok("run", cfg, "-o", out, "--restart", os.path.join(out, "restart.gsd"))
+        self.run_ok("run", cfg, "-o", out, "--overwrite")
+        self.assertFalse(self.summary(out)["restarted"])
+
+
+if __name__ == "__main__":
+    kt.main()
