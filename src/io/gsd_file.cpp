@@ -94,6 +94,34 @@ void write_at(int fd, const void* src, std::size_t bytes, std::uint64_t offset,
   }
 }
 
+[[noreturn]] void not_regular(const std::filesystem::path& path, mode_t mode) {
+  const char* kind = S_ISDIR(mode)    ? "a directory"
+                     : S_ISFIFO(mode) ? "a FIFO"
+                     : S_ISCHR(mode)  ? "a character device"
+                     : S_ISBLK(mode)  ? "a block device"
+                     : S_ISSOCK(mode) ? "a socket"
+                                      : "a special file";
+  throw InputError("'" + path.string() + "' is not a regular file (it is " + kind +
+                   "): give the path of a GSD file");
+}
+
+// Opens an existing GSD file. Only regular files: opening a FIFO would block until some other
+// process writes to it, and a device or directory is never a GSD file. The path is checked
+// before opening (opening some devices has side effects) and the open file once more (the path
+// may have been replaced in between); O_NONBLOCK keeps the open itself from blocking and has
+// no effect on reads of a regular file.
+int open_regular(const std::filesystem::path& path, int flags, const char* what) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) not_regular(path, st.st_mode);
+  const int fd = ::open(path.c_str(), flags | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) fail(path, std::string(what) + ": " + std::strerror(errno));
+  if (::fstat(fd, &st) == 0 && !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    not_regular(path, st.st_mode);
+  }
+  return fd;
+}
+
 void sync(int fd, const std::filesystem::path& path) {
   if (::fsync(fd) != 0) fail(path, std::string("fsync failed: ") + std::strerror(errno));
 }
@@ -272,8 +300,7 @@ Writer Writer::create(const std::filesystem::path& path, std::string_view applic
 }
 
 Writer Writer::open_append(const std::filesystem::path& path) {
-  const int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
-  if (fd < 0) fail(path, std::string("cannot open for appending: ") + std::strerror(errno));
+  const int fd = open_regular(path, O_RDWR, "cannot open for appending");
   auto s = std::make_unique<State>(path, fd);
   Contents c = load(fd, path);
   if (c.names.size() > 0xFFFF) fail(path, "corrupt namelist (more than 65535 names)");
@@ -445,8 +472,7 @@ struct Reader::State {
 };
 
 Reader::Reader(const std::filesystem::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) fail(path, std::string("cannot open: ") + std::strerror(errno));
+  const int fd = open_regular(path, O_RDONLY, "cannot open");
   s_ = std::make_unique<State>(path, fd);
   s_->contents = load(fd, path);
   const auto& names = s_->contents.names;

@@ -76,7 +76,7 @@ class Writer {
   static Writer create(const std::filesystem::path& path, std::string_view application,
                        std::string_view schema = "hoomd",
                        std::uint32_t schema_version = (1u << 16) | 4u);
-  // Opens an existing GSD 2.x file to append frames; InputError if it is not one.
+  // Opens an existing GSD 2.x file (a regular file) to append frames; InputError if it is not.
   static Writer open_append(const std::filesystem::path& path);
 
   Writer(Writer&&) noexcept;
@@ -107,7 +107,9 @@ class Writer {
 // Reads a GSD 2.x file. The header, namelist and index are loaded at construction.
 class Reader {
  public:
-  explicit Reader(const std::filesystem::path& path);  // InputError if missing/not GSD 2.x
+  // InputError if missing, not GSD 2.x, or not a regular file (a FIFO, directory or device is
+  // refused at once: opening a FIFO would wait for a writer).
+  explicit Reader(const std::filesystem::path& path);
   Reader(Reader&&) noexcept;
   Reader& operator=(Reader&&) noexcept;
   ~Reader();

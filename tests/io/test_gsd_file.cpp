@@ -12,9 +12,11 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
+#include "special_files.hpp"
 
 namespace fs = std::filesystem;
 using kairos::InputError;
@@ -304,6 +306,30 @@ TEST_F(GsdFile, MissingFileIsAnInputError) {
   EXPECT_THROW(Reader{file("nope.gsd")}, InputError);
   EXPECT_THROW(Writer::open_append(file("nope.gsd")), InputError);
   EXPECT_THROW(Writer::create(file("no/such/dir.gsd"), "test"), InputError);
+}
+
+// A FIFO, a directory or a device is refused at once: opening a FIFO for reading would wait
+// for a writer forever.
+TEST_F(GsdFile, SpecialFilesAreRefusedWithoutBlocking) {
+  kairos::testing::make_fifo(file("fifo.gsd"));
+  fs::create_directories(file("dir.gsd"));
+  const std::pair<fs::path, std::string> cases[] = {{file("fifo.gsd"), "a FIFO"},
+                                                    {file("dir.gsd"), "a directory"},
+                                                    {"/dev/null", "a character device"}};
+  for (const auto& [path, kind] : cases) {
+    std::string expected = "'";  // (not "'" + ...: a GCC 12 -Wrestrict false positive)
+    expected += path.string();
+    expected += "' is not a regular file (it is " + kind + ")";
+    for (const bool append : {false, true}) {
+      const std::string message = kairos::testing::refusal_without_blocking(path, [&] {
+        if (append)
+          (void)Writer::open_append(path);
+        else
+          (void)Reader{path};
+      });
+      EXPECT_NE(message.find(expected), std::string::npos) << message;
+    }
+  }
 }
 
 TEST_F(GsdFile, GarbageAndDamagedHeadersAreInputErrors) {

@@ -194,6 +194,17 @@ class ConfigErrors(kt.KairosTestCase):
         result = self.kairos("run", self.tmp)
         self.assert_user_error(result, os.path.basename(self.tmp))
 
+    def test_config_is_a_fifo(self):
+        # Reading a FIFO would wait for a writer forever: refused at once.
+        fifo = self.path("fifo.toml")
+        os.mkfifo(fifo)
+        result = self.kairos("run", fifo, timeout=30)
+        self.assert_user_error(result, "fifo.toml", "is not a regular file (it is a FIFO)")
+
+    def test_config_is_a_device(self):
+        result = self.kairos("run", "/dev/null", timeout=30)
+        self.assert_user_error(result, "/dev/null", "is not a regular file (it is a device)")
+
     def test_malformed_toml(self):
         self.check("[system]\nparticles = \npacking_fraction = 0.3\n", "bad.toml", "syntax")
 
@@ -260,15 +271,24 @@ class PistonErrors(kt.KairosTestCase):
 
 
 class InitialStateErrors(kt.KairosTestCase):
-    def run_from(self, gsd_path, dimension=3, *needles):
+    def run_from(self, gsd_path, dimension=3, *needles, timeout=kt.RUN_TIMEOUT):
         config = kt.base_config(dimension=dimension, production=1.0)
         config["system"] = {"dimension": dimension, "initial_state": gsd_path}
         path = self.write_config(config)
-        result = self.kairos("run", path, "-o", self.path("out"))
+        result = self.kairos("run", path, "-o", self.path("out"), timeout=timeout)
         return self.assert_user_error(result, *needles)
 
     def test_missing_initial_state(self):
         self.run_from(self.path("nothing-here.gsd"), 3, "system.initial_state", "nothing-here.gsd")
+
+    def test_initial_state_is_a_fifo(self):
+        fifo = self.path("fifo.gsd")
+        os.mkfifo(fifo)
+        self.run_from(fifo, 3, "fifo.gsd", "is not a regular file (it is a FIFO)", timeout=30)
+
+    def test_initial_state_is_a_directory(self):
+        os.mkdir(self.path("states"))
+        self.run_from(self.path("states"), 3, "states", "is not a regular file (it is a directory)")
 
     def test_initial_state_not_gsd(self):
         p = self.path("text.gsd")
@@ -364,6 +384,13 @@ class RestartErrors(kt.KairosTestCase):
         result = self.kairos("run", self.config, "-o", self.path("out"),
                              "--restart", self.path("adir"))
         self.assert_user_error(result, "adir")
+
+    def test_restart_from_fifo(self):
+        fifo = self.path("restart.gsd")
+        os.mkfifo(fifo)
+        result = self.kairos("run", self.config, "-o", self.path("out"), "--restart", fifo,
+                             timeout=30)
+        self.assert_user_error(result, "restart.gsd", "is not a regular file (it is a FIFO)")
 
     def test_restart_from_python_gsd_file(self):
         p = kt.write_hoomd_file(self.path("plain.gsd"), [[0, 0, 0], [2, 2, 2]], [10, 10, 10])
