@@ -144,6 +144,66 @@ struct Contents {
   std::uint64_t file_size;
 };
 
+// Why index entry `e` cannot be used ("" when it can): `prev_frame` is the frame of the entry
+// before it. Its data must lie inside the file: location + N * M * type size <= file size,
+// checked without overflow, so that no reader ever allocates for data the file cannot hold.
+std::string entry_problem(const Entry& e, const Contents& c, std::uint64_t prev_frame) {
+  const std::uint64_t size = type_size(static_cast<Type>(e.type));
+  if (size == 0) return "invalid type " + std::to_string(e.type);
+  if (e.flags != 0) return "invalid flags";
+  if (e.id >= c.names.size()) return "name id " + std::to_string(e.id) + " beyond the namelist";
+  if (e.frame < prev_frame || e.frame >= c.header.index_allocated_entries)
+    return "frame number " + std::to_string(e.frame) + " out of order";
+  const std::uint64_t location = static_cast<std::uint64_t>(e.location);
+  const bool inside = e.location > 0 && location <= c.file_size &&
+                      (e.N == 0 || e.M == 0 || e.N <= (c.file_size - location) / e.M / size);
+  if (!inside) {
+    return std::to_string(e.N) + " x " + std::to_string(e.M) + " " +
+           std::string(type_name(static_cast<Type>(e.type))) + " values at byte " +
+           std::to_string(e.location) + " lie beyond the end of the file (" +
+           std::to_string(c.file_size) + " bytes)";
+  }
+  return "";
+}
+
+// Whether some entry after slot k, of a frame after `frame`, is sound and inside the file.
+bool later_frame_intact(const Contents& c, std::size_t k, std::size_t used, std::uint64_t frame) {
+  for (std::size_t j = k + 1; j < used; ++j) {
+    const Entry& e = c.index[j];
+    if (e.frame > frame && entry_problem(e, c, frame).empty()) return true;
+  }
+  return false;
+}
+
+// The number of index entries to keep of the `used` slots. By the commit protocol a frame's data
+// is on disk before its entries, and the data of later frames lies after it: an unusable entry
+// is either the torn or truncated tail of the file (no later frame is intact), whose frame is
+// dropped with all later ones, or damage in the middle of the file, an InputError.
+std::size_t drop_torn_tail(const Contents& c, std::size_t used, const std::filesystem::path& path) {
+  std::uint64_t prev_frame = 0;
+  for (std::size_t k = 0; k < used; ++k) {
+    const Entry& e = c.index[k];
+    const std::string problem = entry_problem(e, c, prev_frame);
+    if (problem.empty()) {
+      prev_frame = e.frame;
+      continue;
+    }
+    const bool sane_frame = e.frame >= prev_frame && e.frame < c.header.index_allocated_entries;
+    const std::uint64_t frame = sane_frame ? e.frame : prev_frame;
+    if (later_frame_intact(c, k, used, frame)) {
+      const std::string chunk = e.id < c.names.size() ? "chunk '" + c.names[e.id] + "'" : "a chunk";
+      fail(path, "damaged index: the entry of " + chunk + " in frame " + std::to_string(frame) +
+                     " is invalid (" + problem +
+                     ") while later frames are intact; the file was changed or damaged after "
+                     "it was written");
+    }
+    std::size_t valid = k;
+    while (valid > 0 && c.index[valid - 1].frame >= frame) --valid;
+    return valid;
+  }
+  return used;
+}
+
 Contents load(int fd, const std::filesystem::path& path) {
   Contents c{};
   struct stat st {};
@@ -187,24 +247,7 @@ Contents load(int fd, const std::filesystem::path& path) {
   std::size_t used = 0;
   while (used < c.index.size() && c.index[used].location != 0) ++used;
   c.used_slots = used;
-  std::size_t valid = 0;
-  for (std::uint64_t prev_frame = 0; valid < used; ++valid) {
-    const Entry& e = c.index[valid];
-    const std::uint64_t size = type_size(static_cast<Type>(e.type));
-    const std::uint64_t location = static_cast<std::uint64_t>(e.location);
-    const bool ok = size != 0 && e.flags == 0 && e.id < c.names.size() && e.frame >= prev_frame &&
-                    e.frame < h.index_allocated_entries && e.location > 0 &&
-                    location <= c.file_size &&
-                    (e.N == 0 || e.M == 0 || e.N <= (c.file_size - location) / e.M / size);
-    if (!ok) {
-      // A torn or truncated tail: drop the frame the bad entry belongs to and all later ones.
-      const std::uint64_t cut = std::max(e.frame, prev_frame);
-      while (valid > 0 && c.index[valid - 1].frame >= cut) --valid;
-      break;
-    }
-    prev_frame = e.frame;
-  }
-  c.index.resize(valid);
+  c.index.resize(drop_torn_tail(c, used, path));
   return c;
 }
 

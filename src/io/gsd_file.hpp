@@ -19,8 +19,12 @@
 // the index that already holds the frame's entries are written and fsync'ed. Only then does the
 // frame become visible, by one write of its entries into free index slots or by one 256-byte
 // header write pointing at the new index; fsync. A process killed before that leaves only
-// unreferenced bytes at the end of the file. The Reader treats an invalid index entry (e.g. one
-// pointing past the end of a truncated file) as the end of the index and drops its frame.
+// unreferenced bytes at the end of the file. The Reader checks every index entry before anything
+// is allocated for it (its N x M values must lie inside the file, as must the index and the
+// namelist). An invalid entry (e.g. one pointing past the end of a truncated file) that no intact
+// later frame follows is a torn or truncated tail: it ends the index and its frame is dropped.
+// One that intact later frames follow cannot come from an interrupted write: an InputError
+// naming the chunk.
 //
 // Type::character (added in spec 2.1) is readable, but the Writer refuses it: python-gsd 2.7
 // reports a file holding such a chunk as corrupt. Store strings as int8 (as HOOMD does).

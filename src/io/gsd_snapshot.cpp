@@ -157,6 +157,23 @@ std::vector<T> require(const gsd::Reader& r, std::uint64_t frame, std::string_vi
   return std::move(*v);
 }
 
+// Before anything is allocated for the n particles that particles/N claims, the chunk holding
+// their positions (`positions`, n rows of `width` values, in frame f or 0) must hold them: a
+// damaged or hand-made file can claim any number, while the stored chunks are bounded by the
+// file's size (gsd::Reader). `who` names the file in messages.
+void check_positions_stored(const gsd::Reader& r, std::uint64_t f, std::size_t n,
+                            std::string_view positions, std::uint64_t width,
+                            const std::string& who) {
+  const auto info = r.find(f, positions) ? r.find(f, positions) : r.find(0, positions);
+  const std::string claim = who + ": particles/N = " + std::to_string(n) + " but ";
+  if (!info) throw InputError(claim + "the file has no chunk '" + std::string(positions) + "'");
+  if (info->N * info->M != n * width) {
+    throw InputError(claim + "chunk '" + std::string(positions) + "' holds " +
+                     std::to_string(info->N) + " x " + std::to_string(info->M) + " values, not " +
+                     std::to_string(n) + " x " + std::to_string(width) + ": the file is damaged");
+  }
+}
+
 // Default name of the one bond type of a file that has bonds but no bonds/types chunk (as
 // HOOMD files written without types): that of generated chains.
 constexpr const char* kDefaultBondType = "backbone";
@@ -472,6 +489,7 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
                      "D state but system.dimension = " + std::to_string(D));
   }
   const std::size_t n = require<std::uint32_t>(r, f, "particles/N", path, 1)[0];
+  check_positions_stored(r, f, n, "kairos/state/position", D, "'" + path.string() + "'");
   ParticleSystem<D> s;
   const auto box = require<double>(r, f, "kairos/box", path, D);
   for (int a = 0; a < D; ++a) s.box[a] = box[a];
@@ -675,8 +693,11 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   const std::size_t n = nv && !nv->empty() ? (*nv)[0] : 0;
   if (n < 2)
     throw InputError("system.initial_state '" + path.string() + "' holds fewer than 2 particles");
-  InitialState<D> s;
+  const std::string who = "system.initial_state '" + path.string() + "'";
   const bool exact = r.find(f, "kairos/position").has_value();
+  check_positions_stored(r, f, n, exact ? "kairos/position" : "particles/position", exact ? D : 3,
+                         who);
+  InitialState<D> s;
   if (exact) {
     const auto box = require<double>(r, f, "kairos/box", path, D);
     for (int a = 0; a < D; ++a) s.box[a] = box[a];
@@ -740,8 +761,8 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
       throw InputError("system.initial_state '" + path.string() + "': mass of particle " +
                        std::to_string(i) + " is not a positive number");
   }
-  if (auto tid = read_latest<std::uint32_t>(r, f, "particles/typeid")) {
-    s.species = *tid;
+  if (r.find(f, "particles/typeid") || r.find(0, "particles/typeid")) {
+    s.species = require<std::uint32_t>(r, f, "particles/typeid", path, n);
   } else {
     s.species.assign(n, 0);
   }

@@ -394,6 +394,64 @@ TEST_F(GsdFile, CorruptIndexEntryDropsItsFrame) {
   }
 }
 
+// An entry that claims more data than the file holds, or is otherwise invalid, followed by intact
+// later frames is damage, not an interrupted write: an InputError naming the file and the chunk
+// (reading on would silently lose every later frame).
+TEST_F(GsdFile, DamagedEntryBeforeIntactFramesIsAnInputError) {
+  {
+    auto w = Writer::create(file("m.gsd"), "test");
+    write_frames(w, 0, 3);
+  }
+  const std::string good = slurp(file("m.gsd"));
+  const auto index = get<std::uint64_t>(good, 8);
+  const std::size_t entry = index + 32 * 1;  // frame 0's particles/position
+  ASSERT_EQ(get<std::uint64_t>(good, entry), 0u);
+  ASSERT_EQ(get<std::uint64_t>(good, entry + 8), 1u);
+  std::string huge = good;
+  put<std::uint64_t>(huge, entry + 8, 50'000'000);  // N
+  std::string bad_type = good;
+  bad_type[entry + 30] = static_cast<char>(0x7F);
+  for (const std::string& damaged : {huge, bad_type}) {
+    spit(file("m.gsd"), damaged);
+    for (const bool append : {false, true}) {
+      try {
+        if (append)
+          (void)Writer::open_append(file("m.gsd"));
+        else
+          (void)Reader{file("m.gsd")};
+        ADD_FAILURE() << "a damaged entry before intact frames was accepted";
+      } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(file("m.gsd").string()), std::string::npos) << message;
+        EXPECT_NE(message.find("chunk 'particles/position' in frame 0"), std::string::npos)
+            << message;
+      }
+    }
+  }
+  spit(file("m.gsd"), huge);
+  try {
+    (void)Reader{file("m.gsd")};
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("50000000 x 3 float32 values"), std::string::npos)
+        << e.what();
+  }
+}
+
+// The same claim in the last frame is a truncated tail (the commit protocol): that frame is
+// dropped, the others read, and nothing is allocated for the claim.
+TEST_F(GsdFile, HugeEntryInTheLastFrameEndsTheIndex) {
+  {
+    auto w = Writer::create(file("h.gsd"), "test");
+    write_frames(w, 0, 3);
+  }
+  std::string s = slurp(file("h.gsd"));
+  const std::size_t entry = get<std::uint64_t>(s, 8) + 32 * 6;  // frame 2's particles/position
+  ASSERT_EQ(get<std::uint64_t>(s, entry), 2u);
+  put<std::uint64_t>(s, entry + 8, std::uint64_t{1} << 60);
+  spit(file("h.gsd"), s);
+  expect_frames(Reader(file("h.gsd")), 2);
+}
+
 // Random damage to the header, index or namelist: an InputError or readable data, never a crash.
 TEST_F(GsdFile, RandomlyDamagedFilesNeverCrash) {
   {

@@ -325,5 +325,81 @@ TEST_F(GsdSnapshot, InitialStateBondsFromHoomdFiles) {
   EXPECT_NE(message(file("type.gsd")).find("typeid 2"), std::string::npos);
 }
 
+// A one-frame 3D HOOMD file whose particles/N claims `claimed` particles, with `rows` positions
+// (0: no positions chunk) and, when `typeids` > 0, that many particles/typeid values.
+void write_claiming_frame(const fs::path& path, std::uint32_t claimed, std::uint32_t rows,
+                          std::uint32_t typeids = 0) {
+  auto w = gsd::Writer::create(path, "kairos-test");
+  const std::uint8_t dims = 3;
+  const float box[6] = {10, 10, 10, 0, 0, 0};
+  w.write_chunk("configuration/dimensions", 1, 1, &dims);
+  w.write_chunk("configuration/box", 6, 1, box);
+  w.write_chunk("particles/N", 1, 1, &claimed);
+  std::vector<float> pos(3 * std::size_t{rows});
+  for (std::size_t i = 0; i < rows; ++i) pos[3 * i] = 1.5f * static_cast<float>(i) - 4.0f;
+  if (rows > 0) w.write_chunk("particles/position", rows, 3, pos.data());
+  const std::vector<std::uint32_t> type_id(typeids, 0);
+  if (typeids > 0) w.write_chunk("particles/typeid", typeids, 1, type_id.data());
+  w.end_frame();
+}
+
+std::string initial_state_error(const fs::path& path) {
+  bool v = false;
+  try {
+    (void)read_initial_state<3>(path, v);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+// A small file claiming 5e7 particles is refused before anything is allocated for them (the
+// positions chunk must hold them); it used to take 2.4 GB first.
+TEST_F(GsdSnapshot, ClaimedParticleCountIsCheckedAgainstTheStoredPositions) {
+  write_claiming_frame(file("none.gsd"), 50'000'000, 0);
+  EXPECT_NE(initial_state_error(file("none.gsd"))
+                .find("system.initial_state '" + file("none.gsd").string() +
+                      "': particles/N = 50000000 but the file has no chunk 'particles/position'"),
+            std::string::npos)
+      << initial_state_error(file("none.gsd"));
+  write_claiming_frame(file("few.gsd"), 50'000'000, 4);
+  EXPECT_NE(initial_state_error(file("few.gsd"))
+                .find("particles/N = 50000000 but chunk 'particles/position' holds 4 x 3 values, "
+                      "not 50000000 x 3"),
+            std::string::npos)
+      << initial_state_error(file("few.gsd"));
+
+  // A restart file claiming more particles than its exact positions hold.
+  auto w = gsd::Writer::create(file("claim.gsd"), "kairos-test");
+  const std::uint32_t format = 6, claimed = 50'000'000;
+  const std::uint8_t dims = 3;
+  w.write_chunk("kairos/format", 1, 1, &format);
+  w.write_chunk("kairos/dimension", 1, 1, &dims);
+  w.write_chunk("particles/N", 1, 1, &claimed);
+  w.end_frame();
+  w.close();
+  std::mt19937_64 rng;
+  try {
+    (void)read_restart<3>(file("claim.gsd"), rng);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "particles/N = 50000000 but the file has no chunk 'kairos/state/position'"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// particles/typeid must hold one value per particle (a shorter one was read out of bounds).
+TEST_F(GsdSnapshot, InitialStateTypeidOfTheWrongSizeIsAnInputError) {
+  write_claiming_frame(file("short.gsd"), 4, 4, 2);
+  EXPECT_NE(initial_state_error(file("short.gsd"))
+                .find("chunk 'particles/typeid' holds 2 values, expected 4"),
+            std::string::npos)
+      << initial_state_error(file("short.gsd"));
+  write_claiming_frame(file("right.gsd"), 4, 4, 4);
+  EXPECT_EQ(initial_state_error(file("right.gsd")), "(accepted)");
+}
+
 }  // namespace
 }  // namespace kairos

@@ -17,6 +17,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import unittest
 
 import numpy as np
@@ -128,6 +129,24 @@ def run_kairos(args, cwd, timeout=RUN_TIMEOUT, env=None):
     """Runs `kairos ARGS` in `cwd`; returns the CompletedProcess (text output)."""
     return subprocess.run([KAIROS] + list(args), cwd=cwd, capture_output=True, text=True,
                           timeout=timeout, env=env)
+
+
+def run_kairos_measured(args, cwd, timeout=RUN_TIMEOUT):
+    """Runs `kairos ARGS` in `cwd`; returns (CompletedProcess, peak resident memory of that
+    process alone in bytes, as wait4 reports it)."""
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        proc = subprocess.Popen([KAIROS] + list(args), cwd=cwd, stdout=out, stderr=err, text=True)
+        timer = threading.Timer(timeout, proc.kill)
+        timer.start()
+        try:
+            _, status, usage = os.wait4(proc.pid, 0)
+        finally:
+            timer.cancel()
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        err.seek(0)
+        result = subprocess.CompletedProcess(proc.args, proc.returncode, out.read(), err.read())
+    return result, usage.ru_maxrss * 1024  # kilobytes on Linux
 
 
 def describe(result):

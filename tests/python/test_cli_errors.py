@@ -290,6 +290,25 @@ class InitialStateErrors(kt.KairosTestCase):
         os.mkdir(self.path("states"))
         self.run_from(self.path("states"), 3, "states", "is not a regular file (it is a directory)")
 
+    def test_claimed_particle_count_beyond_the_file(self):
+        # A 5 kB file claiming 5e7 particles is refused before anything is allocated for them
+        # (it used to take 2.3 GB first).
+        p = self.path("claim.gsd")
+        with gsd.fl.open(name=p, mode="wb", application="test", schema="hoomd",
+                         schema_version=[1, 4]) as f:
+            f.write_chunk("configuration/box", np.array([10, 10, 10, 0, 0, 0], np.float32))
+            f.write_chunk("particles/N", np.array([50000000], np.uint32))
+            f.write_chunk("particles/position", np.array([[0, 0, 0], [2, 2, 2]], np.float32))
+            f.end_frame()
+        config = kt.base_config(production=1.0)
+        config["system"] = {"dimension": 3, "initial_state": p}
+        result, peak = kt.run_kairos_measured(
+            ["run", self.write_config(config), "-o", self.path("out")], cwd=self.tmp)
+        self.assertLess(peak, 400 << 20, "peak resident memory %d MB\n%s" %
+                        (peak >> 20, kt.describe(result)))
+        self.assert_user_error(result, "claim.gsd", "particles/N = 50000000",
+                               "'particles/position' holds 2 x 3 values")
+
     def test_initial_state_not_gsd(self):
         p = self.path("text.gsd")
         with open(p, "w") as f:
