@@ -5,6 +5,8 @@
 #include <sstream>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "core/error.hpp"
 #include "core/periodic.hpp"
 #include "io/atomic_file.hpp"
@@ -172,6 +174,20 @@ void check_positions_stored(const gsd::Reader& r, std::uint64_t f, std::size_t n
                      std::to_string(info->N) + " x " + std::to_string(info->M) + " values, not " +
                      std::to_string(n) + " x " + std::to_string(width) + ": the file is damaged");
   }
+}
+
+// Kairos simulates rectangular boxes: a HOOMD box with tilt factors (configuration/box entries
+// xy, xz, yz) would otherwise be run as the rectangular box of its edges, silently another
+// system. `who` names the file in messages.
+void check_rectangular_box(const gsd::Reader& r, std::uint64_t f, const std::string& who) {
+  const auto box = read_latest<float>(r, f, "configuration/box");
+  if (!box || box->size() != 6) return;  // (a missing or short box is reported where it is read)
+  const float xy = (*box)[3], xz = (*box)[4], yz = (*box)[5];
+  if (xy == 0.0f && xz == 0.0f && yz == 0.0f) return;
+  throw InputError(fmt::format(
+      "{}: configuration/box has tilt factors xy = {}, xz = {}, yz = {}, a triclinic box; Kairos "
+      "simulates rectangular boxes only: give a state in a box with xy = xz = yz = 0",
+      who, xy, xz, yz));
 }
 
 // Default name of the one bond type of a file that has bonds but no bonds/types chunk (as
@@ -490,6 +506,7 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   }
   const std::size_t n = require<std::uint32_t>(r, f, "particles/N", path, 1)[0];
   check_positions_stored(r, f, n, "kairos/state/position", D, "'" + path.string() + "'");
+  check_rectangular_box(r, f, "'" + path.string() + "'");
   ParticleSystem<D> s;
   const auto box = require<double>(r, f, "kairos/box", path, D);
   for (int a = 0; a < D; ++a) s.box[a] = box[a];
@@ -697,6 +714,7 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   const bool exact = r.find(f, "kairos/position").has_value();
   check_positions_stored(r, f, n, exact ? "kairos/position" : "particles/position", exact ? D : 3,
                          who);
+  check_rectangular_box(r, f, who);
   InitialState<D> s;
   if (exact) {
     const auto box = require<double>(r, f, "kairos/box", path, D);

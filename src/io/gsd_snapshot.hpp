@@ -84,7 +84,8 @@ int gsd_dimension(const std::filesystem::path& path);
 // positions and velocities when present, else the float32 standard chunks. `has_velocities`
 // tells whether the file held velocities. Bonds come from bonds/* (of that frame, else frame 0;
 // typeid defaults to 0 and, when there are bonds but no bonds/types, the one type is named
-// "backbone"). InputError on a missing file, missing positions, a box too small, particles
+// "backbone"). InputError on a missing file, missing positions, particles/N disagreeing with
+// them, a box too small or tilted (nonzero xy, xz, yz: Kairos boxes are rectangular), particles
 // outside the box, or a bond naming a particle out of range (or twice) or an unknown type.
 template <int D>
 InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_velocities);

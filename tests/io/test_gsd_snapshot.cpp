@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <random>
@@ -328,10 +330,10 @@ TEST_F(GsdSnapshot, InitialStateBondsFromHoomdFiles) {
 // A one-frame 3D HOOMD file whose particles/N claims `claimed` particles, with `rows` positions
 // (0: no positions chunk) and, when `typeids` > 0, that many particles/typeid values.
 void write_claiming_frame(const fs::path& path, std::uint32_t claimed, std::uint32_t rows,
-                          std::uint32_t typeids = 0) {
+                          std::uint32_t typeids = 0, std::array<float, 3> tilt = {}) {
   auto w = gsd::Writer::create(path, "kairos-test");
   const std::uint8_t dims = 3;
-  const float box[6] = {10, 10, 10, 0, 0, 0};
+  const float box[6] = {10, 10, 10, tilt[0], tilt[1], tilt[2]};
   w.write_chunk("configuration/dimensions", 1, 1, &dims);
   w.write_chunk("configuration/box", 6, 1, box);
   w.write_chunk("particles/N", 1, 1, &claimed);
@@ -399,6 +401,21 @@ TEST_F(GsdSnapshot, InitialStateTypeidOfTheWrongSizeIsAnInputError) {
       << initial_state_error(file("short.gsd"));
   write_claiming_frame(file("right.gsd"), 4, 4, 4);
   EXPECT_EQ(initial_state_error(file("right.gsd")), "(accepted)");
+}
+
+// A triclinic box (nonzero tilt factors) is refused, naming the file and the factors: it used
+// to run as the rectangular box of its edges.
+TEST_F(GsdSnapshot, TiltedBoxIsRefused) {
+  write_claiming_frame(file("tilt.gsd"), 4, 4, 0, {0.5f, 0.0f, -0.25f});
+  EXPECT_NE(initial_state_error(file("tilt.gsd"))
+                .find("system.initial_state '" + file("tilt.gsd").string() +
+                      "': configuration/box has tilt factors xy = 0.5, xz = 0, yz = -0.25"),
+            std::string::npos)
+      << initial_state_error(file("tilt.gsd"));
+  write_claiming_frame(file("nan.gsd"), 4, 4, 0, {0.0f, std::nanf(""), 0.0f});
+  EXPECT_NE(initial_state_error(file("nan.gsd")).find("tilt factors"), std::string::npos);
+  write_claiming_frame(file("flat.gsd"), 4, 4, 0, {-0.0f, 0.0f, 0.0f});
+  EXPECT_EQ(initial_state_error(file("flat.gsd")), "(accepted)");
 }
 
 }  // namespace

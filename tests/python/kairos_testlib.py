@@ -286,11 +286,13 @@ def new_frame():
 
 
 def write_hoomd_file(path, positions, box, dimensions=3, diameter=None, velocity=None,
-                     types=("A",), typeid=None, mass=None):
-    """Writes a one-frame HOOMD GSD file with python-gsd. `positions` in HOOMD's centred box."""
+                     types=("A",), typeid=None, mass=None, tilt=(0.0, 0.0, 0.0)):
+    """Writes a one-frame HOOMD GSD file with python-gsd. `positions` in HOOMD's centred box;
+    `tilt` = the box's (xy, xz, yz)."""
     positions = np.asarray(positions, dtype=np.float32)
     frame = new_frame()
-    frame.configuration.box = [float(box[0]), float(box[1]), float(box[2]), 0.0, 0.0, 0.0]
+    frame.configuration.box = [float(box[0]), float(box[1]), float(box[2])] + \
+        [float(t) for t in tilt]
     frame.configuration.dimensions = dimensions
     frame.particles.N = len(positions)
     frame.particles.position = positions

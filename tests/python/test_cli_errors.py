@@ -309,6 +309,13 @@ class InitialStateErrors(kt.KairosTestCase):
         self.assert_user_error(result, "claim.gsd", "particles/N = 50000000",
                                "'particles/position' holds 2 x 3 values")
 
+    def test_tilted_box(self):
+        # A triclinic box used to run as the rectangular box of its edges, without a word.
+        p = kt.write_hoomd_file(self.path("tilted.gsd"), [[0, 0, 0], [2, 2, 2]], [10, 10, 10],
+                                tilt=(0.5, 0.0, 0.0))
+        self.run_from(p, 3, "tilted.gsd", "tilt factors xy = 0.5, xz = 0, yz = 0",
+                      "rectangular boxes only")
+
     def test_initial_state_not_gsd(self):
         p = self.path("text.gsd")
         with open(p, "w") as f:
@@ -483,6 +490,10 @@ class DamagedRestartFiles(kt.KairosTestCase):
 
     def test_corrupt_rng(self):
         self.check(self.damaged(kairos__state__rng=np.frombuffer(b"garbage", np.int8)), "RNG")
+
+    def test_tilted_box(self):
+        self.check(self.damaged(configuration__box=np.array([8, 8, 8, 0, 0.25, 0], np.float32)),
+                   "tilt factors xy = 0, xz = 0.25, yz = 0")
 
     def test_cell_out_of_range(self):
         self.check(self.damaged(kairos__state__cell=np.full(256, 10 ** 8, np.uint32)), "cell")
