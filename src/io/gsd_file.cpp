@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include <zlib.h>
+
 #include "core/error.hpp"
 
 namespace kairos::gsd {
@@ -251,6 +253,23 @@ Contents load(int fd, const std::filesystem::path& path) {
   return c;
 }
 
+// The CRC-32 of a chunk's canonical header (gsd_file.hpp, "Frame checksums"), continuing `crc`.
+std::uint32_t header_crc(std::uint32_t crc, std::string_view name, Type type, std::uint64_t N,
+                         std::uint32_t M) {
+  std::string bytes(name);
+  bytes.push_back('\0');
+  bytes.push_back(static_cast<char>(type));
+  bytes.append(reinterpret_cast<const char*>(&N), sizeof N);  // little-endian (static_assert)
+  bytes.append(reinterpret_cast<const char*>(&M), sizeof M);
+  return static_cast<std::uint32_t>(
+      crc32_z(crc, reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
+}
+
+std::uint32_t data_crc(std::uint32_t crc, const void* data, std::size_t bytes) {
+  if (bytes == 0) return crc;  // (zlib's crc32 of a null buffer is its initial value, 0)
+  return static_cast<std::uint32_t>(crc32_z(crc, static_cast<const Bytef*>(data), bytes));
+}
+
 void copy_name(char (&field)[64], std::string_view value, const char* what) {
   if (value.size() > 63 || value.find('\0') != std::string_view::npos)
     throw std::invalid_argument(std::string("GSD ") + what + " name must have at most 63 bytes");
@@ -290,6 +309,15 @@ struct Writer::State {
   std::uint64_t flushed = 0;  // pending data bytes already written after `end`
   std::vector<Entry> pending;
   std::vector<char> buffer;  // pending data bytes not yet written
+  // With checksums on: per pending chunk its name, the CRC-32 of its canonical serialisation
+  // and that serialisation's length.
+  struct ChunkCrc {
+    std::string name;
+    std::uint32_t crc;
+    std::uint64_t length;
+  };
+  bool checksums = false;
+  std::vector<ChunkCrc> crcs;
 
   State(std::filesystem::path p, int descriptor) : path(std::move(p)), fd(descriptor) {}
 
@@ -392,6 +420,10 @@ void Writer::write_chunk(std::string_view name, Type type, std::uint64_t N, std:
   const std::uint64_t location = s.end + s.flushed + s.buffer.size();
   s.pending.push_back(Entry{s.frames, N, static_cast<std::int64_t>(location), M, id,
                             static_cast<std::uint8_t>(type), 0});
+  if (s.checksums) {
+    const std::uint32_t crc = data_crc(header_crc(0, chunk, type, N, M), data, bytes);
+    s.crcs.push_back({chunk, crc, chunk.size() + 1 + 1 + 8 + 4 + bytes});
+  }
   if (s.buffer.size() + bytes > kBufferBytes) s.flush();
   if (bytes >= kBufferBytes) {
     write_at(s.fd.get(), data, bytes, location, s.path);
@@ -469,6 +501,7 @@ void Writer::end_frame() {
     s.new_names.clear();
     s.entries += n;
     s.pending.clear();
+    s.crcs.clear();
     s.frames += 1;
     s.end = eof;
     s.flushed = 0;
@@ -480,6 +513,24 @@ void Writer::end_frame() {
 
 std::uint64_t Writer::frame_count() const {
   return state("frame_count").frames;
+}
+
+void Writer::enable_checksums() {
+  state("enable_checksums").checksums = true;
+}
+
+std::uint32_t Writer::frame_checksum() const {
+  const State& s = state("frame_checksum");
+  if (!s.checksums) throw std::logic_error("gsd::Writer::frame_checksum without enable_checksums");
+  std::vector<const State::ChunkCrc*> order;
+  for (const auto& c : s.crcs) order.push_back(&c);
+  std::sort(order.begin(), order.end(), [](auto* a, auto* b) { return a->name < b->name; });
+  // The CRC of the concatenation, from the CRCs of its pieces (the data is gone by now).
+  std::uint32_t crc = 0;
+  for (const auto* c : order) {
+    crc = static_cast<std::uint32_t>(crc32_combine(crc, c->crc, static_cast<z_off_t>(c->length)));
+  }
+  return crc;
 }
 
 void Writer::close() noexcept {
@@ -542,6 +593,34 @@ std::uint32_t Reader::schema_version() const {
 }
 std::vector<std::string> Reader::chunk_names() const {
   return s_->contents.names;
+}
+
+std::uint32_t Reader::frame_checksum(std::uint64_t frame, std::string_view except) const {
+  const auto& names = s_->contents.names;
+  std::vector<const Entry*> chunks;
+  for (const Entry& e : s_->contents.index)
+    if (e.frame == frame && names[e.id] != except) chunks.push_back(&e);
+  std::sort(chunks.begin(), chunks.end(),
+            [&](const Entry* a, const Entry* b) { return names[a->id] < names[b->id]; });
+  std::vector<char> buffer;
+  std::uint32_t crc = 0;
+  for (const Entry* e : chunks) {
+    const auto type = static_cast<Type>(e->type);
+    crc = header_crc(crc, names[e->id], type, e->N, e->M);
+    // Bounded by the file's size (load): read in pieces of at most kBufferBytes.
+    std::uint64_t left = e->N * e->M * type_size(type);
+    auto at = static_cast<std::uint64_t>(e->location);
+    while (left > 0) {
+      const std::size_t piece =
+          static_cast<std::size_t>(std::min<std::uint64_t>(left, kBufferBytes));
+      buffer.resize(piece);
+      read_bytes(at, buffer.data(), piece);
+      crc = data_crc(crc, buffer.data(), piece);
+      at += piece;
+      left -= piece;
+    }
+  }
+  return crc;
 }
 
 std::optional<Reader::ChunkInfo> Reader::find(std::uint64_t frame, std::string_view name) const {

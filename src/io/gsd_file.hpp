@@ -26,6 +26,12 @@
 // One that intact later frames follow cannot come from an interrupted write: an InputError
 // naming the chunk.
 //
+// Frame checksums (Writer::enable_checksums, Writer::frame_checksum, Reader::frame_checksum): a
+// CRC-32 (zlib's crc32, the CRC of zip and PNG) over a canonical serialisation of a frame's
+// chunks, independent of the order they were written in and of their place in the file: the
+// chunks in bytewise order of their names, each as its name, one 0 byte, its type (1 byte), N
+// (8 bytes) and M (4 bytes, both little-endian), then its N x M values as stored.
+//
 // Type::character (added in spec 2.1) is readable, but the Writer refuses it: python-gsd 2.7
 // reports a file holding such a chunk as corrupt. Store strings as int8 (as HOOMD does).
 #pragma once
@@ -95,6 +101,13 @@ class Writer {
   // N x M values of `type` at `data` (may be null when N * M == 0).
   void write_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M,
                    const void* data);
+  // From now on, keep the CRC-32 of each chunk written (see "Frame checksums" above), so that
+  // frame_checksum() can be asked before end_frame(). Off by default: trajectories skip the cost.
+  void enable_checksums();
+  // The checksum of the chunks written so far in the frame being built (logic_error unless
+  // enable_checksums() was called first). Write it as a chunk of the same frame, and verify it
+  // with Reader::frame_checksum(frame, that chunk's name).
+  std::uint32_t frame_checksum() const;
   // Commits the frame: on return it is durable on disk (data, namelist, index; fsync).
   // A frame without chunks has no index entry, so it persists only if a later frame has chunks.
   void end_frame();
@@ -138,6 +151,9 @@ class Reader {
     return values;
   }
   std::vector<std::string> chunk_names() const;  // all names in the namelist, in id order
+  // The checksum (see "Frame checksums" above) of all chunks of `frame` but `except` (the chunk
+  // that stores it); reads every chunk of the frame.
+  std::uint32_t frame_checksum(std::uint64_t frame, std::string_view except) const;
 
  private:
   struct Located {

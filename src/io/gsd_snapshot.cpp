@@ -19,8 +19,11 @@ namespace {
 // 4: bonds, pair zones, step counters; 5: soft contacts in progress and soft counters (a
 // format-4 reader would drop the contacts in progress silently, hence the new number); 6:
 // deferred soft contacts (frozen_deferred: a format-5 reader would continue them frozen, not
-// bit-identically). Versions 3 to 5 are still read: the chunks added since are optional.
-constexpr std::uint32_t kRestartFormat = 6;
+// bit-identically); 7: kairos/checksum, the CRC-32 of the frame's other chunks (gsd_snapshot.hpp),
+// required from 7 on. Versions 3 to 6 are still read: the chunks added since are optional.
+constexpr std::uint32_t kRestartFormat = 7;
+constexpr std::uint32_t kFirstChecksummedFormat = 7;
+constexpr const char* kChecksumChunk = "kairos/checksum";
 constexpr std::uint32_t kOldestRestartFormat = 3;
 
 // HOOMD stores type names as an N_types x M int8 array of 0-padded strings.
@@ -190,6 +193,31 @@ void check_rectangular_box(const gsd::Reader& r, std::uint64_t f, const std::str
       who, xy, xz, yz));
 }
 
+// A restart file of `format` carries kairos/checksum from format 7 on (older ones may not); when
+// present it must match the frame's other chunks. A mismatch means the file was changed after
+// Kairos wrote it (a flipped bit, a bad copy, an edit): its state cannot be trusted, even when
+// every value is plausible.
+void verify_checksum(const gsd::Reader& r, std::uint64_t f, std::uint32_t format,
+                     const std::string& who) {
+  const auto info = r.find(f, kChecksumChunk);
+  if (!info) {
+    if (format < kFirstChecksummedFormat) return;
+    throw InputError(fmt::format(
+        "{} is damaged: restart format {} but no {} chunk; use an intact copy of the file", who,
+        format, kChecksumChunk));
+  }
+  const auto stored = r.read<std::uint32_t>(f, kChecksumChunk);
+  const std::uint32_t computed = r.frame_checksum(f, kChecksumChunk);
+  if (stored.size() == 1 && stored[0] == computed) return;
+  throw InputError(fmt::format(
+      "{} is damaged: checksum mismatch ({} holds {}, the file's chunks give {:#010x}); it was "
+      "changed after Kairos wrote it: use an intact copy (e.g. an earlier restart file)",
+      who, kChecksumChunk,
+      stored.size() == 1 ? fmt::format("{:#010x}", stored[0])
+                         : fmt::format("{} values", stored.size()),
+      computed));
+}
+
 // Default name of the one bond type of a file that has bonds but no bonds/types chunk (as
 // HOOMD files written without types): that of generated chains.
 constexpr const char* kDefaultBondType = "backbone";
@@ -323,6 +351,7 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
                    const std::mt19937_64& rng, const RunProgress& progress) {
   replace_file_atomically(path, [&](const std::filesystem::path& tmp) {
     auto w = gsd::Writer::create(tmp, "kairos " KAIROS_VERSION);
+    w.enable_checksums();
     write_standard_chunks(w, s, true);
     const std::uint64_t n = s.size();
     std::vector<double> pos(n * D), vel(n * D), local(n), radius(n), now(n * D);
@@ -472,6 +501,8 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
       if (std::isfinite(progress.dem_time_mark))
         w.write_chunk("kairos/run/dem_time_mark", 1, 1, &progress.dem_time_mark);
     }
+    const std::uint32_t checksum = w.frame_checksum();  // of every chunk above: keep it last
+    w.write_chunk(kChecksumChunk, 1, 1, &checksum);
     w.end_frame();
     w.close();
   });
@@ -492,13 +523,14 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   if (r.frame_count() == 0 || !r.find(f, "kairos/format")) {
     throw InputError("'" + path.string() + "' is not a Kairos restart file (no kairos/format)");
   }
-  if (const auto v = require<std::uint32_t>(r, f, "kairos/format", path, 1)[0];
-      v < kOldestRestartFormat || v > kRestartFormat) {
-    throw InputError("'" + path.string() + "': restart format version " + std::to_string(v) +
+  const std::uint32_t format = require<std::uint32_t>(r, f, "kairos/format", path, 1)[0];
+  if (format < kOldestRestartFormat || format > kRestartFormat) {
+    throw InputError("'" + path.string() + "': restart format version " + std::to_string(format) +
                      ", this Kairos reads versions " + std::to_string(kOldestRestartFormat) +
                      " to " + std::to_string(kRestartFormat) +
                      " (restart files are not portable across other versions)");
   }
+  verify_checksum(r, f, format, "restart file '" + path.string() + "'");
   const int dim = require<std::uint8_t>(r, f, "kairos/dimension", path, 1)[0];
   if (dim != D) {
     throw InputError("'" + path.string() + "' holds a " + std::to_string(dim) +
@@ -701,6 +733,11 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   const gsd::Reader r(path);
   if (r.frame_count() == 0) throw InputError("'" + path.string() + "' holds no frame");
   const std::uint64_t f = r.frame_count() - 1;
+  const std::string who = "system.initial_state '" + path.string() + "'";
+  if (r.find(f, "kairos/format")) {  // a Kairos restart file: damaged?
+    const auto format = require<std::uint32_t>(r, f, "kairos/format", path, 1);
+    verify_checksum(r, f, format[0], who);
+  }
   const int dim = gsd_dimension(path);
   if (dim != D) {
     throw InputError("system.initial_state '" + path.string() + "' is " + std::to_string(dim) +
@@ -710,7 +747,6 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   const std::size_t n = nv && !nv->empty() ? (*nv)[0] : 0;
   if (n < 2)
     throw InputError("system.initial_state '" + path.string() + "' holds fewer than 2 particles");
-  const std::string who = "system.initial_state '" + path.string() + "'";
   const bool exact = r.find(f, "kairos/position").has_value();
   check_positions_stored(r, f, n, exact ? "kairos/position" : "particles/position", exact ? D : 3,
                          who);

@@ -23,7 +23,12 @@
 //   kairos/state/frozen_deferred      float64 F x (1 + 2D): deferred (1 or 0), the release
 //                                     positions i and j (only when some release is deferred;
 //                                     absent: none is)
-// Format 4 files are read with no soft contacts.
+// Format 4 files are read with no soft contacts. Format 6 adds frozen_deferred; format 7 adds
+//   kairos/checksum  uint32 x 1: CRC-32 (zlib) of every other chunk of the frame, over their
+//                    canonical serialisation (gsd_file.hpp, "Frame checksums"), written last
+// and verified by read_restart and read_initial_state before anything else is read; a mismatch
+// (or a format-7 file without it) is an InputError "... is damaged: checksum mismatch". Files of
+// formats 3 to 6 have no checksum and are read unverified.
 #pragma once
 
 #include <cstdint>

@@ -452,6 +452,66 @@ TEST_F(GsdFile, HugeEntryInTheLastFrameEndsTheIndex) {
   expect_frames(Reader(file("h.gsd")), 2);
 }
 
+// CRC-32 (IEEE, reflected, as zlib, zip and PNG compute it) bit by bit: an implementation
+// independent of the library's.
+std::uint32_t reference_crc32(const std::string& bytes) {
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (const char c : bytes) {
+    crc ^= static_cast<unsigned char>(c);
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+// One chunk as the frame checksum serialises it: name, 0, type, N (8 bytes), M (4 bytes), data.
+template <class T>
+std::string canonical(const std::string& name, std::uint64_t N, std::uint32_t M,
+                      const std::vector<T>& values) {
+  std::string out = name;
+  out.push_back('\0');
+  out.push_back(static_cast<char>(type_of<T>()));
+  out.append(reinterpret_cast<const char*>(&N), 8);
+  out.append(reinterpret_cast<const char*>(&M), 4);
+  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+  return out;
+}
+
+// The frame checksum is the CRC-32 of the chunks' canonical serialisation in name order,
+// whatever order they were written in; writer and reader agree, and the reader can leave out
+// the chunk that stores it.
+TEST_F(GsdFile, FrameChecksumIsTheCrcOfTheCanonicalChunksInNameOrder) {
+  const std::vector<double> b = {1.5, -2.0, 3.25, 4.0};
+  const std::vector<std::uint8_t> a = {7};
+  const std::vector<float> empty;
+  const std::uint32_t expected =
+      reference_crc32(canonical("a/one", 1, 1, a) + canonical("b/two", 2, 2, b) +
+                      canonical("c/empty", 0, 3, empty));
+  std::uint32_t written[2] = {};
+  for (const bool reversed : {false, true}) {
+    auto w = Writer::create(file("c.gsd"), "test");
+    w.enable_checksums();
+    if (reversed) {
+      w.write_chunk("c/empty", 0, 3, empty.data());
+      w.write_chunk("b/two", 2, 2, b.data());
+      w.write_chunk("a/one", 1, 1, a.data());
+    } else {
+      w.write_chunk("a/one", 1, 1, a.data());
+      w.write_chunk("b/two", 2, 2, b.data());
+      w.write_chunk("c/empty", 0, 3, empty.data());
+    }
+    written[reversed] = w.frame_checksum();
+    w.write_chunk("z/checksum", 1, 1, &written[reversed]);
+    w.end_frame();
+    w.close();
+    EXPECT_EQ(written[reversed], expected);
+    const Reader r(file("c.gsd"));
+    EXPECT_EQ(r.frame_checksum(0, "z/checksum"), expected);
+    EXPECT_NE(r.frame_checksum(0, ""), expected);  // the checksum chunk itself counts then
+  }
+  auto w = Writer::create(file("d.gsd"), "test");
+  EXPECT_THROW((void)w.frame_checksum(), std::logic_error);  // not enabled
+}
+
 // Random damage to the header, index or namelist: an InputError or readable data, never a crash.
 TEST_F(GsdFile, RandomlyDamagedFilesNeverCrash) {
   {

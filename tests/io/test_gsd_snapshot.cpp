@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <random>
 #include <set>
 #include <string>
@@ -56,46 +57,54 @@ ParticleSystem<D> chain_system(std::uint64_t n = 60, std::uint64_t length = 6) {
   return s;
 }
 
+// Copies chunk `name` of frame 0 from `r` to `w`; `edit` (optional) may change its raw bytes.
+void copy_chunk(const gsd::Reader& r, gsd::Writer& w, const std::string& name,
+                const std::function<void(char*, std::size_t)>& edit = {}) {
+  const auto info = r.find(0, name);
+  ASSERT_TRUE(info) << name;
+  const auto copy = [&](auto zero) {
+    using T = decltype(zero);
+    auto v = r.read<T>(0, name);
+    if (edit) edit(reinterpret_cast<char*>(v.data()), v.size() * sizeof(T));
+    w.write_chunk(name, info->N, info->M, v.data());
+  };
+  switch (info->type) {
+    case gsd::Type::uint8:
+      copy(std::uint8_t{});
+      break;
+    case gsd::Type::uint32:
+      copy(std::uint32_t{});
+      break;
+    case gsd::Type::uint64:
+      copy(std::uint64_t{});
+      break;
+    case gsd::Type::int8:
+      copy(std::int8_t{});
+      break;
+    case gsd::Type::float32:
+      copy(float{});
+      break;
+    case gsd::Type::float64:
+      copy(double{});
+      break;
+    default:
+      FAIL() << name << ": unexpected type";
+  }
+}
+
 // Copies frame 0 of `from` to `to` without the chunks in `drop`, and with kairos/format set to
-// `format`: a restart file as an older Kairos wrote it.
+// `format`: a restart file as an older Kairos wrote it (without kairos/checksum, which format 7
+// added).
 void copy_frame(const fs::path& from, const fs::path& to, const std::set<std::string>& drop,
                 std::uint32_t format) {
   const gsd::Reader r(from);
   auto w = gsd::Writer::create(to, "kairos-test");
   for (const std::string& name : r.chunk_names()) {
-    const auto info = r.find(0, name);
-    if (!info || drop.count(name) != 0) continue;
-    if (name == "kairos/format") {
+    if (!r.find(0, name) || drop.count(name) != 0 || name == "kairos/checksum") continue;
+    if (name == "kairos/format")
       w.write_chunk(name, 1, 1, &format);
-      continue;
-    }
-    const auto copy = [&](auto zero) {
-      using T = decltype(zero);
-      const auto v = r.read<T>(0, name);
-      w.write_chunk(name, info->N, info->M, v.data());
-    };
-    switch (info->type) {
-      case gsd::Type::uint8:
-        copy(std::uint8_t{});
-        break;
-      case gsd::Type::uint32:
-        copy(std::uint32_t{});
-        break;
-      case gsd::Type::uint64:
-        copy(std::uint64_t{});
-        break;
-      case gsd::Type::int8:
-        copy(std::int8_t{});
-        break;
-      case gsd::Type::float32:
-        copy(float{});
-        break;
-      case gsd::Type::float64:
-        copy(double{});
-        break;
-      default:
-        FAIL() << name << ": unexpected type";
-    }
+    else
+      copy_chunk(r, w, name);
   }
   w.end_frame();
 }
@@ -126,7 +135,7 @@ TEST_F(GsdSnapshot, RestartRoundTripsBondsZonesAndStepCounters3D) {
   s.zones = std::vector<PairZone>{{0, 1, 1}, {3, 17, 2}, {5, 59, 7}};
   expect_round_trip<3>(file("restart.gsd"), s);
   const gsd::Reader r(file("restart.gsd"));
-  EXPECT_EQ(r.read<std::uint32_t>(0, "kairos/format"), std::vector<std::uint32_t>{6});
+  EXPECT_EQ(r.read<std::uint32_t>(0, "kairos/format"), std::vector<std::uint32_t>{7});
   EXPECT_EQ(r.read<std::uint64_t>(0, "kairos/state/zone_count"), std::vector<std::uint64_t>{3});
   const auto zones = r.find(0, "kairos/state/zones");
   ASSERT_TRUE(zones);
@@ -193,7 +202,7 @@ TEST_F(GsdSnapshot, ReadsFormat3RestartsWithoutTheNewChunks) {
   EXPECT_TRUE(r.bond_types.empty());
   EXPECT_EQ(r.size(), s.size());
 
-  for (const std::uint32_t bad : {2u, 7u}) {
+  for (const std::uint32_t bad : {2u, 8u}) {
     copy_frame(file("v4.gsd"), file("bad.gsd"), {}, bad);
     try {
       (void)read_restart<3>(file("bad.gsd"), rng);
@@ -325,6 +334,77 @@ TEST_F(GsdSnapshot, InitialStateBondsFromHoomdFiles) {
   EXPECT_NE(message(file("self.gsd")).find("itself"), std::string::npos);
   write_bonded_frame(file("type.gsd"), {0, 1}, {2}, {"a", "b"});
   EXPECT_NE(message(file("type.gsd")).find("typeid 2"), std::string::npos);
+}
+
+// Copies frame 0 of `from` to `to` as it is, kairos/checksum included, but for one byte of
+// chunk `name` changed (its first, or `byte`).
+void copy_with_flipped_byte(const fs::path& from, const fs::path& to, const std::string& name,
+                            std::size_t byte = 0) {
+  const gsd::Reader r(from);
+  auto w = gsd::Writer::create(to, "kairos-test");
+  for (const std::string& chunk : r.chunk_names()) {
+    if (!r.find(0, chunk)) continue;
+    copy_chunk(r, w, chunk, [&](char* data, std::size_t bytes) {
+      if (chunk == name && byte < bytes) data[byte] = static_cast<char>(data[byte] ^ 0x04);
+    });
+  }
+  w.end_frame();
+}
+
+std::string restart_error(const fs::path& path) {
+  std::mt19937_64 rng;
+  try {
+    (void)read_restart<3>(path, rng);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+// A restart file carries the CRC-32 of all its other chunks: one byte changed in any chunk, even
+// to a plausible value (a mass of 1.0 becoming 1.0000000000000009), makes it a damaged file,
+// as a restart and as an initial state. It used to be accepted and change the run.
+TEST_F(GsdSnapshot, RestartChecksumCoversEveryChunk) {
+  auto s = chain_system<3>();
+  s.zones = std::vector<PairZone>{{0, 1, 1}};
+  write_restart<3>(file("good.gsd"), s, std::mt19937_64{});
+  ASSERT_EQ(restart_error(file("good.gsd")), "(accepted)");
+  const gsd::Reader r(file("good.gsd"));
+  std::size_t checked = 0;
+  for (const std::string& name : r.chunk_names()) {
+    const auto info = r.find(0, name);
+    if (name == "kairos/checksum" || !info || info->N * info->M == 0) continue;
+    copy_with_flipped_byte(file("good.gsd"), file("bad.gsd"), name);
+    const std::string expected =
+        "restart file '" + file("bad.gsd").string() + "' is damaged: checksum mismatch";
+    EXPECT_NE(restart_error(file("bad.gsd")).find(expected), std::string::npos)
+        << name << ": " << restart_error(file("bad.gsd"));
+    ++checked;
+  }
+  EXPECT_GT(checked, 30u);
+
+  copy_with_flipped_byte(file("good.gsd"), file("mass.gsd"), "kairos/mass", 8 * 17);
+  bool v = false;
+  try {
+    (void)read_initial_state<3>(file("mass.gsd"), v);
+    ADD_FAILURE() << "a damaged restart file was accepted as an initial state";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("system.initial_state '" + file("mass.gsd").string() +
+                                         "' is damaged: checksum mismatch"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW((void)read_initial_state<3>(file("good.gsd"), v));
+
+  // Format 7 without its checksum is damaged too; format 6 (before checksums) is read.
+  copy_frame(file("good.gsd"), file("none.gsd"), {}, 7);
+  EXPECT_NE(restart_error(file("none.gsd"))
+                .find("is damaged: restart format 7 but no "
+                      "kairos/checksum chunk"),
+            std::string::npos)
+      << restart_error(file("none.gsd"));
+  copy_frame(file("good.gsd"), file("v6.gsd"), {}, 6);
+  EXPECT_EQ(restart_error(file("v6.gsd")), "(accepted)");
 }
 
 // A one-frame 3D HOOMD file whose particles/N claims `claimed` particles, with `rows` positions

@@ -14,11 +14,13 @@ import math
 import os
 import shutil
 import signal
+import struct
 import subprocess
 import sys
 import tempfile
 import threading
 import unittest
+import zlib
 
 import numpy as np
 import gsd.fl
@@ -273,6 +275,49 @@ def read_exact_state(path):
 def restart_chunk(path, name):
     with gsd.fl.open(name=path, mode="rb") as f:
         return f.read_chunk(frame=f.nframes - 1, name=name)
+
+
+# GSD type codes (the file layer's enum) of the numpy dtypes python-gsd reads and writes.
+GSD_TYPE_CODES = {np.dtype(t): code for code, t in enumerate(
+    ["uint8", "uint16", "uint32", "uint64", "int8", "int16", "int32", "int64", "float32",
+     "float64"], start=1)}
+
+CHECKSUM_CHUNK = "kairos/checksum"
+
+
+def restart_checksum(chunks):
+    """The checksum of a restart frame as docs/outputs.md defines it, from {name: array} (every
+    chunk of the frame but kairos/checksum): zlib's CRC-32 over the chunks in bytewise order of
+    their names, each as name, 0 byte, type (1 byte), N (uint64), M (uint32), values."""
+    crc = 0
+    for name in sorted((n for n in chunks if n != CHECKSUM_CHUNK), key=lambda n: n.encode()):
+        data = np.ascontiguousarray(chunks[name])
+        n = data.shape[0] if data.ndim > 0 else 1
+        m = data.shape[1] if data.ndim > 1 else 1
+        header = name.encode() + b"\0" + struct.pack("<BQI", GSD_TYPE_CODES[data.dtype], n, m)
+        crc = zlib.crc32(data.tobytes(), zlib.crc32(header, crc))
+    return crc
+
+
+def read_frame_chunks(path, frame=0):
+    """{name: array} of every chunk in a frame of a GSD file."""
+    with gsd.fl.open(name=path, mode="rb") as f:
+        names = [n for n in f.find_matching_chunk_names("") if f.chunk_exists(frame=frame, name=n)]
+        return {n: f.read_chunk(frame=frame, name=n) for n in names}
+
+
+def write_frame_chunks(path, chunks, reseal=True):
+    """Writes a one-frame GSD file of {name: array}; with `reseal` a fresh kairos/checksum
+    replaces the stored one (a file edited on purpose rather than damaged)."""
+    chunks = dict(chunks)
+    if reseal and CHECKSUM_CHUNK in chunks:
+        chunks[CHECKSUM_CHUNK] = np.array([restart_checksum(chunks)], np.uint32)
+    with gsd.fl.open(name=path, mode="wb", application="test", schema="hoomd",
+                     schema_version=[1, 4]) as g:
+        for name, data in chunks.items():
+            g.write_chunk(name, data)
+        g.end_frame()
+    return path
 
 
 def open_trajectory(path):

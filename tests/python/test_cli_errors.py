@@ -442,19 +442,12 @@ class DamagedRestartFiles(kt.KairosTestCase):
 
     def damaged(self, drop=(), **replace):
         """A copy of the restart file without the chunks in `drop` and with chunks replaced
-        (keyword names use '__' for '/')."""
+        (keyword names use '__' for '/'), with a fresh checksum: the damage passes the checksum
+        (as a file edited on purpose would) and must be caught by the checks behind it."""
         replace = {k.replace("__", "/"): v for k, v in replace.items()}
-        with gsd.fl.open(name=self.source, mode="rb") as f:
-            names = [n for n in f.find_matching_chunk_names("") if f.chunk_exists(frame=0, name=n)]
-            data = {n: f.read_chunk(frame=0, name=n) for n in names}
-        path = self.path("damaged.gsd")
-        with gsd.fl.open(name=path, mode="wb", application="test", schema="hoomd",
-                         schema_version=[1, 4]) as g:
-            for n in names:
-                if n not in drop:
-                    g.write_chunk(n, replace.get(n, data[n]))
-            g.end_frame()
-        return path
+        data = kt.read_frame_chunks(self.source)
+        chunks = {n: replace.get(n, d) for n, d in data.items() if n not in drop}
+        return kt.write_frame_chunks(self.path("damaged.gsd"), chunks)
 
     def check(self, path, *needles):
         result = self.kairos("run", self.config, "-o", self.path("second"), "--restart", path)
