@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/memory_budget.hpp"
 #include "core/periodic.hpp"
 #include "io/atomic_file.hpp"
 
@@ -539,6 +540,8 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   const std::size_t n = require<std::uint32_t>(r, f, "particles/N", path, 1)[0];
   check_positions_stored(r, f, n, "kairos/state/position", D, "'" + path.string() + "'");
   check_rectangular_box(r, f, "'" + path.string() + "'");
+  require_memory(estimated_run_bytes(n, D),
+                 fmt::format("restart file '{}' ({} particles)", path.string(), n));
   ParticleSystem<D> s;
   const auto box = require<double>(r, f, "kairos/box", path, D);
   for (int a = 0; a < D; ++a) s.box[a] = box[a];
@@ -751,6 +754,7 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   check_positions_stored(r, f, n, exact ? "kairos/position" : "particles/position", exact ? D : 3,
                          who);
   check_rectangular_box(r, f, who);
+  require_memory(estimated_run_bytes(n, D), fmt::format("{} ({} particles)", who, n));
   InitialState<D> s;
   if (exact) {
     const auto box = require<double>(r, f, "kairos/box", path, D);

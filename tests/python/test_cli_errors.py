@@ -5,6 +5,7 @@ message. Also: `kairos --help` and `kairos run --help` document every option.
 """
 
 import os
+import time
 import unittest
 
 import numpy as np
@@ -490,6 +491,51 @@ class DamagedRestartFiles(kt.KairosTestCase):
 
     def test_cell_out_of_range(self):
         self.check(self.damaged(kairos__state__cell=np.full(256, 10 ** 8, np.uint32)), "cell")
+
+
+class MemoryEstimate(kt.KairosTestCase):
+    """A run that cannot fit in memory is refused before anything is allocated (it used to fill
+    memory for minutes and end in std::bad_alloc). KAIROS_MEMORY_LIMIT_BYTES stands in for the
+    memory detected, so that these tests do not depend on the machine."""
+
+    def run_with_limit(self, limit, *args):
+        env = dict(os.environ, KAIROS_MEMORY_LIMIT_BYTES=str(limit))
+        return kt.run_kairos(args, cwd=self.tmp, env=env, timeout=60)
+
+    def test_hundred_million_particles_refused_at_once(self):
+        config = self.write_config(kt.base_config(particles=100000000, production=1.0))
+        start = time.monotonic()
+        result = self.run_with_limit(16 << 30, "run", config, "-o", self.path("out"))
+        elapsed = time.monotonic() - start
+        line = self.assert_user_error(result, "system.particles = 100000000 needs about",
+                                      "this machine has 16 GiB available",
+                                      "KAIROS_MEMORY_LIMIT_BYTES")
+        self.assertLess(elapsed, 10.0, line)
+        self.assertFalse(os.path.exists(self.path("out", "summary.json")))
+
+    def test_small_run_in_a_smaller_limit(self):
+        config = self.write_config(kt.base_config(particles=500, production=1.0))
+        self.assert_user_error(self.run_with_limit(10 ** 7, "run", config, "-o", self.path("out")),
+                               "system.particles = 500 needs about", "9.54 MiB available")
+
+    def test_initial_state_and_restart_files_are_checked(self):
+        config = self.write_config(kt.base_config(particles=500, production=1.0))
+        self.run_ok("run", config, "-o", self.path("first"))
+        restart = self.path("first", "restart.gsd")
+        result = self.run_with_limit(10 ** 7, "run", config, "-o", self.path("second"),
+                                     "--restart", restart)
+        self.assert_user_error(result, "restart file '%s' (500 particles) needs about" % restart)
+        from_file = kt.base_config(production=1.0)
+        from_file["system"] = {"dimension": 3, "initial_state": restart}
+        result = self.run_with_limit(10 ** 7, "run", self.write_config(from_file, "file.toml"),
+                                     "-o", self.path("third"))
+        self.assert_user_error(result, "system.initial_state '%s' (500 particles) needs about" %
+                               restart)
+
+    def test_limit_that_is_not_a_number(self):
+        config = self.write_config(kt.base_config(particles=500, production=1.0))
+        self.assert_user_error(self.run_with_limit("8G", "run", config, "-o", self.path("out")),
+                               "KAIROS_MEMORY_LIMIT_BYTES = '8G' is not a number of bytes")
 
 
 class CommandLine(kt.KairosTestCase):
