@@ -7,6 +7,7 @@ packages=(
   build-essential cmake pkg-config
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev
+  zlib1g-dev
   python3 python3-gsd python3-numpy
   python3-dev pybind11-dev
 )

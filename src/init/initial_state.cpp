@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/memory_budget.hpp"
 #include "core/periodic.hpp"
 
 namespace kairos {
@@ -888,6 +889,10 @@ InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& 
     throw InputError(fmt::format("system.temperature = {} is invalid: must be finite and >= 0",
                                  system.temperature));
   }
+
+  // Before anything is allocated: a state too large for this machine would otherwise fill its
+  // memory for minutes and end in std::bad_alloc (or the kernel's OOM killer).
+  require_memory(estimated_run_bytes(N, D), fmt::format("system.particles = {}", N));
 
   if (system.chain_length > 0) return make_chain_state<D>(system, species, N, eta, rng);
 

@@ -1877,12 +1877,31 @@ Config parse_config(std::string_view toml_text, std::string_view source_name,
   return Reader(source, std::move(applied)).read(root);
 }
 
+namespace {
+
+// Only a regular file is read: reading a FIFO would block until another process writes to it,
+// and a directory or a device is never a config file. (A missing file is left to fopen.)
+void require_regular_file(const std::filesystem::path& path) {
+  using std::filesystem::file_type;
+  std::error_code ec;
+  const file_type type = std::filesystem::status(path, ec).type();
+  if (ec || type == file_type::regular || type == file_type::not_found) return;
+  const char* kind = type == file_type::directory                               ? "a directory"
+                     : type == file_type::fifo                                  ? "a FIFO"
+                     : type == file_type::character || type == file_type::block ? "a device"
+                                                                                : "a special file";
+  throw InputError(
+      fmt::format("config file '{}' is not a regular file (it is {}): give the path of a TOML file",
+                  path.string(), kind));
+}
+
+}  // namespace
+
 Config load_config(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
   const auto cannot_read = [&](const std::string& reason) {
     return InputError(fmt::format("cannot read config file '{}': {}", path.string(), reason));
   };
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw cannot_read("Is a directory");
+  require_regular_file(path);
 
   const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
                                                              &std::fclose);

@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include <zlib.h>
+
 #include "core/error.hpp"
 
 namespace kairos::gsd {
@@ -94,6 +96,34 @@ void write_at(int fd, const void* src, std::size_t bytes, std::uint64_t offset,
   }
 }
 
+[[noreturn]] void not_regular(const std::filesystem::path& path, mode_t mode) {
+  const char* kind = S_ISDIR(mode)    ? "a directory"
+                     : S_ISFIFO(mode) ? "a FIFO"
+                     : S_ISCHR(mode)  ? "a character device"
+                     : S_ISBLK(mode)  ? "a block device"
+                     : S_ISSOCK(mode) ? "a socket"
+                                      : "a special file";
+  throw InputError("'" + path.string() + "' is not a regular file (it is " + kind +
+                   "): give the path of a GSD file");
+}
+
+// Opens an existing GSD file. Only regular files: opening a FIFO would block until some other
+// process writes to it, and a device or directory is never a GSD file. The path is checked
+// before opening (opening some devices has side effects) and the open file once more (the path
+// may have been replaced in between); O_NONBLOCK keeps the open itself from blocking and has
+// no effect on reads of a regular file.
+int open_regular(const std::filesystem::path& path, int flags, const char* what) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) not_regular(path, st.st_mode);
+  const int fd = ::open(path.c_str(), flags | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) fail(path, std::string(what) + ": " + std::strerror(errno));
+  if (::fstat(fd, &st) == 0 && !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    not_regular(path, st.st_mode);
+  }
+  return fd;
+}
+
 void sync(int fd, const std::filesystem::path& path) {
   if (::fsync(fd) != 0) fail(path, std::string("fsync failed: ") + std::strerror(errno));
 }
@@ -115,6 +145,66 @@ struct Contents {
   std::uint64_t used_slots;  // index slots before the first location 0 (>= index.size())
   std::uint64_t file_size;
 };
+
+// Why index entry `e` cannot be used ("" when it can): `prev_frame` is the frame of the entry
+// before it. Its data must lie inside the file: location + N * M * type size <= file size,
+// checked without overflow, so that no reader ever allocates for data the file cannot hold.
+std::string entry_problem(const Entry& e, const Contents& c, std::uint64_t prev_frame) {
+  const std::uint64_t size = type_size(static_cast<Type>(e.type));
+  if (size == 0) return "invalid type " + std::to_string(e.type);
+  if (e.flags != 0) return "invalid flags";
+  if (e.id >= c.names.size()) return "name id " + std::to_string(e.id) + " beyond the namelist";
+  if (e.frame < prev_frame || e.frame >= c.header.index_allocated_entries)
+    return "frame number " + std::to_string(e.frame) + " out of order";
+  const std::uint64_t location = static_cast<std::uint64_t>(e.location);
+  const bool inside = e.location > 0 && location <= c.file_size &&
+                      (e.N == 0 || e.M == 0 || e.N <= (c.file_size - location) / e.M / size);
+  if (!inside) {
+    return std::to_string(e.N) + " x " + std::to_string(e.M) + " " +
+           std::string(type_name(static_cast<Type>(e.type))) + " values at byte " +
+           std::to_string(e.location) + " lie beyond the end of the file (" +
+           std::to_string(c.file_size) + " bytes)";
+  }
+  return "";
+}
+
+// Whether some entry after slot k, of a frame after `frame`, is sound and inside the file.
+bool later_frame_intact(const Contents& c, std::size_t k, std::size_t used, std::uint64_t frame) {
+  for (std::size_t j = k + 1; j < used; ++j) {
+    const Entry& e = c.index[j];
+    if (e.frame > frame && entry_problem(e, c, frame).empty()) return true;
+  }
+  return false;
+}
+
+// The number of index entries to keep of the `used` slots. By the commit protocol a frame's data
+// is on disk before its entries, and the data of later frames lies after it: an unusable entry
+// is either the torn or truncated tail of the file (no later frame is intact), whose frame is
+// dropped with all later ones, or damage in the middle of the file, an InputError.
+std::size_t drop_torn_tail(const Contents& c, std::size_t used, const std::filesystem::path& path) {
+  std::uint64_t prev_frame = 0;
+  for (std::size_t k = 0; k < used; ++k) {
+    const Entry& e = c.index[k];
+    const std::string problem = entry_problem(e, c, prev_frame);
+    if (problem.empty()) {
+      prev_frame = e.frame;
+      continue;
+    }
+    const bool sane_frame = e.frame >= prev_frame && e.frame < c.header.index_allocated_entries;
+    const std::uint64_t frame = sane_frame ? e.frame : prev_frame;
+    if (later_frame_intact(c, k, used, frame)) {
+      const std::string chunk = e.id < c.names.size() ? "chunk '" + c.names[e.id] + "'" : "a chunk";
+      fail(path, "damaged index: the entry of " + chunk + " in frame " + std::to_string(frame) +
+                     " is invalid (" + problem +
+                     ") while later frames are intact; the file was changed or damaged after "
+                     "it was written");
+    }
+    std::size_t valid = k;
+    while (valid > 0 && c.index[valid - 1].frame >= frame) --valid;
+    return valid;
+  }
+  return used;
+}
 
 Contents load(int fd, const std::filesystem::path& path) {
   Contents c{};
@@ -159,25 +249,25 @@ Contents load(int fd, const std::filesystem::path& path) {
   std::size_t used = 0;
   while (used < c.index.size() && c.index[used].location != 0) ++used;
   c.used_slots = used;
-  std::size_t valid = 0;
-  for (std::uint64_t prev_frame = 0; valid < used; ++valid) {
-    const Entry& e = c.index[valid];
-    const std::uint64_t size = type_size(static_cast<Type>(e.type));
-    const std::uint64_t location = static_cast<std::uint64_t>(e.location);
-    const bool ok = size != 0 && e.flags == 0 && e.id < c.names.size() && e.frame >= prev_frame &&
-                    e.frame < h.index_allocated_entries && e.location > 0 &&
-                    location <= c.file_size &&
-                    (e.N == 0 || e.M == 0 || e.N <= (c.file_size - location) / e.M / size);
-    if (!ok) {
-      // A torn or truncated tail: drop the frame the bad entry belongs to and all later ones.
-      const std::uint64_t cut = std::max(e.frame, prev_frame);
-      while (valid > 0 && c.index[valid - 1].frame >= cut) --valid;
-      break;
-    }
-    prev_frame = e.frame;
-  }
-  c.index.resize(valid);
+  c.index.resize(drop_torn_tail(c, used, path));
   return c;
+}
+
+// The CRC-32 of a chunk's canonical header (gsd_file.hpp, "Frame checksums"), continuing `crc`.
+std::uint32_t header_crc(std::uint32_t crc, std::string_view name, Type type, std::uint64_t N,
+                         std::uint32_t M) {
+  std::string bytes(name);
+  bytes.push_back('\0');
+  bytes.push_back(static_cast<char>(type));
+  bytes.append(reinterpret_cast<const char*>(&N), sizeof N);  // little-endian (static_assert)
+  bytes.append(reinterpret_cast<const char*>(&M), sizeof M);
+  return static_cast<std::uint32_t>(
+      crc32_z(crc, reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
+}
+
+std::uint32_t data_crc(std::uint32_t crc, const void* data, std::size_t bytes) {
+  if (bytes == 0) return crc;  // (zlib's crc32 of a null buffer is its initial value, 0)
+  return static_cast<std::uint32_t>(crc32_z(crc, static_cast<const Bytef*>(data), bytes));
 }
 
 void copy_name(char (&field)[64], std::string_view value, const char* what) {
@@ -219,6 +309,15 @@ struct Writer::State {
   std::uint64_t flushed = 0;  // pending data bytes already written after `end`
   std::vector<Entry> pending;
   std::vector<char> buffer;  // pending data bytes not yet written
+  // With checksums on: per pending chunk its name, the CRC-32 of its canonical serialisation
+  // and that serialisation's length.
+  struct ChunkCrc {
+    std::string name;
+    std::uint32_t crc;
+    std::uint64_t length;
+  };
+  bool checksums = false;
+  std::vector<ChunkCrc> crcs;
 
   State(std::filesystem::path p, int descriptor) : path(std::move(p)), fd(descriptor) {}
 
@@ -272,8 +371,7 @@ Writer Writer::create(const std::filesystem::path& path, std::string_view applic
 }
 
 Writer Writer::open_append(const std::filesystem::path& path, std::uint64_t keep_frames) {
-  const int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
-  if (fd < 0) fail(path, std::string("cannot open for appending: ") + std::strerror(errno));
+  const int fd = open_regular(path, O_RDWR, "cannot open for appending");
   auto s = std::make_unique<State>(path, fd);
   Contents c = load(fd, path);
   if (c.names.size() > 0xFFFF) fail(path, "corrupt namelist (more than 65535 names)");
@@ -329,6 +427,10 @@ void Writer::write_chunk(std::string_view name, Type type, std::uint64_t N, std:
   const std::uint64_t location = s.end + s.flushed + s.buffer.size();
   s.pending.push_back(Entry{s.frames, N, static_cast<std::int64_t>(location), M, id,
                             static_cast<std::uint8_t>(type), 0});
+  if (s.checksums) {
+    const std::uint32_t crc = data_crc(header_crc(0, chunk, type, N, M), data, bytes);
+    s.crcs.push_back({chunk, crc, chunk.size() + 1 + 1 + 8 + 4 + bytes});
+  }
   if (s.buffer.size() + bytes > kBufferBytes) s.flush();
   if (bytes >= kBufferBytes) {
     write_at(s.fd.get(), data, bytes, location, s.path);
@@ -406,6 +508,7 @@ void Writer::end_frame() {
     s.new_names.clear();
     s.entries += n;
     s.pending.clear();
+    s.crcs.clear();
     s.frames += 1;
     s.end = eof;
     s.flushed = 0;
@@ -417,6 +520,24 @@ void Writer::end_frame() {
 
 std::uint64_t Writer::frame_count() const {
   return state("frame_count").frames;
+}
+
+void Writer::enable_checksums() {
+  state("enable_checksums").checksums = true;
+}
+
+std::uint32_t Writer::frame_checksum() const {
+  const State& s = state("frame_checksum");
+  if (!s.checksums) throw std::logic_error("gsd::Writer::frame_checksum without enable_checksums");
+  std::vector<const State::ChunkCrc*> order;
+  for (const auto& c : s.crcs) order.push_back(&c);
+  std::sort(order.begin(), order.end(), [](auto* a, auto* b) { return a->name < b->name; });
+  // The CRC of the concatenation, from the CRCs of its pieces (the data is gone by now).
+  std::uint32_t crc = 0;
+  for (const auto* c : order) {
+    crc = static_cast<std::uint32_t>(crc32_combine(crc, c->crc, static_cast<z_off_t>(c->length)));
+  }
+  return crc;
 }
 
 void Writer::close() noexcept {
@@ -452,8 +573,7 @@ struct Reader::State {
 };
 
 Reader::Reader(const std::filesystem::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) fail(path, std::string("cannot open: ") + std::strerror(errno));
+  const int fd = open_regular(path, O_RDONLY, "cannot open");
   s_ = std::make_unique<State>(path, fd);
   s_->contents = load(fd, path);
   const auto& names = s_->contents.names;
@@ -480,6 +600,34 @@ std::uint32_t Reader::schema_version() const {
 }
 std::vector<std::string> Reader::chunk_names() const {
   return s_->contents.names;
+}
+
+std::uint32_t Reader::frame_checksum(std::uint64_t frame, std::string_view except) const {
+  const auto& names = s_->contents.names;
+  std::vector<const Entry*> chunks;
+  for (const Entry& e : s_->contents.index)
+    if (e.frame == frame && names[e.id] != except) chunks.push_back(&e);
+  std::sort(chunks.begin(), chunks.end(),
+            [&](const Entry* a, const Entry* b) { return names[a->id] < names[b->id]; });
+  std::vector<char> buffer;
+  std::uint32_t crc = 0;
+  for (const Entry* e : chunks) {
+    const auto type = static_cast<Type>(e->type);
+    crc = header_crc(crc, names[e->id], type, e->N, e->M);
+    // Bounded by the file's size (load): read in pieces of at most kBufferBytes.
+    std::uint64_t left = e->N * e->M * type_size(type);
+    auto at = static_cast<std::uint64_t>(e->location);
+    while (left > 0) {
+      const std::size_t piece =
+          static_cast<std::size_t>(std::min<std::uint64_t>(left, kBufferBytes));
+      buffer.resize(piece);
+      read_bytes(at, buffer.data(), piece);
+      crc = data_crc(crc, buffer.data(), piece);
+      at += piece;
+      left -= piece;
+    }
+  }
+  return crc;
 }
 
 std::optional<Reader::ChunkInfo> Reader::find(std::uint64_t frame, std::string_view name) const {

@@ -19,8 +19,18 @@
 // the index that already holds the frame's entries are written and fsync'ed. Only then does the
 // frame become visible, by one write of its entries into free index slots or by one 256-byte
 // header write pointing at the new index; fsync. A process killed before that leaves only
-// unreferenced bytes at the end of the file. The Reader treats an invalid index entry (e.g. one
-// pointing past the end of a truncated file) as the end of the index and drops its frame.
+// unreferenced bytes at the end of the file. The Reader checks every index entry before anything
+// is allocated for it (its N x M values must lie inside the file, as must the index and the
+// namelist). An invalid entry (e.g. one pointing past the end of a truncated file) that no intact
+// later frame follows is a torn or truncated tail: it ends the index and its frame is dropped.
+// One that intact later frames follow cannot come from an interrupted write: an InputError
+// naming the chunk.
+//
+// Frame checksums (Writer::enable_checksums, Writer::frame_checksum, Reader::frame_checksum): a
+// CRC-32 (zlib's crc32, the CRC of zip and PNG) over a canonical serialisation of a frame's
+// chunks, independent of the order they were written in and of their place in the file: the
+// chunks in bytewise order of their names, each as its name, one 0 byte, its type (1 byte), N
+// (8 bytes) and M (4 bytes, both little-endian), then its N x M values as stored.
 //
 // Type::character (added in spec 2.1) is readable, but the Writer refuses it: python-gsd 2.7
 // reports a file holding such a chunk as corrupt. Store strings as int8 (as HOOMD does).
@@ -76,9 +86,9 @@ class Writer {
   static Writer create(const std::filesystem::path& path, std::string_view application,
                        std::string_view schema = "hoomd",
                        std::uint32_t schema_version = (1u << 16) | 4u);
-  // Opens an existing GSD 2.x file to append frames; InputError if it is not one. Frames from
-  // `keep_frames` on are dropped first (a run continued from an earlier state: the frames it
-  // had written after that state), their bytes left unreferenced.
+  // Opens an existing GSD 2.x file (a regular file) to append frames; InputError if it is not.
+  // Frames from `keep_frames` on are dropped first (a run continued from an earlier state: the
+  // frames it had written after that state), their bytes left unreferenced.
   static Writer open_append(const std::filesystem::path& path,
                             std::uint64_t keep_frames = ~std::uint64_t{0});
 
@@ -94,6 +104,13 @@ class Writer {
   // N x M values of `type` at `data` (may be null when N * M == 0).
   void write_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M,
                    const void* data);
+  // From now on, keep the CRC-32 of each chunk written (see "Frame checksums" above), so that
+  // frame_checksum() can be asked before end_frame(). Off by default: trajectories skip the cost.
+  void enable_checksums();
+  // The checksum of the chunks written so far in the frame being built (logic_error unless
+  // enable_checksums() was called first). Write it as a chunk of the same frame, and verify it
+  // with Reader::frame_checksum(frame, that chunk's name).
+  std::uint32_t frame_checksum() const;
   // Commits the frame: on return it is durable on disk (data, namelist, index; fsync).
   // A frame without chunks has no index entry, so it persists only if a later frame has chunks.
   void end_frame();
@@ -110,7 +127,9 @@ class Writer {
 // Reads a GSD 2.x file. The header, namelist and index are loaded at construction.
 class Reader {
  public:
-  explicit Reader(const std::filesystem::path& path);  // InputError if missing/not GSD 2.x
+  // InputError if missing, not GSD 2.x, or not a regular file (a FIFO, directory or device is
+  // refused at once: opening a FIFO would wait for a writer).
+  explicit Reader(const std::filesystem::path& path);
   Reader(Reader&&) noexcept;
   Reader& operator=(Reader&&) noexcept;
   ~Reader();
@@ -135,6 +154,9 @@ class Reader {
     return values;
   }
   std::vector<std::string> chunk_names() const;  // all names in the namelist, in id order
+  // The checksum (see "Frame checksums" above) of all chunks of `frame` but `except` (the chunk
+  // that stores it); reads every chunk of the frame.
+  std::uint32_t frame_checksum(std::uint64_t frame, std::string_view except) const;
 
  private:
   struct Located {

@@ -5,7 +5,10 @@
 #include <sstream>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "core/error.hpp"
+#include "core/memory_budget.hpp"
 #include "core/periodic.hpp"
 #include "io/atomic_file.hpp"
 
@@ -17,8 +20,11 @@ namespace {
 // 4: bonds, pair zones, step counters; 5: soft contacts in progress and soft counters (a
 // format-4 reader would drop the contacts in progress silently, hence the new number); 6:
 // deferred soft contacts (frozen_deferred: a format-5 reader would continue them frozen, not
-// bit-identically). Versions 3 to 5 are still read: the chunks added since are optional.
-constexpr std::uint32_t kRestartFormat = 6;
+// bit-identically); 7: kairos/checksum, the CRC-32 of the frame's other chunks (gsd_snapshot.hpp),
+// required from 7 on. Versions 3 to 6 are still read: the chunks added since are optional.
+constexpr std::uint32_t kRestartFormat = 7;
+constexpr std::uint32_t kFirstChecksummedFormat = 7;
+constexpr const char* kChecksumChunk = "kairos/checksum";
 constexpr std::uint32_t kOldestRestartFormat = 3;
 
 // HOOMD stores type names as an N_types x M int8 array of 0-padded strings.
@@ -157,6 +163,62 @@ std::vector<T> require(const gsd::Reader& r, std::uint64_t frame, std::string_vi
   return std::move(*v);
 }
 
+// Before anything is allocated for the n particles that particles/N claims, the chunk holding
+// their positions (`positions`, n rows of `width` values, in frame f or 0) must hold them: a
+// damaged or hand-made file can claim any number, while the stored chunks are bounded by the
+// file's size (gsd::Reader). `who` names the file in messages.
+void check_positions_stored(const gsd::Reader& r, std::uint64_t f, std::size_t n,
+                            std::string_view positions, std::uint64_t width,
+                            const std::string& who) {
+  const auto info = r.find(f, positions) ? r.find(f, positions) : r.find(0, positions);
+  const std::string claim = who + ": particles/N = " + std::to_string(n) + " but ";
+  if (!info) throw InputError(claim + "the file has no chunk '" + std::string(positions) + "'");
+  if (info->N * info->M != n * width) {
+    throw InputError(claim + "chunk '" + std::string(positions) + "' holds " +
+                     std::to_string(info->N) + " x " + std::to_string(info->M) + " values, not " +
+                     std::to_string(n) + " x " + std::to_string(width) + ": the file is damaged");
+  }
+}
+
+// Kairos simulates rectangular boxes: a HOOMD box with tilt factors (configuration/box entries
+// xy, xz, yz) would otherwise be run as the rectangular box of its edges, silently another
+// system. `who` names the file in messages.
+void check_rectangular_box(const gsd::Reader& r, std::uint64_t f, const std::string& who) {
+  const auto box = read_latest<float>(r, f, "configuration/box");
+  if (!box || box->size() != 6) return;  // (a missing or short box is reported where it is read)
+  const float xy = (*box)[3], xz = (*box)[4], yz = (*box)[5];
+  if (xy == 0.0f && xz == 0.0f && yz == 0.0f) return;
+  throw InputError(fmt::format(
+      "{}: configuration/box has tilt factors xy = {}, xz = {}, yz = {}, a triclinic box; Kairos "
+      "simulates rectangular boxes only: give a state in a box with xy = xz = yz = 0",
+      who, xy, xz, yz));
+}
+
+// A restart file of `format` carries kairos/checksum from format 7 on (older ones may not); when
+// present it must match the frame's other chunks. A mismatch means the file was changed after
+// Kairos wrote it (a flipped bit, a bad copy, an edit): its state cannot be trusted, even when
+// every value is plausible.
+void verify_checksum(const gsd::Reader& r, std::uint64_t f, std::uint32_t format,
+                     const std::string& who) {
+  const auto info = r.find(f, kChecksumChunk);
+  if (!info) {
+    if (format < kFirstChecksummedFormat) return;
+    throw InputError(fmt::format(
+        "{} is damaged: restart format {} but no {} chunk; use an intact copy of the file", who,
+        format, kChecksumChunk));
+  }
+  const auto stored = r.read<std::uint32_t>(f, kChecksumChunk);
+  const std::uint32_t computed = r.frame_checksum(f, kChecksumChunk);
+  if (stored.size() == 1 && stored[0] == computed) return;
+  throw InputError(fmt::format(
+      "{} is damaged: checksum mismatch ({} holds {}, the file's chunks give {:#010x}); it was "
+      "changed after Kairos wrote it: use an intact copy (e.g. an earlier restart file)",
+      who, kChecksumChunk,
+      stored.size() == 1 ? fmt::format("{:#010x}", stored[0])
+                         : fmt::format("{} values", stored.size()),
+      computed));
+}
+
 // Default name of the one bond type of a file that has bonds but no bonds/types chunk (as
 // HOOMD files written without types): that of generated chains.
 constexpr const char* kDefaultBondType = "backbone";
@@ -290,6 +352,7 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
                    const std::mt19937_64& rng, const RunProgress& progress) {
   replace_file_atomically(path, [&](const std::filesystem::path& tmp) {
     auto w = gsd::Writer::create(tmp, "kairos " KAIROS_VERSION);
+    w.enable_checksums();
     write_standard_chunks(w, s, true);
     const std::uint64_t n = s.size();
     std::vector<double> pos(n * D), vel(n * D), local(n), radius(n), now(n * D);
@@ -466,6 +529,8 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
       if (std::isfinite(progress.dem_time_mark))
         w.write_chunk("kairos/run/dem_time_mark", 1, 1, &progress.dem_time_mark);
     }
+    const std::uint32_t checksum = w.frame_checksum();  // of every chunk above: keep it last
+    w.write_chunk(kChecksumChunk, 1, 1, &checksum);
     w.end_frame();
     w.close();
   });
@@ -486,19 +551,24 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   if (r.frame_count() == 0 || !r.find(f, "kairos/format")) {
     throw InputError("'" + path.string() + "' is not a Kairos restart file (no kairos/format)");
   }
-  if (const auto v = require<std::uint32_t>(r, f, "kairos/format", path, 1)[0];
-      v < kOldestRestartFormat || v > kRestartFormat) {
-    throw InputError("'" + path.string() + "': restart format version " + std::to_string(v) +
+  const std::uint32_t format = require<std::uint32_t>(r, f, "kairos/format", path, 1)[0];
+  if (format < kOldestRestartFormat || format > kRestartFormat) {
+    throw InputError("'" + path.string() + "': restart format version " + std::to_string(format) +
                      ", this Kairos reads versions " + std::to_string(kOldestRestartFormat) +
                      " to " + std::to_string(kRestartFormat) +
                      " (restart files are not portable across other versions)");
   }
+  verify_checksum(r, f, format, "restart file '" + path.string() + "'");
   const int dim = require<std::uint8_t>(r, f, "kairos/dimension", path, 1)[0];
   if (dim != D) {
     throw InputError("'" + path.string() + "' holds a " + std::to_string(dim) +
                      "D state but system.dimension = " + std::to_string(D));
   }
   const std::size_t n = require<std::uint32_t>(r, f, "particles/N", path, 1)[0];
+  check_positions_stored(r, f, n, "kairos/state/position", D, "'" + path.string() + "'");
+  check_rectangular_box(r, f, "'" + path.string() + "'");
+  require_memory(estimated_run_bytes(n, D),
+                 fmt::format("restart file '{}' ({} particles)", path.string(), n));
   ParticleSystem<D> s;
   const auto box = require<double>(r, f, "kairos/box", path, D);
   for (int a = 0; a < D; ++a) s.box[a] = box[a];
@@ -732,6 +802,11 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   const gsd::Reader r(path);
   if (r.frame_count() == 0) throw InputError("'" + path.string() + "' holds no frame");
   const std::uint64_t f = r.frame_count() - 1;
+  const std::string who = "system.initial_state '" + path.string() + "'";
+  if (r.find(f, "kairos/format")) {  // a Kairos restart file: damaged?
+    const auto format = require<std::uint32_t>(r, f, "kairos/format", path, 1);
+    verify_checksum(r, f, format[0], who);
+  }
   const int dim = gsd_dimension(path);
   if (dim != D) {
     throw InputError("system.initial_state '" + path.string() + "' is " + std::to_string(dim) +
@@ -741,8 +816,12 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   const std::size_t n = nv && !nv->empty() ? (*nv)[0] : 0;
   if (n < 2)
     throw InputError("system.initial_state '" + path.string() + "' holds fewer than 2 particles");
-  InitialState<D> s;
   const bool exact = r.find(f, "kairos/position").has_value();
+  check_positions_stored(r, f, n, exact ? "kairos/position" : "particles/position", exact ? D : 3,
+                         who);
+  check_rectangular_box(r, f, who);
+  require_memory(estimated_run_bytes(n, D), fmt::format("{} ({} particles)", who, n));
+  InitialState<D> s;
   if (exact) {
     const auto box = require<double>(r, f, "kairos/box", path, D);
     for (int a = 0; a < D; ++a) s.box[a] = box[a];
@@ -806,8 +885,8 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
       throw InputError("system.initial_state '" + path.string() + "': mass of particle " +
                        std::to_string(i) + " is not a positive number");
   }
-  if (auto tid = read_latest<std::uint32_t>(r, f, "particles/typeid")) {
-    s.species = *tid;
+  if (r.find(f, "particles/typeid") || r.find(0, "particles/typeid")) {
+    s.species = require<std::uint32_t>(r, f, "particles/typeid", path, n);
   } else {
     s.species.assign(n, 0);
   }

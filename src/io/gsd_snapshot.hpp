@@ -23,7 +23,12 @@
 //   kairos/state/frozen_deferred      float64 F x (1 + 2D): deferred (1 or 0), the release
 //                                     positions i and j (only when some release is deferred;
 //                                     absent: none is)
-// Format 4 files are read with no soft contacts.
+// Format 4 files are read with no soft contacts. Format 6 adds frozen_deferred; format 7 adds
+//   kairos/checksum  uint32 x 1: CRC-32 (zlib) of every other chunk of the frame, over their
+//                    canonical serialisation (gsd_file.hpp, "Frame checksums"), written last
+// and verified by read_restart and read_initial_state before anything else is read; a mismatch
+// (or a format-7 file without it) is an InputError "... is damaged: checksum mismatch". Files of
+// formats 3 to 6 have no checksum and are read unverified.
 #pragma once
 
 #include <array>
@@ -105,7 +110,8 @@ int gsd_dimension(const std::filesystem::path& path);
 // positions and velocities when present, else the float32 standard chunks. `has_velocities`
 // tells whether the file held velocities. Bonds come from bonds/* (of that frame, else frame 0;
 // typeid defaults to 0 and, when there are bonds but no bonds/types, the one type is named
-// "backbone"). InputError on a missing file, missing positions, a box too small, particles
+// "backbone"). InputError on a missing file, missing positions, particles/N disagreeing with
+// them, a box too small or tilted (nonzero xy, xz, yz: Kairos boxes are rectangular), particles
 // outside the box, or a bond naming a particle out of range (or twice) or an unknown type.
 template <int D>
 InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_velocities);

@@ -13,9 +13,11 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
+#include "special_files.hpp"
 
 namespace kairos {
 namespace {
@@ -1279,7 +1281,23 @@ TEST_F(ConfigFile, MissingFileIsAnInputError) {
     load_config(dir_);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("Is a directory"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("is not a regular file (it is a directory)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// A FIFO or a device given as the config file is refused at once: reading a FIFO would wait for
+// a writer forever, and /dev/null would read as an empty config.
+TEST_F(ConfigFile, SpecialFilesAreRefusedWithoutBlocking) {
+  const auto fifo = dir_ / "run.toml";
+  kairos::testing::make_fifo(fifo);
+  for (const auto& [path, kind] :
+       {std::pair<std::filesystem::path, std::string>{fifo, "a FIFO"}, {"/dev/null", "a device"}}) {
+    const std::string message =
+        kairos::testing::refusal_without_blocking(path, [&] { (void)load_config(path); });
+    EXPECT_EQ(message, "config file '" + path.string() + "' is not a regular file (it is " + kind +
+                           "): give the path of a TOML file");
   }
 }
 

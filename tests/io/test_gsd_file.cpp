@@ -12,9 +12,11 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
+#include "special_files.hpp"
 
 namespace fs = std::filesystem;
 using kairos::InputError;
@@ -306,6 +308,30 @@ TEST_F(GsdFile, MissingFileIsAnInputError) {
   EXPECT_THROW(Writer::create(file("no/such/dir.gsd"), "test"), InputError);
 }
 
+// A FIFO, a directory or a device is refused at once: opening a FIFO for reading would wait
+// for a writer forever.
+TEST_F(GsdFile, SpecialFilesAreRefusedWithoutBlocking) {
+  kairos::testing::make_fifo(file("fifo.gsd"));
+  fs::create_directories(file("dir.gsd"));
+  const std::pair<fs::path, std::string> cases[] = {{file("fifo.gsd"), "a FIFO"},
+                                                    {file("dir.gsd"), "a directory"},
+                                                    {"/dev/null", "a character device"}};
+  for (const auto& [path, kind] : cases) {
+    std::string expected = "'";  // (not "'" + ...: a GCC 12 -Wrestrict false positive)
+    expected += path.string();
+    expected += "' is not a regular file (it is " + kind + ")";
+    for (const bool append : {false, true}) {
+      const std::string message = kairos::testing::refusal_without_blocking(path, [&] {
+        if (append)
+          (void)Writer::open_append(path);
+        else
+          (void)Reader{path};
+      });
+      EXPECT_NE(message.find(expected), std::string::npos) << message;
+    }
+  }
+}
+
 TEST_F(GsdFile, GarbageAndDamagedHeadersAreInputErrors) {
   {
     auto w = Writer::create(file("good.gsd"), "test");
@@ -366,6 +392,124 @@ TEST_F(GsdFile, CorruptIndexEntryDropsItsFrame) {
     const Reader r(file("e.gsd"));
     expect_frames(r, 2);
   }
+}
+
+// An entry that claims more data than the file holds, or is otherwise invalid, followed by intact
+// later frames is damage, not an interrupted write: an InputError naming the file and the chunk
+// (reading on would silently lose every later frame).
+TEST_F(GsdFile, DamagedEntryBeforeIntactFramesIsAnInputError) {
+  {
+    auto w = Writer::create(file("m.gsd"), "test");
+    write_frames(w, 0, 3);
+  }
+  const std::string good = slurp(file("m.gsd"));
+  const auto index = get<std::uint64_t>(good, 8);
+  const std::size_t entry = index + 32 * 1;  // frame 0's particles/position
+  ASSERT_EQ(get<std::uint64_t>(good, entry), 0u);
+  ASSERT_EQ(get<std::uint64_t>(good, entry + 8), 1u);
+  std::string huge = good;
+  put<std::uint64_t>(huge, entry + 8, 50'000'000);  // N
+  std::string bad_type = good;
+  bad_type[entry + 30] = static_cast<char>(0x7F);
+  for (const std::string& damaged : {huge, bad_type}) {
+    spit(file("m.gsd"), damaged);
+    for (const bool append : {false, true}) {
+      try {
+        if (append)
+          (void)Writer::open_append(file("m.gsd"));
+        else
+          (void)Reader{file("m.gsd")};
+        ADD_FAILURE() << "a damaged entry before intact frames was accepted";
+      } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(file("m.gsd").string()), std::string::npos) << message;
+        EXPECT_NE(message.find("chunk 'particles/position' in frame 0"), std::string::npos)
+            << message;
+      }
+    }
+  }
+  spit(file("m.gsd"), huge);
+  try {
+    (void)Reader{file("m.gsd")};
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("50000000 x 3 float32 values"), std::string::npos)
+        << e.what();
+  }
+}
+
+// The same claim in the last frame is a truncated tail (the commit protocol): that frame is
+// dropped, the others read, and nothing is allocated for the claim.
+TEST_F(GsdFile, HugeEntryInTheLastFrameEndsTheIndex) {
+  {
+    auto w = Writer::create(file("h.gsd"), "test");
+    write_frames(w, 0, 3);
+  }
+  std::string s = slurp(file("h.gsd"));
+  const std::size_t entry = get<std::uint64_t>(s, 8) + 32 * 6;  // frame 2's particles/position
+  ASSERT_EQ(get<std::uint64_t>(s, entry), 2u);
+  put<std::uint64_t>(s, entry + 8, std::uint64_t{1} << 60);
+  spit(file("h.gsd"), s);
+  expect_frames(Reader(file("h.gsd")), 2);
+}
+
+// CRC-32 (IEEE, reflected, as zlib, zip and PNG compute it) bit by bit: an implementation
+// independent of the library's.
+std::uint32_t reference_crc32(const std::string& bytes) {
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (const char c : bytes) {
+    crc ^= static_cast<unsigned char>(c);
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+// One chunk as the frame checksum serialises it: name, 0, type, N (8 bytes), M (4 bytes), data.
+template <class T>
+std::string canonical(const std::string& name, std::uint64_t N, std::uint32_t M,
+                      const std::vector<T>& values) {
+  std::string out = name;
+  out.push_back('\0');
+  out.push_back(static_cast<char>(type_of<T>()));
+  out.append(reinterpret_cast<const char*>(&N), 8);
+  out.append(reinterpret_cast<const char*>(&M), 4);
+  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+  return out;
+}
+
+// The frame checksum is the CRC-32 of the chunks' canonical serialisation in name order,
+// whatever order they were written in; writer and reader agree, and the reader can leave out
+// the chunk that stores it.
+TEST_F(GsdFile, FrameChecksumIsTheCrcOfTheCanonicalChunksInNameOrder) {
+  const std::vector<double> b = {1.5, -2.0, 3.25, 4.0};
+  const std::vector<std::uint8_t> a = {7};
+  const std::vector<float> empty;
+  const std::uint32_t expected =
+      reference_crc32(canonical("a/one", 1, 1, a) + canonical("b/two", 2, 2, b) +
+                      canonical("c/empty", 0, 3, empty));
+  std::uint32_t written[2] = {};
+  for (const bool reversed : {false, true}) {
+    auto w = Writer::create(file("c.gsd"), "test");
+    w.enable_checksums();
+    if (reversed) {
+      w.write_chunk("c/empty", 0, 3, empty.data());
+      w.write_chunk("b/two", 2, 2, b.data());
+      w.write_chunk("a/one", 1, 1, a.data());
+    } else {
+      w.write_chunk("a/one", 1, 1, a.data());
+      w.write_chunk("b/two", 2, 2, b.data());
+      w.write_chunk("c/empty", 0, 3, empty.data());
+    }
+    written[reversed] = w.frame_checksum();
+    w.write_chunk("z/checksum", 1, 1, &written[reversed]);
+    w.end_frame();
+    w.close();
+    EXPECT_EQ(written[reversed], expected);
+    const Reader r(file("c.gsd"));
+    EXPECT_EQ(r.frame_checksum(0, "z/checksum"), expected);
+    EXPECT_NE(r.frame_checksum(0, ""), expected);  // the checksum chunk itself counts then
+  }
+  auto w = Writer::create(file("d.gsd"), "test");
+  EXPECT_THROW((void)w.frame_checksum(), std::logic_error);  // not enabled
 }
 
 // Random damage to the header, index or namelist: an InputError or readable data, never a crash.

@@ -6,8 +6,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <random>
 #include <set>
 #include <string>
@@ -54,46 +57,54 @@ ParticleSystem<D> chain_system(std::uint64_t n = 60, std::uint64_t length = 6) {
   return s;
 }
 
+// Copies chunk `name` of frame 0 from `r` to `w`; `edit` (optional) may change its raw bytes.
+void copy_chunk(const gsd::Reader& r, gsd::Writer& w, const std::string& name,
+                const std::function<void(char*, std::size_t)>& edit = {}) {
+  const auto info = r.find(0, name);
+  ASSERT_TRUE(info) << name;
+  const auto copy = [&](auto zero) {
+    using T = decltype(zero);
+    auto v = r.read<T>(0, name);
+    if (edit) edit(reinterpret_cast<char*>(v.data()), v.size() * sizeof(T));
+    w.write_chunk(name, info->N, info->M, v.data());
+  };
+  switch (info->type) {
+    case gsd::Type::uint8:
+      copy(std::uint8_t{});
+      break;
+    case gsd::Type::uint32:
+      copy(std::uint32_t{});
+      break;
+    case gsd::Type::uint64:
+      copy(std::uint64_t{});
+      break;
+    case gsd::Type::int8:
+      copy(std::int8_t{});
+      break;
+    case gsd::Type::float32:
+      copy(float{});
+      break;
+    case gsd::Type::float64:
+      copy(double{});
+      break;
+    default:
+      FAIL() << name << ": unexpected type";
+  }
+}
+
 // Copies frame 0 of `from` to `to` without the chunks in `drop`, and with kairos/format set to
-// `format`: a restart file as an older Kairos wrote it.
+// `format`: a restart file as an older Kairos wrote it (without kairos/checksum, which format 7
+// added).
 void copy_frame(const fs::path& from, const fs::path& to, const std::set<std::string>& drop,
                 std::uint32_t format) {
   const gsd::Reader r(from);
   auto w = gsd::Writer::create(to, "kairos-test");
   for (const std::string& name : r.chunk_names()) {
-    const auto info = r.find(0, name);
-    if (!info || drop.count(name) != 0) continue;
-    if (name == "kairos/format") {
+    if (!r.find(0, name) || drop.count(name) != 0 || name == "kairos/checksum") continue;
+    if (name == "kairos/format")
       w.write_chunk(name, 1, 1, &format);
-      continue;
-    }
-    const auto copy = [&](auto zero) {
-      using T = decltype(zero);
-      const auto v = r.read<T>(0, name);
-      w.write_chunk(name, info->N, info->M, v.data());
-    };
-    switch (info->type) {
-      case gsd::Type::uint8:
-        copy(std::uint8_t{});
-        break;
-      case gsd::Type::uint32:
-        copy(std::uint32_t{});
-        break;
-      case gsd::Type::uint64:
-        copy(std::uint64_t{});
-        break;
-      case gsd::Type::int8:
-        copy(std::int8_t{});
-        break;
-      case gsd::Type::float32:
-        copy(float{});
-        break;
-      case gsd::Type::float64:
-        copy(double{});
-        break;
-      default:
-        FAIL() << name << ": unexpected type";
-    }
+    else
+      copy_chunk(r, w, name);
   }
   w.end_frame();
 }
@@ -124,7 +135,7 @@ TEST_F(GsdSnapshot, RestartRoundTripsBondsZonesAndStepCounters3D) {
   s.zones = std::vector<PairZone>{{0, 1, 1}, {3, 17, 2}, {5, 59, 7}};
   expect_round_trip<3>(file("restart.gsd"), s);
   const gsd::Reader r(file("restart.gsd"));
-  EXPECT_EQ(r.read<std::uint32_t>(0, "kairos/format"), std::vector<std::uint32_t>{6});
+  EXPECT_EQ(r.read<std::uint32_t>(0, "kairos/format"), std::vector<std::uint32_t>{7});
   EXPECT_EQ(r.read<std::uint64_t>(0, "kairos/state/zone_count"), std::vector<std::uint64_t>{3});
   const auto zones = r.find(0, "kairos/state/zones");
   ASSERT_TRUE(zones);
@@ -191,7 +202,7 @@ TEST_F(GsdSnapshot, ReadsFormat3RestartsWithoutTheNewChunks) {
   EXPECT_TRUE(r.bond_types.empty());
   EXPECT_EQ(r.size(), s.size());
 
-  for (const std::uint32_t bad : {2u, 7u}) {
+  for (const std::uint32_t bad : {2u, 8u}) {
     copy_frame(file("v4.gsd"), file("bad.gsd"), {}, bad);
     try {
       (void)read_restart<3>(file("bad.gsd"), rng);
@@ -323,6 +334,168 @@ TEST_F(GsdSnapshot, InitialStateBondsFromHoomdFiles) {
   EXPECT_NE(message(file("self.gsd")).find("itself"), std::string::npos);
   write_bonded_frame(file("type.gsd"), {0, 1}, {2}, {"a", "b"});
   EXPECT_NE(message(file("type.gsd")).find("typeid 2"), std::string::npos);
+}
+
+// Copies frame 0 of `from` to `to` as it is, kairos/checksum included, but for one byte of
+// chunk `name` changed (its first, or `byte`).
+void copy_with_flipped_byte(const fs::path& from, const fs::path& to, const std::string& name,
+                            std::size_t byte = 0) {
+  const gsd::Reader r(from);
+  auto w = gsd::Writer::create(to, "kairos-test");
+  for (const std::string& chunk : r.chunk_names()) {
+    if (!r.find(0, chunk)) continue;
+    copy_chunk(r, w, chunk, [&](char* data, std::size_t bytes) {
+      if (chunk == name && byte < bytes) data[byte] = static_cast<char>(data[byte] ^ 0x04);
+    });
+  }
+  w.end_frame();
+}
+
+std::string restart_error(const fs::path& path) {
+  std::mt19937_64 rng;
+  try {
+    (void)read_restart<3>(path, rng);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+// A restart file carries the CRC-32 of all its other chunks: one byte changed in any chunk, even
+// to a plausible value (a mass of 1.0 becoming 1.0000000000000009), makes it a damaged file,
+// as a restart and as an initial state. It used to be accepted and change the run.
+TEST_F(GsdSnapshot, RestartChecksumCoversEveryChunk) {
+  auto s = chain_system<3>();
+  s.zones = std::vector<PairZone>{{0, 1, 1}};
+  write_restart<3>(file("good.gsd"), s, std::mt19937_64{});
+  ASSERT_EQ(restart_error(file("good.gsd")), "(accepted)");
+  const gsd::Reader r(file("good.gsd"));
+  std::size_t checked = 0;
+  for (const std::string& name : r.chunk_names()) {
+    const auto info = r.find(0, name);
+    if (name == "kairos/checksum" || !info || info->N * info->M == 0) continue;
+    copy_with_flipped_byte(file("good.gsd"), file("bad.gsd"), name);
+    const std::string expected =
+        "restart file '" + file("bad.gsd").string() + "' is damaged: checksum mismatch";
+    EXPECT_NE(restart_error(file("bad.gsd")).find(expected), std::string::npos)
+        << name << ": " << restart_error(file("bad.gsd"));
+    ++checked;
+  }
+  EXPECT_GT(checked, 30u);
+
+  copy_with_flipped_byte(file("good.gsd"), file("mass.gsd"), "kairos/mass", 8 * 17);
+  bool v = false;
+  try {
+    (void)read_initial_state<3>(file("mass.gsd"), v);
+    ADD_FAILURE() << "a damaged restart file was accepted as an initial state";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("system.initial_state '" + file("mass.gsd").string() +
+                                         "' is damaged: checksum mismatch"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW((void)read_initial_state<3>(file("good.gsd"), v));
+
+  // Format 7 without its checksum is damaged too; format 6 (before checksums) is read.
+  copy_frame(file("good.gsd"), file("none.gsd"), {}, 7);
+  EXPECT_NE(restart_error(file("none.gsd"))
+                .find("is damaged: restart format 7 but no "
+                      "kairos/checksum chunk"),
+            std::string::npos)
+      << restart_error(file("none.gsd"));
+  copy_frame(file("good.gsd"), file("v6.gsd"), {}, 6);
+  EXPECT_EQ(restart_error(file("v6.gsd")), "(accepted)");
+}
+
+// A one-frame 3D HOOMD file whose particles/N claims `claimed` particles, with `rows` positions
+// (0: no positions chunk) and, when `typeids` > 0, that many particles/typeid values.
+void write_claiming_frame(const fs::path& path, std::uint32_t claimed, std::uint32_t rows,
+                          std::uint32_t typeids = 0, std::array<float, 3> tilt = {}) {
+  auto w = gsd::Writer::create(path, "kairos-test");
+  const std::uint8_t dims = 3;
+  const float box[6] = {10, 10, 10, tilt[0], tilt[1], tilt[2]};
+  w.write_chunk("configuration/dimensions", 1, 1, &dims);
+  w.write_chunk("configuration/box", 6, 1, box);
+  w.write_chunk("particles/N", 1, 1, &claimed);
+  std::vector<float> pos(3 * std::size_t{rows});
+  for (std::size_t i = 0; i < rows; ++i) pos[3 * i] = 1.5f * static_cast<float>(i) - 4.0f;
+  if (rows > 0) w.write_chunk("particles/position", rows, 3, pos.data());
+  const std::vector<std::uint32_t> type_id(typeids, 0);
+  if (typeids > 0) w.write_chunk("particles/typeid", typeids, 1, type_id.data());
+  w.end_frame();
+}
+
+std::string initial_state_error(const fs::path& path) {
+  bool v = false;
+  try {
+    (void)read_initial_state<3>(path, v);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+// A small file claiming 5e7 particles is refused before anything is allocated for them (the
+// positions chunk must hold them); it used to take 2.4 GB first.
+TEST_F(GsdSnapshot, ClaimedParticleCountIsCheckedAgainstTheStoredPositions) {
+  write_claiming_frame(file("none.gsd"), 50'000'000, 0);
+  EXPECT_NE(initial_state_error(file("none.gsd"))
+                .find("system.initial_state '" + file("none.gsd").string() +
+                      "': particles/N = 50000000 but the file has no chunk 'particles/position'"),
+            std::string::npos)
+      << initial_state_error(file("none.gsd"));
+  write_claiming_frame(file("few.gsd"), 50'000'000, 4);
+  EXPECT_NE(initial_state_error(file("few.gsd"))
+                .find("particles/N = 50000000 but chunk 'particles/position' holds 4 x 3 values, "
+                      "not 50000000 x 3"),
+            std::string::npos)
+      << initial_state_error(file("few.gsd"));
+
+  // A restart file claiming more particles than its exact positions hold.
+  auto w = gsd::Writer::create(file("claim.gsd"), "kairos-test");
+  const std::uint32_t format = 6, claimed = 50'000'000;
+  const std::uint8_t dims = 3;
+  w.write_chunk("kairos/format", 1, 1, &format);
+  w.write_chunk("kairos/dimension", 1, 1, &dims);
+  w.write_chunk("particles/N", 1, 1, &claimed);
+  w.end_frame();
+  w.close();
+  std::mt19937_64 rng;
+  try {
+    (void)read_restart<3>(file("claim.gsd"), rng);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "particles/N = 50000000 but the file has no chunk 'kairos/state/position'"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// particles/typeid must hold one value per particle (a shorter one was read out of bounds).
+TEST_F(GsdSnapshot, InitialStateTypeidOfTheWrongSizeIsAnInputError) {
+  write_claiming_frame(file("short.gsd"), 4, 4, 2);
+  EXPECT_NE(initial_state_error(file("short.gsd"))
+                .find("chunk 'particles/typeid' holds 2 values, expected 4"),
+            std::string::npos)
+      << initial_state_error(file("short.gsd"));
+  write_claiming_frame(file("right.gsd"), 4, 4, 4);
+  EXPECT_EQ(initial_state_error(file("right.gsd")), "(accepted)");
+}
+
+// A triclinic box (nonzero tilt factors) is refused, naming the file and the factors: it used
+// to run as the rectangular box of its edges.
+TEST_F(GsdSnapshot, TiltedBoxIsRefused) {
+  write_claiming_frame(file("tilt.gsd"), 4, 4, 0, {0.5f, 0.0f, -0.25f});
+  EXPECT_NE(initial_state_error(file("tilt.gsd"))
+                .find("system.initial_state '" + file("tilt.gsd").string() +
+                      "': configuration/box has tilt factors xy = 0.5, xz = 0, yz = -0.25"),
+            std::string::npos)
+      << initial_state_error(file("tilt.gsd"));
+  write_claiming_frame(file("nan.gsd"), 4, 4, 0, {0.0f, std::nanf(""), 0.0f});
+  EXPECT_NE(initial_state_error(file("nan.gsd")).find("tilt factors"), std::string::npos);
+  write_claiming_frame(file("flat.gsd"), 4, 4, 0, {-0.0f, 0.0f, 0.0f});
+  EXPECT_EQ(initial_state_error(file("flat.gsd")), "(accepted)");
 }
 
 }  // namespace

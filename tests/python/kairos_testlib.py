@@ -14,10 +14,13 @@ import math
 import os
 import shutil
 import signal
+import struct
 import subprocess
 import sys
 import tempfile
+import threading
 import unittest
+import zlib
 
 import numpy as np
 import gsd.fl
@@ -128,6 +131,24 @@ def run_kairos(args, cwd, timeout=RUN_TIMEOUT, env=None):
     """Runs `kairos ARGS` in `cwd`; returns the CompletedProcess (text output)."""
     return subprocess.run([KAIROS] + list(args), cwd=cwd, capture_output=True, text=True,
                           timeout=timeout, env=env)
+
+
+def run_kairos_measured(args, cwd, timeout=RUN_TIMEOUT):
+    """Runs `kairos ARGS` in `cwd`; returns (CompletedProcess, peak resident memory of that
+    process alone in bytes, as wait4 reports it)."""
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        proc = subprocess.Popen([KAIROS] + list(args), cwd=cwd, stdout=out, stderr=err, text=True)
+        timer = threading.Timer(timeout, proc.kill)
+        timer.start()
+        try:
+            _, status, usage = os.wait4(proc.pid, 0)
+        finally:
+            timer.cancel()
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        err.seek(0)
+        result = subprocess.CompletedProcess(proc.args, proc.returncode, out.read(), err.read())
+    return result, usage.ru_maxrss * 1024  # kilobytes on Linux
 
 
 def describe(result):
@@ -256,6 +277,49 @@ def restart_chunk(path, name):
         return f.read_chunk(frame=f.nframes - 1, name=name)
 
 
+# GSD type codes (the file layer's enum) of the numpy dtypes python-gsd reads and writes.
+GSD_TYPE_CODES = {np.dtype(t): code for code, t in enumerate(
+    ["uint8", "uint16", "uint32", "uint64", "int8", "int16", "int32", "int64", "float32",
+     "float64"], start=1)}
+
+CHECKSUM_CHUNK = "kairos/checksum"
+
+
+def restart_checksum(chunks):
+    """The checksum of a restart frame as docs/outputs.md defines it, from {name: array} (every
+    chunk of the frame but kairos/checksum): zlib's CRC-32 over the chunks in bytewise order of
+    their names, each as name, 0 byte, type (1 byte), N (uint64), M (uint32), values."""
+    crc = 0
+    for name in sorted((n for n in chunks if n != CHECKSUM_CHUNK), key=lambda n: n.encode()):
+        data = np.ascontiguousarray(chunks[name])
+        n = data.shape[0] if data.ndim > 0 else 1
+        m = data.shape[1] if data.ndim > 1 else 1
+        header = name.encode() + b"\0" + struct.pack("<BQI", GSD_TYPE_CODES[data.dtype], n, m)
+        crc = zlib.crc32(data.tobytes(), zlib.crc32(header, crc))
+    return crc
+
+
+def read_frame_chunks(path, frame=0):
+    """{name: array} of every chunk in a frame of a GSD file."""
+    with gsd.fl.open(name=path, mode="rb") as f:
+        names = [n for n in f.find_matching_chunk_names("") if f.chunk_exists(frame=frame, name=n)]
+        return {n: f.read_chunk(frame=frame, name=n) for n in names}
+
+
+def write_frame_chunks(path, chunks, reseal=True):
+    """Writes a one-frame GSD file of {name: array}; with `reseal` a fresh kairos/checksum
+    replaces the stored one (a file edited on purpose rather than damaged)."""
+    chunks = dict(chunks)
+    if reseal and CHECKSUM_CHUNK in chunks:
+        chunks[CHECKSUM_CHUNK] = np.array([restart_checksum(chunks)], np.uint32)
+    with gsd.fl.open(name=path, mode="wb", application="test", schema="hoomd",
+                     schema_version=[1, 4]) as g:
+        for name, data in chunks.items():
+            g.write_chunk(name, data)
+        g.end_frame()
+    return path
+
+
 def open_trajectory(path):
     return gsd.hoomd.open(path, "rb")
 
@@ -267,11 +331,13 @@ def new_frame():
 
 
 def write_hoomd_file(path, positions, box, dimensions=3, diameter=None, velocity=None,
-                     types=("A",), typeid=None, mass=None):
-    """Writes a one-frame HOOMD GSD file with python-gsd. `positions` in HOOMD's centred box."""
+                     types=("A",), typeid=None, mass=None, tilt=(0.0, 0.0, 0.0)):
+    """Writes a one-frame HOOMD GSD file with python-gsd. `positions` in HOOMD's centred box;
+    `tilt` = the box's (xy, xz, yz)."""
     positions = np.asarray(positions, dtype=np.float32)
     frame = new_frame()
-    frame.configuration.box = [float(box[0]), float(box[1]), float(box[2]), 0.0, 0.0, 0.0]
+    frame.configuration.box = [float(box[0]), float(box[1]), float(box[2])] + \
+        [float(t) for t in tilt]
     frame.configuration.dimensions = dimensions
     frame.particles.N = len(positions)
     frame.particles.position = positions

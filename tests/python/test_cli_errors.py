@@ -5,6 +5,7 @@ message. Also: `kairos --help` and `kairos run --help` document every option.
 """
 
 import os
+import time
 import unittest
 
 import numpy as np
@@ -194,6 +195,17 @@ class ConfigErrors(kt.KairosTestCase):
         result = self.kairos("run", self.tmp)
         self.assert_user_error(result, os.path.basename(self.tmp))
 
+    def test_config_is_a_fifo(self):
+        # Reading a FIFO would wait for a writer forever: refused at once.
+        fifo = self.path("fifo.toml")
+        os.mkfifo(fifo)
+        result = self.kairos("run", fifo, timeout=30)
+        self.assert_user_error(result, "fifo.toml", "is not a regular file (it is a FIFO)")
+
+    def test_config_is_a_device(self):
+        result = self.kairos("run", "/dev/null", timeout=30)
+        self.assert_user_error(result, "/dev/null", "is not a regular file (it is a device)")
+
     def test_malformed_toml(self):
         self.check("[system]\nparticles = \npacking_fraction = 0.3\n", "bad.toml", "syntax")
 
@@ -261,15 +273,50 @@ class PistonErrors(kt.KairosTestCase):
 
 
 class InitialStateErrors(kt.KairosTestCase):
-    def run_from(self, gsd_path, dimension=3, *needles):
+    def run_from(self, gsd_path, dimension=3, *needles, timeout=kt.RUN_TIMEOUT):
         config = kt.base_config(dimension=dimension, production=1.0)
         config["system"] = {"dimension": dimension, "initial_state": gsd_path}
         path = self.write_config(config)
-        result = self.kairos("run", path, "-o", self.path("out"))
+        result = self.kairos("run", path, "-o", self.path("out"), timeout=timeout)
         return self.assert_user_error(result, *needles)
 
     def test_missing_initial_state(self):
         self.run_from(self.path("nothing-here.gsd"), 3, "system.initial_state", "nothing-here.gsd")
+
+    def test_initial_state_is_a_fifo(self):
+        fifo = self.path("fifo.gsd")
+        os.mkfifo(fifo)
+        self.run_from(fifo, 3, "fifo.gsd", "is not a regular file (it is a FIFO)", timeout=30)
+
+    def test_initial_state_is_a_directory(self):
+        os.mkdir(self.path("states"))
+        self.run_from(self.path("states"), 3, "states", "is not a regular file (it is a directory)")
+
+    def test_claimed_particle_count_beyond_the_file(self):
+        # A 5 kB file claiming 5e7 particles is refused before anything is allocated for them
+        # (it used to take 2.3 GB first).
+        p = self.path("claim.gsd")
+        with gsd.fl.open(name=p, mode="wb", application="test", schema="hoomd",
+                         schema_version=[1, 4]) as f:
+            f.write_chunk("configuration/box", np.array([10, 10, 10, 0, 0, 0], np.float32))
+            f.write_chunk("particles/N", np.array([50000000], np.uint32))
+            f.write_chunk("particles/position", np.array([[0, 0, 0], [2, 2, 2]], np.float32))
+            f.end_frame()
+        config = kt.base_config(production=1.0)
+        config["system"] = {"dimension": 3, "initial_state": p}
+        result, peak = kt.run_kairos_measured(
+            ["run", self.write_config(config), "-o", self.path("out")], cwd=self.tmp)
+        self.assertLess(peak, 400 << 20, "peak resident memory %d MB\n%s" %
+                        (peak >> 20, kt.describe(result)))
+        self.assert_user_error(result, "claim.gsd", "particles/N = 50000000",
+                               "'particles/position' holds 2 x 3 values")
+
+    def test_tilted_box(self):
+        # A triclinic box used to run as the rectangular box of its edges, without a word.
+        p = kt.write_hoomd_file(self.path("tilted.gsd"), [[0, 0, 0], [2, 2, 2]], [10, 10, 10],
+                                tilt=(0.5, 0.0, 0.0))
+        self.run_from(p, 3, "tilted.gsd", "tilt factors xy = 0.5, xz = 0, yz = 0",
+                      "rectangular boxes only")
 
     def test_initial_state_not_gsd(self):
         p = self.path("text.gsd")
@@ -366,6 +413,13 @@ class RestartErrors(kt.KairosTestCase):
                              "--restart", self.path("adir"))
         self.assert_user_error(result, "adir")
 
+    def test_restart_from_fifo(self):
+        fifo = self.path("restart.gsd")
+        os.mkfifo(fifo)
+        result = self.kairos("run", self.config, "-o", self.path("out"), "--restart", fifo,
+                             timeout=30)
+        self.assert_user_error(result, "restart.gsd", "is not a regular file (it is a FIFO)")
+
     def test_restart_from_python_gsd_file(self):
         p = kt.write_hoomd_file(self.path("plain.gsd"), [[0, 0, 0], [2, 2, 2]], [10, 10, 10])
         result = self.kairos("run", self.config, "-o", self.path("out"), "--restart", p)
@@ -390,19 +444,12 @@ class DamagedRestartFiles(kt.KairosTestCase):
 
     def damaged(self, drop=(), **replace):
         """A copy of the restart file without the chunks in `drop` and with chunks replaced
-        (keyword names use '__' for '/')."""
+        (keyword names use '__' for '/'), with a fresh checksum: the damage passes the checksum
+        (as a file edited on purpose would) and must be caught by the checks behind it."""
         replace = {k.replace("__", "/"): v for k, v in replace.items()}
-        with gsd.fl.open(name=self.source, mode="rb") as f:
-            names = [n for n in f.find_matching_chunk_names("") if f.chunk_exists(frame=0, name=n)]
-            data = {n: f.read_chunk(frame=0, name=n) for n in names}
-        path = self.path("damaged.gsd")
-        with gsd.fl.open(name=path, mode="wb", application="test", schema="hoomd",
-                         schema_version=[1, 4]) as g:
-            for n in names:
-                if n not in drop:
-                    g.write_chunk(n, replace.get(n, data[n]))
-            g.end_frame()
-        return path
+        data = kt.read_frame_chunks(self.source)
+        chunks = {n: replace.get(n, d) for n, d in data.items() if n not in drop}
+        return kt.write_frame_chunks(self.path("damaged.gsd"), chunks)
 
     def check(self, path, *needles):
         result = self.kairos("run", self.config, "-o", self.path("second"), "--restart", path)
@@ -439,8 +486,57 @@ class DamagedRestartFiles(kt.KairosTestCase):
     def test_corrupt_rng(self):
         self.check(self.damaged(kairos__state__rng=np.frombuffer(b"garbage", np.int8)), "RNG")
 
+    def test_tilted_box(self):
+        self.check(self.damaged(configuration__box=np.array([8, 8, 8, 0, 0.25, 0], np.float32)),
+                   "tilt factors xy = 0, xz = 0.25, yz = 0")
+
     def test_cell_out_of_range(self):
         self.check(self.damaged(kairos__state__cell=np.full(256, 10 ** 8, np.uint32)), "cell")
+
+
+class MemoryEstimate(kt.KairosTestCase):
+    """A run that cannot fit in memory is refused before anything is allocated (it used to fill
+    memory for minutes and end in std::bad_alloc). KAIROS_MEMORY_LIMIT_BYTES stands in for the
+    memory detected, so that these tests do not depend on the machine."""
+
+    def run_with_limit(self, limit, *args):
+        env = dict(os.environ, KAIROS_MEMORY_LIMIT_BYTES=str(limit))
+        return kt.run_kairos(args, cwd=self.tmp, env=env, timeout=60)
+
+    def test_hundred_million_particles_refused_at_once(self):
+        config = self.write_config(kt.base_config(particles=100000000, production=1.0))
+        start = time.monotonic()
+        result = self.run_with_limit(16 << 30, "run", config, "-o", self.path("out"))
+        elapsed = time.monotonic() - start
+        line = self.assert_user_error(result, "system.particles = 100000000 needs about",
+                                      "this machine has 16 GiB available",
+                                      "KAIROS_MEMORY_LIMIT_BYTES")
+        self.assertLess(elapsed, 10.0, line)
+        self.assertFalse(os.path.exists(self.path("out", "summary.json")))
+
+    def test_small_run_in_a_smaller_limit(self):
+        config = self.write_config(kt.base_config(particles=500, production=1.0))
+        self.assert_user_error(self.run_with_limit(10 ** 7, "run", config, "-o", self.path("out")),
+                               "system.particles = 500 needs about", "9.54 MiB available")
+
+    def test_initial_state_and_restart_files_are_checked(self):
+        config = self.write_config(kt.base_config(particles=500, production=1.0))
+        self.run_ok("run", config, "-o", self.path("first"))
+        restart = self.path("first", "restart.gsd")
+        result = self.run_with_limit(10 ** 7, "run", config, "-o", self.path("second"),
+                                     "--restart", restart)
+        self.assert_user_error(result, "restart file '%s' (500 particles) needs about" % restart)
+        from_file = kt.base_config(production=1.0)
+        from_file["system"] = {"dimension": 3, "initial_state": restart}
+        result = self.run_with_limit(10 ** 7, "run", self.write_config(from_file, "file.toml"),
+                                     "-o", self.path("third"))
+        self.assert_user_error(result, "system.initial_state '%s' (500 particles) needs about" %
+                               restart)
+
+    def test_limit_that_is_not_a_number(self):
+        config = self.write_config(kt.base_config(particles=500, production=1.0))
+        self.assert_user_error(self.run_with_limit("8G", "run", config, "-o", self.path("out")),
+                               "KAIROS_MEMORY_LIMIT_BYTES = '8G' is not a number of bytes")
 
 
 class CommandLine(kt.KairosTestCase):

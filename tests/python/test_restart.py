@@ -211,5 +211,65 @@ class RestartBookkeeping(kt.KairosTestCase):
                     "--set", "run.collisions_per_particle=2")
 
 
+class RestartChecksum(kt.KairosTestCase):
+    """kairos/checksum (restart format 7): the CRC-32 of every other chunk of the frame."""
+
+    def setUp(self):
+        super().setUp()
+        self.config = self.write_config(config(3, "calendar", 2.0))
+        self.run_ok("run", self.config, "-o", self.path("first"))
+        self.source = self.path("first", "restart.gsd")
+
+    def test_checksum_is_the_documented_crc_and_python_gsd_reads_the_file(self):
+        chunks = kt.read_frame_chunks(self.source)
+        self.assertEqual(chunks["kairos/format"].tolist(), [7])
+        self.assertEqual(chunks[kt.CHECKSUM_CHUNK].dtype, np.uint32)
+        self.assertEqual(chunks[kt.CHECKSUM_CHUNK].tolist(), [kt.restart_checksum(chunks)])
+        with kt.open_trajectory(self.source) as f:
+            self.assertEqual(len(f), 1)
+            self.assertEqual(f[0].particles.N, 500)
+            self.assertEqual(f[0].particles.position.shape, (500, 3))
+
+    def flipped_mass(self):
+        """A copy of the restart file with one byte of one float64 mass changed: 1.0 becomes
+        1.0000000000000009, plausible, and the run would change (the checksum is not updated)."""
+        with open(self.source, "rb") as f:
+            data = bytearray(f.read())
+        masses = np.ones(500, np.float64).tobytes()
+        self.assertEqual(data.count(masses), 1, "kairos/mass not found in the file")
+        data[data.find(masses) + 8 * 93] ^= 0x04
+        path = self.path("flipped.gsd")
+        with open(path, "wb") as f:
+            f.write(data)
+        self.assertAlmostEqual(kt.restart_chunk(path, "kairos/mass")[93], 1.0, places=12)
+        return path
+
+    def test_flipped_byte_is_refused_as_restart(self):
+        result = self.kairos("run", self.config, "-o", self.path("second"),
+                             "--restart", self.flipped_mass())
+        self.assert_user_error(result, "restart file", "flipped.gsd",
+                               "is damaged: checksum mismatch")
+        self.assertFalse(os.path.exists(self.path("second", "summary.json")))
+
+    def test_flipped_byte_is_refused_as_initial_state(self):
+        cfg = kt.base_config(production=1.0)
+        cfg["system"] = {"dimension": 3, "initial_state": self.flipped_mass()}
+        result = self.kairos("run", self.write_config(cfg, "from_file.toml"),
+                             "-o", self.path("second"))
+        self.assert_user_error(result, "system.initial_state", "flipped.gsd",
+                               "is damaged: checksum mismatch")
+
+    def test_format_6_files_without_checksum_are_still_read(self):
+        chunks = kt.read_frame_chunks(self.source)
+        del chunks[kt.CHECKSUM_CHUNK]
+        chunks["kairos/format"] = np.array([6], np.uint32)
+        old = kt.write_frame_chunks(self.path("format6.gsd"), chunks, reseal=False)
+        self.run_ok("run", self.config, "-o", self.path("second"), "--restart", old)
+        chunks["kairos/format"] = np.array([7], np.uint32)
+        bad = kt.write_frame_chunks(self.path("format7.gsd"), chunks, reseal=False)
+        result = self.kairos("run", self.config, "-o", self.path("third"), "--restart", bad)
+        self.assert_user_error(result, "format7.gsd", "no kairos/checksum chunk")
+
+
 if __name__ == "__main__":
     kt.main()

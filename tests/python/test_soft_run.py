@@ -112,7 +112,7 @@ class SoftRuns(kt.KairosTestCase):
         for name in kt.EXACT_CHUNKS:
             self.assertTrue(np.array_equal(split[name], whole[name]), name)
         self.assertEqual(kt.restart_chunk(self.path("first", "restart.gsd"),
-                                          "kairos/format").tolist(), [6])
+                                          "kairos/format").tolist(), [7])
         counters = [kt.restart_chunk(self.path(d, "restart.gsd"), "kairos/state/soft_counters")
                     for d in ("second", "whole")]
         self.assertTrue(np.array_equal(counters[0], counters[1]))
