@@ -201,6 +201,37 @@ class Module(kt.KairosTestCase):
             self.assertEqual(summary, json.load(f))
         self.assertEqual(summary["sim_time"], 0.5)
 
+    def test_runs_into_one_directory_never_overwrite_each_other(self):
+        # Four threads run into one output directory: one run writes it, the others are
+        # refused (it is in use, or it holds that run's outputs), and its files are whole.
+        cfg = self.write_config(kt.base_config(particles=2000, production=50.0))
+        out = self.path("shared")
+        results = [None] * 4
+
+        def run(k):
+            try:
+                results[k] = kairos.run(cfg, output=out)
+            except kairos.InputError as e:
+                results[k] = e
+
+        threads = [threading.Thread(target=run, args=(k,)) for k in range(4)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(timeout=300)
+        done = [r for r in results if isinstance(r, dict)]
+        refused = [r for r in results if isinstance(r, kairos.InputError)]
+        self.assertEqual(len(done), 1, results)
+        self.assertEqual(len(refused), 3, results)
+        for e in refused:
+            self.assertTrue("in use by another run" in str(e) or "earlier run" in str(e), str(e))
+        self.assertEqual(self.summary(out)["collisions"], done[0]["collisions"])
+        _, rows, text = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        self.assertEqual(rows[-1][3], done[0]["event_counts"]["total_collisions_since_start"])
+        # Asked for, a new run replaces the outputs.
+        again = kairos.run(cfg, output=out, overwrite=True)
+        self.assertEqual(again["collisions"], done[0]["collisions"])
+
     def test_mistakes_raise_input_errors_naming_the_problem(self):
         cfg = self.write_config(hard_config())
         sim = kairos.Simulation(cfg)

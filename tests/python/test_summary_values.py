@@ -4,6 +4,9 @@ last event left a pair in contact to within round-off is a valid start (a contac
 overlap).
 """
 
+import glob
+import json
+import math
 import os
 
 import numpy as np
@@ -110,6 +113,116 @@ class RoundOffContacts(kt.KairosTestCase):
             f.write_chunk("kairos/box", box)
             f.end_frame()
         self.run_ok("run", self.write_config(config), "-o", self.path("c"))
+
+
+def finite_or_null(value, path=""):
+    """Every number in a JSON tree is finite (NaN and inf are not JSON)."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            yield from finite_or_null(v, path + "." + k)
+    elif isinstance(value, list):
+        for k, v in enumerate(value):
+            yield from finite_or_null(v, "%s[%d]" % (path, k))
+    elif isinstance(value, float) and not math.isfinite(value):
+        yield path
+
+
+class SummaryValues(kt.KairosTestCase):
+    def run_summary(self, config, name="out", *args):
+        out = self.path(name)
+        result = self.run_ok("run", self.write_config(config, name + ".toml"), "-o", out, *args)
+        with open(os.path.join(out, "summary.json")) as f:
+            text = f.read()
+        self.assertNotIn("NaN", text)
+        self.assertNotIn("Infinity", text)
+        return json.loads(text), result.stdout
+
+    def test_every_example_reports_no_nan(self):
+        # The examples, shortened: no NaN or inf in summary.json, none on the closing lines.
+        for example in sorted(glob.glob(os.path.join(kt.SOURCE_DIR, "examples", "*.toml"))):
+            name = os.path.basename(example)
+            with self.subTest(name):
+                out = self.path(name)
+                args = ["run", example, "-o", out]
+                for s in ("run.equilibration_collisions_per_particle=0",
+                          "run.collisions_per_particle=2", 'output.progress="never"',
+                          "output.thermo_interval=0", "output.trajectory_interval=0",
+                          "output.restart_interval=0"):
+                    args += ["--set", s]
+                if name == "granular_clustering_2d.toml":
+                    args += ["--set", "system.particles=5000"]
+                result = self.run_ok(*args)
+                for word in ("nan", "inf"):
+                    self.assertNotIn(" " + word, result.stdout.lower(), result.stdout)
+                with open(os.path.join(out, "summary.json")) as f:
+                    s = json.load(f)
+                self.assertEqual(list(finite_or_null(s)), [])
+                for key, reason in s.get("undefined", {}).items():
+                    self.assertTrue(reason, key)
+
+    def test_a_pile_has_no_bulk_pressure(self):
+        # Walls, an open top and gravity: Z and P of the box's volume mean nothing; the Sonine
+        # coefficient of an inhomogeneous bed neither.
+        s, stdout = self.run_summary(pile("random"))
+        self.assertIsNone(s["compressibility"]["mean"])
+        self.assertIsNone(s["pressure"])
+        self.assertIsNone(s["granular"]["sonine_a2"])
+        self.assertIn("not uniform", s["undefined"]["compressibility"])
+        self.assertIn("compressibility Z    n/a (walls, open faces or a field", stdout)
+        self.assertNotIn("Sonine", stdout)
+        self.assertIn("dissipated", stdout)
+
+    def test_a_dem_run_counts_time_steps(self):
+        config = kt.base_config(particles=300, packing_fraction=0.1, lattice="random",
+                                production=2.0)
+        config["soft"] = {"model": "dashpot", "stiffness": 1e4, "restitution": 0.9}
+        config["run"]["integrator"] = "dem"
+        s, stdout = self.run_summary(config)
+        self.assertIn("  time steps ", stdout)
+        self.assertIn("M steps/s", stdout)
+        self.assertNotIn("  events ", stdout)
+        self.assertEqual(s["events"], s["dem"]["steps"])
+
+    def test_a_thermostatted_fluid_shows_no_granular_lines(self):
+        config = kt.base_config(particles=500, packing_fraction=0.2, lattice="random",
+                                production=5.0)
+        config["driving"] = {"kind": "andersen", "rate": 1.0, "temperature": 1.5}
+        text = kt.toml_text(config) + (
+            '\n[[potential]]\nkind = "square_well"\nlambda = 1.5\ndepth = 1.0\n')
+        s, stdout = self.run_summary(text)
+        for line in ("rotational temp.", "Sonine", "dissipated", "work by walls"):
+            self.assertNotIn(line, stdout)
+        self.assertIn("work by driving", stdout)
+        self.assertIn("energy balance", stdout)
+        self.assertIsNotNone(s["compressibility"]["mean"])
+
+    def test_without_a_trajectory_none_is_listed(self):
+        config = kt.base_config(production=2.0)
+        config["output"]["trajectory"] = False
+        s, stdout = self.run_summary(config)
+        self.assertNotIn("trajectory.gsd", s["outputs"])
+        self.assertNotIn("trajectory.gsd", stdout)
+        self.assertIn("thermo.tsv", stdout)
+
+    def test_a_run_at_rest_has_no_pressure(self):
+        # python-gsd's HOOMD writer leaves out zero velocities (its default): write them.
+        positions, edge = kt.cubic_lattice(4, 1.5)
+        start = self.path("rest.gsd")
+        import gsd.fl
+        with gsd.fl.open(name=start, mode="wb", application="test", schema="hoomd",
+                         schema_version=[1, 4]) as f:
+            f.write_chunk("configuration/box", np.array([edge] * 3 + [0] * 3, dtype=np.float32))
+            f.write_chunk("particles/N", np.array([len(positions)], dtype=np.uint32))
+            f.write_chunk("particles/position", np.asarray(positions, dtype=np.float32))
+            f.write_chunk("particles/velocity", np.zeros((len(positions), 3), dtype=np.float32))
+            f.end_frame()
+        config = kt.base_config(production=2.0)
+        config["system"] = {"initial_state": start}
+        s, stdout = self.run_summary(config)
+        self.assertEqual(s["stop_reason"], "no_more_events")
+        self.assertIsNone(s["compressibility"]["mean"])
+        self.assertIsNone(s["mean_free_time"])
+        self.assertIn("n/a", stdout)
 
 
 if __name__ == "__main__":
