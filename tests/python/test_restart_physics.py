@@ -152,5 +152,66 @@ class RestartMatrix(kt.KairosTestCase):
         self.assert_user_error(result, "soft.young", "soft contacts in progress")
 
 
+# The restart matrix (docs/guarantees.md, "Restarts"): key changed at the restart -> expected
+# class. Each continued run is validated against brute force after every event.
+HARD_SPHERE_MATRIX = [
+    ("run.collisions_per_particle=2", "resumed"),
+    ("output.thermo_interval=0.25", "resumed"),
+    ('run.event_queue="tree"', "resumed"),
+    ("contact.restitution=0.9", "resumed"),
+    ("contact.tc=0.001", "resumed"),
+    ("contact.tangential_restitution=0.5", "resumed"),
+    ('driving.kind="andersen"', "resumed"),
+    ("system.species[0].inertia_factor=0.3", "resumed"),
+    ("field.gravity=[0,-0.5,0]", "new_physics"),
+    ('potential=[{kind="square_well", lambda=1.3, depth=0.2}]', "new_physics"),
+    ("system.seed=5", "ignored"),
+    ("system.particles=100", "ignored"),
+    ('system.lattice="sc"', "ignored"),
+    ("system.temperature=2.0", "ignored"),
+    ("system.species[0].diameter=0.9", "refused"),
+    ("system.species[0].mass=3.0", "refused"),
+    ('system.species[0].name="B"', "refused"),
+    ("boundary.shear_rate=0.1", "refused"),
+]
+PILE_MATRIX = [
+    ("contact.sleep_speed=0.01", "new_physics"),
+    ("boundary.wall[4].amplitude=0.05", "new_physics"),
+    ("boundary.wall[4].frequency=2.0", "new_physics"),
+    ("boundary.wall[4].restitution=0.5", "resumed"),
+    ("boundary.wall[0].friction=0.5", "resumed"),
+    ("field.gravity=[0,0,-2]", "new_physics"),
+]
+
+
+class RestartMatrixTable(RestartMatrix):
+    def check_matrix(self, config, matrix):
+        restart = self.base(config)
+        for k, (setting, expected) in enumerate(matrix):
+            with self.subTest(setting):
+                name = "m%d" % k
+                result = self.continue_with(config, restart, name, setting)
+                key = setting.split("=")[0]
+                if expected == "refused":
+                    self.assert_user_error(result, key.split("[")[0].split(".")[0])
+                    continue
+                self.assertEqual(result.returncode, 0, kt.describe(result))
+                s = self.summary(self.path(name))
+                mode = s["restart"]["mode"]
+                if expected == "ignored":
+                    self.assertEqual(mode, "resumed")
+                    self.assertTrue(any(k.startswith(key.split("[")[0])
+                                        for k in s["restart"]["ignored_keys"]), s["restart"])
+                else:
+                    self.assertEqual(mode, expected, s["restart"])
+                self.assertLess(s["max_overlap"], 1e-12)
+
+    def test_hard_spheres(self):
+        self.check_matrix(hard_spheres(), HARD_SPHERE_MATRIX)
+
+    def test_pile(self):
+        self.check_matrix(pile(), PILE_MATRIX)
+
+
 if __name__ == "__main__":
     kt.main()
