@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/stop_flag.hpp"
 #include "io/config.hpp"
 #include "run/run.hpp"
 #include "run/simulation.hpp"
@@ -56,7 +57,9 @@ Config config_from(const py::object& config, const py::object& set) {
 }
 
 // SIGINT during kairos.run: the run stops cleanly after the current event (request_stop(), as
-// in the CLI) and writes every output; Python's handler is back afterwards.
+// in the CLI) and writes every output; Python's handler is back afterwards. During the setup of
+// kairos.run or kairos.Simulation (a table build) it unwinds with Interrupted, which the module
+// turns into KeyboardInterrupt.
 extern "C" void stop_on_sigint(int) {
   request_stop();
 }
@@ -94,6 +97,9 @@ class PySimulation {
   PySimulation(const py::object& config, const py::object& set,
                const std::optional<fs::path>& restart) {
     const Config c = config_from(config, set);
+    // The start may build soft-sphere tables (seconds): without the GIL, and Ctrl-C ends it.
+    SigintStopsRun sigint;
+    py::gil_scoped_release release;
     if (c.system.dimension == 2) {
       sim_ = std::make_unique<Simulation<2>>(c, restart);
     } else {
@@ -208,6 +214,22 @@ PYBIND11_MODULE(kairos, m) {
   m.attr("__version__") = KAIROS_VERSION;
   // A configuration or state the user must fix; Python's ValueError family.
   py::register_exception<kairos::InputError>(m, "InputError", PyExc_ValueError);
+  // A setup stopped by Ctrl-C is Python's KeyboardInterrupt; one stopped by run.max_wall_seconds
+  // a TimeoutError.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const kairos::Interrupted& e) {
+      if (e.cause() == kairos::Interrupted::Cause::kWallTime) {
+        PyErr_SetString(
+            PyExc_TimeoutError,
+            fmt::format("run.max_wall_seconds: {} during the setup; nothing was run", e.what())
+                .c_str());
+      } else {
+        PyErr_SetNone(PyExc_KeyboardInterrupt);
+      }
+    }
+  });
 
   m.def(
       "run",
@@ -217,6 +239,7 @@ PYBIND11_MODULE(kairos, m) {
         if (output) c.output.directory = output->string();
         const kairos::RunOutcome outcome = [&] {
           kairos::SigintStopsRun sigint;
+          const kairos::ScopedStopDeadline setup_limit(c.run.max_wall_seconds);
           py::gil_scoped_release release;  // the run is C++ throughout
           return kairos::run_simulation(c, restart);
         }();

@@ -29,9 +29,6 @@ namespace kairos {
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-static_assert(std::atomic<bool>::is_always_lock_free);
-
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
@@ -160,7 +157,7 @@ void add_shear_flow(const Config& config, InitialState<D>& init) {
 namespace run_detail {
 
 bool stop_requested() noexcept {
-  return g_stop.load(std::memory_order_relaxed);
+  return kairos::stop_requested();
 }
 
 template <int D>
@@ -401,7 +398,7 @@ class RunDriver {
 
   // A stop asked by a signal or by run.max_wall_seconds (stop_reason_ set).
   bool interrupted(Clock::time_point wall_start) {
-    if (g_stop.load(std::memory_order_relaxed)) {
+    if (kairos::stop_requested()) {
       stop_reason_ = "signal";
       return true;
     }
@@ -481,7 +478,7 @@ class RunDriver {
       if (schedule.restart.due(c)) {
         write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
       }
-      if (g_stop.load(std::memory_order_relaxed)) {
+      if (kairos::stop_requested()) {
         stop_reason_ = "signal";
         return true;
       }
@@ -881,13 +878,6 @@ RunOutcome run_with_dimension(const Config& config, const std::optional<fs::path
 }
 
 }  // namespace
-
-void request_stop() noexcept {
-  g_stop.store(true, std::memory_order_relaxed);
-}
-void clear_stop_request() noexcept {
-  g_stop.store(false, std::memory_order_relaxed);
-}
 
 RunOutcome run_simulation(const Config& config, const std::optional<fs::path>& restart_file) {
   int dimension = config.system.dimension;

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/stop_flag.hpp"  // request_stop(), clear_stop_request(): stop a running simulation
 #include "io/config.hpp"
 
 namespace kairos {
@@ -24,9 +25,5 @@ struct RunOutcome {
 // Runs the whole simulation. Throws InputError for anything the user must fix.
 RunOutcome run_simulation(const Config& config,
                           const std::optional<std::filesystem::path>& restart_file = {});
-
-// Asks a running simulation to stop after the current event (async-signal-safe).
-void request_stop() noexcept;
-void clear_stop_request() noexcept;
 
 }  // namespace kairos

@@ -173,6 +173,26 @@ class Module(kt.KairosTestCase):
         self.assertTrue(sim.advance(time=t + 0.1))
         self.assertEqual(sim.time, t + 0.1)
 
+    def test_ctrl_c_stops_a_table_build(self):
+        # A soft-sphere map table of a minute (tight tolerance, empty cache): SIGINT half a
+        # second in ends the setup of Simulation and of run with KeyboardInterrupt at once.
+        config = soft_config()
+        config["soft"] = {"model": "hertz", "young": 1e6, "restitution": 0.8,
+                          "table_tolerance": 1e-9, "table_cache": self.path("tables")}
+        cfg = self.write_config(config)
+        for start in (lambda: kairos.Simulation(cfg),
+                      lambda: kairos.run(cfg, output=self.path("out"))):
+            timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+            timer.start()
+            started = time.monotonic()
+            with self.assertRaises(KeyboardInterrupt):
+                start()
+            timer.join()
+            self.assertLess(time.monotonic() - started, 3.0)
+        self.assertFalse(os.path.exists(self.path("out", "summary.json")))
+        with self.assertRaises(TimeoutError):
+            kairos.run(cfg, output=self.path("out"), set="run.max_wall_seconds=0.5")
+
     def test_advance_lets_other_threads_run_and_guards_the_object(self):
         sim = kairos.Simulation(self.write_config(hard_config()), set="system.particles=4000")
         worker = threading.Thread(target=sim.advance, kwargs={"events": 3_000_000})
