@@ -231,6 +231,14 @@ constexpr std::string_view kBondPotentials[] = {"tether", "spring"};
 constexpr std::string_view kPlacements[] = {"energy", "distance", "volume"};
 constexpr std::string_view kShellEnergies[] = {"midpoint", "volume", "mid_volume", "virial"};
 
+// A key or value as echoed in a message: at most kShownLength characters of it (a megabyte of
+// key would flood the terminal), with its length when cut.
+constexpr std::size_t kShownLength = 64;
+std::string shown(std::string_view text) {
+  if (text.size() <= kShownLength) return std::string(text);
+  return fmt::format("{}... ({} characters)", text.substr(0, kShownLength - 4), text.size());
+}
+
 std::string join_key(std::string_view prefix, std::string_view key) {
   return prefix.empty() ? std::string(key) : fmt::format("{}.{}", prefix, key);
 }
@@ -280,7 +288,15 @@ const KeySpec* find_spec(std::string_view path) {
   return nullptr;
 }
 
-// Case-insensitive Levenshtein distance.
+bool same_ignoring_case(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) ==
+                  std::tolower(static_cast<unsigned char>(y));
+         });
+}
+
+// Case-insensitive Levenshtein distance; O(|a| |b|), so callers compare only keys of similar
+// lengths (the distance is at least the difference of the lengths).
 std::size_t edit_distance(std::string_view a, std::string_view b) {
   std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
   for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
@@ -303,6 +319,8 @@ std::string_view leaf(std::string_view path) {
 
 // " (did you mean 'system.particles'?)" or "".
 std::string suggestion(std::string_view unknown) {
+  // No key is near a very long one, and comparing with one costs its length squared.
+  if (unknown.size() > 4 * kShownLength) return {};
   // Keys of an array of tables are offered for the element the unknown key is in
   // ("contact.pair[2].x" -> "contact.pair[2].*"), else for element 0 ("system.species.name" ->
   // "system.species[0].name").
@@ -332,6 +350,9 @@ std::string suggestion(std::string_view unknown) {
         (unknown[c.size()] == '.' || unknown[c.size()] == '[')) {
       continue;
     }
+    const std::size_t length_gap =
+        unknown.size() > c.size() ? unknown.size() - c.size() : c.size() - unknown.size();
+    if (length_gap >= best_distance) continue;  // the distance is at least the gap
     const std::size_t d = edit_distance(unknown, c);
     // ... nor one more edits away than the last part has letters ("tc" is no typo of "face").
     if (d < best_distance && d < leaf(unknown).size()) {
@@ -341,7 +362,7 @@ std::string suggestion(std::string_view unknown) {
   }
   if (best == nullptr) {  // a known key in the wrong place: "particles" -> "system.particles"
     for (const std::string& c : candidates) {
-      if (edit_distance(leaf(unknown), leaf(c)) == 0) {
+      if (same_ignoring_case(leaf(unknown), leaf(c))) {
         best = &c;
         break;
       }
@@ -364,7 +385,7 @@ std::string describe(const toml::node& node) {
     case toml::node_type::array:
       return "an array";
     case toml::node_type::string:
-      return fmt::format("a string (\"{}\")", node.as_string()->get());
+      return fmt::format("a string (\"{}\")", shown(node.as_string()->get()));
     case toml::node_type::integer:
       return fmt::format("an integer ({})", node.as_integer()->get());
     case toml::node_type::floating_point:
@@ -460,7 +481,7 @@ const char* other_unit_key(std::string_view path) {
 }
 
 AppliedOverride apply_override(toml::table& root, const std::string& text) {
-  const std::string label = fmt::format("override '{}'", text);
+  const std::string label = fmt::format("override '{}'", shown(text));
   const auto error = [&](const std::string& message) {
     return InputError(fmt::format("{}: {}", label, message));
   };
@@ -487,15 +508,16 @@ AppliedOverride apply_override(toml::table& root, const std::string& text) {
     } else {
       const auto bracket = part.find('[');
       const std::string_view name = part.substr(0, bracket);
-      if (!is_bare_key(name)) throw error(fmt::format("invalid key '{}'", key));
+      if (!is_bare_key(name)) throw error(fmt::format("invalid key '{}'", shown(key)));
       tokens.push_back({std::string(name), false});
-      canonical = join_key(canonical, name);
+      if (!canonical.empty()) canonical += '.';  // appended, not rebuilt: linear in the key
+      canonical += name;
       part = bracket == std::string_view::npos ? std::string_view() : part.substr(bracket);
       while (!part.empty()) {
         const auto close = part.find(']');
         if (part[0] != '[' || close == std::string_view::npos ||
             !is_digits(part.substr(1, close - 1))) {
-          throw error(fmt::format("invalid key '{}'", key));
+          throw error(fmt::format("invalid key '{}'", shown(key)));
         }
         tokens.push_back({std::string(part.substr(1, close - 1)), true});
         canonical += part.substr(0, close + 1);
@@ -513,7 +535,7 @@ AppliedOverride apply_override(toml::table& root, const std::string& text) {
       prefix =
           token.is_index ? fmt::format("{}[{}]", prefix, token.key) : join_key(prefix, token.key);
       if (find_spec(prefix) == nullptr) {
-        throw error(fmt::format("unknown key '{}'{}", canonical, suggestion(canonical)));
+        throw error(fmt::format("unknown key '{}'{}", shown(canonical), suggestion(canonical)));
       }
     }
   }
@@ -686,7 +708,7 @@ class Reader {
     const toml::source_region& region =
         unknown->source().begin.line > 0 ? unknown->source() : unknown_node->source();
     throw InputError(
-        fmt::format("{}: unknown key '{}'{}", where(region, path), path, suggestion(path)));
+        fmt::format("{}: unknown key '{}'{}", where(region, path), shown(path), suggestion(path)));
   }
 
   const toml::table& section(const toml::table& root, std::string_view key,
@@ -881,9 +903,9 @@ class Reader {
   void require_choice(const toml::node* node, std::string_view path, const std::string& value,
                       std::span<const std::string_view> choices) const {
     if (!contains(choices, value)) {
-      fail(
-          node, path,
-          fmt::format("{}: '{}' is not valid; valid values: {}", path, value, join_words(choices)));
+      fail(node, path,
+           fmt::format("{}: '{}' is not valid; valid values: {}", path, shown(value),
+                       join_words(choices)));
     }
   }
 
@@ -948,7 +970,7 @@ class Reader {
       if (!contains(valid, s.lattice)) {
         fail(n_lattice, "system.lattice",
              fmt::format("system.lattice: '{}' is not a valid lattice in {}D; valid values: {}",
-                         s.lattice, s.dimension, join_words(valid)));
+                         shown(s.lattice), s.dimension, join_words(valid)));
       }
     }
 

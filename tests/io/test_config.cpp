@@ -223,6 +223,24 @@ TEST(ConfigErrors, UnknownKeyInSpecies) {
                 "did you mean 'system.species[1].diameter'?"});
 }
 
+TEST(ConfigErrors, HugeUnknownKeysAreCutInTheMessage) {
+  // A megabyte of key: rejected at once (no edit distances with a key that long), and echoed as
+  // its first characters and its length.
+  const std::string key(1'000'000, 'k');
+  const std::string m =
+      expect_error(minimal_plus(key + " = 1"),
+                   {"test.toml:4:1", "unknown key 'system.kkkk", "... (1000007 characters)"});
+  EXPECT_LT(m.size(), 200u) << m.substr(0, 300);
+  EXPECT_EQ(m.find("did you mean"), std::string::npos);
+  const std::string o =
+      expect_error(kMinimal, {"override 'system.", "characters)"}, {"system." + key + "=1"});
+  EXPECT_LT(o.size(), 300u) << o.substr(0, 400);
+  // A long value (a string where a number belongs) is cut too.
+  const std::string v =
+      expect_error(minimal_plus("temperature = \"" + key + "\""), {"system.temperature"});
+  EXPECT_LT(v.size(), 200u) << v.substr(0, 300);
+}
+
 TEST(ConfigErrors, FirstUnknownKeyInFileOrderIsReported) {
   expect_error(minimal_plus("zzz = 1\naaa = 2"), {"unknown key 'system.zzz'"});
 }

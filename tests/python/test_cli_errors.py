@@ -5,6 +5,7 @@ message. Also: `kairos --help` and `kairos run --help` document every option.
 """
 
 import os
+import time
 import unittest
 
 import numpy as np
@@ -69,6 +70,24 @@ class ConfigErrors(kt.KairosTestCase):
 
     def test_unknown_section_via_set(self):
         self.check_set(["bogus.key=1"], "bogus")
+
+    def test_megabyte_key_is_rejected_at_once(self):
+        # No "did you mean" search over a megabyte (it took > 30 s), and the message shows the
+        # key's start and length, not the whole key.
+        key = "k" * 1_000_000
+        path = self.write_config(self.good_text() + "\n[field]\n%s = 1\n" % key, "long.toml")
+        started = time.monotonic()
+        result = self.kairos("run", path, "-o", self.path("out"))
+        elapsed = time.monotonic() - started
+        line = self.assert_user_error(result, "unknown key 'field.kkk", "(1000006 characters)")
+        self.assertLess(len(line), 200)
+        self.assertLess(elapsed, 1.0 * kt.SLOWDOWN, "rejecting the key took %.2f s" % elapsed)
+        # An override (an argument holds at most 128 KiB on Linux).
+        started = time.monotonic()
+        result = self.kairos("run", self.config, "--set", "run.%s=1" % key[:100_000])
+        self.assertLess(time.monotonic() - started, 1.0 * kt.SLOWDOWN)
+        line = self.assert_user_error(result, "override 'run.kkk", "(100004 characters)")
+        self.assertLess(len(line), 300)
 
     # ----- wrong types
 
