@@ -38,14 +38,42 @@ bool python_keeps_going() {
   return true;
 }
 
+std::string type_name(const py::handle& object) {
+  return py::str(py::type::handle_of(object).attr("__name__")).cast<std::string>();
+}
+
+// `set`: None, one "key=value" override, or a sequence (list, tuple) of them. Anything else is a
+// TypeError naming what was given (pybind11's own cast error would name C++ types).
+std::vector<std::string> overrides_from(const py::object& set) {
+  if (set.is_none()) return {};
+  if (py::isinstance<py::str>(set)) return {set.cast<std::string>()};
+  const bool sequence = py::isinstance<py::sequence>(set) && !py::isinstance<py::bytes>(set);
+  if (!sequence) {
+    throw py::type_error(fmt::format(
+        "set must be a 'key=value' string or a list of them (e.g. set=[\"run.time=10\"]), not {}",
+        type_name(set)));
+  }
+  std::vector<std::string> overrides;
+  const auto items = set.cast<py::sequence>();
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const py::object item = items[i];
+    if (!py::isinstance<py::str>(item)) {
+      throw py::type_error(
+          fmt::format("set[{}] must be a 'key=value' string, not {}", i, type_name(item)));
+    }
+    overrides.push_back(item.cast<std::string>());
+  }
+  return overrides;
+}
+
 // A config file (str or path-like), or TOML text when the string holds a newline (a path here
 // never does); `set`: one "key=value" override or a sequence of them.
 Config config_from(const py::object& config, const py::object& set) {
-  std::vector<std::string> overrides;
-  if (py::isinstance<py::str>(set)) {
-    overrides.push_back(set.cast<std::string>());
-  } else if (!set.is_none()) {
-    overrides = set.cast<std::vector<std::string>>();
+  const std::vector<std::string> overrides = overrides_from(set);
+  if (!py::isinstance<py::str>(config) && !py::hasattr(config, "__fspath__")) {
+    throw py::type_error(
+        fmt::format("config must be a TOML file's path (str or os.PathLike) or TOML text, not {}",
+                    type_name(config)));
   }
   if (py::isinstance<py::str>(config)) {
     const auto text = config.cast<std::string>();

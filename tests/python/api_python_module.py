@@ -238,6 +238,28 @@ class Module(kt.KairosTestCase):
             self.assertIn(needle, str(caught.exception))
         self.assertTrue(issubclass(kairos.InputError, ValueError))
 
+    def test_arguments_of_the_wrong_type_raise_type_errors(self):
+        # Not pybind11's "Unable to cast Python instance" RuntimeError: a TypeError naming the
+        # argument and what was given.
+        cfg = self.write_config(hard_config())
+        cases = [
+            (lambda: kairos.run(cfg, set=123), "set must be a 'key=value' string", "int"),
+            (lambda: kairos.run(cfg, set=["run.time=1", 2]), "set[1] must be", "int"),
+            (lambda: kairos.Simulation(cfg, set={"run.time": 1.0}), "set must be", "dict"),
+            (lambda: kairos.Simulation(cfg, set=b"run.time=1"), "set must be", "bytes"),
+            (lambda: kairos.run(42), "config must be", "int"),
+            (lambda: kairos.Simulation(None), "config must be", "NoneType"),
+        ]
+        for call, *needles in cases:
+            with self.assertRaises(TypeError) as caught:
+                call()
+            for needle in needles:
+                self.assertIn(needle, str(caught.exception))
+        self.assertFalse(os.path.exists(self.path("out")))
+        # The accepted forms still work: one string, a tuple of strings.
+        sim = kairos.Simulation(cfg, set=("system.particles=100", "system.seed=3"))
+        self.assertEqual(len(sim), 100)
+
 
 if __name__ == "__main__":
     kt.main()
