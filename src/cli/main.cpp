@@ -26,6 +26,7 @@
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
 #include "io/progress.hpp"
+#include "run/config_ranges.hpp"
 #include "run/run.hpp"
 
 namespace {
@@ -148,6 +149,14 @@ void print_step_tables(const kairos::Config& config, double kT, const std::strin
     items.push_back({fmt::format("bond{}_{}", k, config.bonds[k].type), &config.bonds[k].potential,
                      dmax, std::nan("")});
   if (items.empty()) throw kairos::InputError("the config has no [[potential]] and no [[bond]]");
+  // The ranges a run checks against its box (no box here: lengths up to 1e6 diameters).
+  const kairos::RangeScales scales = kairos::range_scales(config);
+  for (std::size_t p = 0; p < config.potentials.size(); ++p) {
+    kairos::check_potential_ranges(config.potentials[p].potential, fmt::format("potential[{}]", p),
+                                   scales);
+  }
+  for (std::size_t k = 0; k < config.bonds.size(); ++k)
+    kairos::check_potential_ranges(config.bonds[k].potential, fmt::format("bond[{}]", k), scales);
   for (const Item& item : items) {
     kairos::throw_if_stop_requested();
     const kairos::StepTable table =

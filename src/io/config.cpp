@@ -9,6 +9,8 @@
 #include <fmt/format.h>
 
 #include <toml++/toml.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -210,6 +212,16 @@ constexpr KeySpec kSchema[] = {
     {"potential[].restitution", Kind::kFloat},
     {"potential[].force_zero", Kind::kBoolean},
 };
+
+constexpr std::uint64_t kMaxParticles = (std::uint64_t{1} << 31) - 1;
+// What a particle costs at least during a run (state, engine, outputs: ~300 bytes measured).
+constexpr double kMinBytesPerParticle = 256.0;
+
+// The machine's physical memory in bytes (0 if unknown).
+double physical_memory_bytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && size > 0 ? static_cast<double>(pages) * static_cast<double>(size) : 0.0;
+}
 
 constexpr std::string_view kLattices3D[] = {"fcc", "sc", "bcc", "random"};
 constexpr std::string_view kLattices2D[] = {"hex", "square", "random"};
@@ -900,6 +912,16 @@ class Reader {
     if (!(value >= 0.0)) fail(node, path, fmt::format("{}: must be >= 0, got {}", path, value));
   }
 
+  // value in [lo, hi]; `why` (may be empty) says where the bounds come from.
+  void require_range(const toml::node* node, std::string_view path, double value, double lo,
+                     double hi, std::string_view why = {}) const {
+    if (!(value >= lo && value <= hi)) {
+      fail(node, path,
+           fmt::format("{}: must be in [{:g}, {:g}]{}{}, got {}", path, lo, hi,
+                       why.empty() ? "" : " ", why, value));
+    }
+  }
+
   void require_choice(const toml::node* node, std::string_view path, const std::string& value,
                       std::span<const std::string_view> choices) const {
     if (!contains(choices, value)) {
@@ -955,10 +977,39 @@ class Reader {
       fail(n_particles, "system.particles",
            fmt::format("system.particles: must be at least 2, got {}", s.particles));
     }
+    // The engine numbers particles in 31 bits (docs/architecture.md).
+    if (s.particles > kMaxParticles) {
+      fail(n_particles, "system.particles",
+           fmt::format("system.particles: must be at most {} (2^31 - 1), got {}", kMaxParticles,
+                       s.particles));
+    }
+    // A state that cannot fit in memory would end the run by the kernel's out-of-memory kill,
+    // not by an error.
+    const double memory = physical_memory_bytes();
+    if (memory > 0.0 && static_cast<double>(s.particles) * kMinBytesPerParticle > memory) {
+      fail(n_particles, "system.particles",
+           fmt::format("system.particles: {} particles need at least {:.3g} GiB ({} bytes per "
+                       "particle), more than this machine's {:.3g} GiB of memory",
+                       s.particles,
+                       static_cast<double>(s.particles) * kMinBytesPerParticle / 1073741824.0,
+                       kMinBytesPerParticle, memory / 1073741824.0));
+    }
     if (!(from_file && s.packing_fraction == 0.0) &&
         !(s.packing_fraction > 0.0 && s.packing_fraction < 1.0)) {
       fail(n_packing, "system.packing_fraction",
            fmt::format("system.packing_fraction: must be in (0, 1), got {}", s.packing_fraction));
+    }
+    // More dilute, and neighbours sit more than ~1e3 diameters apart: the box outgrows what
+    // positions resolve before the gas is any different from one at 1e-9.
+    if (!(from_file && s.packing_fraction == 0.0) && s.packing_fraction < 1e-9) {
+      fail(n_packing, "system.packing_fraction",
+           fmt::format("system.packing_fraction: must be at least 1e-9, got {}",
+                       s.packing_fraction));
+    }
+    if (s.chain_length > 0 && s.particles > 0 && s.chain_length > s.particles) {
+      fail(n_chain, "system.chain_length",
+           fmt::format("system.chain_length: must be at most system.particles = {}, got {}",
+                       s.particles, s.chain_length));
     }
 
     if (s.lattice.empty()) {
@@ -974,8 +1025,17 @@ class Reader {
       }
     }
 
+    // kT is the unit of energy (and with the masses, of speed) that every other range refers to.
     require_positive(n_temperature, "system.temperature", s.temperature);
+    require_range(n_temperature, "system.temperature", s.temperature, 1e-9, 1e9,
+                  "(the unit of energy kT: reduced units keep it near 1)");
     if (s.species.empty()) s.species.emplace_back();
+    double largest = 0.0;
+    for (const SpeciesConfig& sp : s.species) largest = std::max(largest, sp.diameter);
+    if (s.chain_spacing > 0.0) {
+      require_range(n_spacing, "system.chain_spacing", s.chain_spacing, 0.0, 1e6 * largest,
+                    "(0, or up to 1e6 times the largest diameter)");
+    }
 
     std::vector<double> box_scale;
     const toml::node* n_box_scale = get_vector(t, p, "box_scale", s.dimension, box_scale);
@@ -983,6 +1043,10 @@ class Reader {
       if (!(box_scale[i] >= 1.0)) {
         fail(element_of(n_box_scale, i), "system.box_scale",
              fmt::format("system.box_scale[{}]: must be >= 1, got {}", i, box_scale[i]));
+      }
+      if (!(box_scale[i] <= 1e6)) {
+        fail(element_of(n_box_scale, i), "system.box_scale",
+             fmt::format("system.box_scale[{}]: must be at most 1e6, got {}", i, box_scale[i]));
       }
     }
     // All 1 is the same as no scaling: stored as the default, empty.
@@ -1015,13 +1079,24 @@ class Reader {
                            n_name == nullptr ? "; give every species its own name" : ""));
         }
       }
+      // Diameter and mass are units (reduced units keep them near 1); a fraction is relative.
       require_positive(n_diameter, prefix + ".diameter", s.diameter);
       require_positive(n_mass, prefix + ".mass", s.mass);
       require_positive(n_fraction, prefix + ".fraction", s.fraction);
+      require_range(n_diameter, prefix + ".diameter", s.diameter, 1e-9, 1e9);
+      require_range(n_mass, prefix + ".mass", s.mass, 1e-9, 1e9);
+      require_range(n_fraction, prefix + ".fraction", s.fraction, 1e-9, 1e9);
+      // I = q m R^2 with the mass inside the radius: q <= 1 (all of it at R: a ring).
       if (!(s.inertia_factor >= 0.0)) {
         fail(n_inertia, prefix + ".inertia_factor",
              fmt::format("{}.inertia_factor: must be > 0 (or 0 for the default: 2/5 for spheres, "
                          "1/2 for disks), got {}",
+                         prefix, s.inertia_factor));
+      }
+      if (!(s.inertia_factor == 0.0 || (s.inertia_factor >= 1e-9 && s.inertia_factor <= 1.0))) {
+        fail(n_inertia, prefix + ".inertia_factor",
+             fmt::format("{}.inertia_factor: must be in [1e-9, 1] (I = q m R^2 with the mass "
+                         "within R; or 0 for the default: 2/5 for spheres, 1/2 for disks), got {}",
                          prefix, s.inertia_factor));
       }
       out.push_back(std::move(s));
@@ -1256,7 +1331,9 @@ class Reader {
 
       const toml::node* n_amplitude = get_number(wt, prefix, "amplitude", w.amplitude);
       const toml::node* n_frequency = get_number(wt, prefix, "frequency", w.frequency);
-      get_number(wt, prefix, "phase", w.phase);
+      const toml::node* n_phase = get_number(wt, prefix, "phase", w.phase);
+      // Beyond 1e9 rad a double no longer resolves the phase to 1e-7.
+      require_range(n_phase, prefix + ".phase", w.phase, -1e9, 1e9, "(radians)");
       require_non_negative(n_amplitude, prefix + ".amplitude", w.amplitude);
       require_non_negative(n_frequency, prefix + ".frequency", w.frequency);
       b.walls.push_back(std::move(w));
@@ -1464,8 +1541,13 @@ class Reader {
         get_number(t, prefix, "tangential_stiffness", law.tangential_stiffness);
     const toml::node* n_gt = get_number(t, prefix, "tangential_damping", law.tangential_damping);
     require_non_negative(n_mu, path("friction"), law.friction);
+    require_range(n_mu, path("friction"), law.friction, 0.0, 1e9);
+    // Ratios to the normal law: a tangential spring much stiffer than the normal one would be
+    // unstable at the time step chosen for the normal one (physical ratios are 2/3 to 4/3).
     require_positive(n_kt, path("tangential_stiffness"), law.tangential_stiffness);
+    require_range(n_kt, path("tangential_stiffness"), law.tangential_stiffness, 1e-9, 10.0);
     require_non_negative(n_gt, path("tangential_damping"), law.tangential_damping);
+    require_range(n_gt, path("tangential_damping"), law.tangential_damping, 0.0, 1e3);
     if (n_model == nullptr && law.model.empty()) {
       fail(&t, path("model"),
            fmt::format("missing required key '{}' (\"dashpot\" or \"hertz\"): [soft] makes every "
@@ -1544,6 +1626,12 @@ class Reader {
     if (n_tolerance != nullptr && !(soft.table_tolerance < 0.1)) {
       fail(n_tolerance, "soft.table_tolerance",
            fmt::format("soft.table_tolerance: must be below 0.1 (a relative error), got {}",
+                       soft.table_tolerance));
+    }
+    // The nodes are integrated to 1e-13: below 1e-10 no table can be checked to its tolerance.
+    if (!(soft.table_tolerance >= 1e-10)) {
+      fail(n_tolerance, "soft.table_tolerance",
+           fmt::format("soft.table_tolerance: must be at least 1e-10, got {}",
                        soft.table_tolerance));
     }
     get_string(t, p, "table_cache", soft.table_cache);
@@ -1691,9 +1779,14 @@ class Reader {
     const toml::node* n_time = get_number(t, p, "time", r.time);
     const toml::node* n_equilibration_time =
         get_number(t, p, "equilibration_time", r.equilibration_time);
+    // Up to 1e9 collisions per particle: 1e18 collisions of the largest system still count in
+    // 64 bits, and no run gets that far.
     require_non_negative(n_equilibration, "run.equilibration_collisions_per_particle",
                          r.equilibration_collisions_per_particle);
+    require_range(n_equilibration, "run.equilibration_collisions_per_particle",
+                  r.equilibration_collisions_per_particle, 0.0, 1e9);
     require_positive(n_production, "run.collisions_per_particle", r.collisions_per_particle);
+    require_range(n_production, "run.collisions_per_particle", r.collisions_per_particle, 0.0, 1e9);
     if (n_time != nullptr) require_positive(n_time, "run.time", r.time);
     if (n_equilibration_time != nullptr)
       require_non_negative(n_equilibration_time, "run.equilibration_time", r.equilibration_time);
@@ -1709,6 +1802,8 @@ class Reader {
     }
     require_choice(n_queue, "run.event_queue", r.event_queue, kEventQueues);
     require_non_negative(n_wall, "run.max_wall_seconds", r.max_wall_seconds);
+    require_range(n_wall, "run.max_wall_seconds", r.max_wall_seconds, 0.0, 1e9,
+                  "(seconds; 0: no limit)");
     const toml::node* n_integrator = get_string(t, p, "integrator", r.integrator);
     const toml::node* n_step = get_number(t, p, "time_step", r.time_step);
     require_choice(n_integrator, "run.integrator", r.integrator, kIntegrators);

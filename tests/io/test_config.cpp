@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -1074,10 +1075,12 @@ TEST(ConfigToToml, RoundTripIsExact) {
   c.system.temperature = 0.1 + 0.2;  // 0.30000000000000004
   c.system.seed = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
   c.system.species = {{"big \"one\"", 1.4, 2.744, 1e-7},
-                      {"small\\path\ttab\nnewline ünï", 5e-324, 1.7976931348623157e308, 123456.0}};
+                      // The ends of the ranges, one ulp inside.
+                      {"small\\path\ttab\nnewline ünï", std::nextafter(1e-9, 1.0),
+                       std::nextafter(1e9, 0.0), 123456.0}};
   c.system.initial_state = "";
   c.run.equilibration_collisions_per_particle = 0.0;
-  c.run.collisions_per_particle = 1e22;
+  c.run.collisions_per_particle = 1e9;  // the most a run may ask for
   c.run.event_queue = "heap";
   c.run.max_wall_seconds = 86400.5;
   c.run.validate = true;
