@@ -326,6 +326,13 @@ class RangeErrors(kt.KairosTestCase):
         self.refused(self.vibrated_bed(), ["field.gravity=[0, -1e-12]"], "field.gravity[1]",
                      "too weak for the open face y+")
 
+    def test_kairos_steps_refuses_what_spun(self):
+        # No box there: a table reaches at most 1e6 diameters (1e300 spun in the quadrature).
+        path = self.write_config(self.lj())
+        result = self.kairos("steps", path, "--set", "potential.0.cutoff=1e300",
+                             timeout=30 * kt.SLOWDOWN)
+        self.assert_user_error(result, "potential[0]", "1e+300", "1e6 times the largest diameter")
+
     def test_parser_ranges(self):
         good = kt.base_config(production=1.0)
         for override, needle in [

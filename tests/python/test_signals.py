@@ -230,7 +230,8 @@ class InterruptSetup(kt.KairosTestCase):
         time.sleep(1.0)
         self.assertIsNone(proc.poll(), "the setup ended before the signal")
         proc.send_signal(sig)
-        _, stderr, _ = self.stops_within(proc, 3.0, sig.name)
+        # 3 s (6 under the sanitizers, whose exit runs the leak check).
+        _, stderr, _ = self.stops_within(proc, 3.0 * (2.0 if kt.SANITIZED else 1.0), sig.name)
         self.assertEqual(proc.returncode, status, "%s\n%s" % (kt.signal_name(proc.returncode),
                                                               stderr))
         lines = stderr.splitlines()
