@@ -6,9 +6,12 @@
 //
 // User errors (config, files, impossible requests) print one line "kairos: error: ..." and exit
 // with status 2; SIGINT/SIGTERM finish the current event, write every output and exit 130/143.
+// Before the run has begun (loading the config, building tables) a signal ends the process at
+// once with one line "kairos: interrupted ..." and the same status; nothing is written.
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -19,10 +22,12 @@
 
 #include "cli/table_command.hpp"
 #include "core/error.hpp"
+#include "core/stop_flag.hpp"
 #include "interactions/potential_spec.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
 #include "io/progress.hpp"
+#include "run/config_ranges.hpp"
 #include "run/run.hpp"
 
 namespace {
@@ -176,7 +181,16 @@ void print_step_tables(const kairos::Config& config, double kT, const std::strin
     items.push_back({fmt::format("bond{}_{}", k, config.bonds[k].type), &config.bonds[k].potential,
                      dmax, std::nan("")});
   if (items.empty()) throw kairos::InputError("the config has no [[potential]] and no [[bond]]");
+  // The ranges a run checks against its box (no box here: lengths up to 1e6 diameters).
+  const kairos::RangeScales scales = kairos::range_scales(config);
+  for (std::size_t p = 0; p < config.potentials.size(); ++p) {
+    kairos::check_potential_ranges(config.potentials[p].potential, fmt::format("potential[{}]", p),
+                                   scales);
+  }
+  for (std::size_t k = 0; k < config.bonds.size(); ++k)
+    kairos::check_potential_ranges(config.bonds[k].potential, fmt::format("bond[{}]", k), scales);
   for (const Item& item : items) {
+    kairos::throw_if_stop_requested();
     const kairos::StepTable table =
         kairos::make_step_table(*item.spec, item.core, dim, item.reduced_mass);
     const kairos::ContinuousPotential curve = kairos::continuous_potential(*item.spec);
@@ -194,6 +208,26 @@ void print_step_tables(const kairos::Config& config, double kT, const std::strin
           kairos::continuous_curve_tsv(curve, table.core(), table.cutoff() * 1.05));
     }
   }
+}
+
+// Interrupted: a signal or run.max_wall_seconds stopped the setup, before anything was run or
+// written. A signal exits with 128 + its number, as a stopped run does; the wall-time limit is
+// the user's to raise (status 2).
+int report_interrupted_setup(const kairos::Interrupted& e) {
+  if (e.cause() == kairos::Interrupted::Cause::kWallTime) {
+    std::fprintf(stderr,
+                 "kairos: error: run.max_wall_seconds: %s before the run could start (during its "
+                 "setup); nothing was run: raise the limit, or build the soft-sphere tables "
+                 "beforehand with 'kairos table build --config CONFIG'\n",
+                 e.what());
+    return 2;
+  }
+  const int sig = g_signal != 0 ? static_cast<int>(g_signal) : SIGINT;
+  std::fprintf(stderr, "kairos: interrupted by %s before the run started; nothing was written\n",
+               sig == SIGTERM  ? "SIGTERM"
+               : sig == SIGINT ? "SIGINT"
+                               : strsignal(sig));
+  return 128 + sig;
 }
 
 }  // namespace
@@ -279,6 +313,8 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  // Before anything is read: a config or a table can take long, and SIGINT must end that too.
+  install_signal_handlers();
   try {
     // An empty value (e.g. from an unset shell variable) is an error, not "option absent": a
     // silently fresh run would overwrite the outputs it was meant to continue.
@@ -298,11 +334,12 @@ int main(int argc, char** argv) {
     }
     kairos::Config config = kairos::load_config(config_path, overrides);
     if (!outdir.empty()) config.output.directory = outdir;
-    install_signal_handlers();
     const std::optional<std::filesystem::path> restart_file =
         restart.empty() ? std::nullopt : std::optional<std::filesystem::path>(restart);
     kairos::RunOptions options;
     options.overwrite = overwrite;
+    // run.max_wall_seconds from now on, so that a long table build stops too.
+    const kairos::ScopedStopDeadline setup_limit(config.run.max_wall_seconds);
     const kairos::RunOutcome outcome = kairos::run_simulation(config, restart_file, options);
     print_summary(outcome);
     if (!outcome.error.empty()) {
@@ -314,6 +351,8 @@ int main(int argc, char** argv) {
   } catch (const kairos::InputError& e) {
     std::fprintf(stderr, "kairos: error: %s\n", e.what());
     return 2;
+  } catch (const kairos::Interrupted& e) {
+    return report_interrupted_setup(e);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "kairos: internal error: %s\n", e.what());
     return 3;

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/stop_flag.hpp"
 #include "interactions/soft_map_table.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
@@ -197,6 +198,7 @@ void write_plot_files(const SoftMapTable& t, const std::filesystem::path& dir, i
   const double u_span = (g.nu - 1) * g.u_step, w_span = (g.nw - 1) * g.w_step;
   const int n_u = t.spec().head_on ? 1 : error_points;
   for (int b = 0; b < error_points; ++b) {
+    throw_if_stop_requested();  // up to 2000 x 2000 direct integrations
     for (int a = 0; a < n_u; ++a) {
       const double u = t.spec().head_on ? -INFINITY : g.u_min + (a + 0.5) / n_u * u_span;
       const double w = g.w_min + (b + 0.5) / error_points * w_span;
@@ -231,12 +233,15 @@ void build_config_tables(const Config& config) {
   settings.tolerance = config.soft.table_tolerance;
   settings.cache_dir = config.soft.table_cache;
   if (config.driving.kind == "andersen") settings.driving_temperature = config.driving.temperature;
+  // A progress line on terminals only (as for a table from flags): a log gets no \r lines.
+  const bool tell = ::isatty(STDERR_FILENO) != 0;
   const std::vector<SoftTableUse> used =
-      attach_soft_tables(env, start, settings, [](const std::string& contact, double f) {
+      attach_soft_tables(env, start, settings, [tell](const std::string& contact, double f) {
+        if (!tell) return;
         std::fprintf(stderr, "\rbuilding the table of %s: %5.1f %%", contact.c_str(), 100.0 * f);
         std::fflush(stderr);
       });
-  std::fprintf(stderr, "\r%60s\r", "");
+  if (tell) std::fprintf(stderr, "\r%60s\r", "");
   for (const SoftTableUse& use : used) {
     fmt::print("contact {}\n", use.contact);
     fmt::print("{}", describe(SoftMapTable::read_file(use.report.cache_file)));

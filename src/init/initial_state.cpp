@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/memory_budget.hpp"
 #include "core/periodic.hpp"
+#include "core/stop_flag.hpp"
 
 namespace kairos {
 namespace {
@@ -596,6 +597,8 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
         eta, i + 1, N, why, lattice_list(D, false)));
   };
   for (std::size_t i = 0; i < N; ++i) {
+    // SIGINT ends a long insertion (near jamming one particle may take 10^6 tries, see below).
+    if ((i & 1023u) == 1023u) throw_if_stop_requested();
     const double di = state.diameter[i];
     // Whether the exclusion zone (for diameter di) of one placed particle covers the voxel.
     const auto covered = [&](std::uint64_t voxel) {
@@ -619,6 +622,7 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
     }
     bool placed = false;
     for (std::uint64_t attempt = 0; attempt < kMaxInsertionAttempts && !placed; ++attempt) {
+      if ((attempt & 4095u) == 4095u) throw_if_stop_requested();
       if (voxels->empty()) throw fail(i, "found the box jammed");
       const std::size_t slot = voxels->pick(rng);
       const std::uint64_t voxel = voxels->voxel(slot);

@@ -153,6 +153,13 @@ StepTable make_step_table(const PotentialSpec& spec, double core) {
   return make_step_table(spec, core, 3);
 }
 
+double table_cutoff(const PotentialSpec& spec, double core) {
+  if (spec.kind == "square_well" || spec.kind == "square_shoulder") return spec.lambda * core;
+  if (spec.kind == "steps") return spec.boundaries.empty() ? 0.0 : spec.boundaries.front();
+  if (spec.kind == "tether") return spec.max_length;
+  return continuous_potential(spec).cutoff;  // also rejects an unknown kind
+}
+
 namespace {
 
 // spring_dashpot: equal steps from `length` to the core, midpoint energies, the dashpot.

@@ -97,6 +97,12 @@ StepTable make_step_table(const PotentialSpec& spec, double core, int dimension,
 // InputError like make_step_table for its parameters (those that do not involve the core).
 ContinuousPotential continuous_potential(const PotentialSpec& spec);
 
+// The outermost boundary the spec's table will have for a pair of contact distance `core` (its
+// cut-off; max_length for tether and spring, `length` for spring_dashpot), without building it:
+// what the box and the cells must accommodate. 0 for a steps table without boundaries. Throws
+// InputError like continuous_potential for the parameters it needs.
+double table_cutoff(const PotentialSpec& spec, double core);
+
 // "energy" | "distance" | "volume", and "midpoint" | "volume" | "mid_volume" | "virial"; throw
 // InputError listing the accepted names.
 StepPlacement parse_step_placement(const std::string& name);

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "core/error.hpp"
+#include "core/stop_flag.hpp"
 
 namespace kairos {
 namespace {
@@ -157,16 +158,19 @@ struct Endpoint {
 
 // Integrates y' = rhs(t, y) from (0, y0) until ended(y) first holds, located by bisection of the
 // last step's size down to adjacent doubles. check(t, y) is called on every accepted state (it
-// may throw). The ended predicate must be false at y0.
+// may throw). The ended predicate must be false at y0. interruptible: the stop flag is polled
+// at the start and every 1024 steps (MapOptions::interruptible).
 template <std::size_t N, class Rhs, class Ended, class Check>
 Endpoint<N> integrate_until(const Rhs& rhs, const State<N>& y0, const State<N>& atol, double rtol,
-                            double h0, long max_steps, const Ended& ended, const Check& check) {
+                            double h0, long max_steps, bool interruptible, const Ended& ended,
+                            const Check& check) {
   constexpr double kSafety = 0.9, kMinFactor = 0.2, kMaxFactor = 10.0, kExponent = -1.0 / 8.0;
   double t = 0.0, h = h0;
   State<N> y = y0;
   State<N> f = rhs(t, y);
   long accepted = 0;
   for (long attempt = 0; attempt < max_steps; ++attempt) {
+    if (interruptible && (attempt & 1023) == 0) throw_if_stop_requested();
     double err = 0.0;
     const State<N> y_new = dop853_step<N>(rhs, t, y, f, h, atol, rtol, &err);
     if (!(err <= 1.0)) {  // rejected (a NaN error too)
@@ -358,9 +362,9 @@ CollisionMap collision_map(const ReducedCollision& reduced, const MapOptions& op
           l));
   };
   const double atol = 1e-3 * options.tolerance;
-  const Endpoint<5> end =
-      integrate_until<5>(rhs, S{0.0, 1.0, 0.0, 1.0, 0.0}, S{atol, atol, atol, atol, atol},
-                         options.tolerance, 1e-2, options.max_steps, ended, check);
+  const Endpoint<5> end = integrate_until<5>(
+      rhs, S{0.0, 1.0, 0.0, 1.0, 0.0}, S{atol, atol, atol, atol, atol}, options.tolerance, 1e-2,
+      options.max_steps, options.interruptible, ended, check);
   check(end.t, end.y);
   CollisionMap map;
   const double sigma = std::max(end.y[0], 0.0);
@@ -512,8 +516,9 @@ DirectContact integrate_contact_directly(const SoftContactLaw& law, const SoftPa
   const double mu = reduced_mass(mi, mj);
   const double T = model == SoftModel::LinearDashpot ? std::sqrt(mu / k)
                                                      : std::pow(mu * mu / (k * k * f.v_n), 0.2);
-  const Endpoint<12> end = integrate_until<12>(
-      rhs, y0, atol, options.tolerance, 1e-2 * std::sqrt(T), options.max_steps, ended, check);
+  const Endpoint<12> end =
+      integrate_until<12>(rhs, y0, atol, options.tolerance, 1e-2 * std::sqrt(T), options.max_steps,
+                          options.interruptible, ended, check);
   DirectContact out;
   out.state = {unpack(end.y, 0), unpack(end.y, 1), unpack(end.y, 2), unpack(end.y, 3)};
   out.contact_time = end.t * end.t;
@@ -655,7 +660,9 @@ double viscoelastic_head_on_restitution(double c_dis) {
   r.c_phi = 0.0;
   r.l_tilde = 10.0;
   r.c_dis = c_dis;
-  return -collision_map(r).eps_rdot;
+  MapOptions options;
+  options.interruptible = true;  // only solving for a restitution at setup calls this
+  return -collision_map(r, options).eps_rdot;
 }
 
 double viscoelastic_c_dis_for_restitution(double e) {

@@ -112,6 +112,10 @@ CollisionUnits reduce_collision_unchecked(const SoftContactLaw& law, double redu
 struct MapOptions {
   double tolerance = 1e-13;    // relative local error per step (absolute 1e-3 of it); > 0
   long max_steps = 1'000'000;  // accepted + rejected steps before giving up (logic_error)
+  // Setup (table builds, solving for a restitution): poll the stop flag at the start and every
+  // 1024 steps (throw_if_stop_requested, core/stop_flag.hpp), so that SIGINT ends a long
+  // integration. The engine's collisions leave it off: an event is never abandoned half done.
+  bool interruptible = false;
 };
 
 struct CollisionMap {

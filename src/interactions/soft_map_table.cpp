@@ -20,6 +20,7 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "core/stop_flag.hpp"
 
 namespace kairos {
 namespace {
@@ -72,6 +73,8 @@ inline void cubic_weights(double t, double w[4]) {
 
 // ---------------------------------------------------------------------------------------------
 // Work spread over threads; the calling thread takes part and is the one that reports progress.
+// Every chunk polls the stop flag: a SIGINT ends a build within a chunk's time (its Interrupted
+// is rethrown on the calling thread like any other error).
 
 template <class F>
 void parallel_for(std::size_t n, int threads, const F& f,
@@ -87,6 +90,7 @@ void parallel_for(std::size_t n, int threads, const F& f,
       if (begin >= n || failed.load()) return;
       const std::size_t end = std::min(n, begin + kChunk);
       try {
+        throw_if_stop_requested();
         for (std::size_t i = begin; i < end; ++i) f(i);
       } catch (...) {
         const std::lock_guard lock(error_mutex);
@@ -377,6 +381,7 @@ struct SoftMapTableBuilder {
   static void node_logs(const ReducedCollision& r, double* out) {
     MapOptions options;
     options.tolerance = kNodeTolerance;
+    options.interruptible = true;
     const CollisionMap m = collision_map(r, options);
     if (!(m.eps_t > 0.0 && m.eps_rdot < 0.0 && m.eps_phi > 0.0))
       throw std::logic_error(
@@ -426,6 +431,7 @@ struct SoftMapTableBuilder {
     }
     MapOptions tight;
     tight.tolerance = kNodeTolerance;
+    tight.interruptible = true;
     parallel_for(
         points.size(), threads,
         [&](std::size_t k) { points[k].direct = collision_map(points[k].units.reduced, tight); },
@@ -511,6 +517,7 @@ struct SoftMapTableBuilder {
     }
     MapOptions tight;
     tight.tolerance = kNodeTolerance;
+    tight.interruptible = true;
     const std::size_t n_check = inside.size() + below.size();
     parallel_for(
         n_check, threads,
@@ -588,13 +595,14 @@ struct SoftMapTableBuilder {
       w_factor = refine_w ? 2 : 1;
       const long next_nodes =
           static_cast<long>(u_factor * nu_int + 1) * static_cast<long>(w_factor * nw_int + 1);
+      // The user's to fix (a tolerance or a range asked for), so an InputError.
       if (next_nodes > kMaxNodes)
-        throw std::runtime_error(
+        throw InputError(
             fmt::format("soft map table: the tolerance {} is not reached with "
                         "{} nodes (max relative errors "
                         "{:.3g}, {:.3g}, {:.3g}, {:.3g} in eps_t, eps_rdot, "
                         "eps_phi, end_overlap); loosen "
-                        "the tolerance or narrow the speed range",
+                        "the tolerance (soft.table_tolerance) or narrow the speed range",
                         spec.tolerance, nodes, err[0], err[1], err[2], err[3]));
       old_data = t.data_;
       old_grid = g;

@@ -96,7 +96,7 @@ struct SoftTableGrid {
 class SoftMapTable {
  public:
   // Builds the table (integrating every node with collision_map), refining the grid until the
-  // off-grid check meets spec.tolerance. InputError for an invalid spec; std::runtime_error if the
+  // off-grid check meets spec.tolerance. InputError for an invalid spec; InputError too if the
   // tolerance cannot be met within the node limit.
   static SoftMapTable build(const SoftTableSpec& spec, const SoftTableBuildOptions& options = {});
   // The same, through a cache directory: a file keyed by the spec (and the file format version) is

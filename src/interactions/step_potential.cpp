@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/stop_flag.hpp"
 
 namespace kairos {
 
@@ -50,9 +51,20 @@ double crossing(const std::function<double(double)>& f, double level, double lo,
   return 0.5 * (lo + hi);
 }
 
+// Counts the subdivisions of one quadrature to poll the stop flag now and then (and at its
+// start): an integrand the tolerance cannot be met for may subdivide up to depth 40 (2^40
+// panels), and SIGINT must still end it (the result of a quadrature that finishes is unchanged).
+struct QuadratureWork {
+  unsigned long panels = 0;
+  void count() {
+    if ((++panels & 4095u) == 0) throw_if_stop_requested();
+  }
+};
+
 // Adaptive Simpson quadrature of f over [a, b] to an absolute tolerance.
 double simpson(const std::function<double(double)>& f, double a, double b, double fa, double fm,
-               double fb, double whole, double tol, int depth) {
+               double fb, double whole, double tol, int depth, QuadratureWork& work) {
+  work.count();
   const double m = 0.5 * (a + b), lm = 0.5 * (a + m), rm = 0.5 * (m + b);
   const double flm = f(lm), frm = f(rm);
   const double left = (m - a) / 6.0 * (fa + 4.0 * flm + fm);
@@ -60,8 +72,8 @@ double simpson(const std::function<double(double)>& f, double a, double b, doubl
   if (depth <= 0 || std::abs(left + right - whole) <= 15.0 * tol) {
     return left + right + (left + right - whole) / 15.0;
   }
-  return simpson(f, a, m, fa, flm, fm, left, 0.5 * tol, depth - 1) +
-         simpson(f, m, b, fm, frm, fb, right, 0.5 * tol, depth - 1);
+  return simpson(f, a, m, fa, flm, fm, left, 0.5 * tol, depth - 1, work) +
+         simpson(f, m, b, fm, frm, fb, right, 0.5 * tol, depth - 1, work);
 }
 
 // int_a^b f to about 1e-13 of int_a^b |f|: 16 panels, each adaptive, the tolerance set by a
@@ -79,10 +91,12 @@ double integrate(const std::function<double(double)>& f, double a, double b) {
   }
   const double tol = 1e-13 * scale / kPanels + 1e-300;
   double sum = 0.0;
+  throw_if_stop_requested();
+  QuadratureWork work;
   for (int i = 0; i < kPanels; ++i) {
     const double lo = a + h * i, hi = i + 1 == kPanels ? b : a + h * (i + 1);
     const double fa = values[2 * i], fm = values[2 * i + 1], fb = values[2 * i + 2];
-    sum += simpson(f, lo, hi, fa, fm, fb, (hi - lo) / 6.0 * (fa + 4.0 * fm + fb), tol, 40);
+    sum += simpson(f, lo, hi, fa, fm, fb, (hi - lo) / 6.0 * (fa + 4.0 * fm + fb), tol, 40, work);
   }
   return sum;
 }
@@ -142,7 +156,9 @@ void check_monotone(const ContinuousPotential& p, double lo, double hi, bool fal
 // to `inner` (exclusive); levels in order, each strictly between U(outer) and U(inner).
 void push_crossings(StepTable& t, const ContinuousPotential& p, const std::vector<double>& levels,
                     double inner, double outer) {
-  for (const double level : levels) {
+  for (std::size_t k = 0; k < levels.size(); ++k) {
+    if ((k & 255u) == 255u) throw_if_stop_requested();  // up to kMaxShells bisections
+    const double level = levels[k];
     const double r = crossing(p.u, level, inner, outer);
     // A crossing within rounding of the previous boundary or the inner end adds no shell.
     if (r < t.boundary.back() * (1.0 - 1e-12) && r > inner * (1.0 + 1e-12)) t.boundary.push_back(r);

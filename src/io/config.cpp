@@ -9,6 +9,8 @@
 #include <fmt/format.h>
 
 #include <toml++/toml.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -211,6 +213,7 @@ constexpr KeySpec kSchema[] = {
     {"potential[].force_zero", Kind::kBoolean},
 };
 
+constexpr std::uint64_t kMaxParticles = (std::uint64_t{1} << 31) - 1;
 constexpr std::string_view kLattices3D[] = {"fcc", "sc", "bcc", "random"};
 constexpr std::string_view kLattices2D[] = {"hex", "square", "random"};
 constexpr std::string_view kEventQueues[] = {"calendar", "heap", "tree"};
@@ -230,6 +233,14 @@ constexpr std::string_view kPairPotentials[] = {
 constexpr std::string_view kBondPotentials[] = {"tether", "spring"};
 constexpr std::string_view kPlacements[] = {"energy", "distance", "volume"};
 constexpr std::string_view kShellEnergies[] = {"midpoint", "volume", "mid_volume", "virial"};
+
+// A key or value as echoed in a message: at most kShownLength characters of it (a megabyte of
+// key would flood the terminal), with its length when cut.
+constexpr std::size_t kShownLength = 64;
+std::string shown(std::string_view text) {
+  if (text.size() <= kShownLength) return std::string(text);
+  return fmt::format("{}... ({} characters)", text.substr(0, kShownLength - 4), text.size());
+}
 
 std::string join_key(std::string_view prefix, std::string_view key) {
   return prefix.empty() ? std::string(key) : fmt::format("{}.{}", prefix, key);
@@ -280,7 +291,15 @@ const KeySpec* find_spec(std::string_view path) {
   return nullptr;
 }
 
-// Case-insensitive Levenshtein distance.
+bool same_ignoring_case(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) ==
+                  std::tolower(static_cast<unsigned char>(y));
+         });
+}
+
+// Case-insensitive Levenshtein distance; O(|a| |b|), so callers compare only keys of similar
+// lengths (the distance is at least the difference of the lengths).
 std::size_t edit_distance(std::string_view a, std::string_view b) {
   std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
   for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
@@ -303,6 +322,8 @@ std::string_view leaf(std::string_view path) {
 
 // " (did you mean 'system.particles'?)" or "".
 std::string suggestion(std::string_view unknown) {
+  // No key is near a very long one, and comparing with one costs its length squared.
+  if (unknown.size() > 4 * kShownLength) return {};
   // Keys of an array of tables are offered for the element the unknown key is in
   // ("contact.pair[2].x" -> "contact.pair[2].*"), else for element 0 ("system.species.name" ->
   // "system.species[0].name").
@@ -332,6 +353,9 @@ std::string suggestion(std::string_view unknown) {
         (unknown[c.size()] == '.' || unknown[c.size()] == '[')) {
       continue;
     }
+    const std::size_t length_gap =
+        unknown.size() > c.size() ? unknown.size() - c.size() : c.size() - unknown.size();
+    if (length_gap >= best_distance) continue;  // the distance is at least the gap
     const std::size_t d = edit_distance(unknown, c);
     // ... nor one more edits away than the last part has letters ("tc" is no typo of "face").
     if (d < best_distance && d < leaf(unknown).size()) {
@@ -341,7 +365,7 @@ std::string suggestion(std::string_view unknown) {
   }
   if (best == nullptr) {  // a known key in the wrong place: "particles" -> "system.particles"
     for (const std::string& c : candidates) {
-      if (edit_distance(leaf(unknown), leaf(c)) == 0) {
+      if (same_ignoring_case(leaf(unknown), leaf(c))) {
         best = &c;
         break;
       }
@@ -364,7 +388,7 @@ std::string describe(const toml::node& node) {
     case toml::node_type::array:
       return "an array";
     case toml::node_type::string:
-      return fmt::format("a string (\"{}\")", node.as_string()->get());
+      return fmt::format("a string (\"{}\")", shown(node.as_string()->get()));
     case toml::node_type::integer:
       return fmt::format("an integer ({})", node.as_integer()->get());
     case toml::node_type::floating_point:
@@ -460,7 +484,7 @@ const char* other_unit_key(std::string_view path) {
 }
 
 AppliedOverride apply_override(toml::table& root, const std::string& text) {
-  const std::string label = fmt::format("override '{}'", text);
+  const std::string label = fmt::format("override '{}'", shown(text));
   const auto error = [&](const std::string& message) {
     return InputError(fmt::format("{}: {}", label, message));
   };
@@ -487,15 +511,16 @@ AppliedOverride apply_override(toml::table& root, const std::string& text) {
     } else {
       const auto bracket = part.find('[');
       const std::string_view name = part.substr(0, bracket);
-      if (!is_bare_key(name)) throw error(fmt::format("invalid key '{}'", key));
+      if (!is_bare_key(name)) throw error(fmt::format("invalid key '{}'", shown(key)));
       tokens.push_back({std::string(name), false});
-      canonical = join_key(canonical, name);
+      if (!canonical.empty()) canonical += '.';  // appended, not rebuilt: linear in the key
+      canonical += name;
       part = bracket == std::string_view::npos ? std::string_view() : part.substr(bracket);
       while (!part.empty()) {
         const auto close = part.find(']');
         if (part[0] != '[' || close == std::string_view::npos ||
             !is_digits(part.substr(1, close - 1))) {
-          throw error(fmt::format("invalid key '{}'", key));
+          throw error(fmt::format("invalid key '{}'", shown(key)));
         }
         tokens.push_back({std::string(part.substr(1, close - 1)), true});
         canonical += part.substr(0, close + 1);
@@ -513,7 +538,7 @@ AppliedOverride apply_override(toml::table& root, const std::string& text) {
       prefix =
           token.is_index ? fmt::format("{}[{}]", prefix, token.key) : join_key(prefix, token.key);
       if (find_spec(prefix) == nullptr) {
-        throw error(fmt::format("unknown key '{}'{}", canonical, suggestion(canonical)));
+        throw error(fmt::format("unknown key '{}'{}", shown(canonical), suggestion(canonical)));
       }
     }
   }
@@ -686,7 +711,7 @@ class Reader {
     const toml::source_region& region =
         unknown->source().begin.line > 0 ? unknown->source() : unknown_node->source();
     throw InputError(
-        fmt::format("{}: unknown key '{}'{}", where(region, path), path, suggestion(path)));
+        fmt::format("{}: unknown key '{}'{}", where(region, path), shown(path), suggestion(path)));
   }
 
   const toml::table& section(const toml::table& root, std::string_view key,
@@ -878,12 +903,22 @@ class Reader {
     if (!(value >= 0.0)) fail(node, path, fmt::format("{}: must be >= 0, got {}", path, value));
   }
 
+  // value in [lo, hi]; `why` (may be empty) says where the bounds come from.
+  void require_range(const toml::node* node, std::string_view path, double value, double lo,
+                     double hi, std::string_view why = {}) const {
+    if (!(value >= lo && value <= hi)) {
+      fail(node, path,
+           fmt::format("{}: must be in [{:g}, {:g}]{}{}, got {}", path, lo, hi,
+                       why.empty() ? "" : " ", why, value));
+    }
+  }
+
   void require_choice(const toml::node* node, std::string_view path, const std::string& value,
                       std::span<const std::string_view> choices) const {
     if (!contains(choices, value)) {
-      fail(
-          node, path,
-          fmt::format("{}: '{}' is not valid; valid values: {}", path, value, join_words(choices)));
+      fail(node, path,
+           fmt::format("{}: '{}' is not valid; valid values: {}", path, shown(value),
+                       join_words(choices)));
     }
   }
 
@@ -933,10 +968,29 @@ class Reader {
       fail(n_particles, "system.particles",
            fmt::format("system.particles: must be at least 2, got {}", s.particles));
     }
+    // The engine numbers particles in 31 bits (docs/architecture.md).
+    if (s.particles > kMaxParticles) {
+      fail(n_particles, "system.particles",
+           fmt::format("system.particles: must be at most {} (2^31 - 1), got {}", kMaxParticles,
+                       s.particles));
+    }
+    // Whether the state fits in memory is checked before it is built (core/memory_budget).
     if (!(from_file && s.packing_fraction == 0.0) &&
         !(s.packing_fraction > 0.0 && s.packing_fraction < 1.0)) {
       fail(n_packing, "system.packing_fraction",
            fmt::format("system.packing_fraction: must be in (0, 1), got {}", s.packing_fraction));
+    }
+    // More dilute, and neighbours sit more than ~1e3 diameters apart: the box outgrows what
+    // positions resolve before the gas is any different from one at 1e-9.
+    if (!(from_file && s.packing_fraction == 0.0) && s.packing_fraction < 1e-9) {
+      fail(n_packing, "system.packing_fraction",
+           fmt::format("system.packing_fraction: must be at least 1e-9, got {}",
+                       s.packing_fraction));
+    }
+    if (s.chain_length > 0 && s.particles > 0 && s.chain_length > s.particles) {
+      fail(n_chain, "system.chain_length",
+           fmt::format("system.chain_length: must be at most system.particles = {}, got {}",
+                       s.particles, s.chain_length));
     }
 
     if (s.lattice.empty()) {
@@ -948,12 +1002,21 @@ class Reader {
       if (!contains(valid, s.lattice)) {
         fail(n_lattice, "system.lattice",
              fmt::format("system.lattice: '{}' is not a valid lattice in {}D; valid values: {}",
-                         s.lattice, s.dimension, join_words(valid)));
+                         shown(s.lattice), s.dimension, join_words(valid)));
       }
     }
 
+    // kT is the unit of energy (and with the masses, of speed) that every other range refers to.
     require_positive(n_temperature, "system.temperature", s.temperature);
+    require_range(n_temperature, "system.temperature", s.temperature, 1e-9, 1e9,
+                  "(the unit of energy kT: reduced units keep it near 1)");
     if (s.species.empty()) s.species.emplace_back();
+    double largest = 0.0;
+    for (const SpeciesConfig& sp : s.species) largest = std::max(largest, sp.diameter);
+    if (s.chain_spacing > 0.0) {
+      require_range(n_spacing, "system.chain_spacing", s.chain_spacing, 0.0, 1e6 * largest,
+                    "(0, or up to 1e6 times the largest diameter)");
+    }
 
     std::vector<double> box_scale;
     const toml::node* n_box_scale = get_vector(t, p, "box_scale", s.dimension, box_scale);
@@ -961,6 +1024,10 @@ class Reader {
       if (!(box_scale[i] >= 1.0)) {
         fail(element_of(n_box_scale, i), "system.box_scale",
              fmt::format("system.box_scale[{}]: must be >= 1, got {}", i, box_scale[i]));
+      }
+      if (!(box_scale[i] <= 1e6)) {
+        fail(element_of(n_box_scale, i), "system.box_scale",
+             fmt::format("system.box_scale[{}]: must be at most 1e6, got {}", i, box_scale[i]));
       }
     }
     // All 1 is the same as no scaling: stored as the default, empty.
@@ -993,13 +1060,24 @@ class Reader {
                            n_name == nullptr ? "; give every species its own name" : ""));
         }
       }
+      // Diameter and mass are units (reduced units keep them near 1); a fraction is relative.
       require_positive(n_diameter, prefix + ".diameter", s.diameter);
       require_positive(n_mass, prefix + ".mass", s.mass);
       require_positive(n_fraction, prefix + ".fraction", s.fraction);
+      require_range(n_diameter, prefix + ".diameter", s.diameter, 1e-9, 1e9);
+      require_range(n_mass, prefix + ".mass", s.mass, 1e-9, 1e9);
+      require_range(n_fraction, prefix + ".fraction", s.fraction, 1e-9, 1e9);
+      // I = q m R^2 with the mass inside the radius: q <= 1 (all of it at R: a ring).
       if (!(s.inertia_factor >= 0.0)) {
         fail(n_inertia, prefix + ".inertia_factor",
              fmt::format("{}.inertia_factor: must be > 0 (or 0 for the default: 2/5 for spheres, "
                          "1/2 for disks), got {}",
+                         prefix, s.inertia_factor));
+      }
+      if (!(s.inertia_factor == 0.0 || (s.inertia_factor >= 1e-9 && s.inertia_factor <= 1.0))) {
+        fail(n_inertia, prefix + ".inertia_factor",
+             fmt::format("{}.inertia_factor: must be in [1e-9, 1] (I = q m R^2 with the mass "
+                         "within R; or 0 for the default: 2/5 for spheres, 1/2 for disks), got {}",
                          prefix, s.inertia_factor));
       }
       out.push_back(std::move(s));
@@ -1234,7 +1312,9 @@ class Reader {
 
       const toml::node* n_amplitude = get_number(wt, prefix, "amplitude", w.amplitude);
       const toml::node* n_frequency = get_number(wt, prefix, "frequency", w.frequency);
-      get_number(wt, prefix, "phase", w.phase);
+      const toml::node* n_phase = get_number(wt, prefix, "phase", w.phase);
+      // Beyond 1e9 rad a double no longer resolves the phase to 1e-7.
+      require_range(n_phase, prefix + ".phase", w.phase, -1e9, 1e9, "(radians)");
       require_non_negative(n_amplitude, prefix + ".amplitude", w.amplitude);
       require_non_negative(n_frequency, prefix + ".frequency", w.frequency);
       b.walls.push_back(std::move(w));
@@ -1442,8 +1522,13 @@ class Reader {
         get_number(t, prefix, "tangential_stiffness", law.tangential_stiffness);
     const toml::node* n_gt = get_number(t, prefix, "tangential_damping", law.tangential_damping);
     require_non_negative(n_mu, path("friction"), law.friction);
+    require_range(n_mu, path("friction"), law.friction, 0.0, 1e9);
+    // Ratios to the normal law: a tangential spring much stiffer than the normal one would be
+    // unstable at the time step chosen for the normal one (physical ratios are 2/3 to 4/3).
     require_positive(n_kt, path("tangential_stiffness"), law.tangential_stiffness);
+    require_range(n_kt, path("tangential_stiffness"), law.tangential_stiffness, 1e-9, 10.0);
     require_non_negative(n_gt, path("tangential_damping"), law.tangential_damping);
+    require_range(n_gt, path("tangential_damping"), law.tangential_damping, 0.0, 1e3);
     if (n_model == nullptr && law.model.empty()) {
       fail(&t, path("model"),
            fmt::format("missing required key '{}' (\"dashpot\" or \"hertz\"): [soft] makes every "
@@ -1522,6 +1607,12 @@ class Reader {
     if (n_tolerance != nullptr && !(soft.table_tolerance < 0.1)) {
       fail(n_tolerance, "soft.table_tolerance",
            fmt::format("soft.table_tolerance: must be below 0.1 (a relative error), got {}",
+                       soft.table_tolerance));
+    }
+    // The nodes are integrated to 1e-13: below 1e-10 no table can be checked to its tolerance.
+    if (!(soft.table_tolerance >= 1e-10)) {
+      fail(n_tolerance, "soft.table_tolerance",
+           fmt::format("soft.table_tolerance: must be at least 1e-10, got {}",
                        soft.table_tolerance));
     }
     get_string(t, p, "table_cache", soft.table_cache);
@@ -1669,9 +1760,14 @@ class Reader {
     const toml::node* n_time = get_number(t, p, "time", r.time);
     const toml::node* n_equilibration_time =
         get_number(t, p, "equilibration_time", r.equilibration_time);
+    // Up to 1e9 collisions per particle: 1e18 collisions of the largest system still count in
+    // 64 bits, and no run gets that far.
     require_non_negative(n_equilibration, "run.equilibration_collisions_per_particle",
                          r.equilibration_collisions_per_particle);
+    require_range(n_equilibration, "run.equilibration_collisions_per_particle",
+                  r.equilibration_collisions_per_particle, 0.0, 1e9);
     require_positive(n_production, "run.collisions_per_particle", r.collisions_per_particle);
+    require_range(n_production, "run.collisions_per_particle", r.collisions_per_particle, 0.0, 1e9);
     if (n_time != nullptr) require_positive(n_time, "run.time", r.time);
     if (n_equilibration_time != nullptr)
       require_non_negative(n_equilibration_time, "run.equilibration_time", r.equilibration_time);
@@ -1687,6 +1783,8 @@ class Reader {
     }
     require_choice(n_queue, "run.event_queue", r.event_queue, kEventQueues);
     require_non_negative(n_wall, "run.max_wall_seconds", r.max_wall_seconds);
+    require_range(n_wall, "run.max_wall_seconds", r.max_wall_seconds, 0.0, 1e9,
+                  "(seconds; 0: no limit)");
     const toml::node* n_integrator = get_string(t, p, "integrator", r.integrator);
     const toml::node* n_step = get_number(t, p, "time_step", r.time_step);
     require_choice(n_integrator, "run.integrator", r.integrator, kIntegrators);

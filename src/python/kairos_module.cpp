@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/stop_flag.hpp"
 #include "io/config.hpp"
 #include "run/run.hpp"
 #include "run/simulation.hpp"
@@ -37,14 +38,42 @@ bool python_keeps_going() {
   return true;
 }
 
+std::string type_name(const py::handle& object) {
+  return py::str(py::type::handle_of(object).attr("__name__")).cast<std::string>();
+}
+
+// `set`: None, one "key=value" override, or a sequence (list, tuple) of them. Anything else is a
+// TypeError naming what was given (pybind11's own cast error would name C++ types).
+std::vector<std::string> overrides_from(const py::object& set) {
+  if (set.is_none()) return {};
+  if (py::isinstance<py::str>(set)) return {set.cast<std::string>()};
+  const bool sequence = py::isinstance<py::sequence>(set) && !py::isinstance<py::bytes>(set);
+  if (!sequence) {
+    throw py::type_error(fmt::format(
+        "set must be a 'key=value' string or a list of them (e.g. set=[\"run.time=10\"]), not {}",
+        type_name(set)));
+  }
+  std::vector<std::string> overrides;
+  const auto items = set.cast<py::sequence>();
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const py::object item = items[i];
+    if (!py::isinstance<py::str>(item)) {
+      throw py::type_error(
+          fmt::format("set[{}] must be a 'key=value' string, not {}", i, type_name(item)));
+    }
+    overrides.push_back(item.cast<std::string>());
+  }
+  return overrides;
+}
+
 // A config file (str or path-like), or TOML text when the string holds a newline (a path here
 // never does); `set`: one "key=value" override or a sequence of them.
 Config config_from(const py::object& config, const py::object& set) {
-  std::vector<std::string> overrides;
-  if (py::isinstance<py::str>(set)) {
-    overrides.push_back(set.cast<std::string>());
-  } else if (!set.is_none()) {
-    overrides = set.cast<std::vector<std::string>>();
+  const std::vector<std::string> overrides = overrides_from(set);
+  if (!py::isinstance<py::str>(config) && !py::hasattr(config, "__fspath__")) {
+    throw py::type_error(
+        fmt::format("config must be a TOML file's path (str or os.PathLike) or TOML text, not {}",
+                    type_name(config)));
   }
   if (py::isinstance<py::str>(config)) {
     const auto text = config.cast<std::string>();
@@ -56,7 +85,9 @@ Config config_from(const py::object& config, const py::object& set) {
 }
 
 // SIGINT during kairos.run: the run stops cleanly after the current event (request_stop(), as
-// in the CLI) and writes every output; Python's handler is back afterwards.
+// in the CLI) and writes every output; Python's handler is back afterwards. During the setup of
+// kairos.run or kairos.Simulation (a table build) it unwinds with Interrupted, which the module
+// turns into KeyboardInterrupt.
 extern "C" void stop_on_sigint(int) {
   request_stop();
 }
@@ -94,6 +125,9 @@ class PySimulation {
   PySimulation(const py::object& config, const py::object& set,
                const std::optional<fs::path>& restart) {
     const Config c = config_from(config, set);
+    // The start may build soft-sphere tables (seconds): without the GIL, and Ctrl-C ends it.
+    SigintStopsRun sigint;
+    py::gil_scoped_release release;
     if (c.system.dimension == 2) {
       sim_ = std::make_unique<Simulation<2>>(c, restart);
     } else {
@@ -208,6 +242,22 @@ PYBIND11_MODULE(kairos, m) {
   m.attr("__version__") = KAIROS_VERSION;
   // A configuration or state the user must fix; Python's ValueError family.
   py::register_exception<kairos::InputError>(m, "InputError", PyExc_ValueError);
+  // A setup stopped by Ctrl-C is Python's KeyboardInterrupt; one stopped by run.max_wall_seconds
+  // a TimeoutError.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const kairos::Interrupted& e) {
+      if (e.cause() == kairos::Interrupted::Cause::kWallTime) {
+        PyErr_SetString(
+            PyExc_TimeoutError,
+            fmt::format("run.max_wall_seconds: {} during the setup; nothing was run", e.what())
+                .c_str());
+      } else {
+        PyErr_SetNone(PyExc_KeyboardInterrupt);
+      }
+    }
+  });
 
   m.def(
       "run",
@@ -217,6 +267,7 @@ PYBIND11_MODULE(kairos, m) {
         if (output) c.output.directory = output->string();
         const kairos::RunOutcome outcome = [&] {
           kairos::SigintStopsRun sigint;
+          const kairos::ScopedStopDeadline setup_limit(c.run.max_wall_seconds);
           py::gil_scoped_release release;  // the run is C++ throughout
           kairos::RunOptions options;
           options.overwrite = overwrite;

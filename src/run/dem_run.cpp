@@ -283,7 +283,7 @@ class DemRunDriver {
   // step at or after its end); true if stopped early. Outputs in time come at the first step at
   // or after each multiple of their interval.
   bool run_phase(const std::string& phase, PhaseLength length, ProgressLine& progress,
-                 Clock::time_point wall_start) {
+                 Clock::time_point /*wall_start*/) {
     phase_ = phase;
     // The first phase of a continued run starts where the saved run nominally stopped.
     std::uint64_t begin = dem_->collisions();
@@ -380,8 +380,8 @@ class DemRunDriver {
         return true;
       }
       progress.update({phase, done(), length.value, dem_->time(), steps(), length.in_time});
-      if (config_.run.max_wall_seconds > 0 &&
-          std::chrono::duration<double>(Clock::now() - wall_start).count() >
+      if (config_.run.max_wall_seconds > 0 &&  // from the start of the set-up, as run.cpp's
+          std::chrono::duration<double>(Clock::now() - created_).count() >
               config_.run.max_wall_seconds) {
         stop_reason_ = "wall_time_limit";
         return true;
@@ -550,6 +550,7 @@ class DemRunDriver {
     return j;
   }
 
+  Clock::time_point created_ = Clock::now();  // the start of the set-up
   Config config_;
   bool restart_;
   std::string restart_name_;  // the restart file continued, for messages

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "run/config_ranges.hpp"
 
 namespace kairos {
 
@@ -50,13 +51,32 @@ std::vector<double> species_masses(const ParticleSystem<D>& s, std::size_t speci
   return m;
 }
 
+// A step higher than 1e9 kT is never climbed nor left once fallen into, and such energies
+// swamp the kinetic energy in round-off (sigma = 1e6 with a core of 0.85 gave steps of 1e72):
+// InputError naming the largest.
+void check_step_energies(const StepTable& t, double kT, const std::string& where) {
+  for (std::size_t k = 0; k < t.energy.size(); ++k) {
+    if (!(std::abs(t.energy[k]) <= 1e9 * kT)) {
+      throw InputError(fmt::format(
+          "{}: the step table's shell between r = {:.6g} and {:.6g} has the energy {:.6g}, more "
+          "than 1e9 times kT = {:.6g} (system.temperature) in magnitude; such a step is never "
+          "crossed and its energy swamps the kinetic energy: lower epsilon (or depth), or move the "
+          "hard core (the diameter) out where U is smaller",
+          where, t.boundary[k + 1], t.boundary[k], t.energy[k], kT));
+    }
+  }
+}
+
 StepTable build_table(const PotentialSpec& spec, double core, int dimension,
-                      const std::string& where, double reduced_mass = std::nan("")) {
+                      const std::string& where, double kT, double reduced_mass = std::nan("")) {
+  StepTable t;
   try {
-    return make_step_table(spec, core, dimension, reduced_mass);
+    t = make_step_table(spec, core, dimension, reduced_mass);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", where, e.what()));
   }
+  check_step_energies(t, kT, where);
+  return t;
 }
 
 // The step tables of [[potential]] and [[bond]] for the state's sizes and bond types.
@@ -95,7 +115,8 @@ void add_step_potentials(const Config& config, const ParticleSystem<D>& s, Envir
         if (core == 0.0) continue;  // a species without particles
         // The reduced mass (NaN if unknown): spring_dashpot's restitution needs it.
         const double mu = mass[a] * mass[b] / (mass[a] + mass[b]);
-        env.tables.push_back(build_table(pc.potential, core, D, where, mu));
+        env.tables.push_back(
+            build_table(pc.potential, core, D, where, config.system.temperature, mu));
         const int t = static_cast<int>(env.tables.size()) - 1;
         env.pair_table[a * n + b] = t;
         env.pair_table[b * n + a] = t;
@@ -126,7 +147,8 @@ void add_step_potentials(const Config& config, const ParticleSystem<D>& s, Envir
     }
     const std::string where = fmt::format("bond[{}]", it - config.bonds.begin());
     if (bond_core[k] == 0.0) bond_core[k] = 2.0 * s.kinematics[0].radius;  // type unused
-    env.tables.push_back(build_table(it->potential, bond_core[k], D, where));
+    env.tables.push_back(
+        build_table(it->potential, bond_core[k], D, where, config.system.temperature));
     env.bond_table.push_back(static_cast<int>(env.tables.size()) - 1);
   }
   if (!env.pair_table.empty()) env.species = n;
@@ -189,7 +211,7 @@ SoftContactLaw make_soft_law(const SoftLawConfig& c, double mu, double r_eff,
     }
     return SoftContactLaw::viscoelastic_hertz(rho, a);
   } catch (const InputError& e) {
-    if (std::string(e.what()).starts_with(where)) throw;
+    if (std::string(e.what()).starts_with(where + ": ")) throw;  // "soft contact: ..." is not
     throw InputError(fmt::format("{}: {}: {}", where, what, e.what()));
   }
 }
@@ -277,6 +299,8 @@ ContactModel make_contact_model(const ContactConfig& c, const std::string& where
 
 template <int D>
 Environment<D> make_environment(const Config& config, const ParticleSystem<D>& state) {
+  // Before anything is built from them (a cut-off of 1e300 would spin in the step tables).
+  check_ranges(config, range_scales<D>(config, state));
   const std::vector<std::string>& species_names = state.species_names;
   Environment<D> env;
   const auto n = static_cast<std::uint32_t>(std::max<std::size_t>(1, species_names.size()));

@@ -30,9 +30,6 @@ namespace kairos {
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-static_assert(std::atomic<bool>::is_always_lock_free);
-
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
@@ -155,7 +152,7 @@ void add_shear_flow(const Config& config, InitialState<D>& init) {
 namespace run_detail {
 
 bool stop_requested() noexcept {
-  return g_stop.load(std::memory_order_relaxed);
+  return kairos::stop_requested();
 }
 
 template <int D>
@@ -518,14 +515,15 @@ class RunDriver {
     return true;
   }
 
-  // A stop asked by a signal or by run.max_wall_seconds (stop_reason_ set).
-  bool interrupted(Clock::time_point wall_start) {
-    if (g_stop.load(std::memory_order_relaxed)) {
+  // A stop asked by a signal or by run.max_wall_seconds, counted from the start of the set-up
+  // (one limit for set-up and run; stop_reason_ set).
+  bool interrupted(Clock::time_point) {
+    if (kairos::stop_requested()) {
       stop_reason_ = "signal";
       return true;
     }
     if (config_.run.max_wall_seconds > 0 &&
-        std::chrono::duration<double>(Clock::now() - wall_start).count() >
+        std::chrono::duration<double>(Clock::now() - created_).count() >
             config_.run.max_wall_seconds) {
       stop_reason_ = "wall_time_limit";
       return true;
@@ -645,7 +643,7 @@ class RunDriver {
       if (schedule.restart.due(c) &&
           !outputs_.attempt("restart.gsd", [&] { write_restart_file(); }))
         return write_failed();
-      if (g_stop.load(std::memory_order_relaxed)) {
+      if (kairos::stop_requested()) {
         stop_reason_ = "signal";
         return true;
       }
@@ -1006,6 +1004,7 @@ class RunDriver {
     return s;
   }
 
+  Clock::time_point created_ = Clock::now();  // the start of the set-up
   Config config_;
   bool restart_;
   std::string restart_name_;  // the restart file continued, for messages
@@ -1081,13 +1080,6 @@ RunOutcome run_with_dimension(const Config& config, const std::optional<fs::path
 }
 
 }  // namespace
-
-void request_stop() noexcept {
-  g_stop.store(true, std::memory_order_relaxed);
-}
-void clear_stop_request() noexcept {
-  g_stop.store(false, std::memory_order_relaxed);
-}
 
 RunOutcome run_simulation(const Config& config, const std::optional<fs::path>& restart_file,
                           const RunOptions& options) {

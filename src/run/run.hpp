@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/stop_flag.hpp"  // request_stop(), clear_stop_request(): stop a running simulation
 #include "io/config.hpp"
 
 namespace kairos {
@@ -34,9 +35,5 @@ struct RunOptions {
 RunOutcome run_simulation(const Config& config,
                           const std::optional<std::filesystem::path>& restart_file = {},
                           const RunOptions& options = {});
-
-// Asks a running simulation to stop after the current event (async-signal-safe).
-void request_stop() noexcept;
-void clear_stop_request() noexcept;
 
 }  // namespace kairos

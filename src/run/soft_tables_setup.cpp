@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "core/stop_flag.hpp"
 
 namespace kairos {
 
@@ -69,6 +70,7 @@ std::vector<SoftTableUse> attach_soft_tables(
   const std::filesystem::path dir =
       settings.cache_dir.empty() ? default_soft_table_cache_dir() : settings.cache_dir;
   auto build = [&](const std::string& name, SoftTableSpec spec) {
+    throw_if_stop_requested();  // between tables too (a cache load, a wall table after a pair's)
     spec.min_normal_speed = min_speed;
     spec.max_normal_speed = max_speed;
     spec.tolerance = settings.tolerance;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -223,6 +224,24 @@ TEST(ConfigErrors, UnknownKeyInSpecies) {
                             "\"B\"\ndiametre = 2"),
                {"test.toml:8:1", "unknown key 'system.species[1].diametre'",
                 "did you mean 'system.species[1].diameter'?"});
+}
+
+TEST(ConfigErrors, HugeUnknownKeysAreCutInTheMessage) {
+  // A megabyte of key: rejected at once (no edit distances with a key that long), and echoed as
+  // its first characters and its length.
+  const std::string key(1'000'000, 'k');
+  const std::string m =
+      expect_error(minimal_plus(key + " = 1"),
+                   {"test.toml:4:1", "unknown key 'system.kkkk", "... (1000007 characters)"});
+  EXPECT_LT(m.size(), 200u) << m.substr(0, 300);
+  EXPECT_EQ(m.find("did you mean"), std::string::npos);
+  const std::string o =
+      expect_error(kMinimal, {"override 'system.", "characters)"}, {"system." + key + "=1"});
+  EXPECT_LT(o.size(), 300u) << o.substr(0, 400);
+  // A long value (a string where a number belongs) is cut too.
+  const std::string v =
+      expect_error(minimal_plus("temperature = \"" + key + "\""), {"system.temperature"});
+  EXPECT_LT(v.size(), 200u) << v.substr(0, 300);
 }
 
 TEST(ConfigErrors, FirstUnknownKeyInFileOrderIsReported) {
@@ -1058,10 +1077,12 @@ TEST(ConfigToToml, RoundTripIsExact) {
   c.system.temperature = 0.1 + 0.2;  // 0.30000000000000004
   c.system.seed = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
   c.system.species = {{"big \"one\"", 1.4, 2.744, 1e-7},
-                      {"small\\path\ttab\nnewline ünï", 5e-324, 1.7976931348623157e308, 123456.0}};
+                      // The ends of the ranges, one ulp inside.
+                      {"small\\path\ttab\nnewline ünï", std::nextafter(1e-9, 1.0),
+                       std::nextafter(1e9, 0.0), 123456.0}};
   c.system.initial_state = "";
   c.run.equilibration_collisions_per_particle = 0.0;
-  c.run.collisions_per_particle = 1e22;
+  c.run.collisions_per_particle = 1e9;  // the most a run may ask for
   c.run.event_queue = "heap";
   c.run.max_wall_seconds = 86400.5;
   c.run.validate = true;

@@ -176,6 +176,26 @@ class Module(kt.KairosTestCase):
         self.assertTrue(sim.advance(time=t + 0.1))
         self.assertEqual(sim.time, t + 0.1)
 
+    def test_ctrl_c_stops_a_table_build(self):
+        # A soft-sphere map table of a minute (tight tolerance, empty cache): SIGINT half a
+        # second in ends the setup of Simulation and of run with KeyboardInterrupt at once.
+        config = soft_config()
+        config["soft"] = {"model": "hertz", "young": 1e6, "restitution": 0.8,
+                          "table_tolerance": 1e-9, "table_cache": self.path("tables")}
+        cfg = self.write_config(config)
+        for start in (lambda: kairos.Simulation(cfg),
+                      lambda: kairos.run(cfg, output=self.path("out"))):
+            timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+            timer.start()
+            started = time.monotonic()
+            with self.assertRaises(KeyboardInterrupt):
+                start()
+            timer.join()
+            self.assertLess(time.monotonic() - started, 3.0)
+        self.assertFalse(os.path.exists(self.path("out", "summary.json")))
+        with self.assertRaises(TimeoutError):
+            kairos.run(cfg, output=self.path("out"), set="run.max_wall_seconds=0.5")
+
     def test_advance_lets_other_threads_run_and_guards_the_object(self):
         sim = kairos.Simulation(self.write_config(hard_config()), set="system.particles=4000")
         worker = threading.Thread(target=sim.advance, kwargs={"events": 3_000_000})
@@ -251,6 +271,28 @@ class Module(kt.KairosTestCase):
                 call()
             self.assertIn(needle, str(caught.exception))
         self.assertTrue(issubclass(kairos.InputError, ValueError))
+
+    def test_arguments_of_the_wrong_type_raise_type_errors(self):
+        # Not pybind11's "Unable to cast Python instance" RuntimeError: a TypeError naming the
+        # argument and what was given.
+        cfg = self.write_config(hard_config())
+        cases = [
+            (lambda: kairos.run(cfg, set=123), "set must be a 'key=value' string", "int"),
+            (lambda: kairos.run(cfg, set=["run.time=1", 2]), "set[1] must be", "int"),
+            (lambda: kairos.Simulation(cfg, set={"run.time": 1.0}), "set must be", "dict"),
+            (lambda: kairos.Simulation(cfg, set=b"run.time=1"), "set must be", "bytes"),
+            (lambda: kairos.run(42), "config must be", "int"),
+            (lambda: kairos.Simulation(None), "config must be", "NoneType"),
+        ]
+        for call, *needles in cases:
+            with self.assertRaises(TypeError) as caught:
+                call()
+            for needle in needles:
+                self.assertIn(needle, str(caught.exception))
+        self.assertFalse(os.path.exists(self.path("out")))
+        # The accepted forms still work: one string, a tuple of strings.
+        sim = kairos.Simulation(cfg, set=("system.particles=100", "system.seed=3"))
+        self.assertEqual(len(sim), 100)
 
 
 if __name__ == "__main__":

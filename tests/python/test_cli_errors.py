@@ -71,6 +71,24 @@ class ConfigErrors(kt.KairosTestCase):
     def test_unknown_section_via_set(self):
         self.check_set(["bogus.key=1"], "bogus")
 
+    def test_megabyte_key_is_rejected_at_once(self):
+        # No "did you mean" search over a megabyte (it took > 30 s), and the message shows the
+        # key's start and length, not the whole key.
+        key = "k" * 1_000_000
+        path = self.write_config(self.good_text() + "\n[field]\n%s = 1\n" % key, "long.toml")
+        started = time.monotonic()
+        result = self.kairos("run", path, "-o", self.path("out"))
+        elapsed = time.monotonic() - started
+        line = self.assert_user_error(result, "unknown key 'field.kkk", "(1000006 characters)")
+        self.assertLess(len(line), 200)
+        self.assertLess(elapsed, 1.0 * kt.SLOWDOWN, "rejecting the key took %.2f s" % elapsed)
+        # An override (an argument holds at most 128 KiB on Linux).
+        started = time.monotonic()
+        result = self.kairos("run", self.config, "--set", "run.%s=1" % key[:100_000])
+        self.assertLess(time.monotonic() - started, 1.0 * kt.SLOWDOWN)
+        line = self.assert_user_error(result, "override 'run.kkk", "(100004 characters)")
+        self.assertLess(len(line), 300)
+
     # ----- wrong types
 
     def test_string_for_particles(self):
@@ -243,6 +261,103 @@ class ConfigErrors(kt.KairosTestCase):
     def test_set_species_index_out_of_range(self):
         self.check_set(["system.species.5.diameter=1.2"], "system.species")
 
+
+class RangeErrors(kt.KairosTestCase):
+    """Values that were accepted and then spun for ever (ignoring SIGINT, SIGTERM and the
+    wall-time limit) or broke down numerically: each is now refused at once, with its key, its
+    value and the allowed range (docs/config.md)."""
+
+    def lj(self, **sections):
+        config = kt.base_config(particles=500, packing_fraction=0.2572434, lattice="fcc",
+                                production=2.0, system={"temperature": 2.0,
+                                                        "species": [{"name": "A",
+                                                                     "diameter": 0.85}]},
+                                driving={"kind": "andersen", "rate": 5.0, "temperature": 2.0})
+        text = kt.toml_text(config) + (
+            "\n[[potential]]\nkind = \"lennard_jones\"\ncutoff = 2.5\nsteps = 10\n")
+        return text
+
+    def soft(self):
+        config = kt.base_config(particles=300, packing_fraction=0.05, lattice="random",
+                                production=2.0)
+        config["soft"] = {"model": "hertz", "young": 1e6, "restitution": 0.8,
+                          "table_cache": self.path("tables")}
+        return config
+
+    def vibrated_bed(self):
+        return kt.base_config(
+            dimension=2, particles=150, packing_fraction=0.4, lattice="random", production=2.0,
+            system={"box_scale": [1.0, 6.0]}, contact={"restitution": 0.9, "tc": 1e-4},
+            boundary={"open": ["y+"], "wall": [{"face": "x-"}, {"face": "x+"},
+                                               {"face": "y-", "amplitude": 0.1,
+                                                "frequency": 0.87}]},
+            field={"gravity": [0.0, -1.0]})
+
+    def refused(self, config, overrides, *needles):
+        path = self.write_config(config)
+        args = ["run", path, "-o", self.path("out")]
+        for o in overrides:
+            args += ["--set", o]
+        started = time.monotonic()
+        result = self.kairos(*args, timeout=30 * kt.SLOWDOWN)
+        line = self.assert_user_error(result, *needles)
+        self.assertLess(time.monotonic() - started, 5.0 * kt.SLOWDOWN, line)
+        self.assertFalse(os.path.exists(self.path("out", "summary.json")), line)
+        return line
+
+    def test_the_base_configs_run(self):
+        self.run_ok("run", self.write_config(self.lj(), "lj.toml"), "-o", self.path("lj"))
+        self.run_ok("run", self.write_config(self.vibrated_bed(), "bed.toml"), "-o",
+                    self.path("bed"))
+
+    def test_values_that_spun_for_ever(self):
+        self.refused(self.lj(), ["potential.0.cutoff=1e300"], "potential[0]", "1e+300",
+                     "half the smallest box edge")
+        self.refused(self.lj(), ["driving.rate=1e300"], "driving.rate = 1e+300",
+                     "must be in [", "collision rate")
+        self.refused(self.soft(), ["soft.restitution_speed=1e-300"],
+                     "soft.restitution_speed = 1e-300", "must be in [1e-06, 1e+06]")
+
+    def test_values_that_broke_down_numerically(self):
+        self.refused(self.lj(), ["potential.0.epsilon=1e300"], "potential[0].epsilon",
+                     "1e+300", "must be in [")
+        self.refused(self.lj(), ["potential.0.sigma=1e6"], "potential[0]", "1e9 times kT")
+        self.refused(self.lj(), ["driving.temperature=1e300"], "driving.temperature = 1e+300",
+                     "must be in [2e-09, 2e+09]")
+        dem = self.soft()
+        dem["run"]["integrator"] = "dem"
+        self.refused(dem, ["soft.young=1e300"], "soft.young = 1e+300", "must be in [1e-09, 1e+15]")
+        self.refused(self.vibrated_bed(), ["boundary.wall.2.amplitude=1e300"],
+                     "boundary.wall[2].amplitude = 1e+300", "box edges along its axis")
+        sheared = kt.base_config(dimension=2, particles=200, packing_fraction=0.3,
+                                 production=2.0, boundary={"shear_rate": 1e300})
+        self.refused(sheared, [], "boundary.shear_rate = 1e+300", "1e6 / tau")
+        self.refused(self.vibrated_bed(), ["field.gravity=[0, 1e-12]"], "boundary.open",
+                     "does not pull the particles back", "field.gravity[1]")
+        self.refused(self.vibrated_bed(), ["field.gravity=[0, -1e-12]"], "field.gravity[1]",
+                     "too weak for the open face y+")
+
+    def test_kairos_steps_refuses_what_spun(self):
+        # No box there: a table reaches at most 1e6 diameters (1e300 spun in the quadrature).
+        path = self.write_config(self.lj())
+        result = self.kairos("steps", path, "--set", "potential.0.cutoff=1e300",
+                             timeout=30 * kt.SLOWDOWN)
+        self.assert_user_error(result, "potential[0]", "1e+300", "1e6 times the largest diameter")
+
+    def test_parser_ranges(self):
+        good = kt.base_config(production=1.0)
+        for override, needle in [
+                ("system.particles=4294967296", "at most 2147483647"),
+                ("system.packing_fraction=1e-300", "at least 1e-9"),
+                ("system.temperature=1e300", "system.temperature: must be in [1e-09, 1e+09]"),
+                ("system.species.0.diameter=1e300", "diameter: must be in [1e-09, 1e+09]"),
+                ("system.species.0.inertia_factor=2", "must be in [1e-9, 1]"),
+                ("system.box_scale=[1, 1, 1e300]", "at most 1e6"),
+                ("run.collisions_per_particle=1e300", "must be in [0, 1e+09]"),
+                ("run.max_wall_seconds=1e300", "run.max_wall_seconds"),
+                ("output.thermo_interval=1e-300", "at least 1e-6 of the production length")]:
+            with self.subTest(override=override):
+                self.refused(good, [override], needle)
 
 class PistonErrors(kt.KairosTestCase):
     def test_nan_wall_velocity(self):

@@ -1,7 +1,9 @@
 """SIGINT / SIGTERM: the run stops after the current event, writes every output and exits with
 128 + signal number; the restart file it leaves continues the run. Also the wall-time limit
 (status 0, stop_reason "wall_time_limit") and a hard kill (SIGKILL) between periodic restart
-files, which must leave the last restart file and the trajectory readable.
+files, which must leave the last restart file and the trajectory readable. During the setup (a
+soft-sphere table build of a minute) a signal ends the process within a second or two with
+128 + signal and one line, and run.max_wall_seconds stops it there too (status 2).
 """
 
 import math
@@ -194,6 +196,73 @@ class Interrupt(kt.KairosTestCase):
         traj = kt.open_trajectory(os.path.join(out, "trajectory.gsd"))
         times = [float(f.log["time"][0]) for f in traj]
         self.assertEqual(times[-1], s["sim_time"])
+
+
+def slow_table_config(cache):
+    """Soft spheres whose map table takes about a minute to build (a tight tolerance, an empty
+    cache directory), so that the setup is still running when the signal comes."""
+    config = kt.base_config(particles=300, packing_fraction=0.05, lattice="random",
+                            production=5.0)
+    config["soft"] = {"model": "hertz", "young": 1e6, "restitution": 0.8,
+                      "table_tolerance": 1e-9, "table_cache": cache}
+    return config
+
+
+class InterruptSetup(kt.KairosTestCase):
+    def start(self, *args):
+        proc = subprocess.Popen([kt.KAIROS] + list(args), cwd=self.tmp, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+        self.addCleanup(Interrupt.reap, proc)
+        return proc
+
+    def stops_within(self, proc, seconds, what):
+        started = time.monotonic()
+        try:
+            stdout, stderr = proc.communicate(timeout=seconds)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate()
+            self.fail("kairos did not stop within %g s of %s" % (seconds, what))
+        return stdout, stderr, time.monotonic() - started
+
+    def interrupt_setup(self, args, sig, status):
+        proc = self.start(*args)
+        time.sleep(1.0)
+        self.assertIsNone(proc.poll(), "the setup ended before the signal")
+        proc.send_signal(sig)
+        # 3 s (6 under the sanitizers, whose exit runs the leak check).
+        _, stderr, _ = self.stops_within(proc, 3.0 * (2.0 if kt.SANITIZED else 1.0), sig.name)
+        self.assertEqual(proc.returncode, status, "%s\n%s" % (kt.signal_name(proc.returncode),
+                                                              stderr))
+        lines = stderr.splitlines()
+        self.assertEqual(len(lines), 1, stderr)
+        self.assertTrue(lines[0].startswith("kairos: interrupted by %s" % sig.name), stderr)
+        self.assertNotIn("Sanitizer", stderr)
+
+    def test_sigint_during_a_table_build(self):
+        cfg = self.write_config(slow_table_config(self.path("tables")))
+        self.interrupt_setup(["run", cfg, "-o", self.path("out")], signal.SIGINT, 130)
+        self.assertFalse(os.path.exists(self.path("out")), "nothing is written before the run")
+
+    def test_sigterm_during_a_table_build(self):
+        cfg = self.write_config(slow_table_config(self.path("tables")))
+        self.interrupt_setup(["run", cfg, "-o", self.path("out")], signal.SIGTERM, 143)
+
+    def test_sigint_stops_kairos_table_build(self):
+        cfg = self.write_config(slow_table_config(self.path("tables")))
+        self.interrupt_setup(["table", "build", "--config", cfg], signal.SIGINT, 130)
+
+    def test_wall_time_limit_during_a_table_build(self):
+        config = slow_table_config(self.path("tables"))
+        config["run"]["max_wall_seconds"] = 1.0
+        cfg = self.write_config(config)
+        proc = self.start("run", cfg, "-o", self.path("out"))
+        _, stderr, elapsed = self.stops_within(proc, 10.0, "the wall-time limit")
+        self.assertEqual(proc.returncode, 2, stderr)
+        self.assertEqual(len(stderr.splitlines()), 1, stderr)
+        self.assertIn("kairos: error: run.max_wall_seconds", stderr)
+        self.assertIn("1 s was reached", stderr)
+        self.assertFalse(os.path.exists(self.path("out", "summary.json")))
 
 
 if __name__ == "__main__":

@@ -1,0 +1,425 @@
+#include "run/config_ranges.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "interactions/soft_contact.hpp"
+
+namespace kairos {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+
+// "KEY = VALUE: out of range, must be in [LO, HI] (WHY)".
+[[noreturn]] void out_of_range(const std::string& key, double value, double lo, double hi,
+                               const std::string& why) {
+  throw InputError(fmt::format("{} = {}: out of range, must be in [{:.6g}, {:.6g}] ({})", key,
+                               value, lo, hi, why));
+}
+
+void within(const std::string& key, double value, double lo, double hi, const std::string& why) {
+  if (!(value >= lo && value <= hi)) out_of_range(key, value, lo, hi, why);
+}
+
+// The same for a magnitude (a signed value, or 0 meaning off).
+void magnitude_within(const std::string& key, double value, double hi, const std::string& why) {
+  if (!(std::abs(value) <= hi)) {
+    throw InputError(fmt::format("{} = {}: out of range, its magnitude must be at most {:.6g} ({})",
+                                 key, value, hi, why));
+  }
+}
+
+// How the scales read in a message.
+std::string energy_unit(const RangeScales& s) {
+  return fmt::format("kT = {:.6g}, system.temperature", s.kT);
+}
+std::string speed_unit(const RangeScales& s) {
+  return fmt::format("v = sqrt(kT/m) = {:.6g}, the thermal speed of the lightest particles",
+                     s.speed());
+}
+std::string time_unit(const RangeScales& s) {
+  return fmt::format(
+      "tau = d_min / v = {:.6g}, d_min = {:.6g} the smallest diameter and v = {:.6g} "
+      "the thermal speed",
+      s.time(), s.d_min, s.speed());
+}
+std::string length_unit(const RangeScales& s) {
+  return fmt::format("d = {:.6g}, the largest diameter", s.d_max);
+}
+
+// ----- contact laws ([contact], [[contact.pair]], walls)
+
+void check_contact(const ContactConfig& c, const std::string& prefix, const RangeScales& s) {
+  const double v = s.speed();
+  if (c.restitution_model == "viscoelastic") {
+    // e(v) falls as (v / restitution_speed)^(1/5): far outside the run's speeds the fixed e says
+    // nothing about the collisions that happen (every one elastic, or all e = 0).
+    within(prefix + ".restitution_speed", c.restitution_speed, 1e-6 * v, 1e6 * v,
+           "1e-6 to 1e6 times " + speed_unit(s));
+  }
+  for (std::size_t i = 0; i < c.restitution_table.size(); ++i) {
+    within(fmt::format("{}.restitution_table[{}][0]", prefix, i), c.restitution_table[i][0], 0.0,
+           1e9 * v, "up to 1e9 times " + speed_unit(s));
+  }
+  within(prefix + ".elastic_below_speed", c.elastic_below_speed, 0.0, 1e9 * v,
+         "up to 1e9 times " + speed_unit(s));
+}
+
+void check_interactions(const InteractionConfig& in, const RangeScales& s) {
+  check_contact(in.contact, "contact", s);
+  for (std::size_t p = 0; p < in.pairs.size(); ++p)
+    check_contact(in.pairs[p].contact, fmt::format("contact.pair[{}]", p), s);
+  within("contact.tc", in.tc, 0.0, 1e9 * s.time(), "up to 1e9 times " + time_unit(s));
+  if (in.sleep_speed != -1.0) {
+    within("contact.sleep_speed", in.sleep_speed, 0.0, 1e9 * s.speed(),
+           "up to 1e9 times " + speed_unit(s) + ", or -1 for automatic");
+  }
+}
+
+// ----- box, walls, shear, gravity
+
+void check_box(const RangeScales& s) {
+  for (std::size_t a = 0; a < s.box.size(); ++a) {
+    // Positions are doubles: at 1e9 diameters a contact is resolved to ~1e-7 of d_min.
+    if (!(s.box[a] <= 1e9 * s.d_min)) {
+      throw InputError(fmt::format(
+          "the box edge along {} is {:.6g}, more than 1e9 times the smallest diameter {:.6g}: "
+          "positions could no longer resolve a contact; raise system.packing_fraction, lower "
+          "system.box_scale, or narrow the spread of the diameters",
+          "xyz"[a], s.box[a], s.d_min));
+    }
+  }
+}
+
+void check_wall(const WallConfig& w, std::size_t index, const RangeScales& s) {
+  const std::string prefix = fmt::format("boundary.wall[{}]", index);
+  check_contact(w.contact, prefix, s);
+  const double v = s.speed();
+  for (std::size_t a = 0; a < w.velocity.size(); ++a) {
+    magnitude_within(fmt::format("{}.velocity[{}]", prefix, a), w.velocity[a], 1e9 * v,
+                     "1e9 times " + speed_unit(s));
+  }
+  const auto face = std::find(std::begin(kFaces), std::end(kFaces), w.face);
+  const auto axis = static_cast<std::size_t>(face - std::begin(kFaces)) / 2;
+  if (axis < s.box.size()) {
+    // Not half the edge: both walls of a shaken container (a damper) vibrate in phase and may
+    // sweep further; walls that meet are an error when it happens. 1e300 broke the positions.
+    within(prefix + ".amplitude", w.amplitude, 0.0, 1e6 * s.box[axis],
+           fmt::format("up to 1e6 box edges along its axis, {:.6g}", s.box[axis]));
+  }
+  within(prefix + ".frequency", w.frequency, 0.0, 1e9 / s.time(),
+         "up to 1e9 / tau, " + time_unit(s));
+  const double peak = 2.0 * kPi * w.frequency * w.amplitude;
+  if (!(peak <= 1e9 * v)) {
+    throw InputError(fmt::format(
+        "{}: the wall's peak speed 2 pi frequency amplitude = {:.6g} exceeds 1e9 times {}; lower "
+        "its amplitude or frequency",
+        prefix, peak, speed_unit(s)));
+  }
+}
+
+void check_gravity(const Config& c, const RangeScales& s) {
+  double g2 = 0.0;
+  for (const double g : c.field.gravity) g2 += g * g;
+  const double g_unit = s.kT / (s.mass * s.d_max);  // the acceleration of kT over a diameter
+  magnitude_within("field.gravity", std::sqrt(g2), 1e9 * g_unit,
+                   fmt::format("1e9 kT / (m d) = {:.6g} with {}, m = {:.6g} the smallest mass, {}",
+                               1e9 * g_unit, energy_unit(s), s.mass, length_unit(s)));
+  // An open face is for particles that gravity brings back: without a pull back (or with a push
+  // out) they fly off for ever, and the clock and the positions grow without bound.
+  for (const std::string& face : c.boundary.open) {
+    const auto f = static_cast<std::size_t>(std::find(std::begin(kFaces), std::end(kFaces), face) -
+                                            std::begin(kFaces));
+    const std::size_t axis = f / 2;
+    const double g = axis < c.field.gravity.size() ? c.field.gravity[axis] : 0.0;
+    const double pull = f % 2 == 1 ? -g : g;  // towards the inside of the box
+    const std::string key = fmt::format("field.gravity[{}]", axis);
+    if (!(pull > 0.0)) {
+      throw InputError(fmt::format(
+          "boundary.open: face {} is open but {} = {} does not pull the particles back from it, "
+          "so they would fly off for ever; give gravity a component towards {} (or put a wall "
+          "there)",
+          face, key, g, kFaces[f ^ 1u]));
+    }
+    if (axis < s.box.size() && !(s.kT / (s.mass * pull) <= 1e6 * s.box[axis])) {
+      throw InputError(fmt::format(
+          "{} = {}: too weak for the open face {}: particles would rise kT / (m g) = {:.6g}, more "
+          "than 1e6 box edges ({:.6g}) above it before falling back; raise it to at least {:.6g} "
+          "(or put a wall there)",
+          key, g, face, s.kT / (s.mass * pull), s.box[axis], s.kT / (s.mass * 1e6 * s.box[axis])));
+    }
+  }
+}
+
+void check_boundary(const Config& c, const RangeScales& s) {
+  check_box(s);
+  for (std::size_t w = 0; w < c.boundary.walls.size(); ++w) check_wall(c.boundary.walls[w], w, s);
+  // The images slide at gamma L_y; faster than 1e6 / tau the image shifts and the flow's heating
+  // swamp every collision (and 1e300 overflows the positions).
+  magnitude_within("boundary.shear_rate", c.boundary.shear_rate, 1e6 / s.time(),
+                   "1e6 / tau, " + time_unit(s));
+  check_gravity(c, s);
+}
+
+// ----- driving
+
+void check_driving(const DrivingConfig& d, const RangeScales& s) {
+  if (d.kind == "none") return;
+  const double omega = s.dilute_collision_rate();
+  if (omega > 0.0) {
+    // Every kick is an event like a collision: more than 1000 per collision and the run is
+    // nothing but kicks (1e300 made them 1e-300 apart, so that time no longer advanced).
+    within("driving.rate", d.rate, 1e-9 * omega, 1e3 * omega,
+           fmt::format("1e-9 to 1e3 times the collision rate per particle of the start state, "
+                       "{:.6g} (a dilute-gas estimate: Enskog with g = 1)",
+                       omega));
+  }
+  if (d.kind == "andersen") {
+    within("driving.temperature", d.temperature, 1e-9 * s.kT, 1e9 * s.kT,
+           "1e-9 to 1e9 times " + energy_unit(s));
+  }
+  if (d.kind == "white_noise") {
+    const double v2 = s.speed() * s.speed();
+    within("driving.strength", d.strength, 1e-9 * v2 / s.time(), 1e9 * v2 / s.time(),
+           "1e-9 to 1e9 times v^2 / tau, " + time_unit(s));
+    // One kick changes a velocity by sqrt(strength / rate): beyond 1000 thermal speeds the
+    // noise is no diffusion any more but a few huge blows.
+    if (!(d.strength / d.rate <= 1e6 * v2)) {
+      throw InputError(fmt::format(
+          "driving.rate = {}: too low for driving.strength = {}: each kick would change a "
+          "velocity by sqrt(strength / rate) = {:.6g}, more than 1e3 times {}; raise the rate to "
+          "at least {:.6g}",
+          d.rate, d.strength, std::sqrt(d.strength / d.rate), speed_unit(s),
+          d.strength / (1e6 * v2)));
+    }
+  }
+}
+
+// ----- run and output
+
+void check_run(const Config& c, const RangeScales& s) {
+  const double tau = s.time();
+  if (c.run.time > 0.0)
+    within("run.time", c.run.time, 0.0, 1e9 * tau, "up to 1e9 times " + time_unit(s));
+  if (c.run.equilibration_time >= 0.0) {
+    within("run.equilibration_time", c.run.equilibration_time, 0.0, 1e9 * tau,
+           "up to 1e9 times " + time_unit(s));
+  }
+  if (c.run.time_step > 0.0) {
+    within("run.time_step", c.run.time_step, 1e-12 * tau, tau,
+           "1e-12 to 1 times " + time_unit(s) + "; longer steps let particles pass each other");
+  }
+}
+
+void check_outputs(const Config& c, const RangeScales& s) {
+  const bool length_in_time = c.run.time > 0.0;
+  const bool in_time = c.output.interval_unit == "time";
+  const double length = length_in_time ? c.run.time : c.run.collisions_per_particle;
+  for (const auto& [key, value] : {std::pair{"thermo_interval", c.output.thermo_interval},
+                                   {"trajectory_interval", c.output.trajectory_interval},
+                                   {"restart_interval", c.output.restart_interval}}) {
+    if (value == 0.0) continue;  // automatic, or none
+    const std::string path = std::string("output.") + key;
+    if (in_time == length_in_time) {
+      // A million outputs per production at most: more is no sampling but a log of every event.
+      within(path, value, 1e-6 * length, 1e9 * (in_time ? s.time() : 1.0),
+             "at least 1e-6 of the production length, at most 1e9 " +
+                 (in_time ? "times " + time_unit(s) : std::string("collisions per particle")));
+    } else if (in_time) {
+      within(path, value, 1e-9 * s.time(), 1e9 * s.time(), "1e-9 to 1e9 times " + time_unit(s));
+    } else {
+      within(path, value, 1e-9, 1e9, "collisions per particle");
+    }
+  }
+}
+
+// ----- soft laws
+
+void check_soft_law(const SoftLawConfig& law, const std::string& prefix, const RangeScales& s) {
+  const double mu = 0.5 * s.mass;  // two of the lightest particles
+  if (law.model == "dashpot") {
+    // Softer and the particles interpenetrate at thermal speeds; stiffer and the overlap
+    // (~ d sqrt(kT / (k d^2))) is below what doubles resolve within the box.
+    const double k_unit = s.kT / (s.d_max * s.d_max);
+    within(prefix + ".stiffness", law.stiffness, 1e-9 * k_unit, 1e15 * k_unit,
+           fmt::format("1e-9 to 1e15 kT / d^2 with {}, {}", energy_unit(s), length_unit(s)));
+    const double c_dis = law.damping / std::sqrt(law.stiffness * mu);
+    if (!(c_dis <= 1e6)) {
+      throw InputError(fmt::format(
+          "{}.damping = {}: out of range, gamma / sqrt(k mu) = {:.6g} must be at most 1e6 (mu = "
+          "{:.6g}, two of the lightest particles): the contact is overdamped far beyond any "
+          "material; at most {:.6g}",
+          prefix, law.damping, c_dis, mu, 1e6 * std::sqrt(law.stiffness * mu)));
+    }
+    return;
+  }
+  const double y_unit = s.kT / (s.d_max * s.d_max * s.d_max);
+  within(prefix + ".young", law.young, 1e-9 * y_unit, 1e15 * y_unit,
+         fmt::format("1e-9 to 1e15 kT / d^3 with {}, {}", energy_unit(s), length_unit(s)));
+  if (law.restitution > 0.0) {
+    // A is solved from e at this speed; A grows as restitution_speed^(-1/5), so a speed far
+    // below the run's makes every contact overdamped (1e-300 made the table build spin).
+    within(prefix + ".restitution_speed", law.restitution_speed, 1e-6 * s.speed(), 1e6 * s.speed(),
+           "1e-6 to 1e6 times " + speed_unit(s));
+  }
+  const double rho = hertz_rho_one_material(law.young, law.poisson, 0.25 * s.d_max);
+  const double t = std::pow(mu * mu / (rho * rho * s.speed()), 0.2);  // Hertz's time at v
+  if (!(law.dissipation <= 1e3 * t)) {
+    throw InputError(fmt::format(
+        "{}.dissipation = {}: out of range, A / T = {:.6g} must be at most 1e3, T = (mu^2 / (rho^2 "
+        "v))^(1/5) = {:.6g} the Hertz time of a thermal collision ({}): the contact is overdamped "
+        "far beyond any material; at most {:.6g}",
+        prefix, law.dissipation, law.dissipation / t, t, speed_unit(s), 1e3 * t));
+  }
+}
+
+void check_soft(const SoftConfig& soft, const RangeScales& s) {
+  if (!soft.enabled()) return;
+  check_soft_law(soft.law, "soft", s);
+  for (std::size_t p = 0; p < soft.pairs.size(); ++p)
+    check_soft_law(soft.pairs[p].law, fmt::format("soft.pair[{}]", p), s);
+}
+
+bool uses_epsilon(const std::string& kind) {
+  return kind == "lennard_jones" || kind == "wca" || kind == "yukawa" || kind == "morse";
+}
+
+}  // namespace
+
+double RangeScales::speed() const {
+  return std::sqrt(kT / mass);
+}
+
+double RangeScales::time() const {
+  return d_min / speed();
+}
+
+double RangeScales::dilute_collision_rate() const {
+  const double mean = std::sqrt(kPi) * speed();  // sqrt(pi kT / m)
+  return dimension == 3 ? 4.0 * number_density * d_max * d_max * mean
+                        : 2.0 * number_density * d_max * mean;
+}
+
+template <int D>
+RangeScales range_scales(const Config& config, const ParticleSystem<D>& state) {
+  RangeScales s = range_scales(config);
+  s.dimension = D;
+  if (state.size() == 0) return s;
+  s.d_min = s.d_max = 2.0 * state.kinematics[0].radius;
+  s.mass = state.mass[0];
+  for (std::size_t i = 0; i < state.size(); ++i) {
+    s.d_min = std::min(s.d_min, 2.0 * state.kinematics[i].radius);
+    s.d_max = std::max(s.d_max, 2.0 * state.kinematics[i].radius);
+    s.mass = std::min(s.mass, state.mass[i]);
+  }
+  double volume = 1.0;
+  s.box.assign(state.box.begin(), state.box.end());
+  for (const double edge : s.box) volume *= edge;
+  s.number_density = static_cast<double>(state.size()) / volume;
+  return s;
+}
+
+template RangeScales range_scales<2>(const Config&, const ParticleSystem<2>&);
+template RangeScales range_scales<3>(const Config&, const ParticleSystem<3>&);
+
+RangeScales range_scales(const Config& config) {
+  RangeScales s;
+  s.dimension = config.system.dimension;
+  s.kT = config.system.temperature;
+  const auto& species = config.system.species;
+  if (!species.empty()) {
+    s.d_min = s.d_max = species[0].diameter;
+    s.mass = species[0].mass;
+  }
+  for (const SpeciesConfig& sp : species) {
+    s.d_min = std::min(s.d_min, sp.diameter);
+    s.d_max = std::max(s.d_max, sp.diameter);
+    s.mass = std::min(s.mass, sp.mass);
+  }
+  return s;
+}
+
+void check_potential_ranges(const PotentialSpec& spec, const std::string& prefix,
+                            const RangeScales& s) {
+  const auto key = [&](std::string_view k) { return fmt::format("{}.{}", prefix, k); };
+  const std::string energies = "1e-9 to 1e9 times " + energy_unit(s);
+  const std::string lengths = "1e-9 to 1e9 times " + length_unit(s);
+  // Zero, negative and non-finite values have their own errors (make_step_table); here the
+  // ranges of valid ones.
+  if (uses_epsilon(spec.kind) && spec.epsilon != 0.0) {
+    // |eps| / kT beyond 1e9: crossing a step gives speeds whose times the clock cannot resolve.
+    within(key("epsilon") + " (magnitude)", std::abs(spec.epsilon), 1e-9 * s.kT, 1e9 * s.kT,
+           energies);
+  }
+  if (uses_epsilon(spec.kind) && (spec.kind != "morse" || spec.r_min == 0.0) && spec.sigma > 0.0)
+    within(key("sigma"), spec.sigma, 1e-9 * s.d_max, 1e9 * s.d_max, lengths);
+  if ((spec.kind == "square_well" || spec.kind == "square_shoulder") && spec.depth > 0.0)
+    within(key("depth"), spec.depth, 1e-9 * s.kT, 1e9 * s.kT, energies);
+  // A well narrower than 1e-9 of the core is below what the positions resolve.
+  if ((spec.kind == "square_well" || spec.kind == "square_shoulder") && spec.lambda > 1.0)
+    within(key("lambda"), spec.lambda, 1.0 + 1e-9, 1e6, "in units of the contact distance");
+  for (std::size_t k = 0; k < spec.energies.size(); ++k)
+    magnitude_within(fmt::format("{}[{}]", key("energies"), k), spec.energies[k], 1e9 * s.kT,
+                     "1e9 times " + energy_unit(s));
+  if (spec.kind == "yukawa" && spec.kappa > 0.0)
+    within(key("kappa"), spec.kappa, 0.0, 1e9 / s.d_max, "up to 1e9 / d, " + length_unit(s));
+  if (spec.kind == "morse" && spec.alpha > 0.0) {
+    within(key("alpha"), spec.alpha, 1e-9 / s.d_max, 1e9 / s.d_max,
+           "1e-9 to 1e9 / d, " + length_unit(s));
+  }
+  if (spec.kind == "morse" && spec.r_min > 0.0)
+    within(key("r_min"), spec.r_min, 1e-9 * s.d_max, 1e9 * s.d_max, lengths);
+  const bool spring = spec.kind == "spring" || spec.kind == "spring_dashpot";
+  if (spring && spec.stiffness > 0.0) {
+    const double k_unit = s.kT / (s.d_max * s.d_max);
+    within(key("stiffness"), spec.stiffness, 1e-9 * k_unit, 1e15 * k_unit,
+           fmt::format("1e-9 to 1e15 kT / d^2 with {}, {}", energy_unit(s), length_unit(s)));
+  }
+  if (spec.kind == "spring_dashpot" && spec.damping > 0.0 && spec.stiffness > 0.0) {
+    const double limit = 1e6 * std::sqrt(spec.stiffness * s.mass);
+    within(key("damping"), spec.damping, 0.0, limit,
+           fmt::format("gamma / sqrt(k m) up to 1e6, m = {:.6g} the smallest mass", s.mass));
+  }
+  if (spec.shell_energy == "virial" && spec.temperature > 0.0)
+    within(key("temperature"), spec.temperature, 1e-9 * s.kT, 1e9 * s.kT, energies);
+  // The table's outermost radius: a pair must meet one periodic image of its partner (and the
+  // quadratures of the shell energies stay finite; a cut-off of 1e300 spun in them).
+  double outer = 0.0;
+  try {
+    outer = table_cutoff(spec, s.d_max);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", prefix, e.what()));
+  }
+  const auto smallest = std::min_element(s.box.begin(), s.box.end());
+  const double limit = smallest != s.box.end() ? 0.5 * *smallest : 1e6 * s.d_max;
+  if (!(outer <= limit)) {
+    throw InputError(fmt::format(
+        "{}: the table reaches out to r = {:.6g} (its cut-off{}), beyond {}: {:.6g}; shorten it",
+        prefix, outer, spec.kind == "tether" || spec.kind == "spring" ? ", max_length" : "",
+        smallest != s.box.end() ? "half the smallest box edge (a pair must meet one periodic "
+                                  "image of its partner)"
+                                : "1e6 times the largest diameter",
+        limit));
+  }
+}
+
+void check_ranges(const Config& config, const RangeScales& scales) {
+  check_interactions(config.interactions, scales);
+  check_boundary(config, scales);
+  check_driving(config.driving, scales);
+  check_run(config, scales);
+  check_outputs(config, scales);
+  check_soft(config.soft, scales);
+  for (std::size_t p = 0; p < config.potentials.size(); ++p)
+    check_potential_ranges(config.potentials[p].potential, fmt::format("potential[{}]", p), scales);
+  for (std::size_t b = 0; b < config.bonds.size(); ++b)
+    check_potential_ranges(config.bonds[b].potential, fmt::format("bond[{}]", b), scales);
+}
+
+}  // namespace kairos
