@@ -327,9 +327,10 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
 
 // Relative margin of find_squeeze_time: a lone particle squeezed between approaching walls
 // bounces ever faster (speed times gap is an adiabatic invariant), so the exact limit would take
-// without end to reach; this one is reached after some 1e5 bounces, while its events are still
-// 1e5 ulps of the clock apart (at a margin of 1e-6 the clock froze first, 1e-5 short of it).
-constexpr double kSqueezeMargin = 1e-4;
+// without end to reach; this one is reached after some 1e4 bounces, while its events are still
+// 1e7 ulps of the clock apart, far from a frozen clock (at a margin of 1e-6 the clock froze
+// first, 1e-5 time units short of it).
+constexpr double kSqueezeMargin = 1e-3;
 
 // The first time at which the walls of an axis, moving towards each other, are no more than the
 // largest diameter (times 1 + kSqueezeMargin) apart, or leave less room between them than the

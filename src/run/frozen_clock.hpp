@@ -40,12 +40,13 @@ class FrozenClockWatch {
 
   // After an event: true when the window that ends now advanced the clock by no more than
   // round-off (1e-13 of the time: some 500 ulps, where a valid window moves it by ~20 mean
-  // free times), or, a collapse in progress, when its events came less than 1000 ulps of the
-  // clock apart on average and the window moved the clock by less than 1e-6 of the most a
-  // window of this run did (a 2D gas of 5000 disks at e = 0.1 crawled 6e-8 in 10^5 events at
-  // t = 10.9, 10 ulps per event, after windows of up to 2.3 time units). Valid runs change their
-  // time per event by a few orders of magnitude at most (a gas compressed or cooling), and even
-  // 10^8 particles keep their events 10^4 ulps apart. One compare per event.
+  // free times), or, a collapse in progress, when the window moved the clock by less than 1e-6
+  // of the most a window of this run did and its events came less than 10^5 ulps of the clock
+  // apart on average (a 2D gas of 5000 disks at e = 0.1 crawled 6e-8 in 10^5 events at
+  // t = 10.9, 10 ulps per event, after windows of up to 2.3 time units; 100 spheres jammed by a
+  // piston, 1800 ulps per event). Valid runs change their time per event by a few orders of
+  // magnitude at most (a gas compressed or cooling); the ulps guard the rest. One compare per
+  // event.
   template <class Engine>
   bool frozen(const Engine& engine) {
     if (engine.counters().events < next_) return false;
@@ -53,7 +54,7 @@ class FrozenClockWatch {
     const double advance = time - start_time_;
     const double ulps_per_event =
         advance / (static_cast<double>(window_) * std::abs(time) * 0x1p-52);
-    if (!(advance > 1e-13 * std::abs(time)) || (ulps_per_event < 1000.0 && advance < 1e-6 * most_))
+    if (!(advance > 1e-13 * std::abs(time)) || (ulps_per_event < 1e5 && advance < 1e-6 * most_))
       return true;
     most_ = std::max(most_, advance);
     start(engine);
@@ -141,12 +142,13 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
   bool vibrating = false;
   for (const int f : walls) vibrating = vibrating || env.faces[f].wall.vibrates();
   // A wall moving inwards (a piston) squeezes the particles whether it touches the busiest.
-  bool piston = false;
+  std::string pistons;
   for (int f = 0; f < 2 * D; ++f) {
     if (env.faces[f].kind != FaceKind::kWall) continue;
     const double inward = (f % 2 == 0 ? 1.0 : -1.0) * env.faces[f].wall.velocity[f / 2];
-    piston = piston || inward > 0.0;
+    if (inward > 0.0) pistons += (pistons.empty() ? "" : ", ") + face_name(f);
   }
+  const bool piston = !pistons.empty();
   const std::uint64_t events = engine.counters().events - (next_ - window_);
   std::string message = fmt::format(
       "the simulated clock is frozen at t = {:.17g}: the last {} events ({:.3g} per particle) "
@@ -163,9 +165,10 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
       walls.empty() ? ""
                     : fmt::format(", against the wall{} {}", walls.size() == 1 ? "" : "s", where));
   if (piston)
-    return message +
-           ". A wall moving into the particles leaves them no room (they jam): end the run "
-           "earlier or move the wall more slowly";
+    return message + fmt::format(
+                         ". The wall {} moving into the particles leaves them no room (they "
+                         "jam): end the run earlier or move the wall more slowly",
+                         pistons);
   message +=
       ". Remedies: contact.tc (the TC model: a collision soon after a particle's previous one "
       "is elastic), contact.elastic_below_speed (slow impacts are elastic)";

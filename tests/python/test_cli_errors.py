@@ -369,7 +369,7 @@ class PistonErrors(kt.KairosTestCase):
 
     def test_walls_that_leave_no_room_stop_the_run(self):
         # Two spheres (d = 1, 0.4) between a floor and a lid 3 apart that comes down at 5: at
-        # t = (3 - 1.0001) / 5 the large one has no room. The run stops there with an error
+        # t = (3 - 1.001) / 5 the large one has no room. The run stops there with an error
         # naming the walls and the time, not with an overlap or a hang, and writes its outputs.
         p = kt.write_hoomd_file(self.path("slab.gsd"), [[-2, -2, 0], [2, 2, -0.5]],
                                 [10, 10, 3], diameter=[1, 0.4],
@@ -379,10 +379,10 @@ class PistonErrors(kt.KairosTestCase):
         config["boundary"] = {"wall": [{"face": "z-"},
                                        {"face": "z+", "velocity": [0.0, 0.0, -5.0]}]}
         result = self.kairos("run", self.write_config(config), "-o", self.path("out"))
-        line = self.assert_user_error(result, "boundary: at t = 0.3999", "the walls z- and z+",
+        line = self.assert_user_error(result, "boundary: at t = 0.3998", "the walls z- and z+",
                                       "largest particle diameter 1", "no room left",
                                       "the wall z+ moves towards z- at 5",
-                                      "end the run before t = 0.39998")
+                                      "end the run before t = 0.3998")
         self.assertNotIn("internal", line)
         self.assertEqual(self.summary(self.path("out"))["stop_reason"], "error")
 

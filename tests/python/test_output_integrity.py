@@ -23,8 +23,8 @@ import kairos_testlib as kt
 
 def timed_config():
     # Outputs at multiples of their intervals in time; the restart file every 1.0.
-    config = kt.base_config(particles=2000, packing_fraction=0.3, seed=11)
-    config["run"] = {"equilibration_time": 0.0, "time": 40.0}
+    config = kt.base_config(particles=1000, packing_fraction=0.3, seed=11)
+    config["run"] = {"equilibration_time": 0.0, "time": 20.0}
     config["output"].update({"thermo_interval": 0.05, "trajectory_interval": 0.5,
                              "restart_interval": 1.0})
     return config
@@ -33,8 +33,8 @@ def timed_config():
 def collision_config():
     # Intervals in collisions per particle that do not divide each other: the continued run
     # must keep the stored schedule to write the rows an uninterrupted run writes.
-    config = kt.base_config(particles=2000, packing_fraction=0.3, seed=12, equilibration=0.5,
-                            production=2000.0)
+    config = kt.base_config(particles=1000, packing_fraction=0.3, seed=12, equilibration=0.5,
+                            production=1000.0)
     config["output"].update({"thermo_interval": 0.3, "trajectory_interval": 70.0,
                              "restart_interval": 1.1})
     return config
