@@ -238,10 +238,10 @@ class DemRunDriver {
     p.mark_virial = kept_mark_.virial;
     p.mark_events = kept_mark_.events;
     p.mark_collisions = kept_mark_.collisions;
-    if (schedule_ != nullptr) {
-      p.schedule_phase = phase_ == "production" ? 1 : 0;
-      const OutputSchedule::Every* e[3] = {&schedule_->thermo, &schedule_->trajectory,
-                                           &schedule_->restart};
+    if (schedule_phase_ >= 0) {
+      p.schedule_phase = schedule_phase_;
+      const OutputSchedule::Every* e[3] = {&schedule_.thermo, &schedule_.trajectory,
+                                           &schedule_.restart};
       for (int k = 0; k < 3; ++k) {
         p.schedule_step[k] = e[k]->step;
         p.schedule_next[k] = e[k]->next;
@@ -314,8 +314,11 @@ class DemRunDriver {
     phase_target_ = target;
     phase_end_time_ = end_time;
     const bool time_outputs = intervals_in_time(config_);
-    auto [schedule, timed] =
+    auto [fresh, timed] =
         phase_schedules(config_, begin, begin_time, [&](double c) { return collisions_for(c); });
+    schedule_ = fresh;
+    schedule_phase_ = phase == "production" ? 1 : 0;
+    OutputSchedule& schedule = schedule_;
     if (restart_ && first && resumed_.schedule_phase == (phase == "production" ? 1 : 0)) {
       OutputSchedule::Every* e[3] = {&schedule.thermo, &schedule.trajectory, &schedule.restart};
       for (int k = 0; k < 3; ++k)
@@ -323,11 +326,6 @@ class DemRunDriver {
             resumed_.schedule_next[k] > begin)
           e[k]->next = resumed_.schedule_next[k];
     }
-    schedule_ = &schedule;
-    struct Forget {  // the schedule lives in this phase only
-      const OutputSchedule*& s;
-      ~Forget() { s = nullptr; }
-    } forget{schedule_};
     // About 2^20 particle-steps between checks of the clock and the stop flag.
     const long chunk =
         std::max<long>(1, (1l << 20) / static_cast<long>(std::max<std::size_t>(1, n_)));
@@ -564,7 +562,8 @@ class DemRunDriver {
   // As the event driver's (run/run.cpp).
   std::uint64_t rows_kept_ = 0, frames_kept_ = 0;
   ThermoPoint kept_mark_;
-  const OutputSchedule* schedule_ = nullptr;
+  OutputSchedule schedule_;  // as the event driver's (run/run.cpp)
+  int schedule_phase_ = -1;
   bool production_done_ = false;
   std::optional<DemIntegrator<D>> dem_;
   std::size_t n_ = 0;

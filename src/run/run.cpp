@@ -397,10 +397,10 @@ class RunDriver {
     p.mark_virial = kept_mark_.virial;
     p.mark_events = kept_mark_.events;
     p.mark_collisions = kept_mark_.collisions;
-    if (schedule_ != nullptr) {
-      p.schedule_phase = phase_ == "production" ? 1 : 0;
-      const OutputSchedule::Every* e[3] = {&schedule_->thermo, &schedule_->trajectory,
-                                           &schedule_->restart};
+    if (schedule_phase_ >= 0) {
+      p.schedule_phase = schedule_phase_;
+      const OutputSchedule::Every* e[3] = {&schedule_.thermo, &schedule_.trajectory,
+                                           &schedule_.restart};
       for (int k = 0; k < 3; ++k) {
         p.schedule_step[k] = e[k]->step;
         p.schedule_next[k] = e[k]->next;
@@ -555,8 +555,11 @@ class RunDriver {
       production_end_time_ = length.in_time ? end_time : kNever;
     }
     const bool time_outputs = run_detail::intervals_in_time(config_);
-    auto [schedule, timed] = run_detail::phase_schedules(
-        config_, begin, begin_time, [&](double c) { return collisions_for(c); });
+    auto [fresh, timed] = run_detail::phase_schedules(config_, begin, begin_time,
+                                                      [&](double c) { return collisions_for(c); });
+    schedule_ = fresh;
+    schedule_phase_ = phase == "production" ? 1 : 0;
+    OutputSchedule& schedule = schedule_;
     // The first phase of a continued run keeps the stored schedule of the same phase (the rows
     // an uninterrupted run would write), if its steps are unchanged.
     if (restart_ && first_phase_ && resumed_.schedule_phase == (phase == "production" ? 1 : 0)) {
@@ -567,11 +570,6 @@ class RunDriver {
           e[k]->next = resumed_.schedule_next[k];
     }
     first_phase_ = false;
-    schedule_ = &schedule;
-    struct Forget {  // the schedule lives in this phase only
-      const OutputSchedule*& s;
-      ~Forget() { s = nullptr; }
-    } forget{schedule_};
     const auto done = [&] {
       return length.in_time ? engine_->time() - begin_time
                             : per_particle(engine_->counters().collisions - begin);
@@ -1060,7 +1058,10 @@ class RunDriver {
   // point the last kept row ended at (what a restart file records for a continued run).
   std::uint64_t rows_kept_ = 0, frames_kept_ = 0;
   ThermoPoint kept_mark_;
-  const OutputSchedule* schedule_ = nullptr;  // the running phase's schedule in collisions
+  // The output schedule in collisions of the phase running (or last run: a restart file written
+  // when it stopped records it), and that phase (0 equilibration, 1 production; -1: none yet).
+  OutputSchedule schedule_;
+  int schedule_phase_ = -1;
   bool first_phase_ = true;
   bool production_done_ = false;
   std::uint64_t production_target_ = 0;

@@ -40,6 +40,18 @@ def collision_config():
     return config
 
 
+def dem_config():
+    # The DEM: several pairs may enter contact in one step, so a schedule in collisions is met
+    # past its thresholds; a continued run must keep the stored thresholds all the same.
+    config = kt.base_config(particles=1000, packing_fraction=0.2, lattice="random", seed=4,
+                            equilibration=0.5, production=40.0)
+    config["soft"] = {"model": "dashpot", "stiffness": 1e4, "restitution": 0.9}
+    config["run"]["integrator"] = "dem"
+    config["output"].update({"thermo_interval": 0.3, "trajectory_interval": 7.0,
+                             "restart_interval": 1.1})
+    return config
+
+
 def frames(path):
     traj = kt.open_trajectory(path)
     return [np.asarray(f.particles.position) for f in traj], [float(f.log["time"][0]) for f in traj]
@@ -53,10 +65,11 @@ class ContinuedRunsLeaveOneRunsOutputs(kt.KairosTestCase):
         self.addCleanup(lambda: proc.poll() is None and proc.kill())
         return cfg, proc
 
-    def interrupt_and_continue(self, config, sig):
-        whole = self.path("whole")
-        self.run_ok("run", self.write_config(config, "whole.toml"), "-o", whole, timeout=600)
-        out = self.path("out")
+    def interrupt_and_continue(self, config, sig, name="run"):
+        whole = self.path(name + "-whole")
+        if not os.path.exists(whole):
+            self.run_ok("run", self.write_config(config, "whole.toml"), "-o", whole, timeout=600)
+        out = self.path(name)
         cfg, proc = self.start(config, out)
         restart = os.path.join(out, "restart.gsd")
         deadline = time.monotonic() + 120
@@ -91,6 +104,15 @@ class ContinuedRunsLeaveOneRunsOutputs(kt.KairosTestCase):
     def test_sigint_then_restart(self):
         # The rows and frame written at the stop are the interrupted run's, not the whole's.
         self.interrupt_and_continue(timed_config(), signal.SIGINT)
+
+    def test_sigint_then_restart_in_collisions(self):
+        # The restart file written at the stop records the schedule too.
+        self.interrupt_and_continue(collision_config(), signal.SIGINT)
+
+    def test_dem_kill_9_and_sigint_then_restart(self):
+        for sig in (signal.SIGKILL, signal.SIGINT):
+            with self.subTest(sig.name):
+                self.interrupt_and_continue(dem_config(), sig, "dem-%s" % sig.name)
 
 
 class FailedWrites(kt.KairosTestCase):
