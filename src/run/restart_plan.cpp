@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -87,13 +88,71 @@ Effect effect_of(const std::string& key) {
   return Effect::kRepredict;  // field, boundary, potential, bond, soft laws; anything new
 }
 
+// The shortest part of `key` (a table, or an element of an array of tables) that `other` does
+// not hold at all: what was added or removed as a whole ("soft", "boundary.wall[2]").
+std::string whole_part(const std::string& key, const Flat& other) {
+  const auto held = [&](const std::string& part) {
+    return std::any_of(other.begin(), other.end(), [&](const auto& kv) {
+      return kv.first == part || kv.first.starts_with(part + ".") ||
+             kv.first.starts_with(part + "[");
+    });
+  };
+  for (std::size_t k = 0; k < key.size(); ++k) {
+    if (key[k] != '.' && key[k] != ']') continue;
+    const std::string part = key.substr(0, key[k] == ']' ? k + 1 : k);
+    if (!held(part)) return part;
+  }
+  return key;
+}
+
+// The plane of a wall along its axis at time t, less its face's rest position (0 or L): the
+// normal velocity's drift and the vibration (core/environment.hpp).
+double plane_offset(const WallConfig& w, int dimension, double t) {
+  const int axis = w.face[0] - 'x';
+  const double u =
+      axis < static_cast<int>(w.velocity.size()) && axis < dimension ? w.velocity[axis] : 0.0;
+  const double vibration = w.amplitude > 0.0 && w.frequency > 0.0
+                               ? w.amplitude * std::sin(2.0 * M_PI * w.frequency * t + w.phase)
+                               : 0.0;
+  return u * t + vibration;
+}
+
+// A wall whose plane the new configuration puts elsewhere at the state's time (another normal
+// velocity, amplitude, frequency or phase, or a new moving wall: the plane is a function of
+// the absolute time) would jump through the particles: refused, as a new shear rate is.
+void check_walls_stay(const Config& before, const Config& now, double t,
+                      const std::string& restart_file) {
+  if (!(t > 0.0)) return;
+  for (const WallConfig& w : now.boundary.walls) {
+    double was = 0.0;  // a new wall starts from its face
+    for (const WallConfig& old : before.boundary.walls)
+      if (old.face == w.face) was = plane_offset(old, before.system.dimension, t);
+    const double is = plane_offset(w, now.system.dimension, t);
+    if (std::abs(is - was) <= 1e-12 * (1.0 + std::abs(was))) continue;
+    throw InputError(fmt::format(
+        "restart file '{}': boundary.wall (face {}) would jump at once from {:.6g} to {:.6g} "
+        "(relative to its face) at t = {:.6g}: a wall's normal motion and vibration are functions "
+        "of the "
+        "time since t = 0, so its velocity, amplitude, frequency or phase cannot change during "
+        "a run; start a new run from the state with system.initial_state = \"{}\" (its clock "
+        "starts at 0)",
+        restart_file, w.face, was, is, t, restart_file));
+  }
+}
+
 }  // namespace
 
 RestartPlan plan_restart(const Config& now, const std::string& stored, bool contacts_in_progress,
                          double before_time, const std::string& restart_file) {
   RestartPlan plan;
   plan.used = now;
-  if (stored.empty()) return plan;  // an older file: what it was run with is unknown
+  if (stored.empty()) {
+    // An older file: what it was run with is unknown, so every event is predicted afresh
+    // (plan_continuation infers the field its trajectories followed). Contacts in progress
+    // cannot be predicted afresh: those states resume as they are.
+    plan.repredict = !contacts_in_progress;
+    return plan;
+  }
   Config before;
   try {
     before = parse_config(stored, restart_file + " (its kairos/run/config)");
@@ -111,6 +170,7 @@ RestartPlan plan_restart(const Config& now, const std::string& stored, bool cont
   for (const auto& [key, value] : b)
     if (!a.contains(key)) keys.push_back(key);
   std::sort(keys.begin(), keys.end());
+  check_walls_stay(before, now, before_time, restart_file);
   for (const std::string& key : keys) {
     const auto was = a.find(key), is = b.find(key);
     const std::string from = was == a.end() ? "absent" : was->second;
@@ -146,17 +206,15 @@ RestartPlan plan_restart(const Config& now, const std::string& stored, bool cont
               "unchanged, or start a new run from its state with system.initial_state",
               restart_file, key, from, to));
         }
-        // A table added or removed (a wall, a potential) is named once, not key by key.
-        if (was == a.end() || is == b.end()) {
-          const std::string element = key.substr(0, key.rfind(']') + 1);
-          if (!element.empty() && element.back() == ']') {
-            if (std::find(plan.changed.begin(), plan.changed.end(), element) == plan.changed.end())
-              plan.changed.push_back(element);
-            plan.repredict = true;
-            break;
-          }
+        // A table added or removed (a wall, a potential, [soft]) is named once, not key by
+        // key.
+        {
+          const std::string part = was == a.end()  ? whole_part(key, a)
+                                   : is == b.end() ? whole_part(key, b)
+                                                   : key;
+          if (std::find(plan.changed.begin(), plan.changed.end(), part) == plan.changed.end())
+            plan.changed.push_back(part);
         }
-        plan.changed.push_back(key);
         plan.repredict = true;
         break;
     }
@@ -173,11 +231,17 @@ std::string describe_restart(const RestartPlan& plan, const std::string& restart
   };
   std::string text;
   if (!plan.stored_config) {
+    if (plan.repredict) {
+      return fmt::format(
+          "'{}' was written by an older Kairos and does not record its configuration: every "
+          "event is predicted afresh from the restored state under this configuration (not "
+          "bit-identical to the run that wrote it)",
+          restart_file);
+    }
     return fmt::format(
-        "'{}' was written by an older Kairos and does not record its configuration: its "
-        "predictions are resumed as they are, which is right only if gravity, shear, walls, "
-        "potentials, bonds and soft laws are unchanged (to change them, start a new run from "
-        "its state with system.initial_state)",
+        "'{}' was written by an older Kairos, does not record its configuration and holds soft "
+        "contacts in progress: its predictions are resumed as they are, which is right only if "
+        "the physics keys are unchanged",
         restart_file);
   }
   if (plan.repredict) {

@@ -107,11 +107,42 @@ void check_no_overlap_after_new_physics(const Engine& engine) {
 // they rest (their rest was decided under the old physics), the stepped potentials' zones
 // recomputed from the distances if a potential or bond changed, the DEM's own state dropped.
 // InputError for a refused change.
+// The field an older restart file's trajectories followed (it does not record its
+// configuration): from the particle that flew longest since its last event, comparing its
+// stored position now (kairos/position) with its parabola from the local time. Empty: none.
+template <int D>
+std::vector<double> inferred_field(const ParticleSystem<D>& s, const std::string& path) {
+  const gsd::Reader r(path);
+  const std::uint64_t f = r.frame_count() - 1;
+  if (!r.find(f, "kairos/position")) return {};
+  const std::vector<double> now = r.read<double>(f, "kairos/position");
+  std::size_t best = s.size();
+  double longest = 0.0;
+  for (std::size_t i = 0; i < s.size() && now.size() == s.size() * D; ++i) {
+    const double dt = s.time - s.kinematics[i].time;
+    if (!s.is_asleep(i) && dt > longest) {
+      longest = dt;
+      best = i;
+    }
+  }
+  if (best == s.size()) return {};
+  std::vector<double> g(D);
+  const Kinematics<D>& k = s.kinematics[best];
+  for (int a = 0; a < D; ++a) {
+    const double drift =
+        minimum_image(now[best * D + a] - (k.pos[a] + longest * k.vel[a]), s.box[a]);
+    g[a] = 2.0 * drift / (longest * longest);
+  }
+  return g;
+}
+
 template <int D>
 RestartPlan plan_continuation(const Config& config, ParticleSystem<D>& state,
                               const RunProgress& resumed, const std::string& restart_file) {
   RestartPlan plan =
       plan_restart(config, resumed.config, !state.frozen.empty(), state.time, restart_file);
+  if (plan.repredict && !plan.stored_config)
+    plan.stored_gravity = inferred_field(state, restart_file);
   if (plan.repredict) {
     // Every particle brought to the present on its old trajectory (the old field's parabola),
     // so that the new physics starts from where the particles are now.

@@ -57,7 +57,7 @@ class Continuations(kt.KairosTestCase):
         if not soft:  # soft spheres overlap in their contacts
             self.assertLess(s["max_overlap"], 1e-12)
         if mode == "new_physics":
-            self.assertIn("continued with new physics", result.stderr)
+            self.assertIn("predicted afresh", result.stderr)
         else:
             self.assertNotIn("new physics", result.stderr)
         return s
@@ -160,6 +160,54 @@ class RestartMatrix(Continuations):
         self.assert_user_error(result, "soft.young", "soft contacts in progress")
 
 
+def as_older_format(path, out):
+    """The restart file `path` rewritten as an older Kairos wrote it (format 6): without its
+    configuration, its continuation bookkeeping and its checksum."""
+    import gsd.fl
+    left_out = ("kairos/run/config", "kairos/checksum", "kairos/run/outputs",
+                "kairos/run/thermo_mark", "kairos/run/thermo_mark_counts", "kairos/run/schedule",
+                "kairos/run/production_target", "kairos/run/production_end_time")
+    with gsd.fl.open(name=path, mode="rb") as f, \
+            gsd.fl.open(name=out, mode="wb", application="kairos", schema="hoomd",
+                        schema_version=[1, 4]) as g:
+        for name in f.find_matching_chunk_names(""):
+            if name in left_out:
+                continue
+            data = f.read_chunk(frame=0, name=name)
+            if name == "kairos/format":
+                data = np.array([6], dtype=np.uint32)
+            g.write_chunk(name, data)
+        g.end_frame()
+    return out
+
+
+class OlderRestartFiles(Continuations):
+    # A file without its configuration cannot say which keys changed: every event is predicted
+    # afresh (the field its trajectories followed inferred from the file), never resumed stale.
+    def test_gravity_changed_on_an_older_pile_file(self):
+        restart = as_older_format(self.base(pile()), self.path("old.gsd"))
+        result = self.continue_with(pile(), restart, "strong", "field.gravity=[0,0,-20]")
+        s = self.assert_mode(result, "strong", "new_physics")
+        self.assertFalse(s["restart"]["stored_config"])
+        self.assertIn("older Kairos", result.stderr)
+        self.assertLess(s["granular"]["energy_balance_relative"], 1e-9)
+
+    def test_unchanged_older_file_continues_the_same_physics(self):
+        # Predicted afresh, the same trajectory up to the order of events: the energy and the
+        # collision count of a continued hard-sphere fluid.
+        restart = as_older_format(self.base(hard_spheres()), self.path("old.gsd"))
+        result = self.continue_with(hard_spheres(), restart, "same")
+        s = self.assert_mode(result, "same", "new_physics")
+        self.assertLess(s["energy_drift_relative"], 1e-12)
+
+    def test_walls_added_to_an_older_file_are_refused(self):
+        restart = as_older_format(self.base(hard_spheres()), self.path("old.gsd"))
+        result = self.continue_with(hard_spheres(), restart, "walls",
+                                    'boundary.wall=[{face="z-"}, {face="z+"}]')
+        line = self.assert_user_error(result, "overlaps the wall")
+        self.assertNotIn("stored cell", line)
+
+
 # The restart matrix (docs/guarantees.md, "Restarts"): key changed at the restart -> expected
 # class. Each continued run is validated against brute force after every event.
 HARD_SPHERE_MATRIX = [
@@ -187,6 +235,8 @@ PILE_MATRIX = [
     ("boundary.wall[4].amplitude=0.05", "new_physics"),
     ("boundary.wall[4].frequency=2.0", "new_physics"),
     ("boundary.wall[4].restitution=0.5", "resumed"),
+    ("boundary.wall[4].velocity=[0.1,0,0]", "new_physics"),  # sliding: the plane stays
+    ("boundary.wall[4].velocity=[0,0,0.1]", "refused"),  # the floor would jump by 0.1 t
     ("boundary.wall[0].friction=0.5", "resumed"),
     ("field.gravity=[0,0,-2]", "new_physics"),
 ]
