@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <new>
 #include <optional>
 #include <string>
 
@@ -353,6 +354,15 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const kairos::Interrupted& e) {
     return report_interrupted_setup(e);
+  } catch (const std::bad_alloc&) {
+    // The up-front estimate (core/memory_budget) did not foresee it: a limit it cannot see
+    // (ulimit -v), or a structure that grows during the run (the capture map of long-ranged
+    // stepped potentials). Not a bug: the user can give the run more memory or make it smaller.
+    std::fprintf(stderr,
+                 "kairos: error: out of memory: the run needs more memory than this process may "
+                 "use (check `ulimit -v` and the machine's free memory); run fewer particles, a "
+                 "shorter potential cut-off, or on a larger machine\n");
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "kairos: internal error: %s\n", e.what());
     return 3;

@@ -658,10 +658,26 @@ class Reader {
            "system.chain_length: chains need a bond potential ([[bond]] with kind = \"tether\" "
            "or \"spring\")");
     }
+    resolve_chain_spacing(config);
     return config;
   }
 
  private:
+  // system.chain_spacing = 0: halfway between the contact distance and the backbone bond's
+  // range, so that bonded beads start apart (at a spacing of one diameter they start exactly in
+  // contact, and a short run makes all its collisions at t = 0: its clock never moves).
+  static void resolve_chain_spacing(Config& config) {
+    SystemConfig& s = config.system;
+    if (s.chain_length == 0 || s.chain_spacing != 0.0) return;
+    double dmax = 0.0;
+    for (const SpeciesConfig& sp : s.species) dmax = std::max(dmax, sp.diameter);
+    for (const BondConfig& b : config.bonds) {
+      if (b.type != "backbone") continue;
+      const double range = table_cutoff(b.potential, dmax);
+      if (std::isfinite(range) && range > dmax) s.chain_spacing = 0.5 * (dmax + range);
+    }
+  }
+
   // ----- error reporting
 
   // "file:line:col" for nodes from the file, the override's label for nodes an override made.

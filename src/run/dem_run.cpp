@@ -91,6 +91,11 @@ class DemRunDriver {
       dem_.emplace(start, env, options);
     } catch (const InputError& e) {
       if (!restart_file) throw;
+      if (plan_->repredict && plan_->stored_config) {
+        throw InputError(fmt::format("restart file '{}' continued with new physics ({}): {}",
+                                     restart_file->string(), fmt::join(plan_->changed, ", "),
+                                     e.what()));
+      }
       throw InputError("restart file '" + restart_file->string() + "': " + e.what());
     }
     if (!config_.output.profile_axis.empty()) {
