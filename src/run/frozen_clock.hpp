@@ -72,13 +72,14 @@ class FrozenClockWatch {
     next_ = engine.counters().events + window_;
     start_time_ = engine.time();
     start_wall_collisions_ = engine.counters().wall_collisions;
+    start_collisions_ = engine.counters().collisions;
     counts_ = engine.collision_counts();
   }
 
   std::uint64_t window_, next_ = 0;
   double start_time_ = 0.0;
   double most_ = 0.0;  // the largest advance of a window so far
-  std::uint64_t start_wall_collisions_ = 0;
+  std::uint64_t start_wall_collisions_ = 0, start_collisions_ = 0;
   std::vector<std::uint32_t> counts_;  // per particle (caller's numbering), at the window start
 };
 
@@ -99,6 +100,59 @@ std::vector<int> touched_walls(const Environment<D>& env, const Vec<D>& box, con
 
 inline std::string face_name(int f) {
   return fmt::format("{}{}", "xyz"[f / 2], f % 2 == 0 ? '-' : '+');
+}
+
+// Why the clock froze and what changes it, from what collided in the window: the particles
+// against walls (a wall of restitution 0 keeps every grain it meets; grains resting on a fixed
+// floor need to sleep), among themselves (an inelastic collapse, or elastic particles jammed
+// with no room to move), or squeezed by a wall moving inwards.
+template <int D>
+std::string cause(const Environment<D>& env, const std::vector<int>& walls, std::uint64_t pair_hits,
+                  std::uint64_t wall_hits, const std::string& pistons) {
+  if (!pistons.empty()) {
+    return fmt::format(
+        "squeezed by the wall {} moving into them, which leaves them no room (they jam); end "
+        "the run earlier or move the wall more slowly",
+        pistons);
+  }
+  if (wall_hits > pair_hits && !walls.empty()) {
+    std::string sticky, resting;
+    for (const int f : walls) {
+      const Wall<D>& w = env.faces[f].wall;
+      if (w.contact.normal(0.0) == 0.0)
+        sticky += (sticky.empty() ? "" : ", ") + face_name(f);
+      else if (!w.vibrates())
+        resting += (resting.empty() ? "" : ", ") + face_name(f);
+    }
+    if (!sticky.empty()) {
+      return fmt::format(
+          "the wall {} has restitution 0 at slow impacts, so a grain it meets stays on it and "
+          "is met again at once (no contact law, TC model or sleeping undoes that); give it a "
+          "restitution above 0 (boundary.wall restitution)",
+          sticky);
+    }
+    if (!resting.empty() && env.has_gravity()) {
+      return env.sleep_speed == 0.0
+                 ? "grains coming to rest on a fixed wall under gravity bounce ever lower; let "
+                   "them sleep (contact.sleep_speed > 0, or -1 for the automatic speed)"
+                 : "grains coming to rest on a fixed wall under gravity bounce ever lower; "
+                   "raise contact.sleep_speed, or make their slow impacts elastic "
+                   "(boundary.wall elastic_below_speed)";
+    }
+    return "grains pressed against the wall; give the wall a higher restitution or make slow "
+           "impacts elastic (boundary.wall restitution, elastic_below_speed)";
+  }
+  bool inelastic = env.tc > 0.0 || env.dissipative_steps() || env.soft_spheres();
+  for (const ContactModel& c : env.contact)
+    inelastic = inelastic || c.normal(0.0) < 1.0 || c.normal(1.0) < 1.0;
+  if (!inelastic) {
+    return "elastic particles jammed, touching with no room to move (a packing too dense to "
+           "move, or a start in contact); start from a lower packing fraction or with the "
+           "particles apart";
+  }
+  return "an inelastic collapse; the TC model (contact.tc: a collision soon after a "
+         "particle's previous one is elastic) or elastic slow impacts "
+         "(contact.elastic_below_speed) prevent it";
 }
 
 }  // namespace frozen_clock_detail
@@ -139,8 +193,6 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
     where += fmt::format("{}{}", k == 0 ? "" : ", ", face_name(walls[k]));
 
   const auto& env = engine.environment();
-  bool vibrating = false;
-  for (const int f : walls) vibrating = vibrating || env.faces[f].wall.vibrates();
   // A wall moving inwards (a piston) squeezes the particles whether it touches the busiest.
   std::string pistons;
   for (int f = 0; f < 2 * D; ++f) {
@@ -148,36 +200,22 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
     const double inward = (f % 2 == 0 ? 1.0 : -1.0) * env.faces[f].wall.velocity[f / 2];
     if (inward > 0.0) pistons += (pistons.empty() ? "" : ", ") + face_name(f);
   }
-  const bool piston = !pistons.empty();
   const std::uint64_t events = engine.counters().events - (next_ - window_);
+  const double advance = engine.time() - start_time_;
   std::string message = fmt::format(
       "the simulated clock is frozen at t = {:.17g}: the last {} events ({:.3g} per particle) "
       "moved it by {:.3g}",
-      engine.time(), events, static_cast<double>(events) / static_cast<double>(n),
-      engine.time() - start_time_);
+      engine.time(), events, static_cast<double>(events) / static_cast<double>(n), advance);
   if (most_ > 0.0) message += fmt::format(" (earlier windows as long: up to {:.3g})", most_);
   if (busy.empty()) return message + "; no particle collided";
+  const std::uint64_t pair_hits = engine.counters().collisions - start_collisions_;
+  const std::string cause = frozen_clock_detail::cause(env, walls, pair_hits, wall_hits, pistons);
   message += fmt::format(
-      "; particle{} {} collide{} again and again, ever faster ({}){}", busy.size() == 1 ? "" : "s",
-      who, busy.size() == 1 ? "s" : "",
-      piston ? "squeezed by a wall moving inwards, or an inelastic collapse"
-             : "an inelastic collapse",
+      "; particle{} {} collide{} again and again{}{}: {}", busy.size() == 1 ? "" : "s", who,
+      busy.size() == 1 ? "s" : "", advance > 0.0 ? ", ever faster" : " at one instant",
       walls.empty() ? ""
-                    : fmt::format(", against the wall{} {}", walls.size() == 1 ? "" : "s", where));
-  if (piston)
-    return message + fmt::format(
-                         ". The wall {} moving into the particles leaves them no room (they "
-                         "jam): end the run earlier or move the wall more slowly",
-                         pistons);
-  message +=
-      ". Remedies: contact.tc (the TC model: a collision soon after a particle's previous one "
-      "is elastic), contact.elastic_below_speed (slow impacts are elastic)";
-  if (!walls.empty())
-    message += fmt::format(
-        ", or the same for the wall{} (boundary.wall restitution > 0, elastic_below_speed)",
-        walls.size() == 1 ? "" : "s");
-  if (env.has_gravity() && !vibrating)
-    message += ", contact.sleep_speed > 0 (resting grains sleep)";
+                    : fmt::format(", against the wall{} {}", walls.size() == 1 ? "" : "s", where),
+      cause);
   return message;
 }
 

@@ -57,8 +57,11 @@ class FrozenClock(kt.KairosTestCase):
         return line, s
 
     def test_vibrated_floor_with_restitution_zero(self):
-        line, s = self.frozen_run(vibrated_floor_e0(), "wall y-", "restitution > 0",
-                                  "contact.tc")
+        # Only a restitution above 0 undoes it (the TC model and elastic slow impacts do not:
+        # the grain rides on the floor at no relative speed).
+        line, s = self.frozen_run(vibrated_floor_e0(), "wall y-", "restitution 0 at slow impacts",
+                                  "restitution above 0")
+        self.assertNotIn("contact.tc", line)
         self.assertAlmostEqual(s["sim_time"], 0.5631, places=3)
 
     def test_resting_pile_that_may_not_sleep(self):
@@ -87,6 +90,16 @@ class FrozenClock(kt.KairosTestCase):
         config["run"]["collisions_per_particle"] = 300.0
         self.run_ok("run", self.write_config(config, "tc.toml"), "-o", self.path("tc"),
                     timeout=600)
+
+    def test_elastic_spheres_jammed_on_a_touching_lattice(self):
+        # A simple cubic lattice at its close packing: every sphere touches its six neighbours
+        # and none can move; elastic, so no TC model or slow-impact rule applies.
+        config = kt.base_config(particles=1000, packing_fraction=0.5235987755982988,
+                                lattice="sc", production=200.0)
+        line, s = self.frozen_run(config, "at one instant", "elastic particles jammed",
+                                  "lower packing fraction")
+        self.assertNotIn("contact.tc", line)
+        self.assertEqual(s["sim_time"], 0.0)
 
     def test_python_simulation_raises(self):
         # kairos.Simulation.advance stops at a frozen clock too (only where the module is
@@ -144,8 +157,8 @@ class NoRoomLeft(kt.KairosTestCase):
         config["output"]["trajectory"] = False
         out = self.path("out")
         result = self.kairos("run", self.write_config(config), "-o", out, timeout=600)
-        self.assert_user_error(result, "clock is frozen", "wall moving inwards",
-                               "The wall z+ moving into the particles")
+        self.assert_user_error(result, "clock is frozen", "squeezed by the wall z+ moving into",
+                               "they jam")
         self.assert_outputs_exist(out, trajectory=False)
 
 
