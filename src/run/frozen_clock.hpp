@@ -34,7 +34,10 @@ class FrozenClockWatch {
   // that a collapse is caught within seconds.
   template <class Engine>
   explicit FrozenClockWatch(const Engine& engine)
-      : window_(std::max<std::uint64_t>(50000, 20 * static_cast<std::uint64_t>(engine.size()))) {
+      : window_(std::max<std::uint64_t>(50000, 20 * static_cast<std::uint64_t>(engine.size()))),
+        first_time_(engine.time()),
+        first_events_(engine.counters().events),
+        first_collisions_(engine.counters().collisions) {
     start(engine);
   }
 
@@ -61,6 +64,15 @@ class FrozenClockWatch {
     return false;
   }
 
+  // At the end of a run too short for a whole window: true when it made at least one event
+  // per particle and collisions, but did not move the clock at all (a start in contact: all
+  // its collisions at one instant, its pressure undefined).
+  template <class Engine>
+  bool never_moved(const Engine& engine) const {
+    return engine.counters().events >= first_events_ + engine.size() &&
+           engine.counters().collisions > first_collisions_ && engine.time() == first_time_;
+  }
+
   // The error message for a frozen window: where the clock stopped, who collided in the window
   // and against which walls, and the remedies.
   template <class Engine>
@@ -77,6 +89,8 @@ class FrozenClockWatch {
   }
 
   std::uint64_t window_, next_ = 0;
+  double first_time_;  // when the watch began, and its event and collision counts then
+  std::uint64_t first_events_, first_collisions_;
   double start_time_ = 0.0;
   double most_ = 0.0;  // the largest advance of a window so far
   std::uint64_t start_wall_collisions_ = 0, start_collisions_ = 0;

@@ -346,6 +346,11 @@ class RunDriver {
       production_done_ = !stopped;
     }
     progress.finish();
+    if (!stopped && clock_watch_->never_moved(*engine_)) {
+      stopped = true;
+      stop_reason_ = "frozen_clock";
+      error_ = clock_watch_->describe(*engine_);
+    }
     finish_outputs(stopped);
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
     if (outputs_.any()) {

@@ -39,7 +39,8 @@ def pile(sleep_speed):
 
 class FrozenClock(kt.KairosTestCase):
     def frozen_run(self, config, *needles):
-        out = self.path("out")
+        self.runs = getattr(self, "runs", 0) + 1
+        out = self.path("out%d" % self.runs)
         result = self.kairos("run", self.write_config(config), "-o", out)
         line = self.assert_user_error(result, "clock is frozen", *needles)
         self.assertIn("stopped early (frozen_clock)", result.stdout)
@@ -100,6 +101,9 @@ class FrozenClock(kt.KairosTestCase):
                                   "lower packing fraction")
         self.assertNotIn("contact.tc", line)
         self.assertEqual(s["sim_time"], 0.0)
+        # A run too short for a whole window that never moved the clock is caught at its end.
+        config["run"]["collisions_per_particle"] = 0.5
+        self.frozen_run(config, "at one instant")
 
     def test_python_simulation_raises(self):
         # kairos.Simulation.advance stops at a frozen clock too (only where the module is
