@@ -66,6 +66,23 @@ std::vector<std::string> overrides_from(const py::object& set) {
   return overrides;
 }
 
+// An optional path argument (`output`, `restart`): None, a str or an os.PathLike; anything else
+// is a TypeError naming the argument.
+std::optional<fs::path> path_from(const py::object& value, const char* name) {
+  if (value.is_none()) return std::nullopt;
+  if (!py::isinstance<py::str>(value) && !py::hasattr(value, "__fspath__")) {
+    throw py::type_error(fmt::format("{} must be a path (str or os.PathLike) or None, not {}", name,
+                                     type_name(value)));
+  }
+  return fs::path(py::module_::import("os").attr("fspath")(value).cast<std::string>());
+}
+
+bool flag_from(const py::object& value, const char* name) {
+  if (!py::isinstance<py::bool_>(value))
+    throw py::type_error(fmt::format("{} must be True or False, not {}", name, type_name(value)));
+  return value.cast<bool>();
+}
+
 // A config file (str or path-like), or TOML text when the string holds a newline (a path here
 // never does); `set`: one "key=value" override or a sequence of them.
 Config config_from(const py::object& config, const py::object& set) {
@@ -122,8 +139,8 @@ py::array_t<double> as_array(const auto& rows, int dimension) {
 // kairos.Simulation: one of the two dimensions behind one Python class.
 class PySimulation {
  public:
-  PySimulation(const py::object& config, const py::object& set,
-               const std::optional<fs::path>& restart) {
+  PySimulation(const py::object& config, const py::object& set, const py::object& restart_arg) {
+    const std::optional<fs::path> restart = path_from(restart_arg, "restart");
     const Config c = config_from(config, set);
     // The start may build soft-sphere tables (seconds): without the GIL, and Ctrl-C ends it.
     SigintStopsRun sigint;
@@ -261,8 +278,11 @@ PYBIND11_MODULE(kairos, m) {
 
   m.def(
       "run",
-      [](const py::object& config, std::optional<fs::path> output, const py::object& set,
-         std::optional<fs::path> restart, bool overwrite) {
+      [](const py::object& config, const py::object& output_arg, const py::object& set,
+         const py::object& restart_arg, const py::object& overwrite_arg) {
+        const std::optional<fs::path> output = kairos::path_from(output_arg, "output");
+        const std::optional<fs::path> restart = kairos::path_from(restart_arg, "restart");
+        const bool overwrite = kairos::flag_from(overwrite_arg, "overwrite");
         kairos::Config c = kairos::config_from(config, set);
         if (output) c.output.directory = output->string();
         const kairos::RunOutcome outcome = [&] {
@@ -294,8 +314,8 @@ PYBIND11_MODULE(kairos, m) {
                            "An event-driven simulation in memory: the engine of `kairos run` "
                            "started from the same configuration (bit-identical trajectory), "
                            "advanced on request, without output files.")
-      .def(py::init<const py::object&, const py::object&, const std::optional<fs::path>&>(),
-           py::arg("config"), py::arg("set") = py::none(), py::arg("restart") = py::none(),
+      .def(py::init<const py::object&, const py::object&, const py::object&>(), py::arg("config"),
+           py::arg("set") = py::none(), py::arg("restart") = py::none(),
            "config: a TOML file's path, or TOML text; set: 'key=value' overrides; restart: a "
            "restart file to continue from.")
       .def("advance", &PySimulation::advance, py::arg("time") = py::none(),

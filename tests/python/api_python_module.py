@@ -283,6 +283,10 @@ class Module(kt.KairosTestCase):
             (lambda: kairos.Simulation(cfg, set=b"run.time=1"), "set must be", "bytes"),
             (lambda: kairos.run(42), "config must be", "int"),
             (lambda: kairos.Simulation(None), "config must be", "NoneType"),
+            (lambda: kairos.run(cfg, output=123), "output must be a path", "int"),
+            (lambda: kairos.run(cfg, restart=5), "restart must be a path", "int"),
+            (lambda: kairos.run(cfg, overwrite="yes"), "overwrite must be True or False", "str"),
+            (lambda: kairos.Simulation(cfg, restart=3.5), "restart must be a path", "float"),
         ]
         for call, *needles in cases:
             with self.assertRaises(TypeError) as caught:
