@@ -67,8 +67,9 @@ class ContinuedRunsLeaveOneRunsOutputs(kt.KairosTestCase):
 
     def interrupt_and_continue(self, config, sig, name="run"):
         whole = self.path(name + "-whole")
-        if not os.path.exists(whole):
-            self.run_ok("run", self.write_config(config, "whole.toml"), "-o", whole, timeout=600)
+        started = time.monotonic()
+        self.run_ok("run", self.write_config(config, "whole.toml"), "-o", whole, timeout=600)
+        duration = time.monotonic() - started
         out = self.path(name)
         cfg, proc = self.start(config, out)
         restart = os.path.join(out, "restart.gsd")
@@ -76,11 +77,13 @@ class ContinuedRunsLeaveOneRunsOutputs(kt.KairosTestCase):
         while not os.path.exists(restart):  # the first periodic restart file
             self.assertIsNone(proc.poll(), "the run ended before it was interrupted")
             self.assertLess(time.monotonic(), deadline)
-            time.sleep(0.01)
-        time.sleep(0.2)
+            time.sleep(0.001)
+        # A small share of the whole run's wall time after its first restart file: the run is
+        # then still going on a machine of any speed (a fixed delay outlived fast runs).
+        time.sleep(0.02 * duration)
         proc.send_signal(sig)
         proc.communicate(timeout=60)
-        self.assertNotEqual(proc.returncode, 0)
+        self.assertNotEqual(proc.returncode, 0, "the run ended before the signal (%.3f s)" % duration)
         self.run_ok("run", cfg, "--restart", restart, "-o", out, timeout=600)
         with open(os.path.join(out, "thermo.tsv")) as f, \
                 open(os.path.join(whole, "thermo.tsv")) as g:
