@@ -14,6 +14,7 @@
 
 #include "core/error.hpp"
 #include "core/periodic.hpp"
+#include "core/permutation.hpp"
 #include "dynamics/collision_time.hpp"
 #include "dynamics/trajectory_events.hpp"
 #include "engine/candidate_scan.hpp"
@@ -466,48 +467,54 @@ std::uint64_t EventEngine<D, Queue>::next_renumber_after(std::uint64_t collision
 template <int D, class Queue>
 void EventEngine<D, Queue>::renumber(bool queue_filled) {
   const auto n = static_cast<std::uint32_t>(size());
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> rank(n);
-  for (std::uint32_t k = 0; k < n; ++k) rank[k] = {grid_.morton_rank(hot_[k].cell), k};
-  std::sort(rank.begin(), rank.end());
-  std::vector<std::uint32_t> new_index(n);
-  for (std::uint32_t k = 0; k < n; ++k) new_index[rank[k].second] = k;
-  std::vector<double> times(queue_filled ? n : 0);
+  // order[k]: the present index of the particle that moves to k, sorted by (Morton rank of its
+  // cell, present index). In place, with 16 bytes per particle of scratch at most: the arrays
+  // are not copied (docs/performance.md, "Memory").
+  std::vector<std::uint32_t> order(n);
   {
-    HugeVector<HotRecord<D>> hot(n);
-    HugeVector<PendingEvent> pending(n);
-    HugeVector<std::uint32_t> id(n);
-    for (std::uint32_t k = 0; k < n; ++k) {
-      const std::uint32_t old = rank[k].second;
-      hot[k] = hot_[old];
-      pending[k] = pending_[old];
-      std::uint32_t& p = pending[k].partner;
-      if (p < kFirstCode) p = new_index[p];
-      if (p >= kKeptBase && p < kNoneKept) p = kKeptBase + new_index[p - kKeptBase];
-      id[k] = id_[old];
-      if (queue_filled) times[k] = queue_.time_of(old);
+    std::uint64_t top = 0;
+    for (std::uint32_t k = 0; k < n; ++k) top = std::max(top, grid_.morton_rank(hot_[k].cell));
+    if (top < (std::uint64_t{1} << 32)) {  // (rank, index) packed into one integer
+      std::vector<std::uint64_t> key(n);
+      for (std::uint32_t k = 0; k < n; ++k) key[k] = grid_.morton_rank(hot_[k].cell) << 32 | k;
+      std::sort(key.begin(), key.end());
+      for (std::uint32_t k = 0; k < n; ++k) order[k] = static_cast<std::uint32_t>(key[k]);
+    } else {
+      std::vector<std::pair<std::uint64_t, std::uint32_t>> rank(n);
+      for (std::uint32_t k = 0; k < n; ++k) rank[k] = {grid_.morton_rank(hot_[k].cell), k};
+      std::sort(rank.begin(), rank.end());
+      for (std::uint32_t k = 0; k < n; ++k) order[k] = rank[k].second;
     }
-    hot_.swap(hot);
-    pending_.swap(pending);
-    id_.swap(id);
   }
-  auto permute = [&](auto& per_particle, std::size_t size) {
-    if (per_particle.empty()) return;
-    std::remove_reference_t<decltype(per_particle)> moved(size);
-    for (std::uint32_t k = 0; k < n; ++k) moved[k] = per_particle[rank[k].second];
-    per_particle.swap(moved);
-  };
-  permute(shape_, n + 1);
-  permute(spin_, n);
-  permute(last_collision_, n);
-  permute(asleep_, n);
-  permute(frozen_with_, n);
-  permute(release_time_, n);
-  permute(release_velocity_, n);
-  permute(deferred_, n);
+  std::vector<std::uint32_t> new_index(n);
+  for (std::uint32_t k = 0; k < n; ++k) new_index[order[k]] = k;
+  std::vector<double> times(queue_filled ? n : 0);
+  for (std::uint32_t k = 0; queue_filled && k < n; ++k) times[k] = queue_.time_of(order[k]);
+  for (PendingEvent& e : pending_) {
+    std::uint32_t& p = e.partner;
+    if (p < kFirstCode) p = new_index[p];
+    if (p >= kKeptBase && p < kNoneKept) p = kKeptBase + new_index[p - kKeptBase];
+  }
   for (std::uint32_t& p : frozen_with_)
     if (p < kFirstCode) p = new_index[p];
-  if (soft_) rebuild_awaiting_release();
   if (stepped_) steps_.renumber(new_index);
+  std::vector<std::uint32_t>().swap(new_index);
+  std::vector<bool> done;
+  const auto permute = [&](auto& per_particle) {
+    if (!per_particle.empty()) permute_in_place(per_particle, order, done);
+  };
+  permute(hot_);
+  permute(pending_);
+  permute(id_);
+  permute(shape_);  // its spare last entry stays
+  permute(spin_);
+  permute(last_collision_);
+  permute(asleep_);
+  permute(frozen_with_);
+  permute(release_time_);
+  permute(release_velocity_);
+  permute(deferred_);
+  if (soft_) rebuild_awaiting_release();
   insert_all_into_grid();
   if (queue_filled) queue_.reset(times);
 }
@@ -1507,27 +1514,44 @@ EventKind EventEngine<D, Queue>::step() {
 template <int D, class Queue>
 ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
   const std::size_t n = size();
+  ParticleSystem<D> out = export_globals(with_zones);
+  size_particle_arrays(out, n);
+  out.order.assign(id_.begin(), id_.end());
+  for (std::uint32_t k = 0; k < n; ++k) export_particle(k, id_[k], out);
+  return out;
+}
+
+template <int D, class Queue>
+StateBlocks<D> EventEngine<D, Queue>::state_blocks(bool with_zones) const {
+  StateBlocks<D> blocks;
+  blocks.globals_ = std::make_shared<const ParticleSystem<D>>(export_globals(with_zones));
+  blocks.particles = size();
+  auto internal = std::make_shared<std::vector<std::uint32_t>>(size());
+  for (std::uint32_t k = 0; k < size(); ++k) (*internal)[id_[k]] = k;
+  blocks.fill = [this, internal](std::size_t first, std::size_t count, ParticleSystem<D>& out) {
+    size_particle_arrays(out, count);
+    out.order.assign(id_.begin() + static_cast<std::ptrdiff_t>(first),
+                     id_.begin() + static_cast<std::ptrdiff_t>(first + count));
+    for (std::size_t c = 0; c < count; ++c)
+      export_particle((*internal)[first + c], static_cast<std::uint32_t>(c), out);
+  };
+  return blocks;
+}
+
+// export_state() but for the per-particle arrays.
+template <int D, class Queue>
+ParticleSystem<D> EventEngine<D, Queue>::export_globals(bool with_zones) const {
   ParticleSystem<D> out;
   out.box = box_;
   out.time = time_;
   out.counters = counters_;
   out.species_names = species_names_;
-  out.kinematics.resize(n);
-  out.mass.resize(n);
-  out.species.resize(n);
-  out.collision_count.resize(n);
-  out.events.resize(n);
-  out.cell.resize(n);
-  out.order.assign(id_.begin(), id_.end());
   out.gravity = env_.gravity;
   for (int a = 0; a < D; ++a) out.periodic[a] = grid_.periodic(a);
-  out.asleep.assign(sleeping_ > 0 ? n : 0, 0);
-  out.angular_velocity.resize(spin_.size());
-  out.last_collision_time.resize(last_collision_.size());
   out.bonds = bonds_;
   out.bond_types = bond_types_;
   if (stepped_ && with_zones) out.zones = steps_.export_zones(id_.data());
-  for (std::uint32_t k = 0; soft_ && k < n; ++k) {
+  for (std::uint32_t k = 0; soft_ && k < size(); ++k) {
     const std::uint32_t p = frozen_with_[k];
     if (p == kNoPartner || (p < kFirstCode && p < k)) continue;  // each pair once
     if (!deferred_.empty() && deferred_[k] != 0 && !in_deferred_contact(k, time_)) continue;
@@ -1546,27 +1570,44 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
     }
     out.frozen.push_back(c);
   }
-  for (std::uint32_t k = 0; k < n; ++k) {
-    const std::uint32_t c = id_[k];
-    const HotRecord<D>& h = hot_[k];
-    const Shape& sh = shapes_[shape_.empty() ? 0 : shape_[k]];
-    out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};
-    if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
-      out.kinematics[c] = {position_of(k, time_), frozen_velocity_of(k), time_, sh.radius};
-    out.mass[c] = sh.mass;
-    out.species[c] = sh.species;
-    out.collision_count[c] = h.collisions;
-    out.cell[c] = h.cell;
-    if (!spin_.empty()) out.angular_velocity[c] = spin_[k];
-    if (sleeping_ > 0) out.asleep[c] = asleep_[k];
-    if (!last_collision_.empty()) out.last_collision_time[c] = last_collision_[k];
-    const PendingEvent& e = pending_[k];
-    std::uint32_t partner = e.partner < kFirstCode ? id_[e.partner] : e.partner;
-    if (e.partner >= kKeptBase && e.partner < kNoneKept)
-      partner = kKeptBase + id_[e.partner - kKeptBase];
-    out.events[c] = {queue_.time_of(k), partner, e.partner_count};
-  }
   return out;
+}
+
+// The per-particle arrays of `out` for n particles (order excepted), those the engine keeps.
+template <int D, class Queue>
+void EventEngine<D, Queue>::size_particle_arrays(ParticleSystem<D>& out, std::size_t n) const {
+  out.kinematics.resize(n);
+  out.mass.resize(n);
+  out.species.resize(n);
+  out.collision_count.resize(n);
+  out.events.resize(n);
+  out.cell.resize(n);
+  out.asleep.assign(sleeping_ > 0 ? n : 0, 0);
+  out.angular_velocity.resize(spin_.empty() ? 0 : n);
+  out.last_collision_time.resize(last_collision_.empty() ? 0 : n);
+}
+
+// Internal particle k into entry c of out's per-particle arrays (sized by size_particle_arrays).
+template <int D, class Queue>
+void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
+                                            ParticleSystem<D>& out) const {
+  const HotRecord<D>& h = hot_[k];
+  const Shape& sh = shapes_[shape_.empty() ? 0 : shape_[k]];
+  out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};
+  if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
+    out.kinematics[c] = {position_of(k, time_), frozen_velocity_of(k), time_, sh.radius};
+  out.mass[c] = sh.mass;
+  out.species[c] = sh.species;
+  out.collision_count[c] = h.collisions;
+  out.cell[c] = h.cell;
+  if (!spin_.empty()) out.angular_velocity[c] = spin_[k];
+  if (sleeping_ > 0) out.asleep[c] = asleep_[k];
+  if (!last_collision_.empty()) out.last_collision_time[c] = last_collision_[k];
+  const PendingEvent& e = pending_[k];
+  std::uint32_t partner = e.partner < kFirstCode ? id_[e.partner] : e.partner;
+  if (e.partner >= kKeptBase && e.partner < kNoneKept)
+    partner = kKeptBase + id_[e.partner - kKeptBase];
+  out.events[c] = {queue_.time_of(k), partner, e.partner_count};
 }
 
 template <int D, class Queue>
@@ -1619,6 +1660,28 @@ std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
     out[id_[i]] = x;
   }
   return out;
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::for_each_block(const BlockVisitor& f) const {
+  const std::size_t n = size();
+  std::vector<std::uint32_t> internal(n);
+  for (std::uint32_t k = 0; k < n; ++k) internal[id_[k]] = k;
+  const std::size_t block = std::min(n, StateBlocks<D>::kBlock);
+  std::vector<Vec<D>> x(block), v(block);
+  std::vector<double> m(block);
+  for (std::size_t first = 0; first < n; first += block) {
+    const std::size_t count = std::min(block, n - first);
+    for (std::size_t j = 0; j < count; ++j) {
+      const std::uint32_t k = internal[first + j];
+      x[j] = position_of(k, time_);  // as current_positions()
+      for (int a = 0; a < D; ++a)
+        if (grid_.periodic(a)) x[j][a] = wrap_into_box(x[j][a], box_[a]);
+      v[j] = velocity_of(k, time_);
+      m[j] = mass_of(k);
+    }
+    f(first, {x.data(), count}, {v.data(), count}, {m.data(), count});
+  }
 }
 
 template <int D, class Queue>

@@ -28,6 +28,8 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -35,6 +37,7 @@
 #include "core/environment.hpp"
 #include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
+#include "core/state_blocks.hpp"
 #include "dynamics/collision_time.hpp"
 #include "engine/candidate_scan.hpp"
 #include "engine/pair_steps.hpp"
@@ -147,6 +150,10 @@ class EventEngine {
   // resumed from it continues bit-identically. Without zones (stepped potentials' capture map,
   // the costly part), enough for outputs but not for a resume.
   ParticleSystem<D> export_state(bool with_zones = true) const;
+  // The same state read in blocks of particles: outputs of a large system without a copy of
+  // the whole state (4 bytes per particle, the caller's numbering's map to the engine's). Valid
+  // until the engine changes.
+  StateBlocks<D> state_blocks(bool with_zones = true) const;
   std::size_t size() const { return hot_.size(); }
 
   double kinetic_energy() const;  // translational
@@ -184,6 +191,13 @@ class EventEngine {
   // Velocities at the current time, in the caller's numbering: export_state()'s
   // velocity_at(i, time()) to the bit, without copying the rest of the state.
   std::vector<Vec<D>> current_velocities() const;
+  // current_positions(), current_velocities() and the masses of the caller's particles, in
+  // blocks of at most StateBlocks<D>::kBlock in the caller's order: f(first, x, v, m) for the
+  // particles [first, first + x.size()). Sums over particles without a copy of every
+  // particle's position or velocity (4 bytes per particle for the numbering's map).
+  using BlockVisitor = std::function<void(std::size_t first, std::span<const Vec<D>> x,
+                                          std::span<const Vec<D>> v, std::span<const double> m)>;
+  void for_each_block(const BlockVisitor& f) const;
   // Each particle's collision counter (particle and wall collisions; it wraps at 2^32), in the
   // caller's numbering: which particles took part in the events between two calls.
   std::vector<std::uint32_t> collision_counts() const {
@@ -477,6 +491,9 @@ class EventEngine {
            (deferred_.empty() || deferred_[i] == 0 || in_deferred_contact(i, time_));
   }
   void renumber(bool queue_filled);
+  ParticleSystem<D> export_globals(bool with_zones) const;
+  void size_particle_arrays(ParticleSystem<D>& out, std::size_t n) const;
+  void export_particle(std::uint32_t k, std::uint32_t c, ParticleSystem<D>& out) const;
   void insert_all_into_grid();
   void check_restored_cell(std::uint32_t i) const;
   std::uint64_t next_renumber_after(std::uint64_t collisions) const;

@@ -318,6 +318,12 @@ struct Writer::State {
   };
   bool checksums = false;
   std::vector<ChunkCrc> crcs;
+  // The chunk being written in pieces (begin_chunk): its bytes in all and given so far.
+  struct OpenChunk {
+    std::string name;
+    std::size_t bytes = 0, given = 0;
+  };
+  std::optional<OpenChunk> open_chunk;
 
   State(std::filesystem::path p, int descriptor) : path(std::move(p)), fd(descriptor) {}
 
@@ -400,18 +406,26 @@ Writer Writer::open_append(const std::filesystem::path& path, std::uint64_t keep
 
 void Writer::write_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M,
                          const void* data) {
-  State& s = state("write_chunk");
+  if (data == nullptr && N != 0 && M != 0 && type_size(type) != 0)
+    throw std::invalid_argument("GSD chunk '" + std::string(name) + "': null data");
+  begin_chunk(name, type, N, M);
+  append_to_chunk(data, s_->open_chunk->bytes);
+  end_chunk();
+}
+
+void Writer::begin_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M) {
+  State& s = state("begin_chunk");
   const std::size_t size = type_size(type);
   const std::string chunk(name);
   const auto refuse = [&](const std::string& why) {
     throw std::invalid_argument("GSD chunk '" + chunk + "': " + why);
   };
+  if (s.open_chunk) refuse("begun while chunk '" + s.open_chunk->name + "' is being written");
   if (size == 0) refuse("invalid type");
   if (type == Type::character) refuse("type character is not readable by GSD 2.0 readers");
   if (chunk.empty() || chunk.find('\0') != std::string::npos) refuse("invalid name");
   if (M != 0 && N > (std::uint64_t{1} << 62) / M / size) refuse("too large");
   const std::size_t bytes = N * M * size;
-  if (bytes != 0 && data == nullptr) refuse("null data");
 
   auto it = s.ids.find(chunk);
   if (it == s.ids.end()) {
@@ -427,13 +441,25 @@ void Writer::write_chunk(std::string_view name, Type type, std::uint64_t N, std:
   const std::uint64_t location = s.end + s.flushed + s.buffer.size();
   s.pending.push_back(Entry{s.frames, N, static_cast<std::int64_t>(location), M, id,
                             static_cast<std::uint8_t>(type), 0});
-  if (s.checksums) {
-    const std::uint32_t crc = data_crc(header_crc(0, chunk, type, N, M), data, bytes);
-    s.crcs.push_back({chunk, crc, chunk.size() + 1 + 1 + 8 + 4 + bytes});
+  if (s.checksums)
+    s.crcs.push_back(
+        {chunk, header_crc(0, chunk, type, N, M), chunk.size() + 1 + 1 + 8 + 4 + bytes});
+  s.open_chunk = State::OpenChunk{chunk, bytes, 0};
+}
+
+void Writer::append_to_chunk(const void* data, std::size_t bytes) {
+  State& s = state("append_to_chunk");
+  if (!s.open_chunk) throw std::logic_error("GSD: append_to_chunk without begin_chunk");
+  State::OpenChunk& c = *s.open_chunk;
+  if (bytes > c.bytes - c.given) {
+    throw std::logic_error("GSD chunk '" + c.name + "': more data than its N x M values");
   }
+  if (bytes == 0) return;
+  if (s.checksums) s.crcs.back().crc = data_crc(s.crcs.back().crc, data, bytes);
+  c.given += bytes;
   if (s.buffer.size() + bytes > kBufferBytes) s.flush();
   if (bytes >= kBufferBytes) {
-    write_at(s.fd.get(), data, bytes, location, s.path);
+    write_at(s.fd.get(), data, bytes, s.end + s.flushed, s.path);
     s.flushed += bytes;
   } else {
     const char* p = static_cast<const char*>(data);
@@ -441,8 +467,21 @@ void Writer::write_chunk(std::string_view name, Type type, std::uint64_t N, std:
   }
 }
 
+void Writer::end_chunk() {
+  State& s = state("end_chunk");
+  if (!s.open_chunk) throw std::logic_error("GSD: end_chunk without begin_chunk");
+  if (s.open_chunk->given != s.open_chunk->bytes) {
+    throw std::logic_error("GSD chunk '" + s.open_chunk->name + "': ended after " +
+                           std::to_string(s.open_chunk->given) + " of its " +
+                           std::to_string(s.open_chunk->bytes) + " bytes");
+  }
+  s.open_chunk.reset();
+}
+
 void Writer::end_frame() {
   State& s = state("end_frame");
+  if (s.open_chunk)
+    throw std::logic_error("GSD: end_frame while chunk '" + s.open_chunk->name + "' is open");
   try {
     s.flush();
     Header& h = s.header;

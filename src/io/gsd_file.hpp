@@ -104,6 +104,13 @@ class Writer {
   // N x M values of `type` at `data` (may be null when N * M == 0).
   void write_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M,
                    const void* data);
+  // A chunk written in pieces, so that its values never need to be in memory at once:
+  // begin_chunk, then append_to_chunk until its N x M values were given (in order), then
+  // end_chunk (logic_error if fewer or more bytes came). The file holds the same bytes as after
+  // write_chunk of the whole; no other chunk may be written in between.
+  void begin_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M);
+  void append_to_chunk(const void* data, std::size_t bytes);
+  void end_chunk();
   // From now on, keep the CRC-32 of each chunk written (see "Frame checksums" above), so that
   // frame_checksum() can be asked before end_frame(). Off by default: trajectories skip the cost.
   void enable_checksums();

@@ -84,9 +84,31 @@ void write_bonds(gsd::Writer& w, const ParticleSystem<D>& sys) {
   w.write_chunk("bonds/group", nb, 2, group.data());
 }
 
+// Chunk `name` of one row of M values of T per particle, written block by block:
+// row(block, j, values) gives particle j's row of the block (values start zeroed).
+template <class T, int D, class Row>
+void write_particle_chunk(gsd::Writer& w, std::string_view name, std::uint32_t M,
+                          const StateBlocks<D>& s, Row&& row) {
+  w.begin_chunk(name, gsd::type_of<T>(), s.particles, M);
+  std::vector<T> values;
+  s.for_each([&](const ParticleSystem<D>& part, std::size_t) {
+    values.assign(part.size() * M, T{});
+    for (std::size_t j = 0; j < part.size(); ++j) row(part, j, &values[j * M]);
+    w.append_to_chunk(values.data(), values.size() * sizeof(T));
+  });
+  w.end_chunk();
+}
+
+// Which per-particle arrays the state has (one particle's block tells).
 template <int D>
-void write_standard_chunks(gsd::Writer& w, const ParticleSystem<D>& sys, bool with_static) {
-  const auto n = static_cast<std::uint32_t>(sys.size());
+ParticleSystem<D> probe(const StateBlocks<D>& s) {
+  return s.block(0, s.particles == 0 ? 0 : 1);
+}
+
+template <int D>
+void write_standard_chunks(gsd::Writer& w, const StateBlocks<D>& s, bool with_static) {
+  const ParticleSystem<D>& sys = s.globals();
+  const auto n = static_cast<std::uint32_t>(s.particles);
   const std::uint64_t step = sys.counters.events;
   const std::uint8_t dims = D;
   const float box[6] = {static_cast<float>(sys.box[0]),
@@ -99,43 +121,45 @@ void write_standard_chunks(gsd::Writer& w, const ParticleSystem<D>& sys, bool wi
   w.write_chunk("configuration/dimensions", 1, 1, &dims);
   w.write_chunk("configuration/box", 6, 1, box);
   w.write_chunk("particles/N", 1, 1, &n);
-  std::vector<float> pos(3 * n, 0.0f), vel(3 * n, 0.0f);
-  for (std::uint32_t i = 0; i < n; ++i) {
-    const Vec<D> x = sys.position_at(i, sys.time);
-    const Vec<D> v = sys.velocity_at(i, sys.time);
-    for (int a = 0; a < D; ++a) {
-      pos[3 * i + a] = hoomd_coordinate(x[a], sys.box[a], sys.periodic[a]);
-      vel[3 * i + a] = static_cast<float>(v[a]);
-    }
-  }
-  w.write_chunk("particles/position", n, 3, pos.data());
-  w.write_chunk("particles/velocity", n, 3, vel.data());
-  if (!sys.angular_velocity.empty()) {
+  write_particle_chunk<float>(w, "particles/position", 3, s,
+                              [](const ParticleSystem<D>& p, std::size_t j, float* out) {
+                                const Vec<D> x = p.position_at(j, p.time);
+                                for (int a = 0; a < D; ++a)
+                                  out[a] = hoomd_coordinate(x[a], p.box[a], p.periodic[a]);
+                              });
+  write_particle_chunk<float>(w, "particles/velocity", 3, s,
+                              [](const ParticleSystem<D>& p, std::size_t j, float* out) {
+                                const Vec<D> v = p.velocity_at(j, p.time);
+                                for (int a = 0; a < D; ++a) out[a] = static_cast<float>(v[a]);
+                              });
+  if (!probe(s).angular_velocity.empty()) {
     // Per-particle log data: OVITO and python-gsd read log/particles/* as particle
     // properties. In 2D the spin is the z component.
-    std::vector<float> w3(3 * n, 0.0f);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      const auto& om = sys.angular_velocity[i];
-      if constexpr (D == 3) {
-        for (int a = 0; a < 3; ++a) w3[3 * i + a] = static_cast<float>(om[a]);
-      } else {
-        w3[3 * i + 2] = static_cast<float>(om[0]);
-      }
-    }
-    w.write_chunk("log/particles/angular_velocity", n, 3, w3.data());
+    write_particle_chunk<float>(w, "log/particles/angular_velocity", 3, s,
+                                [](const ParticleSystem<D>& p, std::size_t j, float* out) {
+                                  const auto& om = p.angular_velocity[j];
+                                  if constexpr (D == 3) {
+                                    for (int a = 0; a < 3; ++a) out[a] = static_cast<float>(om[a]);
+                                  } else {
+                                    out[2] = static_cast<float>(om[0]);
+                                  }
+                                });
   }
   if (with_static) {
     std::uint32_t m = 0;
     const auto names = pack_type_names(sys.species_names, m);
     w.write_chunk("particles/types", sys.species_names.size(), m, names.data());
-    w.write_chunk("particles/typeid", n, 1, sys.species.data());
-    std::vector<float> diameter(n), mass(n);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      diameter[i] = static_cast<float>(2.0 * sys.kinematics[i].radius);
-      mass[i] = static_cast<float>(sys.mass[i]);
-    }
-    w.write_chunk("particles/diameter", n, 1, diameter.data());
-    w.write_chunk("particles/mass", n, 1, mass.data());
+    write_particle_chunk<std::uint32_t>(
+        w, "particles/typeid", 1, s,
+        [](const ParticleSystem<D>& p, std::size_t j, std::uint32_t* out) { *out = p.species[j]; });
+    write_particle_chunk<float>(w, "particles/diameter", 1, s,
+                                [](const ParticleSystem<D>& p, std::size_t j, float* out) {
+                                  *out = static_cast<float>(2.0 * p.kinematics[j].radius);
+                                });
+    write_particle_chunk<float>(w, "particles/mass", 1, s,
+                                [](const ParticleSystem<D>& p, std::size_t j, float* out) {
+                                  *out = static_cast<float>(p.mass[j]);
+                                });
     write_bonds(w, sys);
   }
   w.write_chunk("log/time", 1, 1, &sys.time);
@@ -342,36 +366,31 @@ std::vector<double> per_particle_property(const gsd::Reader& r, std::uint64_t f,
 }  // namespace
 
 template <int D>
-void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& system) {
-  write_standard_chunks(writer, system, writer.frame_count() == 0);
+void append_trajectory_frame(gsd::Writer& writer, const StateBlocks<D>& state) {
+  write_standard_chunks(writer, state, writer.frame_count() == 0);
   writer.end_frame();
 }
 
 template <int D>
-void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s,
+void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& system) {
+  append_trajectory_frame(writer, StateBlocks<D>::of(system));
+}
+
+template <int D>
+void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& full_state,
+                   const std::mt19937_64& rng, const RunProgress& progress) {
+  write_restart(path, StateBlocks<D>::of(full_state), rng, progress);
+}
+
+template <int D>
+void write_restart(const std::filesystem::path& path, const StateBlocks<D>& blocks,
                    const std::mt19937_64& rng, const RunProgress& progress) {
   replace_file_atomically(path, [&](const std::filesystem::path& tmp) {
     auto w = gsd::Writer::create(tmp, "kairos " KAIROS_VERSION);
     w.enable_checksums();
-    write_standard_chunks(w, s, true);
-    const std::uint64_t n = s.size();
-    std::vector<double> pos(n * D), vel(n * D), local(n), radius(n), now(n * D);
-    std::vector<double> tevent(n);
-    std::vector<std::uint32_t> partner(n), pcount(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& k = s.kinematics[i];
-      const Vec<D> x = s.position_at(i, s.time);
-      for (int a = 0; a < D; ++a) {
-        pos[i * D + a] = k.pos[a];
-        vel[i * D + a] = k.vel[a];
-        now[i * D + a] = s.periodic[a] ? wrap_into_box(x[a], s.box[a]) : x[a];
-      }
-      local[i] = k.time;
-      radius[i] = k.radius;
-      tevent[i] = s.events[i].time;
-      partner[i] = s.events[i].partner;
-      pcount[i] = s.events[i].partner_count;
-    }
+    write_standard_chunks(w, blocks, true);
+    const ParticleSystem<D>& s = blocks.globals();
+    const ParticleSystem<D> has = probe(blocks);
     const std::uint32_t format = kRestartFormat;
     const std::uint8_t dims = D;
     const std::uint64_t counters[4] = {s.counters.events, s.counters.collisions,
@@ -384,18 +403,49 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
     w.write_chunk("kairos/dimension", 1, 1, &dims);
     w.write_chunk("kairos/box", D, 1, s.box.data());
     w.write_chunk("kairos/time", 1, 1, &s.time);
-    w.write_chunk("kairos/position", n, D, now.data());  // at kairos/time, wrapped
-    w.write_chunk("kairos/velocity", n, D, vel.data());
-    w.write_chunk("kairos/mass", n, 1, s.mass.data());
-    w.write_chunk("kairos/radius", n, 1, radius.data());
-    w.write_chunk("kairos/state/position", n, D, pos.data());  // at each local time
-    w.write_chunk("kairos/state/local_time", n, 1, local.data());
-    w.write_chunk("kairos/state/collision_count", n, 1, s.collision_count.data());
-    w.write_chunk("kairos/state/event_time", n, 1, tevent.data());
-    w.write_chunk("kairos/state/partner", n, 1, partner.data());
-    w.write_chunk("kairos/state/partner_count", n, 1, pcount.data());
-    w.write_chunk("kairos/state/cell", n, 1, s.cell.data());
-    if (!s.order.empty()) w.write_chunk("kairos/state/order", n, 1, s.order.data());
+    using Part = const ParticleSystem<D>&;
+    write_particle_chunk<double>(w, "kairos/position", D, blocks,  // at kairos/time, wrapped
+                                 [](Part p, std::size_t j, double* out) {
+                                   const Vec<D> x = p.position_at(j, p.time);
+                                   for (int a = 0; a < D; ++a)
+                                     out[a] = p.periodic[a] ? wrap_into_box(x[a], p.box[a]) : x[a];
+                                 });
+    write_particle_chunk<double>(w, "kairos/velocity", D, blocks,
+                                 [](Part p, std::size_t j, double* out) {
+                                   for (int a = 0; a < D; ++a) out[a] = p.kinematics[j].vel[a];
+                                 });
+    write_particle_chunk<double>(w, "kairos/mass", 1, blocks,
+                                 [](Part p, std::size_t j, double* out) { *out = p.mass[j]; });
+    write_particle_chunk<double>(
+        w, "kairos/radius", 1, blocks,
+        [](Part p, std::size_t j, double* out) { *out = p.kinematics[j].radius; });
+    write_particle_chunk<double>(w, "kairos/state/position", D, blocks,  // at each local time
+                                 [](Part p, std::size_t j, double* out) {
+                                   for (int a = 0; a < D; ++a) out[a] = p.kinematics[j].pos[a];
+                                 });
+    write_particle_chunk<double>(
+        w, "kairos/state/local_time", 1, blocks,
+        [](Part p, std::size_t j, double* out) { *out = p.kinematics[j].time; });
+    write_particle_chunk<std::uint32_t>(
+        w, "kairos/state/collision_count", 1, blocks,
+        [](Part p, std::size_t j, std::uint32_t* out) { *out = p.collision_count[j]; });
+    write_particle_chunk<double>(
+        w, "kairos/state/event_time", 1, blocks,
+        [](Part p, std::size_t j, double* out) { *out = p.events[j].time; });
+    write_particle_chunk<std::uint32_t>(
+        w, "kairos/state/partner", 1, blocks,
+        [](Part p, std::size_t j, std::uint32_t* out) { *out = p.events[j].partner; });
+    write_particle_chunk<std::uint32_t>(
+        w, "kairos/state/partner_count", 1, blocks,
+        [](Part p, std::size_t j, std::uint32_t* out) { *out = p.events[j].partner_count; });
+    write_particle_chunk<std::uint32_t>(
+        w, "kairos/state/cell", 1, blocks,
+        [](Part p, std::size_t j, std::uint32_t* out) { *out = p.cell[j]; });
+    if (!has.order.empty()) {
+      write_particle_chunk<std::uint32_t>(
+          w, "kairos/state/order", 1, blocks,
+          [](Part p, std::size_t j, std::uint32_t* out) { *out = p.order[j]; });
+    }
     w.write_chunk("kairos/state/counters", 4, 1, counters);
     w.write_chunk("kairos/state/virial", 1, 1, &s.counters.virial);
     const std::uint64_t granular[5] = {s.counters.wall_collisions, s.counters.elastic_by_rule,
@@ -464,15 +514,19 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
       }
     }
     w.write_chunk("kairos/run/next_kick_time", 1, 1, &progress.next_kick_time);
-    if (!s.angular_velocity.empty()) {
+    if (!has.angular_velocity.empty()) {
       constexpr std::uint32_t kSpin = D == 3 ? 3 : 1;
-      std::vector<double> flat(n * kSpin);
-      for (std::size_t i = 0; i < n; ++i)
-        for (std::uint32_t a = 0; a < kSpin; ++a) flat[i * kSpin + a] = s.angular_velocity[i][a];
-      w.write_chunk("kairos/state/angular_velocity", n, kSpin, flat.data());
+      write_particle_chunk<double>(w, "kairos/state/angular_velocity", kSpin, blocks,
+                                   [](Part p, std::size_t j, double* out) {
+                                     for (std::uint32_t a = 0; a < kSpin; ++a)
+                                       out[a] = p.angular_velocity[j][a];
+                                   });
     }
-    if (!s.last_collision_time.empty())
-      w.write_chunk("kairos/state/last_collision_time", n, 1, s.last_collision_time.data());
+    if (!has.last_collision_time.empty()) {
+      write_particle_chunk<double>(
+          w, "kairos/state/last_collision_time", 1, blocks,
+          [](Part p, std::size_t j, double* out) { *out = p.last_collision_time[j]; });
+    }
     if (!s.dem.empty()) {  // the DEM's own state (DemIntegrator::checkpoint), chunks when any
       const DemResume& d = s.dem;
       w.write_chunk("kairos/dem/scalars", d.scalars.size(), 1, d.scalars.data());
@@ -485,7 +539,11 @@ void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& s
       put("kairos/dem/list", d.list);
       put("kairos/dem/springs", d.springs);
     }
-    if (!s.asleep.empty()) w.write_chunk("kairos/state/asleep", n, 1, s.asleep.data());
+    if (!has.asleep.empty()) {
+      write_particle_chunk<std::uint8_t>(
+          w, "kairos/state/asleep", 1, blocks,
+          [](Part p, std::size_t j, std::uint8_t* out) { *out = p.asleep[j]; });
+    }
     w.write_chunk("kairos/state/rng", rng_bytes.size(), 1, rng_bytes.data());
     w.write_chunk("kairos/run/equilibration_remaining", 1, 1, &progress.equilibration_remaining);
     if (std::isfinite(progress.equilibration_end_time)) {
@@ -909,6 +967,12 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
 
 template void append_trajectory_frame<2>(gsd::Writer&, const ParticleSystem<2>&);
 template void append_trajectory_frame<3>(gsd::Writer&, const ParticleSystem<3>&);
+template void append_trajectory_frame<2>(gsd::Writer&, const StateBlocks<2>&);
+template void append_trajectory_frame<3>(gsd::Writer&, const StateBlocks<3>&);
+template void write_restart<2>(const std::filesystem::path&, const StateBlocks<2>&,
+                               const std::mt19937_64&, const RunProgress&);
+template void write_restart<3>(const std::filesystem::path&, const StateBlocks<3>&,
+                               const std::mt19937_64&, const RunProgress&);
 template void write_restart<2>(const std::filesystem::path&, const ParticleSystem<2>&,
                                const std::mt19937_64&, const RunProgress&);
 template void write_restart<3>(const std::filesystem::path&, const ParticleSystem<3>&,

@@ -39,6 +39,7 @@
 #include <string>
 
 #include "core/particle_system.hpp"
+#include "core/state_blocks.hpp"
 #include "init/initial_state.hpp"
 #include "io/gsd_file.hpp"
 
@@ -49,6 +50,9 @@ namespace kairos {
 // missing chunks from frame 0).
 template <int D>
 void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& system);
+// The same from a state read in blocks (an engine's, without a copy of its whole state).
+template <int D>
+void append_trajectory_frame(gsd::Writer& writer, const StateBlocks<D>& state);
 
 // Where the run that wrote a restart file stood, beyond the physical state.
 struct RunProgress {
@@ -95,6 +99,10 @@ struct RunProgress {
 // Writes the restart file atomically (temporary file + rename).
 template <int D>
 void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& full_state,
+                   const std::mt19937_64& rng, const RunProgress& progress = {});
+// The same from a state read in blocks (the file holds the same bytes).
+template <int D>
+void write_restart(const std::filesystem::path& path, const StateBlocks<D>& state,
                    const std::mt19937_64& rng, const RunProgress& progress = {});
 
 // Reads a restart file written by write_restart; InputError if it is not one or if its

@@ -228,7 +228,6 @@ class RunDriver {
     }
     const bool resume = restart_ && !plan_->repredict;
     n_ = start.size();
-    mass_ = start.mass;
     volume_ = 1.0;
     for (int a = 0; a < D; ++a) volume_ *= start.box[a];
     particle_volume_ = 0.0;
@@ -297,7 +296,7 @@ class RunDriver {
     if (config_.output.trajectory) {
       run_detail::open_trajectory<D>(trajectory_, dir_, restart_, n_,
                                      continuation_.trajectory_frames,
-                                     [&] { return engine_->export_state(/*with_zones=*/false); });
+                                     [&] { return engine_->state_blocks(/*with_zones=*/false); });
       frames_kept_ = trajectory_->frame_count();
     }
     ke_start_ = engine_->kinetic_energy();
@@ -390,7 +389,7 @@ class RunDriver {
   }
 
   void write_restart_file() const {
-    write_restart(dir_ / "restart.gsd", engine_->export_state(), rng_, progress_now());
+    write_restart(dir_ / "restart.gsd", engine_->state_blocks(), rng_, progress_now());
   }
 
   // Equilibration still owed if the run stops now (a restart file records it).
@@ -444,7 +443,9 @@ class RunDriver {
       if (!p.in_time && p.value > 0.0) collisions += static_cast<double>(collisions_for(p.value));
     if (collisions == 0.0) return;
     double mass = 0.0;
-    for (const double m : mass_) mass += m;
+    engine_->for_each_block([&](std::size_t, auto, auto, auto m) {
+      for (const double mj : m) mass += mj;
+    });
     const auto n = static_cast<double>(n_);
     const run_detail::FlightEstimate flight = run_detail::estimate_flight<D>(
         n, volume_, run_detail::mean_volume_diameter<D>(particle_volume_, n),
@@ -509,7 +510,7 @@ class RunDriver {
   // kept: the frame belongs to the run as an uninterrupted one writes it (not the last frame
   // of a run stopped early).
   void write_trajectory_frame(bool kept = true) {
-    append_trajectory_frame(*trajectory_, engine_->export_state(/*with_zones=*/false));
+    append_trajectory_frame(*trajectory_, engine_->state_blocks(/*with_zones=*/false));
     frame_collisions_ = engine_->counters().collisions;
     frame_time_ = engine_->time();
     if (kept) frames_kept_ = trajectory_->frame_count();
@@ -682,13 +683,12 @@ class RunDriver {
   // mean (under shear: to the mean flow at the particle), sampled at production thermo rows.
   // Under shear each row also gives one sample of the shear stress P_xy: this kinetic part
   // plus the collisional one since the previous row.
-  // c: the peculiar velocities now (peculiar_velocities()), in the caller's numbering.
-  void sample_kinetic_tensor(const std::vector<Vec<D>>& c) {
+  void sample_kinetic_tensor() {
     std::array<double, 9> sample{};
-    for (std::size_t i = 0; i < n_; ++i) {
+    for_each_peculiar_velocity([&](const Vec<D>& c, double m) {
       for (int a = 0; a < D; ++a)
-        for (int b = 0; b < D; ++b) sample[a * D + b] += mass_[i] * c[i][a] * c[i][b];
-    }
+        for (int b = 0; b < D; ++b) sample[a * D + b] += m * c[a] * c[b];
+    });
     for (int k = 0; k < D * D; ++k) kinetic_tensor_sum_[k] += sample[k];
     ++kinetic_tensor_samples_;
     const double time = engine_->time();
@@ -701,26 +701,32 @@ class RunDriver {
     }
   }
 
-  // Velocities now relative to the mean: the centre-of-mass velocity, or under shear the flow
-  // at each particle's position. From the engine's records (no copy of the whole state: a
-  // thermo row of a large, short run spent 11 % of its time in export_state()).
-  std::vector<Vec<D>> peculiar_velocities() const {
-    std::vector<Vec<D>> v = engine_->current_velocities();
+  // f(c, m) for each particle in the caller's order: its velocity now relative to the mean (the
+  // centre-of-mass velocity, or under shear the flow at its position) and its mass. From the
+  // engine's records in blocks: no copy of the whole state, nor of every velocity (a thermo row
+  // of a large, short run spent 11 % of its time in export_state()).
+  template <class F>
+  void for_each_peculiar_velocity(F&& f) const {
+    if (sheared_) {
+      const std::vector<Vec<D>> v = engine_->current_velocities();
+      const ParticleSystem<D> s = engine_->export_state(/*with_zones=*/false);
+      for (std::size_t i = 0; i < n_; ++i)
+        f(v[i] - engine_->environment().streaming_velocity(s.position_at(i, s.time), s.box),
+          s.mass[i]);
+      return;
+    }
     Vec<D> mean{};
     double mass = 0.0;
-    for (std::size_t i = 0; i < n_; ++i) {
-      mean = mean + mass_[i] * v[i];
-      mass += mass_[i];
-    }
+    engine_->for_each_block([&](std::size_t, auto, auto v, auto m) {
+      for (std::size_t j = 0; j < v.size(); ++j) {
+        mean = mean + m[j] * v[j];
+        mass += m[j];
+      }
+    });
     mean = (1.0 / mass) * mean;
-    if (!sheared_) {
-      for (std::size_t i = 0; i < n_; ++i) v[i] = v[i] - mean;
-      return v;
-    }
-    const ParticleSystem<D> s = engine_->export_state(/*with_zones=*/false);
-    for (std::size_t i = 0; i < n_; ++i)
-      v[i] = v[i] - engine_->environment().streaming_velocity(s.position_at(i, s.time), s.box);
-    return v;
+    engine_->for_each_block([&](std::size_t, auto, auto v, auto m) {
+      for (std::size_t j = 0; j < v.size(); ++j) f(v[j] - mean, m[j]);
+    });
   }
 
   // The kinetic energy that makes the temperature: of the peculiar velocities under shear.
@@ -732,7 +738,7 @@ class RunDriver {
   void write_thermo_row(const std::string& phase, bool kept = true) {
     if (phase == "production") {
       if (profile_) sample_profile(engine_->export_state(/*with_zones=*/false));
-      sample_kinetic_tensor(peculiar_velocities());
+      sample_kinetic_tensor();
     }
     const auto& c = engine_->counters();
     const double u = engine_->potential_energy();
@@ -763,22 +769,21 @@ class RunDriver {
     if (!env.has_gravity()) return e;
     for (int a = 0; a < D; ++a)
       if (env.periodic(a) && env.gravity[a] != 0.0) return std::nan("");
-    const ParticleSystem<D> s = engine_->export_state(/*with_zones=*/false);
-    const std::vector<Vec<D>> x = engine_->current_positions();
-    for (std::size_t i = 0; i < n_; ++i) e -= s.mass[i] * dot(env.gravity, x[i]);
+    engine_->for_each_block([&](std::size_t, auto x, auto, auto m) {
+      for (std::size_t j = 0; j < x.size(); ++j) e -= m[j] * dot(env.gravity, x[j]);
+    });
     return e;
   }
 
   // Sonine coefficient of the velocity distribution, a2 = d/(d+2) <v^4>/<v^2>^2 - 1, with
   // velocities taken relative to the mean.
   double sonine_a2_now() const {
-    const std::vector<Vec<D>> v = peculiar_velocities();
     double m2 = 0.0, m4 = 0.0;
-    for (const Vec<D>& u : v) {
+    for_each_peculiar_velocity([&](const Vec<D>& u, double) {
       const double c2 = norm2(u);
       m2 += c2;
       m4 += c2 * c2;
-    }
+    });
     m2 /= static_cast<double>(n_);
     m4 /= static_cast<double>(n_);
     return m2 > 0.0 ? D / (D + 2.0) * m4 / (m2 * m2) - 1.0 : std::nan("");
@@ -790,10 +795,16 @@ class RunDriver {
     const Thermodynamics& th = *thermo_stats_;
     const double kT = th.temperature(ke);
     const Vec<D> p = engine_->momentum();
-    const ParticleSystem<D> state = engine_->export_state(/*with_zones=*/false);
+    // From the engine's state in blocks: no copy of the whole state beside it.
+    const StateBlocks<D> state = engine_->state_blocks(/*with_zones=*/false);
     double pscale = 0.0, dp2 = 0.0;
-    for (std::size_t i = 0; i < n_; ++i)
-      pscale += state.mass[i] * std::sqrt(norm2(state.kinematics[i].vel));
+    std::vector<double> diameters(n_);
+    state.for_each([&](const ParticleSystem<D>& part, std::size_t first) {
+      for (std::size_t j = 0; j < part.size(); ++j) {
+        pscale += part.mass[j] * std::sqrt(norm2(part.kinematics[j].vel));
+        diameters[first + j] = 2.0 * part.kinematics[j].radius;
+      }
+    });
     for (int a = 0; a < D; ++a) dp2 += (p[a] - p_start_[a]) * (p[a] - p_start_[a]);
     const double t_prod = engine_->time() - prod_start_.time;
     const std::uint64_t coll_prod = c.collisions - prod_start_.collisions;
@@ -804,9 +815,7 @@ class RunDriver {
       kT_prod = block_average(production_temperatures_).mean;
     }
     const double z_mean = th.compressibility(c.virial - prod_start_.virial, kT_prod, t_prod);
-    std::vector<double> diameters(n_);
-    for (std::size_t i = 0; i < n_; ++i) diameters[i] = 2.0 * state.kinematics[i].radius;
-    const double overlap = run_detail::current_max_overlap(*engine_, state, diameters);
+    const double overlap = run_detail::current_max_overlap(*engine_, state.globals(), diameters);
     const std::uint64_t events = c.events - events_start_;
     const std::uint64_t collisions = c.collisions - collisions_start_;
     nlohmann::json j;
@@ -1016,7 +1025,6 @@ class RunDriver {
   std::optional<EventEngine<D, Queue>> engine_;
   std::vector<SoftTableUse> tables_;  // soft spheres: the map tables in use
   std::size_t n_ = 0;
-  std::vector<double> mass_;  // per particle, the caller's numbering (masses never change)
   double volume_ = 1.0, particle_volume_ = 0.0;
   fs::path dir_;
   std::optional<ThermoWriter> thermo_;

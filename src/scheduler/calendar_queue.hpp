@@ -50,10 +50,22 @@ class CalendarQueue {
       throw std::length_error("CalendarQueue: at most 2^30 - 2 particles");
     }
     const auto n = static_cast<std::uint32_t>(times.size());
-    key_ = HugeVector<double>(times.begin(), times.end());  // fresh vectors: capacity == size
-    next_ = HugeVector<std::uint32_t>(n, kBeyond);
-    nb_ = std::bit_ceil(std::max<std::uint32_t>(1, n / kParticlesPerBucket));
-    head_ = HugeVector<std::uint32_t>(nb_, kEnd);
+    // Fresh vectors (capacity == size), or the same ones refilled when the size is unchanged
+    // (a renumbering: no second copy of them at any moment).
+    if (key_.size() == n) {
+      std::copy(times.begin(), times.end(), key_.begin());
+      std::fill(next_.begin(), next_.end(), kBeyond);
+    } else {
+      key_ = HugeVector<double>(times.begin(), times.end());
+      next_ = HugeVector<std::uint32_t>(n, kBeyond);
+    }
+    const std::uint32_t nb = std::bit_ceil(std::max<std::uint32_t>(1, n / kParticlesPerBucket));
+    if (nb != nb_ || head_.size() != nb) {
+      nb_ = nb;
+      head_ = HugeVector<std::uint32_t>(nb_, kEnd);
+    } else {
+      std::fill(head_.begin(), head_.end(), kEnd);
+    }
     heap_ = std::vector<std::uint32_t>(16);
     heap_n_ = 0;
     double tmin = kInf, sum = 0.0, count = 0.0;
