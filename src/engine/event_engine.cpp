@@ -54,8 +54,8 @@ AngularVelocity<D> from_spin(const Spin<D>& w) {
 }  // namespace
 
 template <int D, class Queue>
-EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
-                                   EngineOptions options, const Environment<D>& environment)
+EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOptions options,
+                                   const Environment<D>& environment)
     : box_(s.box),
       time_(s.time),
       counters_(s.counters),
@@ -69,6 +69,8 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
     throw InputError("the state needs a mass and a species for every particle");
   }
   build_shapes(s);
+  std::vector<double>().swap(s.mass);  // in shapes_ now
+  std::vector<std::uint32_t>().swap(s.species);
   bonds_ = s.bonds;
   bond_types_ = s.bond_types;
   setup_environment(s);
@@ -113,6 +115,9 @@ EventEngine<D, Queue>::EventEngine(const ParticleSystem<D>& s, StartMode mode,
     const Kinematics<D>& kin = s.kinematics[id_[k]];
     hot_[k] = {kin.pos, kin.vel, kin.time, has_counts ? s.collision_count[id_[k]] : 0u, 0u};
   }
+  // Read (shapes_ hold the radii): released before the queue and the renumbering take their
+  // memory (docs/performance.md, "Memory").
+  std::vector<Kinematics<D>>().swap(s.kinematics);
   restore_frozen(s, mode);
   // Spins are tracked when contacts can change them, or when the state carries them.
   if (env_.rotates() || !s.angular_velocity.empty()) {

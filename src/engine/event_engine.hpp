@@ -118,7 +118,9 @@ class EventEngine {
   // InputError if it is missing or inconsistent with the positions.
   // The environment (gravity, walls, contact laws) defaults to elastic hard spheres in a
   // periodic box.
-  explicit EventEngine(const ParticleSystem<D>& system, StartMode mode = StartMode::kPredict,
+  // Pass the state moved (std::move) to keep one copy of it in memory: its largest arrays are
+  // released as soon as they are read.
+  explicit EventEngine(ParticleSystem<D> system, StartMode mode = StartMode::kPredict,
                        EngineOptions options = {}, const Environment<D>& environment = {});
 
   // Processes the next event. Returns kNone when nothing can ever happen again.

@@ -110,6 +110,27 @@ ParticleSystem<D> to_particle_system(const InitialState<D>& init) {
   return s;
 }
 
+// The same, taking the state over: its arrays are moved or released as they are read, so that
+// the two forms of a large state are never in memory at once.
+template <int D>
+ParticleSystem<D> to_particle_system(InitialState<D>&& init) {
+  ParticleSystem<D> s;
+  s.box = init.box;
+  s.kinematics.resize(init.position.size());
+  for (std::size_t i = 0; i < init.position.size(); ++i) {
+    s.kinematics[i] = {init.position[i], init.velocity[i], 0.0, 0.5 * init.diameter[i]};
+  }
+  std::vector<std::array<double, D>>().swap(init.position);
+  std::vector<std::array<double, D>>().swap(init.velocity);
+  std::vector<double>().swap(init.diameter);
+  s.mass = std::move(init.mass);
+  s.species = std::move(init.species);
+  s.species_names = std::move(init.species_names);
+  s.bonds = std::move(init.bonds);
+  s.bond_types = std::move(init.bond_types);
+  return s;
+}
+
 // Renumbers the particles in row-major order of cells as wide as the largest diameter, so
 // particles close in space are close in memory (random insertion otherwise leaves them in
 // insertion order). Applied to generated random states; files keep their particle order. Bonds

@@ -181,7 +181,7 @@ ParticleSystem<D> build_start_state(const Config& config,
       assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
       add_shear_flow(config, init);
     }
-    return to_particle_system<D>(init);
+    return to_particle_system<D>(std::move(init));
   }
   InitialState<D> init = make_initial_state<D>(config.system, rng);
   std::array<bool, D> periodic;
@@ -190,7 +190,7 @@ ParticleSystem<D> build_start_state(const Config& config,
   check_no_overlap<D>(init, periodic, "generated initial state", /*exact=*/true);
   make_room_for_walls(config, init);
   add_shear_flow(config, init);
-  return to_particle_system<D>(init);
+  return to_particle_system<D>(std::move(init));
 }
 
 template ParticleSystem<2> build_start_state<2>(const Config&, const std::optional<fs::path>&,
