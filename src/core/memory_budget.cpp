@@ -21,7 +21,8 @@ constexpr const char* kLimitVariable = "KAIROS_MEMORY_LIMIT_BYTES";
 // Peak resident memory per particle, measured with /usr/bin/time -f %M on Release builds
 // (2026-12-02, N = 0.2 to 3.2 million, 0.2 collisions per particle, default outputs; the peak
 // includes writing restart.gsd):
-//   3D: hard spheres (fcc or random) 320-390 B, soft spheres (event integrator) 400 B,
+//   3D: hard spheres (fcc or random) 320-390 B (165 B since 2026-12-04: outputs written from
+//       the engine's arrays in blocks, docs/performance.md), soft spheres (event integrator) 400 B,
 //       DEM 510-545 B (also at packing fraction 0.4);
 //   2D: hard disks 270-290 B, soft disks (event) 335 B, DEM 405 B;
 //   a state read from a file (restart, initial state, trajectory frame): as generated (3D hard
