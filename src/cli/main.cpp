@@ -271,8 +271,8 @@ int main(int argc, char** argv) {
       "time) are simulated");
   bool overwrite = false;
   run->add_flag("--overwrite", overwrite,
-                "A new run (no --restart) may replace the outputs an earlier run left in OUTDIR "
-                "(refused otherwise)");
+                "Replace the outputs an earlier run left in OUTDIR (refused otherwise); with "
+                "--restart, those of another run (not the restart file's lineage)");
   run->footer(
       "Outputs in OUTDIR: config.toml, thermo.tsv, trajectory.gsd, restart.gsd, summary.json.\n"
       "SIGINT/SIGTERM stop after the current event and still write every output.");

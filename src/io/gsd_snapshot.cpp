@@ -1,6 +1,7 @@
 #include "io/gsd_snapshot.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -556,6 +557,10 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& bloc
       const std::vector<std::int8_t> text(progress.config.begin(), progress.config.end());
       w.write_chunk("kairos/run/config", text.size(), 1, text.data());
     }
+    if (!progress.run_id.empty()) {
+      const std::vector<std::int8_t> id(progress.run_id.begin(), progress.run_id.end());
+      w.write_chunk("kairos/run/id", id.size(), 1, id.data());
+    }
     if (progress.thermo_rows >= 0 || progress.trajectory_frames >= 0) {
       const std::int64_t outputs[2] = {progress.thermo_rows, progress.trajectory_frames};
       w.write_chunk("kairos/run/outputs", 2, 1, outputs);
@@ -797,6 +802,15 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
     if (r.find(f, "kairos/run/config")) {
       const auto text = r.read<std::int8_t>(f, "kairos/run/config");
       progress->config.assign(text.begin(), text.end());
+    }
+    if (r.find(f, "kairos/run/id")) {  // optional (files written before run ids)
+      const auto id = r.read<std::int8_t>(f, "kairos/run/id");
+      progress->run_id.assign(id.begin(), id.end());
+      const bool plain = !progress->run_id.empty() && progress->run_id.size() <= 64 &&
+                         std::all_of(progress->run_id.begin(), progress->run_id.end(), [](char c) {
+                           return std::isalnum(static_cast<unsigned char>(c));
+                         });
+      if (!plain) throw InputError("'" + path.string() + "': corrupt kairos/run/id (not a run id)");
     }
     if (r.find(f, "kairos/run/outputs")) {
       const auto outputs = require<std::int64_t>(r, f, "kairos/run/outputs", path, 2);

@@ -28,7 +28,10 @@
 //                    canonical serialisation (gsd_file.hpp, "Frame checksums"), written last
 // and verified by read_restart and read_initial_state before anything else is read; a mismatch
 // (or a format-7 file without it) is an InputError "... is damaged: checksum mismatch". Files of
-// formats 3 to 6 have no checksum and are read unverified.
+// formats 3 to 6 have no checksum and are read unverified. Format 7 files may hold
+//   kairos/run/id    int8 text: the run id (RunProgress::run_id), optional: files without it
+//                    (written before run ids) still load; a reader that ignores it loses only
+//                    the lineage check, so the format number did not change
 #pragma once
 
 #include <array>
@@ -77,6 +80,9 @@ struct RunProgress {
   // The configuration the state was run under (to_toml; kairos/run/config), so that a continued
   // run knows which of its keys changed (run/restart_plan.hpp). Empty: not recorded (older files).
   std::string config;
+  // The run's id (kairos/run/id, 32 hex digits), the lineage of its outputs: kept by every run
+  // continued from this file (run/output_directory.hpp). Empty: not recorded (older files).
+  std::string run_id;
   // The run's outputs up to this state (kairos/run/outputs), so that a run continued into the
   // same directory leaves them as one uninterrupted run would: rows and frames written after
   // this state (before an interruption) are dropped. -1: not recorded.

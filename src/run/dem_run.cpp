@@ -112,7 +112,8 @@ class DemRunDriver {
     for (const double m : start.mass) mass += m;
     check_collisions_happen(mass);
     if (plan_) print_restart_note(*plan_, restart_name_);
-    out_dir_.emplace(prepare_output_directory(config_, restart_, run_options));
+    run_id_ = lineage_run_id(restart_file, resumed_);
+    out_dir_.emplace(prepare_output_directory(config_, restart_file, resumed_.run_id, run_options));
     dir_ = out_dir_->path();
   }
 
@@ -136,7 +137,7 @@ class DemRunDriver {
 
   RunOutcome run() {
     const auto wall_start = Clock::now();
-    continuation_ = output_continuation(restart_file_, dir_, resumed_);
+    continuation_ = output_continuation(out_dir_->continues_outputs(), resumed_);
     thermo_.emplace(dir_ / "thermo.tsv", restart_, continuation_.thermo_rows);
     rows_kept_ = thermo_->rows();
     if (config_.output.trajectory) {
@@ -236,6 +237,7 @@ class DemRunDriver {
     }
     p.integrator = "dem";
     p.config = to_toml(config_);
+    p.run_id = run_id_;
     p.thermo_rows = static_cast<std::int64_t>(rows_kept_);
     p.trajectory_frames = trajectory_ ? static_cast<std::int64_t>(frames_kept_) : -1;
     p.has_thermo_mark = true;
@@ -487,6 +489,7 @@ class DemRunDriver {
     j["particles"] = n_;
     j["packing_fraction"] = particle_volume_ / volume_;
     j["number_density"] = static_cast<double>(n_) / volume_;
+    j["run_id"] = run_id_;
     j["restarted"] = restart_;
     if (plan_) j["restart"] = restart_summary(*plan_);
     j["stop_reason"] = stop_reason_;
@@ -561,6 +564,7 @@ class DemRunDriver {
   RunProgress resumed_;
   std::optional<RestartPlan> plan_;  // a restart: how it used the changed configuration
   std::optional<fs::path> restart_file_;
+  std::string run_id_;                      // the lineage of the outputs (kept by continued runs)
   std::optional<OutputDirectory> out_dir_;  // claimed (locked) while the run lasts
   OutputContinuation continuation_;
   OutputFailures outputs_;

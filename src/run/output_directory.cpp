@@ -7,12 +7,16 @@
 #include <array>
 #include <cerrno>
 #include <cstring>
+#include <fstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "io/gsd_file.hpp"
 
 namespace kairos {
 
@@ -31,9 +35,55 @@ std::string holder_of(int fd) {
   return pid.empty() ? "another run" : "another run (process " + pid + ")";
 }
 
+// The run id a file of the directory records: "" if none (an older Kairos) or unreadable.
+struct RecordedId {
+  std::string file, id;
+};
+std::vector<RecordedId> recorded_run_ids(const fs::path& dir, const fs::path& restart_file) {
+  std::vector<RecordedId> out;
+  std::error_code ec;
+  const fs::path restart = dir / "restart.gsd";
+  // The restart file continued is no evidence of what the directory holds (it may have been
+  // copied there).
+  if (fs::exists(restart, ec) && !fs::equivalent(restart, restart_file, ec)) {
+    std::string id;
+    try {
+      const gsd::Reader r(restart);
+      const std::uint64_t f = r.frame_count() == 0 ? 0 : r.frame_count() - 1;
+      if (r.frame_count() > 0 && r.find(f, "kairos/run/id")) {
+        const auto text = r.read<std::int8_t>(f, "kairos/run/id");
+        id.assign(text.begin(), text.end());
+      }
+    } catch (const std::exception&) {
+      id.clear();  // unreadable: no evidence either way
+    }
+    out.push_back({"restart.gsd", id});
+  }
+  const fs::path summary = dir / "summary.json";
+  if (fs::exists(summary, ec)) {
+    std::string id;
+    try {
+      std::ifstream in(summary);
+      const nlohmann::json j = nlohmann::json::parse(in);
+      if (j.contains("run_id") && j["run_id"].is_string()) id = j["run_id"].get<std::string>();
+    } catch (const std::exception&) {
+      id.clear();
+    }
+    out.push_back({"summary.json", id});
+  }
+  return out;
+}
+
 }  // namespace
 
-OutputDirectory::OutputDirectory(const fs::path& dir, bool continuing, bool overwrite) : dir_(dir) {
+void OutputDirectory::release() noexcept {
+  if (lock_fd_ >= 0) ::close(lock_fd_);
+  lock_fd_ = -1;
+}
+
+OutputDirectory::OutputDirectory(const fs::path& dir,
+                                 const std::optional<RestartLineage>& continuing, bool overwrite)
+    : dir_(dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec || !fs::is_directory(dir)) {
@@ -59,15 +109,64 @@ OutputDirectory::OutputDirectory(const fs::path& dir, bool continuing, bool over
   if (::ftruncate(lock_fd_, 0) != 0 || ::pwrite(lock_fd_, pid.data(), pid.size(), 0) < 0) {
     // The pid only makes the message of a refused second run nicer.
   }
-  if (continuing) return;
   std::string found;
   for (const char* name : kOutputs)
     if (fs::exists(dir / name, ec)) found += (found.empty() ? "" : ", ") + std::string(name);
   if (found.empty()) return;
+  const auto remove_outputs = [&] {
+    for (const char* name : kOutputs) {
+      // The restart file being continued stays until the continued run replaces it.
+      if (continuing && fs::equivalent(dir / name, continuing->restart_file, ec)) continue;
+      fs::remove(dir / name, ec);
+      if (ec) {
+        release();
+        throw InputError(
+            fmt::format("cannot remove '{}': {}", (dir / name).string(), ec.message()));
+      }
+    }
+  };
+  if (continuing) {
+    const RestartLineage& lineage = *continuing;
+    const fs::path home =
+        lineage.restart_file.has_parent_path() ? lineage.restart_file.parent_path() : ".";
+    const bool own_directory = fs::equivalent(home, dir, ec) && !ec;
+    std::string other;  // the first file recording another run id
+    bool matched = false;
+    for (const RecordedId& r : recorded_run_ids(dir, lineage.restart_file)) {
+      if (r.id.empty()) continue;
+      if (r.id == lineage.run_id) {
+        matched = true;
+      } else if (other.empty()) {
+        other = fmt::format("run id {} in its {}", r.id, r.file);
+      }
+    }
+    // A restart file without a run id (an older Kairos) continues its own directory's outputs.
+    if (own_directory && lineage.run_id.empty()) other.clear();
+    if (other.empty() && (matched || own_directory)) {
+      continues_ = true;
+      return;
+    }
+    if (!overwrite) {
+      release();
+      const std::string theirs =
+          other.empty() ? "a run that records no run id (an older Kairos, or a run killed before "
+                          "its first restart file), so they cannot be told to be the same run's"
+                        : "another run (" + other + ")";
+      const std::string ours = lineage.run_id.empty() ? "records no run id (an older file)"
+                                                      : "is of run " + lineage.run_id;
+      throw InputError(fmt::format(
+          "output.directory '{}' holds outputs ({}) of {}, and restart file '{}' {}: continuing "
+          "there would mix two runs' files; continue into the restart file's own directory or an "
+          "empty one (-o), or pass --overwrite to replace those outputs (the continued run then "
+          "writes them afresh from the restart point)",
+          dir.string(), found, theirs, lineage.restart_file.string(), ours));
+    }
+    remove_outputs();
+    return;
+  }
   if (!overwrite) {
     const bool restartable = fs::exists(dir / "restart.gsd", ec);
-    ::close(lock_fd_);
-    lock_fd_ = -1;
+    release();
     throw InputError(fmt::format(
         "output.directory '{}' holds the outputs of an earlier run ({}): {}write this run to "
         "another directory (-o), or pass --overwrite to replace them",
@@ -75,18 +174,16 @@ OutputDirectory::OutputDirectory(const fs::path& dir, bool continuing, bool over
         restartable ? fmt::format("continue it with --restart {}, ", (dir / "restart.gsd").string())
                     : ""));
   }
-  for (const char* name : kOutputs) {
-    fs::remove(dir / name, ec);
-    if (ec)
-      throw InputError(fmt::format("cannot remove '{}': {}", (dir / name).string(), ec.message()));
-  }
+  remove_outputs();
 }
 
 OutputDirectory::OutputDirectory(OutputDirectory&& other) noexcept
-    : dir_(std::move(other.dir_)), lock_fd_(std::exchange(other.lock_fd_, -1)) {}
+    : dir_(std::move(other.dir_)),
+      lock_fd_(std::exchange(other.lock_fd_, -1)),
+      continues_(other.continues_) {}
 
 OutputDirectory::~OutputDirectory() {
-  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock
+  release();  // releases the lock
 }
 
 }  // namespace kairos

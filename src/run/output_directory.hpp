@@ -2,19 +2,37 @@
 // run for as long as this one lasts (flock on OUTDIR/.kairos.lock: two runs writing one
 // directory would overwrite each other's files), and never holding another run's outputs
 // unless the user asks to overwrite them.
+//
+// Lineage: every run has a random run id (kairos/run/id in its restart files, run_id in
+// summary.json), kept by every run continued from its restart files. A continued run may append
+// to the outputs in a directory only when they are of its own lineage (the directory's
+// restart.gsd and summary.json carry its id); outputs of another run are refused unless
+// overwritten, so that the files of two runs are never mixed.
 #pragma once
 
 #include <filesystem>
+#include <optional>
+#include <string>
 
 namespace kairos {
 
+// A run continued from a restart file (--restart).
+struct RestartLineage {
+  std::filesystem::path restart_file;
+  std::string run_id;  // of the restart file ("": an older file that records none)
+};
+
 class OutputDirectory {
  public:
-  // `continuing`: a restart (--restart), which may append to the outputs found there.
-  // `overwrite`: a new run may replace the outputs of an earlier one (they are removed first).
+  // `continuing`: a restart, which appends to the outputs found there if they are of its own
+  // lineage (continues_outputs()), else refuses them (InputError naming the directory and both
+  // runs) unless `overwrite`. An empty directory is fine. A restart file that records no run id
+  // (older files) continues the outputs of its own directory, as before run ids.
+  // `overwrite`: the outputs of an earlier (or another) run are removed first.
   // InputError naming the directory if it cannot be created, is in use by another run, or
-  // holds an earlier run's outputs.
-  OutputDirectory(const std::filesystem::path& dir, bool continuing, bool overwrite);
+  // holds another run's outputs.
+  OutputDirectory(const std::filesystem::path& dir, const std::optional<RestartLineage>& continuing,
+                  bool overwrite);
   ~OutputDirectory();
   OutputDirectory(OutputDirectory&& other) noexcept;
   OutputDirectory& operator=(OutputDirectory&&) = delete;
@@ -22,10 +40,15 @@ class OutputDirectory {
   OutputDirectory& operator=(const OutputDirectory&) = delete;
 
   const std::filesystem::path& path() const { return dir_; }
+  // A restart whose lineage's outputs are in the directory: thermo.tsv and trajectory.gsd are
+  // cut back to the restart point and appended to. False: the directory holds no outputs (now).
+  bool continues_outputs() const { return continues_; }
 
  private:
+  void release() noexcept;
   std::filesystem::path dir_;
   int lock_fd_ = -1;
+  bool continues_ = false;
 };
 
 }  // namespace kairos

@@ -284,13 +284,15 @@ class RunDriver {
                   : run_detail::equilibration_length(config_.run),
          run_detail::production_length(config_.run)});
     if (plan_) run_detail::print_restart_note(*plan_, restart_name_);
-    out_dir_.emplace(run_detail::prepare_output_directory(config_, restart_, run_options));
+    run_id_ = run_detail::lineage_run_id(restart_file, resumed_);
+    out_dir_.emplace(
+        run_detail::prepare_output_directory(config_, restart_file, resumed_.run_id, run_options));
     dir_ = out_dir_->path();
   }
 
   RunOutcome run() {
     const auto wall_start = Clock::now();
-    continuation_ = run_detail::output_continuation(restart_file_, dir_, resumed_);
+    continuation_ = run_detail::output_continuation(out_dir_->continues_outputs(), resumed_);
     thermo_.emplace(dir_ / "thermo.tsv", restart_, continuation_.thermo_rows);
     rows_kept_ = thermo_->rows();
     if (config_.output.trajectory) {
@@ -430,6 +432,7 @@ class RunDriver {
     p.next_kick_time = driven_ ? next_kick_ : -1.0;
     if (!tables_.empty()) p.soft_table_max_speed = tables_.front().spec.max_normal_speed;
     p.config = to_toml(config_);
+    p.run_id = run_id_;
     return p;
   }
 
@@ -826,6 +829,7 @@ class RunDriver {
     j["number_density"] = static_cast<double>(n_) / volume_;
     j["integrator"] = "event";
     j["event_queue"] = engine_->queue_name();
+    j["run_id"] = run_id_;
     j["restarted"] = restart_;
     if (plan_) j["restart"] = run_detail::restart_summary(*plan_);
     j["stop_reason"] = stop_reason_;
@@ -1065,6 +1069,7 @@ class RunDriver {
   std::optional<FrozenClockWatch> clock_watch_;
   std::optional<RestartPlan> plan_;  // a restart: how it used the changed configuration
   std::optional<fs::path> restart_file_;
+  std::string run_id_;                      // the lineage of the outputs (kept by continued runs)
   std::optional<OutputDirectory> out_dir_;  // claimed (locked) while the run lasts
   run_detail::OutputContinuation continuation_;
   run_detail::OutputFailures outputs_;

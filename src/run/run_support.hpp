@@ -219,31 +219,48 @@ inline void check_restart_integrator(const std::optional<fs::path>& restart_file
                   restart_file->string(), resumed.integrator, integrator));
 }
 
+// A new run's id: 128 random bits as 32 hex digits (the lineage of its outputs,
+// run/output_directory.hpp; kept by every run continued from its restart files).
+inline std::string new_run_id() {
+  std::random_device device;
+  std::string id;
+  for (int k = 0; k < 4; ++k) id += fmt::format("{:08x}", static_cast<std::uint32_t>(device()));
+  return id;
+}
+
+// The run id of a run: the restart file's (its lineage), else a new one (a new run, or an
+// older restart file that records none).
+inline std::string lineage_run_id(const std::optional<fs::path>& restart_file,
+                                  const RunProgress& resumed) {
+  return restart_file && !resumed.run_id.empty() ? resumed.run_id : new_run_id();
+}
+
 // Claims the output directory (run/output_directory.hpp) and writes the effective
 // configuration into it (after a restart: the configuration as run, RestartPlan::used).
-inline OutputDirectory prepare_output_directory(const Config& config, bool continuing,
+// `restart_file`, `restart_run_id`: the file continued and its run id ("" : none recorded).
+inline OutputDirectory prepare_output_directory(const Config& config,
+                                                const std::optional<fs::path>& restart_file,
+                                                const std::string& restart_run_id,
                                                 const RunOptions& options) {
-  OutputDirectory dir(config.output.directory, continuing, options.overwrite);
+  std::optional<RestartLineage> lineage;
+  if (restart_file) lineage = RestartLineage{*restart_file, restart_run_id};
+  OutputDirectory dir(config.output.directory, lineage, options.overwrite);
   write_text_atomically(dir.path() / "config.toml", to_toml(config));
   return dir;
 }
 
-// Where a run continued from a restart file picks up its outputs: in the directory that holds
-// the restart file (its own run's), thermo.tsv and trajectory.gsd are cut back to the rows and
-// frames the state had written (those after it came from a run interrupted later: a continued
-// run leaves the files as one uninterrupted run would), and the next row is measured from the
-// last kept one; in another directory they continue as they are.
+// Where a run continued from a restart file picks up its outputs: in a directory holding its
+// own lineage's outputs (OutputDirectory::continues_outputs), thermo.tsv and trajectory.gsd are
+// cut back to the rows and frames the state had written (those after it came from a run
+// interrupted later: a continued run leaves the files as one uninterrupted run would), and the
+// next row is measured from the last kept one; elsewhere (no outputs there) they start afresh.
 struct OutputContinuation {
-  bool same_directory = false;
+  bool same_directory = false;  // the lineage's outputs are continued
   std::optional<std::uint64_t> thermo_rows, trajectory_frames;
 };
-inline OutputContinuation output_continuation(const std::optional<fs::path>& restart_file,
-                                              const fs::path& dir, const RunProgress& resumed) {
+inline OutputContinuation output_continuation(bool continues_outputs, const RunProgress& resumed) {
   OutputContinuation c;
-  if (!restart_file) return c;
-  std::error_code ec;
-  const fs::path home = restart_file->has_parent_path() ? restart_file->parent_path() : ".";
-  c.same_directory = fs::exists(dir, ec) && fs::equivalent(home, dir, ec) && !ec;
+  c.same_directory = continues_outputs;
   if (!c.same_directory) return c;
   if (resumed.thermo_rows >= 0) c.thermo_rows = static_cast<std::uint64_t>(resumed.thermo_rows);
   if (resumed.trajectory_frames >= 0)

@@ -61,6 +61,7 @@ Simulation<D>::Simulation(const Config& config,
   engine_ = std::make_unique<EventEngine<D, CalendarQueue>>(
       std::move(start), resume ? StartMode::kResume : StartMode::kPredict, options, environment);
   progress_.config = to_toml(config_);
+  progress_.run_id = run_detail::lineage_run_id(restart_file, progress_);
   if (plan && plan->repredict) run_detail::check_no_overlap_after_new_physics(*engine_);
   if (plan) run_detail::print_restart_note(*plan, restart_file->string());
   clock_watch_ = std::make_unique<FrozenClockWatch>(*engine_);

@@ -184,10 +184,10 @@ class RestartBookkeeping(kt.KairosTestCase):
         self.run_ok("run", cfg2, "-o", self.path("b"))
         frames = len(kt.open_trajectory(self.path("a", "trajectory.gsd")))
         # Continuing the 2D state into the 3D run's directory would append 400-particle 2D
-        # frames to a 500-particle 3D trajectory.
+        # frames to a 500-particle 3D trajectory: another run's outputs (test_run_lineage.py).
         result = self.kairos("run", cfg2, "--restart", self.path("b", "restart.gsd"),
                              "-o", self.path("a"))
-        self.assert_user_error(result, "trajectory.gsd", "another system")
+        self.assert_user_error(result, "trajectory.gsd", "another run")
         self.assertEqual(len(kt.open_trajectory(self.path("a", "trajectory.gsd"))), frames)
 
     def test_periodic_restart_files(self):

@@ -164,7 +164,7 @@ def as_older_format(path, out):
     """The restart file `path` rewritten as an older Kairos wrote it (format 6): without its
     configuration, its continuation bookkeeping and its checksum."""
     import gsd.fl
-    left_out = ("kairos/run/config", "kairos/checksum", "kairos/run/outputs",
+    left_out = ("kairos/run/config", "kairos/checksum", "kairos/run/outputs", "kairos/run/id",
                 "kairos/run/thermo_mark", "kairos/run/thermo_mark_counts", "kairos/run/schedule",
                 "kairos/run/production_target", "kairos/run/production_end_time")
     with gsd.fl.open(name=path, mode="rb") as f, \
