@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <new>
 #include <vector>
@@ -35,22 +36,40 @@ struct HugePageAllocator {
       return static_cast<T*>(::operator new (bytes, std::align_val_t{alignof(T)}));
     }
     const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+#if defined(__linux__)
+    // A mapping of its own, never memory the heap reuses: pages another array already touched
+    // stay 4 KiB pages whatever the advice (after the start state was released, a tenth of
+    // the working set at N = 10^6 came back on small pages and the run was 15 % slower).
+    void* map = mmap(nullptr, rounded + kHugePage, PROT_READ | PROT_WRITE,
+                     MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (map == MAP_FAILED) throw std::bad_alloc();
+    const auto start = reinterpret_cast<std::uintptr_t>(map);
+    const std::uintptr_t aligned = (start + kHugePage - 1) / kHugePage * kHugePage;
+    if (aligned > start) munmap(map, aligned - start);
+    const std::size_t tail = start + rounded + kHugePage - (aligned + rounded);
+    if (tail > 0) munmap(reinterpret_cast<void*>(aligned + rounded), tail);
+    void* p = reinterpret_cast<void*>(aligned);
+#if defined(MADV_HUGEPAGE) && !defined(KAIROS_NO_HUGE_PAGES)
+    madvise(p, rounded, MADV_HUGEPAGE);  // advice only: failure changes nothing
+#endif
+#else
     void* p = std::aligned_alloc(kHugePage, rounded);
     if (p == nullptr) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(KAIROS_NO_HUGE_PAGES)
-    madvise(p, rounded, MADV_HUGEPAGE);  // advice only: failure changes nothing
 #endif
     return static_cast<T*>(p);
   }
-
   void deallocate(T* p, std::size_t n) noexcept {
-    if (n * sizeof(T) < kHugePage) {
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes < kHugePage) {
       ::operator delete (p, std::align_val_t{alignof(T)});
-    } else {
-      std::free(p);
+      return;
     }
+#if defined(__linux__)
+    munmap(p, (bytes + kHugePage - 1) / kHugePage * kHugePage);
+#else
+    std::free(p);
+#endif
   }
-
   template <class U>
   bool operator==(const HugePageAllocator<U>&) const noexcept {
     return true;
