@@ -26,6 +26,7 @@
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/periodic.hpp"
+#include "core/stop_flag.hpp"
 #include "dem/dem_integrator.hpp"
 #include "init/initial_state.hpp"
 #include "io/atomic_file.hpp"
@@ -112,6 +113,10 @@ class DemRunDriver {
     for (const double m : start.mass) mass += m;
     check_collisions_happen(mass);
     if (plan_) print_restart_note(*plan_, restart_name_);
+    // The end of the setup, before anything is written: a signal or run.max_wall_seconds that
+    // came during a part that does not poll (the engine's first predictions) ends it here, as
+    // an interrupted setup (nothing written; the limit an error), not as a run.
+    throw_if_stop_requested();
     run_id_ = lineage_run_id(restart_file, resumed_);
     out_dir_.emplace(prepare_output_directory(config_, restart_file, resumed_.run_id, run_options));
     dir_ = out_dir_->path();

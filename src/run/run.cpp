@@ -13,6 +13,7 @@
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/periodic.hpp"
+#include "core/stop_flag.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
 #include "io/atomic_file.hpp"
@@ -61,7 +62,8 @@ void check_no_overlap(const InitialState<D>& init, const std::array<bool, D>& pe
     }
   }
   std::uint32_t i = 0, j = 0;
-  const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, &i, &j);
+  const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, &i, &j,
+                                      /*interruptible=*/true);
   double smallest = std::numeric_limits<double>::infinity();
   for (const double d : init.diameter) smallest = std::min(smallest, d);
   const double round_off = exact ? 1e-12 * smallest : 0.0;
@@ -88,7 +90,8 @@ void expand_away_rounding_overlaps(InitialState<D>& init, const std::array<bool,
   const double tolerance =
       std::min(8.0 * std::numeric_limits<float>::epsilon() * edge, 1e-3 * smallest);
   for (int attempt = 0; attempt < 8; ++attempt) {
-    const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter);
+    const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, nullptr,
+                                        nullptr, /*interruptible=*/true);
     if (worst == 0.0 || worst > tolerance) return;
     // Every overlapping pair has r >= sigma - worst with sigma >= smallest.
     const double factor =
@@ -285,6 +288,10 @@ class RunDriver {
                   : run_detail::equilibration_length(config_.run),
          run_detail::production_length(config_.run)});
     if (plan_) run_detail::print_restart_note(*plan_, restart_name_);
+    // The end of the setup, before anything is written: a signal or run.max_wall_seconds that
+    // came during a part that does not poll (the engine's first predictions) ends it here, as
+    // an interrupted setup (nothing written; the limit an error), not as a run.
+    throw_if_stop_requested();
     run_id_ = run_detail::lineage_run_id(restart_file, resumed_);
     out_dir_.emplace(
         run_detail::prepare_output_directory(config_, restart_file, resumed_.run_id, run_options));
