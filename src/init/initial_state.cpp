@@ -1122,10 +1122,14 @@ void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std:
   }
 }
 
-template <int D>
-double max_overlap(const std::array<double, D>& box, const std::vector<std::array<double, D>>& pos,
-                   const std::vector<double>& diameter, std::uint32_t* worst_i,
-                   std::uint32_t* worst_j, bool interruptible) {
+namespace {
+
+// The pair whose overlap scores highest by measure(overlap, d_i, d_j) (> 0 for overlap > 0)
+// over all overlapping pairs; 0 and kNoParticle when none overlaps. max_overlap's engine.
+template <int D, class Measure>
+double worst_pair(const std::array<double, D>& box, const std::vector<std::array<double, D>>& pos,
+                  const std::vector<double>& diameter, std::uint32_t* worst_i,
+                  std::uint32_t* worst_j, bool interruptible, const Measure& measure) {
   if (worst_i != nullptr) *worst_i = kNoParticle;
   if (worst_j != nullptr) *worst_j = kNoParticle;
   if (pos.size() != diameter.size()) {
@@ -1158,8 +1162,10 @@ double max_overlap(const std::array<double, D>& box, const std::vector<std::arra
     grid.for_each_neighbour(grid.coords(pos[i]), [&](std::uint32_t j) {
       if (j <= i) return false;  // each pair once: j's cell is visited once from i's cell
       const double ov = pair_overlap<D>(box, pos[i], pos[j], diameter[i], diameter[j]);
-      if (ov > worst) {
-        worst = ov;
+      if (!(ov > 0.0)) return false;
+      const double score = measure(ov, diameter[i], diameter[j]);
+      if (score > worst) {
+        worst = score;
         if (worst_i != nullptr) *worst_i = static_cast<std::uint32_t>(i);
         if (worst_j != nullptr) *worst_j = j;
       }
@@ -1172,13 +1178,13 @@ double max_overlap(const std::array<double, D>& box, const std::vector<std::arra
 // Along the bounded axes the positions are moved into a box padded by three largest diameters
 // beyond their extent, so that the periodic search sees no pair through the wrap-around (the
 // distance through it is at least 3 d_max): the same pairs and distances as without images.
-template <int D>
-double max_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
-                   const std::vector<std::array<double, D>>& pos,
-                   const std::vector<double>& diameter, std::uint32_t* worst_i,
-                   std::uint32_t* worst_j, bool interruptible) {
+template <int D, class Measure>
+double worst_pair(const std::array<double, D>& box, const std::array<bool, D>& periodic,
+                  const std::vector<std::array<double, D>>& pos,
+                  const std::vector<double>& diameter, std::uint32_t* worst_i,
+                  std::uint32_t* worst_j, bool interruptible, const Measure& measure) {
   if (std::all_of(periodic.begin(), periodic.end(), [](bool p) { return p; }) || pos.empty())
-    return max_overlap<D>(box, pos, diameter, worst_i, worst_j, interruptible);
+    return worst_pair<D>(box, pos, diameter, worst_i, worst_j, interruptible, measure);
   double dmax = 0.0;
   for (const double d : diameter) dmax = std::max(dmax, std::isfinite(d) ? d : 0.0);
   std::array<double, D> padded = box;
@@ -1195,7 +1201,42 @@ double max_overlap(const std::array<double, D>& box, const std::array<bool, D>& 
     for (auto& x : moved) x[k] = x[k] - lo + dmax;
     padded[k] = (hi - lo) + 3.0 * dmax + (dmax > 0.0 ? 0.0 : 1.0);
   }
-  return max_overlap<D>(padded, moved, diameter, worst_i, worst_j, interruptible);
+  return worst_pair<D>(padded, moved, diameter, worst_i, worst_j, interruptible, measure);
+}
+
+// Scores of worst_pair.
+inline double overlap_itself(double overlap, double, double) {
+  return overlap;
+}
+inline double overlap_per_smaller_radius(double overlap, double di, double dj) {
+  return overlap / (0.5 * std::min(di, dj));
+}
+
+}  // namespace
+
+template <int D>
+double max_overlap(const std::array<double, D>& box, const std::vector<std::array<double, D>>& pos,
+                   const std::vector<double>& diameter, std::uint32_t* worst_i,
+                   std::uint32_t* worst_j, bool interruptible) {
+  return worst_pair<D>(box, pos, diameter, worst_i, worst_j, interruptible, overlap_itself);
+}
+
+template <int D>
+double max_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
+                   const std::vector<std::array<double, D>>& pos,
+                   const std::vector<double>& diameter, std::uint32_t* worst_i,
+                   std::uint32_t* worst_j, bool interruptible) {
+  return worst_pair<D>(box, periodic, pos, diameter, worst_i, worst_j, interruptible,
+                       overlap_itself);
+}
+
+template <int D>
+double max_relative_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
+                            const std::vector<std::array<double, D>>& pos,
+                            const std::vector<double>& diameter, std::uint32_t* worst_i,
+                            std::uint32_t* worst_j, bool interruptible) {
+  return worst_pair<D>(box, periodic, pos, diameter, worst_i, worst_j, interruptible,
+                       overlap_per_smaller_radius);
 }
 
 template <int D>
@@ -1236,6 +1277,10 @@ double max_overlap_bruteforce(const std::array<double, D>& box,
                                  const std::vector<std::array<double, D>>&,                  \
                                  const std::vector<double>&, std::uint32_t*, std::uint32_t*, \
                                  bool);                                                      \
+  template double max_relative_overlap<D>(                                                   \
+      const std::array<double, D>&, const std::array<bool, D>&,                              \
+      const std::vector<std::array<double, D>>&, const std::vector<double>&, std::uint32_t*, \
+      std::uint32_t*, bool);                                                                 \
   template double max_overlap_bruteforce<D>(const std::array<double, D>&,                    \
                                             const std::vector<std::array<double, D>>&,       \
                                             const std::vector<double>&);                     \

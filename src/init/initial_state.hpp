@@ -147,6 +147,15 @@ double max_overlap(const std::array<double, D>& box, const std::array<bool, D>& 
                    const std::vector<double>& diameter, std::uint32_t* worst_i = nullptr,
                    std::uint32_t* worst_j = nullptr, bool interruptible = false);
 
+// The largest overlap as a share of the smaller radius of its pair, overlap / min(R_i, R_j)
+// (soft spheres may start overlapping by up to half of it), over the same pairs as max_overlap;
+// 0 when no pair overlaps.
+template <int D>
+double max_relative_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
+                            const std::vector<std::array<double, D>>& pos,
+                            const std::vector<double>& diameter, std::uint32_t* worst_i = nullptr,
+                            std::uint32_t* worst_j = nullptr, bool interruptible = false);
+
 // The same by an O(N^2) loop over all pairs: the reference for tests (all axes periodic unless
 // `periodic` says otherwise).
 template <int D>

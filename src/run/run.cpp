@@ -47,12 +47,9 @@ std::array<bool, D> periodic_axes(const Config& config) {
   return periodic;
 }
 
-// No pair overlaps by more than round-off. `exact`: float64 positions from a Kairos file, whose
-// last event may have left a pair in contact to within round-off (relative 1e-12 of the contact
-// distance): a contact, not an overlap.
+// The box of a state to check: finite edges > 0.
 template <int D>
-void check_no_overlap(const InitialState<D>& init, const std::array<bool, D>& periodic,
-                      const std::string& source, bool exact = false) {
+void check_box(const InitialState<D>& init, const std::string& source) {
   for (int a = 0; a < D; ++a) {
     if (!std::isfinite(init.box[a]) || !(init.box[a] > 0.0)) {
       throw InputError(
@@ -61,6 +58,16 @@ void check_no_overlap(const InitialState<D>& init, const std::array<bool, D>& pe
                       source, a, init.box[a]));
     }
   }
+}
+
+// No pair overlaps by more than round-off. `exact`: float64 positions from a Kairos file, whose
+// last event may have left a pair in contact to within round-off (relative 1e-12 of the contact
+// distance): a contact, not an overlap. `why`: what the message says of overlaps.
+template <int D>
+void check_no_overlap(const InitialState<D>& init, const std::array<bool, D>& periodic,
+                      const std::string& source, bool exact = false,
+                      std::string_view why = "hard particles must not overlap") {
+  check_box(init, source);
   std::uint32_t i = 0, j = 0;
   const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, &i, &j,
                                       /*interruptible=*/true);
@@ -69,9 +76,26 @@ void check_no_overlap(const InitialState<D>& init, const std::array<bool, D>& pe
   const double round_off = exact ? 1e-12 * smallest : 0.0;
   if (worst > round_off) {
     throw InputError(
-        fmt::format("{}: particles {} and {} overlap by {:.6g} (hard particles must "
-                    "not overlap)",
-                    source, i, j, worst));
+        fmt::format("{}: particles {} and {} overlap by {:.6g} ({})", source, i, j, worst, why));
+  }
+}
+
+// Soft spheres under the DEM may start overlapping (the force law pushes the pairs apart), by
+// at most half the smaller radius of each pair: a deeper overlap is no contact the force laws
+// are meant for (the spheres would be more inside each other than touching).
+template <int D>
+void check_soft_overlaps(const InitialState<D>& init, const std::array<bool, D>& periodic,
+                         const std::string& source) {
+  check_box(init, source);
+  std::uint32_t i = 0, j = 0;
+  const double worst = max_relative_overlap<D>(init.box, periodic, init.position, init.diameter, &i,
+                                               &j, /*interruptible=*/true);
+  if (worst > 0.5) {
+    const double smaller = 0.5 * std::min(init.diameter[i], init.diameter[j]);
+    throw InputError(fmt::format(
+        "{}: particles {} and {} overlap by {:.6g}, more than half the smaller radius ({:.6g}): "
+        "soft spheres may start overlapping by at most that; separate them further",
+        source, i, j, worst * smaller, 0.5 * smaller));
   }
 }
 
@@ -178,7 +202,20 @@ ParticleSystem<D> build_start_state(const Config& config,
     const std::array<bool, D> periodic = periodic_axes<D>(config);
     const bool exact = holds_exact_positions(path);
     if (!exact) expand_away_rounding_overlaps<D>(init, periodic);
-    check_no_overlap<D>(init, periodic, "system.initial_state '" + path.string() + "'", exact);
+    const std::string source = "system.initial_state '" + path.string() + "'";
+    if (config.soft.enabled() && config.run.integrator == "dem") {
+      check_soft_overlaps<D>(init, periodic, source);
+    } else if (config.soft.enabled()) {
+      // The event integrator maps a soft contact from its first touch (formulas.md §1.6): a
+      // pair that starts inside one has no first touch, and would collide instantaneously (its
+      // overlap's elastic energy lost), not as the force law says.
+      check_no_overlap<D>(init, periodic, source, exact,
+                          "the event integrator maps soft contacts from their first touch and "
+                          "cannot start inside one: use run.integrator = \"dem\", which accepts "
+                          "overlaps of up to half the smaller radius, or a state without overlaps");
+    } else {
+      check_no_overlap<D>(init, periodic, source, exact);
+    }
     note_ignored_system_keys(config, init.position.size(), "system.initial_state");
     if (!has_velocities) {
       assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
