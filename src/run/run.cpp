@@ -345,6 +345,9 @@ class RunDriver {
                                      continuation_.trajectory_frames,
                                      [&] { return engine_->export_state(/*with_zones=*/false); });
       frames_kept_ = trajectory_->frame_count();
+    } else {
+      frames_not_written_ =
+          run_detail::cut_back_trajectory<D>(dir_, n_, continuation_.trajectory_frames);
     }
     ke_start_ = engine_->kinetic_energy();
     u_start_ = engine_->potential_energy();
@@ -399,8 +402,12 @@ class RunDriver {
     }
     finish_outputs(stopped);
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
+    const std::string run_error = error_;  // why the run could not go on, before any write
+    const auto with_outputs = [&] {
+      return run_error.empty() ? outputs_.error : run_error + "; " + outputs_.error;
+    };
     if (outputs_.any()) {
-      error_ = error_.empty() ? outputs_.error : error_ + "; " + outputs_.error;
+      error_ = with_outputs();
       if (stop_reason_ == "completed" || stop_reason_ == "signal") stop_reason_ = "write_failed";
     }
     RunOutcome outcome;
@@ -412,7 +419,8 @@ class RunDriver {
     outputs_.attempt("summary.json", [&] {
       write_text_atomically(dir_ / "summary.json", outcome.summary.dump(2) + "\n");
     });
-    if (outputs_.failed_file("summary.json")) outcome.error = error_ + "; " + outputs_.error;
+    // outputs_.error now ends with the summary's failure (error_ holds the earlier ones).
+    if (outputs_.failed_file("summary.json")) outcome.error = with_outputs();
     return outcome;
   }
 
@@ -443,7 +451,8 @@ class RunDriver {
   RunProgress progress_now() const {
     RunProgress p;
     p.thermo_rows = static_cast<std::int64_t>(rows_kept_);
-    p.trajectory_frames = trajectory_ ? static_cast<std::int64_t>(frames_kept_) : -1;
+    p.trajectory_frames =
+        trajectory_ ? static_cast<std::int64_t>(frames_kept_) : frames_not_written_;
     p.has_thermo_mark = true;
     p.mark_time = kept_mark_.time;
     p.mark_virial = kept_mark_.virial;
@@ -945,13 +954,16 @@ class RunDriver {
     g["work_by_driving"] = c.work_by_driving - counters_start_.work_by_driving;
     g["driving_kicks"] = c.driving_kicks - counters_start_.driving_kicks;
     g["work_by_shear"] = c.work_by_shear - counters_start_.work_by_shear;
-    g["energy_start"] = energy_start_;
-    g["energy_end"] = energy;
-    run_detail::set_or_explain(
-        j, g, "energy_balance_relative", scale > 0.0 ? std::abs(balance) / scale : 0.0,
-        std::isfinite(energy) ? ""
-                              : "gravity along a periodic axis: the potential energy is unbounded",
-        "granular.energy_balance_relative");
+    const std::string unbounded =
+        std::isfinite(energy) && std::isfinite(energy_start_)
+            ? ""
+            : "gravity along a periodic axis: the potential energy is unbounded";
+    run_detail::set_or_explain(j, g, "energy_start", energy_start_, unbounded,
+                               "granular.energy_start");
+    run_detail::set_or_explain(j, g, "energy_end", energy, unbounded, "granular.energy_end");
+    run_detail::set_or_explain(j, g, "energy_balance_relative",
+                               scale > 0.0 ? std::abs(balance) / scale : 0.0, unbounded,
+                               "granular.energy_balance_relative");
     j["granular"] = g;
     if (sheared_) j["shear"] = shear_summary(kT_prod);
     return j;
@@ -1112,6 +1124,9 @@ class RunDriver {
   // Rows and frames of this directory's files that an uninterrupted run also writes, and the
   // point the last kept row ended at (what a restart file records for a continued run).
   std::uint64_t rows_kept_ = 0, frames_kept_ = 0;
+  // output.trajectory = false: the frames of the lineage's trajectory.gsd, cut back to the
+  // restart point (-1: none).
+  std::int64_t frames_not_written_ = -1;
   ThermoPoint kept_mark_;
   // The output schedule in collisions of the phase running (or last run: a restart file written
   // when it stopped records it), and that phase (0 equilibration, 1 production; -1: none yet).
