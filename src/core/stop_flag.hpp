@@ -3,7 +3,9 @@
 // SIGINT/SIGTERM handlers call request_stop() (async-signal-safe: one relaxed atomic store).
 // The run loops poll stop_requested() after each event and stop cleanly, writing every output.
 // Long setup loops (soft-sphere map tables, the collision-map integrator at setup, step tables
-// and their quadratures, random insertion) call throw_if_stop_requested() now and then: before
+// and their quadratures, random insertion, every loop over all particles that generates, sorts
+// or checks the start state) call throw_if_stop_requested() now and then, and the run drivers
+// once more at the end of the setup, before anything is written: before
 // the run has begun there is nothing to write, so they unwind with kairos::Interrupted, which
 // the front ends turn into a one-line message (the CLI: exit status 128 + signal).
 #pragma once

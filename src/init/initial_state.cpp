@@ -23,6 +23,12 @@ namespace {
 // Platform-independent random numbers (the standard distributions are implementation-defined).
 
 // Uniform in [0, 1) with 53 random bits.
+// Loops over all particles of the setup poll the stop flag every so many iterations (a few
+// milliseconds of work): SIGINT and run.max_wall_seconds end the setup of 10^7 particles too.
+inline void poll_stop(std::uint64_t i) {
+  if ((i & 0xffffu) == 0xffffu) throw_if_stop_requested();
+}
+
 double uniform01(std::mt19937_64& rng) {
   return static_cast<double>(rng() >> 11) * 0x1.0p-53;
 }
@@ -401,6 +407,7 @@ void place_on_lattice(const Layout<D>& layout, InitialState<D>& state) {
   const std::uint64_t N = state.position.size();
   const std::uint64_t whole = layout.sites / N, part = layout.sites % N;
   for (std::uint64_t i = 0; i < N; ++i) {
+    poll_stop(i);
     // Site floor(i * sites / N), without overflow (N < 2^32): occupied sites evenly spread.
     const std::uint64_t site = i * whole + (i * part) / N;
     std::uint64_t cell = site / lat.sites_per_cell;
@@ -441,7 +448,10 @@ class VoxelSampler {
       voxels *= m_[k];
     }
     live_.resize(voxels);
-    for (std::uint64_t v = 0; v < voxels; ++v) live_[v] = v;
+    for (std::uint64_t v = 0; v < voxels; ++v) {
+      poll_stop(v);
+      live_[v] = v;
+    }
   }
 
   std::size_t size() const { return live_.size(); }
@@ -553,6 +563,7 @@ class VoxelSampler {
     }
     bool too_many = false;
     for (std::size_t s = 0; s < live_.size() && !too_many; ++s) {
+      if ((s & 0xfffu) == 0xfffu) throw_if_stop_requested();  // up to 16 N voxels, 2^D children
       children(live_[s], [&](std::uint64_t id) {
         if (finer.live_.size() >= max_live) {
           too_many = true;
@@ -792,6 +803,7 @@ InitialState<D> make_chain_state(const SystemConfig& system,
   state.diameter.resize(N);
   state.mass.resize(N);
   for (std::size_t i = 0; i < N; ++i) {
+    poll_stop(i);
     state.diameter[i] = species[state.species[i]].diameter;
     state.mass[i] = species[state.species[i]].mass;
   }
@@ -934,6 +946,7 @@ InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& 
     const bool hopeless = lattice != nullptr && eta > lattice->close_packed;
     std::uint64_t needed = 0;
     for (std::uint64_t n = N + 1; !hopeless && n <= N + kScan && n < kNoParticle; ++n) {
+      poll_stop(n - N);
       const Layout<D> trial = make_layout<D>(species, n, eta, lattice);
       if (fits_lattice(trial, dmax) && fits_cell_list(trial, dmax)) {
         needed = n;
@@ -1021,6 +1034,7 @@ void sort_spatially(InitialState<D>& state) {
   const double width = *std::max_element(state.diameter.begin(), state.diameter.end());
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keys(n);
   for (std::size_t i = 0; i < n; ++i) {
+    poll_stop(i);
     std::uint64_t key = 0;
     for (int k = D - 1; k >= 0; --k) {
       const auto along =
@@ -1031,8 +1045,10 @@ void sort_spatially(InitialState<D>& state) {
     keys[i] = {key, static_cast<std::uint32_t>(i)};
   }
   std::sort(keys.begin(), keys.end());
+  throw_if_stop_requested();
   InitialState<D> sorted = state;
   for (std::size_t i = 0; i < n; ++i) {
+    poll_stop(i);
     const std::uint32_t from = keys[i].second;
     sorted.position[i] = state.position[from];
     sorted.species[i] = state.species[from];
@@ -1073,6 +1089,7 @@ void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std:
   if (N == 0) return;
   NormalSource normal;
   for (std::size_t i = 0; i < N; ++i) {
+    poll_stop(i);
     const double sd = std::sqrt(kT / state.mass[i]);
     for (int k = 0; k < D; ++k) state.velocity[i][k] = sd * normal(rng);
   }
@@ -1082,6 +1099,7 @@ void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std:
   for (int pass = 0; pass < 2; ++pass) {
     std::array<CompensatedSum, D> momentum{};
     for (std::size_t i = 0; i < N; ++i) {
+      poll_stop(i);
       for (int k = 0; k < D; ++k) momentum[k].add(state.mass[i] * state.velocity[i][k]);
     }
     for (int k = 0; k < D; ++k) {
@@ -1104,10 +1122,14 @@ void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std:
   }
 }
 
-template <int D>
-double max_overlap(const std::array<double, D>& box, const std::vector<std::array<double, D>>& pos,
-                   const std::vector<double>& diameter, std::uint32_t* worst_i,
-                   std::uint32_t* worst_j) {
+namespace {
+
+// The pair whose overlap scores highest by measure(overlap, d_i, d_j) (> 0 for overlap > 0)
+// over all overlapping pairs; 0 and kNoParticle when none overlaps. max_overlap's engine.
+template <int D, class Measure>
+double worst_pair(const std::array<double, D>& box, const std::vector<std::array<double, D>>& pos,
+                  const std::vector<double>& diameter, std::uint32_t* worst_i,
+                  std::uint32_t* worst_j, bool interruptible, const Measure& measure) {
   if (worst_i != nullptr) *worst_i = kNoParticle;
   if (worst_j != nullptr) *worst_j = kNoParticle;
   if (pos.size() != diameter.size()) {
@@ -1136,11 +1158,14 @@ double max_overlap(const std::array<double, D>& box, const std::vector<std::arra
   for (std::size_t i = 0; i < N; ++i) grid.insert(static_cast<std::uint32_t>(i), pos[i]);
   double worst = 0.0;
   for (std::size_t i = 0; i < N; ++i) {
+    if (interruptible) poll_stop(i);
     grid.for_each_neighbour(grid.coords(pos[i]), [&](std::uint32_t j) {
       if (j <= i) return false;  // each pair once: j's cell is visited once from i's cell
       const double ov = pair_overlap<D>(box, pos[i], pos[j], diameter[i], diameter[j]);
-      if (ov > worst) {
-        worst = ov;
+      if (!(ov > 0.0)) return false;
+      const double score = measure(ov, diameter[i], diameter[j]);
+      if (score > worst) {
+        worst = score;
         if (worst_i != nullptr) *worst_i = static_cast<std::uint32_t>(i);
         if (worst_j != nullptr) *worst_j = j;
       }
@@ -1153,13 +1178,13 @@ double max_overlap(const std::array<double, D>& box, const std::vector<std::arra
 // Along the bounded axes the positions are moved into a box padded by three largest diameters
 // beyond their extent, so that the periodic search sees no pair through the wrap-around (the
 // distance through it is at least 3 d_max): the same pairs and distances as without images.
-template <int D>
-double max_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
-                   const std::vector<std::array<double, D>>& pos,
-                   const std::vector<double>& diameter, std::uint32_t* worst_i,
-                   std::uint32_t* worst_j) {
+template <int D, class Measure>
+double worst_pair(const std::array<double, D>& box, const std::array<bool, D>& periodic,
+                  const std::vector<std::array<double, D>>& pos,
+                  const std::vector<double>& diameter, std::uint32_t* worst_i,
+                  std::uint32_t* worst_j, bool interruptible, const Measure& measure) {
   if (std::all_of(periodic.begin(), periodic.end(), [](bool p) { return p; }) || pos.empty())
-    return max_overlap<D>(box, pos, diameter, worst_i, worst_j);
+    return worst_pair<D>(box, pos, diameter, worst_i, worst_j, interruptible, measure);
   double dmax = 0.0;
   for (const double d : diameter) dmax = std::max(dmax, std::isfinite(d) ? d : 0.0);
   std::array<double, D> padded = box;
@@ -1176,7 +1201,42 @@ double max_overlap(const std::array<double, D>& box, const std::array<bool, D>& 
     for (auto& x : moved) x[k] = x[k] - lo + dmax;
     padded[k] = (hi - lo) + 3.0 * dmax + (dmax > 0.0 ? 0.0 : 1.0);
   }
-  return max_overlap<D>(padded, moved, diameter, worst_i, worst_j);
+  return worst_pair<D>(padded, moved, diameter, worst_i, worst_j, interruptible, measure);
+}
+
+// Scores of worst_pair.
+inline double overlap_itself(double overlap, double, double) {
+  return overlap;
+}
+inline double overlap_per_smaller_radius(double overlap, double di, double dj) {
+  return overlap / (0.5 * std::min(di, dj));
+}
+
+}  // namespace
+
+template <int D>
+double max_overlap(const std::array<double, D>& box, const std::vector<std::array<double, D>>& pos,
+                   const std::vector<double>& diameter, std::uint32_t* worst_i,
+                   std::uint32_t* worst_j, bool interruptible) {
+  return worst_pair<D>(box, pos, diameter, worst_i, worst_j, interruptible, overlap_itself);
+}
+
+template <int D>
+double max_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
+                   const std::vector<std::array<double, D>>& pos,
+                   const std::vector<double>& diameter, std::uint32_t* worst_i,
+                   std::uint32_t* worst_j, bool interruptible) {
+  return worst_pair<D>(box, periodic, pos, diameter, worst_i, worst_j, interruptible,
+                       overlap_itself);
+}
+
+template <int D>
+double max_relative_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
+                            const std::vector<std::array<double, D>>& pos,
+                            const std::vector<double>& diameter, std::uint32_t* worst_i,
+                            std::uint32_t* worst_j, bool interruptible) {
+  return worst_pair<D>(box, periodic, pos, diameter, worst_i, worst_j, interruptible,
+                       overlap_per_smaller_radius);
 }
 
 template <int D>
@@ -1205,22 +1265,27 @@ double max_overlap_bruteforce(const std::array<double, D>& box,
   return max_overlap_bruteforce<D>(box, periodic, pos, diameter);
 }
 
-#define KAIROS_INSTANTIATE(D)                                                                 \
-  template double packing_fraction<D>(const InitialState<D>&);                                \
-  template InitialState<D> make_initial_state<D>(const SystemConfig&, std::mt19937_64&);      \
-  template void assign_maxwell_boltzmann_velocities<D>(InitialState<D>&, double,              \
-                                                       std::mt19937_64&);                     \
-  template double max_overlap<D>(const std::array<double, D>&,                                \
-                                 const std::vector<std::array<double, D>>&,                   \
-                                 const std::vector<double>&, std::uint32_t*, std::uint32_t*); \
-  template double max_overlap<D>(const std::array<double, D>&, const std::array<bool, D>&,    \
-                                 const std::vector<std::array<double, D>>&,                   \
-                                 const std::vector<double>&, std::uint32_t*, std::uint32_t*); \
-  template double max_overlap_bruteforce<D>(const std::array<double, D>&,                     \
-                                            const std::vector<std::array<double, D>>&,        \
-                                            const std::vector<double>&);                      \
-  template double max_overlap_bruteforce<D>(                                                  \
-      const std::array<double, D>&, const std::array<bool, D>&,                               \
+#define KAIROS_INSTANTIATE(D)                                                                \
+  template double packing_fraction<D>(const InitialState<D>&);                               \
+  template InitialState<D> make_initial_state<D>(const SystemConfig&, std::mt19937_64&);     \
+  template void assign_maxwell_boltzmann_velocities<D>(InitialState<D>&, double,             \
+                                                       std::mt19937_64&);                    \
+  template double max_overlap<D>(                                                            \
+      const std::array<double, D>&, const std::vector<std::array<double, D>>&,               \
+      const std::vector<double>&, std::uint32_t*, std::uint32_t*, bool);                     \
+  template double max_overlap<D>(const std::array<double, D>&, const std::array<bool, D>&,   \
+                                 const std::vector<std::array<double, D>>&,                  \
+                                 const std::vector<double>&, std::uint32_t*, std::uint32_t*, \
+                                 bool);                                                      \
+  template double max_relative_overlap<D>(                                                   \
+      const std::array<double, D>&, const std::array<bool, D>&,                              \
+      const std::vector<std::array<double, D>>&, const std::vector<double>&, std::uint32_t*, \
+      std::uint32_t*, bool);                                                                 \
+  template double max_overlap_bruteforce<D>(const std::array<double, D>&,                    \
+                                            const std::vector<std::array<double, D>>&,       \
+                                            const std::vector<double>&);                     \
+  template double max_overlap_bruteforce<D>(                                                 \
+      const std::array<double, D>&, const std::array<bool, D>&,                              \
       const std::vector<std::array<double, D>>&, const std::vector<double>&);
 
 KAIROS_INSTANTIATE(2)

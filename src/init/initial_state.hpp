@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/particle_system.hpp"
+#include "core/stop_flag.hpp"
 #include "io/config.hpp"
 
 namespace kairos {
@@ -100,6 +101,7 @@ ParticleSystem<D> to_particle_system(const InitialState<D>& init) {
   s.box = init.box;
   s.kinematics.resize(init.position.size());
   for (std::size_t i = 0; i < init.position.size(); ++i) {
+    if ((i & 0xffffu) == 0xffffu) throw_if_stop_requested();  // a setup loop (core/stop_flag)
     s.kinematics[i] = {init.position[i], init.velocity[i], 0.0, 0.5 * init.diameter[i]};
   }
   s.mass = init.mass;
@@ -150,10 +152,12 @@ void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std:
 // image convention, found with a cell grid (exact: every pair that can overlap is checked).
 // Returns 0 when no pair overlaps. `worst_i` < `worst_j` (optional) receive the worst pair, or
 // kNoParticle when no pair overlaps. Positions outside [0, box) are wrapped into it.
+// `interruptible` (the setup's checks): polls throw_if_stop_requested() (core/stop_flag.hpp);
+// never during a run, whose outputs must still be written after a stop.
 template <int D>
 double max_overlap(const std::array<double, D>& box, const std::vector<std::array<double, D>>& pos,
                    const std::vector<double>& diameter, std::uint32_t* worst_i = nullptr,
-                   std::uint32_t* worst_j = nullptr);
+                   std::uint32_t* worst_j = nullptr, bool interruptible = false);
 
 // The same in a box whose axes need not all be periodic (walls or open faces): along an axis
 // with periodic[k] false no minimum image is taken (two particles at opposite faces are far
@@ -162,7 +166,16 @@ template <int D>
 double max_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
                    const std::vector<std::array<double, D>>& pos,
                    const std::vector<double>& diameter, std::uint32_t* worst_i = nullptr,
-                   std::uint32_t* worst_j = nullptr);
+                   std::uint32_t* worst_j = nullptr, bool interruptible = false);
+
+// The largest overlap as a share of the smaller radius of its pair, overlap / min(R_i, R_j)
+// (soft spheres may start overlapping by up to half of it), over the same pairs as max_overlap;
+// 0 when no pair overlaps.
+template <int D>
+double max_relative_overlap(const std::array<double, D>& box, const std::array<bool, D>& periodic,
+                            const std::vector<std::array<double, D>>& pos,
+                            const std::vector<double>& diameter, std::uint32_t* worst_i = nullptr,
+                            std::uint32_t* worst_j = nullptr, bool interruptible = false);
 
 // The same by an O(N^2) loop over all pairs: the reference for tests (all axes periodic unless
 // `periodic` says otherwise).

@@ -244,6 +244,36 @@ void verify_checksum(const gsd::Reader& r, std::uint64_t f, std::uint32_t format
       computed));
 }
 
+// A restart file without a checksum (formats 3 to 6) is at least plausible: the float32 copies
+// a restart file's standard chunks hold of each particle's mass and diameter (particles/mass,
+// particles/diameter, written from the float64 values) must be float(kairos/mass) and
+// float(2 kairos/radius). A byte changed in either copy (a flipped bit, an edit) is refused,
+// naming the particle; damage elsewhere is not seen (docs/guarantees.md).
+void check_float32_copies(const gsd::Reader& r, std::uint64_t f, const std::filesystem::path& path,
+                          std::uint32_t format, const std::vector<double>& mass,
+                          const std::vector<double>& radius) {
+  const std::size_t n = mass.size();
+  const auto copy = [&](const char* name) {
+    const auto info = r.find(f, name);
+    if (!info || info->type != gsd::Type::float32 || info->N != n || info->M != 1)
+      return std::vector<float>{};  // not there to compare (HOOMD's defaults apply)
+    return r.read<float>(f, name);
+  };
+  const std::vector<float> m32 = copy("particles/mass"), d32 = copy("particles/diameter");
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool mass_ok = m32.empty() || static_cast<float>(mass[i]) == m32[i];
+    const bool diameter_ok = d32.empty() || static_cast<float>(2.0 * radius[i]) == d32[i];
+    if (mass_ok && diameter_ok) continue;
+    throw InputError(fmt::format(
+        "restart file '{}' is damaged: particle {}: {} is {} but {} holds {} (its float32 copy); "
+        "a restart file of format {} has no checksum, and its copies of the state disagree: use "
+        "an intact copy (e.g. an earlier restart file)",
+        path.string(), i, mass_ok ? "2 x kairos/radius" : "kairos/mass",
+        mass_ok ? 2.0 * radius[i] : mass[i], mass_ok ? "particles/diameter" : "particles/mass",
+        mass_ok ? d32[i] : m32[i], format));
+  }
+}
+
 // Default name of the one bond type of a file that has bonds but no bonds/types chunk (as
 // HOOMD files written without types): that of generated chains.
 constexpr const char* kDefaultBondType = "backbone";
@@ -641,6 +671,7 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   const auto local = require<double>(r, f, "kairos/state/local_time", path, n);
   const auto radius = require<double>(r, f, "kairos/radius", path, n);
   s.mass = require<double>(r, f, "kairos/mass", path, n);
+  if (format < kFirstChecksummedFormat) check_float32_copies(r, f, path, format, s.mass, radius);
   s.species = require<std::uint32_t>(r, f, "particles/typeid", path, n);
   const auto types = r.find(f, "particles/types");
   if (!types) throw InputError("'" + path.string() + "' has no chunk 'particles/types'");

@@ -26,6 +26,7 @@
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/periodic.hpp"
+#include "core/stop_flag.hpp"
 #include "dem/dem_integrator.hpp"
 #include "init/initial_state.hpp"
 #include "io/atomic_file.hpp"
@@ -112,6 +113,10 @@ class DemRunDriver {
     for (const double m : start.mass) mass += m;
     check_collisions_happen(mass);
     if (plan_) print_restart_note(*plan_, restart_name_);
+    // The end of the setup, before anything is written: a signal or run.max_wall_seconds that
+    // came during a part that does not poll (the engine's first predictions) ends it here, as
+    // an interrupted setup (nothing written; the limit an error), not as a run.
+    throw_if_stop_requested();
     run_id_ = lineage_run_id(restart_file, resumed_);
     out_dir_.emplace(prepare_output_directory(config_, restart_file, resumed_.run_id, run_options));
     dir_ = out_dir_->path();
@@ -144,6 +149,8 @@ class DemRunDriver {
       open_trajectory<D>(trajectory_, dir_, restart_, n_, continuation_.trajectory_frames,
                          [&] { return dem_->export_state(); });
       frames_kept_ = trajectory_->frame_count();
+    } else {
+      frames_not_written_ = cut_back_trajectory<D>(dir_, n_, continuation_.trajectory_frames);
     }
     ke_start_ = dem_->kinetic_energy();
     energy_start_ = total_energy();
@@ -239,7 +246,8 @@ class DemRunDriver {
     p.config = to_toml(config_);
     p.run_id = run_id_;
     p.thermo_rows = static_cast<std::int64_t>(rows_kept_);
-    p.trajectory_frames = trajectory_ ? static_cast<std::int64_t>(frames_kept_) : -1;
+    p.trajectory_frames =
+        trajectory_ ? static_cast<std::int64_t>(frames_kept_) : frames_not_written_;
     p.has_thermo_mark = true;
     p.mark_time = kept_mark_.time;
     p.mark_virial = kept_mark_.virial;
@@ -499,7 +507,14 @@ class DemRunDriver {
                    {steps, collisions, coll_prod, dem_->time(), t_prod, wall,
                     per_particle(coll_prod), kT, ke, kT_prod, z_mean},
                    th, bulk_);
-    j["energy_drift_relative"] = ke_start_ > 0 ? std::abs(energy - energy_start_) / ke_start_ : 0.0;
+    // E includes the gravitational energy: unbounded along a periodic axis (then null).
+    const std::string field_unbounded =
+        "gravity along a periodic axis: the potential energy is unbounded";
+    const std::string unbounded =
+        std::isfinite(energy) && std::isfinite(energy_start_) ? "" : field_unbounded;
+    set_or_explain(j, j, "energy_drift_relative",
+                   ke_start_ > 0 ? std::abs(energy - energy_start_) / ke_start_ : 0.0, unbounded,
+                   "energy_drift_relative");
     j["momentum_drift"] = pscale > 0 ? std::sqrt(dp2) / pscale : 0.0;
     j["max_overlap"] = max_overlap<D>(state.box, state.periodic, x, diameters);
     j["peak_rss_bytes"] = peak_rss_bytes();
@@ -514,11 +529,13 @@ class DemRunDriver {
     d["ns_per_particle_step"] =
         steps > 0 ? 1e9 * wall / (static_cast<double>(steps) * static_cast<double>(n_)) : 0.0;
     d["potential_energy"] = dem_->potential_energy();
-    d["field_energy"] = dem_->field_energy();
+    const double field = dem_->field_energy();
+    set_or_explain(j, d, "field_energy", field, std::isfinite(field) ? "" : field_unbounded,
+                   "dem.field_energy");
     d["wall_collisions"] = dem_->wall_collisions();
     d["dissipated_energy"] = dem_->dissipated_energy() - dissipated_start_;
-    d["energy_start"] = energy_start_;
-    d["energy_end"] = energy;
+    set_or_explain(j, d, "energy_start", energy_start_, unbounded, "dem.energy_start");
+    set_or_explain(j, d, "energy_end", energy, unbounded, "dem.energy_end");
     j["dem"] = d;
     if (!granular_) return j;
     // Damping, walls or gravity: the energy budget, as the event engine reports it for
@@ -544,13 +561,10 @@ class DemRunDriver {
     g["dissipated_at_walls"] = at_walls;
     g["work_by_walls"] = by_walls;
     g["wall_collisions"] = dem_->wall_collisions();
-    g["energy_start"] = energy_start_;
-    g["energy_end"] = energy;
+    set_or_explain(j, g, "energy_start", energy_start_, unbounded, "granular.energy_start");
+    set_or_explain(j, g, "energy_end", energy, unbounded, "granular.energy_end");
     set_or_explain(j, g, "energy_balance_relative",
-                   scale > 0.0 ? std::abs(energy - energy_start_) / scale : 0.0,
-                   std::isfinite(energy)
-                       ? ""
-                       : "gravity along a periodic axis: the potential energy is unbounded",
+                   scale > 0.0 ? std::abs(energy - energy_start_) / scale : 0.0, unbounded,
                    "granular.energy_balance_relative");
     j["granular"] = g;
     return j;
@@ -570,6 +584,7 @@ class DemRunDriver {
   OutputFailures outputs_;
   // As the event driver's (run/run.cpp).
   std::uint64_t rows_kept_ = 0, frames_kept_ = 0;
+  std::int64_t frames_not_written_ = -1;  // output.trajectory = false: as the event driver's
   ThermoPoint kept_mark_;
   OutputSchedule schedule_;  // as the event driver's (run/run.cpp)
   int schedule_phase_ = -1;

@@ -13,6 +13,7 @@
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/periodic.hpp"
+#include "core/stop_flag.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
 #include "io/atomic_file.hpp"
@@ -46,12 +47,9 @@ std::array<bool, D> periodic_axes(const Config& config) {
   return periodic;
 }
 
-// No pair overlaps by more than round-off. `exact`: float64 positions from a Kairos file, whose
-// last event may have left a pair in contact to within round-off (relative 1e-12 of the contact
-// distance): a contact, not an overlap.
+// The box of a state to check: finite edges > 0.
 template <int D>
-void check_no_overlap(const InitialState<D>& init, const std::array<bool, D>& periodic,
-                      const std::string& source, bool exact = false) {
+void check_box(const InitialState<D>& init, const std::string& source) {
   for (int a = 0; a < D; ++a) {
     if (!std::isfinite(init.box[a]) || !(init.box[a] > 0.0)) {
       throw InputError(
@@ -60,16 +58,44 @@ void check_no_overlap(const InitialState<D>& init, const std::array<bool, D>& pe
                       source, a, init.box[a]));
     }
   }
+}
+
+// No pair overlaps by more than round-off. `exact`: float64 positions from a Kairos file, whose
+// last event may have left a pair in contact to within round-off (relative 1e-12 of the contact
+// distance): a contact, not an overlap. `why`: what the message says of overlaps.
+template <int D>
+void check_no_overlap(const InitialState<D>& init, const std::array<bool, D>& periodic,
+                      const std::string& source, bool exact = false,
+                      std::string_view why = "hard particles must not overlap") {
+  check_box(init, source);
   std::uint32_t i = 0, j = 0;
-  const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, &i, &j);
+  const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, &i, &j,
+                                      /*interruptible=*/true);
   double smallest = std::numeric_limits<double>::infinity();
   for (const double d : init.diameter) smallest = std::min(smallest, d);
   const double round_off = exact ? 1e-12 * smallest : 0.0;
   if (worst > round_off) {
     throw InputError(
-        fmt::format("{}: particles {} and {} overlap by {:.6g} (hard particles must "
-                    "not overlap)",
-                    source, i, j, worst));
+        fmt::format("{}: particles {} and {} overlap by {:.6g} ({})", source, i, j, worst, why));
+  }
+}
+
+// Soft spheres under the DEM may start overlapping (the force law pushes the pairs apart), by
+// at most half the smaller radius of each pair: a deeper overlap is no contact the force laws
+// are meant for (the spheres would be more inside each other than touching).
+template <int D>
+void check_soft_overlaps(const InitialState<D>& init, const std::array<bool, D>& periodic,
+                         const std::string& source) {
+  check_box(init, source);
+  std::uint32_t i = 0, j = 0;
+  const double worst = max_relative_overlap<D>(init.box, periodic, init.position, init.diameter, &i,
+                                               &j, /*interruptible=*/true);
+  if (worst > 0.5) {
+    const double smaller = 0.5 * std::min(init.diameter[i], init.diameter[j]);
+    throw InputError(fmt::format(
+        "{}: particles {} and {} overlap by {:.6g}, more than half the smaller radius ({:.6g}): "
+        "soft spheres may start overlapping by at most that; separate them further",
+        source, i, j, worst * smaller, 0.5 * smaller));
   }
 }
 
@@ -88,7 +114,8 @@ void expand_away_rounding_overlaps(InitialState<D>& init, const std::array<bool,
   const double tolerance =
       std::min(8.0 * std::numeric_limits<float>::epsilon() * edge, 1e-3 * smallest);
   for (int attempt = 0; attempt < 8; ++attempt) {
-    const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter);
+    const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, nullptr,
+                                        nullptr, /*interruptible=*/true);
     if (worst == 0.0 || worst > tolerance) return;
     // Every overlapping pair has r >= sigma - worst with sigma >= smallest.
     const double factor =
@@ -175,7 +202,20 @@ ParticleSystem<D> build_start_state(const Config& config,
     const std::array<bool, D> periodic = periodic_axes<D>(config);
     const bool exact = holds_exact_positions(path);
     if (!exact) expand_away_rounding_overlaps<D>(init, periodic);
-    check_no_overlap<D>(init, periodic, "system.initial_state '" + path.string() + "'", exact);
+    const std::string source = "system.initial_state '" + path.string() + "'";
+    if (config.soft.enabled() && config.run.integrator == "dem") {
+      check_soft_overlaps<D>(init, periodic, source);
+    } else if (config.soft.enabled()) {
+      // The event integrator maps a soft contact from its first touch (formulas.md §1.6): a
+      // pair that starts inside one has no first touch, and would collide instantaneously (its
+      // overlap's elastic energy lost), not as the force law says.
+      check_no_overlap<D>(init, periodic, source, exact,
+                          "the event integrator maps soft contacts from their first touch and "
+                          "cannot start inside one: use run.integrator = \"dem\", which accepts "
+                          "overlaps of up to half the smaller radius, or a state without overlaps");
+    } else {
+      check_no_overlap<D>(init, periodic, source, exact);
+    }
     note_ignored_system_keys(config, init.position.size(), "system.initial_state");
     if (!has_velocities) {
       assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
@@ -284,6 +324,10 @@ class RunDriver {
                   : run_detail::equilibration_length(config_.run),
          run_detail::production_length(config_.run)});
     if (plan_) run_detail::print_restart_note(*plan_, restart_name_);
+    // The end of the setup, before anything is written: a signal or run.max_wall_seconds that
+    // came during a part that does not poll (the engine's first predictions) ends it here, as
+    // an interrupted setup (nothing written; the limit an error), not as a run.
+    throw_if_stop_requested();
     run_id_ = run_detail::lineage_run_id(restart_file, resumed_);
     out_dir_.emplace(
         run_detail::prepare_output_directory(config_, restart_file, resumed_.run_id, run_options));
@@ -300,6 +344,9 @@ class RunDriver {
                                      continuation_.trajectory_frames,
                                      [&] { return engine_->state_blocks(/*with_zones=*/false); });
       frames_kept_ = trajectory_->frame_count();
+    } else {
+      frames_not_written_ =
+          run_detail::cut_back_trajectory<D>(dir_, n_, continuation_.trajectory_frames);
     }
     ke_start_ = engine_->kinetic_energy();
     u_start_ = engine_->potential_energy();
@@ -354,8 +401,12 @@ class RunDriver {
     }
     finish_outputs(stopped);
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
+    const std::string run_error = error_;  // why the run could not go on, before any write
+    const auto with_outputs = [&] {
+      return run_error.empty() ? outputs_.error : run_error + "; " + outputs_.error;
+    };
     if (outputs_.any()) {
-      error_ = error_.empty() ? outputs_.error : error_ + "; " + outputs_.error;
+      error_ = with_outputs();
       if (stop_reason_ == "completed" || stop_reason_ == "signal") stop_reason_ = "write_failed";
     }
     RunOutcome outcome;
@@ -367,7 +418,8 @@ class RunDriver {
     outputs_.attempt("summary.json", [&] {
       write_text_atomically(dir_ / "summary.json", outcome.summary.dump(2) + "\n");
     });
-    if (outputs_.failed_file("summary.json")) outcome.error = error_ + "; " + outputs_.error;
+    // outputs_.error now ends with the summary's failure (error_ holds the earlier ones).
+    if (outputs_.failed_file("summary.json")) outcome.error = with_outputs();
     return outcome;
   }
 
@@ -398,7 +450,8 @@ class RunDriver {
   RunProgress progress_now() const {
     RunProgress p;
     p.thermo_rows = static_cast<std::int64_t>(rows_kept_);
-    p.trajectory_frames = trajectory_ ? static_cast<std::int64_t>(frames_kept_) : -1;
+    p.trajectory_frames =
+        trajectory_ ? static_cast<std::int64_t>(frames_kept_) : frames_not_written_;
     p.has_thermo_mark = true;
     p.mark_time = kept_mark_.time;
     p.mark_virial = kept_mark_.virial;
@@ -910,13 +963,16 @@ class RunDriver {
     g["work_by_driving"] = c.work_by_driving - counters_start_.work_by_driving;
     g["driving_kicks"] = c.driving_kicks - counters_start_.driving_kicks;
     g["work_by_shear"] = c.work_by_shear - counters_start_.work_by_shear;
-    g["energy_start"] = energy_start_;
-    g["energy_end"] = energy;
-    run_detail::set_or_explain(
-        j, g, "energy_balance_relative", scale > 0.0 ? std::abs(balance) / scale : 0.0,
-        std::isfinite(energy) ? ""
-                              : "gravity along a periodic axis: the potential energy is unbounded",
-        "granular.energy_balance_relative");
+    const std::string unbounded =
+        std::isfinite(energy) && std::isfinite(energy_start_)
+            ? ""
+            : "gravity along a periodic axis: the potential energy is unbounded";
+    run_detail::set_or_explain(j, g, "energy_start", energy_start_, unbounded,
+                               "granular.energy_start");
+    run_detail::set_or_explain(j, g, "energy_end", energy, unbounded, "granular.energy_end");
+    run_detail::set_or_explain(j, g, "energy_balance_relative",
+                               scale > 0.0 ? std::abs(balance) / scale : 0.0, unbounded,
+                               "granular.energy_balance_relative");
     j["granular"] = g;
     if (sheared_) j["shear"] = shear_summary(kT_prod);
     return j;
@@ -1076,6 +1132,9 @@ class RunDriver {
   // Rows and frames of this directory's files that an uninterrupted run also writes, and the
   // point the last kept row ended at (what a restart file records for a continued run).
   std::uint64_t rows_kept_ = 0, frames_kept_ = 0;
+  // output.trajectory = false: the frames of the lineage's trajectory.gsd, cut back to the
+  // restart point (-1: none).
+  std::int64_t frames_not_written_ = -1;
   ThermoPoint kept_mark_;
   // The output schedule in collisions of the phase running (or last run: a restart file written
   // when it stopped records it), and that phase (0 equilibration, 1 production; -1: none yet).

@@ -165,6 +165,18 @@ RestartPlan plan_continuation(const Config& config, ParticleSystem<D>& state,
   return plan;
 }
 
+// An InputError from setting up a restored state (its environment, the engine, the overlap
+// check) as the drivers report it: naming the restart file and, under new physics, the keys
+// that changed.
+inline InputError restart_setup_error(const InputError& e, const fs::path& restart_file,
+                                      const RestartPlan& plan) {
+  if (plan.repredict && plan.stored_config) {
+    return InputError(fmt::format("restart file '{}' continued with new physics ({}): {}",
+                                  restart_file.string(), fmt::join(plan.changed, ", "), e.what()));
+  }
+  return InputError("restart file '" + restart_file.string() + "': " + e.what());
+}
+
 // The note on stderr about a restart whose configuration changed (once it is set up).
 inline void print_restart_note(const RestartPlan& plan, const std::string& restart_file) {
   const std::string note = describe_restart(plan, restart_file);
@@ -283,6 +295,23 @@ void open_trajectory(std::optional<gsd::Writer>& writer, const fs::path& dir, bo
     writer.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
     append_trajectory_frame(*writer, first_frame());
   }
+}
+
+// A continued run that writes no trajectory (output.trajectory = false) still cuts its lineage's
+// trajectory.gsd in `dir` back to the `keep_frames` frames written up to the restart point, so
+// that no frame past it is left (the next continuation with a trajectory appends after them).
+// Returns the frames the file then holds, -1 when there is no file or nothing to keep recorded.
+template <int D>
+std::int64_t cut_back_trajectory(const fs::path& dir, std::size_t n,
+                                 std::optional<std::uint64_t> keep_frames) {
+  const fs::path traj = dir / "trajectory.gsd";
+  std::error_code ec;
+  if (!keep_frames || !fs::exists(traj, ec)) return -1;
+  check_same_trajectory(traj, n, D, dir);
+  gsd::Writer writer = gsd::Writer::open_append(traj, *keep_frames);
+  const auto frames = static_cast<std::int64_t>(writer.frame_count());
+  writer.close();
+  return frames;
 }
 
 // The outputs of a run whose writing failed (a full disk, a size limit): a failed write stops

@@ -46,23 +46,28 @@ Simulation<D>::Simulation(const Config& config,
   species_ = start.species;
   species_names_ = start.species_names;
   for (int a = 0; a < D; ++a) volume_ *= start.box[a];
-  Environment<D> environment = make_environment<D>(config_, start);
-  if (environment.soft_spheres() && config_.soft.tables) {
-    // The tables `kairos run` would use (the same speeds covered: the same maps, bit for bit).
-    SoftTableSettings settings;
-    settings.tolerance = config_.soft.table_tolerance;
-    settings.cache_dir = config_.soft.table_cache;
-    settings.max_speed = progress_.soft_table_max_speed;
-    const std::vector<SoftTableUse> tables = attach_soft_tables(environment, start, settings);
-    if (!tables.empty()) progress_.soft_table_max_speed = tables.front().spec.max_normal_speed;
+  try {
+    Environment<D> environment = make_environment<D>(config_, start);
+    if (environment.soft_spheres() && config_.soft.tables) {
+      // The tables `kairos run` would use (the same speeds covered: the same maps, bit for bit).
+      SoftTableSettings settings;
+      settings.tolerance = config_.soft.table_tolerance;
+      settings.cache_dir = config_.soft.table_cache;
+      settings.max_speed = progress_.soft_table_max_speed;
+      const std::vector<SoftTableUse> tables = attach_soft_tables(environment, start, settings);
+      if (!tables.empty()) progress_.soft_table_max_speed = tables.front().spec.max_normal_speed;
+    }
+    EngineOptions options;
+    options.defer_soft_releases = config_.soft.defer_releases;
+    engine_ = std::make_unique<EventEngine<D, CalendarQueue>>(
+        std::move(start), resume ? StartMode::kResume : StartMode::kPredict, options, environment);
+    progress_.config = to_toml(config_);
+    progress_.run_id = run_detail::lineage_run_id(restart_file, progress_);
+    if (plan && plan->repredict) run_detail::check_no_overlap_after_new_physics(*engine_);
+  } catch (const InputError& e) {
+    if (!plan) throw;
+    throw run_detail::restart_setup_error(e, *restart_file, *plan);
   }
-  EngineOptions options;
-  options.defer_soft_releases = config_.soft.defer_releases;
-  engine_ = std::make_unique<EventEngine<D, CalendarQueue>>(
-      std::move(start), resume ? StartMode::kResume : StartMode::kPredict, options, environment);
-  progress_.config = to_toml(config_);
-  progress_.run_id = run_detail::lineage_run_id(restart_file, progress_);
-  if (plan && plan->repredict) run_detail::check_no_overlap_after_new_physics(*engine_);
   if (plan) run_detail::print_restart_note(*plan, restart_file->string());
   clock_watch_ = std::make_unique<FrozenClockWatch>(*engine_);
   // A saved state continues with production.

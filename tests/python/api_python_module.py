@@ -272,6 +272,20 @@ class Module(kt.KairosTestCase):
             self.assertIn(needle, str(caught.exception))
         self.assertTrue(issubclass(kairos.InputError, ValueError))
 
+    def test_restart_errors_name_the_file_and_the_keys(self):
+        # As `kairos run` says them: the restart file, and under new physics the keys changed.
+        cfg = self.write_config(hard_config(time=0.5))
+        restart = self.path("state.gsd")
+        kairos.Simulation(cfg).save(restart)
+        walls = 'boundary.wall=[{face="z-"}, {face="z+"}]'
+        with self.assertRaises(kairos.InputError) as caught:
+            kairos.Simulation(cfg, restart=restart, set=[walls])
+        message = str(caught.exception)
+        for needle in (restart, "new physics", "boundary.wall[0]", "overlaps the wall"):
+            self.assertIn(needle, message)
+        cli = self.kairos("run", cfg, "--restart", restart, "-o", self.path("cli"), "--set", walls)
+        self.assertEqual(cli.stderr.strip(), "kairos: error: " + message)
+
     def test_arguments_of_the_wrong_type_raise_type_errors(self):
         # Not pybind11's "Unable to cast Python instance" RuntimeError: a TypeError naming the
         # argument and what was given.

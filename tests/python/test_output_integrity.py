@@ -155,6 +155,33 @@ class FailedWrites(kt.KairosTestCase):
         del line
 
 
+    def test_each_failure_is_reported_once(self):
+        # thermo.tsv fails first (a file size limit), then summary.json (a directory in its
+        # place): the error names each failure once, in order.
+        config = kt.base_config(particles=300, packing_fraction=0.3, seed=3, production=2.0)
+        config["output"].update({"thermo_interval": 0.01, "trajectory": False})
+        cfg = self.write_config(config)
+        out = self.path("out")
+        self.run_ok("run", cfg, "-o", out)
+        os.remove(os.path.join(out, "summary.json"))
+        os.makedirs(os.path.join(out, "summary.json", "in-the-way"))
+        limit = os.path.getsize(os.path.join(out, "thermo.tsv")) + 20000
+
+        def limit_file_size():
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+        result = subprocess.run([kt.KAIROS, "run", cfg, "--restart",
+                                 os.path.join(out, "restart.gsd"), "-o", out,
+                                 "--set", "run.collisions_per_particle=500"],
+                                cwd=self.tmp, capture_output=True, text=True, timeout=300,
+                                preexec_fn=limit_file_size)
+        line = self.assert_user_error(result, "thermo.tsv", "File too large", "summary.json")
+        self.assertEqual(line.count("thermo.tsv"), 1, line)
+        self.assertEqual(line.count("summary.json"), 1, line)
+        self.assertLess(line.index("thermo.tsv"), line.index("summary.json"), line)
+
+
 class OutputDirectories(kt.KairosTestCase):
     def test_a_directory_in_use_is_refused(self):
         config = kt.base_config(particles=4000, packing_fraction=0.4, production=100000.0)

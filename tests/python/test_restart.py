@@ -102,10 +102,11 @@ class RestartBookkeeping(kt.KairosTestCase):
         self.assertEqual(phases, {"production"}, "a restart must not equilibrate again")
 
     def test_interrupted_equilibration_is_resumed(self):
-        # The wall-time limit is checked every 16384 events: with a limit of 0.1 ms the run
-        # stops at event 16384, deep inside 200 collisions per particle of equilibration.
-        cfg = kt.base_config(particles=500, packing_fraction=0.4, equilibration=200.0,
-                             production=5.0, run={"max_wall_seconds": 0.0001})
+        # A wall-time limit of 0.3 s, far beyond the setup (a limit reached during the setup
+        # is an error, test_signals.py), stops the run deep inside 20000 collisions per particle
+        # of equilibration (several seconds).
+        cfg = kt.base_config(particles=500, packing_fraction=0.4, equilibration=20000.0,
+                             production=5.0, run={"max_wall_seconds": 0.3})
         first = self.write_config(cfg, "first.toml")
         self.run_ok("run", first, "-o", self.path("a"))
         stopped = self.summary(self.path("a"))
@@ -119,7 +120,7 @@ class RestartBookkeeping(kt.KairosTestCase):
                     "-o", self.path("b"))
         done = self.summary(self.path("b"))
         # The rest of the equilibration, then the whole production.
-        self.assertEqual(done["event_counts"]["total_collisions_since_start"], (200 + 5) * 250)
+        self.assertEqual(done["event_counts"]["total_collisions_since_start"], (20000 + 5) * 250)
         self.assertEqual(done["production_collisions_per_particle"], 5.0)
         _, rows, _ = kt.read_thermo(self.path("b", "thermo.tsv"))
         self.assertEqual(rows[0][0], "equilibration")

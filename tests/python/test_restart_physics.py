@@ -200,6 +200,28 @@ class OlderRestartFiles(Continuations):
         s = self.assert_mode(result, "same", "new_physics")
         self.assertLess(s["energy_drift_relative"], 1e-12)
 
+    def damaged_older_file(self, chunk, particle, byte):
+        """An older file (no checksum) with one byte of a particle's float64 `chunk` flipped
+        (little-endian: byte 6 holds the top bits of the mantissa)."""
+        restart = as_older_format(self.base(hard_spheres()), self.path("old.gsd"))
+        chunks = kt.read_frame_chunks(restart)
+        values = chunks[chunk].copy()
+        values.view(np.uint8)[8 * particle + byte] ^= 0x10
+        chunks[chunk] = values
+        return kt.write_frame_chunks(restart, chunks, reseal=False)
+
+    def test_a_byte_flipped_in_the_mass_of_an_older_file_is_refused(self):
+        restart = self.damaged_older_file("kairos/mass", 37, 6)
+        result = self.continue_with(hard_spheres(), restart, "damaged")
+        self.assert_user_error(result, restart, "is damaged", "particle 37", "kairos/mass",
+                               "particles/mass", "format 6")
+
+    def test_a_byte_flipped_in_the_radius_of_an_older_file_is_refused(self):
+        restart = self.damaged_older_file("kairos/radius", 5, 6)
+        result = self.continue_with(hard_spheres(), restart, "damaged")
+        self.assert_user_error(result, restart, "is damaged", "particle 5", "kairos/radius",
+                               "particles/diameter")
+
     def test_walls_added_to_an_older_file_are_refused(self):
         restart = as_older_format(self.base(hard_spheres()), self.path("old.gsd"))
         result = self.continue_with(hard_spheres(), restart, "walls",

@@ -112,6 +112,26 @@ class ContinuedIntoADirectory(kt.KairosTestCase):
         row_times = [row[1] for row in kt.read_thermo(os.path.join(self.a, "thermo.tsv"))[1]]
         self.assertEqual(row_times, sorted(set(row_times)))
 
+    def test_a_continuation_without_a_trajectory_cuts_it_back_to_the_restart_point(self):
+        # The run extended to t = 4, then continued again from its state at t = 2 with
+        # output.trajectory = false: the frames after t = 2 are the extension's and must go.
+        saved = self.path("saved")
+        os.mkdir(saved)
+        shutil.copy(self.restart, os.path.join(saved, "restart.gsd"))
+        at_restart = frame_times(os.path.join(self.a, "trajectory.gsd"))
+        self.run_ok("run", self.cfg, "--restart", self.restart, "-o", self.a)
+        self.assertGreater(len(frame_times(os.path.join(self.a, "trajectory.gsd"))),
+                           len(at_restart))
+        self.run_ok("run", self.cfg, "--restart", os.path.join(saved, "restart.gsd"), "-o", self.a,
+                    "--set", "output.trajectory=false")
+        self.assertEqual(frame_times(os.path.join(self.a, "trajectory.gsd")), at_restart)
+        # Its restart file records those frames, for the next continuation.
+        outputs = kt.restart_chunk(self.restart, "kairos/run/outputs")
+        self.assertEqual(int(outputs[1]), len(at_restart))
+        # The rows of thermo.tsv were cut back as well, and continued to t = 4 once.
+        rows = kt.read_thermo(os.path.join(self.a, "thermo.tsv"))[1]
+        self.assertEqual(len(rows), 40)
+
     def test_an_older_restart_file_without_a_run_id_still_continues_its_directory(self):
         chunks = kt.read_frame_chunks(self.restart)
         del chunks["kairos/run/id"]

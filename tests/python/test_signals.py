@@ -2,8 +2,9 @@
 128 + signal number; the restart file it leaves continues the run. Also the wall-time limit
 (status 0, stop_reason "wall_time_limit") and a hard kill (SIGKILL) between periodic restart
 files, which must leave the last restart file and the trajectory readable. During the setup (a
-soft-sphere table build of a minute) a signal ends the process within a second or two with
-128 + signal and one line, and run.max_wall_seconds stops it there too (status 2).
+soft-sphere table build of a minute, or the setup of a million particles at any moment) a
+signal ends the process within a second or two with 128 + signal and one line, and
+run.max_wall_seconds stops it there too (status 2).
 """
 
 import math
@@ -263,6 +264,95 @@ class InterruptSetup(kt.KairosTestCase):
         self.assertIn("kairos: error: run.max_wall_seconds", stderr)
         self.assertIn("1 s was reached", stderr)
         self.assertFalse(os.path.exists(self.path("out", "summary.json")))
+
+
+def large_random_config():
+    """A million spheres inserted at random: a setup of a few seconds (insertion, the spatial
+    sort, the overlap check, the velocities, the engine's first predictions) and a run of a few
+    hundred collisions after it."""
+    config = kt.base_config(particles=1000000, packing_fraction=0.1, lattice="random",
+                            production=0.0002)
+    config["output"]["trajectory"] = False
+    return config
+
+
+class InterruptLargeSetup(kt.KairosTestCase):
+    """Every long loop of the setup polls the stop flag (core/stop_flag.hpp): a signal or
+    run.max_wall_seconds at any moment of it ends the process at once, with nothing written.
+    The moments are shares of the setup's duration, measured first (until config.toml, written
+    when the setup is done); a moment that turns out to come after the setup (config.toml
+    written before it) proves nothing and is skipped, one before it must stop the setup."""
+
+    def setUp(self):
+        super().setUp()
+        self.cfg = self.write_config(large_random_config())
+        out = self.path("measured")
+        started = time.time()
+        proc = subprocess.Popen([kt.KAIROS, "run", self.cfg, "-o", out], cwd=self.tmp,
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.addCleanup(Interrupt.reap, proc)
+        while not os.path.exists(os.path.join(out, "config.toml")):
+            self.assertIsNone(proc.poll(), "the measuring run failed")
+            time.sleep(0.002)
+        self.setup_seconds = time.time() - started
+        proc.wait(timeout=120)
+
+    def start(self, out, *extra):
+        proc = subprocess.Popen([kt.KAIROS, "run", self.cfg, "-o", out] + list(extra),
+                                cwd=self.tmp, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True)
+        self.addCleanup(Interrupt.reap, proc)
+        return proc
+
+    def setup_ended_before(self, out, moment):
+        config = os.path.join(out, "config.toml")
+        return os.path.exists(config) and os.stat(config).st_mtime < moment
+
+    def test_sigint_at_any_moment_of_the_setup(self):
+        conclusive = 0
+        for share in (0.3, 0.6, 0.75, 0.85, 0.92):
+            with self.subTest(share=share):
+                out = self.path("out-%g" % share)
+                proc = self.start(out)
+                time.sleep(share * self.setup_seconds)
+                sent = time.time()
+                proc.send_signal(signal.SIGINT)
+                try:
+                    _, stderr = proc.communicate(timeout=30)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                    self.fail("kairos did not stop after SIGINT")
+                latency = time.time() - sent
+                if self.setup_ended_before(out, sent):
+                    continue  # the signal came during the run
+                conclusive += 1
+                self.assertFalse(os.path.exists(out),
+                                 "the setup went on after SIGINT and wrote outputs (%s)" %
+                                 (os.listdir(out) if os.path.isdir(out) else out))
+                self.assertEqual(proc.returncode, 130, stderr)
+                self.assertTrue(stderr.startswith("kairos: interrupted by SIGINT before the run "
+                                                  "started"), stderr)
+                self.assertLess(latency, 2.0 * kt.SLOWDOWN, "SIGINT took %.2f s" % latency)
+        self.assertGreaterEqual(conclusive, 3, "too few signals came during the setup")
+
+    def test_a_wall_time_limit_reached_late_in_the_setup_is_an_error(self):
+        conclusive = 0
+        for share in (0.7, 0.85, 0.95):
+            with self.subTest(share=share):
+                out = self.path("out-%g" % share)
+                limit = share * self.setup_seconds
+                started = time.time()
+                proc = self.start(out, "--set", "run.max_wall_seconds=%r" % limit)
+                _, stderr = proc.communicate(timeout=60)
+                if self.setup_ended_before(out, started + limit):
+                    continue  # this time the setup was quicker than the limit
+                conclusive += 1
+                self.assertEqual(proc.returncode, 2, "a limit reached during the setup: %s\n%s"
+                                 % (kt.signal_name(proc.returncode), stderr))
+                self.assertIn("kairos: error: run.max_wall_seconds", stderr)
+                self.assertIn("during its setup", stderr)
+                self.assertFalse(os.path.exists(out), "outputs written after the limit")
+        self.assertGreaterEqual(conclusive, 1, "the setup was always quicker than the limit")
 
 
 if __name__ == "__main__":

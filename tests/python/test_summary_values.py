@@ -127,7 +127,48 @@ def finite_or_null(value, path=""):
         yield path
 
 
+def nulls(value, path=""):
+    """The dotted paths of every null in a JSON tree (summary.json's own notation: no leading
+    dot, list items as [k])."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            yield from nulls(v, (path + "." if path else "") + k)
+    elif isinstance(value, list):
+        for k, v in enumerate(value):
+            yield from nulls(v, "%s[%d]" % (path, k))
+    elif value is None:
+        yield path
+
+
 class SummaryValues(kt.KairosTestCase):
+    def assert_every_null_explained(self, s):
+        undefined = s.get("undefined", {})
+        for path in nulls(s):
+            # compressibility.mean is explained as "compressibility" (its own key), the rest
+            # under their dotted paths.
+            key = {"compressibility.mean": "compressibility",
+                   "compressibility.stderr": "compressibility_stderr"}.get(path, path)
+            self.assertIn(key, undefined, "%s is null without a reason" % path)
+            self.assertTrue(undefined[key], path)
+
+    def test_gravity_along_a_periodic_axis_explains_every_null(self):
+        # The gravitational energy of a periodic axis is unbounded: the energies and the budget
+        # are null, each with its reason; so for the DEM is its energy drift.
+        event = kt.base_config(particles=300, packing_fraction=0.1, lattice="random",
+                               production=2.0, field={"gravity": [0.0, 0.0, -1.0]})
+        dem = json.loads(json.dumps(event))
+        dem["soft"] = {"model": "dashpot", "stiffness": 1e4, "restitution": 0.9}
+        dem["run"]["integrator"] = "dem"
+        for name, config in (("event", event), ("dem", dem)):
+            with self.subTest(name):
+                s, _ = self.run_summary(config, name)
+                self.assertIsNone(s["granular"]["energy_end"])
+                self.assertIn("periodic axis", s["undefined"]["granular.energy_end"])
+                if name == "dem":
+                    self.assertIsNone(s["energy_drift_relative"])
+                    self.assertIsNone(s["dem"]["energy_start"])
+                self.assert_every_null_explained(s)
+
     def run_summary(self, config, name="out", *args):
         out = self.path(name)
         result = self.run_ok("run", self.write_config(config, name + ".toml"), "-o", out, *args)

@@ -128,21 +128,24 @@ class TimeLengths(kt.KairosTestCase):
         self.assertEqual(len(frame_times(out)), 4)  # 0, 0.3, 0.6 and 0.9
 
     def test_an_interrupted_equilibration_in_time_resumes_exactly(self):
-        # Stopped at its first output (wall-time limit), continued, against one run: the end of
-        # the equilibration is recorded, not recomputed as time + remaining (1 ulp off here).
+        # Stopped at an output inside the equilibration (a wall-time limit of 0.3 s, far beyond
+        # the setup: a limit reached during the setup is an error), continued, against one run:
+        # the end of the equilibration is recorded, not recomputed as time + remaining (which
+        # is off by an ulp for most stops, e.g. 0.7 + (27.2 - 0.7) is not 27.2 in doubles).
         for integrator in ("event", "dem"):
             with self.subTest(integrator=integrator):
                 if integrator == "event":
-                    # Stopped at 0.7: 0.7 + (2.72 - 0.7) is not 2.72 in doubles.
-                    config = timed_config(1.3, 2.72, output={"thermo_interval": 0.7,
+                    config = timed_config(1.3, 27.2, output={"thermo_interval": 0.7,
                                                              "trajectory_interval": 1.4})
+                    config["system"]["particles"] = 20000
                 else:
                     config = soft_dem_config(0.5, output={"thermo_interval": 0.25,
                                                           "trajectory_interval": 0.25})
-                    config["run"]["equilibration_time"] = 0.5
+                    # 500 / dt = 714285.7: the equilibration ends 0.7 of a step past its end.
+                    config["run"]["equilibration_time"] = 500.0
                 cfg = self.write_config(config, integrator + ".toml")
                 first, second, whole = (self.path(integrator + x) for x in ("1", "2", "w"))
-                self.run_ok("run", cfg, "-o", first, "--set", "run.max_wall_seconds=1e-9")
+                self.run_ok("run", cfg, "-o", first, "--set", "run.max_wall_seconds=0.3")
                 self.assertEqual(self.summary(first)["stop_reason"], "wall_time_limit")
                 self.run_ok("run", cfg, "--restart", os.path.join(first, "restart.gsd"),
                             "-o", second)
@@ -161,10 +164,13 @@ class TimeLengths(kt.KairosTestCase):
                 self.assertEqual(rows[0], rows[1])
 
     def test_an_unfinished_equilibration_continues_in_its_own_unit(self):
-        config = kt.base_config(equilibration=50.0, production=10.0)
+        # Stopped by a wall-time limit of 0.3 s inside a long equilibration (beyond the setup:
+        # a limit reached during the setup is an error).
+        config = kt.base_config(equilibration=1e6, production=10.0)
         cfg = self.write_config(config)
         first = self.path("first")
-        self.run_ok("run", cfg, "-o", first, "--set", "run.max_wall_seconds=1e-9")
+        self.run_ok("run", cfg, "-o", first, "--set", "run.max_wall_seconds=0.3")
+        self.assertEqual(self.summary(first)["stop_reason"], "wall_time_limit")
         result = self.kairos("run", cfg, "--restart", os.path.join(first, "restart.gsd"),
                              "-o", self.path("second"), "--set", "run.equilibration_time=1.0")
         self.assert_user_error(result, "restart.gsd", "collisions per particle",
