@@ -94,32 +94,16 @@ template <int D>
 InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& rng);
 
 // The engine's starting state: every particle at time 0 with radius = diameter / 2, no
-// scheduler state (the engine predicts every event).
-template <int D>
-ParticleSystem<D> to_particle_system(const InitialState<D>& init) {
-  ParticleSystem<D> s;
-  s.box = init.box;
-  s.kinematics.resize(init.position.size());
-  for (std::size_t i = 0; i < init.position.size(); ++i) {
-    if ((i & 0xffffu) == 0xffffu) throw_if_stop_requested();  // a setup loop (core/stop_flag)
-    s.kinematics[i] = {init.position[i], init.velocity[i], 0.0, 0.5 * init.diameter[i]};
-  }
-  s.mass = init.mass;
-  s.species = init.species;
-  s.species_names = init.species_names;
-  s.bonds = init.bonds;
-  s.bond_types = init.bond_types;
-  return s;
-}
-
-// The same, taking the state over: its arrays are moved or released as they are read, so that
-// the two forms of a large state are never in memory at once.
+// scheduler state (the engine predicts every event). Takes the state over: its arrays are moved
+// or released as they are read, so that the two forms of a large state are never in memory at
+// once (pass a copy to keep it).
 template <int D>
 ParticleSystem<D> to_particle_system(InitialState<D>&& init) {
   ParticleSystem<D> s;
   s.box = init.box;
   s.kinematics.resize(init.position.size());
   for (std::size_t i = 0; i < init.position.size(); ++i) {
+    if ((i & 0xffffu) == 0xffffu) throw_if_stop_requested();  // a setup loop (core/stop_flag)
     s.kinematics[i] = {init.position[i], init.velocity[i], 0.0, 0.5 * init.diameter[i]};
   }
   std::vector<std::array<double, D>>().swap(init.position);
@@ -131,6 +115,11 @@ ParticleSystem<D> to_particle_system(InitialState<D>&& init) {
   s.bonds = std::move(init.bonds);
   s.bond_types = std::move(init.bond_types);
   return s;
+}
+
+template <int D>
+ParticleSystem<D> to_particle_system(const InitialState<D>& init) {
+  return to_particle_system<D>(InitialState<D>(init));
 }
 
 // Renumbers the particles in row-major order of cells as wide as the largest diameter, so
