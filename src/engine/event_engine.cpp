@@ -472,6 +472,7 @@ std::uint64_t EventEngine<D, Queue>::next_renumber_after(std::uint64_t collision
 template <int D, class Queue>
 void EventEngine<D, Queue>::renumber(bool queue_filled) {
   const auto n = static_cast<std::uint32_t>(size());
+  block_order_.reset();  // id_ changes
   // order[k]: the present index of the particle that moves to k, sorted by (Morton rank of its
   // cell, present index). In place, with 16 bytes per particle of scratch at most: the arrays
   // are not copied (docs/performance.md, "Memory").
@@ -1531,16 +1532,44 @@ StateBlocks<D> EventEngine<D, Queue>::state_blocks(bool with_zones) const {
   StateBlocks<D> blocks;
   blocks.globals_ = std::make_shared<const ParticleSystem<D>>(export_globals(with_zones));
   blocks.particles = size();
-  auto internal = std::make_shared<std::vector<std::uint32_t>>(size());
-  for (std::uint32_t k = 0; k < size(); ++k) (*internal)[id_[k]] = k;
-  blocks.fill = [this, internal](std::size_t first, std::size_t count, ParticleSystem<D>& out) {
+  block_order();
+  std::shared_ptr<const BlockOrder> order = block_order_;
+  blocks.fill = [this, order](std::size_t first, std::size_t count, ParticleSystem<D>& out) {
     size_particle_arrays(out, count);
     out.order.assign(id_.begin() + static_cast<std::ptrdiff_t>(first),
                      id_.begin() + static_cast<std::ptrdiff_t>(first + count));
-    for (std::size_t c = 0; c < count; ++c)
-      export_particle((*internal)[first + c], static_cast<std::uint32_t>(c), out);
+    if (count == 0) return;
+    const std::size_t last = (first + count - 1) / StateBlocks<D>::kBlock;
+    for (std::size_t b = first / StateBlocks<D>::kBlock; b <= last; ++b) {
+      for (std::uint32_t m = order->start[b]; m < order->start[b + 1]; ++m) {
+        const std::uint32_t k = order->members[m];
+        const std::size_t c = id_[k];
+        if (c >= first && c < first + count)
+          export_particle(k, static_cast<std::uint32_t>(c - first), out);
+      }
+    }
   };
   return blocks;
+}
+
+// The engine's particles grouped by block of the caller's numbering (a counting sort on
+// id_ / kBlock), each block's in increasing internal index: a pass over the blocks then reads
+// the records in memory order, each once, where reading them in the caller's order would jump
+// at random (at N = 10^6, 20 times slower).
+template <int D, class Queue>
+const typename EventEngine<D, Queue>::BlockOrder& EventEngine<D, Queue>::block_order() const {
+  if (block_order_) return *block_order_;
+  constexpr std::size_t kBlock = StateBlocks<D>::kBlock;
+  const std::size_t blocks = (size() + kBlock - 1) / kBlock;
+  BlockOrder order;
+  order.start.assign(blocks + 1, 0);
+  for (std::uint32_t k = 0; k < size(); ++k) ++order.start[id_[k] / kBlock + 1];
+  for (std::size_t b = 0; b < blocks; ++b) order.start[b + 1] += order.start[b];
+  std::vector<std::uint32_t> next(order.start.begin(), order.start.end() - 1);
+  order.members.resize(size());
+  for (std::uint32_t k = 0; k < size(); ++k) order.members[next[id_[k] / kBlock]++] = k;
+  block_order_ = std::make_shared<const BlockOrder>(std::move(order));
+  return *block_order_;
 }
 
 // export_state() but for the per-particle arrays.
@@ -1668,24 +1697,26 @@ std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
 }
 
 template <int D, class Queue>
-void EventEngine<D, Queue>::for_each_block(const BlockVisitor& f) const {
+void EventEngine<D, Queue>::for_each_block(const BlockVisitor& f, bool with_positions) const {
   const std::size_t n = size();
-  std::vector<std::uint32_t> internal(n);
-  for (std::uint32_t k = 0; k < n; ++k) internal[id_[k]] = k;
+  const BlockOrder& order = block_order();
   const std::size_t block = std::min(n, StateBlocks<D>::kBlock);
   std::vector<Vec<D>> x(block), v(block);
   std::vector<double> m(block);
-  for (std::size_t first = 0; first < n; first += block) {
+  for (std::size_t b = 0, first = 0; first < n; ++b, first += block) {
     const std::size_t count = std::min(block, n - first);
-    for (std::size_t j = 0; j < count; ++j) {
-      const std::uint32_t k = internal[first + j];
-      x[j] = position_of(k, time_);  // as current_positions()
-      for (int a = 0; a < D; ++a)
-        if (grid_.periodic(a)) x[j][a] = wrap_into_box(x[j][a], box_[a]);
+    for (std::uint32_t e = order.start[b]; e < order.start[b + 1]; ++e) {
+      const std::uint32_t k = order.members[e];
+      const std::size_t j = id_[k] - first;
+      if (with_positions) {
+        x[j] = position_of(k, time_);  // as current_positions()
+        for (int a = 0; a < D; ++a)
+          if (grid_.periodic(a)) x[j][a] = wrap_into_box(x[j][a], box_[a]);
+      }
       v[j] = velocity_of(k, time_);
       m[j] = mass_of(k);
     }
-    f(first, {x.data(), count}, {v.data(), count}, {m.data(), count});
+    f(first, {x.data(), with_positions ? count : 0}, {v.data(), count}, {m.data(), count});
   }
 }
 

@@ -499,9 +499,11 @@ class RunDriver {
       if (!p.in_time && p.value > 0.0) collisions += static_cast<double>(collisions_for(p.value));
     if (collisions == 0.0) return;
     double mass = 0.0;
-    engine_->for_each_block([&](std::size_t, auto, auto, auto m) {
-      for (const double mj : m) mass += mj;
-    });
+    engine_->for_each_block(
+        [&](std::size_t, auto, auto, auto m) {
+          for (const double mj : m) mass += mj;
+        },
+        /*with_positions=*/false);
     const auto n = static_cast<double>(n_);
     const run_detail::FlightEstimate flight = run_detail::estimate_flight<D>(
         n, volume_, run_detail::mean_volume_diameter<D>(particle_volume_, n),
@@ -773,16 +775,20 @@ class RunDriver {
     }
     Vec<D> mean{};
     double mass = 0.0;
-    engine_->for_each_block([&](std::size_t, auto, auto v, auto m) {
-      for (std::size_t j = 0; j < v.size(); ++j) {
-        mean = mean + m[j] * v[j];
-        mass += m[j];
-      }
-    });
+    engine_->for_each_block(
+        [&](std::size_t, auto, auto v, auto m) {
+          for (std::size_t j = 0; j < v.size(); ++j) {
+            mean = mean + m[j] * v[j];
+            mass += m[j];
+          }
+        },
+        /*with_positions=*/false);
     mean = (1.0 / mass) * mean;
-    engine_->for_each_block([&](std::size_t, auto, auto v, auto m) {
-      for (std::size_t j = 0; j < v.size(); ++j) f(v[j] - mean, m[j]);
-    });
+    engine_->for_each_block(
+        [&](std::size_t, auto, auto v, auto m) {
+          for (std::size_t j = 0; j < v.size(); ++j) f(v[j] - mean, m[j]);
+        },
+        /*with_positions=*/false);
   }
 
   // The kinetic energy that makes the temperature: of the peculiar velocities under shear.
