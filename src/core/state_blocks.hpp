@@ -15,6 +15,15 @@ namespace kairos {
 template <int D>
 struct StateBlocks {
   static constexpr std::size_t kBlock = std::size_t{1} << 16;  // particles per block
+  // Which per-particle arrays a reader needs (fill may leave the others unset): a chunk of
+  // positions need not read the scheduler's arrays.
+  enum Fields : unsigned {
+    kKinematics = 1,  // kinematics, asleep
+    kIdentity = 2,    // mass, species
+    kScheduler = 4,   // collision_count, events, cell, order
+    kExtras = 8,      // angular_velocity, last_collision_time
+    kAll = 15
+  };
 
   // Every field of the state except the per-particle arrays (kinematics, mass, species,
   // collision_count, events, cell, order, asleep, angular_velocity, last_collision_time), which
@@ -25,14 +34,16 @@ struct StateBlocks {
   // Sets the per-particle arrays of `out` to those of particles [first, first + count), in the
   // caller's numbering (an array the state lacks stays empty); the other fields of `out` are
   // left alone.
-  std::function<void(std::size_t first, std::size_t count, ParticleSystem<D>& out)> fill;
+  // Arrays outside `fields` may be left as they were.
+  std::function<void(std::size_t first, std::size_t count, ParticleSystem<D>& out, unsigned fields)>
+      fill;
 
   // The blocks of a whole state (copies of its ranges); `whole` must outlive the result.
   static StateBlocks of(const ParticleSystem<D>& whole) {
     StateBlocks b;
     b.globals_ = std::shared_ptr<const ParticleSystem<D>>(&whole, [](const ParticleSystem<D>*) {});
     b.particles = whole.size();
-    b.fill = [&whole](std::size_t first, std::size_t count, ParticleSystem<D>& out) {
+    b.fill = [&whole](std::size_t first, std::size_t count, ParticleSystem<D>& out, unsigned) {
       const auto range = [&](const auto& all, auto& part) {
         if (all.empty()) {
           part.clear();
@@ -57,23 +68,23 @@ struct StateBlocks {
 
   // The state's particles [first, first + count) with the fields their positions and
   // velocities at the state's time need (box, time, gravity, periodic axes, counters).
-  ParticleSystem<D> block(std::size_t first, std::size_t count) const {
+  ParticleSystem<D> block(std::size_t first, std::size_t count, unsigned fields = kAll) const {
     ParticleSystem<D> out;
     out.box = globals().box;
     out.time = globals().time;
     out.gravity = globals().gravity;
     out.periodic = globals().periodic;
     out.counters = globals().counters;
-    fill(first, count, out);
+    fill(first, count, out, fields);
     return out;
   }
 
   // Calls f(block, first) for the blocks of at most kBlock particles, in order.
   template <class F>
-  void for_each(F&& f) const {
+  void for_each(F&& f, unsigned fields = kAll) const {
     ParticleSystem<D> part = block(0, 0);
     for (std::size_t first = 0; first < particles; first += kBlock) {
-      fill(first, std::min(kBlock, particles - first), part);
+      fill(first, std::min(kBlock, particles - first), part, fields);
       f(static_cast<const ParticleSystem<D>&>(part), first);
     }
   }

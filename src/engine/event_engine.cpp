@@ -1523,7 +1523,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
   ParticleSystem<D> out = export_globals(with_zones);
   size_particle_arrays(out, n);
   out.order.assign(id_.begin(), id_.end());
-  for (std::uint32_t k = 0; k < n; ++k) export_particle(k, id_[k], out);
+  for (std::uint32_t k = 0; k < n; ++k) export_particle(k, id_[k], out, StateBlocks<D>::kAll);
   return out;
 }
 
@@ -1534,10 +1534,12 @@ StateBlocks<D> EventEngine<D, Queue>::state_blocks(bool with_zones) const {
   blocks.particles = size();
   block_order();
   std::shared_ptr<const BlockOrder> order = block_order_;
-  blocks.fill = [this, order](std::size_t first, std::size_t count, ParticleSystem<D>& out) {
+  blocks.fill = [this, order](std::size_t first, std::size_t count, ParticleSystem<D>& out,
+                              unsigned fields) {
     size_particle_arrays(out, count);
-    out.order.assign(id_.begin() + static_cast<std::ptrdiff_t>(first),
-                     id_.begin() + static_cast<std::ptrdiff_t>(first + count));
+    if ((fields & StateBlocks<D>::kScheduler) != 0)
+      out.order.assign(id_.begin() + static_cast<std::ptrdiff_t>(first),
+                       id_.begin() + static_cast<std::ptrdiff_t>(first + count));
     if (count == 0) return;
     const std::size_t last = (first + count - 1) / StateBlocks<D>::kBlock;
     for (std::size_t b = first / StateBlocks<D>::kBlock; b <= last; ++b) {
@@ -1545,7 +1547,7 @@ StateBlocks<D> EventEngine<D, Queue>::state_blocks(bool with_zones) const {
         const std::uint32_t k = order->members[m];
         const std::size_t c = id_[k];
         if (c >= first && c < first + count)
-          export_particle(k, static_cast<std::uint32_t>(c - first), out);
+          export_particle(k, static_cast<std::uint32_t>(c - first), out, fields);
       }
     }
   };
@@ -1624,24 +1626,34 @@ void EventEngine<D, Queue>::size_particle_arrays(ParticleSystem<D>& out, std::si
 // Internal particle k into entry c of out's per-particle arrays (sized by size_particle_arrays).
 template <int D, class Queue>
 void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
-                                            ParticleSystem<D>& out) const {
-  const HotRecord<D>& h = hot_[k];
+                                            ParticleSystem<D>& out, unsigned fields) const {
+  using Blocks = StateBlocks<D>;
   const Shape& sh = shapes_[shape_.empty() ? 0 : shape_[k]];
-  out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};
-  if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
-    out.kinematics[c] = {position_of(k, time_), frozen_velocity_of(k), time_, sh.radius};
-  out.mass[c] = sh.mass;
-  out.species[c] = sh.species;
-  out.collision_count[c] = h.collisions;
-  out.cell[c] = h.cell;
-  if (!spin_.empty()) out.angular_velocity[c] = spin_[k];
-  if (sleeping_ > 0) out.asleep[c] = asleep_[k];
-  if (!last_collision_.empty()) out.last_collision_time[c] = last_collision_[k];
-  const PendingEvent& e = pending_[k];
-  std::uint32_t partner = e.partner < kFirstCode ? id_[e.partner] : e.partner;
-  if (e.partner >= kKeptBase && e.partner < kNoneKept)
-    partner = kKeptBase + id_[e.partner - kKeptBase];
-  out.events[c] = {queue_.time_of(k), partner, e.partner_count};
+  if ((fields & Blocks::kKinematics) != 0) {
+    const HotRecord<D>& h = hot_[k];
+    out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};
+    if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
+      out.kinematics[c] = {position_of(k, time_), frozen_velocity_of(k), time_, sh.radius};
+    if (sleeping_ > 0) out.asleep[c] = asleep_[k];
+  }
+  if ((fields & Blocks::kIdentity) != 0) {
+    out.mass[c] = sh.mass;
+    out.species[c] = sh.species;
+  }
+  if ((fields & Blocks::kExtras) != 0) {
+    if (!spin_.empty()) out.angular_velocity[c] = spin_[k];
+    if (!last_collision_.empty()) out.last_collision_time[c] = last_collision_[k];
+  }
+  if ((fields & Blocks::kScheduler) != 0) {
+    const HotRecord<D>& h = hot_[k];
+    out.collision_count[c] = h.collisions;
+    out.cell[c] = h.cell;
+    const PendingEvent& e = pending_[k];
+    std::uint32_t partner = e.partner < kFirstCode ? id_[e.partner] : e.partner;
+    if (e.partner >= kKeptBase && e.partner < kNoneKept)
+      partner = kKeptBase + id_[e.partner - kKeptBase];
+    out.events[c] = {queue_.time_of(k), partner, e.partner_count};
+  }
 }
 
 template <int D, class Queue>
@@ -1724,6 +1736,13 @@ template <int D, class Queue>
 std::vector<Vec<D>> EventEngine<D, Queue>::current_velocities() const {
   std::vector<Vec<D>> out(size());
   for (std::uint32_t i = 0; i < size(); ++i) out[id_[i]] = velocity_of(i, time_);
+  return out;
+}
+
+template <int D, class Queue>
+std::vector<double> EventEngine<D, Queue>::masses() const {
+  std::vector<double> out(size());
+  for (std::uint32_t i = 0; i < size(); ++i) out[id_[i]] = mass_of(i);
   return out;
 }
 

@@ -194,6 +194,7 @@ class EventEngine {
   // Velocities at the current time, in the caller's numbering: export_state()'s
   // velocity_at(i, time()) to the bit, without copying the rest of the state.
   std::vector<Vec<D>> current_velocities() const;
+  std::vector<double> masses() const;  // in the caller's numbering
   // current_positions(), current_velocities() and the masses of the caller's particles, in
   // blocks of at most StateBlocks<D>::kBlock in the caller's order: f(first, x, v, m) for the
   // particles [first, first + x.size()). Sums over particles without a copy of every
@@ -504,7 +505,8 @@ class EventEngine {
   const BlockOrder& block_order() const;
   mutable std::shared_ptr<const BlockOrder> block_order_;
   void size_particle_arrays(ParticleSystem<D>& out, std::size_t n) const;
-  void export_particle(std::uint32_t k, std::uint32_t c, ParticleSystem<D>& out) const;
+  void export_particle(std::uint32_t k, std::uint32_t c, ParticleSystem<D>& out,
+                       unsigned fields) const;
   void insert_all_into_grid();
   void check_restored_cell(std::uint32_t i) const;
   std::uint64_t next_renumber_after(std::uint64_t collisions) const;

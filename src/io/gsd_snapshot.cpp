@@ -87,16 +87,33 @@ void write_bonds(gsd::Writer& w, const ParticleSystem<D>& sys) {
 
 // Chunk `name` of one row of M values of T per particle, written block by block:
 // row(block, j, values) gives particle j's row of the block (values start zeroed).
+// Only the arrays the chunk needs are read (fields_of).
+unsigned fields_of(std::string_view name) {
+  using F = StateBlocks<3>;
+  if (name == "particles/typeid" || name == "particles/mass" || name == "kairos/mass")
+    return F::kIdentity;
+  if (name == "log/particles/angular_velocity" || name == "kairos/state/angular_velocity" ||
+      name == "kairos/state/last_collision_time")
+    return F::kExtras;
+  if (name == "kairos/state/collision_count" || name == "kairos/state/event_time" ||
+      name == "kairos/state/partner" || name == "kairos/state/partner_count" ||
+      name == "kairos/state/cell" || name == "kairos/state/order")
+    return F::kScheduler;
+  return F::kKinematics;  // positions, velocities, radii, local times, asleep
+}
+
 template <class T, int D, class Row>
 void write_particle_chunk(gsd::Writer& w, std::string_view name, std::uint32_t M,
                           const StateBlocks<D>& s, Row&& row) {
   w.begin_chunk(name, gsd::type_of<T>(), s.particles, M);
   std::vector<T> values;
-  s.for_each([&](const ParticleSystem<D>& part, std::size_t) {
-    values.assign(part.size() * M, T{});
-    for (std::size_t j = 0; j < part.size(); ++j) row(part, j, &values[j * M]);
-    w.append_to_chunk(values.data(), values.size() * sizeof(T));
-  });
+  s.for_each(
+      [&](const ParticleSystem<D>& part, std::size_t) {
+        values.assign(part.size() * M, T{});
+        for (std::size_t j = 0; j < part.size(); ++j) row(part, j, &values[j * M]);
+        w.append_to_chunk(values.data(), values.size() * sizeof(T));
+      },
+      fields_of(name));
   w.end_chunk();
 }
 

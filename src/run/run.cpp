@@ -773,22 +773,19 @@ class RunDriver {
           s.mass[i]);
       return;
     }
+    // Whole copies of the velocities and masses (32 bytes per particle for the moment of a
+    // thermo row, below the set-up's peak): read in the engine's memory order, twice as fast at
+    // N = 10^6 as two passes over the blocks.
+    const std::vector<Vec<D>> v = engine_->current_velocities();
+    const std::vector<double> m = engine_->masses();
     Vec<D> mean{};
     double mass = 0.0;
-    engine_->for_each_block(
-        [&](std::size_t, auto, auto v, auto m) {
-          for (std::size_t j = 0; j < v.size(); ++j) {
-            mean = mean + m[j] * v[j];
-            mass += m[j];
-          }
-        },
-        /*with_positions=*/false);
+    for (std::size_t i = 0; i < n_; ++i) {
+      mean = mean + m[i] * v[i];
+      mass += m[i];
+    }
     mean = (1.0 / mass) * mean;
-    engine_->for_each_block(
-        [&](std::size_t, auto, auto v, auto m) {
-          for (std::size_t j = 0; j < v.size(); ++j) f(v[j] - mean, m[j]);
-        },
-        /*with_positions=*/false);
+    for (std::size_t i = 0; i < n_; ++i) f(v[i] - mean, m[i]);
   }
 
   // The kinetic energy that makes the temperature: of the peculiar velocities under shear.
@@ -861,12 +858,14 @@ class RunDriver {
     const StateBlocks<D> state = engine_->state_blocks(/*with_zones=*/false);
     double pscale = 0.0, dp2 = 0.0;
     std::vector<double> diameters(n_);
-    state.for_each([&](const ParticleSystem<D>& part, std::size_t first) {
-      for (std::size_t j = 0; j < part.size(); ++j) {
-        pscale += part.mass[j] * std::sqrt(norm2(part.kinematics[j].vel));
-        diameters[first + j] = 2.0 * part.kinematics[j].radius;
-      }
-    });
+    state.for_each(
+        [&](const ParticleSystem<D>& part, std::size_t first) {
+          for (std::size_t j = 0; j < part.size(); ++j) {
+            pscale += part.mass[j] * std::sqrt(norm2(part.kinematics[j].vel));
+            diameters[first + j] = 2.0 * part.kinematics[j].radius;
+          }
+        },
+        StateBlocks<D>::kKinematics | StateBlocks<D>::kIdentity);
     for (int a = 0; a < D; ++a) dp2 += (p[a] - p_start_[a]) * (p[a] - p_start_[a]);
     const double t_prod = engine_->time() - prod_start_.time;
     const std::uint64_t coll_prod = c.collisions - prod_start_.collisions;
