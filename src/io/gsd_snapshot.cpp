@@ -612,6 +612,10 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& bloc
       const std::int64_t outputs[2] = {progress.thermo_rows, progress.trajectory_frames};
       w.write_chunk("kairos/run/outputs", 2, 1, outputs);
     }
+    if (progress.has_frame_mark) {
+      w.write_chunk("kairos/run/frame_mark", 1, 1, &progress.frame_time);
+      w.write_chunk("kairos/run/frame_mark_collisions", 1, 1, &progress.frame_collisions);
+    }
     if (progress.has_thermo_mark) {
       const double mark[2] = {progress.mark_time, progress.mark_virial};
       const std::uint64_t counts[2] = {progress.mark_events, progress.mark_collisions};
@@ -864,6 +868,15 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
       const auto outputs = require<std::int64_t>(r, f, "kairos/run/outputs", path, 2);
       progress->thermo_rows = std::max<std::int64_t>(-1, outputs[0]);
       progress->trajectory_frames = std::max<std::int64_t>(-1, outputs[1]);
+    }
+    if (r.find(f, "kairos/run/frame_mark")) {
+      const auto time = require<double>(r, f, "kairos/run/frame_mark", path, 1);
+      const auto count = require<std::uint64_t>(r, f, "kairos/run/frame_mark_collisions", path, 1);
+      if (!std::isfinite(time[0]) || time[0] > s.time || count[0] > s.counters.collisions)
+        throw InputError("'" + path.string() + "': kairos/run/frame_mark lies after the state");
+      progress->has_frame_mark = true;
+      progress->frame_time = time[0];
+      progress->frame_collisions = count[0];
     }
     if (r.find(f, "kairos/run/thermo_mark")) {
       const auto mark = require<double>(r, f, "kairos/run/thermo_mark", path, 2);

@@ -91,6 +91,11 @@ struct RunProgress {
   bool has_thermo_mark = false;
   double mark_time = 0.0, mark_virial = 0.0;
   std::uint64_t mark_events = 0, mark_collisions = 0;
+  // The last kept trajectory frame's state (kairos/run/frame_mark): a continued run writes no
+  // second frame of it.
+  bool has_frame_mark = false;
+  double frame_time = 0.0;
+  std::uint64_t frame_collisions = 0;
   // Output schedules in collisions (kairos/run/schedule) of the phase the state is in (0:
   // equilibration, 1: production, -1: not recorded): thermo, trajectory, restart; a step of 0:
   // not scheduled. A continued run in that phase with the same steps keeps them.

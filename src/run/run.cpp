@@ -340,10 +340,22 @@ class RunDriver {
     thermo_.emplace(dir_ / "thermo.tsv", restart_, continuation_.thermo_rows);
     rows_kept_ = thermo_->rows();
     if (config_.output.trajectory) {
-      run_detail::open_trajectory<D>(trajectory_, dir_, restart_, n_,
-                                     continuation_.trajectory_frames,
-                                     [&] { return engine_->state_blocks(/*with_zones=*/false); });
+      const bool created = run_detail::open_trajectory<D>(
+          trajectory_, dir_, restart_, n_, continuation_.trajectory_frames,
+          [&] { return engine_->state_blocks(/*with_zones=*/false); });
       frames_kept_ = trajectory_->frame_count();
+      // The state of the last frame kept: this one's, or, continuing the lineage's file, the
+      // one the restart file recorded (a continued run with nothing left to do writes no
+      // second frame of it).
+      if (created && restart_) {
+        frame_collisions_ = engine_->counters().collisions;
+        frame_time_ = engine_->time();
+      } else if (!created && continuation_.same_directory && resumed_.has_frame_mark) {
+        frame_collisions_ = resumed_.frame_collisions;
+        frame_time_ = resumed_.frame_time;
+      }
+      kept_frame_collisions_ = frame_collisions_;
+      kept_frame_time_ = frame_time_;
     } else {
       frames_not_written_ =
           run_detail::cut_back_trajectory<D>(dir_, n_, continuation_.trajectory_frames);
@@ -452,6 +464,11 @@ class RunDriver {
     p.thermo_rows = static_cast<std::int64_t>(rows_kept_);
     p.trajectory_frames =
         trajectory_ ? static_cast<std::int64_t>(frames_kept_) : frames_not_written_;
+    if (trajectory_) {
+      p.has_frame_mark = true;
+      p.frame_time = kept_frame_time_;
+      p.frame_collisions = kept_frame_collisions_;
+    }
     p.has_thermo_mark = true;
     p.mark_time = kept_mark_.time;
     p.mark_virial = kept_mark_.virial;
@@ -571,7 +588,11 @@ class RunDriver {
     append_trajectory_frame(*trajectory_, engine_->state_blocks(/*with_zones=*/false));
     frame_collisions_ = engine_->counters().collisions;
     frame_time_ = engine_->time();
-    if (kept) frames_kept_ = trajectory_->frame_count();
+    if (kept) {
+      frames_kept_ = trajectory_->frame_count();
+      kept_frame_collisions_ = frame_collisions_;
+      kept_frame_time_ = frame_time_;
+    }
   }
 
   // A periodic output could not be written: the run stops (outputs_ holds the error).
@@ -1096,6 +1117,8 @@ class RunDriver {
   std::optional<gsd::Writer> trajectory_;
   std::uint64_t frame_collisions_ = 0;
   double frame_time_ = 0.0;
+  std::uint64_t kept_frame_collisions_ = 0;  // of the last frame kept (frames_kept_)
+  double kept_frame_time_ = 0.0;
   // Some length or the output intervals in simulated time: rows and frames also when no
   // collision happened since the last.
   bool timed_ = false;

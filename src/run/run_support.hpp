@@ -282,19 +282,20 @@ inline OutputContinuation output_continuation(bool continues_outputs, const RunP
 
 // trajectory.gsd of the run in `dir`: appended to when a restarted run finds its own system's
 // file there (keeping its first `keep_frames` frames when given), else created with
-// `first_frame` (a callable giving the state) as frame 0.
+// `first_frame` (a callable giving the state) as frame 0; true then.
 template <int D, class FirstFrame>
-void open_trajectory(std::optional<gsd::Writer>& writer, const fs::path& dir, bool restarted,
+bool open_trajectory(std::optional<gsd::Writer>& writer, const fs::path& dir, bool restarted,
                      std::size_t n, std::optional<std::uint64_t> keep_frames,
                      FirstFrame&& first_frame) {
   const fs::path traj = dir / "trajectory.gsd";
   if (restarted && fs::exists(traj)) {
     check_same_trajectory(traj, n, D, dir);
     writer.emplace(gsd::Writer::open_append(traj, keep_frames.value_or(~std::uint64_t{0})));
-  } else {
-    writer.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
-    append_trajectory_frame(*writer, first_frame());
+    return false;
   }
+  writer.emplace(gsd::Writer::create(traj, "kairos " KAIROS_VERSION));
+  append_trajectory_frame(*writer, first_frame());
+  return true;
 }
 
 // A continued run that writes no trajectory (output.trajectory = false) still cuts its lineage's
