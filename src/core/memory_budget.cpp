@@ -31,8 +31,14 @@ constexpr const char* kLimitVariable = "KAIROS_MEMORY_LIMIT_BYTES";
 // 1.5 to 1.8 times the need. Not covered: stepped potentials with long cut-offs, whose capture
 // map lists every pair within a cut-off (stepped Lennard-Jones at rho* = 0.8, r_c = 2.5: 1.5 kB
 // per particle).
-constexpr std::uint64_t kBytesPerParticle3D = 580;
+// Since 2026-12-04 (outputs written from the engine's arrays in blocks, docs/performance.md),
+// N = 10^6, the event integrator: 3D hard spheres fcc 164 B, random 259 B, soft spheres 211 B;
+// 2D hard disks hex 137 B, random 150 B, soft disks 172 B; the DEM 3D 459 B. The event figures
+// below cover these with ~15 % to spare.
+constexpr std::uint64_t kBytesPerParticle3D = 580;  // the DEM
 constexpr std::uint64_t kBytesPerParticle2D = 440;
+constexpr std::uint64_t kEventBytesPerParticle3D = 300;
+constexpr std::uint64_t kEventBytesPerParticle2D = 200;
 constexpr std::uint64_t kBaseBytes = std::uint64_t{32} << 20;  // program, libraries, buffers
 
 // A cgroup limit this large means "no limit" (v1 writes 2^63 - 4096 for none).
@@ -162,8 +168,11 @@ std::optional<AvailableMemory> available_memory(const MemorySources& sources) {
   return best;
 }
 
-std::uint64_t estimated_run_bytes(std::uint64_t particles, int dimension) {
-  const std::uint64_t per = dimension == 2 ? kBytesPerParticle2D : kBytesPerParticle3D;
+std::uint64_t estimated_run_bytes(std::uint64_t particles, int dimension, RunKind kind) {
+  const bool event = kind == RunKind::kEventDriven;
+  const std::uint64_t per = dimension == 2
+                                ? (event ? kEventBytesPerParticle2D : kBytesPerParticle2D)
+                                : (event ? kEventBytesPerParticle3D : kBytesPerParticle3D);
   return kBaseBytes + particles * per;  // no overflow: particles < 2^32
 }
 

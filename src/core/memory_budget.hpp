@@ -39,7 +39,11 @@ std::optional<AvailableMemory> available_memory(const MemorySources& sources = {
 // The peak resident memory of a run of `particles` particles in `dimension` D, from generating
 // (or reading) its state to writing its restart file, whichever integrator runs it (the figures
 // and what they leave out are in memory_budget.cpp).
-std::uint64_t estimated_run_bytes(std::uint64_t particles, int dimension);
+// Which integrator runs the state: the DEM keeps its own, larger layout. kDem, the larger
+// estimate, where the integrator is not known.
+enum class RunKind { kEventDriven, kDem };
+std::uint64_t estimated_run_bytes(std::uint64_t particles, int dimension,
+                                  RunKind kind = RunKind::kDem);
 
 // InputError "<what> needs about X GiB, this machine has Y GiB available (...)" when `bytes`
 // exceed the memory available; nothing when they fit or nothing is known.

@@ -884,7 +884,7 @@ double packing_fraction(const InitialState<D>& state) {
 }
 
 template <int D>
-InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& rng) {
+InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& rng, RunKind kind) {
   static_assert(D == 2 || D == 3);
   if (system.dimension != D) {
     throw std::invalid_argument(fmt::format(
@@ -908,7 +908,7 @@ InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& 
 
   // Before anything is allocated: a state too large for this machine would otherwise fill its
   // memory for minutes and end in std::bad_alloc (or the kernel's OOM killer).
-  require_memory(estimated_run_bytes(N, D), fmt::format("system.particles = {}", N));
+  require_memory(estimated_run_bytes(N, D, kind), fmt::format("system.particles = {}", N));
 
   if (system.chain_length > 0) return make_chain_state<D>(system, species, N, eta, rng);
 
@@ -1265,27 +1265,27 @@ double max_overlap_bruteforce(const std::array<double, D>& box,
   return max_overlap_bruteforce<D>(box, periodic, pos, diameter);
 }
 
-#define KAIROS_INSTANTIATE(D)                                                                \
-  template double packing_fraction<D>(const InitialState<D>&);                               \
-  template InitialState<D> make_initial_state<D>(const SystemConfig&, std::mt19937_64&);     \
-  template void assign_maxwell_boltzmann_velocities<D>(InitialState<D>&, double,             \
-                                                       std::mt19937_64&);                    \
-  template double max_overlap<D>(                                                            \
-      const std::array<double, D>&, const std::vector<std::array<double, D>>&,               \
-      const std::vector<double>&, std::uint32_t*, std::uint32_t*, bool);                     \
-  template double max_overlap<D>(const std::array<double, D>&, const std::array<bool, D>&,   \
-                                 const std::vector<std::array<double, D>>&,                  \
-                                 const std::vector<double>&, std::uint32_t*, std::uint32_t*, \
-                                 bool);                                                      \
-  template double max_relative_overlap<D>(                                                   \
-      const std::array<double, D>&, const std::array<bool, D>&,                              \
-      const std::vector<std::array<double, D>>&, const std::vector<double>&, std::uint32_t*, \
-      std::uint32_t*, bool);                                                                 \
-  template double max_overlap_bruteforce<D>(const std::array<double, D>&,                    \
-                                            const std::vector<std::array<double, D>>&,       \
-                                            const std::vector<double>&);                     \
-  template double max_overlap_bruteforce<D>(                                                 \
-      const std::array<double, D>&, const std::array<bool, D>&,                              \
+#define KAIROS_INSTANTIATE(D)                                                                     \
+  template double packing_fraction<D>(const InitialState<D>&);                                    \
+  template InitialState<D> make_initial_state<D>(const SystemConfig&, std::mt19937_64&, RunKind); \
+  template void assign_maxwell_boltzmann_velocities<D>(InitialState<D>&, double,                  \
+                                                       std::mt19937_64&);                         \
+  template double max_overlap<D>(                                                                 \
+      const std::array<double, D>&, const std::vector<std::array<double, D>>&,                    \
+      const std::vector<double>&, std::uint32_t*, std::uint32_t*, bool);                          \
+  template double max_overlap<D>(const std::array<double, D>&, const std::array<bool, D>&,        \
+                                 const std::vector<std::array<double, D>>&,                       \
+                                 const std::vector<double>&, std::uint32_t*, std::uint32_t*,      \
+                                 bool);                                                           \
+  template double max_relative_overlap<D>(                                                        \
+      const std::array<double, D>&, const std::array<bool, D>&,                                   \
+      const std::vector<std::array<double, D>>&, const std::vector<double>&, std::uint32_t*,      \
+      std::uint32_t*, bool);                                                                      \
+  template double max_overlap_bruteforce<D>(const std::array<double, D>&,                         \
+                                            const std::vector<std::array<double, D>>&,            \
+                                            const std::vector<double>&);                          \
+  template double max_overlap_bruteforce<D>(                                                      \
+      const std::array<double, D>&, const std::array<bool, D>&,                                   \
       const std::vector<std::array<double, D>>&, const std::vector<double>&);
 
 KAIROS_INSTANTIATE(2)

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/memory_budget.hpp"
 #include "core/particle_system.hpp"
 #include "core/stop_flag.hpp"
 #include "io/config.hpp"
@@ -91,7 +92,9 @@ double packing_fraction(const InitialState<D>& state);
 // valid in this dimension, invalid species/particles/temperature values. Throws
 // std::invalid_argument when system.dimension != D.
 template <int D>
-InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& rng);
+// `kind`: the integrator that will run it, for the memory estimate checked first.
+InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& rng,
+                                   RunKind kind = RunKind::kDem);
 
 // The engine's starting state: every particle at time 0 with radius = diameter / 2, no
 // scheduler state (the engine predicts every event). Takes the state over: its arrays are moved

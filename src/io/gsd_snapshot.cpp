@@ -659,7 +659,7 @@ int gsd_dimension(const std::filesystem::path& path) {
 
 template <int D>
 ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_64& rng,
-                               RunProgress* progress) {
+                               RunProgress* progress, RunKind kind) {
   const gsd::Reader r(path);
   const std::uint64_t f = r.frame_count() == 0 ? 0 : r.frame_count() - 1;
   if (r.frame_count() == 0 || !r.find(f, "kairos/format")) {
@@ -681,7 +681,7 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   const std::size_t n = require<std::uint32_t>(r, f, "particles/N", path, 1)[0];
   check_positions_stored(r, f, n, "kairos/state/position", D, "'" + path.string() + "'");
   check_rectangular_box(r, f, "'" + path.string() + "'");
-  require_memory(estimated_run_bytes(n, D),
+  require_memory(estimated_run_bytes(n, D, kind),
                  fmt::format("restart file '{}' ({} particles)", path.string(), n));
   ParticleSystem<D> s;
   const auto box = require<double>(r, f, "kairos/box", path, D);
@@ -931,7 +931,8 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
 }
 
 template <int D>
-InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_velocities) {
+InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_velocities,
+                                   RunKind kind) {
   const gsd::Reader r(path);
   if (r.frame_count() == 0) throw InputError("'" + path.string() + "' holds no frame");
   const std::uint64_t f = r.frame_count() - 1;
@@ -953,7 +954,7 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
   check_positions_stored(r, f, n, exact ? "kairos/position" : "particles/position", exact ? D : 3,
                          who);
   check_rectangular_box(r, f, who);
-  require_memory(estimated_run_bytes(n, D), fmt::format("{} ({} particles)", who, n));
+  require_memory(estimated_run_bytes(n, D, kind), fmt::format("{} ({} particles)", who, n));
   InitialState<D> s;
   if (exact) {
     const auto box = require<double>(r, f, "kairos/box", path, D);
@@ -1053,10 +1054,10 @@ template void write_restart<2>(const std::filesystem::path&, const ParticleSyste
 template void write_restart<3>(const std::filesystem::path&, const ParticleSystem<3>&,
                                const std::mt19937_64&, const RunProgress&);
 template ParticleSystem<2> read_restart<2>(const std::filesystem::path&, std::mt19937_64&,
-                                           RunProgress*);
+                                           RunProgress*, RunKind);
 template ParticleSystem<3> read_restart<3>(const std::filesystem::path&, std::mt19937_64&,
-                                           RunProgress*);
-template InitialState<2> read_initial_state<2>(const std::filesystem::path&, bool&);
-template InitialState<3> read_initial_state<3>(const std::filesystem::path&, bool&);
+                                           RunProgress*, RunKind);
+template InitialState<2> read_initial_state<2>(const std::filesystem::path&, bool&, RunKind);
+template InitialState<3> read_initial_state<3>(const std::filesystem::path&, bool&, RunKind);
 
 }  // namespace kairos

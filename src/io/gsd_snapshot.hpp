@@ -119,8 +119,9 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& stat
 // Reads a restart file written by write_restart; InputError if it is not one or if its
 // dimension differs from D. `progress` (optional) receives the run's progress.
 template <int D>
+// `kind`: the integrator that will run the state, for the memory estimate checked first.
 ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_64& rng,
-                               RunProgress* progress = nullptr);
+                               RunProgress* progress = nullptr, RunKind kind = RunKind::kDem);
 
 // The spatial dimension stored in a GSD file's last frame (configuration/dimensions).
 int gsd_dimension(const std::filesystem::path& path);
@@ -133,6 +134,7 @@ int gsd_dimension(const std::filesystem::path& path);
 // them, a box too small or tilted (nonzero xy, xz, yz: Kairos boxes are rectangular), particles
 // outside the box, or a bond naming a particle out of range (or twice) or an unknown type.
 template <int D>
-InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_velocities);
+InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_velocities,
+                                   RunKind kind = RunKind::kDem);
 
 }  // namespace kairos

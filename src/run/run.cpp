@@ -186,11 +186,13 @@ template <int D>
 ParticleSystem<D> build_start_state(const Config& config,
                                     const std::optional<fs::path>& restart_file,
                                     std::mt19937_64& rng, RunProgress& progress) {
+  // The memory estimate checked before the state is built or read: the DEM's layout is larger.
+  const RunKind kind = config.run.integrator == "dem" ? RunKind::kDem : RunKind::kEventDriven;
   if (restart_file) {
     if (!fs::exists(*restart_file)) {
       throw InputError("restart file '" + restart_file->string() + "' does not exist");
     }
-    return read_restart<D>(*restart_file, rng, &progress);  // plan_continuation says the rest
+    return read_restart<D>(*restart_file, rng, &progress, kind);  // plan_continuation says the rest
   }
   if (!config.system.initial_state.empty()) {
     const fs::path path = config.system.initial_state;
@@ -198,7 +200,7 @@ ParticleSystem<D> build_start_state(const Config& config,
       throw InputError("system.initial_state: file '" + path.string() + "' does not exist");
     }
     bool has_velocities = false;
-    InitialState<D> init = read_initial_state<D>(path, has_velocities);
+    InitialState<D> init = read_initial_state<D>(path, has_velocities, kind);
     const std::array<bool, D> periodic = periodic_axes<D>(config);
     const bool exact = holds_exact_positions(path);
     if (!exact) expand_away_rounding_overlaps<D>(init, periodic);
@@ -223,7 +225,7 @@ ParticleSystem<D> build_start_state(const Config& config,
     }
     return to_particle_system<D>(std::move(init));
   }
-  InitialState<D> init = make_initial_state<D>(config.system, rng);
+  InitialState<D> init = make_initial_state<D>(config.system, rng, kind);
   std::array<bool, D> periodic;
   periodic.fill(true);  // generated in a periodic box; make_room_for_walls then adds the gaps
   // A lattice at its close packing has its neighbours in contact to within round-off.

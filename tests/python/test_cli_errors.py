@@ -648,6 +648,20 @@ class MemoryEstimate(kt.KairosTestCase):
         self.assert_user_error(result, "system.initial_state '%s' (500 particles) needs about" %
                                restart)
 
+    def test_the_estimate_is_the_integrators(self):
+        # 200 000 particles: the event integrator's estimate (300 B/particle in 3D, ~92 MB)
+        # fits under 120 MB, the DEM's (580 B/particle, ~148 MB) does not.
+        config = kt.base_config(particles=200000, production=0.01)
+        config["output"]["trajectory"] = False
+        event = self.write_config(config, "event.toml")
+        self.assertEqual(self.run_with_limit(120 << 20, "run", event, "-o", self.path("event"))
+                         .returncode, 0)
+        config["soft"] = {"model": "dashpot", "stiffness": 1e4, "restitution": 0.9}
+        config["run"]["integrator"] = "dem"
+        dem = self.write_config(config, "dem.toml")
+        self.assert_user_error(self.run_with_limit(120 << 20, "run", dem, "-o", self.path("dem")),
+                               "system.particles = 200000 needs about")
+
     def test_limit_that_is_not_a_number(self):
         config = self.write_config(kt.base_config(particles=500, production=1.0))
         self.assert_user_error(self.run_with_limit("8G", "run", config, "-o", self.path("out")),

@@ -55,6 +55,9 @@ class PeakMemory(kt.KairosTestCase):
         self.assertLess(per_particle, PER_PARTICLE_BOUND,
                         "%.0f bytes per particle" % per_particle)
         self.assertGreater(per_particle, 64.0)  # the engine's hot records alone
+        # The estimate checked before a run (core/memory_budget: 32 MiB + 300 B/particle for
+        # the event integrator in 3D) is not below what the run takes.
+        self.assertLess(large, (32 << 20) + 300 * large_n)
 
 
 if __name__ == "__main__":
