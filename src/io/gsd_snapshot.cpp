@@ -612,6 +612,10 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& bloc
       const std::int64_t outputs[2] = {progress.thermo_rows, progress.trajectory_frames};
       w.write_chunk("kairos/run/outputs", 2, 1, outputs);
     }
+    if (progress.owed_outputs != 0) {
+      const auto owed = static_cast<std::uint8_t>(progress.owed_outputs);
+      w.write_chunk("kairos/run/owed", 1, 1, &owed);
+    }
     if (progress.has_frame_mark) {
       w.write_chunk("kairos/run/frame_mark", 1, 1, &progress.frame_time);
       w.write_chunk("kairos/run/frame_mark_collisions", 1, 1, &progress.frame_collisions);
@@ -868,6 +872,12 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
       const auto outputs = require<std::int64_t>(r, f, "kairos/run/outputs", path, 2);
       progress->thermo_rows = std::max<std::int64_t>(-1, outputs[0]);
       progress->trajectory_frames = std::max<std::int64_t>(-1, outputs[1]);
+    }
+    if (r.find(f, "kairos/run/owed")) {
+      const auto owed = require<std::uint8_t>(r, f, "kairos/run/owed", path, 1)[0];
+      if (owed > (RunProgress::kOwedRow | RunProgress::kOwedFrame))
+        throw InputError("'" + path.string() + "': kairos/run/owed is not a set of outputs");
+      progress->owed_outputs = owed;
     }
     if (r.find(f, "kairos/run/frame_mark")) {
       const auto time = require<double>(r, f, "kairos/run/frame_mark", path, 1);

@@ -91,6 +91,10 @@ struct RunProgress {
   bool has_thermo_mark = false;
   double mark_time = 0.0, mark_virial = 0.0;
   std::uint64_t mark_events = 0, mark_collisions = 0;
+  // The thermo row and trajectory frame due at this state whose writing failed
+  // (kairos/run/owed, uint8): a run continued in the same directory writes them first.
+  static constexpr unsigned kOwedRow = 1, kOwedFrame = 2;
+  unsigned owed_outputs = 0;
   // The last kept trajectory frame's state (kairos/run/frame_mark): a continued run writes no
   // second frame of it.
   bool has_frame_mark = false;

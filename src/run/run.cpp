@@ -471,6 +471,7 @@ class RunDriver {
       p.frame_time = kept_frame_time_;
       p.frame_collisions = kept_frame_collisions_;
     }
+    p.owed_outputs = owed_;
     p.has_thermo_mark = true;
     p.mark_time = kept_mark_.time;
     p.mark_virial = kept_mark_.virial;
@@ -597,6 +598,19 @@ class RunDriver {
     }
   }
 
+  // The periodic outputs due now, in order; false when one could not be written (the run then
+  // stops). The row and frame due and not written are owed (RunProgress::owed_outputs): a run
+  // continued in this directory writes them first, as one uninterrupted run has them.
+  bool write_due_outputs(const std::string& phase, bool row, bool frame, bool restart) {
+    owed_ = (row ? RunProgress::kOwedRow : 0) | (frame ? RunProgress::kOwedFrame : 0);
+    if (row && !outputs_.attempt("thermo.tsv", [&] { write_thermo_row(phase); })) return false;
+    owed_ &= ~RunProgress::kOwedRow;
+    if (frame && !outputs_.attempt("trajectory.gsd", [&] { write_trajectory_frame(); }))
+      return false;
+    owed_ = 0;
+    return !restart || outputs_.attempt("restart.gsd", [&] { write_restart_file(); });
+  }
+
   // A periodic output could not be written: the run stops (outputs_ holds the error).
   bool write_failed() {
     stop_reason_ = "write_failed";
@@ -657,6 +671,13 @@ class RunDriver {
             resumed_.schedule_next[k] > begin)
           e[k]->next = resumed_.schedule_next[k];
     }
+    // Continued in its own directory from a state whose row or frame could not be written: they
+    // come first.
+    if (restart_ && first_phase_ && continuation_.same_directory && resumed_.owed_outputs != 0) {
+      const bool row = (resumed_.owed_outputs & RunProgress::kOwedRow) != 0;
+      const bool frame = (resumed_.owed_outputs & RunProgress::kOwedFrame) != 0 && trajectory_;
+      if (!write_due_outputs(phase, row, frame, false)) return write_failed();
+    }
     first_phase_ = false;
     const auto done = [&] {
       return length.in_time ? engine_->time() - begin_time
@@ -679,15 +700,8 @@ class RunDriver {
         if (engine_->next_event_time() > stop) {
           engine_->advance_clock(stop);
           const double t = engine_->time();
-          if (timed.thermo.due(t) &&
-              !outputs_.attempt("thermo.tsv", [&] { write_thermo_row(phase); }))
-            return write_failed();
-          if (timed.trajectory.due(t) && trajectory_ &&
-              !outputs_.attempt("trajectory.gsd", [&] { write_trajectory_frame(); }))
-            return write_failed();
-          if (timed.restart.due(t) &&
-              !outputs_.attempt("restart.gsd", [&] { write_restart_file(); }))
-            return write_failed();
+          const bool row = timed.thermo.due(t), frame = timed.trajectory.due(t) && trajectory_;
+          if (!write_due_outputs(phase, row, frame, timed.restart.due(t))) return write_failed();
           // A system at rest passes its output times without events: the stop checks too.
           if (interrupted(wall_start)) return true;
           if ((++clock_stops_ & 0x3ffu) == 0) {
@@ -720,15 +734,8 @@ class RunDriver {
         return true;
       }
       const std::uint64_t c = engine_->counters().collisions;
-      if (schedule.thermo.due(c) &&
-          !outputs_.attempt("thermo.tsv", [&] { write_thermo_row(phase); }))
-        return write_failed();
-      if (schedule.trajectory.due(c) && trajectory_ &&
-          !outputs_.attempt("trajectory.gsd", [&] { write_trajectory_frame(); }))
-        return write_failed();
-      if (schedule.restart.due(c) &&
-          !outputs_.attempt("restart.gsd", [&] { write_restart_file(); }))
-        return write_failed();
+      const bool row = schedule.thermo.due(c), frame = schedule.trajectory.due(c) && trajectory_;
+      if (!write_due_outputs(phase, row, frame, schedule.restart.due(c))) return write_failed();
       if (kairos::stop_requested()) {
         stop_reason_ = "signal";
         return true;
@@ -1119,6 +1126,7 @@ class RunDriver {
   std::optional<gsd::Writer> trajectory_;
   std::uint64_t frame_collisions_ = 0;
   double frame_time_ = 0.0;
+  unsigned owed_ = 0;                        // RunProgress::owed_outputs of the present state
   std::uint64_t kept_frame_collisions_ = 0;  // of the last frame kept (frames_kept_)
   double kept_frame_time_ = 0.0;
   // Some length or the output intervals in simulated time: rows and frames also when no

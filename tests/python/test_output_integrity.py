@@ -155,6 +155,33 @@ class FailedWrites(kt.KairosTestCase):
         del line
 
 
+    def test_a_run_continued_after_a_failed_write_writes_the_failed_row(self):
+        # The row whose write failed is written by the continued run (once there is room):
+        # thermo.tsv then holds one uninterrupted run's rows.
+        # thermo.tsv grows past the limit; the restart file (~300 kB) is smaller.
+        config = kt.base_config(particles=2000, packing_fraction=0.3, seed=3, production=600.0)
+        config["output"].update({"thermo_interval": 0.1, "trajectory": False})
+        cfg = self.write_config(config)
+        whole = self.path("whole")
+        self.run_ok("run", cfg, "-o", whole, timeout=300)
+        limit = 400000
+
+        def limit_file_size():
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+        out = self.path("out")
+        result = subprocess.run([kt.KAIROS, "run", cfg, "-o", out], cwd=self.tmp,
+                                capture_output=True, text=True, timeout=300,
+                                preexec_fn=limit_file_size)
+        self.assertNotEqual(result.returncode, 0, kt.describe(result))
+        self.assertIn("stopped early (write_failed)", result.stdout)
+        self.run_ok("run", cfg, "--restart", os.path.join(out, "restart.gsd"), "-o", out,
+                    timeout=300)
+        with open(os.path.join(out, "thermo.tsv")) as f, \
+                open(os.path.join(whole, "thermo.tsv")) as g:
+            self.assertEqual(f.read(), g.read(), "thermo.tsv differs from one uninterrupted run's")
+
     def test_each_failure_is_reported_once(self):
         # thermo.tsv fails first (a file size limit), then summary.json (a directory in its
         # place): the error names each failure once, in order.
