@@ -146,9 +146,16 @@ class DemRunDriver {
     thermo_.emplace(dir_ / "thermo.tsv", restart_, continuation_.thermo_rows);
     rows_kept_ = thermo_->rows();
     if (config_.output.trajectory) {
-      open_trajectory<D>(trajectory_, dir_, restart_, n_, continuation_.trajectory_frames,
-                         [&] { return dem_->export_state(); });
+      const bool created =
+          open_trajectory<D>(trajectory_, dir_, restart_, n_, continuation_.trajectory_frames,
+                             [&] { return dem_->export_state(); });
       frames_kept_ = trajectory_->frame_count();
+      // The present state's frame is there already (written now, or the last kept one the
+      // restart file recorded): a continued run with nothing left to do writes no second one.
+      if (restart_ && (created || (continuation_.same_directory && resumed_.has_frame_mark &&
+                                   resumed_.frame_time == dem_->time())))
+        frame_steps_ = dem_->steps();
+      kept_frame_time_ = created || !resumed_.has_frame_mark ? dem_->time() : resumed_.frame_time;
     } else {
       frames_not_written_ = cut_back_trajectory<D>(dir_, n_, continuation_.trajectory_frames);
     }
@@ -248,6 +255,11 @@ class DemRunDriver {
     p.thermo_rows = static_cast<std::int64_t>(rows_kept_);
     p.trajectory_frames =
         trajectory_ ? static_cast<std::int64_t>(frames_kept_) : frames_not_written_;
+    if (trajectory_) {
+      p.has_frame_mark = true;
+      p.frame_time = kept_frame_time_;
+      p.frame_collisions = 0;  // the DEM's frames are told apart by their time
+    }
     p.has_thermo_mark = true;
     p.mark_time = kept_mark_.time;
     p.mark_virial = kept_mark_.virial;
@@ -291,7 +303,10 @@ class DemRunDriver {
   void write_trajectory_frame(bool kept = true) {
     append_trajectory_frame(*trajectory_, dem_->export_state());
     frame_steps_ = dem_->steps();
-    if (kept) frames_kept_ = trajectory_->frame_count();
+    if (kept) {
+      frames_kept_ = trajectory_->frame_count();
+      kept_frame_time_ = dem_->time();
+    }
   }
 
   // Steps until `length` more collisions per particle or simulated time (then to the first
@@ -607,6 +622,7 @@ class DemRunDriver {
   double ke_peak_ = 0.0;  // the largest kinetic energy seen (the scale of "at rest")
   Vec<D> p_start_{};
   long frame_steps_ = 0;
+  double kept_frame_time_ = 0.0;  // of the last frame kept (frames_kept_)
   // Time steps of the runs this one continues (the state's event counter at the start).
   std::uint64_t collisions_start_ = 0, base_events_ = 0;
   std::vector<double> production_temperatures_;
