@@ -339,7 +339,8 @@ class InterruptLargeSetup(kt.KairosTestCase):
 
     def test_a_wall_time_limit_reached_late_in_the_setup_is_an_error(self):
         conclusive = 0
-        for share in (0.7, 0.85, 0.95):
+        # Earlier shares too: on a loaded machine the measured setup may have been slow.
+        for share in (0.3, 0.5, 0.7, 0.85, 0.95):
             with self.subTest(share=share):
                 out = self.path("out-%g" % share)
                 limit = share * self.setup_seconds
