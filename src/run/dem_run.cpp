@@ -92,12 +92,7 @@ class DemRunDriver {
       dem_.emplace(start, env, options);
     } catch (const InputError& e) {
       if (!restart_file) throw;
-      if (plan_->repredict && plan_->stored_config) {
-        throw InputError(fmt::format("restart file '{}' continued with new physics ({}): {}",
-                                     restart_file->string(), fmt::join(plan_->changed, ", "),
-                                     e.what()));
-      }
-      throw InputError("restart file '" + restart_file->string() + "': " + e.what());
+      throw restart_setup_error(e, *restart_file, *plan_);
     }
     if (!config_.output.profile_axis.empty()) {
       const int axis = config_.output.profile_axis[0] - 'x';

@@ -208,9 +208,9 @@ ParticleSystem<D> build_start_state(const Config& config,
     if (config.soft.enabled() && config.run.integrator == "dem") {
       check_soft_overlaps<D>(init, periodic, source);
     } else if (config.soft.enabled()) {
-      // The event integrator maps a soft contact from its first touch (formulas.md §1.6): a
-      // pair that starts inside one has no first touch, and would collide instantaneously (its
-      // overlap's elastic energy lost), not as the force law says.
+      // The event integrator maps a soft contact from its first touch (Müller and Pöschel, Phys.
+      // Rev. E 87, 033301 (2013)): a pair that starts inside one has no first touch, and would
+      // collide instantaneously (its overlap's elastic energy lost), not as the force law says.
       check_no_overlap<D>(init, periodic, source, exact,
                           "the event integrator maps soft contacts from their first touch and "
                           "cannot start inside one: use run.integrator = \"dem\", which accepts "
@@ -306,12 +306,7 @@ class RunDriver {
              (environment.wall_moves(f) || norm2(environment.faces[f].wall.velocity) > 0.0));
     } catch (const InputError& e) {
       if (!restart_file) throw;
-      if (restart_ && !resume && plan_->stored_config) {
-        throw InputError(fmt::format("restart file '{}' continued with new physics ({}): {}",
-                                     restart_file->string(), fmt::join(plan_->changed, ", "),
-                                     e.what()));
-      }
-      throw InputError("restart file '" + restart_file->string() + "': " + e.what());
+      throw run_detail::restart_setup_error(e, *restart_file, *plan_);
     }
     if (!config_.output.profile_axis.empty()) {
       const int axis = config_.output.profile_axis[0] - 'x';
@@ -791,8 +786,8 @@ class RunDriver {
 
   // f(c, m) for each particle in the caller's order: its velocity now relative to the mean (the
   // centre-of-mass velocity, or under shear the flow at its position) and its mass. From the
-  // engine's records in blocks: no copy of the whole state, nor of every velocity (a thermo row
-  // of a large, short run spent 11 % of its time in export_state()).
+  // engine's records, without a copy of the whole state (a thermo row of a large, short run
+  // spent 11 % of its time in export_state()).
   template <class F>
   void for_each_peculiar_velocity(F&& f) const {
     if (sheared_) {
