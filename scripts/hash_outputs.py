@@ -2,20 +2,25 @@
 """The bit-identity gate of refactors (DEVELOPERS: outputs bit-identical before and after).
 
 Runs every example in examples/*.toml, shortened (a few collisions per particle, or a short
-time), with the given kairos binary, and prints one SHA-256 per example over what a refactor
-must not change: the exact state of restart.gsd (every kairos/state chunk, positions,
-velocities, time, counters; not the run's bookkeeping such as the stored configuration or the
-checksum), the positions of every trajectory frame and thermo.tsv. Compare two builds with
+time), plus the benchmark cases and a few paths the examples miss (other queues, a restart
+continued, a run that is resumed with changed physics, profiles), with the given kairos
+binary, and prints one SHA-256 per case over what a refactor must not change: the exact state
+of restart.gsd (every kairos/state chunk, positions, velocities, time, counters; not the run's
+bookkeeping such as the stored configuration or the checksum), the positions and velocities of
+every trajectory frame, thermo.tsv, profile.tsv, and every value of summary.json except the
+timings, the memory figures and the run id. Compare two builds with
 
     scripts/hash_outputs.py OLD/build/kairos > old.txt
     scripts/hash_outputs.py NEW/build/kairos > new.txt
     diff old.txt new.txt
 
-(run from the repository root; takes a few minutes). Use /usr/bin/python3 (python3-gsd).
+(run from anywhere; takes a few minutes). `--only SUBSTRING` runs the cases whose name
+contains it. Use /usr/bin/python3 (python3-gsd).
 """
 
 import glob
 import hashlib
+import json
 import os
 import subprocess
 import sys
@@ -31,6 +36,47 @@ SHORT = ["run.equilibration_collisions_per_particle=1", "run.collisions_per_part
 SMALLER = {"granular_clustering_2d.toml": ["system.particles=20000"]}
 STATE_PREFIXES = ("kairos/state/", "kairos/position", "kairos/velocity", "kairos/time",
                   "kairos/box", "kairos/mass", "kairos/radius", "kairos/dem/")
+# summary.json keys that differ between two runs of one binary, or that a layout change may
+# move without changing a trajectory (the engine's own bytes per particle).
+VOLATILE = {"wall_seconds", "collisions_per_second", "events_per_second", "steps_per_second",
+            "peak_rss_bytes", "run_id", "bytes_per_particle", "kairos_version",
+            "setup_seconds", "timing", "ns_per_particle_step"}
+
+# Cases beyond the examples: (name, config file relative to the repository or None for
+# inline TOML, inline TOML, overrides, a continuation's overrides or None).
+HARD = "[system]\nparticles = 4000\npacking_fraction = {eta}\n"
+DISKS = "[system]\ndimension = 2\nparticles = 4000\npacking_fraction = {eta}\n"
+EXTRA = [
+    ("bench_hs_eta005", None, HARD.format(eta=0.05), [], None),
+    ("bench_hs_eta020", None, HARD.format(eta=0.2), [], None),
+    ("bench_hs_eta045", None, HARD.format(eta=0.45), [], None),
+    ("bench_disks_eta070", None, DISKS.format(eta=0.7), [], None),
+    ("bench_hs_heap", None, HARD.format(eta=0.3), ['run.event_queue="heap"'], None),
+    ("bench_hs_tree", None, HARD.format(eta=0.3), ['run.event_queue="tree"'], None),
+    ("bench_hs_random", None, HARD.format(eta=0.3), ['system.lattice="random"'], None),
+    ("continued_hs", None, HARD.format(eta=0.45), [], []),
+    ("continued_pile", "examples/granular_pile_3d.toml", None, [], []),
+    ("continued_soft", "examples/soft_viscoelastic_gas_3d.toml", None, [], []),
+    ("continued_steps", "examples/square_well_fluid_3d.toml", None, [], []),
+    ("continued_shear", "examples/shear_flow_2d.toml", None, [], []),
+    ("continued_vibrated", "examples/vibrated_bed_2d.toml", None, [], []),
+    ("continued_dem", "examples/dem_pile_3d.toml", None, [], []),
+    ("repredicted_pile_gravity", "examples/granular_pile_3d.toml", None, [],
+     ["field.gravity=[0.0, 0.0, -2.0]"]),
+    ("profile_vibrated", "examples/vibrated_bed_3d.toml", None, ['output.profile_axis="z"'],
+     None),
+    ("driven_andersen", None, HARD.format(eta=0.3),
+     ['driving.kind="andersen"', "driving.rate=0.5"], None),
+    # Long enough to renumber (every 32 collisions per particle) a few times.
+    ("long_hs_renumbered", None, "[system]\nparticles = 500\npacking_fraction = 0.4\n",
+     ["run.collisions_per_particle=100"], None),
+    ("long_soft_renumbered", "examples/soft_viscoelastic_gas_3d.toml", None,
+     ["system.particles=500", "run.collisions_per_particle=70"], None),
+    ("long_steps_renumbered", "examples/stepped_lj_liquid_3d.toml", None,
+     ["system.particles=500", "run.collisions_per_particle=70"], None),
+    ("long_granular_renumbered", "examples/granular_cooling_3d.toml", None,
+     ["system.particles=1000", "run.collisions_per_particle=70"], None),
+]
 
 
 def hash_restart(path, h):
@@ -50,33 +96,89 @@ def hash_trajectory(path, h):
                     h.update(f.read_chunk(frame=frame, name=name).tobytes())
 
 
+def stable(value):
+    if isinstance(value, dict):
+        return {k: stable(v) for k, v in value.items() if k not in VOLATILE}
+    if isinstance(value, list):
+        return [stable(v) for v in value]
+    return value
+
+
+def hash_outputs(out, h):
+    hash_restart(os.path.join(out, "restart.gsd"), h)
+    traj = os.path.join(out, "trajectory.gsd")
+    if os.path.exists(traj):
+        hash_trajectory(traj, h)
+    for name in ("thermo.tsv", "profile.tsv"):
+        path = os.path.join(out, name)
+        if os.path.exists(path):
+            with open(path, "rb") as f:
+                h.update(f.read())
+    with open(os.path.join(out, "summary.json"), encoding="utf-8") as f:
+        summary = stable(json.load(f))
+    h.update(json.dumps(summary, sort_keys=True).encode())
+
+
+def run_case(kairos, config, overrides, out, cwd, extra=()):
+    args = [kairos, "run", config, "-o", out] + list(extra)
+    for s in overrides:
+        args += ["--set", s]
+    return subprocess.run(args, capture_output=True, text=True, cwd=cwd)
+
+
+def report(name, h, result):
+    print("%s %s%s" % (h.hexdigest()[:16], name,
+                       "" if result.returncode == 0 else
+                       "  (exit %d: %s)" % (result.returncode, result.stderr.strip()[-200:])))
+    sys.stdout.flush()
+
+
 def main():
-    if len(sys.argv) < 2:
+    args = sys.argv[1:]
+    only = ""
+    if "--only" in args:
+        k = args.index("--only")
+        only = args[k + 1]
+        del args[k:k + 2]
+    if len(args) < 1:
         sys.exit(__doc__)
-    kairos = os.path.abspath(sys.argv[1])
+    kairos = os.path.abspath(args[0])
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     with tempfile.TemporaryDirectory(prefix="kairos-hash-") as tmp:
         for example in sorted(glob.glob(os.path.join(root, "examples", "*.toml"))):
             name = os.path.basename(example)
+            if only not in name:
+                continue
             out = os.path.join(tmp, name)
-            args = [kairos, "run", example, "-o", out]
-            for s in SHORT + SMALLER.get(name, []):
-                args += ["--set", s]
-            result = subprocess.run(args, capture_output=True, text=True, cwd=tmp)
+            result = run_case(kairos, example, SHORT + SMALLER.get(name, []), out, tmp)
             h = hashlib.sha256()
             h.update(str(result.returncode).encode())
             if result.returncode == 0:
-                hash_restart(os.path.join(out, "restart.gsd"), h)
-                traj = os.path.join(out, "trajectory.gsd")
-                if os.path.exists(traj):
-                    hash_trajectory(traj, h)
-                with open(os.path.join(out, "thermo.tsv"), "rb") as f:
-                    h.update(f.read())
-            print("%s %s%s" % (h.hexdigest()[:16], name,
-                               "" if result.returncode == 0 else
-                               "  (exit %d: %s)" % (result.returncode,
-                                                    result.stderr.strip()[-200:])))
-            sys.stdout.flush()
+                hash_outputs(out, h)
+            report(name, h, result)
+        for name, path, text, overrides, continuation in EXTRA:
+            if only not in name:
+                continue
+            config = os.path.join(tmp, name + ".toml")
+            if path is not None:
+                config = os.path.join(root, path)
+            else:
+                with open(config, "w", encoding="utf-8") as f:
+                    f.write(text)
+            out = os.path.join(tmp, name)
+            first = SHORT + overrides
+            if continuation is not None:  # stop after 2 collisions per particle, continue to 3
+                first = first + ["run.collisions_per_particle=2"]
+            result = run_case(kairos, config, first, out, tmp)
+            h = hashlib.sha256()
+            h.update(str(result.returncode).encode())
+            if result.returncode == 0 and continuation is not None:
+                result = run_case(kairos, config, SHORT + overrides + continuation, out, tmp,
+                                  ["--restart", os.path.join(out, "restart.gsd")])
+                h.update(str(result.returncode).encode())
+            if result.returncode == 0:
+                hash_outputs(out, h)
+            report(name, h, result)
 
 
 if __name__ == "__main__":
