@@ -4,11 +4,8 @@
 // fully periodic hard-sphere fluid.
 //
 // The environment is set up from the run configuration, never stored in a restart file: it is
-// the model, not the state. Walls are the faces of the box; a wall at the low face of axis k
-// is the plane x_k = u_k t + A sin(w t + phi) with normal +e_k, one at the high face the plane
-// x_k = L_k + u_k t + A sin(w t + phi) with normal -e_k (u_k = A = 0: fixed), where u is the
-// wall's velocity and t the absolute simulation time (so the plane is a function of the state's
-// time alone, and restarts need nothing more).
+// the model, not the state. Walls are the faces of the box (boundaries/face_wall.hpp: their
+// planes are functions of the time alone, so restarts need nothing more).
 #pragma once
 
 #include <array>
@@ -21,6 +18,7 @@
 #include "core/periodic.hpp"
 #include "core/vec.hpp"
 
+#include "boundaries/face_wall.hpp"
 #include "interactions/granular_contact.hpp"
 #include "interactions/soft_contact.hpp"
 #include "interactions/soft_map_table.hpp"
@@ -28,32 +26,12 @@
 
 namespace kairos {
 
-enum class FaceKind { kPeriodic, kWall, kOpen };
-
 // How a soft contact is carried out (formulas.md §1.6): kMapped, the Müller–Pöschel algorithm
 // (the pair is placed where the contact ends, frozen in its centre-of-mass frame, and released
 // with the post-contact velocities t_c later); kInstantaneous, a hard-sphere collision at first
 // contact with the same normal restitution e(v_n) = -eps_rdot (the model the mapping improves
 // on, kept for comparisons).
 enum class SoftCollisions { kMapped, kInstantaneous };
-
-template <int D>
-struct Wall {
-  ContactModel contact;  // restitution and roughness of particle-wall collisions
-  // Velocity of the wall: the components in its plane slide it (a shear plate), the one along
-  // its normal moves the plane at that constant speed (a piston).
-  Vec<D> velocity{};
-  double amplitude = 0.0;          // vibration along the normal: offset A sin(w t + phi)
-  double angular_frequency = 0.0;  // w
-  double phase = 0.0;              // phi
-  bool vibrates() const { return amplitude > 0.0 && angular_frequency > 0.0; }
-};
-
-template <int D>
-struct Face {
-  FaceKind kind = FaceKind::kPeriodic;
-  Wall<D> wall;  // used when kind == kWall
-};
 
 template <int D>
 struct Environment {
@@ -131,16 +109,12 @@ struct Environment {
   }
   // Whether face f is a wall whose plane moves (a normal velocity or a vibration).
   bool wall_moves(int f) const {
-    const Wall<D>& w = faces[f].wall;
-    return faces[f].kind == FaceKind::kWall && (w.velocity[f / 2] != 0.0 || w.vibrates());
+    return faces[f].kind == FaceKind::kWall && faces[f].wall.plane_moves(f);
   }
   // Where the plane of wall face f lies along its axis at time t (box: the box's edges): the
   // plane of the header comment. The event engine and the outputs read walls through this.
   double wall_position(int f, const Vec<D>& box, double t) const {
-    const Wall<D>& w = faces[f].wall;
-    double x = f % 2 == 0 ? 0.0 : box[f / 2];
-    if (w.velocity[f / 2] != 0.0) x += w.velocity[f / 2] * t;
-    return w.vibrates() ? x + w.amplitude * std::sin(w.angular_frequency * t + w.phase) : x;
+    return faces[f].wall.plane_position(f, box, t);
   }
   bool has_walls() const {
     for (const Face<D>& f : faces)

@@ -208,24 +208,6 @@ void DemIntegrator<D>::set_walls(const Environment<D>& env) {
 }
 
 template <int D>
-double DemIntegrator<D>::plane(int face, double t) const {
-  const Wall<D>& w = walls_[static_cast<std::size_t>(face)];
-  const int k = face / 2;
-  double x = face % 2 == 0 ? 0.0 : box_[k];
-  if (w.velocity[k] != 0.0) x += w.velocity[k] * t;
-  return w.vibrates() ? x + w.amplitude * std::sin(w.angular_frequency * t + w.phase) : x;
-}
-
-template <int D>
-double DemIntegrator<D>::plane_velocity(int face, double t) const {
-  const Wall<D>& w = walls_[static_cast<std::size_t>(face)];
-  const double u = w.velocity[face / 2];
-  return w.vibrates()
-             ? u + w.amplitude * w.angular_frequency * std::cos(w.angular_frequency * t + w.phase)
-             : u;
-}
-
-template <int D>
 void DemIntegrator<D>::init(const DemOptions& options) {
   const ParticleSystem<D>& system = base_;
   // The laws (SoftContactLaw's factories validate; a hand-built one is checked here).
@@ -928,11 +910,12 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
     if (!wall_on_[static_cast<std::size_t>(f)]) continue;
     const int k = f / 2;
     const double sign = f % 2 == 0 ? 1.0 : -1.0;  // the wall's normal (into the box) along k
-    const double p = plane(f, t), w = plane_velocity(f, t);
-    const double p_before = plane(f, t - dt_);
+    const Wall<D>& wall = walls_[static_cast<std::size_t>(f)];
+    const double p = wall.plane_position(f, box_, t), w = wall.plane_speed(f, t);
+    const double p_before = wall.plane_position(f, box_, t - dt_);
     const double* const x = x_[k].data();
     // Friction: the wall's velocity (sliding in its plane, moving along its normal) and normal.
-    Vec<D> wall_velocity = walls_[static_cast<std::size_t>(f)].velocity, normal{};
+    Vec<D> wall_velocity = wall.velocity, normal{};
     wall_velocity[k] = w;
     normal[k] = sign;
     std::vector<Vec<D>>& springs = wall_shear_[static_cast<std::size_t>(f)];

@@ -170,9 +170,6 @@ class DemIntegrator {
   std::size_t resume_stride() const;
   void set_walls(const Environment<D>& env);
   void set_friction(const Environment<D>& env);
-  // The plane of wall face f along its axis at time t, and its velocity along the axis.
-  double plane(int face, double t) const;
-  double plane_velocity(int face, double t) const;
   // Wall forces (added to f_) at positions x and predicted velocities vp at time t.
   void compute_wall_forces(bool count_collisions, double t);
   template <bool Gravity, bool Walls>

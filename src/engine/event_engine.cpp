@@ -38,10 +38,6 @@ Spin<D> to_spin(const AngularVelocity<D>& w) {
     return w[0];
   }
 }
-// a / b rounded down (b > 0), for negative a too.
-constexpr std::int64_t floor_div(std::int64_t a, std::int64_t b) {
-  return a >= 0 ? a / b : -((-a + b - 1) / b);
-}
 
 template <int D>
 AngularVelocity<D> from_spin(const Spin<D>& w) {
@@ -130,8 +126,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   }
   // Sleepers predict no events of their own, so a wall moving along its normal (vibrating or a
   // piston) could move into one unseen: then nothing sleeps (resting piles need the TC model).
-  bool moving = false;
-  for (int f = 0; f < 2 * D; ++f) moving = moving || env_.wall_moves(f);
+  const bool moving = face_walls_.any_plane_moves();
   if (stepped_ && env_.sleep_speed > 0.0) {
     throw InputError(
         "contact.sleep_speed: resting particles cannot sleep under stepped potentials (a "
@@ -160,7 +155,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
       for (std::uint32_t k = 0; k < n; ++k) last_collision_[k] = s.last_collision_time[id_[k]];
   }
   std::vector<double> times(n);
-  pending_.assign(n, {kNoPartner, 0});
+  pending_.assign(n, {Code::crossing(), 0});
   if (mode == StartMode::kResume) {
     if (s.events.size() != n || s.cell.size() != n || !has_counts) {
       throw InputError("cannot resume: the state carries no scheduler state (events, cells)");
@@ -173,19 +168,15 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
         throw InputError("cannot resume: the pending event of particle " + std::to_string(id_[k]) +
                          " is not at or after the state's time");
       }
-      const bool particle = e.partner < n;
-      const bool kept = e.partner >= kKeptBase && e.partner - kKeptBase < n;
-      if (!particle && !kept && e.partner < kNoneKept) {
+      if (!Code::valid_bits(e.partner, static_cast<std::uint32_t>(n))) {
         throw InputError("cannot resume: particle " + std::to_string(id_[k]) +
                          " has an event partner code out of range");
       }
-      pending_[k] = {particle ? internal[e.partner]
-                     : kept   ? kKeptBase + internal[e.partner - kKeptBase]
-                              : e.partner,
-                     e.partner_count};
+      const Code code =
+          Code::from_bits(e.partner).renumbered([&](std::uint32_t p) { return internal[p]; });
+      pending_[k] = {code, e.partner_count};
       // Files written with incremental crossings resumed without them: full scans.
-      if (!incremental_crossings_ && is_crossing(pending_[k].partner))
-        pending_[k] = {kNoPartner, 0};
+      if (!incremental_crossings_ && code.is_crossing()) pending_[k] = {Code::crossing(), 0};
       times[k] = e.time;
       hot_[k].cell = s.cell[id_[k]];
       check_restored_cell(k);
@@ -198,19 +189,8 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
       for (int a = 0; a < D; ++a)
         if (grid_.periodic(a)) hot_[k].pos[a] = wrap_into_box(hot_[k].pos[a], box_[a]);
       hot_[k].cell = grid_.locate(hot_[k].pos);
-      for (int f = 0; f < 2 * D; ++f) {
-        if (env_.faces[f].kind != FaceKind::kWall) continue;
-        if (soft_ && frozen_with_[k] != kNoPartner) continue;  // pressed into its wall
-        const int a = f / 2;
-        const double gap = f % 2 == 0 ? hot_[k].pos[a] - wall_offset(f, time_)
-                                      : wall_offset(f, time_) - hot_[k].pos[a];
-        if (gap < radius_of(k) * (1.0 - 1e-12)) {
-          throw InputError("particle " + std::to_string(id_[k]) + " overlaps the wall at the " +
-                           (f % 2 == 0 ? "low" : "high") + " face of axis " +
-                           std::string(1, "xyz"[a]) + " (centre " + std::to_string(gap) +
-                           " from the wall, radius " + std::to_string(radius_of(k)) + ")");
-        }
-      }
+      if (walls_ && !(soft_ && frozen_with_[k] != kNoPartner))  // a soft contact: pressed in
+        face_walls_.check_start(hot_[k].pos, radius_of(k), time_, id_[k]);
     }
     if (options_.renumber_interval > 0.0) {
       renumber(/*queue_filled=*/false);  // fills the grid in the new numbering
@@ -276,7 +256,8 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   }
   accelerated_ = env_.has_gravity();
   half_gravity_ = 0.5 * env_.gravity;
-  walls_ = env_.has_walls();
+  face_walls_ = FaceWalls<D>(env_.faces, box_, env_.gravity);
+  walls_ = face_walls_.any();
   granular_contacts_ = !env_.plain() || env_.tc > 0.0;
   double rmax = 0.0;
   for (const Shape& sh : shapes_) rmax = std::max(rmax, sh.radius);
@@ -307,133 +288,26 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
               : options_.max_cells_per_particle;
   grid_ = CellGrid<D>(box_, min_width, periodic, s.size(), cells_per_particle);
   bounded_ = bounded;
-  // Layers of cells next to a face that a fixed or vibrating wall can reach: the particle's
-  // centre lies within its radius of the plane, which moves up to the amplitude into the box.
-  for (int f = 0; f < 2 * D; ++f) {
-    const double reach = env_.faces[f].wall.amplitude + rmax;
-    wall_layers_[f] = 1 + static_cast<int>(std::floor(reach / grid_.width(f / 2)));
-  }
-  sheared_ = env_.sheared();
-  if (sheared_) {
-    shear_speed_ = env_.shear_rate * box_[1];
-    image_step_ = image_step_at(time_);
-    next_image_shift_ = image_shift_time(image_step_);
-  }
+  face_walls_.set_reach(grid_, rmax);
+  shear_ = LeesEdwards<D>(env_.shear_rate, box_, grid_, time_);
+  sheared_ = shear_.on();
   double particle_volume = 0.0;
   for (const Kinematics<D>& k : s.kinematics)
     particle_volume +=
         D == 3 ? 4.0 / 3.0 * M_PI * k.radius * k.radius * k.radius : M_PI * k.radius * k.radius;
-  find_squeeze_time(rmax, particle_volume);
-  if (time_ >= squeeze_time_) throw_squeezed(time_);
+  face_walls_.find_squeeze_time(rmax, particle_volume, uniform_radius_);
+  if (time_ >= face_walls_.squeeze_time()) throw_squeezed(time_);
   // Shear (sliding images) and steps (zones) keep full scans.
   incremental_crossings_ = options_.incremental_crossings && !stepped_ && !sheared_;
   for (int a = 0; a < D; ++a)
     three_cell_axis_ = three_cell_axis_ || (grid_.periodic(a) && grid_.cells_along(a) == 3);
 }
 
-// Relative margin of find_squeeze_time: a lone particle squeezed between approaching walls
-// bounces ever faster (speed times gap is an adiabatic invariant), so the exact limit would take
-// without end to reach; this one is reached after some 1e4 bounces, while its events are still
-// 1e7 ulps of the clock apart, far from a frozen clock (at a margin of 1e-6 the clock froze
-// first, 1e-5 time units short of it).
-constexpr double kSqueezeMargin = 1e-3;
-
-// The first time at which the walls of an axis, moving towards each other, are no more than the
-// largest diameter (times 1 + kSqueezeMargin) apart, or leave less room between them than the
-// particles' volume at the densest packing, vibration amplitudes counted as if both walls were
-// at their innermost: from then on the particles have no room between them (a gas compressed by
-// a piston jams before that, which the run drivers' frozen-clock watch reports). The densest
-// packing: pi / sqrt 18 for equal spheres (Kepler's conjecture, Hales, Ann. Math. 162, 1065
-// (2005)), pi / sqrt 12 for equal disks (Thue); particles of several sizes can pack denser,
-// so for them the bound is 1 (no room at all).
-template <int D, class Queue>
-void EventEngine<D, Queue>::find_squeeze_time(double rmax, double particle_volume) {
-  squeeze_time_ = kNever;
-  const double densest = !uniform_radius_ ? 1.0
-                         : D == 3         ? M_PI / std::sqrt(18.0)
-                                          : M_PI / std::sqrt(12.0);
-  for (int a = 0; a < D; ++a) {
-    const Face<D>& lo = env_.faces[2 * a];
-    const Face<D>& hi = env_.faces[2 * a + 1];
-    if (lo.kind != FaceKind::kWall || hi.kind != FaceKind::kWall) continue;
-    const double approach = lo.wall.velocity[a] - hi.wall.velocity[a];
-    if (!(approach > 0.0)) continue;
-    double cross_section = 1.0;
-    for (int b = 0; b < D; ++b)
-      if (b != a) cross_section *= box_[b];
-    const double needed =
-        std::max(2.0 * rmax * (1.0 + kSqueezeMargin), particle_volume / (densest * cross_section));
-    const double room = box_[a] - lo.wall.amplitude - hi.wall.amplitude - needed;
-    if (room / approach < squeeze_time_) {
-      squeeze_time_ = room / approach;
-      squeeze_axis_ = a;
-      squeeze_needed_ = needed;
-    }
-  }
-}
-
 template <int D, class Queue>
 void EventEngine<D, Queue>::throw_squeezed(double t) const {
-  const int a = squeeze_axis_;
-  const std::string lo = std::string(1, "xyz"[a]) + "-", hi = std::string(1, "xyz"[a]) + "+";
-  const Wall<D>& wl = env_.faces[2 * a].wall;
-  const Wall<D>& wh = env_.faces[2 * a + 1].wall;
   double dmax = 0.0;
   for (const Shape& sh : shapes_) dmax = std::max(dmax, 2.0 * sh.radius);
-  std::ostringstream msg;
-  msg.precision(10);
-  msg << "boundary: at t = " << t << " the walls " << lo << " and " << hi << " are "
-      << box_[a] + (wh.velocity[a] - wl.velocity[a]) * t << " apart";
-  if (wl.vibrates() || wh.vibrates()) {
-    msg << " (their vibrations take up to " << wl.amplitude + wh.amplitude << " of that)";
-  }
-  if (squeeze_needed_ > dmax * (1.0 + 2.0 * kSqueezeMargin)) {
-    msg << ", less than the " << squeeze_needed_
-        << " the particles need between them at the densest packing"
-        << (uniform_radius_ ? (D == 3 ? " of equal spheres" : " of equal disks") : "")
-        << ": there is no room left between them (";
-  } else {
-    msg << ", no more than the largest particle diameter " << dmax
-        << ": there is no room left between them (";
-  }
-  if (wl.velocity[a] != 0.0 && wh.velocity[a] != 0.0) {
-    msg << "the walls " << lo << " and " << hi << " move towards each other";
-  } else {
-    msg << "the wall " << (wl.velocity[a] != 0.0 ? lo : hi) << " moves towards "
-        << (wl.velocity[a] != 0.0 ? hi : lo);
-  }
-  msg << " at " << wl.velocity[a] - wh.velocity[a]
-      << ", from the box's faces at t = 0); end the run before t = " << squeeze_time_
-      << ", or move the walls more slowly or less far";
-  throw InputError(msg.str());
-}
-
-// Position of a wall's plane along its axis at time t.
-template <int D, class Queue>
-double EventEngine<D, Queue>::wall_offset(int face, double t) const {
-  return env_.wall_position(face, box_, t);
-}
-
-// Along the wall's normal n (into the box: +e_a at the low face, -e_a at the high one) the
-// plane's offset is d(t) = d0 + u t (+ the vibration): in the frame moving with u the particle's
-// normal velocity is v - u, and the solvers of a fixed or vibrated plane apply. With u = 0 the
-// result is the fixed (vibrated) plane's bit for bit.
-template <int D, class Queue>
-double EventEngine<D, Queue>::wall_event_time(int face, const Vec<D>& x, const Vec<D>& v,
-                                              double radius, double t, double horizon) const {
-  const Wall<D>& w = env_.faces[face].wall;
-  const int a = face / 2;
-  const double sgn = face % 2 == 0 ? 1.0 : -1.0;
-  const NormalMotion m{sgn * x[a] - radius, sgn * v[a], sgn * env_.gravity[a]};
-  const double u = sgn * w.velocity[a];
-  const double d = (face % 2 == 0 ? 0.0 : -box_[a]) + (u != 0.0 ? u * t : 0.0);
-  if (w.vibrates()) {
-    const NormalMotion rel{m.height, m.velocity - u, m.accel};
-    const VibratedPlane plane{d, sgn * w.amplitude, w.angular_frequency,
-                              std::remainder(w.angular_frequency * t + w.phase, 2.0 * M_PI)};
-    return vibrated_plane_event_time(rel, plane, horizon);
-  }
-  return moving_plane_event_time(m, d, u, horizon);
+  face_walls_.throw_squeezed(t, dmax, uniform_radius_);
 }
 
 // A restored cell must exist and contain the particle's position (up to round-off): a damaged
@@ -496,11 +370,8 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   for (std::uint32_t k = 0; k < n; ++k) new_index[order[k]] = k;
   std::vector<double> times(queue_filled ? n : 0);
   for (std::uint32_t k = 0; queue_filled && k < n; ++k) times[k] = queue_.time_of(order[k]);
-  for (PendingEvent& e : pending_) {
-    std::uint32_t& p = e.partner;
-    if (p < kFirstCode) p = new_index[p];
-    if (p >= kKeptBase && p < kNoneKept) p = kKeptBase + new_index[p - kKeptBase];
-  }
+  for (PendingEvent& e : pending_)
+    e.code = e.code.renumbered([&](std::uint32_t p) { return new_index[p]; });
   for (std::uint32_t& p : frozen_with_)
     if (p < kFirstCode) p = new_index[p];
   if (stepped_) steps_.renumber(new_index);
@@ -668,7 +539,7 @@ template <int D, class Queue>
 template <int D, class Queue>
 void EventEngine<D, Queue>::gather(CellCode cell, CandidateList& list) {
   if (sheared_) [[unlikely]] {
-    list.sheared = next_to_shear_face(cell);
+    list.sheared = shear_.next_to_face(cell, grid_);
     if (list.sheared) {
       gather_sheared(cell, list);
       return;
@@ -896,20 +767,20 @@ double EventEngine<D, Queue>::conclude_prediction(std::uint32_t i, double t,
                                                   double best) {
   double when = crossing.time;
   if (partner != kNoPartner) {
-    pending_[i] = {partner, hot_[partner].collisions};
+    pending_[i] = {Code::collision(partner), hot_[partner].collisions};
     when = t + best;
   } else {
-    pending_[i] = {kNoPartner, 0};
+    pending_[i] = {Code::crossing(), 0};
   }
   if (walls_) {
     const auto [dt, face] = next_wall_contact(i, t, when - t);
     if (face >= 0) {
-      pending_[i] = {kFirstWall + static_cast<std::uint32_t>(face), 0};
+      pending_[i] = {Code::wall(face), 0};
       when = t + dt;
     }
   }
   if (soft_ && awaits_release(i) && release_time_[i] <= when) [[unlikely]] {
-    pending_[i] = {kRelease, 0};
+    pending_[i] = {Code::release(), 0};
     when = release_time_[i];
   }
   return when > t ? when : t;  // never in the past, whatever the round-off
@@ -923,10 +794,10 @@ double EventEngine<D, Queue>::conclude_unbounded(std::uint32_t i, double t,
   if (partner != kNoPartner && soonest < crossing.time - t)
     return conclude_prediction(i, t, crossing, partner, soonest);
   const double when = conclude_prediction(i, t, crossing, kNoPartner, 0.0);
-  if (pending_[i].partner == kNoPartner) {  // the crossing (no wall or release came first)
+  if (pending_[i].code.is_full_scan_crossing()) {  // the crossing (no wall or release first)
     pending_[i] = partner == kNoPartner
-                      ? PendingEvent{kNoneKept, 0}
-                      : PendingEvent{kKeptBase + partner, hot_[partner].collisions};
+                      ? PendingEvent{Code::crossing_keeping_none(), 0}
+                      : PendingEvent{Code::crossing_keeping(partner), hot_[partner].collisions};
   }
   return when;
 }
@@ -1009,7 +880,9 @@ template <int D, class Queue>
 double EventEngine<D, Queue>::predict_asleep(const CandidateList& list, std::uint32_t i, double t) {
   double best = kNever;
   const std::uint32_t partner = scan_with_sleepers(list, i, t, best);
-  pending_[i] = {partner, partner == kNoPartner ? 0u : hot_[partner].collisions};
+  pending_[i] = partner == kNoPartner
+                    ? PendingEvent{Code::crossing(), 0}
+                    : PendingEvent{Code::collision(partner), hot_[partner].collisions};
   return partner == kNoPartner ? kNever : t + best;
 }
 
@@ -1164,30 +1037,12 @@ void EventEngine<D, Queue>::separate(std::uint32_t i, std::uint32_t j, const Vec
   add_virial_tensor(r, lambda * r);
 }
 
-// Whether a cell lies within wall_layers_[f] layers of face f (a non-periodic axis).
-template <int D, class Queue>
-bool EventEngine<D, Queue>::near_face(CellCode c, int f) const {
-  const int a = f / 2, k = grid_.coordinate(c, a);
-  return f % 2 == 0 ? k < wall_layers_[f] : grid_.cells_along(a) - 1 - k < wall_layers_[f];
-}
-
-// The soonest contact of particle i with a wall, from time t and before t + horizon. Only the
-// layers next to a face that its wall's vibration can reach (near_face) can touch a fixed or
-// vibrating wall; a wall with a normal velocity (a piston) may reach any layer.
 template <int D, class Queue>
 std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i, double t,
                                                                 double horizon) const {
-  std::pair<double, int> best{horizon, -1};
   const HotRecord<D>& h = hot_[i];
-  const Vec<D> xt = position_at(h, t), vt = velocity_at(h, t);
-  for (int f = 0; f < 2 * D; ++f) {
-    const int a = f / 2;
-    if (env_.faces[f].kind != FaceKind::kWall) continue;
-    if (env_.faces[f].wall.velocity[a] == 0.0 && !near_face(h.cell, f)) continue;
-    const double when = wall_event_time(f, xt, vt, radius_of(i), t, best.first);
-    if (when < best.first) best = {when, f};
-  }
-  return best;
+  return face_walls_.next_contact(position_at(h, t), velocity_at(h, t), radius_of(i), h.cell, grid_,
+                                  t, horizon);
 }
 
 // A particle meets a wall: the wall is a partner of infinite mass moving with its velocity
@@ -1195,7 +1050,7 @@ std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i,
 // velocity relative to the wall.
 template <int D, class Queue>
 void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
-  if (t >= squeeze_time_) throw_squeezed(t);
+  if (t >= face_walls_.squeeze_time()) throw_squeezed(t);
   if (soft_) [[unlikely]] {
     hit_wall_soft(i, face, t);
     return;
@@ -1203,34 +1058,22 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
   const bool again = wedged(i, t);
   advance_to(i, t);
   HotRecord<D>& h = hot_[i];
-  const Wall<D>& w = env_.faces[face].wall;
-  const int a = face / 2;
+  const Wall<D>& w = face_walls_.wall(face);
   bool elastic = false;
   if (!last_collision_.empty()) {
     elastic = t - last_collision_[i] < env_.tc;
     last_collision_[i] = t;
   }
-  WallContactInput<D> in;
-  in.normal = Vec<D>{};
-  in.normal[a] = face % 2 == 0 ? 1.0 : -1.0;
-  in.wall_velocity = w.velocity;
-  if (w.vibrates()) {
-    in.wall_velocity[a] +=
-        w.amplitude * w.angular_frequency * std::cos(w.angular_frequency * t + w.phase);
-  }
-  in.mass = mass_of(i);
-  in.radius = radius_of(i);
-  in.inertia_factor = env_.inertia_factor_of(species_of(i));
-  in.force_elastic = elastic;
   Spin<D> wi{};
   if (!spin_.empty()) wi = to_spin<D>(spin_[i]);
-  const ContactResult<D> res = resolve_wall_contact(w.contact, in, h.vel, wi);
+  const ContactResult<D> res = face_walls_.resolve(
+      face, t, mass_of(i), radius_of(i), env_.inertia_factor_of(species_of(i)), elastic, h.vel, wi);
   if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
   counters_.dissipated_at_walls += res.dissipated;
-  counters_.work_by_walls +=
-      res.translational_energy_change + res.rotational_energy_change + res.dissipated;
+  counters_.work_by_walls += FaceWalls<D>::work(res);
   if (sleep_speed_ > 0.0 && !w.vibrates()) {
-    counters_.dissipated_at_walls -= settle_after_contact(i, in.normal, w.velocity, t, again);
+    counters_.dissipated_at_walls -=
+        settle_after_contact(i, face_normal<D>(face), w.velocity, t, again);
   }
   counters_.elastic_by_rule += res.made_elastic ? 1u : 0u;
   counters_.sliding_collisions += res.slid ? 1u : 0u;
@@ -1323,14 +1166,10 @@ bool EventEngine<D, Queue>::resting_on_support(std::uint32_t i, double t) {
       4.0 * sleep_speed_ * sleep_speed_ / std::sqrt(norm2(env_.gravity)) + 1e-12 * radius_of(i);
   const Vec<D> x = position_of(i, t);
   for (int f = 0; f < 2 * D; ++f) {
-    const Face<D>& face = env_.faces[f];
-    if (face.kind != FaceKind::kWall || face.wall.vibrates() || norm2(face.wall.velocity) != 0.0)
-      continue;
-    const int a = f / 2;
-    Vec<D> normal{};
-    normal[a] = f % 2 == 0 ? 1.0 : -1.0;
-    const double gap = f % 2 == 0 ? x[a] - wall_offset(f, t) : wall_offset(f, t) - x[a];
-    if (holds_up(normal) && gap - radius_of(i) < eps) return true;
+    if (!face_walls_.is_wall(f)) continue;
+    const Wall<D>& w = face_walls_.wall(f);
+    if (w.vibrates() || norm2(w.velocity) != 0.0) continue;
+    if (holds_up(face_normal<D>(f)) && face_walls_.gap(f, x, t) - radius_of(i) < eps) return true;
   }
   CandidateList& list = lists_[1];
   gather(hot_[i].cell, list);
@@ -1439,9 +1278,9 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   // Whether the prediction that scheduled this crossing kept the contact beyond it, and whether
   // that is still good: its partner's motion unchanged (counter), read before i moves.
   std::uint32_t kept = kNoPartner;
-  bool incremental = e.partner == kNoneKept;
-  if (e.partner >= kKeptBase && e.partner < kNoneKept) {
-    kept = e.partner - kKeptBase;
+  bool incremental = e.code.keeps_nothing();
+  if (e.code.keeps_contact()) {
+    kept = e.code.kept_partner();
     incremental = hot_[kept].collisions == e.partner_count;
   }
   advance_to(i, t);
@@ -1476,7 +1315,7 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
 
 template <int D, class Queue>
 EventKind EventEngine<D, Queue>::step() {
-  if (sheared_ && next_image_shift_ <= queue_.top_time()) [[unlikely]] {
+  if (sheared_ && shear_.next_shift_time() <= queue_.top_time()) [[unlikely]] {
     shift_images();
     return EventKind::kImageShift;
   }
@@ -1492,24 +1331,24 @@ EventKind EventEngine<D, Queue>::step() {
     __builtin_prefetch(&pending_[k]);
   }
   const PendingEvent e = pending_[i];
-  if (e.partner >= kFirstCode) {
-    if (is_crossing(e.partner)) [[likely]] {
+  if (!e.code.is_collision()) {
+    if (e.code.is_crossing()) [[likely]] {
       cross(i, t);
       return EventKind::kCellCrossing;
     }
-    if (e.partner == kRelease) {
+    if (e.code.is_release()) {
       release_event(i, t);
       return EventKind::kSoftRelease;
     }
-    hit_wall(i, static_cast<int>(e.partner - kFirstWall), t);
+    hit_wall(i, e.code.wall_face(), t);
     return EventKind::kWallCollision;
   }
-  if (hot_[e.partner].collisions != e.partner_count) {
+  if (hot_[e.code.partner()].collisions != e.partner_count) {
     ++counters_.stale_events;
     queue_.update(i, predict(i, t));
     return EventKind::kStale;
   }
-  collide(i, e.partner, t);
+  collide(i, e.code.partner(), t);
   if (counters_.collisions >= next_renumber_) {
     renumber(/*queue_filled=*/true);
     next_renumber_ = next_renumber_after(counters_.collisions);
@@ -1568,49 +1407,13 @@ double EventEngine<D, Queue>::bytes_per_particle() const {
          shapes + grid_.bytes_per_particle() + static_cast<double>(queue_.bytes_per_particle());
 }
 
-// --- Lees-Edwards shear ---------------------------------------------------------------------
-//
-// The images above the box (y + L_y) sit displaced along x by image_offset(t) and move at
-// shear_speed_ = shear_rate L_y; those below by the opposite. A particle leaving through a y
-// face re-enters as its image: x and v_x jump by the offset and the image velocity. Pairs
-// across a y face are searched in the row of cells beyond the face, 4 cells wide in x around
-// where the image of the particle's own column sits now; that window stays right while the
-// offset moves by less than a cell width, so every time it has moved one cell width on
-// (image_step_ counts those, unwrapped) the particles next to the y faces are predicted again.
+// --- Lees-Edwards shear (boundaries/lees_edwards.hpp) ----------------------------------------
 
-// The offset, consistent with image_step_: in [k w, (k + 1) w] up to round-off, where
-// k = image_step_ mod n_x and w the cell width along x.
-template <int D, class Queue>
-double EventEngine<D, Queue>::image_offset(double t) const {
-  const std::int64_t nx = grid_.cells_along(0);
-  const std::int64_t wraps = floor_div(image_step_, nx);
-  return shear_speed_ * t - static_cast<double>(wraps) * box_[0];
-}
-
-// When the image offset, now image_step cell widths (rounded down), reaches the next step.
-template <int D, class Queue>
-double EventEngine<D, Queue>::image_shift_time(std::int64_t step) const {
-  const double edge = static_cast<double>(shear_speed_ > 0 ? step + 1 : step);
-  return edge * grid_.width(0) / shear_speed_;
-}
-
-// The image step at time t: every shift due at or before t has happened (as in a run that
-// reached t), so a resumed run continues with the same step.
-template <int D, class Queue>
-std::int64_t EventEngine<D, Queue>::image_step_at(double t) const {
-  auto step = static_cast<std::int64_t>(std::floor(shear_speed_ * t / grid_.width(0)));
-  const std::int64_t back = shear_speed_ > 0 ? -1 : 1;
-  while (image_shift_time(step) <= t) step = next_image_step(step);
-  while (image_shift_time(step + back) > t) step += back;
-  return step;
-}
-
+// The images moved on by a cell width: the particles of the two face rows (every (x, z) column
+// at y = 0 and y = n_y - 1) are predicted again.
 template <int D, class Queue>
 void EventEngine<D, Queue>::shift_images() {
-  time_ = next_image_shift_;
-  image_step_ = next_image_step(image_step_);
-  next_image_shift_ = image_shift_time(image_step_);
-  // The cells of the two face rows: every (x, z) column at y = 0 and y = n_y - 1.
+  time_ = shear_.shift();
   const int nx = grid_.cells_along(0), ny = grid_.cells_along(1);
   const int nz = D == 3 ? grid_.cells_along(D - 1) : 1;
   for (const int y : {0, ny - 1}) {
@@ -1630,60 +1433,23 @@ void EventEngine<D, Queue>::shift_images() {
 // as usual, the row beyond the face through the sliding images.
 template <int D, class Queue>
 void EventEngine<D, Queue>::gather_sheared(CellCode cell, CandidateList& list) {
-  const int nx = grid_.cells_along(0), ny = grid_.cells_along(1);
-  std::array<int, D> c;
-  for (int a = 0; a < D; ++a) c[a] = grid_.coordinate(cell, a);
-  const std::int64_t k = image_step_ - floor_div(image_step_, nx) * nx;
-  const double offset = image_offset(time_);  // predictions happen at time_
-  std::uint32_t n = 0, n_shifts = 1;          // shifts[0]: none
+  std::uint32_t n = 0, n_shifts = 1;  // shifts[0]: none
   list.shifts[0] = Vec<D>{};
   list.velocity_shifts[0] = Vec<D>{};
-  auto add_cell = [&](const std::array<int, D>& at, const Vec<D>& shift, const Vec<D>& vshift) {
-    const std::uint32_t tag = n_shifts++;
-    list.shifts[tag] = shift;
-    list.velocity_shifts[tag] = vshift;
-    for (std::uint32_t p = grid_.first(grid_.index(grid_.code_at(at))); p != grid_.end();
-         p = grid_.next(p)) {
-      if (list.ids.size() - n < kCandidateSlack) grow(list);
-      list.ids[n] = p;
-      list.shift[n++] = tag;
-    }
-  };
-  for (int dy = -1; dy <= 1; ++dy) {
-    std::array<int, D> at = c;
-    Vec<D> shift{}, vshift{};
-    at[1] = c[1] + dy;
-    const int side = at[1] < 0 ? -1 : (at[1] >= ny ? 1 : 0);
-    at[1] -= side * ny;
-    shift[1] = side * box_[1];
-    vshift[0] = side * shear_speed_;
-    // Columns m (unwrapped) whose members, moved by the image offset, can reach column c[0].
-    const int first =
-        side == 0 ? c[0] - 1
-                  : (side > 0 ? c[0] - static_cast<int>(k) - 2 : c[0] + static_cast<int>(k) - 1);
-    const int columns = side == 0 ? 3 : 4;
-    for (int q = 0; q < columns; ++q) {
-      const int m = first + q;
-      const int wraps = static_cast<int>(floor_div(m, nx));
-      at[0] = m - wraps * nx;
-      shift[0] = side * offset + wraps * box_[0];
-      if constexpr (D == 3) {
-        for (int dz = -1; dz <= 1; ++dz) {
-          at[2] = c[2] + dz;
-          Vec<D> s = shift;
-          if (at[2] < 0 || at[2] >= grid_.cells_along(2)) {
-            if (!grid_.periodic(2)) continue;  // beyond a wall or open face: nothing there
-            const int wz = at[2] < 0 ? -1 : 1;
-            at[2] -= wz * grid_.cells_along(2);
-            s[2] = wz * box_[2];
-          }
-          add_cell(at, s, vshift);
+  // Predictions happen at time_.
+  shear_.for_each_neighbour_cell(
+      cell, grid_, time_,
+      [&](const std::array<int, D>& at, const Vec<D>& shift, const Vec<D>& vshift) {
+        const std::uint32_t tag = n_shifts++;
+        list.shifts[tag] = shift;
+        list.velocity_shifts[tag] = vshift;
+        for (std::uint32_t p = grid_.first(grid_.index(grid_.code_at(at))); p != grid_.end();
+             p = grid_.next(p)) {
+          if (list.ids.size() - n < kCandidateSlack) grow(list);
+          list.ids[n] = p;
+          list.shift[n++] = tag;
         }
-      } else {
-        add_cell(at, shift, vshift);
-      }
-    }
-  }
+      });
   list.count = n;
   list.n_shifts = n_shifts;
 }
@@ -1712,15 +1478,8 @@ std::uint32_t EventEngine<D, Queue>::scan_sheared(const CandidateList& list, std
 template <int D, class Queue>
 Vec<D> EventEngine<D, Queue>::sheared_separation(std::uint32_t i, std::uint32_t j, double t,
                                                  Vec<D>& image_velocity) const {
-  Vec<D> r = position_of(i, t) - position_of(j, t);
-  image_velocity = Vec<D>{};
-  const int side = r[1] > 0.5 * box_[1] ? 1 : (r[1] < -0.5 * box_[1] ? -1 : 0);
-  r[1] -= side * box_[1];
-  r[0] -= side * image_offset(t);
-  image_velocity[0] = side * shear_speed_;
-  for (int a = 0; a < D; ++a)
-    if (a != 1 && grid_.periodic(a)) r[a] = minimum_image(r[a], box_[a]);
-  return r;
+  return shear_.separation(position_of(i, t) - position_of(j, t), t, periodic_axes(),
+                           image_velocity);
 }
 
 // A collision under shear: the impulse is the ordinary one between i and the image of j it
@@ -1753,11 +1512,8 @@ void EventEngine<D, Queue>::cross_shear_face(std::uint32_t i, int side, double t
                                              std::array<int, D>& c) {
   HotRecord<D>& h = hot_[i];
   const double ke = norm2(h.vel);
-  h.pos[0] = wrap_into_box(h.pos[0] - side * image_offset(t), box_[0]);
-  h.vel[0] -= side * shear_speed_;
+  c[0] = shear_.cross_face(h.pos, h.vel, side, t, grid_);
   counters_.work_by_shear += 0.5 * mass_of(i) * (norm2(h.vel) - ke);
-  c[0] = std::clamp(static_cast<int>(std::floor(h.pos[0] / grid_.width(0))), 0,
-                    grid_.cells_along(0) - 1);
 }
 
 template <int D, class Queue>
@@ -1788,16 +1544,16 @@ void EventEngine<D, Queue>::validate() {
     const HotRecord<D>& h = hot_[i];
     const Vec<D> x = position_of(i, t);
     for (int f = 0; f < 2 * D; ++f) {
-      if (env_.faces[f].kind != FaceKind::kWall) continue;
-      const double gap = f % 2 == 0 ? x[f / 2] - wall_offset(f, t) : wall_offset(f, t) - x[f / 2];
+      if (!face_walls_.is_wall(f)) continue;
+      const double gap = face_walls_.gap(f, x, t);
       if (gap >= radius_of(i) * (1.0 - 1e-9)) continue;
       // A soft contact overlaps its wall while frozen and after its release, leaving; turned
       // back towards the wall (by a third body), it meets the wall now.
       const double leaving = (f % 2 == 0 ? 1.0 : -1.0) *
-                             (velocity_of(i, t)[f / 2] - env_.faces[f].wall.velocity[f / 2]);
-      const bool soft_ok = soft_ && gap > 0.75 * radius_of(i) &&
-                           (frozen_with_[i] == kFirstWall + static_cast<std::uint32_t>(f) ||
-                            leaving >= 0.0 || queue_.time_of(i) <= t);
+                             (velocity_of(i, t)[f / 2] - face_walls_.wall(f).velocity[f / 2]);
+      const bool soft_ok =
+          soft_ && gap > 0.75 * radius_of(i) &&
+          (frozen_with_[i] == wall_partner(f) || leaving >= 0.0 || queue_.time_of(i) <= t);
       if (!soft_ok) fail("particle " + name(i) + " overlaps a wall");
     }
     for (int a = 0; a < D; ++a) {
@@ -1805,12 +1561,12 @@ void EventEngine<D, Queue>::validate() {
       if (x[a] < grid_.lower_bound(h.cell, a) - tol || x[a] > grid_.upper_bound(h.cell, a) + tol)
         fail("particle " + name(i) + " outside its cell");
     }
-    if (pending_[i].partner < kFirstCode && pending_[i].partner >= n)
+    const Code code = pending_[i].code;
+    if (code.is_collision() && code.partner() >= n)
       fail("particle " + name(i) + " has a partner out of range");
-    const std::uint32_t code = pending_[i].partner;
-    if (code != kNoPartner && is_crossing(code) && !incremental_crossings_)
+    if (code.is_crossing() && !code.is_full_scan_crossing() && !incremental_crossings_)
       fail("particle " + name(i) + " keeps a contact beyond its crossing with full scans");
-    if (code >= kKeptBase && code < kNoneKept && code - kKeptBase >= n)
+    if (code.keeps_contact() && code.kept_partner() >= n)
       fail("particle " + name(i) + " keeps a contact partner out of range");
   }
   // Whether a pending event lies after a contact due at `due`, beyond round-off: positions are
@@ -1825,13 +1581,14 @@ void EventEngine<D, Queue>::validate() {
     if (in_deferred_contact(i, t)) {  // frozen until the release, then as its record says
       const HotRecord<D>& h = hot_[i];
       for (int f = 0; f < 2 * D; ++f) {
-        if (env_.faces[f].kind != FaceKind::kWall) continue;
-        if (wall_event_time(f, position_of(i, t), frozen_velocity_of(i), radius_of(i), t,
-                            h.time - t) < h.time - t)
+        if (!face_walls_.is_wall(f)) continue;
+        if (face_walls_.event_time(f, position_of(i, t), frozen_velocity_of(i), radius_of(i), t,
+                                   h.time - t) < h.time - t)
           fail("particle " + name(i) + " meets wall " + std::to_string(f) +
                " inside its deferred soft contact");
-        const double due = h.time + wall_event_time(f, h.pos, h.vel, radius_of(i), h.time, kNever);
-        const double speed = std::abs(h.vel[f / 2] - env_.faces[f].wall.velocity[f / 2]);
+        const double due =
+            h.time + face_walls_.event_time(f, h.pos, h.vel, radius_of(i), h.time, kNever);
+        const double speed = std::abs(h.vel[f / 2] - face_walls_.wall(f).velocity[f / 2]);
         if (std::isfinite(due) && late(queue_.time_of(i), due, speed))
           fail("particle " + name(i) + " meets wall " + std::to_string(f) +
                " after its deferred release before its pending event");
@@ -1840,16 +1597,16 @@ void EventEngine<D, Queue>::validate() {
     }
     const Vec<D> x = position_of(i, t), v = velocity_of(i, t);
     for (int f = 0; f < 2 * D; ++f) {
-      if (env_.faces[f].kind != FaceKind::kWall) continue;
-      const double due = t + wall_event_time(f, x, v, radius_of(i), t, kNever);
+      if (!face_walls_.is_wall(f)) continue;
+      const double due = t + face_walls_.event_time(f, x, v, radius_of(i), t, kNever);
       const int a = f / 2;
       const double speed_at_contact =
-          std::abs(v[a] + env_.gravity[a] * (due - t) - env_.faces[f].wall.velocity[a]);
+          std::abs(v[a] + env_.gravity[a] * (due - t) - face_walls_.wall(f).velocity[a]);
       if (std::isfinite(due) && late(queue_.time_of(i), due, speed_at_contact)) {
         fail("particle " + name(i) + " meets wall " + std::to_string(f) + " at " +
              std::to_string(due) + " before its pending event (at " +
              std::to_string(queue_.time_of(i)) + ", partner code " +
-             std::to_string(pending_[i].partner) + ", cell " + std::to_string(hot_[i].cell) +
+             std::to_string(pending_[i].code.bits()) + ", cell " + std::to_string(hot_[i].cell) +
              ", local time " + std::to_string(hot_[i].time) + ")");
       }
     }
@@ -1971,8 +1728,9 @@ void EventEngine<D, Queue>::validate() {
         t + pair_contact_time_accelerated<D>(r.data(), g.data(), accel.data(), sigma);
     double bound = std::min(queue_.time_of(i), queue_.time_of(j));
     // Under shear the next image shift predicts the particles next to the y faces again.
-    if (sheared_ && (next_to_shear_face(hot_[i].cell) || next_to_shear_face(hot_[j].cell)))
-      bound = std::min(bound, next_image_shift_);
+    if (sheared_ &&
+        (shear_.next_to_face(hot_[i].cell, grid_) || shear_.next_to_face(hot_[j].cell, grid_)))
+      bound = std::min(bound, shear_.next_shift_time());
     // A straight-line pair that would only graze (its overlap at closest approach is at the
     // round-off level, as in the near-tangential contacts of a collapsing cluster) may be
     // called a hit or a near miss by round-off; either is right.

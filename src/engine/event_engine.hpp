@@ -35,12 +35,15 @@
 #include <string>
 #include <vector>
 
+#include "boundaries/face_walls.hpp"
+#include "boundaries/lees_edwards.hpp"
 #include "core/environment.hpp"
 #include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
 #include "core/state_blocks.hpp"
 #include "dynamics/collision_time.hpp"
 #include "engine/candidate_scan.hpp"
+#include "engine/event_code.hpp"
 #include "engine/pair_steps.hpp"
 #include "scheduler/cell_grid.hpp"
 
@@ -129,7 +132,7 @@ class EventEngine {
 
   double time() const { return time_; }
   // When the next event happens (kNever if nothing ever will).
-  double next_event_time() { return std::min(queue_.top_time(), next_image_shift_); }
+  double next_event_time() { return std::min(queue_.top_time(), shear_.next_shift_time()); }
 
   // Driving (thermostats, random kicks) acts between events: it sets the velocity of particle k
   // at time t, with time() <= t <= next_event_time(), wakes it if it sleeps, invalidates
@@ -220,10 +223,8 @@ class EventEngine {
   const CellGrid<D>& grid() const { return grid_; }
 
  private:
-  struct PendingEvent {
-    std::uint32_t partner;        // a particle, or a code from kFirstCode on (see below)
-    std::uint32_t partner_count;  // the partner's (or kept partner's) collision counter
-  };
+  using Code = EventCode<D>;
+  using PendingEvent = kairos::PendingEvent<D>;
   // Scratch of a prediction: candidate partners and the periodic shift of each one's cell. Two,
   // so that both partners of a collision gather (and prefetch) before either is tested.
   // Under shear, the row of cells beyond a y face is searched 4 cells wide (its images slide),
@@ -245,21 +246,11 @@ class EventEngine {
     int sign;     // +1 up, -1 down
   };
 
-  // Partner codes of a PendingEvent above the particle indices: a wall (one per box face),
-  // and kNoPartner (or one of the codes of is_crossing) for a cell crossing.
-  static constexpr std::uint32_t kFirstWall = EventSlot::kNoPartner - 2 * D;
-  // Soft spheres: the release of the frozen contact the particle sits in.
-  static constexpr std::uint32_t kRelease = kFirstWall - 1;
-  // Incremental crossings (see cross()): a crossing whose prediction found no contact at all,
-  // and a crossing that keeps the soonest contact after it, with particle p: kKeptBase + p
-  // (partner_count: p's counter). kNoPartner is a crossing that kept nothing (a full scan next).
-  static constexpr std::uint32_t kNoneKept = kRelease - 1;
-  static constexpr std::uint32_t kKeptBase = EventSlot::kKeptBase;
-  // Codes from kFirstCode on are not particles; particle indices stay below it.
-  static constexpr std::uint32_t kFirstCode = kKeptBase;
-  static bool is_crossing(std::uint32_t code) {
-    return code == EventSlot::kNoPartner || (code >= kKeptBase && code <= kNoneKept);
-  }
+  // A soft contact's partner (frozen_with_): a particle, a wall (its event code's bits) or
+  // kNoPartner.
+  static constexpr std::uint32_t kFirstCode = Code::kFirstCode;
+  static bool is_particle(std::uint32_t partner) { return partner < kFirstCode; }
+  static std::uint32_t wall_partner(int face) { return Code::wall(face).bits(); }
   static constexpr auto all_neighbours_ = [] {
     std::array<std::uint8_t, CellGrid<D>::kNeighbourCells> all{};
     for (int n = 0; n < CellGrid<D>::kNeighbourCells; ++n) all[n] = static_cast<std::uint8_t>(n);
@@ -275,17 +266,10 @@ class EventEngine {
   }
   Vec<D> position_at(const HotRecord<D>& h, double t) const;
   Vec<D> velocity_at(const HotRecord<D>& h, double t) const;
-  double wall_offset(int face, double t) const;
-  // Relative time from t of the contact of a particle (position x, velocity v at t) with the
-  // plane of face f, kNever if after t + horizon.
-  double wall_event_time(int face, const Vec<D>& x, const Vec<D>& v, double radius, double t,
-                         double horizon) const;
   // The particle's soonest wall contact from time t before t + horizon: (relative time, face).
   std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
-  bool near_face(CellCode c, int f) const;
   void hit_wall(std::uint32_t i, int face, double t);
-  // Walls moving towards each other: when they leave no room for the largest particle.
-  void find_squeeze_time(double rmax, double particle_volume);
+  // Walls moving towards each other left no room for the particles (FaceWalls::squeeze_time).
   [[noreturn]] void throw_squeezed(double t) const;
   // Sleeping particles (gravity with walls): see Environment::sleep_speed.
   bool is_asleep(std::uint32_t i) const { return !asleep_.empty() && asleep_[i] != 0; }
@@ -382,18 +366,8 @@ class EventEngine {
   // The pair's separation i - j under the box's boundaries (nearest image on periodic axes).
   Vec<D> separation(std::uint32_t i, std::uint32_t j, double t) const;
   void predict_pair(std::uint32_t i, std::uint32_t j, double t);
-  // Lees-Edwards shear (see Environment::shear_rate).
-  double image_offset(double t) const;  // x displacement of the images above the box
-  double image_shift_time(std::int64_t step) const;
-  std::int64_t next_image_step(std::int64_t step) const {
-    return step + (shear_speed_ > 0 ? 1 : -1);
-  }
-  std::int64_t image_step_at(double t) const;
+  // Lees-Edwards shear (boundaries/lees_edwards.hpp).
   void shift_images();
-  bool next_to_shear_face(CellCode c) const {
-    const int y = grid_.coordinate(c, 1);
-    return y == 0 || y == grid_.cells_along(1) - 1;
-  }
   void gather_sheared(CellCode cell, CandidateList& list);
   std::uint32_t scan_sheared(const CandidateList& list, std::uint32_t i, double t,
                              double& best) const;
@@ -402,6 +376,11 @@ class EventEngine {
                             Vec<D>& image_velocity) const;
   void collide_sheared(std::uint32_t i, std::uint32_t j, double t);
   void cross_shear_face(std::uint32_t i, int side, double t, std::array<int, D>& c);
+  std::array<bool, D> periodic_axes() const {
+    std::array<bool, D> p;
+    for (int a = 0; a < D; ++a) p[a] = grid_.periodic(a);
+    return p;
+  }
   void cross(std::uint32_t i, double t);
   // Soft spheres (formulas.md §1.6; engine/soft_contacts.cpp).
   void setup_soft(const ParticleSystem<D>& s);
@@ -532,10 +511,7 @@ class EventEngine {
   HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
   bool accelerated_ = false;      // uniform gravity
   Vec<D> half_gravity_{};
-  bool walls_ = false;
-  double squeeze_time_ = 0.0;  // see find_squeeze_time: kNever unless walls approach
-  int squeeze_axis_ = -1;
-  double squeeze_needed_ = 0.0;          // the room the particles need along squeeze_axis_
+  bool walls_ = false;                   // face_walls_.any()
   bool bounded_ = false;                 // some axis has walls or open faces
   bool granular_contacts_ = false;       // some contact law is not elastic and smooth
   HugeVector<AngularVelocity<D>> spin_;  // rough particles only
@@ -546,11 +522,7 @@ class EventEngine {
   CellGrid<D> grid_;
   Queue queue_;
   std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions
-  std::array<int, 2 * D> wall_layers_{};  // layers next to each face a wall can reach
-  bool sheared_ = false;
-  double shear_speed_ = 0.0;     // shear_rate * L_y: velocity of the images above the box
-  std::int64_t image_step_ = 0;  // image offset in cell widths, rounded down (unwrapped)
-  double next_image_shift_ = kNever;
+  bool sheared_ = false;                                   // shear_.on()
   bool stepped_ = false;  // some pair has a step potential, or there are bonds
   PairSteps steps_;
   std::uint64_t step_captures_ = 0;            // see step_captures()
@@ -563,7 +535,7 @@ class EventEngine {
   std::vector<Bond> bonds_;  // the caller's numbering, kept for export
   std::vector<std::string> bond_types_;
 
-  // Soft spheres: per particle, the partner of its frozen contact (kFirstWall + face for a wall,
+  // Soft spheres: per particle, the partner of its frozen contact (wall_partner(face) for a wall,
   // kNoPartner: none), when it is released and with what velocity. Empty unless soft_.
   bool soft_ = false;
   HugeVector<std::uint32_t> frozen_with_;
@@ -576,7 +548,9 @@ class EventEngine {
   std::vector<std::uint64_t> awaiting_release_;  // see awaits_release()
 
   CandidateList lists_[2];
-  Environment<D> env_;  // last: the hot members above share fewer cache lines
+  FaceWalls<D> face_walls_;  // the walls on the box's faces (boundaries/face_walls.hpp)
+  LeesEdwards<D> shear_;     // Lees-Edwards images (boundaries/lees_edwards.hpp)
+  Environment<D> env_;       // last: the hot members above share fewer cache lines
 };
 
 }  // namespace kairos

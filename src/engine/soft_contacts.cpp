@@ -72,7 +72,7 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
   // A piston (a wall at constant velocity) is an inertial frame: the map holds in it, and the
   // frozen particle moves with the wall. A vibrated wall accelerates during the contact.
   for (int f = 0; f < 2 * D; ++f) {
-    if (env_.faces[f].kind == FaceKind::kWall && env_.faces[f].wall.vibrates())
+    if (face_walls_.is_wall(f) && face_walls_.wall(f).vibrates())
       throw InputError(
           "soft spheres cannot meet vibrating walls (the wall accelerates during a contact; "
           "use run.integrator = \"dem\")");
@@ -107,11 +107,11 @@ void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s, StartMode
     if (frozen_with_[i] != kNone)
       throw InputError("particle " + std::to_string(c.i) + " is in two soft contacts");
     if (wall) {
-      if (env_.faces[c.face].kind != FaceKind::kWall)
+      if (!face_walls_.is_wall(static_cast<int>(c.face)))
         throw InputError("particle " + std::to_string(c.i) +
                          " is in contact with a face that is "
                          "not a wall");
-      frozen_with_[i] = kFirstWall + c.face;
+      frozen_with_[i] = wall_partner(static_cast<int>(c.face));
     } else {
       const std::uint32_t j = internal[c.j];
       if (frozen_with_[j] != kNone)
@@ -213,11 +213,7 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
   auto overlaps = [&](std::uint32_t p, const CandidateList& list, int slot) {
     const Vec<D>& x = hot_[p].pos;
     const double radius = radius_of(p);
-    for (int f = 0; f < 2 * D; ++f) {
-      if (f == skip_face || env_.faces[f].kind != FaceKind::kWall) continue;
-      const double gap = f % 2 == 0 ? x[f / 2] - wall_offset(f, t) : wall_offset(f, t) - x[f / 2];
-      if (gap < radius) return true;
-    }
+    if (walls_ && face_walls_.overlaps(x, radius, t, skip_face)) return true;
     std::uint32_t delayed = 0;
     const CandidateScan<D> scan = scan_of(list, p, &delayed);
     ContactProbe<D> probe{x, velocity, span, i, j, false};
@@ -376,8 +372,9 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
         return false;
     }
     for (int f = 0; walls_ && f < 2 * D; ++f) {
-      if (env_.faces[f].kind == FaceKind::kWall &&
-          wall_event_time(f, h.pos, window.velocity, radius_of(both[k]), t, until - t) < until - t)
+      if (face_walls_.is_wall(f) &&
+          face_walls_.event_time(f, h.pos, window.velocity, radius_of(both[k]), t, until - t) <
+              until - t)
         return false;
     }
   }
@@ -544,7 +541,7 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   const double sgn = face % 2 == 0 ? 1.0 : -1.0;
   // The wall's normal velocity: constant (setup refuses vibrations), so the map holds in its
   // frame; the frozen particle moves with the wall.
-  const double wall_speed = env_.faces[face].wall.velocity[a];
+  const double wall_speed = face_walls_.wall(face).velocity[a];
   const double vn = -sgn * (h.vel[a] - wall_speed);
   if (!(vn > 0.0)) {  // released early, it now leaves the wall
     ++h.collisions;
@@ -564,7 +561,7 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   counters_.work_by_walls += m * wall_speed * (after[a] - h.vel[a]);  // impulse . wall velocity
   // Already overlapping the wall (released from it, then turned back by a third body): no
   // first contact to start the map from, so the contact is instantaneous.
-  const double gap = sgn * (h.pos[a] - wall_offset(face, t));
+  const double gap = sgn * (h.pos[a] - face_walls_.position(face, t));
   const bool overlapping = gap < radius * (1.0 - 1e-9);
   if (overlapping) ++counters_.soft_overlap_fallbacks;
   bool placed = false;
@@ -577,7 +574,7 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
       frozen_velocity[a] = wall_speed;
       counters_.soft_contact_energy += 0.5 * m * (norm2(after) - norm2(frozen_velocity));
       h.vel = frozen_velocity;
-      begin_contact(i, kFirstWall + static_cast<std::uint32_t>(face));
+      begin_contact(i, wall_partner(face));
       set_awaits_release(i, true);
       release_time_[i] = t + map.eps_t * units.time_unit;
       release_velocity_[i] = after;

@@ -103,7 +103,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_globals(bool with_zones) const {
       c.velocity_j = c.deferred ? hot_[p].vel : release_velocity_[p];
       if (c.deferred) c.release_position_j = hot_[p].pos;
     } else {
-      c.face = p - kFirstWall;
+      c.face = Code::from_bits(p).wall_face();
     }
     out.frozen.push_back(c);
   }
@@ -150,10 +150,8 @@ void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
     out.collision_count[c] = h.collisions;
     out.cell[c] = h.cell;
     const PendingEvent& e = pending_[k];
-    std::uint32_t partner = e.partner < kFirstCode ? id_[e.partner] : e.partner;
-    if (e.partner >= kKeptBase && e.partner < kNoneKept)
-      partner = kKeptBase + id_[e.partner - kKeptBase];
-    out.events[c] = {queue_.time_of(k), partner, e.partner_count};
+    const Code code = e.code.renumbered([&](std::uint32_t p) { return id_[p]; });
+    out.events[c] = {queue_.time_of(k), code.bits(), e.partner_count};
   }
 }
 

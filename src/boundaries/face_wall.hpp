@@ -1,0 +1,76 @@
+// A wall on a face of the box: what it is made of and how its plane moves. The one place the
+// wall's kinematics is written; the event engine (boundaries/face_walls.hpp), the DEM and the
+// outputs read it from here.
+//
+// Face 2k is the low face of axis k, 2k + 1 the high one. A wall at the low face of axis k is
+// the plane x_k = u_k t + A sin(w t + phi) with normal +e_k, one at the high face the plane
+// x_k = L_k + u_k t + A sin(w t + phi) with normal -e_k (u_k = A = 0: fixed), where u is the
+// wall's velocity and t the absolute simulation time: the plane is a function of the state's
+// time alone, so restarts need nothing more.
+#pragma once
+
+#include <cmath>
+
+#include "core/vec.hpp"
+#include "interactions/granular_contact.hpp"
+
+namespace kairos {
+
+enum class FaceKind { kPeriodic, kWall, kOpen };
+
+template <int D>
+struct Wall {
+  ContactModel contact;  // restitution and roughness of particle-wall collisions
+  // Velocity of the wall: the components in its plane slide it (a shear plate), the one along
+  // its normal moves the plane at that constant speed (a piston).
+  Vec<D> velocity{};
+  double amplitude = 0.0;          // vibration along the normal: offset A sin(w t + phi)
+  double angular_frequency = 0.0;  // w
+  double phase = 0.0;              // phi
+  bool vibrates() const { return amplitude > 0.0 && angular_frequency > 0.0; }
+  // Whether the plane moves (a normal velocity or a vibration) as the wall of `face`.
+  bool plane_moves(int face) const { return velocity[face / 2] != 0.0 || vibrates(); }
+
+  // Where the plane of the wall at `face` lies along its axis at time t, in a box of edges
+  // `box` (the header's formula).
+  double plane_position(int face, const Vec<D>& box, double t) const {
+    double x = face % 2 == 0 ? 0.0 : box[face / 2];
+    if (velocity[face / 2] != 0.0) x += velocity[face / 2] * t;
+    return vibrates() ? x + amplitude * std::sin(angular_frequency * t + phase) : x;
+  }
+  // The plane's velocity along its axis at time t: u_k plus the vibration's.
+  double plane_speed(int face, double t) const {
+    const double u = velocity[face / 2];
+    return vibrates() ? u + amplitude * angular_frequency * std::cos(angular_frequency * t + phase)
+                      : u;
+  }
+  // The wall's whole velocity at time t (sliding, along the normal, vibrating).
+  Vec<D> velocity_at(int face, double t) const {
+    Vec<D> v = velocity;
+    if (vibrates())
+      v[face / 2] += amplitude * angular_frequency * std::cos(angular_frequency * t + phase);
+    return v;
+  }
+};
+
+template <int D>
+struct Face {
+  FaceKind kind = FaceKind::kPeriodic;
+  Wall<D> wall;  // used when kind == kWall
+};
+
+// The unit normal of a face's wall, into the box.
+template <int D>
+Vec<D> face_normal(int face) {
+  Vec<D> n{};
+  n[face / 2] = face % 2 == 0 ? 1.0 : -1.0;
+  return n;
+}
+
+// The distance of a point (a particle's centre) from the plane of a face's wall at `plane`,
+// positive inside the box.
+inline double face_gap(int face, double x, double plane) {
+  return face % 2 == 0 ? x - plane : plane - x;
+}
+
+}  // namespace kairos

@@ -1,0 +1,196 @@
+#include "boundaries/face_walls.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "dynamics/collision_time.hpp"
+#include "dynamics/trajectory_events.hpp"
+
+namespace kairos {
+
+template <int D>
+FaceWalls<D>::FaceWalls(const std::array<Face<D>, 2 * D>& faces, const Vec<D>& box,
+                        const Vec<D>& gravity)
+    : faces_(faces), box_(box), gravity_(gravity) {
+  for (const Face<D>& f : faces_) any_ = any_ || f.kind == FaceKind::kWall;
+}
+
+template <int D>
+bool FaceWalls<D>::any_plane_moves() const {
+  for (int f = 0; f < 2 * D; ++f)
+    if (is_wall(f) && wall(f).plane_moves(f)) return true;
+  return false;
+}
+
+// Along the wall's normal n (into the box: +e_a at the low face, -e_a at the high one) the
+// plane's offset is d(t) = d0 + u t (+ the vibration): in the frame moving with u the particle's
+// normal velocity is v - u, and the solvers of a fixed or vibrated plane apply. With u = 0 the
+// result is the fixed (vibrated) plane's bit for bit.
+template <int D>
+double FaceWalls<D>::event_time(int face, const Vec<D>& x, const Vec<D>& v, double radius, double t,
+                                double horizon) const {
+  const Wall<D>& w = faces_[face].wall;
+  const int a = face / 2;
+  const double sgn = face % 2 == 0 ? 1.0 : -1.0;
+  const NormalMotion m{sgn * x[a] - radius, sgn * v[a], sgn * gravity_[a]};
+  const double u = sgn * w.velocity[a];
+  const double d = (face % 2 == 0 ? 0.0 : -box_[a]) + (u != 0.0 ? u * t : 0.0);
+  if (w.vibrates()) {
+    const NormalMotion rel{m.height, m.velocity - u, m.accel};
+    const VibratedPlane plane{d, sgn * w.amplitude, w.angular_frequency,
+                              std::remainder(w.angular_frequency * t + w.phase, 2.0 * M_PI)};
+    return vibrated_plane_event_time(rel, plane, horizon);
+  }
+  return moving_plane_event_time(m, d, u, horizon);
+}
+
+template <int D>
+void FaceWalls<D>::set_reach(const CellGrid<D>& grid, double rmax) {
+  for (int f = 0; f < 2 * D; ++f) {
+    const double reach = faces_[f].wall.amplitude + rmax;
+    layers_[f] = 1 + static_cast<int>(std::floor(reach / grid.width(f / 2)));
+  }
+}
+
+// Whether a cell lies within layers_[f] layers of face f (a non-periodic axis).
+template <int D>
+bool FaceWalls<D>::reaches(int f, CellCode c, const CellGrid<D>& grid) const {
+  const int a = f / 2, k = grid.coordinate(c, a);
+  return f % 2 == 0 ? k < layers_[f] : grid.cells_along(a) - 1 - k < layers_[f];
+}
+
+// Only the layers next to a face that its wall's vibration can reach can touch a fixed or
+// vibrating wall; a wall with a normal velocity (a piston) may reach any layer.
+template <int D>
+std::pair<double, int> FaceWalls<D>::next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
+                                                  CellCode cell, const CellGrid<D>& grid, double t,
+                                                  double horizon) const {
+  std::pair<double, int> best{horizon, -1};
+  for (int f = 0; f < 2 * D; ++f) {
+    const int a = f / 2;
+    if (faces_[f].kind != FaceKind::kWall) continue;
+    if (faces_[f].wall.velocity[a] == 0.0 && !reaches(f, cell, grid)) continue;
+    const double when = event_time(f, x, v, radius, t, best.first);
+    if (when < best.first) best = {when, f};
+  }
+  return best;
+}
+
+template <int D>
+ContactResult<D> FaceWalls<D>::resolve(int f, double t, double mass, double radius,
+                                       double inertia_factor, bool force_elastic, Vec<D>& v,
+                                       Spin<D>& w) const {
+  const Wall<D>& wall = faces_[f].wall;
+  WallContactInput<D> in;
+  in.normal = face_normal<D>(f);
+  in.wall_velocity = wall.velocity_at(f, t);
+  in.mass = mass;
+  in.radius = radius;
+  in.inertia_factor = inertia_factor;
+  in.force_elastic = force_elastic;
+  return resolve_wall_contact(wall.contact, in, v, w);
+}
+
+template <int D>
+bool FaceWalls<D>::overlaps(const Vec<D>& x, double radius, double t, int skip_face) const {
+  for (int f = 0; f < 2 * D; ++f) {
+    if (f == skip_face || faces_[f].kind != FaceKind::kWall) continue;
+    if (gap(f, x, t) < radius) return true;
+  }
+  return false;
+}
+
+template <int D>
+void FaceWalls<D>::check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const {
+  for (int f = 0; f < 2 * D; ++f) {
+    if (faces_[f].kind != FaceKind::kWall) continue;
+    const int a = f / 2;
+    const double g = gap(f, x, t);
+    if (g < radius * (1.0 - 1e-12)) {
+      throw InputError("particle " + std::to_string(id) + " overlaps the wall at the " +
+                       (f % 2 == 0 ? "low" : "high") + " face of axis " + std::string(1, "xyz"[a]) +
+                       " (centre " + std::to_string(g) + " from the wall, radius " +
+                       std::to_string(radius) + ")");
+    }
+  }
+}
+
+// Relative margin of find_squeeze_time: a lone particle squeezed between approaching walls
+// bounces ever faster (speed times gap is an adiabatic invariant), so the exact limit would take
+// without end to reach; this one is reached after some 1e4 bounces, while its events are still
+// 1e7 ulps of the clock apart, far from a frozen clock (at a margin of 1e-6 the clock froze
+// first, 1e-5 time units short of it).
+constexpr double kSqueezeMargin = 1e-3;
+
+// The first time at which the walls of an axis, moving towards each other, are no more than the
+// largest diameter (times 1 + kSqueezeMargin) apart, or leave less room between them than the
+// particles' volume at the densest packing, vibration amplitudes counted as if both walls were
+// at their innermost: from then on the particles have no room between them (a gas compressed by
+// a piston jams before that, which the run drivers' frozen-clock watch reports). The densest
+// packing: pi / sqrt 18 for equal spheres (Kepler's conjecture, Hales, Ann. Math. 162, 1065
+// (2005)), pi / sqrt 12 for equal disks (Thue); particles of several sizes can pack denser,
+// so for them the bound is 1 (no room at all).
+template <int D>
+void FaceWalls<D>::find_squeeze_time(double rmax, double particle_volume, bool uniform) {
+  squeeze_time_ = kNever;
+  const double densest = !uniform ? 1.0 : D == 3 ? M_PI / std::sqrt(18.0) : M_PI / std::sqrt(12.0);
+  for (int a = 0; a < D; ++a) {
+    const Face<D>& lo = faces_[2 * a];
+    const Face<D>& hi = faces_[2 * a + 1];
+    if (lo.kind != FaceKind::kWall || hi.kind != FaceKind::kWall) continue;
+    const double approach = lo.wall.velocity[a] - hi.wall.velocity[a];
+    if (!(approach > 0.0)) continue;
+    double cross_section = 1.0;
+    for (int b = 0; b < D; ++b)
+      if (b != a) cross_section *= box_[b];
+    const double needed =
+        std::max(2.0 * rmax * (1.0 + kSqueezeMargin), particle_volume / (densest * cross_section));
+    const double room = box_[a] - lo.wall.amplitude - hi.wall.amplitude - needed;
+    if (room / approach < squeeze_time_) {
+      squeeze_time_ = room / approach;
+      squeeze_axis_ = a;
+      squeeze_needed_ = needed;
+    }
+  }
+}
+
+template <int D>
+void FaceWalls<D>::throw_squeezed(double t, double dmax, bool uniform) const {
+  const int a = squeeze_axis_;
+  const std::string lo = std::string(1, "xyz"[a]) + "-", hi = std::string(1, "xyz"[a]) + "+";
+  const Wall<D>& wl = faces_[2 * a].wall;
+  const Wall<D>& wh = faces_[2 * a + 1].wall;
+  std::ostringstream msg;
+  msg.precision(10);
+  msg << "boundary: at t = " << t << " the walls " << lo << " and " << hi << " are "
+      << box_[a] + (wh.velocity[a] - wl.velocity[a]) * t << " apart";
+  if (wl.vibrates() || wh.vibrates()) {
+    msg << " (their vibrations take up to " << wl.amplitude + wh.amplitude << " of that)";
+  }
+  if (squeeze_needed_ > dmax * (1.0 + 2.0 * kSqueezeMargin)) {
+    msg << ", less than the " << squeeze_needed_
+        << " the particles need between them at the densest packing"
+        << (uniform ? (D == 3 ? " of equal spheres" : " of equal disks") : "")
+        << ": there is no room left between them (";
+  } else {
+    msg << ", no more than the largest particle diameter " << dmax
+        << ": there is no room left between them (";
+  }
+  if (wl.velocity[a] != 0.0 && wh.velocity[a] != 0.0) {
+    msg << "the walls " << lo << " and " << hi << " move towards each other";
+  } else {
+    msg << "the wall " << (wl.velocity[a] != 0.0 ? lo : hi) << " moves towards "
+        << (wl.velocity[a] != 0.0 ? hi : lo);
+  }
+  msg << " at " << wl.velocity[a] - wh.velocity[a]
+      << ", from the box's faces at t = 0); end the run before t = " << squeeze_time_
+      << ", or move the walls more slowly or less far";
+  throw InputError(msg.str());
+}
+
+template class FaceWalls<2>;
+template class FaceWalls<3>;
+
+}  // namespace kairos

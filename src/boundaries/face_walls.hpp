@@ -1,0 +1,100 @@
+// The walls on the faces of the box, as the event engine meets them: the first boundary
+// component (docs/extending.md, "A boundary geometry").
+//
+// It owns what the walls are and the rules of meeting them: when a particle (position x and
+// velocity v at time t, under the uniform field) first touches a wall's plane, which layers of
+// cells a wall can reach, the contact's response with its energy split, whether a start state
+// overlaps a wall, and when approaching walls leave no room for the particles. It keeps no
+// per-particle state: a wall's plane is a function of the time (boundaries/face_wall.hpp), so
+// it adds nothing to restart files. The engine calls it and it never calls back.
+//
+// Conventions: face 2k is the low face of axis k, 2k + 1 the high one; normals point into the
+// box; the particle's relative time to an event is returned (kNever: none before the horizon).
+#pragma once
+
+#include <array>
+#include <string>
+#include <utility>
+
+#include "boundaries/face_wall.hpp"
+#include "core/vec.hpp"
+#include "dynamics/collision_time.hpp"
+#include "interactions/granular_contact.hpp"
+#include "scheduler/cell_grid.hpp"
+
+namespace kairos {
+
+template <int D>
+class FaceWalls {
+ public:
+  FaceWalls() = default;
+  // The faces (only kWall ones are walls), the box and the uniform acceleration particles feel.
+  FaceWalls(const std::array<Face<D>, 2 * D>& faces, const Vec<D>& box, const Vec<D>& gravity);
+
+  bool any() const { return any_; }
+  bool is_wall(int f) const { return faces_[f].kind == FaceKind::kWall; }
+  const Wall<D>& wall(int f) const { return faces_[f].wall; }
+  // Some wall's plane moves (a piston or a vibration).
+  bool any_plane_moves() const;
+
+  // Where the plane of wall f lies along its axis at time t.
+  double position(int f, double t) const { return faces_[f].wall.plane_position(f, box_, t); }
+  // The centre's distance from the plane of wall f at time t, positive inside the box.
+  double gap(int f, const Vec<D>& x, double t) const {
+    return face_gap(f, x[f / 2], position(f, t));
+  }
+  // Relative time from t of the contact of a particle of this radius (at x with velocity v at
+  // t) with the plane of wall f; kNever if after t + horizon.
+  double event_time(int f, const Vec<D>& x, const Vec<D>& v, double radius, double t,
+                    double horizon) const;
+
+  // The layers of cells next to each face that a fixed or vibrating wall can reach (the
+  // particle's centre within its radius of the plane, which moves up to the amplitude into the
+  // box), for cells of the grid's widths and particles up to rmax.
+  void set_reach(const CellGrid<D>& grid, double rmax);
+  // Whether a particle in cell c can touch wall f (a piston, moving along its normal, reaches
+  // every layer).
+  bool reaches(int f, CellCode c, const CellGrid<D>& grid) const;
+  // The particle's soonest wall contact from time t before t + horizon: (relative time, face),
+  // face -1 if none.
+  std::pair<double, int> next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
+                                      CellCode cell, const CellGrid<D>& grid, double t,
+                                      double horizon) const;
+
+  // A particle (velocity v, spin w, updated in place) meets wall f at time t: the wall is a
+  // partner of infinite mass moving with its whole velocity (sliding, normal, vibrating), so
+  // restitution acts on the normal velocity relative to the wall.
+  ContactResult<D> resolve(int f, double t, double mass, double radius, double inertia_factor,
+                           bool force_elastic, Vec<D>& v, Spin<D>& w) const;
+  // The energy the wall gave the particle in that contact: its work (the kinetic energy
+  // change plus what was dissipated).
+  static double work(const ContactResult<D>& r) {
+    return r.translational_energy_change + r.rotational_energy_change + r.dissipated;
+  }
+
+  // Whether a particle of this radius centred at x overlaps a wall (other than skip_face) at
+  // time t.
+  bool overlaps(const Vec<D>& x, double radius, double t, int skip_face = -1) const;
+  // A start state's particle `id` at x: throws InputError naming the particle and the wall it
+  // overlaps (round-off contacts, 1e-12 of the radius, are contacts).
+  void check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const;
+
+  // Walls approaching each other: the first time they leave no room for the particles (the
+  // largest radius rmax, their total volume, `uniform` sizes), kNever if never.
+  void find_squeeze_time(double rmax, double particle_volume, bool uniform);
+  double squeeze_time() const { return squeeze_time_; }
+  // The InputError of a run that reached the squeeze time (t), naming the walls.
+  [[noreturn]] void throw_squeezed(double t, double dmax, bool uniform) const;
+
+ private:
+  std::array<Face<D>, 2 * D> faces_{};
+  Vec<D> box_{};
+  Vec<D> gravity_{};
+  bool any_ = false;
+  std::array<int, 2 * D> layers_{};  // see set_reach
+  double squeeze_time_ = kNever;
+  int squeeze_axis_ = -1;
+  double squeeze_needed_ = 0.0;  // the room the particles need along squeeze_axis_
+};
+
+}  // namespace kairos
