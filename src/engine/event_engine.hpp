@@ -403,7 +403,7 @@ class EventEngine {
   void collide_sheared(std::uint32_t i, std::uint32_t j, double t);
   void cross_shear_face(std::uint32_t i, int side, double t, std::array<int, D>& c);
   void cross(std::uint32_t i, double t);
-  // Soft spheres (formulas.md §1.6; engine/soft_contacts.cpp).
+  // Soft spheres (docs/physics.md#event-driven-soft-contacts; engine/soft_contacts.cpp).
   void setup_soft(const ParticleSystem<D>& s);
   void restore_frozen(const ParticleSystem<D>& s, StartMode mode);
   void collide_soft(std::uint32_t i, std::uint32_t j, double t);
