@@ -1,6 +1,6 @@
-// Physics against published reference values (docs/physics.md#reference-values-for-validation),
-// run through the whole pipeline (config -> initial state -> engine -> summary) on the configs
-// in examples/validation/. Tolerances are 3 standard errors (block averaging) plus the stated
+// Physics against published reference values (docs/physics.md#validation-references), run
+// through the whole pipeline (config -> initial state -> engine -> summary) on the configs in
+// examples/validation/. Tolerances are 3 standard errors (block averaging) plus the stated
 // systematic allowance.
 #include <gtest/gtest.h>
 
