@@ -4,12 +4,12 @@
 // elastic hard-sphere fluid is started on the fcc lattice and equilibrated (untimed); its
 // temperature T (per degree of freedom, measured) gives the mean free time
 // tau = 1 / omega_E, with omega_E the Enskog collision frequency 4 sigma^2 n g(sigma)
-// sqrt(pi T / m) (formulas.md §6, analysis/granular_theory.hpp). For every contact law and
-// ratio R = tau / t_c the law is chosen so that its head-on contact time is t_c = tau / R and its
-// head-on restitution is e:
+// sqrt(pi T / m) (docs/physics.md#enskog-collision-frequency, analysis/granular_theory.hpp). For
+// every contact law and ratio R = tau / t_c the law is chosen so that its head-on contact time is
+// t_c = tau / R and its head-on restitution is e:
 //   dashpot: zeta = gamma / (2 sqrt(k mu)) from e (closed form with the force-zero end,
-//            formulas.md §2.1), omega_0 = t_c~(zeta) / t_c, k = mu omega_0^2, gamma = 2 zeta
-//            sqrt(k mu): t_c and e are the same at every impact speed;
+//            docs/physics.md#dashpot-head-on), omega_0 = t_c~(zeta) / t_c, k = mu omega_0^2,
+//            gamma = 2 zeta sqrt(k mu): t_c and e are the same at every impact speed;
 //   hertz:   c_dis from e (exact map), rho and A from T = t_c / eps_t(c_dis) at the reference
 //            speed v_ref = 2 sqrt(T/m) (the rms normal impact speed of a Maxwellian gas's
 //            collisions, <g_n^2> = 4 T / m): t_c and e hold at v_ref only.

@@ -1,10 +1,12 @@
-// Bannerman's stepped spring-dashpot (formulas.md §4.3, [[potential]] kind = "spring_dashpot")
-// against the Müller-Pöschel collision map of the continuous spring-dashpot (docs/validation.md,
-// "Stepped spring-dashpot (Bannerman) vs the mapping"; bench/README.md).
+// Bannerman's stepped spring-dashpot (docs/physics.md#spring-dashpot-by-steps, [[potential]]
+// kind = "spring_dashpot") against the Müller-Pöschel collision map of the continuous
+// spring-dashpot (docs/validation.md, "Stepped spring-dashpot (Bannerman) vs the mapping";
+// bench/README.md).
 //
 //   1. Head-on restitution e(N) of the stepped model in the engine (two particles, m = 1 and 2)
-//      against the closed forms of §2.1 (force-zero end with the cap, naive end without) and
-//      the map (exact to ~1e-13), beta/omega_0 = 0.1, core 1.5 v/omega_0 inside the contact.
+//      against the closed forms of docs/physics.md#dashpot-head-on (force-zero end with the cap,
+//      naive end without) and the map (exact to ~1e-13), beta/omega_0 = 0.1, core 1.5 v/omega_0
+//      inside the contact.
 //   2. One oblique collision (v_t / v_n = 1): the outgoing relative speed and its direction,
 //      stepped (several N) vs the map vs an instantaneous hard-sphere collision with the same
 //      head-on e.

@@ -137,8 +137,8 @@ int grazing_command(const std::vector<double>& l_tildes, int points, double step
     }
   }
   std::fclose(f);
-  // The numbers of formulas.md §1.7.
-  std::printf("e_eff at v_t/v_n = 20 (formulas.md §1.7):\n");
+  // The numbers of docs/physics.md#hard-sphere-failure.
+  std::printf("e_eff at v_t/v_n = 20 (docs/physics.md#hard-sphere-failure):\n");
   for (const SoftModel model : {SoftModel::LinearDashpot, SoftModel::ViscoelasticHertz}) {
     for (const double lt : {100.0, 1000.0}) {
       BinarySpec spec;

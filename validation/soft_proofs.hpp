@@ -1,15 +1,16 @@
 // Two proofs that the event-driven soft-sphere method (Müller–Pöschel collision mapping,
-// formulas.md §1) reproduces force-based dynamics (issue 6, "Proof"): the measurements shared by
-// the validation program (validation/soft_proofs.cpp) and the tests
+// docs/physics.md#event-driven-soft-contacts) reproduces force-based dynamics (issue 6, "Proof"):
+// the measurements shared by the validation program (validation/soft_proofs.cpp) and the tests
 // (tests/engine/test_soft_proofs.cpp).
 //
 // 1. Trajectory divergence of a dilute gas: the same initial state run by the mapped event-driven
 //    engine, by the instantaneous hard-sphere model with the same head-on restitution, and by the
 //    DEM integrator at a small time step (the reference); particle position differences (minimum
 //    image, per radius) sampled in time.
-// 2. Isolated binary collisions over v_t / v_n (formulas.md §1.7): the outgoing relative velocity
-//    and the effective normal restitution against the initial normal n0, for the hard model, the
-//    mapped engine, the DEM at a tiny time step and direct integration of Newton's equations.
+// 2. Isolated binary collisions over v_t / v_n (docs/physics.md#hard-sphere-failure): the
+//    outgoing relative velocity and the effective normal restitution against the initial normal
+//    n0, for the hard model, the mapped engine, the DEM at a tiny time step and direct
+//    integration of Newton's equations.
 //
 // Units: diameter 1 (gas), mass 1, kT = 1. A law is given by its reduced parameters (l~, c_dis)
 // at normal impact speed 1 (law_with_reduced_parameters).
@@ -40,8 +41,9 @@ namespace kairos::proofs {
 using Engine = EventEngine<3, CalendarQueue>;
 
 // The law of a pair (reduced mass mu, contact distance l) whose reduced parameters at normal
-// impact speed v_n are l~ = l / (v_n T) and c_dis (formulas.md §1.2): dashpot T = sqrt(mu / k),
-// c_dis = gamma / sqrt(k mu); Hertz T = (mu^2 / (rho^2 v_n))^(1/5), c_dis = A / T.
+// impact speed v_n are l~ = l / (v_n T) and c_dis (docs/physics.md#reduced-units): dashpot
+// T = sqrt(mu / k), c_dis = gamma / sqrt(k mu); Hertz T = (mu^2 / (rho^2 v_n))^(1/5),
+// c_dis = A / T.
 inline SoftContactLaw law_with_reduced_parameters(SoftModel model, double mu, double l,
                                                   double l_tilde, double c_dis, double v_n = 1.0) {
   const double T = l / (l_tilde * v_n);
@@ -148,7 +150,8 @@ struct GasSample {
   double time = 0.0;
   double collisions_per_particle = 0.0;  // 2 N_coll / N of the mapped engine
   double kinetic_energy = 0.0;           // per particle, DEM
-  // Exceptions A and B of the mapped engine so far (formulas.md §1.6): its approximations.
+  // Exceptions A and B of the mapped engine so far (docs/physics.md#event-driven-soft-contacts):
+  // its approximations.
   std::uint64_t overlap_fallbacks = 0, early_releases = 0;
   Divergence mapped, hard, dem_coarse;  // each against the DEM reference
 };
@@ -203,7 +206,8 @@ inline Divergence divergence(const Vec<3>& box, const std::vector<Vec<3>>& x,
 // Runs the three methods (four with dem_check) from the same state and samples the position
 // differences. Particles in a contact at a sample time (overlapping in the DEM run, or frozen in
 // a mapped contact) are left out of that sample: inside the contact window the mapped engine
-// places the pair where the contact ends (formulas.md §1.6), by design.
+// places the pair where the contact ends (docs/physics.md#event-driven-soft-contacts), by
+// design.
 inline GasRun run_gas_divergence(const GasSpec& spec, const GasRunOptions& options) {
   const ParticleSystem<3> start = dilute_gas(spec);
   const std::size_t n = start.size();
@@ -307,7 +311,7 @@ inline double first_time_above(const std::vector<GasSample>& samples, Divergence
 }
 
 // ---------------------------------------------------------------------------------------------
-// 2. Isolated binary collisions (formulas.md §1.7).
+// 2. Isolated binary collisions (docs/physics.md#hard-sphere-failure).
 
 struct BinarySpec {
   SoftModel model = SoftModel::LinearDashpot;

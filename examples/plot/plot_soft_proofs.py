@@ -156,7 +156,7 @@ def grazing(path, out):
         ax.set_xscale("log")
         ax.grid(alpha=0.3)
     fig.suptitle("Isolated collisions: the hard-sphere failure for grazing contacts "
-                 "(formulas.md §1.7)", fontsize=11)
+                 "(docs/physics.md#hard-sphere-failure)", fontsize=11)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
 

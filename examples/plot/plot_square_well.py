@@ -29,7 +29,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import kairos_output as ko
 
-T_C = 1.218  # lambda = 1.5 (reference-values.md)
+T_C = 1.218  # lambda = 1.5 (Orkoulas & Panagiotopoulos, J. Chem. Phys. 110, 1581 (1999))
 
 
 def run_info(outdir):

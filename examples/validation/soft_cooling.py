@@ -2,9 +2,10 @@
 """Cooling of a dilute viscoelastic gas: the event-driven soft-sphere mapping against DEM.
 
 Issue 6, "Proof": viscoelastic (Hertz) spheres have a coefficient of restitution e(v_n) that
-grows towards 1 as the impact speed falls (formulas.md §2.2), so a cooling gas becomes more
-elastic as it cools and cools more slowly than Haff's law (formulas.md §6) with the e of its
-initial temperature. The same gas, from the same initial states (same seeds), is run by
+grows towards 1 as the impact speed falls (docs/physics.md#viscoelastic-head-on), so a cooling
+gas becomes more elastic as it cools and cools more slowly than Haff's law
+(docs/physics.md#homogeneous-cooling) with the e of its initial temperature. The same gas, from
+the same initial states (same seeds), is run by
 
   mapped         the event-driven Müller–Pöschel mapping (run.integrator = "event"),
   instantaneous  hard spheres with the same e(v_n) (soft.collisions = "instantaneous"),
@@ -24,7 +25,8 @@ until its release, a DEM pair only part of it, so the kinetic T of the two diffe
 t_c / tau_f of T; T_E does not have that offset.
 
 Theory (no fit): e(v) from the head-on viscoelastic ODE integrated here (RK4; checked against
-formulas.md §7.2 to 1e-6), with the dissipation fixed by e(restitution_speed) = restitution.
+the values of docs/physics.md#viscoelastic-head-on to 1e-6), with the dissipation fixed by
+e(restitution_speed) = restitution.
 With Maxwell velocities each collision dissipates (m/4)(1 - e(g_n)^2) g_n^2, g_n distributed as
 g_n exp(-g_n^2 / 4T) (collision-weighted), so
 
@@ -59,7 +61,8 @@ import numpy as np
 ETA = 0.05          # packing fraction
 T0 = 1.0            # initial temperature (m = sigma = 1)
 RESTITUTION = 0.8   # Hertz: e at the impact speed RESTITUTION_SPEED
-RESTITUTION_SPEED = 2.0  # = sqrt(<g_n^2>) of the colliding pairs at T0 (formulas.md §6)
+RESTITUTION_SPEED = 2.0  # = sqrt(<g_n^2>) of the colliding pairs at T0
+#                          (docs/physics.md#enskog-collision-frequency)
 YOUNG = 1.0e5       # t_c ~ 0.03 at v = 2, against tau_f ~ 1.5: t_c / tau_f ~ 2 %
 POISSON = 0.3
 DASHPOT_STIFFNESS = 1.0e4  # t_c = 0.022
@@ -72,9 +75,10 @@ METHODS = ("mapped", "instantaneous", "dem")
 
 def head_on_restitution(c_dis, h=1.0e-3):
     """Viscoelastic head-on restitution e(c_dis), c_dis = A / T with T = (mu^2/(rho^2 v))^(1/5)
-    (formulas.md §7.2): s'' = -s^(3/2) - (3/2) c s^(1/2) s', s(0) = 0, s'(0) = 1, ending where the
-    force vanishes (s + (3/2) c s' = 0); e = -s' there. RK4, vectorised over c_dis; the end is
-    interpolated linearly within the last step. Error ~3e-7 at h = 1e-3."""
+    (docs/physics.md#viscoelastic-head-on): s'' = -s^(3/2) - (3/2) c s^(1/2) s', s(0) = 0,
+    s'(0) = 1, ending where the force vanishes (s + (3/2) c s' = 0); e = -s' there. RK4,
+    vectorised over c_dis; the end is interpolated linearly within the last step. Error ~3e-7 at
+    h = 1e-3."""
     c = np.atleast_1d(np.asarray(c_dis, dtype=float))
     s = np.zeros_like(c)
     v = np.ones_like(c)
@@ -167,7 +171,8 @@ class ViscoelasticTheory:
 
 
 def enskog_frequency(temperature, eta=ETA):
-    """Collisions per particle per unit time, 3D, sigma = m = 1 (formulas.md §6)."""
+    """Collisions per particle per unit time, 3D, sigma = m = 1
+    (docs/physics.md#enskog-collision-frequency)."""
     n = 6.0 * eta / math.pi
     g = (1.0 - eta / 2.0) / (1.0 - eta) ** 3
     return 4.0 * n * g * math.sqrt(math.pi * temperature)

@@ -1,6 +1,6 @@
 // Kinetic-theory predictions for granular gases, used by validation tests and the docs.
 //
-// Smooth inelastic spheres/disks: formulas.md §6 and reference-values.md (Enskog collision
+// Smooth inelastic spheres/disks: docs/physics.md#granular-kinetic-theory (Enskog collision
 // frequency, Haff's law, van Noije–Ernst a2). Rough spheres/disks with constant e and beta:
 // our mean-field (Huthmann–Zippelius type) theory of the homogeneous cooling state, derived in
 // docs/theory-rough-hcs.md for equal particles (mass m, diameter sigma, I = q m sigma^2/4).

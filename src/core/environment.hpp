@@ -26,11 +26,11 @@
 
 namespace kairos {
 
-// How a soft contact is carried out (formulas.md §1.6): kMapped, the Müller–Pöschel algorithm
-// (the pair is placed where the contact ends, frozen in its centre-of-mass frame, and released
-// with the post-contact velocities t_c later); kInstantaneous, a hard-sphere collision at first
-// contact with the same normal restitution e(v_n) = -eps_rdot (the model the mapping improves
-// on, kept for comparisons).
+// How a soft contact is carried out (docs/physics.md#event-driven-soft-contacts): kMapped, the
+// Müller–Pöschel algorithm (the pair is placed where the contact ends, frozen in its
+// centre-of-mass frame, and released with the post-contact velocities t_c later);
+// kInstantaneous, a hard-sphere collision at first contact with the same normal restitution
+// e(v_n) = -eps_rdot (the model the mapping improves on, kept for comparisons).
 enum class SoftCollisions { kMapped, kInstantaneous };
 
 template <int D>
@@ -59,14 +59,14 @@ struct Environment {
   // the mean flow is u_x = shear_rate * (y - L_y / 2). Flow along x, gradient along y; both
   // axes periodic, no gravity. 0: an ordinary periodic box.
   double shear_rate = 0.0;
-  // Stepped potentials (formulas.md §4): the step table of species pair (a, b) is
+  // Stepped potentials (docs/physics.md#step-tables): the step table of species pair (a, b) is
   // tables[pair_table[a * species + b]] (symmetric; -1: hard spheres), that of a bond of type k
   // tables[bond_table[k]]. A table's hard core must be the pair's contact distance (the sum of
   // the radii). Empty pair_table and bond_table: hard spheres only.
   std::vector<StepTable> tables;
   std::vector<int> pair_table;
   std::vector<int> bond_table;
-  // Soft spheres (formulas.md §1): the soft contact law of species pair (a, b) at
+  // Soft spheres (docs/physics.md#soft-spheres): the soft contact law of species pair (a, b) at
   // soft[a * species + b] (symmetric), and of species s against every wall at soft_wall[s].
   // Empty: contacts are hard (the `contact` laws). A soft law replaces the pair's ContactModel.
   // soft_tables / soft_wall_tables (same indices, null or empty: none) hold the lookup tables

@@ -72,12 +72,13 @@ struct EventCounters {
   // core) and crossed it or bounced off it. Both also count in `collisions`.
   std::uint64_t step_crossings = 0;
   std::uint64_t step_bounces = 0;
-  // Soft spheres (formulas.md §1.6). soft_contacts: contacts carried out by the mapping (pair
-  // and wall contacts; they also count in `collisions` / `wall_collisions`). Exception A
-  // (soft_overlap_fallbacks): the placed pair would overlap a third body, so the contact was
-  // instantaneous with e = -eps_rdot. Exception B (soft_early_releases): a third body met a
-  // frozen pair before its release, which was then released at once. soft_direct_maps: maps
-  // integrated directly because the collision lay outside the lookup table (or no table).
+  // Soft spheres (docs/physics.md#event-driven-soft-contacts). soft_contacts: contacts carried
+  // out by the mapping (pair and wall contacts; they also count in `collisions` /
+  // `wall_collisions`). Exception A (soft_overlap_fallbacks): the placed pair would overlap a
+  // third body, so the contact was instantaneous with e = -eps_rdot. Exception B
+  // (soft_early_releases): a third body met a frozen pair before its release, which was then
+  // released at once. soft_direct_maps: maps integrated directly because the collision lay
+  // outside the lookup table (or no table).
   std::uint64_t soft_contacts = 0;
   std::uint64_t soft_overlap_fallbacks = 0;
   std::uint64_t soft_early_releases = 0;
@@ -107,9 +108,10 @@ struct PairZone {
   bool operator==(const PairZone&) const = default;
 };
 
-// Soft spheres (formulas.md §1.6): a pair frozen inside a mapped contact, moving with its
-// centre-of-mass velocity until its release gives it the post-contact velocities (or a
-// particle frozen against wall `face`). Scheduler state: part of an exact restart.
+// Soft spheres (docs/physics.md#event-driven-soft-contacts): a pair frozen inside a mapped
+// contact, moving with its centre-of-mass velocity until its release gives it the post-contact
+// velocities (or a particle frozen against wall `face`). Scheduler state: part of an exact
+// restart.
 template <int D>
 struct FrozenContact {
   static constexpr std::uint32_t kWall = 0xffffffffu;

@@ -2,10 +2,11 @@
 // or between walls, with or without gravity (issue 6): the yardstick the event-driven
 // soft-sphere engine is checked against, and an integrator for dense granular matter.
 //
-// Physics (formulas.md §1.2–1.3): the normal force of a pair is that of a SoftContactLaw
-// (interactions/soft_contact.hpp: linear dashpot or viscoelastic Hertz), clipped at zero,
-// F = max(0, F_law(xi, rdot)) while r < R_i + R_j: no attraction, so a receding pair whose law
-// force turned negative (the force-zero end of §1.3) feels nothing although it still overlaps.
+// Physics (docs/physics.md#dem-normal-forces): the normal force of a pair is that of a
+// SoftContactLaw (interactions/soft_contact.hpp: linear dashpot or viscoelastic Hertz), clipped
+// at zero, F = max(0, F_law(xi, rdot)) while r < R_i + R_j: no attraction, so a receding pair
+// whose law force turned negative (the force-zero end of contact,
+// docs/physics.md#force-zero-end-of-contact) feels nothing although it still overlaps.
 //
 // Integrator: velocity Verlet. The damping force depends on the velocity, so the force at the
 // new positions is evaluated with the predicted velocity v_n + dt a_n (not the half-step

@@ -3,9 +3,11 @@
 // For a pair with relative position r and relative velocity g (both of i minus j) and contact
 // distance sigma, the overlap function is f(t) = |r + g t|^2 - sigma^2 = a + b t + c t^2 with
 // a = r^2 - sigma^2, b = 2 r.g, c = g^2. The event is the earliest t >= 0 with f(t) <= 0 and
-// f'(t) < 0 (Bannerman et al. 2014, formulas.md §3): an overlapping, approaching pair collides
-// now (t = 0), an overlapping, receding pair never does, a tangent pair never does. The root
-// 2a / (-b + sqrt(D)) avoids the cancellation of the textbook (-b - sqrt(D)) / 2c.
+// f'(t) < 0 (Bannerman et al., Comput. Part. Mech. 1, 191 (2014);
+// docs/physics.md#stable-event-rule): an overlapping, approaching pair collides now (t = 0), an
+// overlapping, receding pair never does, a tangent pair never does. The root 2a / (-b + sqrt(D))
+// avoids the cancellation of the textbook (-b - sqrt(D)) / 2c
+// (docs/physics.md#hard-sphere-contact-time).
 #pragma once
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 // Event solvers that need iteration: the vibrated plane (transcendental) and the quartic pair
-// contact of formulas.md §3.3. See trajectory_events.hpp for the contracts.
+// contact (docs/physics.md#quartic-pair-contact). See trajectory_events.hpp for the contracts.
 #include "dynamics/trajectory_events.hpp"
 
 #include <limits>

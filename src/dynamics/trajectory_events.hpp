@@ -1,12 +1,13 @@
 // Event times of accelerated trajectories: cell exits under gravity, sphere-plane contacts with
 // fixed, moving and vibrated planes, and sphere pairs under a constant relative acceleration.
 //
-// Conventions follow collision_time.hpp and formulas.md §3. Times are relative to the current
-// state (t >= 0). For an overlap function f (f < 0 means an invalid, overlapping state) the
-// event is the earliest t >= 0 with f(t) <= 0 and f'(t) < 0, where "earliest" is the infimum:
-// a state touching with f = 0, f' = 0 and f'' < 0 has its event at t = 0, because f' < 0 holds
-// for every later instant while f <= 0. Every solver takes a horizon t_max and returns kNever
-// for an event after it; the engine never needs events beyond a particle's next cell exit.
+// Conventions follow collision_time.hpp and docs/physics.md#event-detection. Times are relative
+// to the current state (t >= 0). For an overlap function f (f < 0 means an invalid, overlapping
+// state) the event is the earliest t >= 0 with f(t) <= 0 and f'(t) < 0, where "earliest" is the
+// infimum: a state touching with f = 0, f' = 0 and f'' < 0 has its event at t = 0, because
+// f' < 0 holds for every later instant while f <= 0. Every solver takes a horizon t_max and
+// returns kNever for an event after it; the engine never needs events beyond a particle's next
+// cell exit.
 //
 // Resting contact. A sphere resting exactly on a fixed floor with gravity into it (f = 0,
 // f' = 0, f'' < 0) has its event now. Reporting "never" would let it sink through the floor
@@ -29,9 +30,10 @@ inline double within_horizon(double t, double t_max) {
   return t <= t_max ? t : kNever;
 }
 
-// Stable event time of f(t) = a + b t + c t^2 for any sign of c (formulas.md §3.2). For c > 0
-// this is quadratic_contact_time. For c < 0 (a gap that is eventually closed, e.g. by gravity)
-// an event always exists; every branch uses the root formula free of cancellation.
+// Stable event time of f(t) = a + b t + c t^2 for any sign of c
+// (docs/physics.md#accelerated-motion). For c > 0 this is quadratic_contact_time. For c < 0 (a
+// gap that is eventually closed, e.g. by gravity) an event always exists; every branch uses the
+// root formula free of cancellation.
 inline double quadratic_event_time(double a, double b, double c) {
   if (c > 0.0) return quadratic_contact_time(a, b, c);
   if (c == 0.0) return b < 0.0 ? std::fmax(0.0, -a / b) : kNever;
@@ -140,10 +142,11 @@ inline VibratedPlane rephased(const VibratedPlane& p, double dt) {
 double vibrated_plane_event_time(const NormalMotion& m, const VibratedPlane& p,
                                  double t_max = kNever);
 
-// Stable event time of the polynomial f(t) = c[0] + c[1] t + ... + c[4] t^4 (formulas.md §3.3):
-// f' vanishes on monotone pieces of f found from the roots of f'' (closed form) and a bracketed
-// Newton search on f', so every piece is monotone, and the pieces are walked in time order. An
-// event inside a piece is polished to a few ulps. Degree 2 or less is quadratic_event_time.
+// Stable event time of the polynomial f(t) = c[0] + c[1] t + ... + c[4] t^4
+// (docs/physics.md#quartic-pair-contact): f' vanishes on monotone pieces of f found from the
+// roots of f'' (closed form) and a bracketed Newton search on f', so every piece is monotone,
+// and the pieces are walked in time order. An event inside a piece is polished to a few ulps.
+// Degree 2 or less is quadratic_event_time.
 double quartic_event_time(const std::array<double, 5>& c, double t_max = kNever);
 
 // Contact time of a pair at relative position r, velocity v and constant relative acceleration

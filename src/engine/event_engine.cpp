@@ -1987,8 +1987,8 @@ std::uint32_t EventEngine<D, Queue>::scan_stepped_loop(const CandidateList& list
 // A pair event under a stepped potential. Approaching, the pair meets its zone's inner boundary
 // (the hard core in the innermost zone: returns false, an ordinary collision); receding, the
 // outer one. It crosses into the next zone if its normal kinetic energy pays the step, else
-// bounces (formulas.md §4.2); with a dashpot on the table the crossing also pays the dashpot's
-// work, which counts as dissipated (§4.3).
+// bounces (docs/physics.md#step-event); with a dashpot on the table the crossing also pays the
+// dashpot's work, which counts as dissipated (docs/physics.md#spring-dashpot-by-steps).
 template <int D, class Queue>
 bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t) {
   const PairSteps::Zone z = steps_.find(i, j, steps_.pair_table(species_of(i), species_of(j)));
@@ -2014,7 +2014,7 @@ bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t
   const double distance = std::sqrt(r2);
   const double mi = mass_of(i), mj = mass_of(j);
   StepOutcome out;
-  if (table.damping > 0.0) [[unlikely]] {  // a dashpot by steps (formulas.md §4.3)
+  if (table.damping > 0.0) [[unlikely]] {  // docs/physics.md#spring-dashpot-by-steps
     const DissipativeStepOutcome d = dissipative_step_event(
         mi * mj / (mi + mj), rg / distance, table.energy[next] - table.energy[z.zone],
         table.damping, table.width[std::max(next, z.zone)], table.force_zero);

@@ -382,7 +382,7 @@ class EventEngine {
     return p;
   }
   void cross(std::uint32_t i, double t);
-  // Soft spheres (formulas.md §1.6; engine/soft_contacts.cpp).
+  // Soft spheres (docs/physics.md#event-driven-soft-contacts; engine/soft_contacts.cpp).
   void setup_soft(const ParticleSystem<D>& s);
   void restore_frozen(const ParticleSystem<D>& s, StartMode mode);
   void collide_soft(std::uint32_t i, std::uint32_t j, double t);

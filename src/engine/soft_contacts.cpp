@@ -1,4 +1,5 @@
-// Soft spheres in the event-driven engine: the Müller–Pöschel algorithm (formulas.md §1.6).
+// Soft spheres in the event-driven engine: the Müller–Pöschel algorithm (Phys. Rev. E 87, 033301
+// (2013); docs/physics.md#event-driven-soft-contacts).
 //
 // At first contact (r = l, found by the ordinary hard-sphere prediction) the collision map
 // gives where and how the contact ends. The pair is placed at once where it will be at the end
@@ -12,9 +13,9 @@
 //
 // A released pair still overlaps by the contact's end overlap and recedes: the hard-sphere
 // prediction never sees an overlapping, receding pair collide (collision_time.hpp), which is
-// the force-zero end of formulas.md §1.3. Wall contacts are the head-on map with mu = m and
-// l = R: the particle is pushed into the wall by the end overlap and keeps only its tangential
-// velocity until its release.
+// the force-zero end of contact (docs/physics.md#force-zero-end-of-contact). Wall contacts are
+// the head-on map with mu = m and l = R: the particle is pushed into the wall by the end overlap
+// and keeps only its tangential velocity until its release.
 #include <algorithm>
 #include <cmath>
 #include <functional>

@@ -54,7 +54,8 @@ double viscoelastic_variable_for(double e) {
 }  // namespace
 
 double viscoelastic_restitution(double x) {
-  // MP2011 coefficients as given in formulas.md §2.2.
+  // The coefficients of Müller & Pöschel, Phys. Rev. E 84, 021302 (2011)
+  // (docs/physics.md#restitution-models).
   constexpr double a1 = 0.501086, b2 = 1.15345, b3 = 0.577977, b4 = 0.532178;
   const double numerator = 1.0 + a1 * x;
   return numerator / (numerator + x * x * (b2 + x * (b3 + x * b4)));

@@ -2,10 +2,11 @@
 // (2D), instantaneous binary collisions and collisions with a (possibly moving) wall.
 //
 // Pure functions of the pre-collision state; no engine knowledge. Conventions follow
-// formulas.md §0 and §5: n = (x_i - x_j)/|x_i - x_j|, J is the impulse on i (-J acts on j),
-// the contact-point relative velocity is g = v_i - v_j - (R_i w_i + R_j w_j) x n, and a
-// collision maps g_n -> -e_n g_n and g_t -> -beta g_t (beta = -1 smooth, +1 perfectly rough).
-// Moments of inertia are I = q m R^2 with q per particle.
+// docs/physics.md#conventions and docs/physics.md#rough-collision: n = (x_i - x_j)/|x_i - x_j|,
+// J is the impulse on i (-J acts on j), the contact-point relative velocity is
+// g = v_i - v_j - (R_i w_i + R_j w_j) x n, and a collision maps g_n -> -e_n g_n and
+// g_t -> -beta g_t (beta = -1 smooth, +1 perfectly rough). Moments of inertia are I = q m R^2
+// with q per particle.
 #pragma once
 
 #include <limits>
@@ -48,8 +49,9 @@ inline double spin_dot(const Vec<3>& a, const Vec<3>& b) {
   return dot(a, b);
 }
 
-// MP2011 compact [1/4] Padé form of the viscoelastic restitution (formulas.md §2.2) in its
-// series variable x = beta_A^(1/2) v^(1/10). Decreases monotonically from e(0) = 1 to 0.
+// The compact [1/4] Padé form of the viscoelastic restitution of Müller & Pöschel, Phys. Rev. E
+// 84, 021302 (2011) (docs/physics.md#restitution-models), in its series variable
+// x = beta_A^(1/2) v^(1/10). Decreases monotonically from e(0) = 1 to 0.
 double viscoelastic_restitution(double x);
 
 // Normal restitution e_n as a function of the normal impact speed |g_n|. Construction
@@ -62,9 +64,10 @@ class NormalRestitution {
   static NormalRestitution constant(double e);
   // Viscoelastic spheres: e = viscoelastic_restitution(k |g_n|^(1/10)), k >= 0.
   static NormalRestitution viscoelastic(double k);
-  // Viscoelastic spheres from the material (formulas.md §1.2, §2.2): dissipative time constant
-  // A, Hertz prefactor rho (F = rho xi^(3/2)) and reduced mass mu. Because k depends on rho
-  // (hence on R_eff) and on mu, a model built this way belongs to one species pair.
+  // Viscoelastic spheres from the material (docs/physics.md#restitution-models): dissipative
+  // time constant A, Hertz prefactor rho (F = rho xi^(3/2), docs/physics.md#soft-contact-laws)
+  // and reduced mass mu. Because k depends on rho (hence on R_eff) and on mu, a model built this
+  // way belongs to one species pair.
   static NormalRestitution viscoelastic_from_material(double dissipative_time, double hertz_rho,
                                                       double reduced_mass);
   // Viscoelastic spheres with the constant solved so that e(reference_speed) = e_reference,
@@ -189,7 +192,8 @@ ContactResult<D> resolve_wall_contact(const ContactModel& model, const WallConta
 
 // Effective masses of a contact: g_n changes by J_n / m_n and g_t by J_t / m_t, with
 // 1/m_n = 1/m_i + 1/m_j and 1/m_t = 1/m_i + 1/m_j + R_i^2/I_i + R_j^2/I_j. For equal q,
-// m_t = m_n q / (1 + q) (formulas.md §5). R^2/I = 1/(q m) does not depend on R.
+// m_t = m_n q / (1 + q) (docs/physics.md#tangential-restitution). R^2/I = 1/(q m) does not
+// depend on R.
 template <int D>
 double normal_mass(const ContactInput<D>& in) {
   return 1.0 / (1.0 / in.mass_i + 1.0 / in.mass_j);

@@ -1,8 +1,8 @@
 // Hard spheres / disks: the interaction's math only (prediction and collision rule).
 //
-// Pair quantities follow formulas.md §0: r = r_i - r_j, g = v_i - v_j, contact distance
-// sigma = R_i + R_j, J the impulse on i (-J acts on j). The engine's loops call these; a new
-// interaction supplies the same two functions.
+// Pair quantities follow docs/physics.md#conventions: r = r_i - r_j, g = v_i - v_j, contact
+// distance sigma = R_i + R_j, J the impulse on i (-J acts on j). The engine's loops call these; a
+// new interaction supplies the same two functions.
 #pragma once
 
 #include "dynamics/collision_time.hpp"

@@ -39,18 +39,19 @@ struct PotentialSpec {
   double max_length = 0.0;
   double stiffness = 0.0;
   double length = 0.0;
-  // Stepping of continuous potentials (formulas.md §4.1): number of steps (for ΔU placement:
-  // steps on the attractive branch, the repulsive branch continuing in the same ΔU down to the
-  // core), placement energy | distance | volume, shell energies midpoint | volume | mid_volume
-  // | virial (at `temperature`).
+  // Stepping of continuous potentials (docs/physics.md#stepping-continuous-potentials): number
+  // of steps (for ΔU placement: steps on the attractive branch, the repulsive branch continuing
+  // in the same ΔU down to the core), placement energy | distance | volume, shell energies
+  // midpoint | volume | mid_volume | virial (at `temperature`).
   int steps = 10;
   std::string placement = "energy";
   std::string shell_energy = "volume";
   double temperature = 1.0;
-  // spring_dashpot (formulas.md §4.3): a repulsive spring (stiffness, from `length` in) in
-  // `steps` equal steps with a dashpot per step: damping gamma, or the head-on restitution e of
-  // the continuous spring-dashpot (> 0: gamma from the closed form of §2.1 for the pair's
-  // reduced mass); force_zero: no net attraction while separating (false: the naive dashpot).
+  // spring_dashpot (docs/physics.md#spring-dashpot-by-steps): a repulsive spring (stiffness,
+  // from `length` in) in `steps` equal steps with a dashpot per step: damping gamma, or the
+  // head-on restitution e of the continuous spring-dashpot (> 0: gamma from the closed form of
+  // docs/physics.md#dashpot-head-on for the pair's reduced mass); force_zero: no net attraction
+  // while separating (false: the naive dashpot).
   double damping = 0.0;
   double restitution = 0.0;  // 0: not given
   bool force_zero = true;

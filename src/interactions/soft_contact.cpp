@@ -589,7 +589,7 @@ double viscoelastic_series_coefficient(int k) {
     case 5:
       return 4.0 / 15.0;
     case 6:
-      return -0.522;  // fitted (formulas.md §2.2), uncertain in the third digit
+      return -0.522;  // fitted, third digit uncertain (docs/physics.md#viscoelastic-head-on)
     case 7:
       return -0.48;  // fitted
     default:

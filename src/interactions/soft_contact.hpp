@@ -1,11 +1,12 @@
 // Soft, frictionless spheres: the two-body contact and the Müller–Pöschel collision map
-// (formulas.md §1–2).
+// (docs/physics.md#soft-spheres).
 //
 // Pure functions, no engine knowledge. A contact starts when the centres are l = R_i + R_j
 // apart and approaching, and ends at the first instant the normal force would turn attractive
-// (F = 0 with rdot > 0, formulas.md §1.3): both models end while the particles still overlap.
-// Conventions of formulas.md §0: r = r_i - r_j, g = v_i - v_j, overlap xi = l - |r|,
-// rdot = d|r|/dt, F > 0 repulsive, v_n = -g.n (> 0 approaching), v_t = |g - (g.n) n|.
+// (F = 0 with rdot > 0, docs/physics.md#force-zero-end-of-contact): both models end while the
+// particles still overlap. Conventions of docs/physics.md#conventions: r = r_i - r_j,
+// g = v_i - v_j, overlap xi = l - |r|, rdot = d|r|/dt, F > 0 repulsive, v_n = -g.n (> 0
+// approaching), v_t = |g - (g.n) n|.
 //
 // Units: any consistent set (SI in the comments). Lengths [m], masses [kg], times [s],
 // velocities [m/s]; a dashpot's k [N/m] and gamma [kg/s]; Hertz's rho [N/m^(3/2)] and its
@@ -30,7 +31,7 @@ double hertz_rho(double effective_modulus, double effective_radius);
 double hertz_rho_one_material(double young, double poisson, double effective_radius);
 
 // ---------------------------------------------------------------------------------------------
-// Force laws (formulas.md §1.2).
+// Force laws (docs/physics.md#soft-contact-laws).
 
 enum class SoftModel { LinearDashpot, ViscoelasticHertz };
 
@@ -69,7 +70,7 @@ struct SoftFriction {
 };
 
 // ---------------------------------------------------------------------------------------------
-// Reduced units (formulas.md §1.2). The two-body problem in the collision plane,
+// Reduced units (docs/physics.md#reduced-units). The two-body problem in the collision plane,
 //   x'' = c_phi^2 / x^3 + f(x, x'),  phi' = c_phi / x^2,  x(0) = l~, x'(0) = -1, phi(0) = 0,
 // with x = r / (v_n T) and tau = t / T; f = (l~ - x) - c_dis x' (dashpot) or
 // (l~ - x)^(3/2) - (3/2) c_dis x' (l~ - x)^(1/2) (Hertz).
@@ -102,12 +103,13 @@ CollisionUnits reduce_collision_unchecked(const SoftContactLaw& law, double redu
                                           double contact_distance, double v_n, double v_t);
 
 // ---------------------------------------------------------------------------------------------
-// The collision map (formulas.md §1.4), by adaptive Dormand–Prince 8(5,3) integration of the
-// reduced problem up to the force-zero end of contact, located to round-off (bisection on the
-// last step). The Hertz force's sqrt(l~ - x) is not analytic at the start (nor at an elastic
-// end); the integration runs in a Sundman variable theta, d tau/d theta = sqrt(l~ - x), with
-// sqrt(l~ - x) a state variable, in which both models' equations are polynomial and the
-// solution analytic through both ends. Default tolerance: ~1e-13 on every component (§7 tests).
+// The collision map (docs/physics.md#collision-map), by adaptive Dormand–Prince 8(5,3)
+// integration of the reduced problem up to the force-zero end of contact, located to round-off
+// (bisection on the last step). The Hertz force's sqrt(l~ - x) is not analytic at the start (nor
+// at an elastic end); the integration runs in a Sundman variable theta, d tau/d theta =
+// sqrt(l~ - x), with sqrt(l~ - x) a state variable, in which both models' equations are
+// polynomial and the solution analytic through both ends. Default tolerance: ~1e-13 on every
+// component (tested against the independent values of docs/physics.md#collision-map).
 
 struct MapOptions {
   double tolerance = 1e-13;    // relative local error per step (absolute 1e-3 of it); > 0
@@ -135,7 +137,7 @@ struct CollisionMap {
 CollisionMap collision_map(const ReducedCollision& reduced, const MapOptions& options = {});
 
 // ---------------------------------------------------------------------------------------------
-// The pair in 3D and the post-contact state (formulas.md §1.4).
+// The pair in 3D and the post-contact state (docs/physics.md#collision-map).
 
 struct SoftPair {
   double m_i = 1.0, m_j = 1.0;            // masses > 0
@@ -178,7 +180,7 @@ DirectContact integrate_contact_directly(const SoftContactLaw& law, const SoftPa
                                          const MapOptions& options = {});
 
 // ---------------------------------------------------------------------------------------------
-// Closed forms for head-on collisions (formulas.md §2).
+// Closed forms for head-on collisions (docs/physics.md#dashpot-head-on and the sections after it).
 
 struct HeadOn {
   double contact_time = 0.0;  // t_c

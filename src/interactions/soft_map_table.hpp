@@ -1,5 +1,5 @@
-// Lookup tables of the Müller–Pöschel collision map (formulas.md §1.5) for one soft contact: one
-// species pair (or a species against a wall) under one SoftContactLaw.
+// Lookup tables of the Müller–Pöschel collision map (docs/physics.md#map-tables) for one soft
+// contact: one species pair (or a species against a wall) under one SoftContactLaw.
 //
 // For a fixed law, reduced mass mu and contact distance l, the reduced parameters of a collision
 // (c_phi, l~, c_dis) depend only on the impact velocity (v_n, v_t): the dashpot's c_dis is a

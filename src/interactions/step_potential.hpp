@@ -1,5 +1,6 @@
 // Pair potentials made of steps (square wells and shoulders, many-step tables, continuous
-// potentials mapped onto steps; formulas.md §4), and the event at a step: bounce or cross.
+// potentials mapped onto steps; docs/physics.md#stepped-potentials), and the event at a step:
+// bounce or cross.
 //
 // A table holds strictly decreasing boundaries r_0 > r_1 > ... > r_K: the energy is `beyond`
 // (0, or +inf for a bond) beyond r_0 (the cut-off), energy[k] on the shell r_{k+1} < r < r_k,
@@ -22,12 +23,12 @@ struct StepTable {
   // Energy beyond the cut-off: 0 for a pair potential, +inf for a bond (the pair can never
   // separate further than r_0).
   double beyond = 0.0;
-  // A dashpot by steps (formulas.md §4.3): each crossing of a boundary removes gamma |v_n| dr
-  // from the pair's normal kinetic energy, dr the width of the deeper of the two shells and v_n
-  // the normal speed before the crossing (dissipative_step_event). 0: no dissipation (the
-  // conservative step rule, bit for bit). force_zero: while separating down a step the pair
-  // gains max(0, -delta_u - gamma |v_n| dr), never less (no net attraction: the force-zero end
-  // of contact); false: the naive dashpot, whose pair may be pulled back.
+  // A dashpot by steps (docs/physics.md#spring-dashpot-by-steps): each crossing of a boundary
+  // removes gamma |v_n| dr from the pair's normal kinetic energy, dr the width of the deeper of
+  // the two shells and v_n the normal speed before the crossing (dissipative_step_event). 0: no
+  // dissipation (the conservative step rule, bit for bit). force_zero: while separating down a
+  // step the pair gains max(0, -delta_u - gamma |v_n| dr), never less (no net attraction: the
+  // force-zero end of contact); false: the naive dashpot, whose pair may be pulled back.
   double damping = 0.0;
   bool force_zero = true;
 
@@ -56,17 +57,18 @@ double second_virial(const StepTable& table, double kT, int dimension = 3);
 // v_n (n from j to i; v_n < 0 approaching), meets a boundary where its energy would change by
 // delta_u. Bounce (it cannot climb): the normal velocity reverses. Cross: it changes to
 // sgn(v_n) sqrt(v_n^2 - 2 delta_u / mu). The impulse on i along n is returned in the
-// cancellation-free form -2 delta_u / (v_n + v_n') for a crossing (formulas.md §4.2).
+// cancellation-free form -2 delta_u / (v_n + v_n') for a crossing (docs/physics.md#step-event).
 struct StepOutcome {
   bool crosses = false;
   double impulse = 0.0;  // J: v_i += J n / m_i, v_j -= J n / m_j
 };
 StepOutcome step_event(double mu, double v_n, double delta_u);
 
-// The same step with a dashpot (formulas.md §4.3): crossing a boundary costs the dashpot work
-// dE = gamma |v_n| width, with v_n the normal velocity before the crossing. Approaching (or
-// climbing, delta_u >= 0): the pair crosses if (1/2) mu v_n^2 >= delta_u + dE and then loses
-// delta_u + dE, else it bounces (elastically: no step is crossed, nothing is dissipated).
+// The same step with a dashpot (docs/physics.md#spring-dashpot-by-steps): crossing a boundary
+// costs the dashpot work dE = gamma |v_n| width, with v_n the normal velocity before the
+// crossing. Approaching (or climbing, delta_u >= 0): the pair crosses if
+// (1/2) mu v_n^2 >= delta_u + dE and then loses delta_u + dE, else it bounces (elastically: no
+// step is crossed, nothing is dissipated).
 // Separating down a step (delta_u < 0): with force_zero it gains max(0, -delta_u - dE) and always
 // crosses (the step never pulls it back: no net attraction); without, it is charged
 // delta_u + dE like a climb (and may bounce back inwards). `dissipated` = the kinetic energy lost
@@ -126,7 +128,8 @@ ContinuousPotential harmonic_spring(double k, double length, double max_length);
 
 // The repulsive half of a spring, (k / 2) (length - r)^2 for r < length and 0 beyond (cut-off
 // `length`, r_min = 0: monotone, repulsive): the elastic part of a linear spring-dashpot contact
-// that begins at the centre distance `length` (formulas.md §4.3). Requires k > 0, length > 0.
+// that begins at the centre distance `length` (docs/physics.md#spring-dashpot-by-steps).
+// Requires k > 0, length > 0.
 ContinuousPotential repulsive_spring(double k, double length);
 
 // A potential read from a text file of two whitespace-separated columns r U, one point per line
@@ -143,8 +146,9 @@ ContinuousPotential tabulated(const std::string& file, bool shifted);
 enum class StepEnergyRule { kMidpoint, kVolumeAverage, kMidVolume, kVirial };
 enum class StepPlacement { kEnergy, kDistance, kVolume };
 
-// A continuous potential mapped onto steps (Thomson-Lue-Bannerman; formulas.md §4.1), for a
-// pair whose hard core is `core` (core < p.cutoff; U(core) finite). Boundaries by `placement`:
+// A continuous potential mapped onto steps (Thomson, Lue & Bannerman, J. Chem. Phys. 140, 034105
+// (2014); docs/physics.md#stepping-continuous-potentials), for a pair whose hard core is `core`
+// (core < p.cutoff; U(core) finite). Boundaries by `placement`:
 //   kDistance: `steps` shells of equal width from the cut-off to the core;
 //   kVolume:   `steps` shells of equal volume (r^d equally spaced; d = dimension, 2 or 3);
 //   kEnergy:   boundaries where U crosses equally spaced levels (DynamO's default), the last
@@ -159,19 +163,21 @@ enum class StepPlacement { kEnergy, kDistance, kVolume };
 //       the levels U(cutoff) +- k dU, k = 1..steps-1: exactly `steps` shells.
 //     It throws InputError if U is not monotone on each branch (sampled; a tabulated U with two
 //       wells: use kDistance or kVolume) or if more than kMaxShells shells would be needed.
-// Shell energies by `rule` (formulas.md §4.1, with r^d and r^(d-1) dr in d dimensions): U at
-// the shell's middle radius, its volume average, U at the radius halving its volume, or the
-// virial rule exp(-U_k/kT) = <exp(-U/kT)> over the shell volume, which keeps the table's B2 at
-// temperature kT equal to the potential's (second_virial below). The table's `beyond` is the
-// potential's. Throws InputError (without naming the potential: callers add that) for steps <
-// 1, a core outside (0, cutoff), kT <= 0, a dimension other than 2 or 3.
+// Shell energies by `rule` (docs/physics.md#stepping-continuous-potentials, with r^d and
+// r^(d-1) dr in d dimensions): U at the shell's middle radius, its volume average, U at the
+// radius halving its volume, or the virial rule exp(-U_k/kT) = <exp(-U/kT)> over the shell
+// volume, which keeps the table's B2 at temperature kT equal to the potential's (second_virial
+// below). The table's `beyond` is the potential's. Throws InputError (without naming the
+// potential: callers add that) for steps < 1, a core outside (0, cutoff), kT <= 0, a dimension
+// other than 2 or 3.
 inline constexpr int kMaxShells = 100000;
 StepTable step_potential(const ContinuousPotential& p, StepPlacement placement, int steps,
                          double core, StepEnergyRule rule, double kT = 1.0, int dimension = 3);
 
 // Equal energy steps as above, but ending at a core *energy* rather than a core distance: the
 // hard core is where the inner branch reaches core_energy (the levels go on in steps of dU until
-// then), and dU = |U_min| / attractive_steps with the levels -k dU (formulas.md §7.9).
+// then), and dU = |U_min| / attractive_steps with the levels -k dU
+// (docs/physics.md#stepping-continuous-potentials).
 StepTable step_by_energy(const ContinuousPotential& p, int attractive_steps, double core_energy,
                          StepEnergyRule rule, double kT = 1.0, int dimension = 3);
 

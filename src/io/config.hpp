@@ -51,8 +51,8 @@ struct SystemConfig {
   bool operator==(const SystemConfig&) const = default;
 };
 
-// A contact law (particle-particle for a species pair, or particle-wall): formulas.md §2.2,
-// §3.5, §5.
+// A contact law (particle-particle for a species pair, or particle-wall):
+// docs/physics.md#granular-contacts.
 struct ContactConfig {
   double restitution = 1.0;                    // e_n (constant), or e at restitution_speed
   std::string restitution_model = "constant";  // constant | viscoelastic | table
@@ -168,7 +168,8 @@ struct PairPotentialConfig {
   bool operator==(const PairPotentialConfig&) const = default;
 };
 
-// [[bond]]: the potential of the bonds of one type (tether or spring; formulas.md §4).
+// [[bond]]: the potential of the bonds of one type (tether or spring;
+// docs/physics.md#continuous-potentials).
 struct BondConfig {
   std::string type = "backbone";
   PotentialSpec potential;
@@ -176,8 +177,8 @@ struct BondConfig {
   bool operator==(const BondConfig&) const = default;
 };
 
-// A soft contact law, [soft] or [[soft.pair]] (formulas.md §1.2, docs/config.md). The keys of
-// the other model are kept (inherited by pairs) but not used.
+// A soft contact law, [soft] or [[soft.pair]] (docs/physics.md#soft-contact-laws,
+// docs/config.md). The keys of the other model are kept (inherited by pairs) but not used.
 struct SoftLawConfig {
   std::string model;               // dashpot | hertz; "" only when there is no [soft]
   double stiffness = 0.0;          // dashpot: k > 0 (required)

@@ -1028,7 +1028,8 @@ class RunDriver {
   }
 
   // Soft spheres: how the contacts were carried out in this invocation (mapped, or one of the
-  // two exceptions of formulas.md §1.6), where the maps came from, and the tables used.
+  // two exceptions of docs/physics.md#event-driven-soft-contacts), where the maps came from, and
+  // the tables used.
   nlohmann::json soft_summary(const EventCounters& c) const {
     const std::uint64_t collisions = c.collisions - counters_start_.collisions;
     auto fraction = [&](std::uint64_t k) {

@@ -1,6 +1,6 @@
-// Lookup tables of the soft-sphere collision map for a run (formulas.md §1.5): one per species
-// pair present, and one per species against the walls, over the normal impact speeds the run
-// can see, loaded from the cache or built (interactions/soft_map_table.hpp).
+// Lookup tables of the soft-sphere collision map for a run (docs/physics.md#map-tables): one per
+// species pair present, and one per species against the walls, over the normal impact speeds the
+// run can see, loaded from the cache or built (interactions/soft_map_table.hpp).
 #pragma once
 
 #include <filesystem>

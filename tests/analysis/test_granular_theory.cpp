@@ -1,6 +1,7 @@
-// Granular kinetic theory (src/analysis/granular_theory.hpp): §7.10's numbers, and the rough
-// homogeneous cooling state of docs/theory-rough-hcs.md checked against a Monte Carlo of
-// collision-weighted binary encounters run through the real collision operator.
+// Granular kinetic theory (src/analysis/granular_theory.hpp): the reference values of
+// docs/physics.md#homogeneous-cooling, and the rough homogeneous cooling state of
+// docs/theory-rough-hcs.md checked against a Monte Carlo of collision-weighted binary encounters
+// run through the real collision operator.
 #include "analysis/granular_theory.hpp"
 
 #include <gtest/gtest.h>
@@ -17,7 +18,8 @@ namespace kairos {
 namespace {
 
 // ---------------------------------------------------------------------------------------------
-// Smooth spheres: formulas.md §7.10 (T0 = m = sigma = 1), to the printed digits.
+// Smooth spheres: independent reference values (T0 = m = sigma = 1), to the printed digits
+// (docs/physics.md#homogeneous-cooling, docs/physics.md#van-noije-ernst-a2).
 
 TEST(GranularTheory, HaffReferenceValues) {
   struct Row {

@@ -1,7 +1,8 @@
 // The force-based DEM reference integrator (src/dem/dem_integrator.hpp): head-on collisions
-// against the closed forms of formulas.md §2 with dt^2 convergence, an oblique unequal-mass
-// collision against integrate_contact_directly, energy and momentum in elastic gases, the energy
-// budget of a cooling gas, 2D and 3D, input validation.
+// against the closed forms (docs/physics.md#dashpot-head-on, docs/physics.md#hertz-contact-time)
+// with dt^2 convergence, an oblique unequal-mass collision against integrate_contact_directly,
+// energy and momentum in elastic gases, the energy budget of a cooling gas, 2D and 3D, input
+// validation.
 #include "dem/dem_integrator.hpp"
 
 #include <gmock/gmock.h>

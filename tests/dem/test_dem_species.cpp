@@ -171,14 +171,16 @@ young = 1e5
 }
 
 TEST(SoftInverse, RestitutionToDissipationMatchesTheReferenceTables) {
-  // formulas.md §7.1 and §7.2.
+  // The head-on values of docs/physics.md#dashpot-head-on and
+  // docs/physics.md#viscoelastic-head-on.
   EXPECT_NEAR(dashpot_zeta_for_restitution(0.7440793977), 0.1, 1e-9);
   EXPECT_NEAR(dashpot_zeta_for_restitution(0.0237695141), 3.0, 1e-8);  // overdamped
   EXPECT_EQ(dashpot_zeta_for_restitution(1.0), 0.0);
   EXPECT_NEAR(viscoelastic_head_on_restitution(0.1), 0.8451438063, 1e-9);
   EXPECT_NEAR(viscoelastic_c_dis_for_restitution(0.8451438063), 0.1, 1e-8);
   EXPECT_NEAR(viscoelastic_c_dis_for_restitution(0.2811310301), 1.0, 1e-8);
-  // The physical example of §7.2: mu = 1e-3, rho = 1e7, v = 1 -> T = 1e-4, A = c T = 1e-5.
+  // The physical example of docs/physics.md#viscoelastic-head-on: mu = 1e-3, rho = 1e7, v = 1
+  // -> T = 1e-4, A = c T = 1e-5.
   EXPECT_NEAR(viscoelastic_dissipation_for_restitution(1e-3, 1e7, 0.845143806333, 1.0), 1e-5,
               1e-13);
   EXPECT_THROW(dashpot_zeta_for_restitution(0.0), InputError);

@@ -1,4 +1,5 @@
-// Event detection edge cases of formulas.md §7.8 (sigma = 1; R, V relative).
+// Event detection edge cases of docs/physics.md#hard-sphere-contact-time (sigma = 1; R, V
+// relative).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,6 +1,7 @@
-// Event times of accelerated trajectories: formulas.md §3 rule and §7.8 values, plus randomized
-// checks against dense brute-force sampling (the solver must never report a later event than
-// the first sampled one, and at its time the stable-rule condition must hold).
+// Event times of accelerated trajectories: the rule of docs/physics.md#stable-event-rule and the
+// values of docs/physics.md#quartic-pair-contact, plus randomized checks against dense
+// brute-force sampling (the solver must never report a later event than the first sampled one,
+// and at its time the stable-rule condition must hold).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -16,7 +17,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // ---------------------------------------------------------------------------------------------
-// quadratic_event_time (formulas.md §3.2)
+// quadratic_event_time (docs/physics.md#accelerated-motion)
 
 TEST(QuadraticEventTime, PositiveCurvatureIsTheContactQuadratic) {
   std::mt19937_64 rng(1);
@@ -340,7 +341,7 @@ TEST(VibratedPlane, RandomAgainstSampling) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Quartic pair contact (formulas.md §3.3, §7.8)
+// Quartic pair contact (docs/physics.md#quartic-pair-contact)
 
 double quartic(std::array<double, 3> r, std::array<double, 3> v, std::array<double, 3> a,
                double t_max = kNever) {

@@ -1,5 +1,6 @@
 // Granular dynamics in the engine: inelastic and rough collisions against kinetic theory
-// (formulas.md §5, §6; reference-values.md "Granular gas"), conservation laws and exactness.
+// (docs/physics.md#rough-collision, docs/physics.md#granular-kinetic-theory), conservation laws
+// and exactness.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,7 +1,7 @@
-// Physics against published reference values (../shared/physics/reference-values.md), run
+// Physics against published reference values (docs/physics.md#validation-references), run
 // through the whole pipeline (config -> initial state -> engine -> summary) on the configs in
-// examples/validation/. Tolerances are
-// 3 standard errors (block averaging) plus the stated systematic allowance.
+// examples/validation/. Tolerances are 3 standard errors (block averaging) plus the stated
+// systematic allowance.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -34,7 +34,8 @@ nlohmann::json run(const std::string& example) {
   return outcome.summary;
 }
 
-// Kolafa-Labik-Malijevsky-form series for hard spheres (reference-values.md).
+// Kolafa-Labik-Malijevsky-form series for hard spheres, with the coefficients of Pieprzyk et al.,
+// Phys. Chem. Chem. Phys. 21, 6886 (2019) (docs/physics.md#equations-of-state).
 double z_hard_spheres(double eta) {
   const double x = eta / (1.0 - eta);
   return 1 + 4 * x + 6 * x * x + 2.3647684 * std::pow(x, 3) - 0.8698551 * std::pow(x, 4) +

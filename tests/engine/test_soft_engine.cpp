@@ -1,10 +1,10 @@
-// Soft spheres in the event-driven engine (formulas.md §1.6, Müller–Pöschel): an isolated oblique
-// collision of unequal spheres ends where Newton's equations put it (direct integration, and the
-// DEM integrator at a tiny time step); gases under both laws keep every invariant (brute-force
-// validation after every event, the energy budget kinetic + contact + dissipated, momentum); both
-// exceptions happen where constructed and are counted; a wall contact reproduces the closed-form
-// dashpot; the instantaneous mode is the hard-sphere model with e(v_n); resumes with contacts in
-// progress are bit-identical.
+// Soft spheres in the event-driven engine (docs/physics.md#event-driven-soft-contacts,
+// Müller–Pöschel): an isolated oblique collision of unequal spheres ends where Newton's equations
+// put it (direct integration, and the DEM integrator at a tiny time step); gases under both laws
+// keep every invariant (brute-force validation after every event, the energy budget kinetic +
+// contact + dissipated, momentum); both exceptions happen where constructed and are counted; a
+// wall contact reproduces the closed-form dashpot; the instantaneous mode is the hard-sphere model
+// with e(v_n); resumes with contacts in progress are bit-identical.
 #include <gtest/gtest.h>
 #include <cstdio>
 

@@ -2,9 +2,10 @@
 // docs/validation.md "Soft spheres in the engine"):
 // - a dilute gas run by the mapped event-driven engine follows the DEM reference (particle
 //   positions) longer than the instantaneous hard-sphere model with the same head-on restitution;
-// - grazing collisions (formulas.md §1.7): against the initial normal the outgoing normal velocity
-//   keeps its sign (negative effective restitution) under the mapped engine and the DEM, as
-//   Newton's equations say, while the hard model gives +e; its outgoing direction is degrees off.
+// - grazing collisions (docs/physics.md#hard-sphere-failure): against the initial normal the
+//   outgoing normal velocity keeps its sign (negative effective restitution) under the mapped
+//   engine and the DEM, as Newton's equations say, while the hard model gives +e; its outgoing
+//   direction is degrees off.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -69,14 +70,15 @@ TEST(SoftProofs, GasTrajectoriesFollowTheDemLongerThanHardSpheres) {
 struct GrazingCase {
   SoftModel model;
   double c_dis;
-  double e_eff_100, e_eff_1000;  // formulas.md §1.7 at v_t / v_n = 20, l~ = 100 and 1000
+  // docs/physics.md#hard-sphere-failure at v_t / v_n = 20, l~ = 100 and 1000
+  double e_eff_100, e_eff_1000;
 };
 
 class SoftGrazing : public ::testing::TestWithParam<GrazingCase> {};
 
-// formulas.md §1.7: at l~ = 100 and 1000, v_t / v_n = 20, e_eff = -0.95 / -0.08 (dashpot,
-// head-on e 0.74) and -0.99 / -0.11 (Hertz, 0.85); every method from the same state, unequal
-// masses and radii, the centre of mass moving.
+// docs/physics.md#hard-sphere-failure: at l~ = 100 and 1000, v_t / v_n = 20,
+// e_eff = -0.95 / -0.08 (dashpot, head-on e 0.74) and -0.99 / -0.11 (Hertz, 0.85); every method
+// from the same state, unequal masses and radii, the centre of mass moving.
 TEST_P(SoftGrazing, GrazingCollisionsReverseTheNormalVelocityUnlikeHardSpheres) {
   const GrazingCase c = GetParam();
   for (const double l_tilde : {100.0, 1000.0}) {

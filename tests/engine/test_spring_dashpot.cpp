@@ -1,6 +1,7 @@
-// The spring-dashpot by steps (formulas.md §4.3) in the engine: a repulsive linear spring in N
-// equal steps with the dashpot's work taken at every crossing. Head-on restitution against the
-// closed forms of §2.1 (force-zero end with the cap, naive end without), converging as 1/N;
+// The spring-dashpot by steps (docs/physics.md#spring-dashpot-by-steps) in the engine: a
+// repulsive linear spring in N equal steps with the dashpot's work taken at every crossing.
+// Head-on restitution against the closed forms of docs/physics.md#dashpot-head-on (force-zero end
+// with the cap, naive end without), converging as 1/N;
 // the cap never lets a pair leave faster than it came nor pulls it back; an oblique collision
 // against the Müller-Pöschel map; kinetic + potential + dissipated energy constant in a gas,
 // checked by brute force after every event.
@@ -22,8 +23,9 @@ using Engine = EventEngine<3, CalendarQueue>;
 
 // A pair of masses 1 and 2 (mu = 2/3), contact (spring) length 1, approaching at closing speed
 // v = 1. Stiffness from the elastic penetration v / omega_0 = 0.02; the hard core (the sum of the
-// radii) sits 1.5 v / omega_0 inside the contact, as in the 1-D tests of formulas.md §4.3, deeper
-// than any pair of this file gets (a damped pair penetrates less than an elastic one).
+// radii) sits 1.5 v / omega_0 inside the contact, as in the 1-D tests of
+// docs/physics.md#spring-dashpot-by-steps, deeper than any pair of this file gets (a damped pair
+// penetrates less than an elastic one).
 constexpr double kMassI = 1.0, kMassJ = 2.0;
 constexpr double kMu = kMassI * kMassJ / (kMassI + kMassJ);
 constexpr double kLength = 1.0;
@@ -124,8 +126,9 @@ TEST(SpringDashpot, TableIsTheSteppedRepulsiveSpringWithItsDashpot) {
   EXPECT_NEAR(dashpot_head_on(kMu, kStiffness, r.damping).restitution, 0.8, 1e-12);
 }
 
-// formulas.md §4.3: e(N) -> the force-zero e of §2.1 as 1/N, from below; 0.744051 at N = 4000
-// for beta/omega_0 = 0.1 (the closed form is 0.744079) with the core 1.5 v/omega_0 deep.
+// docs/physics.md#spring-dashpot-by-steps: e(N) -> the force-zero e of
+// docs/physics.md#dashpot-head-on as 1/N, from below; 0.744051 at N = 4000 for
+// beta/omega_0 = 0.1 (the closed form is 0.744079) with the core 1.5 v/omega_0 deep.
 TEST(SpringDashpot, HeadOnRestitutionConvergesAsOneOverNToTheForceZeroClosedForm) {
   const double zeta = 0.1;
   const double exact = dashpot_head_on_reduced(zeta).restitution;

@@ -1,5 +1,6 @@
 // Collision operators for granular particles (src/interactions/granular_contact.hpp) against
-// formulas.md §2.2, §5 and §7.6, and against the conservation laws they must obey.
+// docs/physics.md#restitution-models and docs/physics.md#rough-collision (with its reference
+// values), and against the conservation laws they must obey.
 #include "interactions/granular_contact.hpp"
 
 #include <gtest/gtest.h>
@@ -132,7 +133,7 @@ ContactModel model_of(double e, const TangentialModel& tangential) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// §7.6: the reference collision of two rough spheres.
+// The reference collision of two rough spheres (docs/physics.md#rough-collision).
 
 TEST(GranularContact, RoughSpheresReferenceValues) {
   Body<3> i, j;
@@ -261,7 +262,8 @@ TEST(GranularContact, ConservesMomentumAndAngularMomentum2D) {
   check_conservation<2>();
 }
 
-// §5's energy formula, with the general tangential mass and, for equal q, literally.
+// The energy formula of docs/physics.md#rough-collision, with the general tangential mass and,
+// for equal q, literally.
 template <int D>
 void check_energy_formula() {
   std::mt19937_64 rng(3 + D);
@@ -448,7 +450,7 @@ TEST(GranularContact, WaltonSlidesOnTheCoulombCone) {
   EXPECT_LT(distance<3>(gt_after, (-beta_eff) * gt), 1e-14);
   EXPECT_GE(beta_eff, -1.0);
   EXPECT_LT(beta_eff, beta0);
-  // Energy: §5 with beta_eff; and the tangential loss is positive.
+  // Energy: docs/physics.md#rough-collision with beta_eff; and the tangential loss is positive.
   const ContactInput<3> in = input_of(c.i, c.j);
   const double gn = dot(g, n);
   const double normal_loss = 0.5 * normal_mass(in) * (1 - e * e) * gn * gn;
@@ -628,7 +630,8 @@ TEST(NormalRestitution, ConstantAndDefault) {
   EXPECT_THROW(NormalRestitution::constant(std::nan("")), InputError);
 }
 
-// e(x) = 1 + h2 x^2 + h4 x^4 + h5 x^5 + O(x^6) with the §2.2 coefficients; h3 = 0.
+// e(x) = 1 + h2 x^2 + h4 x^4 + h5 x^5 + O(x^6) with the coefficients of
+// docs/physics.md#viscoelastic-head-on; h3 = 0.
 TEST(NormalRestitution, PadeReproducesItsSeries) {
   const double c1 = std::tgamma(0.6) * std::sqrt(std::numbers::pi) /
                     (std::pow(2.0, 0.2) * std::pow(5.0, 0.4) * std::tgamma(2.1));
@@ -648,10 +651,11 @@ TEST(NormalRestitution, PadeReproducesItsSeries) {
   }
 }
 
-// §7.2: the Padé row to its printed digits, and its quoted error against the exact ODE.
+// The Padé row of the viscoelastic head-on values to its printed digits, and its error against
+// the exact ODE as quoted in docs/physics.md#restitution-models.
 TEST(NormalRestitution, PadeMatchesTheTabulatedViscoelasticValues) {
   struct Row {
-    double c, exact, pade, quoted_error, last_digit;  // error quoted in §2.2 (0: none)
+    double c, exact, pade, quoted_error, last_digit;  // error quoted in docs/physics.md (0: none)
   };
   for (const Row& row :
        {Row{0.001, 0.9982716442, 0.998272, 0, 0}, Row{0.01, 0.9828832905, 0.982884, 2e-7, 1e-7},
@@ -667,8 +671,8 @@ TEST(NormalRestitution, PadeMatchesTheTabulatedViscoelasticValues) {
 }
 
 TEST(NormalRestitution, ViscoelasticFromMaterial) {
-  // §7.2's physical example: mu = 1e-3 kg, rho = 1e7 N m^-3/2, A = 1e-5 s, v = 1 m/s gives
-  // beta_A = 0.15, c_dis = 0.1.
+  // The physical example of docs/physics.md#viscoelastic-head-on: mu = 1e-3 kg,
+  // rho = 1e7 N m^-3/2, A = 1e-5 s, v = 1 m/s gives beta_A = 0.15, c_dis = 0.1.
   const NormalRestitution e = NormalRestitution::viscoelastic_from_material(1e-5, 1e7, 1e-3);
   EXPECT_NEAR(e(1.0), viscoelastic_restitution(std::sqrt(0.15)), 1e-15);
   EXPECT_NEAR(e(1.0), 0.845276, 5e-7);

@@ -34,7 +34,8 @@ TEST(PotentialSpec, SquareWellAndShoulderScaleWithTheCore) {
   EXPECT_EQ(w.boundary, (std::vector<double>{1.5, 1.0}));
   EXPECT_EQ(w.energy, (std::vector<double>{-1.0}));
   EXPECT_EQ(w.beyond, 0.0);
-  EXPECT_NEAR(second_virial(w, 1.0), -6.4526623820, 1e-9);  // formulas.md §7.9
+  // docs/physics.md#second-virial-coefficient
+  EXPECT_NEAR(second_virial(w, 1.0), -6.4526623820, 1e-9);
   const StepTable w2 = make_step_table(s, 2.0);
   EXPECT_EQ(w2.boundary, (std::vector<double>{3.0, 2.0}));
   s.kind = "square_shoulder";
@@ -272,8 +273,9 @@ TEST(PotentialSpec, EveryBadValueIsNamed) {
   EXPECT_INPUT_ERROR(continuous_potential(spec_of("soft")), "unknown potential kind 'soft'");
 }
 
-// spring_dashpot (formulas.md §4.3): the repulsive spring from `length` in, N equal steps to the
-// core with midpoint energies, the dashpot on the table; its errors name the key.
+// spring_dashpot (docs/physics.md#spring-dashpot-by-steps): the repulsive spring from `length`
+// in, N equal steps to the core with midpoint energies, the dashpot on the table; its errors
+// name the key.
 TEST(PotentialSpec, SpringDashpot) {
   PotentialSpec s = spec_of("spring_dashpot");
   s.stiffness = 100.0;

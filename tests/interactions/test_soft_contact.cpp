@@ -1,7 +1,8 @@
 // Soft frictionless spheres (src/interactions/soft_contact.hpp): the reduced two-body solver and
-// collision map against the independent values of formulas.md §7.1–7.3 and the closed forms of
-// §2, the 3D reconstruction against direct force integration, §1.7's hard-sphere failure, and
-// input validation.
+// collision map against independent values (docs/physics.md#dashpot-head-on,
+// docs/physics.md#viscoelastic-head-on, docs/physics.md#collision-map) and the closed forms, the
+// 3D reconstruction against direct force integration, the hard-sphere failure
+// (docs/physics.md#hard-sphere-failure), and input validation.
 #include "interactions/soft_contact.hpp"
 
 #include <gmock/gmock.h>
@@ -54,7 +55,7 @@ CollisionMap head_on(SoftModel model, double c_dis) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// §7.1: dashpot head-on, closed form and ODE, to the digits given.
+// Dashpot head-on (docs/physics.md#dashpot-head-on), closed form and ODE, to the digits given.
 
 struct DashpotRow {
   double zeta;
@@ -117,7 +118,7 @@ TEST(SoftContact, DashpotPhysicalExample) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// §7.2: viscoelastic head-on.
+// Viscoelastic head-on (docs/physics.md#viscoelastic-head-on).
 
 TEST(SoftContact, ViscoelasticHeadOnTable) {
   const std::vector<double> c = {0, 0.001, 0.01, 0.05, 0.1, 0.2, 0.5, 1, 2};
@@ -167,7 +168,7 @@ TEST(SoftContact, ViscoelasticPhysicalExample) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// §7.3: oblique maps.
+// Oblique maps (docs/physics.md#collision-map).
 
 struct ObliqueRow {
   SoftModel model;
@@ -258,7 +259,8 @@ TEST(SoftContact, MapConvergesWithTolerance) {
 // ---------------------------------------------------------------------------------------------
 // Closed forms against the ODE, to at least 10 digits.
 
-// The piecewise forms of §2.1, written independently of dashpot_head_on_reduced.
+// The piecewise forms of docs/physics.md#dashpot-head-on, written independently of
+// dashpot_head_on_reduced.
 double piecewise_dashpot_time(double zeta) {
   const double beta = zeta;  // omega_0 = 1
   if (zeta < 1.0) {
@@ -378,8 +380,8 @@ TEST(SoftContact, ReducedParametersFromPhysicalInputs) {
   EXPECT_NEAR(hertz_rho_one_material(2e11, 0.3, 5e-4),
               hertz_rho(effective_modulus(2e11, 0.3, 2e11, 0.3), 5e-4), 1e-6);
   EXPECT_NEAR(effective_modulus(2e11, 0.3, 7e10, 0.25), 1.0 / (0.91 / 2e11 + 0.9375 / 7e10), 1e-3);
-  // formulas.md §1.2: steel, R = 1 mm, at 1 m/s gives l~ ~ 1.05e3 (Hertz). Assumed steel:
-  // Y = 200 GPa, nu = 0.3, density 7850 kg/m^3, two equal spheres.
+  // docs/physics.md#reduced-units: steel, R = 1 mm, at 1 m/s gives l~ ~ 1.05e3 (Hertz). Assumed
+  // steel: Y = 200 GPa, nu = 0.3, density 7850 kg/m^3, two equal spheres.
   const double m = 7850.0 * 4.0 / 3.0 * std::numbers::pi * 1e-9;
   const double rho = hertz_rho_one_material(2e11, 0.3, effective_radius(1e-3, 1e-3));
   const CollisionUnits steel = reduce_collision(SoftContactLaw::viscoelastic_hertz(rho, 0.0),
@@ -502,8 +504,9 @@ TEST(SoftContact, ReconstructionMatchesDirect3DIntegration) {
   }
 }
 
-// v_t = 0: no rotation, -eps_rdot = e(v) of §2, the velocities stay along n0; eps_phi is the
-// finite limit v_t -> 0 (phi_c = eps_phi Phi is 0 because Phi is).
+// v_t = 0: no rotation, -eps_rdot = e(v) of docs/physics.md#dashpot-head-on and
+// docs/physics.md#viscoelastic-head-on, the velocities stay along n0; eps_phi is the finite
+// limit v_t -> 0 (phi_c = eps_phi Phi is 0 because Phi is).
 TEST(SoftContact, HeadOnLimit) {
   for (SoftModel model : {SoftModel::LinearDashpot, SoftModel::ViscoelasticHertz}) {
     const double c = 0.2;
@@ -539,8 +542,9 @@ TEST(SoftContact, HeadOnLimit) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// §1.7: the hard-sphere failure. e_eff = -(g_c.n0)/(g0.n0) at l~ = 100, v_t/v_n = 20 is -0.95
-// (dashpot) and -0.99 (Hertz), with head-on e 0.74 and 0.85; at l~ = 1000, -0.08 and -0.11.
+// The hard-sphere failure (docs/physics.md#hard-sphere-failure). e_eff = -(g_c.n0)/(g0.n0) at
+// l~ = 100, v_t/v_n = 20 is -0.95 (dashpot) and -0.99 (Hertz), with head-on e 0.74 and 0.85; at
+// l~ = 1000, -0.08 and -0.11.
 
 double effective_restitution(const CollisionMap& m, double ratio) {
   // In the (n0, t0) basis with v_n = 1: g_c.n0 = -eps_rdot cos(phi_c) - (v_t/eps_r) sin(phi_c).

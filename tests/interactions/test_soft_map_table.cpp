@@ -1,8 +1,8 @@
 // Lookup tables of the soft-sphere collision map (src/interactions/soft_map_table.hpp): lookups
 // against direct integration (collision_map) at random off-grid points, the ranges, head-on tables
-// against the closed forms of formulas.md §2, the cache file (round trip, damaged, stale and
-// other-spec files) and input validation. Small speed ranges keep the builds short; one table is
-// built at the default tolerance 1e-6.
+// against the head-on closed forms (docs/physics.md#dashpot-head-on and the sections after it),
+// the cache file (round trip, damaged, stale and other-spec files) and input validation. Small
+// speed ranges keep the builds short; one table is built at the default tolerance 1e-6.
 #include "interactions/soft_map_table.hpp"
 
 #include <gtest/gtest.h>
@@ -250,7 +250,8 @@ TEST(SoftMapTable, LookupRejectsTheUnitsOfAnotherPair) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Head-on tables (walls) against the closed forms of formulas.md §2.
+// Head-on tables (walls) against the closed forms (docs/physics.md#dashpot-head-on,
+// docs/physics.md#viscoelastic-head-on, docs/physics.md#hertz-contact-time).
 
 TEST(SoftMapTable, DashpotHeadOnTableIsTheClosedForm) {
   for (double c_dis : {0.2, 1.0, 3.0}) {

@@ -1,9 +1,10 @@
-// Step tables and the step event rule against the independent numbers of formulas.md: the step
-// events of §7.7, the stepped Lennard-Jones table of §7.9 (boundaries, volume-averaged and
-// virial energies) and the square-well B2 of §4.1 / §7.9; then the continuous potentials, the
-// three placements (against closed-form level crossings, equal widths and volumes), the energy
-// rules in 2D and 3D against closed-form integrals, B2 of tables against B2 of their potentials,
-// tabulated files and their errors, bonds, and the report.
+// Step tables and the step event rule against independent numbers: the step events of
+// docs/physics.md#step-event, the stepped Lennard-Jones table of
+// docs/physics.md#stepping-continuous-potentials (boundaries, volume-averaged and virial
+// energies) and the square-well B2 of docs/physics.md#second-virial-coefficient; then the
+// continuous potentials, the three placements (against closed-form level crossings, equal widths
+// and volumes), the energy rules in 2D and 3D against closed-form integrals, B2 of tables against
+// B2 of their potentials, tabulated files and their errors, bonds, and the report.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -25,7 +26,8 @@
 namespace kairos {
 namespace {
 
-// §7.7: m_i = 1, m_j = 3 (mu = 3/4), r along x, so v_n is the x component of g (r / |r| = +x).
+// docs/physics.md#step-event: m_i = 1, m_j = 3 (mu = 3/4), r along x, so v_n is the x component
+// of g (r / |r| = +x).
 TEST(StepEvent, CrossesOrBouncesWithTheReferenceImpulses) {
   const double mu = 0.75;
   const StepOutcome a = step_event(mu, -1.0, -1.0);
@@ -60,7 +62,8 @@ TEST(StepEvent, ThresholdIsExactAndEnergyConserved) {
   }
 }
 
-// §7.9: shifted LJ cut at 3, 4 attractive equal-energy steps.
+// docs/physics.md#stepping-continuous-potentials: shifted LJ cut at 3, 4 attractive
+// equal-energy steps.
 TEST(StepTableFromLennardJones, MatchesTheReferenceBoundariesAndEnergies) {
   const ContinuousPotential lj = lennard_jones(1.0, 1.0, 3.0, true);
   EXPECT_NEAR(lj.u(lj.r_min), -0.9945205583, 1e-10);
@@ -240,8 +243,8 @@ TEST(StepPlacement, EqualVolumeGivesEqualShellVolumesIn3DAnd2D) {
 }
 
 // Equal energy steps down to a core distance: shifted LJ cut at 3 with 4 steps reproduces the
-// §7.9 boundaries and volume energies, and every boundary sits on the closed-form crossing of
-// its level.
+// boundaries and volume energies of docs/physics.md#stepping-continuous-potentials, and every
+// boundary sits on the closed-form crossing of its level.
 TEST(StepPlacement, EqualEnergyDownToACoreDistanceMatchesClosedFormCrossings) {
   const ContinuousPotential p = lennard_jones(1.0, 1.0, 3.0, true);
   const StepTable t =
@@ -572,10 +575,11 @@ TEST(Report, HeaderAndTableReadBack) {
                                p.u(1.5), p.u(2.0)));
 }
 
-// formulas.md §4.3: a crossing pays the dashpot's work gamma |v_n| width at the speed before
-// it. Approaching: cross if the energy pays step + work, else bounce with nothing dissipated.
-// Separating down a step: with the cap the pair gains max(0, -dU - work) and always crosses;
-// without, it is charged dU + work and may be pulled back. No damping: step_event bit for bit.
+// docs/physics.md#spring-dashpot-by-steps: a crossing pays the dashpot's work gamma |v_n| width
+// at the speed before it. Approaching: cross if the energy pays step + work, else bounce with
+// nothing dissipated. Separating down a step: with the cap the pair gains max(0, -dU - work) and
+// always crosses; without, it is charged dU + work and may be pulled back. No damping:
+// step_event bit for bit.
 TEST(DissipativeStepEvent, PaysTheDashpotWorkAndCapsTheGain) {
   const double mu = 0.75, gamma = 2.0, width = 0.01;
   for (const double v : {-3.0, -1.2, 0.7, 2.5}) {

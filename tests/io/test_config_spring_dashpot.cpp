@@ -1,5 +1,5 @@
-// [[potential]] kind = "spring_dashpot" (formulas.md §4.3): its keys, their errors (each naming
-// the key), and the round trip through the effective configuration.
+// [[potential]] kind = "spring_dashpot" (docs/physics.md#spring-dashpot-by-steps): its keys,
+// their errors (each naming the key), and the round trip through the effective configuration.
 #include <gtest/gtest.h>
 
 #include <string>

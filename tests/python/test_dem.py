@@ -1,7 +1,7 @@
 """The DEM integrator as a run choice (run.integrator = "dem", [soft]) end to end: energy of
 elastic soft gases conserved to O(dt^2), Haff cooling of a dashpot gas of constant restitution
-against formulas.md §6, a pile settling between walls under gravity (examples/dem_pile_3d.toml),
-the outputs, restarts that continue, and the errors.
+against docs/physics.md#homogeneous-cooling, a pile settling between walls under gravity
+(examples/dem_pile_3d.toml), the outputs, restarts that continue, and the errors.
 """
 
 import json
@@ -57,8 +57,8 @@ class DemRuns(kt.KairosTestCase):
             self.assertGreater(errors[0] / errors[1], 2.5, (soft, errors))
 
     def test_dashpot_gas_of_constant_restitution_cools_as_haff(self):
-        # formulas.md §6: T = T0 exp(-(1 - e^2) c / 3) in collisions per particle c, and
-        # T0 / (1 + t / tau0)^2 in time with the Enskog frequency at T0.
+        # docs/physics.md#homogeneous-cooling: T = T0 exp(-(1 - e^2) c / 3) in collisions per
+        # particle c, and T0 / (1 + t / tau0)^2 in time with the Enskog frequency at T0.
         e, eta, n_particles = 0.9, 0.05, 2000
         config = dem_config(dict(DASHPOT, restitution=e), particles=n_particles, production=10.0,
                             output={"thermo_interval": 1.0})

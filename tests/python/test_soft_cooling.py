@@ -17,8 +17,10 @@ hard-coded but the multiples):
 - the viscoelastic gas ends warmer than Haff's law with the constant e0 of its initial
   temperature (1 - e0^2 = the collision-averaged 1 - e(g_n)^2 of a Maxwell gas at T0) by more
   than MARGIN errors of its mean, and its T(c) stays within a few percent of the Maxwellian
-  kinetic theory with the same e(v) (formulas.md §6 with e(v) of §2.2);
-- the head-on restitution integrated by the theory reproduces formulas.md §7.2.
+  kinetic theory with the same e(v) (docs/physics.md#homogeneous-cooling with e(v) of
+  docs/physics.md#viscoelastic-head-on);
+- the head-on restitution integrated by the theory reproduces the values of
+  docs/physics.md#viscoelastic-head-on.
 
 Event-driven runs integrate every contact directly (soft.tables = false: exact maps, ~35 us
 each, no table build at start, which would dominate under the sanitizers).
@@ -104,9 +106,10 @@ class SoftCooling(kt.KairosTestCase):
             err = t[m].std(axis=0, ddof=1) / math.sqrt(len(SEEDS))
             self.assertGreater(mean[-1] - haff[-1], MARGIN * err[-1],
                                "%s: T = %.4f +- %.4f, Haff %.4f" % (m, mean[-1], err[-1], haff[-1]))
-            # formulas.md §6 leaves out the non-Gaussian corrections (a2) and the soft contacts'
-            # own corrections (oblique collisions dissipate less than e(v_n) says, O(1/l~)):
-            # together a few percent at the end (docs/validation.md).
+            # The kinetic theory of docs/physics.md#homogeneous-cooling leaves out the
+            # non-Gaussian corrections (a2) and the soft contacts' own corrections (oblique
+            # collisions dissipate less than e(v_n) says, O(1/l~)): together a few percent at
+            # the end (docs/validation.md).
             self.assertLess(np.max(np.abs(mean / kinetic - 1.0)), 0.06, m)
         # The gas really is viscoelastic: Haff underestimates the end temperature by > 5 %.
         self.assertGreater(kinetic[-1] / haff[-1], 1.05)

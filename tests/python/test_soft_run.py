@@ -1,7 +1,7 @@
-"""Soft spheres with the event integrator through `kairos run` ([soft], formulas.md §1.6): the
-map tables built once and then read from the cache (the same run either way), the summary's
-soft block and energy budget, a split run equal to the whole one with contacts in progress
-across the restart, the example, and the errors.
+"""Soft spheres with the event integrator through `kairos run` ([soft],
+docs/physics.md#event-driven-soft-contacts): the map tables built once and then read from the
+cache (the same run either way), the summary's soft block and energy budget, a split run equal to
+the whole one with contacts in progress across the restart, the example, and the errors.
 """
 
 import os

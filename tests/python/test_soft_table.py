@@ -86,7 +86,8 @@ class SoftTableCli(kt.KairosTestCase):
         self.assertIn("head-on", result.stdout)
         t = kairos_output().read_soft_table(out)
         self.assertEqual(t["eps_t"].shape[1], 1)
-        # The dashpot's head-on map does not depend on the speed: formulas.md §7.1 at zeta = 0.1.
+        # The dashpot's head-on map does not depend on the speed: docs/physics.md#dashpot-head-on
+        # at zeta = 0.1.
         self.assertTrue(np.allclose(t["eps_t"], 2.9560753247, rtol=1e-8))
         self.assertTrue(np.allclose(-t["eps_rdot"], 0.7440793977, rtol=1e-8))
         self.draw(out)
