@@ -69,13 +69,17 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   std::vector<std::uint32_t>().swap(s.species);
   bonds_ = s.bonds;
   bond_types_ = s.bond_types;
+  // The vector loop indexes records with 32-bit offsets.
+  vector_scan_ = options_.vector_scan && cpu_has_avx512() &&
+                 static_cast<double>(n) * sizeof(HotRecord<D>) < 2e9;
+  vector_gather_ =
+      vector_scan_ && (options_.list_gather == ListGather::kVector ||
+                       (options_.list_gather == ListGather::kAuto && cpu_gathers_fast()));
+  row_loads_ =
+      vector_scan_ && (options_.record_loads == RecordLoads::kRows ||
+                       (options_.record_loads == RecordLoads::kAuto && !cpu_gathers_fast()));
   setup_environment(s);
   setup_soft(s);
-  for (CandidateList& list : lists_) {
-    list.ids.resize(256);
-    list.shift.resize(256);
-    list.delayed.resize(256 + 8);
-  }
 
   // Internal numbering: the stored one when resuming, else the caller's (renumbered below).
   id_.resize(n);
@@ -95,16 +99,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
     shape_.resize(n + 1);  // one spare entry: the vector loop reads shapes 4 bytes at a time
     for (std::size_t k = 0; k < n; ++k) shape_[k] = shape_by_id[id_[k]];
   }
-  for (const Shape& sh : shapes_) shape_radius_.push_back(sh.radius);
-  // The vector loop indexes records with 32-bit offsets.
-  vector_scan_ = options_.vector_scan && cpu_has_avx512() &&
-                 static_cast<double>(n) * sizeof(HotRecord<D>) < 2e9;
-  vector_gather_ =
-      vector_scan_ && (options_.list_gather == ListGather::kVector ||
-                       (options_.list_gather == ListGather::kAuto && cpu_gathers_fast()));
-  row_loads_ =
-      vector_scan_ && (options_.record_loads == RecordLoads::kRows ||
-                       (options_.record_loads == RecordLoads::kAuto && !cpu_gathers_fast()));
+  for (const ParticleKind& sh : shapes_) shape_radius_.push_back(sh.radius);
   const bool has_counts = s.collision_count.size() == n;
   hot_.resize(n);
   for (std::uint32_t k = 0; k < n; ++k) {
@@ -134,19 +129,13 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   }
   if (accelerated_ && walls_ && !moving && !stepped_) {
     double dmin = kNever;
-    for (const Shape& sh : shapes_) dmin = std::min(dmin, 2.0 * sh.radius);
-    sleep_speed_ = env_.sleep_speed >= 0.0
-                       ? env_.sleep_speed
-                       : std::sqrt(2.0 * std::sqrt(norm2(env_.gravity)) * 1e-6 * dmin);
-  }
-  if (sleep_speed_ > 0.0) {
-    asleep_.assign(n, 0);
-    if (s.asleep.size() == n) {
-      for (std::uint32_t k = 0; k < n; ++k) {
-        asleep_[k] = s.asleep[id_[k]] != 0 ? 1 : 0;
-        sleeping_ += asleep_[k];
-        if (asleep_[k] != 0) hot_[k].vel = Vec<D>{};
-      }
+    for (const ParticleKind& sh : shapes_) dmin = std::min(dmin, 2.0 * sh.radius);
+    const double speed = Resting::speed_for(env_.sleep_speed, env_.gravity, dmin);
+    if (speed > 0.0) {
+      resting_ = Resting(n, speed, env_.gravity);
+      resting_.restore(s.asleep, id_);
+      for (std::uint32_t k = 0; k < n; ++k)
+        if (resting_.asleep(k)) hot_[k].vel = Vec<D>{};
     }
   }
   if (env_.tc > 0.0) {
@@ -181,21 +170,21 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
       hot_[k].cell = s.cell[id_[k]];
       check_restored_cell(k);
     }
-    insert_all_into_grid();
+    cells_.insert_all(hot_.data(), static_cast<std::uint32_t>(size()));
     init_zones(s, mode);
   } else {
     for (std::uint32_t k = 0; k < n; ++k) {
       advance_to(k, time_);
       for (int a = 0; a < D; ++a)
-        if (grid_.periodic(a)) hot_[k].pos[a] = wrap_into_box(hot_[k].pos[a], box_[a]);
-      hot_[k].cell = grid_.locate(hot_[k].pos);
-      if (walls_ && !(soft_ && frozen_with_[k] != kNoPartner))  // a soft contact: pressed in
+        if (cells_.grid().periodic(a)) hot_[k].pos[a] = wrap_into_box(hot_[k].pos[a], box_[a]);
+      hot_[k].cell = cells_.grid().locate(hot_[k].pos);
+      if (walls_ && !(soft_ && soft_state_.partner(k) != kNoPartner))  // a soft contact: pressed in
         face_walls_.check_start(hot_[k].pos, radius_of(k), time_, id_[k]);
     }
     if (options_.renumber_interval > 0.0) {
       renumber(/*queue_filled=*/false);  // fills the grid in the new numbering
     } else {
-      insert_all_into_grid();
+      cells_.insert_all(hot_.data(), static_cast<std::uint32_t>(size()));
     }
     init_zones(s, mode);
     for (std::uint32_t k = 0; k < n; ++k) times[k] = predict(k, time_);
@@ -233,8 +222,9 @@ void EventEngine<D, Queue>::build_shapes(const ParticleSystem<D>& s) {
     }
     shape[i] = it->second;
   }
-  uniform_radius_ = std::all_of(shapes_.begin(), shapes_.end(),
-                                [&](const Shape& sh) { return sh.radius == shapes_[0].radius; });
+  uniform_radius_ = std::all_of(shapes_.begin(), shapes_.end(), [&](const ParticleKind& sh) {
+    return sh.radius == shapes_[0].radius;
+  });
   if (shapes_.size() > 1) shape_ = std::move(shape);  // caller's numbering; permuted by caller
 }
 
@@ -245,7 +235,7 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   env_.check();
   std::uint32_t species = 1;
-  for (const Shape& sh : shapes_) species = std::max(species, sh.species + 1);
+  for (const ParticleKind& sh : shapes_) species = std::max(species, sh.species + 1);
   if (!env_.contact.empty() && env_.species < species) {
     throw InputError("the contact laws cover " + std::to_string(env_.species) +
                      " species but particles use " + std::to_string(species));
@@ -260,7 +250,7 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   walls_ = face_walls_.any();
   granular_contacts_ = !env_.plain() || env_.tc > 0.0;
   double rmax = 0.0;
-  for (const Shape& sh : shapes_) rmax = std::max(rmax, sh.radius);
+  for (const ParticleKind& sh : shapes_) rmax = std::max(rmax, sh.radius);
   if (!bonds_.empty() && env_.bond_table.empty())
     throw InputError("the state has bonds but no bond potential is given ([bond])");
   stepped_ = env_.stepped();
@@ -286,10 +276,11 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   const double cells_per_particle =
       bounded ? std::max(options_.max_cells_per_particle, kBoundedCellsPerParticle)
               : options_.max_cells_per_particle;
-  grid_ = CellGrid<D>(box_, min_width, periodic, s.size(), cells_per_particle);
+  cells_ =
+      Cells(CellGrid<D>(box_, min_width, periodic, s.size(), cells_per_particle), vector_gather_);
   bounded_ = bounded;
-  face_walls_.set_reach(grid_, rmax);
-  shear_ = LeesEdwards<D>(env_.shear_rate, box_, grid_, time_);
+  face_walls_.set_reach(cells_.grid(), rmax);
+  shear_ = LeesEdwards<D>(env_.shear_rate, box_, cells_.grid(), time_);
   sheared_ = shear_.on();
   double particle_volume = 0.0;
   for (const Kinematics<D>& k : s.kinematics)
@@ -300,13 +291,14 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   // Shear (sliding images) and steps (zones) keep full scans.
   incremental_crossings_ = options_.incremental_crossings && !stepped_ && !sheared_;
   for (int a = 0; a < D; ++a)
-    three_cell_axis_ = three_cell_axis_ || (grid_.periodic(a) && grid_.cells_along(a) == 3);
+    three_cell_axis_ =
+        three_cell_axis_ || (cells_.grid().periodic(a) && cells_.grid().cells_along(a) == 3);
 }
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::throw_squeezed(double t) const {
   double dmax = 0.0;
-  for (const Shape& sh : shapes_) dmax = std::max(dmax, 2.0 * sh.radius);
+  for (const ParticleKind& sh : shapes_) dmax = std::max(dmax, 2.0 * sh.radius);
   face_walls_.throw_squeezed(t, dmax, uniform_radius_);
 }
 
@@ -315,23 +307,16 @@ void EventEngine<D, Queue>::throw_squeezed(double t) const {
 template <int D, class Queue>
 void EventEngine<D, Queue>::check_restored_cell(std::uint32_t i) const {
   const CellCode c = hot_[i].cell;
-  bool ok = grid_.valid(c);
+  bool ok = cells_.grid().valid(c);
   for (int a = 0; ok && a < D; ++a) {
     const double x = hot_[i].pos[a];
     const double tol = 1e-9 * box_[a];
-    ok = x >= grid_.lower_bound(c, a) - tol && x <= grid_.upper_bound(c, a) + tol;
+    ok = x >= cells_.grid().lower_bound(c, a) - tol && x <= cells_.grid().upper_bound(c, a) + tol;
   }
   if (!ok) {
     throw InputError("restart state is inconsistent: particle " + std::to_string(id_[i]) +
                      " is not inside its stored cell " + std::to_string(c));
   }
-}
-
-template <int D, class Queue>
-void EventEngine<D, Queue>::insert_all_into_grid() {
-  grid_.clear();
-  // Inserting from the back leaves every cell's list in increasing index order.
-  for (auto k = static_cast<std::uint32_t>(size()); k-- > 0;) grid_.insert(k, hot_[k].cell);
 }
 
 template <int D, class Queue>
@@ -353,15 +338,17 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   std::vector<std::uint32_t> order(n);
   {
     std::uint64_t top = 0;
-    for (std::uint32_t k = 0; k < n; ++k) top = std::max(top, grid_.morton_rank(hot_[k].cell));
+    for (std::uint32_t k = 0; k < n; ++k)
+      top = std::max(top, cells_.grid().morton_rank(hot_[k].cell));
     if (top < (std::uint64_t{1} << 32)) {  // (rank, index) packed into one integer
       std::vector<std::uint64_t> key(n);
-      for (std::uint32_t k = 0; k < n; ++k) key[k] = grid_.morton_rank(hot_[k].cell) << 32 | k;
+      for (std::uint32_t k = 0; k < n; ++k)
+        key[k] = cells_.grid().morton_rank(hot_[k].cell) << 32 | k;
       std::sort(key.begin(), key.end());
       for (std::uint32_t k = 0; k < n; ++k) order[k] = static_cast<std::uint32_t>(key[k]);
     } else {
       std::vector<std::pair<std::uint64_t, std::uint32_t>> rank(n);
-      for (std::uint32_t k = 0; k < n; ++k) rank[k] = {grid_.morton_rank(hot_[k].cell), k};
+      for (std::uint32_t k = 0; k < n; ++k) rank[k] = {cells_.grid().morton_rank(hot_[k].cell), k};
       std::sort(rank.begin(), rank.end());
       for (std::uint32_t k = 0; k < n; ++k) order[k] = rank[k].second;
     }
@@ -372,8 +359,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   for (std::uint32_t k = 0; queue_filled && k < n; ++k) times[k] = queue_.time_of(order[k]);
   for (PendingEvent& e : pending_)
     e.code = e.code.renumbered([&](std::uint32_t p) { return new_index[p]; });
-  for (std::uint32_t& p : frozen_with_)
-    if (p < kFirstCode) p = new_index[p];
+  soft_state_.renumber_partners(new_index, kFirstCode);
   if (stepped_) steps_.renumber(new_index);
   std::vector<std::uint32_t>().swap(new_index);
   std::vector<bool> done;
@@ -386,13 +372,9 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(shape_);  // its spare last entry stays
   permute(spin_);
   permute(last_collision_);
-  permute(asleep_);
-  permute(frozen_with_);
-  permute(release_time_);
-  permute(release_velocity_);
-  permute(deferred_);
-  if (soft_) rebuild_awaiting_release();
-  insert_all_into_grid();
+  resting_.permute(order, done);
+  soft_state_.permute(order, done);
+  cells_.insert_all(hot_.data(), static_cast<std::uint32_t>(size()));
   if (queue_filled) queue_.reset(times);
 }
 
@@ -461,7 +443,8 @@ typename EventEngine<D, Queue>::Crossing EventEngine<D, Queue>::next_crossing(
     const double v = h.vel[a];
     const int up = v > 0.0 ? 1 : 0;
     const __m128d vv = _mm_set_sd(v);
-    const __m128d face = _mm_set_sd((grid_.coordinate(h.cell, a) + up) * grid_.width(a));
+    const __m128d face =
+        _mm_set_sd((cells_.grid().coordinate(h.cell, a) + up) * cells_.grid().width(a));
     // (face - x) / v, at least 0 (max_sd gives its second operand for NaN, as the ternary did);
     // never for v = 0.
     const __m128d dt = _mm_max_sd(_mm_div_sd(_mm_sub_sd(face, _mm_set_sd(h.pos[a])), vv), zero);
@@ -484,7 +467,8 @@ typename EventEngine<D, Queue>::Crossing EventEngine<D, Queue>::next_crossing_ge
   Crossing x{kNever, -1, 0};
   {
     for (int a = 0; a < D; ++a) {
-      const double lo = grid_.lower_bound(h.cell, a), hi = grid_.upper_bound(h.cell, a);
+      const double lo = cells_.grid().lower_bound(h.cell, a),
+                   hi = cells_.grid().upper_bound(h.cell, a);
       const double g = env_.gravity[a];
       const double dt = interval_exit_time_accelerated(h.pos[a], h.vel[a], g, lo, hi);
       if (!(h.time + dt < x.time)) continue;
@@ -498,178 +482,16 @@ typename EventEngine<D, Queue>::Crossing EventEngine<D, Queue>::next_crossing_ge
   return x;
 }
 
-// Doubles a candidate list's storage (rare: a crowded neighbourhood); returns the new storage.
-template <int D, class Queue>
-std::uint32_t* EventEngine<D, Queue>::grow(CandidateList& list) {
-  list.ids.resize(2 * list.ids.size());
-  list.shift.resize(list.ids.size());
-  list.delayed.resize(list.ids.size() + 8);
-  return list.ids.data();
-}
-
-// Appends the members of the list starting at p to cand[n...]: walk_lists' rest of a crowded
-// cell (from its third member on). The first two links are followed without a branch (an empty
-// slot is written but not counted); only a further member takes the loop. Records are
-// prefetched so that the cache misses of a whole prediction overlap.
-template <int D, class Queue>
-[[gnu::always_inline]] inline void EventEngine<D, Queue>::append_members(
-    std::uint32_t p, const Links& links, CandidateList& list, std::uint32_t& n,
-    std::uint32_t*& cand, std::uint32_t& cap) {
-  const std::uint32_t* next = links.next;
-  const std::uint32_t end = links.end;
-  const HotRecord<D>* hot = links.hot;
-  for (int unrolled = 0; unrolled < 2; ++unrolled) {
-    __builtin_prefetch(hot + p);
-    cand[n] = p;
-    n += p != end ? 1u : 0u;
-    p = next[p];
-  }
-  for (; p != end; p = next[p]) {
-    if (cap - n < kCandidateSlack) [[unlikely]] {
-      cand = grow(list);
-      cap = static_cast<std::uint32_t>(list.ids.size());
-    }
-    __builtin_prefetch(hot + p);
-    cand[n++] = p;
-  }
-}
-
-// Collects the members of the 3^D cells around `cell` as candidates. Cells away from the box
-// faces (most) need no periodic shifts and take a loop over fixed index offsets.
 template <int D, class Queue>
 void EventEngine<D, Queue>::gather(CellCode cell, CandidateList& list) {
   if (sheared_) [[unlikely]] {
-    list.sheared = shear_.next_to_face(cell, grid_);
+    list.sheared = shear_.next_to_face(cell, cells_.grid());
     if (list.sheared) {
       gather_sheared(cell, list);
       return;
     }
   }
-  gather_cells(cell, all_neighbours_.data(), CellGrid<D>::kNeighbourCells, list);
-}
-
-// gather() for the cells numbered which[0 .. count) among the 3^D around `cell` (see
-// CellGrid::neighbour's numbering), in that order.
-template <int D, class Queue>
-void EventEngine<D, Queue>::gather_cells(CellCode cell, const std::uint8_t* which, int count,
-                                         CandidateList& list) {
-  if (vector_gather_) {
-    gather_vector(cell, which, count, list);
-    return;
-  }
-  constexpr int kMost = CellGrid<D>::kNeighbourCells;
-  std::uint32_t cells[kMost], tags[kMost];
-  if (grid_.interior(cell)) {
-    const std::uint32_t centre = grid_.index(cell);
-    const std::int32_t* delta = grid_.neighbour_deltas();
-    for (int c = 0; c < count; ++c) cells[c] = centre + static_cast<std::uint32_t>(delta[which[c]]);
-    list.n_shifts = 1;
-    walk_lists<false>(cells, tags, count, list);
-  } else {
-    std::uint32_t n_shifts = 1;  // shifts[0] is the zero shift
-    for (int c = 0; c < count; ++c) {
-      const typename CellGrid<D>::Neighbour nb = grid_.neighbour(cell, which[c]);
-      cells[c] = nb.cell;
-      tags[c] = nb.shifted ? n_shifts : 0;
-      if (nb.shifted) list.shifts[n_shifts++] = nb.shift;
-    }
-    list.n_shifts = n_shifts;
-    walk_lists<true>(cells, tags, count, list);
-  }
-}
-
-// The members of the lists of cells[0 .. count), in list order, as candidates (with their
-// cells' shift numbers tags[] when kTagged). The first three links of every list are loaded in
-// three waves of independent loads (heads, second members, third links), not in a chain per
-// cell, so that each wave's cache misses overlap; only crowded cells follow links further.
-template <int D, class Queue>
-template <bool kTagged>
-void EventEngine<D, Queue>::walk_lists(const std::uint32_t* cells, const std::uint32_t* tags,
-                                       int count, CandidateList& list) {
-  const std::uint32_t* heads = grid_.heads();
-  // Read once: the stores into the candidate list could alias them for the compiler.
-  const Links links{grid_.links(), grid_.end(), hot_.data()};
-  const std::uint32_t* next = links.next;
-  const std::uint32_t end = links.end;
-  constexpr int kMost = CellGrid<D>::kNeighbourCells;
-  std::uint32_t first[kMost], second[kMost], third[kMost];
-  for (int c = 0; c < count; ++c) first[c] = heads[cells[c]];
-  for (int c = 0; c < count; ++c) second[c] = next[first[c]];  // next[end] is end
-  for (int c = 0; c < count; ++c) third[c] = next[second[c]];
-  // Two slots per cell are written unchecked (an empty one is overwritten).
-  const auto room = [&](int cells_left) {
-    return kCandidateSlack + 2 * static_cast<std::uint32_t>(cells_left);
-  };
-  std::uint32_t n = 0;
-  auto cap = static_cast<std::uint32_t>(list.ids.size());
-  std::uint32_t* cand = list.ids.data();
-  while (cap < room(count)) [[unlikely]] {
-      cand = grow(list);
-      cap = static_cast<std::uint32_t>(list.ids.size());
-    }
-  for (int c = 0; c < count; ++c) {
-    const std::uint32_t from = n;
-    __builtin_prefetch(links.hot + first[c]);
-    cand[n] = first[c];
-    n += first[c] != end ? 1u : 0u;
-    __builtin_prefetch(links.hot + second[c]);
-    cand[n] = second[c];
-    n += second[c] != end ? 1u : 0u;
-    if (third[c] != end) [[unlikely]] {  // a crowded cell: the rest by links
-      append_members(third[c], links, list, n, cand, cap);
-      while (cap - n < room(count - c - 1)) {
-        cand = grow(list);
-        cap = static_cast<std::uint32_t>(list.ids.size());
-      }
-    }
-    if constexpr (kTagged) {
-      for (std::uint32_t k = from; k < n; ++k) list.shift[k] = tags[c];
-    }
-  }
-  list.count = n;
-}
-
-// gather_cells() with AVX-512: the cells' list heads and their successors are fetched and
-// compressed sixteen lists at a time; the rare third and later members follow by links.
-template <int D, class Queue>
-void EventEngine<D, Queue>::gather_vector(CellCode cell, const std::uint8_t* which, int count,
-                                          CandidateList& list) {
-  constexpr auto kCells = static_cast<std::uint32_t>(CellGrid<D>::kNeighbourCells);
-  while (list.ids.size() < 2 * kCells + kCandidateSlack) grow(list);
-  std::uint32_t cells[kCells], tags[kCells];
-  const bool interior = grid_.interior(cell);
-  std::uint32_t n_shifts = 1;  // shifts[0] is the zero shift
-  if (interior) {
-    const std::uint32_t centre = grid_.index(cell);
-    const std::int32_t* delta = grid_.neighbour_deltas();
-    for (int c = 0; c < count; ++c) cells[c] = centre + static_cast<std::uint32_t>(delta[which[c]]);
-  } else {
-    for (int c = 0; c < count; ++c) {
-      const typename CellGrid<D>::Neighbour nb = grid_.neighbour(cell, which[c]);
-      cells[c] = nb.cell;
-      tags[c] = nb.shifted ? n_shifts : 0;
-      if (nb.shifted) list.shifts[n_shifts++] = nb.shift;
-    }
-  }
-  const Neighbourhood nb{
-      grid_.heads(), grid_.links(), grid_.end(), cells, interior ? nullptr : tags, count};
-  std::uint32_t third[kCells], third_tag[kCells];
-  std::uint32_t n_third = 0;
-  std::uint32_t n =
-      gather_lists_avx512(nb, list.ids.data(), list.shift.data(), third, third_tag, n_third);
-  for (std::uint32_t k = 0; k < n_third; ++k) {
-    for (std::uint32_t p = third[k]; p != grid_.end(); p = grid_.next(p)) {
-      if (list.ids.size() - n < kCandidateSlack) [[unlikely]]
-        grow(list);
-      list.ids[n] = p;
-      list.shift[n++] = third_tag[k];
-    }
-  }
-  const HotRecord<D>* hot = hot_.data();
-  const std::uint32_t* ids = list.ids.data();
-  for (std::uint32_t k = 0; k < n; ++k) __builtin_prefetch(hot + ids[k]);
-  list.count = n;
-  list.n_shifts = n_shifts;
+  cells_.gather(cell, list, hot_.data());
 }
 
 // The candidate loops' view of a gathered list for particle i; candidates in deferred soft
@@ -729,22 +551,23 @@ std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, 
 // comes before the particle leaves its cell, else the crossing. Stores it; returns its time.
 template <int D, class Queue>
 double EventEngine<D, Queue>::predict(std::uint32_t i, double t) {
-  gather(hot_[i].cell, lists_[0]);
-  return predict_from(lists_[0], i, t);
+  gather(hot_[i].cell, cells_.list(0));
+  return predict_from(cells_.list(0), i, t);
 }
 
 // predict() with the candidates already gathered (from the particle's own cell).
 template <int D, class Queue>
 double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint32_t i, double t) {
   const HotRecord<D>& h = hot_[i];
-  if (sleeping_ > 0 && is_asleep(i)) [[unlikely]] {
+  if (resting_.count() > 0 && is_asleep(i)) [[unlikely]] {
     return predict_asleep(list, i, t);
   }
   const Crossing crossing = next_crossing(h);
   double best = crossing.time - t;
   const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
   std::uint32_t partner;
-  if (stepped_ || (sleeping_ > 0 && sleeper_among(list)) || list.sheared) [[unlikely]] {
+  if (stepped_ || (resting_.count() > 0 && resting_.any_of(list.ids.data(), list.count)) ||
+      list.sheared) [[unlikely]] {
     partner = stepped_       ? scan_stepped(list, i, t, best)
               : list.sheared ? scan_sheared(list, i, t, best)
                              : scan_with_sleepers(list, i, t, best);
@@ -779,9 +602,9 @@ double EventEngine<D, Queue>::conclude_prediction(std::uint32_t i, double t,
       when = t + dt;
     }
   }
-  if (soft_ && awaits_release(i) && release_time_[i] <= when) [[unlikely]] {
+  if (soft_ && soft_state_.awaits_release(i) && soft_state_.release_time(i) <= when) [[unlikely]] {
     pending_[i] = {Code::release(), 0};
-    when = release_time_[i];
+    when = soft_state_.release_time(i);
   }
   return when > t ? when : t;  // never in the past, whatever the round-off
 }
@@ -803,7 +626,7 @@ double EventEngine<D, Queue>::conclude_unbounded(std::uint32_t i, double t,
 }
 
 // After a crossing at time t (already in its new cell, the new layer of cells gathered
-// into lists_[0] by cross()): the particle's old neighbours
+// into cells_.list(0) by cross()): the particle's old neighbours
 // were all tested by the prediction that scheduled the crossing, and the soonest contact among
 // them came after it (`kept`, due in kept_dt; kNoPartner: none). A neighbour whose motion
 // changed since was predicted again then, against this particle's unchanged motion, so that
@@ -813,9 +636,9 @@ template <int D, class Queue>
 double EventEngine<D, Queue>::predict_after_crossing(std::uint32_t i, double t, std::uint32_t kept,
                                                      double kept_dt) {
   const HotRecord<D>& h = hot_[i];
-  const CandidateList& list = lists_[0];
+  const CandidateList& list = cells_.list(0);
   // A sleeper in the new layer needs the loop of scan_with_sleepers: the full prediction.
-  if (sleeping_ > 0 && sleeper_among(list)) [[unlikely]]
+  if (resting_.count() > 0 && resting_.any_of(list.ids.data(), list.count)) [[unlikely]]
     return predict(i, t);
   const Crossing crossing = next_crossing(h);
   const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
@@ -838,7 +661,7 @@ bool EventEngine<D, Queue>::kept_contact_time(std::uint32_t i, std::uint32_t p, 
   const HotRecord<D>& hi = hot_[i];
   const HotRecord<D>& hp = hot_[p];
   std::array<int, D> d;
-  if (!grid_.neighbour_offset(hi.cell, hp.cell, d)) return false;
+  if (!cells_.grid().neighbour_offset(hi.cell, hp.cell, d)) return false;
   // With a periodic axis only 3 cells wide, a crossing along it makes the old far layer the new
   // one, through the other image: a partner kept there had its contact through the old image,
   // which the new one does not give back, and that contact bounded the old neighbours' ones.
@@ -853,8 +676,8 @@ bool EventEngine<D, Queue>::kept_contact_time(std::uint32_t i, std::uint32_t p, 
   const Vec<D> vp = accelerated_ ? velocity_at(hp, t) : hp.vel;
   Vec<D> r, g;
   for (int a = 0; a < D; ++a) {
-    const int c = grid_.coordinate(hi.cell, a) + d[a];
-    const double shift = c < 0 ? -box_[a] : c >= grid_.cells_along(a) ? box_[a] : 0.0;
+    const int c = cells_.grid().coordinate(hi.cell, a) + d[a];
+    const double shift = c < 0 ? -box_[a] : c >= cells_.grid().cells_along(a) ? box_[a] : 0.0;
     r[a] = xi[a] - (xp[a] + shift);
     g[a] = vi[a] - vp[a];
   }
@@ -864,14 +687,6 @@ bool EventEngine<D, Queue>::kept_contact_time(std::uint32_t i, std::uint32_t p, 
 
 // Whether some candidate sleeps: only then does a pair need the quartic of scan_with_sleepers;
 // predictions away from the resting particles keep the vector loop.
-template <int D, class Queue>
-bool EventEngine<D, Queue>::sleeper_among(const CandidateList& list) const {
-  const std::uint8_t* asleep = asleep_.data();
-  std::uint8_t any = 0;
-  for (std::uint32_t k = 0; k < list.count; ++k) any |= asleep[list.ids[k]];
-  return any != 0;
-}
-
 // A sleeper moves on no event of its own (no crossing, no wall), but the awake particles around
 // it were predicted while it still moved: its own scan keeps every pair (sleeper, awake) covered,
 // as any particle's prediction covers its pairs after its motion changed. Among sleepers alone
@@ -898,13 +713,13 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
     collide_sheared(i, j, t);
     return;
   }
-  if (sleeping_ > 0 && (is_asleep(i) || is_asleep(j))) [[unlikely]] {
+  if (resting_.count() > 0 && (is_asleep(i) || is_asleep(j))) [[unlikely]] {
     if (is_asleep(i)) std::swap(i, j);  // i is the awake one
     const bool again = wedged(i, t);
     advance_to(i, t);
     Vec<D> r = hot_[i].pos - hot_[j].pos;
     for (int a = 0; a < D; ++a)
-      if (grid_.periodic(a)) r[a] = minimum_image(r[a], box_[a]);
+      if (cells_.grid().periodic(a)) r[a] = minimum_image(r[a], box_[a]);
     collide_with_sleeper(i, j, t, r, norm2(r), again);
     return;
   }
@@ -918,7 +733,7 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
   double g_dot_r = 0.0, r2 = 0.0;
   for (int a = 0; a < D; ++a) {
     const double raw = hi.pos[a] - hj.pos[a];
-    const double d = !bounded_ || grid_.periodic(a) ? minimum_image(raw, box_[a]) : raw;
+    const double d = !bounded_ || cells_.grid().periodic(a) ? minimum_image(raw, box_[a]) : raw;
     r[a] = d;
     r2 += d * d;
     g_dot_r += (hi.vel[a] - hj.vel[a]) * d;
@@ -945,11 +760,11 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
 // records prefetched) before either is tested; partners in one cell share one list.
 template <int D, class Queue>
 inline void EventEngine<D, Queue>::predict_pair(std::uint32_t i, std::uint32_t j, double t) {
-  gather(hot_[i].cell, lists_[0]);
+  gather(hot_[i].cell, cells_.list(0));
   const bool shared = hot_[j].cell == hot_[i].cell;
-  if (!shared) gather(hot_[j].cell, lists_[1]);
-  queue_.update(i, predict_from(lists_[0], i, t));
-  queue_.update(j, predict_from(lists_[shared ? 0 : 1], j, t));
+  if (!shared) gather(hot_[j].cell, cells_.list(1));
+  queue_.update(i, predict_from(cells_.list(0), i, t));
+  queue_.update(j, predict_from(cells_.list(shared ? 0 : 1), j, t));
 }
 
 // The impulse of a pair collision at separation r (i minus j) with the particles' present
@@ -1041,8 +856,8 @@ template <int D, class Queue>
 std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i, double t,
                                                                 double horizon) const {
   const HotRecord<D>& h = hot_[i];
-  return face_walls_.next_contact(position_at(h, t), velocity_at(h, t), radius_of(i), h.cell, grid_,
-                                  t, horizon);
+  return face_walls_.next_contact(position_at(h, t), velocity_at(h, t), radius_of(i), h.cell,
+                                  cells_.grid(), t, horizon);
 }
 
 // A particle meets a wall: the wall is a partner of infinite mass moving with its velocity
@@ -1071,7 +886,7 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
   if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
   counters_.dissipated_at_walls += res.dissipated;
   counters_.work_by_walls += FaceWalls<D>::work(res);
-  if (sleep_speed_ > 0.0 && !w.vibrates()) {
+  if (resting_.on() && !w.vibrates()) {
     counters_.dissipated_at_walls -=
         settle_after_contact(i, face_normal<D>(face), w.velocity, t, again);
   }
@@ -1094,15 +909,13 @@ void EventEngine<D, Queue>::fall_asleep(std::uint32_t i, double t) {
   h.time = t;
   h.vel = Vec<D>{};
   if (!spin_.empty()) spin_[i] = AngularVelocity<D>{};
-  asleep_[i] = 1;
-  ++sleeping_;
+  resting_.fall_asleep(i);
   ++counters_.fell_asleep;
 }
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::wake(std::uint32_t i, double t) {
-  asleep_[i] = 0;
-  --sleeping_;
+  resting_.wake(i);
   hot_[i].time = t;  // at rest where it slept
 }
 
@@ -1110,34 +923,19 @@ template <int D, class Queue>
 double EventEngine<D, Queue>::settle_after_contact(std::uint32_t i, const Vec<D>& n,
                                                    const Vec<D>& support_velocity, double t,
                                                    bool again) {
-  if (sleep_speed_ <= 0.0) return 0.0;
+  using Settle = typename Resting::Settle;
   HotRecord<D>& h = hot_[i];
+  const Settle settle =
+      resting_.settle(h.vel, n, support_velocity, again, [&] { return resting_on_support(i, t); });
   const double m = mass_of(i);
-  auto sleep = [&] {
+  if (settle.kind == Settle::kSleep) {
     const double before = 0.5 * m * norm2(h.vel) + spin_energy(i);
     fall_asleep(i, t);
     return -before;
-  };
-  const bool still = norm2(support_velocity) == 0.0;
-  // Wedged between resting things with no clearance (see wedged()): bouncing on would take
-  // endless contacts; it stops (plastic) and sleeps.
-  if (again && still) return sleep();
-  // Slow and held up: by this contact, or (a contact from the side, e.g. a sleeper beside it
-  // on the floor) by something under it.
-  const Vec<D> rel = h.vel - support_velocity;
-  if (still && norm2(rel) < sleep_speed_ * sleep_speed_ &&
-      (holds_up(n) || resting_on_support(i, t))) {
-    return sleep();
   }
-  if (!(dot(env_.gravity, n) < 0.0)) return 0.0;  // gravity does not press it into this contact
-  const double vn = dot(rel, n);
-  if (vn >= sleep_speed_) return 0.0;  // a real bounce
-  // Pressed into the contact but still sliding, on a slope too steep to rest on, or carried by
-  // a moving support: leave with half the sleep speed along n, so that the next contact is a
-  // finite flight away, not the first of an endless cascade of ever smaller bounces. Half: a
-  // particle rattling in a pocket then lands slower than the sleep speed and sleeps.
+  if (settle.kind == Settle::kNothing) return 0.0;
   const double before = 0.5 * m * norm2(h.vel);
-  h.vel = h.vel + (0.5 * sleep_speed_ - vn) * n;
+  h.vel = h.vel + settle.lift * n;
   return 0.5 * m * norm2(h.vel) - before;
 }
 
@@ -1148,7 +946,7 @@ double EventEngine<D, Queue>::settle_after_contact(std::uint32_t i, const Vec<D>
 template <int D, class Queue>
 bool EventEngine<D, Queue>::wedged(std::uint32_t i, double t) const {
   const double moved = (t - hot_[i].time) * std::sqrt(norm2(velocity_of(i, t)));
-  return moved <= 2e-9 * radius_of(i);
+  return Resting::wedged(moved, radius_of(i));
 }
 
 template <int D, class Queue>
@@ -1162,16 +960,16 @@ double EventEngine<D, Queue>::spin_energy(std::uint32_t i) const {
 // sleeper that gravity presses it onto.
 template <int D, class Queue>
 bool EventEngine<D, Queue>::resting_on_support(std::uint32_t i, double t) {
-  const double eps =
-      4.0 * sleep_speed_ * sleep_speed_ / std::sqrt(norm2(env_.gravity)) + 1e-12 * radius_of(i);
+  const double eps = resting_.support_distance(radius_of(i));
   const Vec<D> x = position_of(i, t);
   for (int f = 0; f < 2 * D; ++f) {
     if (!face_walls_.is_wall(f)) continue;
     const Wall<D>& w = face_walls_.wall(f);
     if (w.vibrates() || norm2(w.velocity) != 0.0) continue;
-    if (holds_up(face_normal<D>(f)) && face_walls_.gap(f, x, t) - radius_of(i) < eps) return true;
+    if (resting_.holds_up(face_normal<D>(f)) && face_walls_.gap(f, x, t) - radius_of(i) < eps)
+      return true;
   }
-  CandidateList& list = lists_[1];
+  CandidateList& list = cells_.list(1);
   gather(hot_[i].cell, list);
   for (std::uint32_t k = 0; k < list.count; ++k) {
     const std::uint32_t j = list.ids[k];
@@ -1179,7 +977,8 @@ bool EventEngine<D, Queue>::resting_on_support(std::uint32_t i, double t) {
     Vec<D> r = x - hot_[j].pos;
     if (list.n_shifts > 1) r = r - list.shifts[list.shift[k]];
     const double dist = std::sqrt(norm2(r));
-    if (holds_up((1.0 / dist) * r) && dist - (radius_of(i) + radius_of(j)) < eps) return true;
+    if (resting_.holds_up((1.0 / dist) * r) && dist - (radius_of(i) + radius_of(j)) < eps)
+      return true;
   }
   return false;
 }
@@ -1192,7 +991,7 @@ void EventEngine<D, Queue>::collide_with_sleeper(std::uint32_t i, std::uint32_t 
   HotRecord<D>& hi = hot_[i];
   const Vec<D> n = (1.0 / std::sqrt(r2)) * r;
   const double gn = dot(hi.vel, n);
-  if (-gn >= sleep_speed_) {
+  if (resting_.hit_wakes(gn)) {
     wake(j, t);
     resolve_pair(i, j, t, r, r2);
     ++hot_[j].collisions;
@@ -1285,28 +1084,28 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   }
   advance_to(i, t);
   std::array<int, D> c;
-  for (int a = 0; a < D; ++a) c[a] = grid_.coordinate(h.cell, a);
+  for (int a = 0; a < D; ++a) c[a] = cells_.grid().coordinate(h.cell, a);
   c[x.axis] += x.sign;
-  if (!grid_.periodic(x.axis)) {
+  if (!cells_.grid().periodic(x.axis)) {
     // Outer layers are unbounded, so a crossing never leaves the grid; round-off aside.
-    c[x.axis] = std::clamp(c[x.axis], 0, grid_.cells_along(x.axis) - 1);
+    c[x.axis] = std::clamp(c[x.axis], 0, cells_.grid().cells_along(x.axis) - 1);
   } else if (c[x.axis] < 0) {
-    c[x.axis] += grid_.cells_along(x.axis);
+    c[x.axis] += cells_.grid().cells_along(x.axis);
     h.pos[x.axis] += box_[x.axis];
     if (sheared_ && x.axis == 1) cross_shear_face(i, -1, t, c);
-  } else if (c[x.axis] >= grid_.cells_along(x.axis)) {
-    c[x.axis] -= grid_.cells_along(x.axis);
+  } else if (c[x.axis] >= cells_.grid().cells_along(x.axis)) {
+    c[x.axis] -= cells_.grid().cells_along(x.axis);
     h.pos[x.axis] -= box_[x.axis];
     if (sheared_ && x.axis == 1) cross_shear_face(i, 1, t, c);
   }
-  const CellCode entered = grid_.code_at(c);
+  const CellCode entered = cells_.grid().code_at(c);
   // The layer new to the neighbourhood, gathered first so that the misses on its records overlap
   // the list surgery and the kept contact's time (its cells are neither the old nor the new one).
   if (incremental)
-    gather_cells(entered, grid_.layer(x.axis, x.sign), CellGrid<D>::kLayerCells, lists_[0]);
-  grid_.erase(i, h.cell);
+    cells_.gather_cells(entered, cells_.grid().layer(x.axis, x.sign), CellGrid<D>::kLayerCells,
+                        cells_.list(0), hot_.data());
+  cells_.move(i, h.cell, entered);
   h.cell = entered;
-  grid_.insert(i, h.cell);
   ++counters_.cell_crossings;
   double kept_dt = kNever;
   if (incremental && kept != kNoPartner) incremental = kept_contact_time(i, kept, t, kept_dt);
@@ -1359,7 +1158,7 @@ EventKind EventEngine<D, Queue>::step() {
 template <int D, class Queue>
 double EventEngine<D, Queue>::kinetic_energy() const {
   double ke = 0.0;
-  if (accelerated_ || !deferred_.empty()) {
+  if (accelerated_ || soft_state_.defers()) {
     for (std::uint32_t i = 0; i < size(); ++i)
       ke += 0.5 * mass_of(i) * norm2(velocity_of(i, time_));
     return ke;
@@ -1401,10 +1200,11 @@ double EventEngine<D, Queue>::bytes_per_particle() const {
   // Per-particle arrays plus the grid's and the queue's own (cells and buckets included,
   // divided by N); the shape table is a few bytes in all.
   const double shapes =
-      static_cast<double>(shapes_.size() * sizeof(Shape)) / static_cast<double>(size());
+      static_cast<double>(shapes_.size() * sizeof(ParticleKind)) / static_cast<double>(size());
   return static_cast<double>(sizeof(HotRecord<D>) + sizeof(PendingEvent) + sizeof(std::uint32_t) +
                              (shape_.empty() ? 0 : sizeof(std::uint16_t))) +
-         shapes + grid_.bytes_per_particle() + static_cast<double>(queue_.bytes_per_particle());
+         shapes + cells_.grid().bytes_per_particle() +
+         static_cast<double>(queue_.bytes_per_particle());
 }
 
 // --- Lees-Edwards shear (boundaries/lees_edwards.hpp) ----------------------------------------
@@ -1414,16 +1214,17 @@ double EventEngine<D, Queue>::bytes_per_particle() const {
 template <int D, class Queue>
 void EventEngine<D, Queue>::shift_images() {
   time_ = shear_.shift();
-  const int nx = grid_.cells_along(0), ny = grid_.cells_along(1);
-  const int nz = D == 3 ? grid_.cells_along(D - 1) : 1;
+  const int nx = cells_.grid().cells_along(0), ny = cells_.grid().cells_along(1);
+  const int nz = D == 3 ? cells_.grid().cells_along(D - 1) : 1;
   for (const int y : {0, ny - 1}) {
     for (int column = 0; column < nx * nz; ++column) {
       std::array<int, D> at{};
       at[0] = column % nx;
       at[1] = y;
       if constexpr (D == 3) at[2] = column / nx;
-      const std::uint32_t cell = grid_.index(grid_.code_at(at));
-      for (std::uint32_t p = grid_.first(cell); p != grid_.end(); p = grid_.next(p))
+      const std::uint32_t cell = cells_.grid().index(cells_.grid().code_at(at));
+      for (std::uint32_t p = cells_.grid().first(cell); p != cells_.grid().end();
+           p = cells_.grid().next(p))
         queue_.update(p, predict(p, time_));
     }
   }
@@ -1438,14 +1239,14 @@ void EventEngine<D, Queue>::gather_sheared(CellCode cell, CandidateList& list) {
   list.velocity_shifts[0] = Vec<D>{};
   // Predictions happen at time_.
   shear_.for_each_neighbour_cell(
-      cell, grid_, time_,
+      cell, cells_.grid(), time_,
       [&](const std::array<int, D>& at, const Vec<D>& shift, const Vec<D>& vshift) {
         const std::uint32_t tag = n_shifts++;
         list.shifts[tag] = shift;
         list.velocity_shifts[tag] = vshift;
-        for (std::uint32_t p = grid_.first(grid_.index(grid_.code_at(at))); p != grid_.end();
-             p = grid_.next(p)) {
-          if (list.ids.size() - n < kCandidateSlack) grow(list);
+        for (std::uint32_t p = cells_.grid().first(cells_.grid().index(cells_.grid().code_at(at)));
+             p != cells_.grid().end(); p = cells_.grid().next(p)) {
+          if (list.ids.size() - n < Cells::kCandidateSlack) Cells::grow(list);
           list.ids[n] = p;
           list.shift[n++] = tag;
         }
@@ -1512,7 +1313,7 @@ void EventEngine<D, Queue>::cross_shear_face(std::uint32_t i, int side, double t
                                              std::array<int, D>& c) {
   HotRecord<D>& h = hot_[i];
   const double ke = norm2(h.vel);
-  c[0] = shear_.cross_face(h.pos, h.vel, side, t, grid_);
+  c[0] = shear_.cross_face(h.pos, h.vel, side, t, cells_.grid());
   counters_.work_by_shear += 0.5 * mass_of(i) * (norm2(h.vel) - ke);
 }
 
@@ -1527,20 +1328,8 @@ void EventEngine<D, Queue>::validate() {
     throw std::logic_error(os.str());
   };
   auto name = [&](std::uint32_t i) { return std::to_string(id_[i]); };
-  // Cell membership and the cell lists themselves.
-  std::vector<std::uint32_t> listed(n, 0);
-  for (std::uint32_t c = 0; c < grid_.cell_count(); ++c) {
-    std::uint32_t steps = 0;
-    for (std::uint32_t p = grid_.first(c); p != grid_.end(); p = grid_.next(p)) {
-      if (p >= n || ++steps > n) fail("cell " + std::to_string(c) + " has a broken list");
-      if (grid_.index(hot_[p].cell) != c)
-        fail("particle " + name(p) + " listed in a cell it is not in");
-      ++listed[p];
-    }
-  }
+  cells_.validate(hot_.data(), n, fail, name);  // the cell lists
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (listed[i] != 1)
-      fail("particle " + name(i) + " listed " + std::to_string(listed[i]) + " times");
     const HotRecord<D>& h = hot_[i];
     const Vec<D> x = position_of(i, t);
     for (int f = 0; f < 2 * D; ++f) {
@@ -1553,12 +1342,13 @@ void EventEngine<D, Queue>::validate() {
                              (velocity_of(i, t)[f / 2] - face_walls_.wall(f).velocity[f / 2]);
       const bool soft_ok =
           soft_ && gap > 0.75 * radius_of(i) &&
-          (frozen_with_[i] == wall_partner(f) || leaving >= 0.0 || queue_.time_of(i) <= t);
+          (soft_state_.partner(i) == wall_partner(f) || leaving >= 0.0 || queue_.time_of(i) <= t);
       if (!soft_ok) fail("particle " + name(i) + " overlaps a wall");
     }
     for (int a = 0; a < D; ++a) {
       const double tol = 1e-9 * box_[a];
-      if (x[a] < grid_.lower_bound(h.cell, a) - tol || x[a] > grid_.upper_bound(h.cell, a) + tol)
+      if (x[a] < cells_.grid().lower_bound(h.cell, a) - tol ||
+          x[a] > cells_.grid().upper_bound(h.cell, a) + tol)
         fail("particle " + name(i) + " outside its cell");
     }
     const Code code = pending_[i].code;
@@ -1728,8 +1518,8 @@ void EventEngine<D, Queue>::validate() {
         t + pair_contact_time_accelerated<D>(r.data(), g.data(), accel.data(), sigma);
     double bound = std::min(queue_.time_of(i), queue_.time_of(j));
     // Under shear the next image shift predicts the particles next to the y faces again.
-    if (sheared_ &&
-        (shear_.next_to_face(hot_[i].cell, grid_) || shear_.next_to_face(hot_[j].cell, grid_)))
+    if (sheared_ && (shear_.next_to_face(hot_[i].cell, cells_.grid()) ||
+                     shear_.next_to_face(hot_[j].cell, cells_.grid())))
       bound = std::min(bound, shear_.next_shift_time());
     // A straight-line pair that would only graze (its overlap at closest approach is at the
     // round-off level, as in the near-tangential contacts of a collapsing cluster) may be
@@ -1769,18 +1559,18 @@ void EventEngine<D, Queue>::validate() {
       const Vec<D> raw = xi - position_of(j, t);
       // The image the engine tests (neighbouring cells).
       std::array<int, D> d;
-      if (grid_.neighbour_offset(ci, hot_[j].cell, d)) {
+      if (cells_.grid().neighbour_offset(ci, hot_[j].cell, d)) {
         Vec<D> r = raw;
         for (int a = 0; a < D; ++a) {
-          const int c = grid_.coordinate(ci, a) + d[a];
-          if (grid_.periodic(a) && c < 0) r[a] += box_[a];
-          if (grid_.periodic(a) && c >= grid_.cells_along(a)) r[a] -= box_[a];
+          const int c = cells_.grid().coordinate(ci, a) + d[a];
+          if (cells_.grid().periodic(a) && c < 0) r[a] += box_[a];
+          if (cells_.grid().periodic(a) && c >= cells_.grid().cells_along(a)) r[a] -= box_[a];
         }
         check_covered(i, j, r, "neighbour-cell image");
       }
       Vec<D> r = raw;
       for (int a = 0; a < D; ++a)
-        if (grid_.periodic(a)) r[a] = minimum_image(r[a], box_[a]);
+        if (cells_.grid().periodic(a)) r[a] = minimum_image(r[a], box_[a]);
       if (norm2(r) < sigma * sigma * (1.0 - 1e-9)) {
         // Soft spheres overlap while frozen in a contact and after its release, receding; an
         // approaching overlap must collide now (check_covered).
@@ -1801,7 +1591,7 @@ template <int D, class Queue>
 Vec<D> EventEngine<D, Queue>::separation(std::uint32_t i, std::uint32_t j, double t) const {
   Vec<D> r = position_of(i, t) - position_of(j, t);
   for (int a = 0; a < D; ++a)
-    if (grid_.periodic(a)) r[a] = minimum_image(r[a], box_[a]);
+    if (cells_.grid().periodic(a)) r[a] = minimum_image(r[a], box_[a]);
   return r;
 }
 
@@ -1859,8 +1649,8 @@ void EventEngine<D, Queue>::init_zones(const ParticleSystem<D>& s, StartMode mod
   }
   const Vec<D> no_shift{};
   for (std::uint32_t i = 0; i < n; ++i) {
-    gather(hot_[i].cell, lists_[0]);
-    const CandidateList& list = lists_[0];
+    gather(hot_[i].cell, cells_.list(0));
+    const CandidateList& list = cells_.list(0);
     const Vec<D> xi = position_of(i, time_);
     for (std::uint32_t k = 0; k < list.count; ++k) {
       const std::uint32_t j = list.ids[k];

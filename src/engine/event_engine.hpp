@@ -43,8 +43,12 @@
 #include "core/state_blocks.hpp"
 #include "dynamics/collision_time.hpp"
 #include "engine/candidate_scan.hpp"
+#include "engine/cell_neighbourhood.hpp"
 #include "engine/event_code.hpp"
+#include "engine/hot_record.hpp"
 #include "engine/pair_steps.hpp"
+#include "engine/resting_particles.hpp"
+#include "engine/soft_contact_state.hpp"
 #include "scheduler/cell_grid.hpp"
 
 namespace kairos {
@@ -65,24 +69,6 @@ enum class EventKind {
 // How an engine starts: predict every event from the state, or resume the scheduler state the
 // ParticleSystem carries (from export_state() or a restart file) to continue bit-identically.
 enum class StartMode { kPredict, kResume };
-
-// What a pair test reads of a particle, in one cache line (3D).
-template <int D>
-struct alignas(D == 3 ? 64 : 16) HotRecord {
-  Vec<D> pos;                // position at local time `time`
-  Vec<D> vel;                // velocity
-  double time;               // local time of `pos`
-  std::uint32_t collisions;  // collision counter: invalidates partners' predictions
-  CellCode cell;             // the cell the particle is in
-};
-static_assert(sizeof(HotRecord<3>) == 64, "3D hot record must fill one cache line");
-
-// Radius, mass and species shared by many particles.
-struct Shape {
-  double radius;
-  double mass;
-  std::uint32_t species;
-};
 
 // How the cell lists of a neighbourhood are walked: kVector gathers sixteen list heads at a time
 // with AVX-512 (fast on Intel's cores, slow on AMD's Zen 4), kScalar follows them one by one,
@@ -173,8 +159,8 @@ class EventEngine {
   // potential + dissipated energy stays constant through a contact).
   double potential_energy() const {
     if (stepped_) return steps_.energy();
-    return deferred_.empty() ? counters_.soft_contact_energy
-                             : counters_.soft_contact_energy + deferred_contact_energy();
+    return !soft_state_.defers() ? counters_.soft_contact_energy
+                                 : counters_.soft_contact_energy + deferred_contact_energy();
   }
   bool soft() const { return soft_; }
   // How many particles sit in a frozen soft contact now.
@@ -183,7 +169,7 @@ class EventEngine {
   // Pairs that crossed the outermost step of their potential inwards since this engine was
   // built (not part of the state): the contacts of a stepped soft potential (spring_dashpot).
   std::uint64_t step_captures() const { return step_captures_; }
-  std::uint32_t sleeping() const { return sleeping_; }
+  std::uint32_t sleeping() const { return resting_.count(); }
   // Cell crossings since this engine was built (not part of the state) that scanned only the
   // cells new to the particle's neighbourhood (EngineOptions::incremental_crossings).
   std::uint64_t incremental_crossing_scans() const { return incremental_scans_; }
@@ -220,42 +206,24 @@ class EventEngine {
 
   double bytes_per_particle() const;
   const char* queue_name() const { return Queue::name(); }
-  const CellGrid<D>& grid() const { return grid_; }
+  const CellGrid<D>& grid() const { return cells_.grid(); }
 
  private:
   using Code = EventCode<D>;
   using PendingEvent = kairos::PendingEvent<D>;
-  // Scratch of a prediction: candidate partners and the periodic shift of each one's cell. Two,
-  // so that both partners of a collision gather (and prefetch) before either is tested.
-  // Under shear, the row of cells beyond a y face is searched 4 cells wide (its images slide),
-  // and images there also move at +-shear_rate L_y: `sheared` lists carry velocity shifts.
-  static constexpr int kMaxShifts = CellGrid<D>::kNeighbourCells * 4 / 3 + 1;
-  struct CandidateList {
-    std::vector<std::uint32_t> ids;
-    std::vector<std::uint32_t> shift;  // per candidate, into shifts; read only if n_shifts > 1
-    // Scratch of the candidate loops: which candidates sit in deferred soft contacts.
-    mutable std::vector<std::uint32_t> delayed;
-    Vec<D> shifts[kMaxShifts] = {};
-    Vec<D> velocity_shifts[kMaxShifts] = {};  // read only if sheared
-    std::uint32_t count = 0, n_shifts = 1;
-    bool sheared = false;
-  };
+  using CandidateList = kairos::CandidateList<D>;
+  using Cells = CellNeighbourhood<D>;
   struct Crossing {
     double time;  // absolute
     int axis;     // -1: never
     int sign;     // +1 up, -1 down
   };
 
-  // A soft contact's partner (frozen_with_): a particle, a wall (its event code's bits) or
+  // A soft contact's partner (SoftContactState): a particle, a wall (its event code's bits) or
   // kNoPartner.
   static constexpr std::uint32_t kFirstCode = Code::kFirstCode;
   static bool is_particle(std::uint32_t partner) { return partner < kFirstCode; }
   static std::uint32_t wall_partner(int face) { return Code::wall(face).bits(); }
-  static constexpr auto all_neighbours_ = [] {
-    std::array<std::uint8_t, CellGrid<D>::kNeighbourCells> all{};
-    for (int n = 0; n < CellGrid<D>::kNeighbourCells; ++n) all[n] = static_cast<std::uint8_t>(n);
-    return all;
-  }();
   // Cells per particle allowed when some axis has walls or open faces (see setup_environment).
   static constexpr double kBoundedCellsPerParticle = 8.0;
 
@@ -272,7 +240,7 @@ class EventEngine {
   // Walls moving towards each other left no room for the particles (FaceWalls::squeeze_time).
   [[noreturn]] void throw_squeezed(double t) const;
   // Sleeping particles (gravity with walls): see Environment::sleep_speed.
-  bool is_asleep(std::uint32_t i) const { return !asleep_.empty() && asleep_[i] != 0; }
+  bool is_asleep(std::uint32_t i) const { return resting_.asleep(i); }
   // Where particle i is and how it moves at time t (not before its local time, unless it sits
   // in a deferred soft contact: then the frozen motion until the release).
   Vec<D> position_of(std::uint32_t i, double t) const {
@@ -295,11 +263,6 @@ class EventEngine {
                               double t, bool again);
   double spin_energy(std::uint32_t i) const;
   bool wedged(std::uint32_t i, double t) const;
-  // Whether a contact of normal n (unit, from the support to the particle) holds the particle
-  // up against gravity: n within 60 degrees of straight up. Steeper contacts are side contacts.
-  bool holds_up(const Vec<D>& n) const {
-    return dot(env_.gravity, n) < -0.5 * std::sqrt(norm2(env_.gravity));
-  }
   bool resting_on_support(std::uint32_t i, double t);
   void collide_with_sleeper(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2,
                             bool again);
@@ -319,7 +282,6 @@ class EventEngine {
   double conclude_prediction(std::uint32_t i, double t, const Crossing& crossing,
                              std::uint32_t partner, double best);
   double predict_asleep(const CandidateList& list, std::uint32_t i, double t);
-  bool sleeper_among(const CandidateList& list) const;
   // Incremental crossings: after a crossing, only the new layer of cells is scanned and the
   // result is merged with the contact the last prediction kept beyond the crossing (see
   // cross()).
@@ -334,22 +296,9 @@ class EventEngine {
   // the contact kept as the one beyond it.
   double conclude_unbounded(std::uint32_t i, double t, const Crossing& crossing,
                             std::uint32_t partner, double soonest);
+  // The candidates of the 3^D cells around `cell` (cells_.gather, or through the sliding
+  // images next to a sheared face).
   void gather(CellCode cell, CandidateList& list);
-  void gather_cells(CellCode cell, const std::uint8_t* which, int count, CandidateList& list);
-  void gather_vector(CellCode cell, const std::uint8_t* which, int count, CandidateList& list);
-  template <bool kTagged>
-  void walk_lists(const std::uint32_t* cells, const std::uint32_t* tags, int count,
-                  CandidateList& list);
-  struct Links {
-    const std::uint32_t* next;
-    std::uint32_t end;
-    const HotRecord<D>* hot;
-  };
-  void append_members(std::uint32_t p, const Links& links, CandidateList& list, std::uint32_t& n,
-                      std::uint32_t*& cand, std::uint32_t& cap);
-  static std::uint32_t* grow(CandidateList& list);
-  // Free candidate slots kept before each list is appended (its unconditional writes).
-  static constexpr std::uint32_t kCandidateSlack = 4;
   std::uint32_t test_candidates(const CandidateList& list, std::uint32_t i, double t,
                                 const Vec<D>& xi, double& best) const;
   CandidateScan<D> scan_of(const CandidateList& list, std::uint32_t i,
@@ -378,7 +327,7 @@ class EventEngine {
   void cross_shear_face(std::uint32_t i, int side, double t, std::array<int, D>& c);
   std::array<bool, D> periodic_axes() const {
     std::array<bool, D> p;
-    for (int a = 0; a < D; ++a) p[a] = grid_.periodic(a);
+    for (int a = 0; a < D; ++a) p[a] = cells_.grid().periodic(a);
     return p;
   }
   void cross(std::uint32_t i, double t);
@@ -394,11 +343,11 @@ class EventEngine {
   void release_event(std::uint32_t i, double t);
   // Deferred releases: the pair (or particle and wall) already moves as after the contact in its
   // record, whose local time is the release time; until then it is frozen (frozen_velocity_of).
-  // Only frozen_with_ and deferred_ are written for it (release_time_ and release_velocity_
+  // Only its partner and deferred flag are written for it (release times and velocities
   // belong to frozen contacts with release events).
   // Only such a record has a local time after the present.
   bool in_deferred_contact(std::uint32_t i, double t) const {
-    return !deferred_.empty() && t < hot_[i].time;
+    return soft_state_.defers() && t < hot_[i].time;
   }
   // A pair contact frozen at `velocity` until `until` (see try_place). With `predict` (a contact
   // that may be deferred), try_place also finds each particle's soonest event after the release
@@ -426,44 +375,21 @@ class EventEngine {
   std::uint32_t scan_deferred(const CandidateList& list, std::uint32_t count, std::uint32_t i,
                               double t, const Vec<D>& xi, const Vec<D>& vi, double from,
                               double& best) const;
-  // A deferred contact keeps its flags after its release (nothing needs to happen then) until
-  // the particle's next contact overwrites them: readers of frozen_with_ take a particle with
-  // deferred_ set and a record time not after the present as in no contact.
-  void forget_contact(std::uint32_t k) {
-    deferred_[k] = 0;
-    frozen_with_[k] = EventSlot::kNoPartner;
-  }
-  // Particle k frozen with `partner` (a particle or a wall code), not (yet) deferred.
-  void begin_contact(std::uint32_t k, std::uint32_t partner) {
-    frozen_with_[k] = partner;
-    if (!deferred_.empty()) deferred_[k] = 0;
-  }
   // The centre-of-mass velocity of a deferred pair (its frozen motion), from the records after
   // the release: the same bits for both particles (summed in index order).
   Vec<D> frozen_velocity_of(std::uint32_t k) const {
-    const std::uint32_t p = frozen_with_[k];
+    const std::uint32_t p = soft_state_.partner(k);
     const std::uint32_t a = std::min(k, p), b = std::max(k, p);
     const double ma = mass_of(a), mb = mass_of(b);
     return (1.0 / (ma + mb)) * (ma * hot_[a].vel + mb * hot_[b].vel);
   }
   double deferred_contact_energy() const;
-  // Particles frozen until a release event, one bit each: every prediction asks, and the bits
-  // stay in the first-level cache where the per-particle arrays would not.
-  bool awaits_release(std::uint32_t i) const {
-    return ((awaiting_release_[i >> 6] >> (i & 63u)) & 1u) != 0;
-  }
-  void set_awaits_release(std::uint32_t i, bool on) {
-    const std::uint64_t bit = std::uint64_t{1} << (i & 63u);
-    awaiting_release_[i >> 6] =
-        on ? awaiting_release_[i >> 6] | bit : awaiting_release_[i >> 6] & ~bit;
-  }
-  void rebuild_awaiting_release();
   // The map from the table, or integrated directly outside it (counted).
   CollisionMap soft_map(const SoftMapTable* table, const CollisionUnits& units);
   // Places i at xi (and j at xj, unless j is kNoPartner) at time t unless that overlaps a third
   // particle or a wall (other than face skip_face; exception A): then nothing changes and the
-  // result is false. Placed, the neighbourhoods of i and j are left gathered in lists_[0] and
-  // (unless `shared`, one cell) lists_[1].
+  // result is false. Placed, the neighbourhoods of i and j are left gathered in cells_.list(0) and
+  // (unless `shared`, one cell) cells_.list(1).
   // With a window, also sets window->met if a third particle meets the pair, frozen at
   // window->velocity, before window->until (and predicts, see FrozenWindow).
   bool try_place(std::uint32_t i, const Vec<D>& xi, std::uint32_t j, const Vec<D>& xj, double t,
@@ -471,8 +397,8 @@ class EventEngine {
   // Moves particle i into the cell of its (changed) position.
   void relocate(std::uint32_t i);
   bool frozen_pair(std::uint32_t i, std::uint32_t j) const {
-    return soft_ && frozen_with_[i] == j && frozen_with_[j] == i &&
-           (deferred_.empty() || deferred_[i] == 0 || in_deferred_contact(i, time_));
+    return soft_ && soft_state_.partner(i) == j && soft_state_.partner(j) == i &&
+           (!soft_state_.deferred(i) || in_deferred_contact(i, time_));
   }
   void renumber(bool queue_filled);
   ParticleSystem<D> export_globals(bool with_zones) const;
@@ -486,7 +412,6 @@ class EventEngine {
   void size_particle_arrays(ParticleSystem<D>& out, std::size_t n) const;
   void export_particle(std::uint32_t k, std::uint32_t c, ParticleSystem<D>& out,
                        unsigned fields) const;
-  void insert_all_into_grid();
   void check_restored_cell(std::uint32_t i) const;
   std::uint64_t next_renumber_after(std::uint64_t collisions) const;
 
@@ -502,7 +427,7 @@ class EventEngine {
   bool incremental_crossings_ = false;
   bool three_cell_axis_ = false;     // some periodic axis is 3 cells wide: kept contacts unused
   HugeVector<std::uint16_t> shape_;  // per particle; empty when there is a single shape
-  std::vector<Shape> shapes_;
+  std::vector<ParticleKind> shapes_;
   bool uniform_radius_ = true;
   std::vector<double> shape_radius_;  // radius per shape, for the candidate loops
   bool vector_scan_ = false;
@@ -516,10 +441,9 @@ class EventEngine {
   bool granular_contacts_ = false;       // some contact law is not elastic and smooth
   HugeVector<AngularVelocity<D>> spin_;  // rough particles only
   HugeVector<double> last_collision_;    // TC model only
-  HugeVector<std::uint8_t> asleep_;      // gravity with walls only
-  std::uint32_t sleeping_ = 0;           // how many are asleep
-  double sleep_speed_ = 0.0;
-  CellGrid<D> grid_;
+  using Resting = RestingParticles<D>;
+  Resting resting_;  // who sleeps (gravity with walls only; engine/resting_particles.hpp)
+  Cells cells_;      // the cell grid and the neighbourhood walk (engine/cell_neighbourhood.hpp)
   Queue queue_;
   std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions
   bool sheared_ = false;                                   // shear_.on()
@@ -535,19 +459,10 @@ class EventEngine {
   std::vector<Bond> bonds_;  // the caller's numbering, kept for export
   std::vector<std::string> bond_types_;
 
-  // Soft spheres: per particle, the partner of its frozen contact (wall_partner(face) for a wall,
-  // kNoPartner: none), when it is released and with what velocity. Empty unless soft_.
+  // Soft spheres: the contacts in progress (engine/soft_contact_state.hpp; empty unless soft_).
   bool soft_ = false;
-  HugeVector<std::uint32_t> frozen_with_;
-  HugeVector<double> release_time_;
-  HugeVector<Vec<D>> release_velocity_;
-  // Deferred releases: per particle 1 while its contact is deferred (its record holds the motion
-  // after the release) and the frozen velocity until then. The energy a deferred contact holds
-  // is not in counters_.soft_contact_energy (see potential_energy()).
-  HugeVector<std::uint8_t> deferred_;
-  std::vector<std::uint64_t> awaiting_release_;  // see awaits_release()
+  SoftContactState<D> soft_state_;
 
-  CandidateList lists_[2];
   FaceWalls<D> face_walls_;  // the walls on the box's faces (boundaries/face_walls.hpp)
   LeesEdwards<D> shear_;     // Lees-Edwards images (boundaries/lees_edwards.hpp)
   Environment<D> env_;       // last: the hot members above share fewer cache lines

@@ -44,7 +44,7 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
     return;
   }
   std::uint32_t species = 1;
-  for (const Shape& sh : shapes_) species = std::max(species, sh.species + 1);
+  for (const ParticleKind& sh : shapes_) species = std::max(species, sh.species + 1);
   const std::size_t pairs = static_cast<std::size_t>(env_.species) * env_.species;
   if (env_.species < species || env_.soft.size() != pairs) {
     throw InputError("the soft contact laws cover " + std::to_string(env_.species) + " species (" +
@@ -79,13 +79,7 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
           "use run.integrator = \"dem\")");
   }
   const std::size_t n = s.size();
-  frozen_with_.assign(n, kNone);
-  awaiting_release_.assign((n + 63) / 64, 0);
-  release_time_.assign(n, kNever);
-  release_velocity_.assign(n, Vec<D>{});
-  if (options_.defer_soft_releases) {
-    deferred_.assign(n, 0);
-  }
+  soft_state_ = SoftContactState<D>(n, options_.defer_soft_releases);
 }
 
 // The contacts in progress of the state, in the engine's numbering (id_ is set, the hot
@@ -105,62 +99,50 @@ void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s, StartMode
                        " is inconsistent (partner, face or release time)");
     }
     const std::uint32_t i = internal[c.i];
-    if (frozen_with_[i] != kNone)
+    if (soft_state_.partner(i) != kNone)
       throw InputError("particle " + std::to_string(c.i) + " is in two soft contacts");
     if (wall) {
       if (!face_walls_.is_wall(static_cast<int>(c.face)))
         throw InputError("particle " + std::to_string(c.i) +
                          " is in contact with a face that is "
                          "not a wall");
-      frozen_with_[i] = wall_partner(static_cast<int>(c.face));
+      soft_state_.restore(i, wall_partner(static_cast<int>(c.face)), c.release_time, c.velocity_i);
     } else {
       const std::uint32_t j = internal[c.j];
-      if (frozen_with_[j] != kNone)
+      if (soft_state_.partner(j) != kNone)
         throw InputError("particle " + std::to_string(c.j) + " is in two soft contacts");
-      frozen_with_[i] = j;
-      frozen_with_[j] = i;
-      release_time_[j] = c.release_time;
-      release_velocity_[j] = c.velocity_j;
+      soft_state_.restore(i, j, c.release_time, c.velocity_i);
+      soft_state_.restore(j, i, c.release_time, c.velocity_j);
     }
-    release_time_[i] = c.release_time;
-    release_velocity_[i] = c.velocity_i;
-    if (c.deferred && !wall && mode == StartMode::kResume && !deferred_.empty() &&
+    if (c.deferred && !wall && mode == StartMode::kResume && soft_state_.defers() &&
         c.release_time > s.time) {
       const std::uint32_t j = internal[c.j];
       const std::pair<std::uint32_t, Vec<D>> both[2] = {{i, c.release_position_i},
                                                         {j, c.release_position_j}};
       for (const auto& [k, x] : both) {
         hot_[k].pos = x;
-        hot_[k].vel = release_velocity_[k];
+        hot_[k].vel = soft_state_.release_velocity(k);
         hot_[k].time = c.release_time;
-        deferred_[k] = 1;
+        soft_state_.set_deferred(k, true);
       }
     } else if (c.deferred) {  // continues frozen: the counter now holds what it will give back
       const std::uint32_t j = wall ? kNone : internal[c.j];
       for (const std::uint32_t k : {i, j}) {
         if (k != kNone)
           counters_.soft_contact_energy +=
-              0.5 * mass_of(k) * (norm2(release_velocity_[k]) - norm2(hot_[k].vel));
+              0.5 * mass_of(k) * (norm2(soft_state_.release_velocity(k)) - norm2(hot_[k].vel));
       }
     }
   }
-  rebuild_awaiting_release();
-}
-
-template <int D, class Queue>
-void EventEngine<D, Queue>::rebuild_awaiting_release() {
-  std::fill(awaiting_release_.begin(), awaiting_release_.end(), 0);
-  for (std::uint32_t k = 0; k < frozen_with_.size(); ++k)
-    if (frozen_with_[k] != kNone && (deferred_.empty() || deferred_[k] == 0))
-      set_awaits_release(k, true);
+  soft_state_.rebuild_awaiting_release();
 }
 
 template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::frozen() const {
   std::uint32_t count = 0;
-  for (std::uint32_t k = 0; k < frozen_with_.size(); ++k) {
-    const bool stale = !deferred_.empty() && deferred_[k] != 0 && !in_deferred_contact(k, time_);
-    count += frozen_with_[k] != kNone && !stale ? 1u : 0u;
+  for (std::uint32_t k = 0; k < soft_state_.size(); ++k) {
+    const bool stale = soft_state_.deferred(k) && !in_deferred_contact(k, time_);
+    count += soft_state_.partner(k) != kNone && !stale ? 1u : 0u;
   }
   return count;
 }
@@ -178,12 +160,11 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::relocate(std::uint32_t i) {
   HotRecord<D>& h = hot_[i];
   for (int a = 0; a < D; ++a)
-    if (grid_.periodic(a)) h.pos[a] = wrap_into_box(h.pos[a], box_[a]);
-  const CellCode c = grid_.locate(h.pos);
+    if (cells_.grid().periodic(a)) h.pos[a] = wrap_into_box(h.pos[a], box_[a]);
+  const CellCode c = cells_.grid().locate(h.pos);
   if (c == h.cell) return;
-  grid_.erase(i, h.cell);
+  cells_.move(i, h.cell, c);
   h.cell = c;
-  grid_.insert(i, c);
 }
 
 // The placed particles are moved first and their neighbourhoods gathered from their new cells:
@@ -206,9 +187,9 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
     h.pos = to[k];
     relocate(both[k]);
   }
-  gather(hot_[i].cell, lists_[0]);
+  gather(hot_[i].cell, cells_.list(0));
   shared = count == 1 || hot_[j].cell == hot_[i].cell;
-  if (!shared) gather(hot_[j].cell, lists_[1]);
+  if (!shared) gather(hot_[j].cell, cells_.list(1));
   const double span = window != nullptr ? window->until - t : 0.0;
   const Vec<D> velocity = window != nullptr ? window->velocity : Vec<D>{};
   auto overlaps = [&](std::uint32_t p, const CandidateList& list, int slot) {
@@ -264,15 +245,15 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
     }
     return false;
   };
-  if (!overlaps(i, lists_[0], 0) && (count == 1 || !overlaps(j, lists_[shared ? 0 : 1], 1)))
+  if (!overlaps(i, cells_.list(0), 0) &&
+      (count == 1 || !overlaps(j, cells_.list(shared ? 0 : 1), 1)))
     return true;
   for (int k = 0; k < count; ++k) {  // put back, cells included
     HotRecord<D>& h = hot_[both[k]];
     h.pos = from[k];
     if (h.cell != cell[k]) {
-      grid_.erase(both[k], h.cell);
+      cells_.move(both[k], h.cell, cell[k]);
       h.cell = cell[k];
-      grid_.insert(both[k], h.cell);
     }
   }
   return false;
@@ -281,11 +262,11 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
 template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool early) {
   // Most particles are in no contact: the bit and the record (already read) say so, without a
-  // (cache-missing) look at frozen_with_. A deferred contact that is over keeps its flags.
+  // (cache-missing) look at its partner. A deferred contact that is over keeps its flags.
   const bool deferred = in_deferred_contact(i, t);
-  if (!awaits_release(i) && !deferred) [[likely]]
+  if (!soft_state_.awaits_release(i) && !deferred) [[likely]]
     return kNone;
-  const std::uint32_t p = frozen_with_[i];
+  const std::uint32_t p = soft_state_.partner(i);
   if (deferred) [[unlikely]] {
     // Early: from where the frozen pair is now, with the post-contact velocities.
     auto give_back = [&](std::uint32_t k) {
@@ -293,7 +274,7 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
       h.pos = h.pos - (h.time - t) * frozen_velocity_of(k);
       h.time = t;
       ++h.collisions;
-      forget_contact(k);
+      soft_state_.forget(k);
     };
     give_back(i);
     if (p < kFirstCode) give_back(p);
@@ -304,12 +285,10 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
     advance_to(k, t);
     HotRecord<D>& h = hot_[k];
     counters_.soft_contact_energy -=
-        0.5 * mass_of(k) * (norm2(release_velocity_[k]) - norm2(h.vel));
-    h.vel = release_velocity_[k];
+        0.5 * mass_of(k) * (norm2(soft_state_.release_velocity(k)) - norm2(h.vel));
+    h.vel = soft_state_.release_velocity(k);
     ++h.collisions;
-    frozen_with_[k] = kNone;
-    set_awaits_release(k, false);
-    release_time_[k] = kNever;
+    soft_state_.end_release(k);
   };
   give_back(i);
   if (p < kFirstCode) give_back(p);
@@ -322,7 +301,7 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
 template <int D, class Queue>
 double EventEngine<D, Queue>::deferred_contact_energy() const {
   double e = 0.0;
-  for (std::uint32_t k = 0; k < deferred_.size(); ++k) {
+  for (std::uint32_t k = 0; soft_state_.defers() && k < soft_state_.size(); ++k) {
     if (in_deferred_contact(k, time_))
       e += 0.5 * mass_of(k) * (norm2(hot_[k].vel) - norm2(frozen_velocity_of(k)));
   }
@@ -339,7 +318,8 @@ std::uint32_t EventEngine<D, Queue>::scan_deferred(const CandidateList& list, st
     const std::uint32_t k = list.delayed[n];
     const std::uint32_t q = list.ids[k];
     const HotRecord<D>& h = hot_[q];
-    if (q == i || (frozen_with_[i] == q && frozen_with_[q] == i)) continue;  // its own pair
+    if (q == i || (soft_state_.partner(i) == q && soft_state_.partner(q) == i))
+      continue;  // its own pair
     Vec<D> xq = h.pos - (h.time - t) * frozen_velocity_of(q);
     if (list.n_shifts > 1) xq = xq + list.shifts[list.shift[k]];
     const double ends[2] = {h.time, kNever};
@@ -369,7 +349,8 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
     start[k] = h.pos;
     for (int a = 0; a < D; ++a) {
       end[k][a] = h.pos[a] + window.velocity[a] * (until - t);  // as advance_to() would move it
-      if (!(grid_.lower_bound(h.cell, a) < end[k][a] && end[k][a] < grid_.upper_bound(h.cell, a)))
+      if (!(cells_.grid().lower_bound(h.cell, a) < end[k][a] &&
+            end[k][a] < cells_.grid().upper_bound(h.cell, a)))
         return false;
     }
     for (int f = 0; walls_ && f < 2 * D; ++f) {
@@ -384,7 +365,7 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
     h.pos = end[k];
     h.vel = window.after[k];
     h.time = until;
-    deferred_[both[k]] = 1;
+    soft_state_.set_deferred(both[k], true);
   }
   double when[2];
   for (int k = 0; k < 2; ++k)
@@ -402,7 +383,7 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
     h.pos = start[k];
     h.vel = window.velocity;
     h.time = t;
-    deferred_[both[k]] = 0;
+    soft_state_.set_deferred(both[k], false);
   }
   return false;
 }
@@ -432,7 +413,7 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
   Vec<D> r;
   for (int a = 0; a < D; ++a) {
     const double raw = hi.pos[a] - hj.pos[a];
-    r[a] = !bounded_ || grid_.periodic(a) ? minimum_image(raw, box_[a]) : raw;
+    r[a] = !bounded_ || cells_.grid().periodic(a) ? minimum_image(raw, box_[a]) : raw;
   }
   const Vec<D> g = hi.vel - hj.vel;
   const double r2 = norm2(r), rg = dot(r, g);
@@ -474,10 +455,10 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
     FrozenWindow window;
     window.velocity = V;
     window.until = t + map.eps_t * units.time_unit;
-    window.predict = !deferred_.empty();
+    window.predict = soft_state_.defers();
     window.after[0] = after_i;
     window.after[1] = after_j;
-    if (try_place(i, xi, j, xj, t, -1, shared, deferred_.empty() ? nullptr : &window)) {
+    if (try_place(i, xi, j, xj, t, -1, shared, soft_state_.defers() ? &window : nullptr)) {
       const double until = window.until;
       const Vec<D> impulse = mi * (after_i - hi.vel);
       // The impulse acts while the line of centres turns from r to rc: the mean lever arm.
@@ -488,24 +469,21 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
       counters_.dissipated_in_collisions += ke_before - ke_after;
       hi.vel = V;
       hj.vel = V;
-      begin_contact(i, j);
-      begin_contact(j, i);
+      soft_state_.begin(i, j);
+      soft_state_.begin(j, i);
       ++counters_.soft_contacts;
       ++counters_.collisions;
       ++hi.collisions;
       ++hj.collisions;
-      if (!deferred_.empty() && !window.met && try_defer(i, j, t, window)) {
+      if (soft_state_.defers() && !window.met && try_defer(i, j, t, window)) {
         predict_released();  // deferred: what the contact holds is in its records
         return;
       }
-      release_time_[i] = release_time_[j] = until;
-      release_velocity_[i] = after_i;
-      release_velocity_[j] = after_j;
-      set_awaits_release(i, true);
-      set_awaits_release(j, true);
+      soft_state_.schedule_release(i, until, after_i);
+      soft_state_.schedule_release(j, until, after_j);
       counters_.soft_contact_energy += ke_after - 0.5 * total * norm2(V);
-      queue_.update(i, predict_from(lists_[0], i, t));
-      queue_.update(j, predict_from(lists_[shared ? 0 : 1], j, t));
+      queue_.update(i, predict_from(cells_.list(0), i, t));
+      queue_.update(j, predict_from(cells_.list(shared ? 0 : 1), j, t));
       predict_released();
       return;
     } else {
@@ -575,14 +553,12 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
       frozen_velocity[a] = wall_speed;
       counters_.soft_contact_energy += 0.5 * m * (norm2(after) - norm2(frozen_velocity));
       h.vel = frozen_velocity;
-      begin_contact(i, wall_partner(face));
-      set_awaits_release(i, true);
-      release_time_[i] = t + map.eps_t * units.time_unit;
-      release_velocity_[i] = after;
+      soft_state_.begin(i, wall_partner(face));
+      soft_state_.schedule_release(i, t + map.eps_t * units.time_unit, after);
       ++counters_.soft_contacts;
       ++counters_.wall_collisions;
       ++h.collisions;
-      queue_.update(i, predict_from(lists_[0], i, t));
+      queue_.update(i, predict_from(cells_.list(0), i, t));
       return;
     } else {
       ++counters_.soft_overlap_fallbacks;
@@ -598,7 +574,6 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                         \
   template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&, StartMode);          \
   template std::uint32_t EventEngine<D, Q>::frozen() const;                                      \
-  template void EventEngine<D, Q>::rebuild_awaiting_release();                                   \
   template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&); \
   template void EventEngine<D, Q>::relocate(std::uint32_t);                                      \
   template bool EventEngine<D, Q>::try_place(std::uint32_t, const Vec<D>&, std::uint32_t,        \

@@ -84,23 +84,23 @@ ParticleSystem<D> EventEngine<D, Queue>::export_globals(bool with_zones) const {
   out.counters = counters_;
   out.species_names = species_names_;
   out.gravity = env_.gravity;
-  for (int a = 0; a < D; ++a) out.periodic[a] = grid_.periodic(a);
+  for (int a = 0; a < D; ++a) out.periodic[a] = cells_.grid().periodic(a);
   out.bonds = bonds_;
   out.bond_types = bond_types_;
   if (stepped_ && with_zones) out.zones = steps_.export_zones(id_.data());
   for (std::uint32_t k = 0; soft_ && k < size(); ++k) {
-    const std::uint32_t p = frozen_with_[k];
+    const std::uint32_t p = soft_state_.partner(k);
     if (p == kNoPartner || (p < kFirstCode && p < k)) continue;  // each pair once
-    if (!deferred_.empty() && deferred_[k] != 0 && !in_deferred_contact(k, time_)) continue;
+    if (soft_state_.deferred(k) && !in_deferred_contact(k, time_)) continue;
     FrozenContact<D> c;
     c.i = id_[k];
-    c.deferred = !deferred_.empty() && deferred_[k] != 0;
-    c.release_time = c.deferred ? hot_[k].time : release_time_[k];
-    c.velocity_i = c.deferred ? hot_[k].vel : release_velocity_[k];
+    c.deferred = soft_state_.deferred(k);
+    c.release_time = c.deferred ? hot_[k].time : soft_state_.release_time(k);
+    c.velocity_i = c.deferred ? hot_[k].vel : soft_state_.release_velocity(k);
     if (c.deferred) c.release_position_i = hot_[k].pos;
     if (p < kFirstCode) {
       c.j = id_[p];
-      c.velocity_j = c.deferred ? hot_[p].vel : release_velocity_[p];
+      c.velocity_j = c.deferred ? hot_[p].vel : soft_state_.release_velocity(p);
       if (c.deferred) c.release_position_j = hot_[p].pos;
     } else {
       c.face = Code::from_bits(p).wall_face();
@@ -119,7 +119,7 @@ void EventEngine<D, Queue>::size_particle_arrays(ParticleSystem<D>& out, std::si
   out.collision_count.resize(n);
   out.events.resize(n);
   out.cell.resize(n);
-  out.asleep.assign(sleeping_ > 0 ? n : 0, 0);
+  out.asleep.assign(resting_.count() > 0 ? n : 0, 0);
   out.angular_velocity.resize(spin_.empty() ? 0 : n);
   out.last_collision_time.resize(last_collision_.empty() ? 0 : n);
 }
@@ -129,13 +129,13 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
                                             ParticleSystem<D>& out, unsigned fields) const {
   using Blocks = StateBlocks<D>;
-  const Shape& sh = shapes_[shape_.empty() ? 0 : shape_[k]];
+  const ParticleKind& sh = shapes_[shape_.empty() ? 0 : shape_[k]];
   if ((fields & Blocks::kKinematics) != 0) {
     const HotRecord<D>& h = hot_[k];
     out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};
     if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
       out.kinematics[c] = {position_of(k, time_), frozen_velocity_of(k), time_, sh.radius};
-    if (sleeping_ > 0) out.asleep[c] = asleep_[k];
+    if (resting_.count() > 0) out.asleep[c] = resting_.flag(k);
   }
   if ((fields & Blocks::kIdentity) != 0) {
     out.mass[c] = sh.mass;
@@ -161,7 +161,7 @@ std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
   for (std::uint32_t i = 0; i < size(); ++i) {
     Vec<D> x = position_of(i, time_);
     for (int a = 0; a < D; ++a)
-      if (grid_.periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
+      if (cells_.grid().periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
     out[id_[i]] = x;
   }
   return out;
@@ -182,7 +182,7 @@ void EventEngine<D, Queue>::for_each_block(const BlockVisitor& f, bool with_posi
       if (with_positions) {
         x[j] = position_of(k, time_);  // as current_positions()
         for (int a = 0; a < D; ++a)
-          if (grid_.periodic(a)) x[j][a] = wrap_into_box(x[j][a], box_[a]);
+          if (cells_.grid().periodic(a)) x[j][a] = wrap_into_box(x[j][a], box_[a]);
       }
       v[j] = velocity_of(k, time_);
       m[j] = mass_of(k);

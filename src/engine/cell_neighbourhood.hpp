@@ -1,0 +1,290 @@
+// The neighbourhood walk of the event engine: the cell grid (scheduler/cell_grid.hpp) with the
+// particles' cell lists, and the gathering of a particle's candidate partners from the 3^D cells
+// around it into a flat list (with the periodic shift of each one's cell), their records
+// prefetched so that the cache misses of a whole prediction overlap.
+//
+// It owns the grid and two candidate lists (so that both partners of a collision gather before
+// either is tested); the particles' records stay the engine's and are passed in, for prefetching
+// only. The cell each particle is in is kept in its record (HotRecord::cell), so restart files
+// store it with the record; validate() checks the lists against the records. Hot code: every
+// function is defined here, inline, for the engine's translation unit.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/vec.hpp"
+#include "engine/candidate_scan.hpp"
+#include "engine/hot_record.hpp"
+#include "scheduler/cell_grid.hpp"
+
+namespace kairos {
+
+// Scratch of a prediction: candidate partners and the periodic shift of each one's cell.
+// Under shear, the row of cells beyond a y face is searched 4 cells wide (its images slide),
+// and images there also move at +-shear_rate L_y: `sheared` lists carry velocity shifts.
+template <int D>
+struct CandidateList {
+  static constexpr int kMaxShifts = CellGrid<D>::kNeighbourCells * 4 / 3 + 1;
+  std::vector<std::uint32_t> ids;
+  std::vector<std::uint32_t> shift;  // per candidate, into shifts; read only if n_shifts > 1
+  // Scratch of the candidate loops: which candidates sit in deferred soft contacts.
+  mutable std::vector<std::uint32_t> delayed;
+  Vec<D> shifts[kMaxShifts] = {};
+  Vec<D> velocity_shifts[kMaxShifts] = {};  // read only if sheared
+  std::uint32_t count = 0, n_shifts = 1;
+  bool sheared = false;
+};
+
+template <int D>
+class CellNeighbourhood {
+ public:
+  // Free candidate slots kept before each list is appended (its unconditional writes).
+  static constexpr std::uint32_t kCandidateSlack = 4;
+  static constexpr auto kAllNeighbours = [] {
+    std::array<std::uint8_t, CellGrid<D>::kNeighbourCells> all{};
+    for (int n = 0; n < CellGrid<D>::kNeighbourCells; ++n) all[n] = static_cast<std::uint8_t>(n);
+    return all;
+  }();
+
+  CellNeighbourhood() = default;
+  // vector_gather: gather the lists' heads sixteen at a time with AVX-512 (gather_lists_avx512)
+  // instead of walking them one by one; the same candidates, in another order.
+  CellNeighbourhood(const CellGrid<D>& grid, bool vector_gather)
+      : grid_(grid), vector_gather_(vector_gather) {
+    for (CandidateList<D>& list : lists_) {
+      list.ids.resize(256);
+      list.shift.resize(256);
+      list.delayed.resize(256 + 8);
+    }
+  }
+
+  CellGrid<D>& grid() { return grid_; }
+  const CellGrid<D>& grid() const { return grid_; }
+  CandidateList<D>& list(int k) { return lists_[k]; }
+
+  // The members of the 3^D cells around `cell` as candidates. Cells away from the box faces
+  // (most) need no periodic shifts and take a loop over fixed index offsets.
+  void gather(CellCode cell, CandidateList<D>& list, const HotRecord<D>* hot) {
+    gather_cells(cell, kAllNeighbours.data(), CellGrid<D>::kNeighbourCells, list, hot);
+  }
+  // gather() for the cells numbered which[0 .. count) among the 3^D around `cell` (see
+  // CellGrid::neighbour's numbering), in that order.
+  void gather_cells(CellCode cell, const std::uint8_t* which, int count, CandidateList<D>& list,
+                    const HotRecord<D>* hot);
+  // Doubles a candidate list's storage (rare: a crowded neighbourhood); returns the new storage.
+  static std::uint32_t* grow(CandidateList<D>& list) {
+    list.ids.resize(2 * list.ids.size());
+    list.shift.resize(list.ids.size());
+    list.delayed.resize(list.ids.size() + 8);
+    return list.ids.data();
+  }
+
+  // Fills the lists from the records' cells; inserting from the back leaves every cell's list
+  // in increasing index order.
+  void insert_all(const HotRecord<D>* hot, std::uint32_t n) {
+    grid_.clear();
+    for (auto k = n; k-- > 0;) grid_.insert(k, hot[k].cell);
+  }
+  // Particle i moves from cell `from` to cell `to`.
+  void move(std::uint32_t i, CellCode from, CellCode to) {
+    grid_.erase(i, from);
+    grid_.insert(i, to);
+  }
+  // Every particle listed once, in the cell its record names; fail(message) otherwise. name(i)
+  // names particle i in messages.
+  template <class Fail, class Name>
+  void validate(const HotRecord<D>* hot, std::uint32_t n, Fail&& fail, Name&& name) const;
+
+ private:
+  struct Links {
+    const std::uint32_t* next;
+    std::uint32_t end;
+    const HotRecord<D>* hot;
+  };
+  void gather_vector(CellCode cell, const std::uint8_t* which, int count, CandidateList<D>& list,
+                     const HotRecord<D>* hot);
+  template <bool kTagged>
+  void walk_lists(const std::uint32_t* cells, const std::uint32_t* tags, int count,
+                  CandidateList<D>& list, const HotRecord<D>* hot);
+  void append_members(std::uint32_t p, const Links& links, CandidateList<D>& list, std::uint32_t& n,
+                      std::uint32_t*& cand, std::uint32_t& cap);
+
+  CellGrid<D> grid_;
+  CandidateList<D> lists_[2];
+  bool vector_gather_ = false;
+};
+
+// Appends the members of the list starting at p to cand[n...]: walk_lists' rest of a crowded
+// cell (from its third member on). The first two links are followed without a branch (an empty
+// slot is written but not counted); only a further member takes the loop. Records are
+// prefetched so that the cache misses of a whole prediction overlap.
+template <int D>
+[[gnu::always_inline]] inline void CellNeighbourhood<D>::append_members(
+    std::uint32_t p, const Links& links, CandidateList<D>& list, std::uint32_t& n,
+    std::uint32_t*& cand, std::uint32_t& cap) {
+  const std::uint32_t* next = links.next;
+  const std::uint32_t end = links.end;
+  const HotRecord<D>* hot = links.hot;
+  for (int unrolled = 0; unrolled < 2; ++unrolled) {
+    __builtin_prefetch(hot + p);
+    cand[n] = p;
+    n += p != end ? 1u : 0u;
+    p = next[p];
+  }
+  for (; p != end; p = next[p]) {
+    if (cap - n < kCandidateSlack) [[unlikely]] {
+      cand = grow(list);
+      cap = static_cast<std::uint32_t>(list.ids.size());
+    }
+    __builtin_prefetch(hot + p);
+    cand[n++] = p;
+  }
+}
+
+// gather() for the cells numbered which[0 .. count) among the 3^D around `cell` (see
+// CellGrid::neighbour's numbering), in that order.
+template <int D>
+inline void CellNeighbourhood<D>::gather_cells(CellCode cell, const std::uint8_t* which, int count,
+                                               CandidateList<D>& list, const HotRecord<D>* hot) {
+  if (vector_gather_) {
+    gather_vector(cell, which, count, list, hot);
+    return;
+  }
+  constexpr int kMost = CellGrid<D>::kNeighbourCells;
+  std::uint32_t cells[kMost], tags[kMost];
+  if (grid_.interior(cell)) {
+    const std::uint32_t centre = grid_.index(cell);
+    const std::int32_t* delta = grid_.neighbour_deltas();
+    for (int c = 0; c < count; ++c) cells[c] = centre + static_cast<std::uint32_t>(delta[which[c]]);
+    list.n_shifts = 1;
+    walk_lists<false>(cells, tags, count, list, hot);
+  } else {
+    std::uint32_t n_shifts = 1;  // shifts[0] is the zero shift
+    for (int c = 0; c < count; ++c) {
+      const typename CellGrid<D>::Neighbour nb = grid_.neighbour(cell, which[c]);
+      cells[c] = nb.cell;
+      tags[c] = nb.shifted ? n_shifts : 0;
+      if (nb.shifted) list.shifts[n_shifts++] = nb.shift;
+    }
+    list.n_shifts = n_shifts;
+    walk_lists<true>(cells, tags, count, list, hot);
+  }
+}
+
+// The members of the lists of cells[0 .. count), in list order, as candidates (with their
+// cells' shift numbers tags[] when kTagged). The first three links of every list are loaded in
+// three waves of independent loads (heads, second members, third links), not in a chain per
+// cell, so that each wave's cache misses overlap; only crowded cells follow links further.
+template <int D>
+template <bool kTagged>
+void CellNeighbourhood<D>::walk_lists(const std::uint32_t* cells, const std::uint32_t* tags,
+                                      int count, CandidateList<D>& list, const HotRecord<D>* hot) {
+  const std::uint32_t* heads = grid_.heads();
+  // Read once: the stores into the candidate list could alias them for the compiler.
+  const Links links{grid_.links(), grid_.end(), hot};
+  const std::uint32_t* next = links.next;
+  const std::uint32_t end = links.end;
+  constexpr int kMost = CellGrid<D>::kNeighbourCells;
+  std::uint32_t first[kMost], second[kMost], third[kMost];
+  for (int c = 0; c < count; ++c) first[c] = heads[cells[c]];
+  for (int c = 0; c < count; ++c) second[c] = next[first[c]];  // next[end] is end
+  for (int c = 0; c < count; ++c) third[c] = next[second[c]];
+  // Two slots per cell are written unchecked (an empty one is overwritten).
+  const auto room = [&](int cells_left) {
+    return kCandidateSlack + 2 * static_cast<std::uint32_t>(cells_left);
+  };
+  std::uint32_t n = 0;
+  auto cap = static_cast<std::uint32_t>(list.ids.size());
+  std::uint32_t* cand = list.ids.data();
+  while (cap < room(count)) [[unlikely]] {
+      cand = grow(list);
+      cap = static_cast<std::uint32_t>(list.ids.size());
+    }
+  for (int c = 0; c < count; ++c) {
+    const std::uint32_t from = n;
+    __builtin_prefetch(links.hot + first[c]);
+    cand[n] = first[c];
+    n += first[c] != end ? 1u : 0u;
+    __builtin_prefetch(links.hot + second[c]);
+    cand[n] = second[c];
+    n += second[c] != end ? 1u : 0u;
+    if (third[c] != end) [[unlikely]] {  // a crowded cell: the rest by links
+      append_members(third[c], links, list, n, cand, cap);
+      while (cap - n < room(count - c - 1)) {
+        cand = grow(list);
+        cap = static_cast<std::uint32_t>(list.ids.size());
+      }
+    }
+    if constexpr (kTagged) {
+      for (std::uint32_t k = from; k < n; ++k) list.shift[k] = tags[c];
+    }
+  }
+  list.count = n;
+}
+
+// gather_cells() with AVX-512: the cells' list heads and their successors are fetched and
+// compressed sixteen lists at a time; the rare third and later members follow by links.
+template <int D>
+inline void CellNeighbourhood<D>::gather_vector(CellCode cell, const std::uint8_t* which, int count,
+                                                CandidateList<D>& list, const HotRecord<D>* hot) {
+  constexpr auto kCells = static_cast<std::uint32_t>(CellGrid<D>::kNeighbourCells);
+  while (list.ids.size() < 2 * kCells + kCandidateSlack) grow(list);
+  std::uint32_t cells[kCells], tags[kCells];
+  const bool interior = grid_.interior(cell);
+  std::uint32_t n_shifts = 1;  // shifts[0] is the zero shift
+  if (interior) {
+    const std::uint32_t centre = grid_.index(cell);
+    const std::int32_t* delta = grid_.neighbour_deltas();
+    for (int c = 0; c < count; ++c) cells[c] = centre + static_cast<std::uint32_t>(delta[which[c]]);
+  } else {
+    for (int c = 0; c < count; ++c) {
+      const typename CellGrid<D>::Neighbour nb = grid_.neighbour(cell, which[c]);
+      cells[c] = nb.cell;
+      tags[c] = nb.shifted ? n_shifts : 0;
+      if (nb.shifted) list.shifts[n_shifts++] = nb.shift;
+    }
+  }
+  const Neighbourhood nb{
+      grid_.heads(), grid_.links(), grid_.end(), cells, interior ? nullptr : tags, count};
+  std::uint32_t third[kCells], third_tag[kCells];
+  std::uint32_t n_third = 0;
+  std::uint32_t n =
+      gather_lists_avx512(nb, list.ids.data(), list.shift.data(), third, third_tag, n_third);
+  for (std::uint32_t k = 0; k < n_third; ++k) {
+    for (std::uint32_t p = third[k]; p != grid_.end(); p = grid_.next(p)) {
+      if (list.ids.size() - n < kCandidateSlack) [[unlikely]]
+        grow(list);
+      list.ids[n] = p;
+      list.shift[n++] = third_tag[k];
+    }
+  }
+  const std::uint32_t* ids = list.ids.data();
+  for (std::uint32_t k = 0; k < n; ++k) __builtin_prefetch(hot + ids[k]);
+  list.count = n;
+  list.n_shifts = n_shifts;
+}
+
+template <int D>
+template <class Fail, class Name>
+void CellNeighbourhood<D>::validate(const HotRecord<D>* hot, std::uint32_t n, Fail&& fail,
+                                    Name&& name) const {
+  std::vector<std::uint32_t> listed(n, 0);
+  for (std::uint32_t c = 0; c < grid_.cell_count(); ++c) {
+    std::uint32_t steps = 0;
+    for (std::uint32_t p = grid_.first(c); p != grid_.end(); p = grid_.next(p)) {
+      if (p >= n || ++steps > n) fail("cell " + std::to_string(c) + " has a broken list");
+      if (grid_.index(hot[p].cell) != c)
+        fail("particle " + name(p) + " listed in a cell it is not in");
+      ++listed[p];
+    }
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (listed[i] != 1)
+      fail("particle " + name(i) + " listed " + std::to_string(listed[i]) + " times");
+  }
+}
+
+}  // namespace kairos
