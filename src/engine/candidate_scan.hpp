@@ -11,9 +11,12 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "core/vec.hpp"
 #include "dynamics/collision_time.hpp"
+#include "engine/pair_steps.hpp"
+#include "engine/relative_motion.hpp"
 
 namespace kairos {
 
@@ -82,30 +85,11 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
     if (rec == nullptr) [[unlikely]]
       continue;
     const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
-    double r2 = 0.0, rg = 0.0, g2 = 0.0;
-    for (int a = 0; a < D; ++a) {
-      double xj = rec[a] + rec[D + a] * dtj;
-      double vj = rec[D + a];
-      if constexpr (kAccelerated) {
-        xj = xj + (s.half_accel[a] * dtj) * dtj;
-        vj = vj + s.accel[a] * dtj;
-      }
-      const double r = xi[a] - (xj + shift[a]);
-      const double g = vi[a] - vj;
-      r2 = r2 + r * r;
-      rg = rg + r * g;
-      g2 = g2 + g * g;
-    }
+    const RelativeMotion p =
+        relative_motion_at<D, kAccelerated>(xi, vi, rec, dtj, shift, s.half_accel, s.accel);
     const double sigma = s.uniform ? s.sigma : s.radius_i + s.shape_radius[s.shape[j]];
-    const double gap = r2 - sigma * sigma;
-    // Cheap rejection before the square root: the contact time gap/(-rg + sqrt(...)) is at
-    // least gap/(-2 rg), so a pair that cannot beat `best` is skipped. Receding pairs
-    // (r.g >= 0, the particle itself included) fail the same test.
-    if (!(rg < 0.0) || gap > -2.0 * rg * best) continue;
-    const double disc = rg * rg - g2 * gap;
-    if (!(disc > 0.0)) continue;  // a near miss
-    double dt = gap / (-rg + std::sqrt(disc));
-    if (!(dt > 0.0)) dt = 0.0;  // overlapping and approaching: now
+    double dt;
+    if (!contact_before(p, sigma * sigma, best, dt)) continue;
     if (dt < best) {
       best = dt;
       found = k;
@@ -150,38 +134,22 @@ ContactProbeResult probe_contact_scalar(const CandidateScan<D>& s, double t,
     if (rec == nullptr) [[unlikely]]
       continue;
     const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
-    double p2 = 0.0, pg = 0.0, q2 = 0.0;  // the placed particle's r.r, r.g, g.g
-    double r2 = 0.0, rg = 0.0, g2 = 0.0;  // the released motion's
-    for (int a = 0; a < D; ++a) {
-      const double xj = rec[a] + rec[D + a] * dtj + shift[a];
-      const double vj = rec[D + a];
-      const double rp = probe.placed[a] - xj, gp = probe.frozen_velocity[a] - vj;
-      p2 = p2 + rp * rp;
-      pg = pg + rp * gp;
-      q2 = q2 + gp * gp;
-      const double r = xi[a] - xj, g = vi[a] - vj;
-      r2 = r2 + r * r;
-      rg = rg + r * g;
-      g2 = g2 + g * g;
-    }
+    // The placed particle, frozen, and its motion after the release.
+    const RelativeMotion placed =
+        relative_motion_at<D>(probe.placed, probe.frozen_velocity, rec, dtj, shift);
     const double sigma = s.uniform ? s.sigma : s.radius_i + s.shape_radius[s.shape[j]];
     const double sigma2 = sigma * sigma;
-    const double gap_placed = p2 - sigma2;
+    const double gap_placed = placed.r2 - sigma2;
     if (gap_placed < 0.0) {
       out.overlap = true;
       return out;
     }
-    if (pg < 0.0 && gap_placed <= -2.0 * pg * probe.span) {
-      const double disc = pg * pg - q2 * gap_placed;
-      if (disc > 0.0 && gap_placed / (-pg + std::sqrt(disc)) < probe.span) out.met = true;
-    }
+    double met_after;
+    if (contact_before(placed, sigma2, probe.span, met_after) && met_after < probe.span)
+      out.met = true;
     if (!probe.predict) continue;
-    const double gap = r2 - sigma2;
-    if (!(rg < 0.0) || gap > -2.0 * rg * best) continue;
-    const double disc = rg * rg - g2 * gap;
-    if (!(disc > 0.0)) continue;
-    double dt = gap / (-rg + std::sqrt(disc));
-    if (!(dt > 0.0)) dt = 0.0;
+    double dt;
+    if (!contact_before(relative_motion_at<D>(xi, vi, rec, dtj, shift), sigma2, best, dt)) continue;
     if (dt < best) {
       best = dt;
       out.found = k;
@@ -256,9 +224,72 @@ struct SteppedScan {
   double* held_g2 = nullptr;
   std::uint64_t* held_stamp = nullptr;
   std::uint32_t* held_index = nullptr;
+  const ZoneTable* tables = nullptr;  // the scalar loop's event times (ZoneTable::event_time)
 };
 
-// AVX-512 version of EventEngine::scan_stepped_loop: the same zone-0 test (cheap bound, then
+// The stepped loops' scratch, kept between predictions: per kind, the squared reach of the
+// predicted particle's pairs, and (AVX-512 loop) room for the held candidates.
+struct SteppedScanScratch {
+  std::vector<double> row_reach2;
+  std::vector<double> held;  // r.r, r.g, g.g of each held candidate, in three runs
+  std::vector<std::uint64_t> held_stamp;
+  std::vector<std::uint32_t> held_index;
+  // Points the scan's held arrays at room for `count` candidates.
+  template <int D>
+  void hold(SteppedScan<D>& scan, std::uint32_t count) {
+    const std::size_t room = count + 8;
+    if (held_index.size() < room) {
+      held.resize(3 * room);
+      held_stamp.resize(room);
+      held_index.resize(room);
+    }
+    const std::size_t stride = held_index.size();
+    scan.held_r2 = held.data();
+    scan.held_rg = held.data() + stride;
+    scan.held_g2 = held.data() + 2 * stride;
+    scan.held_stamp = held_stamp.data();
+    scan.held_index = held_index.data();
+  }
+};
+
+// Scalar reference of the stepped loop: per candidate, the zone from the capture map's stamps
+// and the time to the zone's next boundary (for a pair without steps, its contact). Most
+// candidates sit beyond every step (zone 0): for them only an approach to the outermost
+// boundary counts, and the hard-sphere test (contact_before) applies. Returns the index (into
+// base.candidates) of the soonest event earlier than t + best and lowers best to it.
+template <int D, bool kAccelerated = false>
+std::uint32_t scan_stepped_scalar(const SteppedScan<D>& s, double t, const Vec<D>& xi,
+                                  const Vec<D>& vi, double& best) {
+  const CandidateScan<D>& c = s.base;
+  std::uint32_t found = kNoCandidate;
+  const Vec<D> no_shift{};
+  for (std::uint32_t k = 0; k < c.count; ++k) {
+    const std::uint32_t j = c.candidates[k];
+    if (j == s.self) continue;
+    const Vec<D>& shift = c.any_shift ? c.shifts[c.shift_index[k]] : no_shift;
+    const double* rec =
+        c.records + static_cast<std::size_t>(j) * static_cast<std::size_t>(c.stride);
+    const double dtj = t - rec[2 * D];
+    const RelativeMotion p =
+        relative_motion_at<D, kAccelerated>(xi, vi, rec, dtj, shift, c.half_accel, c.accel);
+    const std::uint16_t sj = s.shape != nullptr ? s.shape[j] : 0;
+    const std::uint64_t stamp = s.stamps[j];
+    double dt;
+    if ((stamp >> 32) != s.epoch || static_cast<std::uint16_t>(stamp) == 0) {  // zone 0
+      if (!contact_before(p, s.row_reach2[sj], best, dt)) continue;
+    } else {
+      const ZoneTable& table = s.tables[static_cast<std::uint16_t>(stamp >> 16)];
+      dt = table.event_time(static_cast<std::uint16_t>(stamp), p.r2, p.rg, p.g2);
+    }
+    if (dt < best) {
+      best = dt;
+      found = k;
+    }
+  }
+  return found;
+}
+
+// AVX-512 version of scan_stepped_scalar: the same zone-0 test (cheap bound, then
 // the approach to the outermost boundary) and, for listed lanes, ZoneTable::event_time, with
 // the same expressions in the same order, so the result is bit-identical. Returns the index
 // (into base.candidates) of the soonest event earlier than t + best and lowers best to it;

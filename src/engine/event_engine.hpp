@@ -308,9 +308,6 @@ class EventEngine {
   // event at a step (false: the pair meets its hard core, an ordinary collision).
   void init_zones(const ParticleSystem<D>& s, StartMode mode);
   std::uint32_t scan_stepped(const CandidateList& list, std::uint32_t i, double t, double& best);
-  template <bool kAccelerated>
-  std::uint32_t scan_stepped_loop(const CandidateList& list, std::uint32_t i, double t,
-                                  double& best) const;
   bool step_pair(std::uint32_t i, std::uint32_t j, double t);
   // The pair's separation i - j under the box's boundaries (nearest image on periodic axes).
   Vec<D> separation(std::uint32_t i, std::uint32_t j, double t) const;
@@ -449,14 +446,10 @@ class EventEngine {
   bool sheared_ = false;                                   // shear_.on()
   bool stepped_ = false;  // some pair has a step potential, or there are bonds
   PairSteps steps_;
-  std::uint64_t step_captures_ = 0;            // see step_captures()
-  std::uint64_t incremental_scans_ = 0;        // see incremental_crossing_scans()
-  std::vector<std::uint16_t> step_row_table_;  // scan_stepped's scratch, per shape
-  std::vector<double> step_row_reach2_;
-  std::vector<double> step_held_;  // the vector loop's held candidates: r.r, r.g, g.g
-  std::vector<std::uint64_t> step_held_stamp_;
-  std::vector<std::uint32_t> step_held_index_;
-  std::vector<Bond> bonds_;  // the caller's numbering, kept for export
+  std::uint64_t step_captures_ = 0;      // see step_captures()
+  std::uint64_t incremental_scans_ = 0;  // see incremental_crossing_scans()
+  SteppedScanScratch step_scratch_;      // scan_stepped's
+  std::vector<Bond> bonds_;              // the caller's numbering, kept for export
   std::vector<std::string> bond_types_;
 
   // Soft spheres: the contacts in progress (engine/soft_contact_state.hpp; empty unless soft_).
@@ -467,5 +460,62 @@ class EventEngine {
   LeesEdwards<D> shear_;     // Lees-Edwards images (boundaries/lees_edwards.hpp)
   Environment<D> env_;       // last: the hot members above share fewer cache lines
 };
+
+// Small members every event path uses, visible to each of the engine's files.
+
+template <int D, class Queue>
+inline void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
+  HotRecord<D>& h = hot_[i];
+  if (accelerated_) [[unlikely]] {
+    if (is_asleep(i)) {
+      h.time = t;  // it does not move
+    } else {
+      advance_accelerated(h, t);
+    }
+    return;
+  }
+  const double dt = t - h.time;
+  for (int a = 0; a < D; ++a) h.pos[a] += h.vel[a] * dt;
+  h.time = t;
+}
+
+// Where a record's particle is at time t: a straight line, or a parabola under gravity. The
+// candidate loops evaluate the same expressions in the same order.
+template <int D, class Queue>
+inline Vec<D> EventEngine<D, Queue>::position_at(const HotRecord<D>& h, double t) const {
+  const double dt = t - h.time;
+  Vec<D> x;
+  for (int a = 0; a < D; ++a) {
+    x[a] = h.pos[a] + h.vel[a] * dt;
+    if (accelerated_) x[a] = x[a] + (half_gravity_[a] * dt) * dt;
+  }
+  return x;
+}
+
+template <int D, class Queue>
+inline Vec<D> EventEngine<D, Queue>::velocity_at(const HotRecord<D>& h, double t) const {
+  if (!accelerated_) return h.vel;
+  const double dt = t - h.time;
+  Vec<D> v;
+  for (int a = 0; a < D; ++a) v[a] = h.vel[a] + env_.gravity[a] * dt;
+  return v;
+}
+
+template <int D, class Queue>
+inline void EventEngine<D, Queue>::add_virial_tensor(const Vec<D>& r, const Vec<D>& impulse) {
+  for (int a = 0; a < D; ++a)
+    for (int b = 0; b < D; ++b) counters_.virial_tensor[a * D + b] += r[a] * impulse[b];
+}
+
+// New events for both partners of a collision. Both neighbourhoods are gathered (and their
+// records prefetched) before either is tested; partners in one cell share one list.
+template <int D, class Queue>
+inline void EventEngine<D, Queue>::predict_pair(std::uint32_t i, std::uint32_t j, double t) {
+  gather(hot_[i].cell, cells_.list(0));
+  const bool shared = hot_[j].cell == hot_[i].cell;
+  if (!shared) gather(hot_[j].cell, cells_.list(1));
+  queue_.update(i, predict_from(cells_.list(0), i, t));
+  queue_.update(j, predict_from(cells_.list(shared ? 0 : 1), j, t));
+}
 
 }  // namespace kairos

@@ -570,32 +570,11 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   queue_.update(i, predict(i, t));
 }
 
-#define KAIROS_SOFT_MEMBERS(D, Q)                                                                \
-  template void EventEngine<D, Q>::setup_soft(const ParticleSystem<D>&);                         \
-  template void EventEngine<D, Q>::restore_frozen(const ParticleSystem<D>&, StartMode);          \
-  template std::uint32_t EventEngine<D, Q>::frozen() const;                                      \
-  template CollisionMap EventEngine<D, Q>::soft_map(const SoftMapTable*, const CollisionUnits&); \
-  template void EventEngine<D, Q>::relocate(std::uint32_t);                                      \
-  template bool EventEngine<D, Q>::try_place(std::uint32_t, const Vec<D>&, std::uint32_t,        \
-                                             const Vec<D>&, double, int, bool&, FrozenWindow*);  \
-  template std::uint32_t EventEngine<D, Q>::release(std::uint32_t, double, bool);                \
-  template void EventEngine<D, Q>::release_event(std::uint32_t, double);                         \
-  template void EventEngine<D, Q>::collide_soft(std::uint32_t, std::uint32_t, double);           \
-  template double EventEngine<D, Q>::deferred_contact_energy() const;                            \
-  template std::uint32_t EventEngine<D, Q>::scan_deferred(const CandidateList&, std::uint32_t,   \
-                                                          std::uint32_t, double, const Vec<D>&,  \
-                                                          const Vec<D>&, double, double&) const; \
-  template bool EventEngine<D, Q>::try_defer(std::uint32_t, std::uint32_t, double,               \
-                                             const FrozenWindow&);                               \
-  template void EventEngine<D, Q>::hit_wall_soft(std::uint32_t, int, double);
-
-KAIROS_SOFT_MEMBERS(2, BinaryHeapQueue)
-KAIROS_SOFT_MEMBERS(3, BinaryHeapQueue)
-KAIROS_SOFT_MEMBERS(2, CalendarQueue)
-KAIROS_SOFT_MEMBERS(3, CalendarQueue)
-KAIROS_SOFT_MEMBERS(2, TournamentTreeQueue)
-KAIROS_SOFT_MEMBERS(3, TournamentTreeQueue)
-
-#undef KAIROS_SOFT_MEMBERS
+template class EventEngine<2, BinaryHeapQueue>;
+template class EventEngine<3, BinaryHeapQueue>;
+template class EventEngine<2, CalendarQueue>;
+template class EventEngine<3, CalendarQueue>;
+template class EventEngine<2, TournamentTreeQueue>;
+template class EventEngine<3, TournamentTreeQueue>;
 
 }  // namespace kairos

@@ -205,26 +205,11 @@ std::vector<double> EventEngine<D, Queue>::masses() const {
   return out;
 }
 
-#define KAIROS_EXPORT_MEMBERS(D, Q)                                                             \
-  template ParticleSystem<D> EventEngine<D, Q>::export_state(bool) const;                       \
-  template StateBlocks<D> EventEngine<D, Q>::state_blocks(bool) const;                          \
-  template const EventEngine<D, Q>::BlockOrder& EventEngine<D, Q>::block_order() const;         \
-  template ParticleSystem<D> EventEngine<D, Q>::export_globals(bool) const;                     \
-  template void EventEngine<D, Q>::size_particle_arrays(ParticleSystem<D>&, std::size_t) const; \
-  template void EventEngine<D, Q>::export_particle(std::uint32_t, std::uint32_t,                \
-                                                   ParticleSystem<D>&, unsigned) const;         \
-  template std::vector<Vec<D>> EventEngine<D, Q>::current_positions() const;                    \
-  template void EventEngine<D, Q>::for_each_block(const BlockVisitor&, bool) const;             \
-  template std::vector<Vec<D>> EventEngine<D, Q>::current_velocities() const;                   \
-  template std::vector<double> EventEngine<D, Q>::masses() const;
-
-KAIROS_EXPORT_MEMBERS(2, BinaryHeapQueue)
-KAIROS_EXPORT_MEMBERS(3, BinaryHeapQueue)
-KAIROS_EXPORT_MEMBERS(2, CalendarQueue)
-KAIROS_EXPORT_MEMBERS(3, CalendarQueue)
-KAIROS_EXPORT_MEMBERS(2, TournamentTreeQueue)
-KAIROS_EXPORT_MEMBERS(3, TournamentTreeQueue)
-
-#undef KAIROS_EXPORT_MEMBERS
+template class EventEngine<2, BinaryHeapQueue>;
+template class EventEngine<3, BinaryHeapQueue>;
+template class EventEngine<2, CalendarQueue>;
+template class EventEngine<3, CalendarQueue>;
+template class EventEngine<2, TournamentTreeQueue>;
+template class EventEngine<3, TournamentTreeQueue>;
 
 }  // namespace kairos

@@ -1,0 +1,344 @@
+// Granular matter in the event engine (docs/architecture.md, "Granular matter"): collisions
+// under contact laws, wall contacts, and resting particles (engine/resting_particles.hpp decides,
+// this file applies). The plain elastic path never comes here.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <string_view>
+
+#include "core/error.hpp"
+#include "core/periodic.hpp"
+#include "dynamics/collision_time.hpp"
+#include "dynamics/trajectory_events.hpp"
+#include "engine/event_engine.hpp"
+#include "interactions/granular_contact.hpp"
+#include "interactions/hard_sphere.hpp"
+#include "scheduler/binary_heap_queue.hpp"
+#include "scheduler/calendar_queue.hpp"
+#include "scheduler/tournament_tree_queue.hpp"
+
+namespace kairos {
+
+namespace {
+constexpr std::uint32_t kNoPartner = EventSlot::kNoPartner;
+
+// The engine stores 2D spins as one-component vectors; the contact laws take a scalar.
+template <int D>
+Spin<D> to_spin(const AngularVelocity<D>& w) {
+  if constexpr (D == 3) {
+    return w;
+  } else {
+    return w[0];
+  }
+}
+
+template <int D>
+AngularVelocity<D> from_spin(const Spin<D>& w) {
+  if constexpr (D == 3) {
+    return w;
+  } else {
+    return {w};
+  }
+}
+}  // namespace
+
+// Whether some candidate sleeps: only then does a pair need the quartic of scan_with_sleepers;
+// predictions away from the resting particles keep the vector loop.
+// A sleeper moves on no event of its own (no crossing, no wall), but the awake particles around
+// it were predicted while it still moved: its own scan keeps every pair (sleeper, awake) covered,
+// as any particle's prediction covers its pairs after its motion changed. Among sleepers alone
+// this is never.
+template <int D, class Queue>
+double EventEngine<D, Queue>::predict_asleep(const CandidateList& list, std::uint32_t i, double t) {
+  double best = kNever;
+  const std::uint32_t partner = scan_with_sleepers(list, i, t, best);
+  pending_[i] = partner == kNoPartner
+                    ? PendingEvent{Code::crossing(), 0}
+                    : PendingEvent{Code::collision(partner), hot_[partner].collisions};
+  return partner == kNoPartner ? kNever : t + best;
+}
+
+// The impulse of a pair collision at separation r (i minus j) with the particles' present
+// velocities: the contact law's, or the elastic one. For the rarer paths (a sleeper woken, a
+// collision through a sheared face); collide() keeps its own one-pass elastic loop.
+template <int D, class Queue>
+void EventEngine<D, Queue>::resolve_pair(std::uint32_t i, std::uint32_t j, double t,
+                                         const Vec<D>& r, double r2) {
+  if (granular_contacts_) {
+    collide_granular(i, j, t, r, r2);
+    return;
+  }
+  HotRecord<D>& hi = hot_[i];
+  HotRecord<D>& hj = hot_[j];
+  const double mi = mass_of(i), mj = mass_of(j);
+  const double s = HardSphere::impulse_factor(dot(hi.vel - hj.vel, r), r2, mi * mj / (mi + mj));
+  hi.vel = hi.vel + (s / mi) * r;
+  hj.vel = hj.vel - (s / mj) * r;
+  counters_.virial += s * r2;
+  add_virial_tensor(r, s * r);
+}
+
+// A collision under a granular contact law (restitution, roughness, TC model). The plain
+// elastic case never comes here (collide() keeps its two-line impulse).
+template <int D, class Queue>
+void EventEngine<D, Queue>::collide_granular(std::uint32_t i, std::uint32_t j, double t,
+                                             const Vec<D>& r, double r2) {
+  HotRecord<D>& hi = hot_[i];
+  HotRecord<D>& hj = hot_[j];
+  bool elastic = false;
+  if (!last_collision_.empty()) {
+    elastic = t - last_collision_[i] < env_.tc || t - last_collision_[j] < env_.tc;
+    last_collision_[i] = t;
+    last_collision_[j] = t;
+  }
+  const std::uint32_t si = species_of(i), sj = species_of(j);
+  ContactInput<D> in;
+  in.normal = (1.0 / std::sqrt(r2)) * r;
+  in.mass_i = mass_of(i);
+  in.mass_j = mass_of(j);
+  in.radius_i = radius_of(i);
+  in.radius_j = radius_of(j);
+  in.inertia_factor_i = env_.inertia_factor_of(si);
+  in.inertia_factor_j = env_.inertia_factor_of(sj);
+  in.force_elastic = elastic;
+  Spin<D> wi{}, wj{};
+  if (!spin_.empty()) {
+    wi = to_spin<D>(spin_[i]);
+    wj = to_spin<D>(spin_[j]);
+  }
+  const ContactResult<D> res =
+      resolve_contact(*env_.contact_of(si, sj), in, hi.vel, hj.vel, wi, wj);
+  if (!spin_.empty()) {
+    spin_[i] = from_spin<D>(wi);
+    spin_[j] = from_spin<D>(wj);
+  }
+  counters_.virial += dot(r, res.impulse);
+  add_virial_tensor(r, res.impulse);
+  counters_.dissipated_in_collisions += res.dissipated;
+  counters_.elastic_by_rule += res.made_elastic ? 1u : 0u;
+  counters_.sliding_collisions += res.slid ? 1u : 0u;
+  separate(i, j, r, r2);
+}
+
+// After an inelastic collision the pair must recede as the candidate loops see it. A grazing
+// pair whose approach speed is at round-off level may come out of the contact law still
+// "approaching" in the loops' arithmetic (or not approaching in the law's, so no impulse), and
+// would then collide again and again at one instant. A momentum-conserving nudge along r makes
+// r.g slightly positive; its energy (round-off level) counts as dissipated with a minus sign.
+template <int D, class Queue>
+void EventEngine<D, Queue>::separate(std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2) {
+  HotRecord<D>& hi = hot_[i];
+  HotRecord<D>& hj = hot_[j];
+  const double speed = std::sqrt(norm2(hi.vel)) + std::sqrt(norm2(hj.vel));
+  const double wanted = 1e-12 * std::sqrt(r2) * speed;
+  const double rg = dot(r, hi.vel - hj.vel);
+  if (rg >= wanted) return;
+  const double mi = mass_of(i), mj = mass_of(j);
+  const double before = 0.5 * (mi * norm2(hi.vel) + mj * norm2(hj.vel));
+  const double lambda = (wanted - rg) / (r2 * (1.0 / mi + 1.0 / mj));
+  hi.vel = hi.vel + (lambda / mi) * r;
+  hj.vel = hj.vel - (lambda / mj) * r;
+  counters_.dissipated_in_collisions -= 0.5 * (mi * norm2(hi.vel) + mj * norm2(hj.vel)) - before;
+  counters_.virial += lambda * r2;
+  add_virial_tensor(r, lambda * r);
+}
+
+template <int D, class Queue>
+std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i, double t,
+                                                                double horizon) const {
+  const HotRecord<D>& h = hot_[i];
+  return face_walls_.next_contact(position_at(h, t), velocity_at(h, t), radius_of(i), h.cell,
+                                  cells_.grid(), t, horizon);
+}
+
+// A particle meets a wall: the wall is a partner of infinite mass moving with its velocity
+// (sliding and normal) plus its vibration velocity, so restitution applies to the normal
+// velocity relative to the wall.
+template <int D, class Queue>
+void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
+  if (t >= face_walls_.squeeze_time()) throw_squeezed(t);
+  if (soft_) [[unlikely]] {
+    hit_wall_soft(i, face, t);
+    return;
+  }
+  const bool again = wedged(i, t);
+  advance_to(i, t);
+  HotRecord<D>& h = hot_[i];
+  const Wall<D>& w = face_walls_.wall(face);
+  bool elastic = false;
+  if (!last_collision_.empty()) {
+    elastic = t - last_collision_[i] < env_.tc;
+    last_collision_[i] = t;
+  }
+  Spin<D> wi{};
+  if (!spin_.empty()) wi = to_spin<D>(spin_[i]);
+  const ContactResult<D> res = face_walls_.resolve(
+      face, t, mass_of(i), radius_of(i), env_.inertia_factor_of(species_of(i)), elastic, h.vel, wi);
+  if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
+  counters_.dissipated_at_walls += res.dissipated;
+  counters_.work_by_walls += FaceWalls<D>::work(res);
+  if (resting_.on() && !w.vibrates()) {
+    counters_.dissipated_at_walls -=
+        settle_after_contact(i, face_normal<D>(face), w.velocity, t, again);
+  }
+  counters_.elastic_by_rule += res.made_elastic ? 1u : 0u;
+  counters_.sliding_collisions += res.slid ? 1u : 0u;
+  ++counters_.wall_collisions;
+  ++h.collisions;  // its velocity changed: partners' predictions with it are stale
+  queue_.update(i, predict(i, t));
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::fall_asleep(std::uint32_t i, double t) {
+  HotRecord<D>& h = hot_[i];
+  h.time = t;
+  h.vel = Vec<D>{};
+  if (!spin_.empty()) spin_[i] = AngularVelocity<D>{};
+  resting_.fall_asleep(i);
+  ++counters_.fell_asleep;
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::wake(std::uint32_t i, double t) {
+  resting_.wake(i);
+  hot_[i].time = t;  // at rest where it slept
+}
+
+template <int D, class Queue>
+double EventEngine<D, Queue>::settle_after_contact(std::uint32_t i, const Vec<D>& n,
+                                                   const Vec<D>& support_velocity, double t,
+                                                   bool again) {
+  using Settle = typename Resting::Settle;
+  HotRecord<D>& h = hot_[i];
+  const Settle settle =
+      resting_.settle(h.vel, n, support_velocity, again, [&] { return resting_on_support(i, t); });
+  const double m = mass_of(i);
+  if (settle.kind == Settle::kSleep) {
+    const double before = 0.5 * m * norm2(h.vel) + spin_energy(i);
+    fall_asleep(i, t);
+    return -before;
+  }
+  if (settle.kind == Settle::kNothing) return 0.0;
+  const double before = 0.5 * m * norm2(h.vel);
+  h.vel = h.vel + settle.lift * n;
+  return 0.5 * m * norm2(h.vel) - before;
+}
+
+// Whether particle i meets something again after moving less than 1e-9 of its diameter since
+// its previous event: between resting things with no clearance (a gap of exactly its size, to
+// round-off) the contacts would follow each other without end, at one instant or in a Zeno
+// sequence. (Called before the particle is advanced to t.)
+template <int D, class Queue>
+bool EventEngine<D, Queue>::wedged(std::uint32_t i, double t) const {
+  const double moved = (t - hot_[i].time) * std::sqrt(norm2(velocity_of(i, t)));
+  return Resting::wedged(moved, radius_of(i));
+}
+
+template <int D, class Queue>
+double EventEngine<D, Queue>::spin_energy(std::uint32_t i) const {
+  if (spin_.empty()) return 0.0;
+  const double r = radius_of(i);
+  return 0.5 * env_.inertia_factor_of(species_of(i)) * mass_of(i) * r * r * norm2(spin_[i]);
+}
+
+// Whether particle i touches (within a few sleep-speed bounce heights) a fixed wall or a
+// sleeper that gravity presses it onto.
+template <int D, class Queue>
+bool EventEngine<D, Queue>::resting_on_support(std::uint32_t i, double t) {
+  const double eps = resting_.support_distance(radius_of(i));
+  const Vec<D> x = position_of(i, t);
+  for (int f = 0; f < 2 * D; ++f) {
+    if (!face_walls_.is_wall(f)) continue;
+    const Wall<D>& w = face_walls_.wall(f);
+    if (w.vibrates() || norm2(w.velocity) != 0.0) continue;
+    if (resting_.holds_up(face_normal<D>(f)) && face_walls_.gap(f, x, t) - radius_of(i) < eps)
+      return true;
+  }
+  CandidateList& list = cells_.list(1);
+  gather(hot_[i].cell, list);
+  for (std::uint32_t k = 0; k < list.count; ++k) {
+    const std::uint32_t j = list.ids[k];
+    if (j == i || !is_asleep(j)) continue;
+    Vec<D> r = x - hot_[j].pos;
+    if (list.n_shifts > 1) r = r - list.shifts[list.shift[k]];
+    const double dist = std::sqrt(norm2(r));
+    if (resting_.holds_up((1.0 / dist) * r) && dist - (radius_of(i) + radius_of(j)) < eps)
+      return true;
+  }
+  return false;
+}
+
+// An awake particle i meets a sleeping j. A gentle contact leaves j asleep (an immovable
+// support, as a wall of infinite mass); a harder one wakes j for an ordinary collision.
+template <int D, class Queue>
+void EventEngine<D, Queue>::collide_with_sleeper(std::uint32_t i, std::uint32_t j, double t,
+                                                 const Vec<D>& r, double r2, bool again) {
+  HotRecord<D>& hi = hot_[i];
+  const Vec<D> n = (1.0 / std::sqrt(r2)) * r;
+  const double gn = dot(hi.vel, n);
+  if (resting_.hit_wakes(gn)) {
+    wake(j, t);
+    resolve_pair(i, j, t, r, r2);
+    ++hot_[j].collisions;
+  } else {
+    const ContactModel plain;
+    WallContactInput<D> in;
+    in.normal = n;
+    in.mass = mass_of(i);
+    in.radius = radius_of(i);
+    in.inertia_factor = env_.inertia_factor_of(species_of(i));
+    const ContactModel& law =
+        env_.contact.empty() ? plain : *env_.contact_of(species_of(i), species_of(j));
+    Spin<D> wi{};
+    if (!spin_.empty()) wi = to_spin<D>(spin_[i]);
+    const ContactResult<D> res = resolve_wall_contact(law, in, hi.vel, wi);
+    if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
+    counters_.dissipated_in_collisions += res.dissipated;
+    counters_.virial += dot(r, res.impulse);
+    add_virial_tensor(r, res.impulse);
+    counters_.dissipated_in_collisions -= settle_after_contact(i, n, Vec<D>{}, t, again);
+  }
+  ++counters_.collisions;
+  ++hi.collisions;
+  queue_.update(i, predict(i, t));
+  queue_.update(j, predict(j, t));
+}
+
+// The candidate test when some particles sleep: a sleeping candidate does not fall, so the
+// pair's relative acceleration is +-g and its contact time a quartic. Scalar; only gravity
+// runs with resting particles take it.
+template <int D, class Queue>
+std::uint32_t EventEngine<D, Queue>::scan_with_sleepers(const CandidateList& list, std::uint32_t i,
+                                                        double t, double& best) const {
+  const Vec<D> xi = position_of(i, t), vi = velocity_of(i, t);
+  const bool si = is_asleep(i);
+  std::uint32_t found = kNoPartner;
+  for (std::uint32_t k = 0; k < list.count; ++k) {
+    const std::uint32_t j = list.ids[k];
+    const bool sj = is_asleep(j);
+    if (j == i || (si && sj)) continue;  // sleepers never meet each other
+    Vec<D> r = xi - position_of(j, t);
+    if (list.n_shifts > 1) r = r - list.shifts[list.shift[k]];
+    const Vec<D> g = vi - velocity_of(j, t);
+    // Relative acceleration: gravity acts on the awake one of a mixed pair.
+    const Vec<D> accel = sj ? env_.gravity : (si ? -1.0 * env_.gravity : Vec<D>{});
+    const double sigma = radius_of(i) + radius_of(j);
+    const double dt =
+        pair_contact_time_accelerated<D>(r.data(), g.data(), accel.data(), sigma, best);
+    if (dt < best) {
+      best = dt;
+      found = j;
+    }
+  }
+  return found;
+}
+
+template class EventEngine<2, BinaryHeapQueue>;
+template class EventEngine<3, BinaryHeapQueue>;
+template class EventEngine<2, CalendarQueue>;
+template class EventEngine<3, CalendarQueue>;
+template class EventEngine<2, TournamentTreeQueue>;
+template class EventEngine<3, TournamentTreeQueue>;
+
+}  // namespace kairos
