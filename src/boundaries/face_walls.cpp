@@ -17,13 +17,6 @@ FaceWalls<D>::FaceWalls(const std::array<Face<D>, 2 * D>& faces, const Vec<D>& b
   for (const Face<D>& f : faces_) any_ = any_ || f.kind == FaceKind::kWall;
 }
 
-template <int D>
-bool FaceWalls<D>::any_plane_moves() const {
-  for (int f = 0; f < 2 * D; ++f)
-    if (is_wall(f) && wall(f).plane_moves(f)) return true;
-  return false;
-}
-
 // Along the wall's normal n (into the box: +e_a at the low face, -e_a at the high one) the
 // plane's offset is d(t) = d0 + u t (+ the vibration): in the frame moving with u the particle's
 // normal velocity is v - u, and the solvers of a fixed or vibrated plane apply. With u = 0 the

@@ -17,6 +17,7 @@
 #include <utility>
 
 #include "boundaries/face_wall.hpp"
+#include "core/environment.hpp"
 #include "core/vec.hpp"
 #include "dynamics/collision_time.hpp"
 #include "interactions/granular_contact.hpp"
@@ -24,18 +25,41 @@
 
 namespace kairos {
 
+// The energy a wall gave a particle in a contact: its work (the kinetic energy change plus
+// what was dissipated).
+template <int D>
+double work_on_particle(const ContactResult<D>& r) {
+  return r.translational_energy_change + r.rotational_energy_change + r.dissipated;
+}
+
 template <int D>
 class FaceWalls {
  public:
   FaceWalls() = default;
   // The faces (only kWall ones are walls), the box and the uniform acceleration particles feel.
   FaceWalls(const std::array<Face<D>, 2 * D>& faces, const Vec<D>& box, const Vec<D>& gravity);
+  // The walls of a run's model (its faces and gravity).
+  FaceWalls(const Environment<D>& environment, const Vec<D>& box)
+      : FaceWalls(environment.faces, box, environment.gravity) {}
 
   bool any() const { return any_; }
   bool is_wall(int f) const { return faces_[f].kind == FaceKind::kWall; }
   const Wall<D>& wall(int f) const { return faces_[f].wall; }
-  // Some wall's plane moves (a piston or a vibration).
-  bool any_plane_moves() const;
+
+  // The boundary interface (boundaries/boundaries.hpp): the surfaces are the 2D faces, a
+  // surface exists where the face is a wall.
+  static constexpr int surfaces() { return 2 * D; }
+  bool is_surface(int f) const { return is_wall(f); }
+  Vec<D> normal(int f, const Vec<D>& /*x*/, double /*t*/) const { return face_normal<D>(f); }
+  Vec<D> velocity(int f, const Vec<D>& /*x*/, double t) const {
+    return faces_[f].wall.velocity_at(f, t);
+  }
+  bool holds_still(int f) const {
+    const Wall<D>& w = faces_[f].wall;
+    return !w.vibrates() && norm2(w.velocity) == 0.0;
+  }
+  bool surface_moves(int f) const { return faces_[f].wall.plane_moves(f); }
+  bool accelerates(int f) const { return faces_[f].wall.vibrates(); }
 
   // Where the plane of wall f lies along its axis at time t.
   double position(int f, double t) const { return faces_[f].wall.plane_position(f, box_, t); }
@@ -66,11 +90,6 @@ class FaceWalls {
   // restitution acts on the normal velocity relative to the wall.
   ContactResult<D> resolve(int f, double t, double mass, double radius, double inertia_factor,
                            bool force_elastic, Vec<D>& v, Spin<D>& w) const;
-  // The energy the wall gave the particle in that contact: its work (the kinetic energy
-  // change plus what was dissipated).
-  static double work(const ContactResult<D>& r) {
-    return r.translational_energy_change + r.rotational_energy_change + r.dissipated;
-  }
 
   // Whether a particle of this radius centred at x overlaps a wall (other than skip_face) at
   // time t.

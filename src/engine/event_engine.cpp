@@ -103,7 +103,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   }
   // Sleepers predict no events of their own, so a wall moving along its normal (vibrating or a
   // piston) could move into one unseen: then nothing sleeps (resting piles need the TC model).
-  const bool moving = face_walls_.any_plane_moves();
+  const bool moving = boundaries_.any_surface_moves();
   if (stepped_ && env_.sleep_speed > 0.0) {
     throw InputError(
         "contact.sleep_speed: resting particles cannot sleep under stepped potentials (a "
@@ -161,7 +161,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
         if (cells_.grid().periodic(a)) hot_[k].pos[a] = wrap_into_box(hot_[k].pos[a], box_[a]);
       hot_[k].cell = cells_.grid().locate(hot_[k].pos);
       if (walls_ && !(soft_ && soft_state_.partner(k) != kNoPartner))  // a soft contact: pressed in
-        face_walls_.check_start(hot_[k].pos, radius_of(k), time_, id_[k]);
+        boundaries_.check_start(hot_[k].pos, radius_of(k), time_, id_[k]);
     }
     if (options_.renumber_interval > 0.0) {
       renumber(/*queue_filled=*/false);  // fills the grid in the new numbering
@@ -228,8 +228,8 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   }
   accelerated_ = env_.has_gravity();
   half_gravity_ = 0.5 * env_.gravity;
-  face_walls_ = FaceWalls<D>(env_.faces, box_, env_.gravity);
-  walls_ = face_walls_.any();
+  boundaries_ = Boundaries<D>(env_, box_);
+  walls_ = boundaries_.any();
   granular_contacts_ = !env_.plain() || env_.tc > 0.0;
   double rmax = 0.0;
   for (const ParticleKind& sh : shapes_) rmax = std::max(rmax, sh.radius);
@@ -261,15 +261,15 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   cells_ =
       Cells(CellGrid<D>(box_, min_width, periodic, s.size(), cells_per_particle), vector_gather_);
   bounded_ = bounded;
-  face_walls_.set_reach(cells_.grid(), rmax);
+  boundaries_.faces().set_reach(cells_.grid(), rmax);
   shear_ = LeesEdwards<D>(env_.shear_rate, box_, cells_.grid(), time_);
   sheared_ = shear_.on();
   double particle_volume = 0.0;
   for (const Kinematics<D>& k : s.kinematics)
     particle_volume +=
         D == 3 ? 4.0 / 3.0 * M_PI * k.radius * k.radius * k.radius : M_PI * k.radius * k.radius;
-  face_walls_.find_squeeze_time(rmax, particle_volume, uniform_radius_);
-  if (time_ >= face_walls_.squeeze_time()) throw_squeezed(time_);
+  boundaries_.faces().find_squeeze_time(rmax, particle_volume, uniform_radius_);
+  if (time_ >= boundaries_.squeeze_time()) throw_squeezed(time_);
   // Shear (sliding images) and steps (zones) keep full scans.
   incremental_crossings_ = options_.incremental_crossings && !stepped_ && !sheared_;
   for (int a = 0; a < D; ++a)
@@ -281,7 +281,7 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::throw_squeezed(double t) const {
   double dmax = 0.0;
   for (const ParticleKind& sh : shapes_) dmax = std::max(dmax, 2.0 * sh.radius);
-  face_walls_.throw_squeezed(t, dmax, uniform_radius_);
+  boundaries_.faces().throw_squeezed(t, dmax, uniform_radius_);
 }
 
 // A restored cell must exist and contain the particle's position (up to round-off): a damaged

@@ -35,7 +35,7 @@
 #include <string>
 #include <vector>
 
-#include "boundaries/face_walls.hpp"
+#include "boundaries/boundaries.hpp"
 #include "boundaries/lees_edwards.hpp"
 #include "core/environment.hpp"
 #include "core/huge_page_allocator.hpp"
@@ -236,7 +236,7 @@ class EventEngine {
   Vec<D> velocity_at(const HotRecord<D>& h, double t) const;
   // The particle's soonest wall contact from time t before t + horizon: (relative time, face).
   std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
-  void hit_wall(std::uint32_t i, int face, double t);
+  void hit_wall(std::uint32_t i, int surface, double t);
   // Walls moving towards each other left no room for the particles (FaceWalls::squeeze_time).
   [[noreturn]] void throw_squeezed(double t) const;
   // Sleeping particles (gravity with walls): see Environment::sleep_speed.
@@ -433,7 +433,7 @@ class EventEngine {
   HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
   bool accelerated_ = false;      // uniform gravity
   Vec<D> half_gravity_{};
-  bool walls_ = false;                   // face_walls_.any()
+  bool walls_ = false;                   // boundaries_.any()
   bool bounded_ = false;                 // some axis has walls or open faces
   bool granular_contacts_ = false;       // some contact law is not elastic and smooth
   HugeVector<AngularVelocity<D>> spin_;  // rough particles only
@@ -456,9 +456,9 @@ class EventEngine {
   bool soft_ = false;
   SoftContactState<D> soft_state_;
 
-  FaceWalls<D> face_walls_;  // the walls on the box's faces (boundaries/face_walls.hpp)
-  LeesEdwards<D> shear_;     // Lees-Edwards images (boundaries/lees_edwards.hpp)
-  Environment<D> env_;       // last: the hot members above share fewer cache lines
+  Boundaries<D> boundaries_;  // every wall (boundaries/boundaries.hpp: the face walls so far)
+  LeesEdwards<D> shear_;      // Lees-Edwards images (boundaries/lees_edwards.hpp)
+  Environment<D> env_;        // last: the hot members above share fewer cache lines
 };
 
 // Small members every event path uses, visible to each of the engine's files.

@@ -148,7 +148,7 @@ template <int D, class Queue>
 std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i, double t,
                                                                 double horizon) const {
   const HotRecord<D>& h = hot_[i];
-  return face_walls_.next_contact(position_at(h, t), velocity_at(h, t), radius_of(i), h.cell,
+  return boundaries_.next_contact(position_at(h, t), velocity_at(h, t), radius_of(i), h.cell,
                                   cells_.grid(), t, horizon);
 }
 
@@ -156,16 +156,15 @@ std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i,
 // (sliding and normal) plus its vibration velocity, so restitution applies to the normal
 // velocity relative to the wall.
 template <int D, class Queue>
-void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
-  if (t >= face_walls_.squeeze_time()) throw_squeezed(t);
+void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t) {
+  if (t >= boundaries_.squeeze_time()) throw_squeezed(t);
   if (soft_) [[unlikely]] {
-    hit_wall_soft(i, face, t);
+    hit_wall_soft(i, surface, t);
     return;
   }
   const bool again = wedged(i, t);
   advance_to(i, t);
   HotRecord<D>& h = hot_[i];
-  const Wall<D>& w = face_walls_.wall(face);
   bool elastic = false;
   if (!last_collision_.empty()) {
     elastic = t - last_collision_[i] < env_.tc;
@@ -173,14 +172,16 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int face, double t) {
   }
   Spin<D> wi{};
   if (!spin_.empty()) wi = to_spin<D>(spin_[i]);
-  const ContactResult<D> res = face_walls_.resolve(
-      face, t, mass_of(i), radius_of(i), env_.inertia_factor_of(species_of(i)), elastic, h.vel, wi);
+  const ContactResult<D> res =
+      boundaries_.resolve(surface, t, mass_of(i), radius_of(i),
+                          env_.inertia_factor_of(species_of(i)), elastic, h.vel, wi);
   if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
   counters_.dissipated_at_walls += res.dissipated;
-  counters_.work_by_walls += FaceWalls<D>::work(res);
-  if (resting_.on() && !w.vibrates()) {
+  counters_.work_by_walls += work_on_particle(res);
+  if (resting_.on() && !boundaries_.accelerates(surface)) {
     counters_.dissipated_at_walls -=
-        settle_after_contact(i, face_normal<D>(face), w.velocity, t, again);
+        settle_after_contact(i, boundaries_.normal(surface, h.pos, t),
+                             boundaries_.velocity(surface, h.pos, t), t, again);
   }
   counters_.elastic_by_rule += res.made_elastic ? 1u : 0u;
   counters_.sliding_collisions += res.slid ? 1u : 0u;
@@ -248,11 +249,10 @@ template <int D, class Queue>
 bool EventEngine<D, Queue>::resting_on_support(std::uint32_t i, double t) {
   const double eps = resting_.support_distance(radius_of(i));
   const Vec<D> x = position_of(i, t);
-  for (int f = 0; f < 2 * D; ++f) {
-    if (!face_walls_.is_wall(f)) continue;
-    const Wall<D>& w = face_walls_.wall(f);
-    if (w.vibrates() || norm2(w.velocity) != 0.0) continue;
-    if (resting_.holds_up(face_normal<D>(f)) && face_walls_.gap(f, x, t) - radius_of(i) < eps)
+  for (int s = 0; s < boundaries_.surfaces(); ++s) {
+    if (!boundaries_.is_surface(s) || !boundaries_.holds_still(s)) continue;
+    if (resting_.holds_up(boundaries_.normal(s, x, t)) &&
+        boundaries_.gap(s, x, t) - radius_of(i) < eps)
       return true;
   }
   CandidateList& list = cells_.list(1);

@@ -73,7 +73,7 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
   // A piston (a wall at constant velocity) is an inertial frame: the map holds in it, and the
   // frozen particle moves with the wall. A vibrated wall accelerates during the contact.
   for (int f = 0; f < 2 * D; ++f) {
-    if (face_walls_.is_wall(f) && face_walls_.wall(f).vibrates())
+    if (boundaries_.faces().is_wall(f) && boundaries_.faces().wall(f).vibrates())
       throw InputError(
           "soft spheres cannot meet vibrating walls (the wall accelerates during a contact; "
           "use run.integrator = \"dem\")");
@@ -102,7 +102,7 @@ void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s, StartMode
     if (soft_state_.partner(i) != kNone)
       throw InputError("particle " + std::to_string(c.i) + " is in two soft contacts");
     if (wall) {
-      if (!face_walls_.is_wall(static_cast<int>(c.face)))
+      if (!boundaries_.faces().is_wall(static_cast<int>(c.face)))
         throw InputError("particle " + std::to_string(c.i) +
                          " is in contact with a face that is "
                          "not a wall");
@@ -195,7 +195,7 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
   auto overlaps = [&](std::uint32_t p, const CandidateList& list, int slot) {
     const Vec<D>& x = hot_[p].pos;
     const double radius = radius_of(p);
-    if (walls_ && face_walls_.overlaps(x, radius, t, skip_face)) return true;
+    if (walls_ && boundaries_.faces().overlaps(x, radius, t, skip_face)) return true;
     std::uint32_t delayed = 0;
     const CandidateScan<D> scan = scan_of(list, p, &delayed);
     ContactProbe<D> probe{x, velocity, span, i, j, false};
@@ -353,9 +353,9 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
             end[k][a] < cells_.grid().upper_bound(h.cell, a)))
         return false;
     }
-    for (int f = 0; walls_ && f < 2 * D; ++f) {
-      if (face_walls_.is_wall(f) &&
-          face_walls_.event_time(f, h.pos, window.velocity, radius_of(both[k]), t, until - t) <
+    for (int f = 0; walls_ && f < boundaries_.surfaces(); ++f) {
+      if (boundaries_.is_surface(f) &&
+          boundaries_.event_time(f, h.pos, window.velocity, radius_of(both[k]), t, until - t) <
               until - t)
         return false;
     }
@@ -520,7 +520,7 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   const double sgn = face % 2 == 0 ? 1.0 : -1.0;
   // The wall's normal velocity: constant (setup refuses vibrations), so the map holds in its
   // frame; the frozen particle moves with the wall.
-  const double wall_speed = face_walls_.wall(face).velocity[a];
+  const double wall_speed = boundaries_.faces().wall(face).velocity[a];
   const double vn = -sgn * (h.vel[a] - wall_speed);
   if (!(vn > 0.0)) {  // released early, it now leaves the wall
     ++h.collisions;
@@ -540,7 +540,7 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   counters_.work_by_walls += m * wall_speed * (after[a] - h.vel[a]);  // impulse . wall velocity
   // Already overlapping the wall (released from it, then turned back by a third body): no
   // first contact to start the map from, so the contact is instantaneous.
-  const double gap = sgn * (h.pos[a] - face_walls_.position(face, t));
+  const double gap = sgn * (h.pos[a] - boundaries_.faces().position(face, t));
   const bool overlapping = gap < radius * (1.0 - 1e-9);
   if (overlapping) ++counters_.soft_overlap_fallbacks;
   bool placed = false;

@@ -37,14 +37,14 @@ void EventEngine<D, Queue>::validate() {
   for (std::uint32_t i = 0; i < n; ++i) {
     const HotRecord<D>& h = hot_[i];
     const Vec<D> x = position_of(i, t);
-    for (int f = 0; f < 2 * D; ++f) {
-      if (!face_walls_.is_wall(f)) continue;
-      const double gap = face_walls_.gap(f, x, t);
+    for (int f = 0; f < boundaries_.surfaces(); ++f) {
+      if (!boundaries_.is_surface(f)) continue;
+      const double gap = boundaries_.gap(f, x, t);
       if (gap >= radius_of(i) * (1.0 - 1e-9)) continue;
       // A soft contact overlaps its wall while frozen and after its release, leaving; turned
       // back towards the wall (by a third body), it meets the wall now.
-      const double leaving = (f % 2 == 0 ? 1.0 : -1.0) *
-                             (velocity_of(i, t)[f / 2] - face_walls_.wall(f).velocity[f / 2]);
+      const double leaving =
+          dot(velocity_of(i, t) - boundaries_.velocity(f, x, t), boundaries_.normal(f, x, t));
       const bool soft_ok =
           soft_ && gap > 0.75 * radius_of(i) &&
           (soft_state_.partner(i) == wall_partner(f) || leaving >= 0.0 || queue_.time_of(i) <= t);
@@ -75,15 +75,16 @@ void EventEngine<D, Queue>::validate() {
     if (is_asleep(i)) continue;
     if (in_deferred_contact(i, t)) {  // frozen until the release, then as its record says
       const HotRecord<D>& h = hot_[i];
-      for (int f = 0; f < 2 * D; ++f) {
-        if (!face_walls_.is_wall(f)) continue;
-        if (face_walls_.event_time(f, position_of(i, t), frozen_velocity_of(i), radius_of(i), t,
+      for (int f = 0; f < boundaries_.surfaces(); ++f) {
+        if (!boundaries_.is_surface(f)) continue;
+        if (boundaries_.event_time(f, position_of(i, t), frozen_velocity_of(i), radius_of(i), t,
                                    h.time - t) < h.time - t)
           fail("particle " + name(i) + " meets wall " + std::to_string(f) +
                " inside its deferred soft contact");
         const double due =
-            h.time + face_walls_.event_time(f, h.pos, h.vel, radius_of(i), h.time, kNever);
-        const double speed = std::abs(h.vel[f / 2] - face_walls_.wall(f).velocity[f / 2]);
+            h.time + boundaries_.event_time(f, h.pos, h.vel, radius_of(i), h.time, kNever);
+        const double speed = std::abs(
+            dot(h.vel - boundaries_.velocity(f, h.pos, due), boundaries_.normal(f, h.pos, due)));
         if (std::isfinite(due) && late(queue_.time_of(i), due, speed))
           fail("particle " + name(i) + " meets wall " + std::to_string(f) +
                " after its deferred release before its pending event");
@@ -91,12 +92,13 @@ void EventEngine<D, Queue>::validate() {
       continue;
     }
     const Vec<D> x = position_of(i, t), v = velocity_of(i, t);
-    for (int f = 0; f < 2 * D; ++f) {
-      if (!face_walls_.is_wall(f)) continue;
-      const double due = t + face_walls_.event_time(f, x, v, radius_of(i), t, kNever);
-      const int a = f / 2;
+    for (int f = 0; f < boundaries_.surfaces(); ++f) {
+      if (!boundaries_.is_surface(f)) continue;
+      const double due = t + boundaries_.event_time(f, x, v, radius_of(i), t, kNever);
+      const Vec<D> x_due = x + (due - t) * v;  // near enough for the surface's normal there
       const double speed_at_contact =
-          std::abs(v[a] + env_.gravity[a] * (due - t) - face_walls_.wall(f).velocity[a]);
+          std::abs(dot(v + (due - t) * env_.gravity - boundaries_.velocity(f, x_due, due),
+                       boundaries_.normal(f, x_due, due)));
       if (std::isfinite(due) && late(queue_.time_of(i), due, speed_at_contact)) {
         fail("particle " + name(i) + " meets wall " + std::to_string(f) + " at " +
              std::to_string(due) + " before its pending event (at " +

@@ -1,0 +1,171 @@
+// Every boundary component of a run, behind one interface: the registry of boundary geometries
+// (docs/extending.md, "A boundary geometry").
+//
+// A component owns some contact surfaces (FaceWalls: the walls on the box's faces). Surfaces
+// are numbered across the components in the order of the registry below, and a wall event's
+// code names its surface (EventCode::wall). Each component provides, for its own surfaces s
+// (0 .. surfaces() - 1):
+//
+//   int surfaces() const;                       how many it owns (some may be absent: is_surface)
+//   bool is_surface(int s) const;               surface s exists in this run
+//   double event_time(int s, x, v, radius, t, horizon) const;
+//                                               when a particle (at x, velocity v at time t,
+//                                               under the uniform field) first touches it
+//   std::pair<double, int> next_contact(x, v, radius, cell, grid, t, horizon) const;
+//                                               the soonest of its surfaces a particle in `cell`
+//                                               can reach (its own filter by cells)
+//   double gap(int s, x, t) const;              centre to surface, positive inside
+//   Vec<D> normal(int s, x, t) const;           unit normal into the domain at x's contact point
+//   Vec<D> velocity(int s, x, t) const;         the surface's velocity there
+//   bool holds_still(int s) const;              never moves (a support resting particles sleep on)
+//   bool surface_moves(int s) const;            the surface itself moves through space (a piston,
+//                                               a vibration; not a plane sliding in itself)
+//   bool accelerates(int s) const;              its velocity changes (a vibration)
+//   ContactResult<D> resolve(int s, t, mass, radius, inertia_factor, force_elastic, v, w) const;
+//                                               the contact's response and its energy split
+//   bool overlaps(x, radius, t) const;          a particle overlaps one of its surfaces
+//   void check_start(x, radius, t, id) const;   throws InputError naming particle and surface
+//   double squeeze_time() const;                when moving surfaces leave no room (kNever)
+//
+// is made from the model as C(environment, box), and has no per-particle state (FaceWalls needs
+// none: its planes are functions of the time); a component with state (a wall with mass) adds its
+// restart data to ParticleSystem and its part of EventEngine::validate(). Dispatch is static (the
+// tuple below): no virtual call.
+#pragma once
+
+#include <cstdint>
+#include <tuple>
+#include <utility>
+
+#include "boundaries/face_walls.hpp"
+#include "core/environment.hpp"
+#include "scheduler/cell_grid.hpp"
+
+namespace kairos {
+
+template <int D>
+class Boundaries {
+ public:
+  // The registry: one line per boundary geometry.
+  using Components = std::tuple<FaceWalls<D>>;
+
+  Boundaries() = default;
+  // Every component made from the run's model: C(environment, box).
+  Boundaries(const Environment<D>& environment, const Vec<D>& box)
+      : components_(make(environment, box, static_cast<Components*>(nullptr))) {
+    for_each([&](const auto& c) {
+      any_ = any_ || c.any();
+      surfaces_ += c.surfaces();
+    });
+  }
+
+  bool any() const { return any_; }
+  int surfaces() const { return surfaces_; }
+  const FaceWalls<D>& faces() const { return std::get<FaceWalls<D>>(components_); }
+  FaceWalls<D>& faces() { return std::get<FaceWalls<D>>(components_); }
+
+  // f(component, first surface) for each component, in registry order.
+  template <class F>
+  void for_each(F&& f) const {
+    std::apply([&](const auto&... c) { (f(c), ...); }, components_);
+  }
+  template <class F>
+  void for_each(F&& f) {
+    std::apply([&](auto&... c) { (f(c), ...); }, components_);
+  }
+
+  // g(component, local surface) for surface s; returns what g returns.
+  template <class G>
+  decltype(auto) at(int s, G&& g) const {
+    return dispatch<0>(s, std::forward<G>(g));
+  }
+
+  bool is_surface(int s) const {
+    return at(s, [](const auto& c, int k) { return c.is_surface(k); });
+  }
+  double event_time(int s, const Vec<D>& x, const Vec<D>& v, double radius, double t,
+                    double horizon) const {
+    return at(s, [&](const auto& c, int k) { return c.event_time(k, x, v, radius, t, horizon); });
+  }
+  double gap(int s, const Vec<D>& x, double t) const {
+    return at(s, [&](const auto& c, int k) { return c.gap(k, x, t); });
+  }
+  Vec<D> normal(int s, const Vec<D>& x, double t) const {
+    return at(s, [&](const auto& c, int k) { return c.normal(k, x, t); });
+  }
+  Vec<D> velocity(int s, const Vec<D>& x, double t) const {
+    return at(s, [&](const auto& c, int k) { return c.velocity(k, x, t); });
+  }
+  bool holds_still(int s) const {
+    return at(s, [](const auto& c, int k) { return c.holds_still(k); });
+  }
+  bool surface_moves(int s) const {
+    return at(s, [](const auto& c, int k) { return c.surface_moves(k); });
+  }
+  bool accelerates(int s) const {
+    return at(s, [](const auto& c, int k) { return c.accelerates(k); });
+  }
+  ContactResult<D> resolve(int s, double t, double mass, double radius, double inertia_factor,
+                           bool force_elastic, Vec<D>& v, Spin<D>& w) const {
+    return at(s, [&](const auto& c, int k) {
+      return c.resolve(k, t, mass, radius, inertia_factor, force_elastic, v, w);
+    });
+  }
+  // Whether some surface moves (a sleeper predicts no events of its own and would not see it
+  // coming).
+  bool any_surface_moves() const {
+    bool moves = false;
+    for (int s = 0; s < surfaces_; ++s) moves = moves || (is_surface(s) && surface_moves(s));
+    return moves;
+  }
+  // The soonest contact of a particle in `cell` with any surface from time t before
+  // t + horizon: (relative time, surface), surface -1 if none.
+  std::pair<double, int> next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
+                                      CellCode cell, const CellGrid<D>& grid, double t,
+                                      double horizon) const {
+    std::pair<double, int> best{horizon, -1};
+    int first = 0;
+    for_each([&](const auto& c) {
+      const auto [dt, k] = c.next_contact(x, v, radius, cell, grid, t, best.first);
+      if (k >= 0 && dt < best.first) best = {dt, first + k};
+      first += c.surfaces();
+    });
+    return best;
+  }
+  bool overlaps(const Vec<D>& x, double radius, double t) const {
+    bool any = false;
+    for_each([&](const auto& c) { any = any || c.overlaps(x, radius, t); });
+    return any;
+  }
+  void check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const {
+    for_each([&](const auto& c) { c.check_start(x, radius, t, id); });
+  }
+  double squeeze_time() const {
+    double t = kNever;
+    for_each([&](const auto& c) { t = std::min(t, c.squeeze_time()); });
+    return t;
+  }
+
+ private:
+  template <class... C>
+  static std::tuple<C...> make(const Environment<D>& environment, const Vec<D>& box,
+                               std::tuple<C...>*) {
+    return std::tuple<C...>(C(environment, box)...);
+  }
+  template <std::size_t I, class G>
+  decltype(auto) dispatch(int s, G&& g) const {
+    const auto& c = std::get<I>(components_);
+    if constexpr (I + 1 == std::tuple_size_v<Components>) {
+      return g(c, s);
+    } else {
+      if (s < c.surfaces()) return g(c, s);
+      return dispatch<I + 1>(s - c.surfaces(), std::forward<G>(g));
+    }
+  }
+
+  Components components_;
+  bool any_ = false;
+  int surfaces_ = 0;
+};
+
+}  // namespace kairos
