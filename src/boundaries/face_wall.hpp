@@ -45,7 +45,7 @@ struct Wall {
                       : u;
   }
   // The wall's whole velocity at time t (sliding, along the normal, vibrating).
-  Vec<D> velocity_at(int face, double t) const {
+  Vec<D> surface_velocity(int face, double t) const {
     Vec<D> v = velocity;
     if (vibrates())
       v[face / 2] += amplitude * angular_frequency * std::cos(angular_frequency * t + phase);

@@ -78,7 +78,7 @@ ContactResult<D> FaceWalls<D>::resolve(int f, double t, double mass, double radi
   const Wall<D>& wall = faces_[f].wall;
   WallContactInput<D> in;
   in.normal = face_normal<D>(f);
-  in.wall_velocity = wall.velocity_at(f, t);
+  in.wall_velocity = wall.surface_velocity(f, t);
   in.mass = mass;
   in.radius = radius;
   in.inertia_factor = inertia_factor;

@@ -52,7 +52,7 @@ class FaceWalls {
   bool is_surface(int f) const { return is_wall(f); }
   Vec<D> normal(int f, const Vec<D>& /*x*/, double /*t*/) const { return face_normal<D>(f); }
   Vec<D> velocity(int f, const Vec<D>& /*x*/, double t) const {
-    return faces_[f].wall.velocity_at(f, t);
+    return faces_[f].wall.surface_velocity(f, t);
   }
   bool holds_still(int f) const {
     const Wall<D>& w = faces_[f].wall;

@@ -362,8 +362,8 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::advance_accelerated(HotRecord<D>& h, double t) const {
-  const Vec<D> x = position_at(h, t);
-  h.vel = velocity_at(h, t);
+  const Vec<D> x = flight_position(h, t);
+  h.vel = flight_velocity(h, t);
   h.pos = x;
   h.time = t;
 }
@@ -476,7 +476,7 @@ std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, 
   const CandidateScan<D> scan = scan_of(list, i, &delayed);
   std::uint32_t k;
   if (accelerated_) {
-    const Vec<D> vi = velocity_at(hot_[i], t);
+    const Vec<D> vi = flight_velocity(hot_[i], t);
     k = vector_scan_ ? scan_candidates_avx512<D, true>(scan, t, xi, vi, best)
                      : scan_candidates_scalar<D, true>(scan, t, xi, vi, best);
   } else {
@@ -508,7 +508,7 @@ double EventEngine<D, Queue>::predict_from(const CandidateList& list, std::uint3
   }
   const Crossing crossing = next_crossing(h);
   double best = crossing.time - t;
-  const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
+  const Vec<D> xi = accelerated_ ? flight_position(h, t) : h.pos + (t - h.time) * h.vel;
   std::uint32_t partner;
   if (stepped_ || (resting_.count() > 0 && resting_.any_of(list.ids.data(), list.count)) ||
       list.sheared) [[unlikely]] {
@@ -585,7 +585,7 @@ double EventEngine<D, Queue>::predict_after_crossing(std::uint32_t i, double t, 
   if (resting_.count() > 0 && resting_.any_of(list.ids.data(), list.count)) [[unlikely]]
     return predict(i, t);
   const Crossing crossing = next_crossing(h);
-  const Vec<D> xi = accelerated_ ? position_at(h, t) : h.pos + (t - h.time) * h.vel;
+  const Vec<D> xi = accelerated_ ? flight_position(h, t) : h.pos + (t - h.time) * h.vel;
   double soonest = kNever;
   std::uint32_t partner = test_candidates(list, i, t, xi, soonest);
   if (kept != kNoPartner && kept_dt < soonest) {
@@ -614,8 +614,8 @@ bool EventEngine<D, Queue>::kept_contact_time(std::uint32_t i, std::uint32_t p, 
   if (three_cell_axis_) return false;
   if (in_deferred_contact(p, t) || is_asleep(p)) [[unlikely]]
     return false;
-  const Vec<D> xi = accelerated_ ? position_at(hi, t) : hi.pos + (t - hi.time) * hi.vel;
-  const Vec<D> vi = accelerated_ ? velocity_at(hi, t) : hi.vel;
+  const Vec<D> xi = accelerated_ ? flight_position(hi, t) : hi.pos + (t - hi.time) * hi.vel;
+  const Vec<D> vi = accelerated_ ? flight_velocity(hi, t) : hi.vel;
   Vec<D> shift;
   for (int a = 0; a < D; ++a) {
     const int c = cells_.grid().coordinate(hi.cell, a) + d[a];
@@ -797,8 +797,7 @@ template <int D, class Queue>
 double EventEngine<D, Queue>::kinetic_energy() const {
   double ke = 0.0;
   if (accelerated_ || soft_state_.defers()) {
-    for (std::uint32_t i = 0; i < size(); ++i)
-      ke += 0.5 * mass_of(i) * norm2(velocity_of(i, time_));
+    for (std::uint32_t i = 0; i < size(); ++i) ke += 0.5 * mass_of(i) * norm2(velocity(i, time_));
     return ke;
   }
   for (std::uint32_t i = 0; i < size(); ++i) ke += 0.5 * mass_of(i) * norm2(hot_[i].vel);
@@ -810,8 +809,8 @@ double EventEngine<D, Queue>::peculiar_kinetic_energy() const {
   if (!sheared_) return kinetic_energy();
   double ke = 0.0;
   for (std::uint32_t i = 0; i < size(); ++i) {
-    const Vec<D> u = env_.streaming_velocity(position_of(i, time_), box_);
-    ke += 0.5 * mass_of(i) * norm2(velocity_of(i, time_) - u);
+    const Vec<D> u = env_.streaming_velocity(position(i, time_), box_);
+    ke += 0.5 * mass_of(i) * norm2(velocity(i, time_) - u);
   }
   return ke;
 }
@@ -829,7 +828,7 @@ double EventEngine<D, Queue>::rotational_energy() const {
 template <int D, class Queue>
 Vec<D> EventEngine<D, Queue>::momentum() const {
   Vec<D> p{};
-  for (std::uint32_t i = 0; i < size(); ++i) p = p + mass_of(i) * velocity_of(i, time_);
+  for (std::uint32_t i = 0; i < size(); ++i) p = p + mass_of(i) * velocity(i, time_);
   return p;
 }
 

@@ -124,8 +124,18 @@ class EventEngine {
   // at time t, with time() <= t <= next_event_time(), wakes it if it sleeps, invalidates
   // predictions made against it and re-predicts it. k is the engine's internal index: any
   // numbering serves a uniform random choice, and it is restored on resume.
-  Vec<D> velocity(std::uint32_t k, double t) const { return velocity_of(k, t); }
-  Vec<D> position(std::uint32_t k, double t) const { return position_of(k, t); }
+  // Where particle i (the engine's numbering) is and how it moves at time t (not before its local
+  // time, unless it sits in a deferred soft contact: then the frozen motion until the release).
+  Vec<D> position(std::uint32_t i, double t) const {
+    if (in_deferred_contact(i, t)) [[unlikely]]
+      return hot_[i].pos - (hot_[i].time - t) * frozen_velocity_of(i);
+    return is_asleep(i) ? hot_[i].pos : flight_position(hot_[i], t);
+  }
+  Vec<D> velocity(std::uint32_t i, double t) const {
+    if (in_deferred_contact(i, t)) [[unlikely]]
+      return frozen_velocity_of(i);
+    return is_asleep(i) ? Vec<D>{} : flight_velocity(hot_[i], t);
+  }
   double particle_mass(std::uint32_t k) const { return mass_of(k); }
   void set_velocity(std::uint32_t k, double t, const Vec<D>& v);
   // Moves the present to t without an event (time() <= t <= next_event_time()), for outputs at
@@ -181,7 +191,7 @@ class EventEngine {
   // Positions at the current time, wrapped into the box, in the caller's numbering.
   std::vector<Vec<D>> current_positions() const;
   // Velocities at the current time, in the caller's numbering: export_state()'s
-  // velocity_at(i, time()) to the bit, without copying the rest of the state.
+  // flight_velocity(i, time()) to the bit, without copying the rest of the state.
   std::vector<Vec<D>> current_velocities() const;
   std::vector<double> masses() const;  // in the caller's numbering
   // current_positions(), current_velocities() and the masses of the caller's particles, in
@@ -232,8 +242,10 @@ class EventEngine {
   std::uint32_t species_of(std::uint32_t i) const {
     return shapes_[shape_.empty() ? 0 : shape_[i]].species;
   }
-  Vec<D> position_at(const HotRecord<D>& h, double t) const;
-  Vec<D> velocity_at(const HotRecord<D>& h, double t) const;
+  // Where a record's free flight (a straight line, or a parabola under gravity) is at time t:
+  // the record alone, whether the particle sleeps or sits in a deferred contact or not.
+  Vec<D> flight_position(const HotRecord<D>& h, double t) const;
+  Vec<D> flight_velocity(const HotRecord<D>& h, double t) const;
   // The particle's soonest wall contact from time t before t + horizon: (relative time, face).
   std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
   void hit_wall(std::uint32_t i, int surface, double t);
@@ -241,18 +253,6 @@ class EventEngine {
   [[noreturn]] void throw_squeezed(double t) const;
   // Sleeping particles (gravity with walls): see Environment::sleep_speed.
   bool is_asleep(std::uint32_t i) const { return resting_.asleep(i); }
-  // Where particle i is and how it moves at time t (not before its local time, unless it sits
-  // in a deferred soft contact: then the frozen motion until the release).
-  Vec<D> position_of(std::uint32_t i, double t) const {
-    if (in_deferred_contact(i, t)) [[unlikely]]
-      return hot_[i].pos - (hot_[i].time - t) * frozen_velocity_of(i);
-    return is_asleep(i) ? hot_[i].pos : position_at(hot_[i], t);
-  }
-  Vec<D> velocity_of(std::uint32_t i, double t) const {
-    if (in_deferred_contact(i, t)) [[unlikely]]
-      return frozen_velocity_of(i);
-    return is_asleep(i) ? Vec<D>{} : velocity_at(hot_[i], t);
-  }
   void add_virial_tensor(const Vec<D>& r, const Vec<D>& impulse);
   void fall_asleep(std::uint32_t i, double t);
   void wake(std::uint32_t i, double t);
@@ -482,7 +482,7 @@ inline void EventEngine<D, Queue>::advance_to(std::uint32_t i, double t) {
 // Where a record's particle is at time t: a straight line, or a parabola under gravity. The
 // candidate loops evaluate the same expressions in the same order.
 template <int D, class Queue>
-inline Vec<D> EventEngine<D, Queue>::position_at(const HotRecord<D>& h, double t) const {
+inline Vec<D> EventEngine<D, Queue>::flight_position(const HotRecord<D>& h, double t) const {
   const double dt = t - h.time;
   Vec<D> x;
   for (int a = 0; a < D; ++a) {
@@ -493,7 +493,7 @@ inline Vec<D> EventEngine<D, Queue>::position_at(const HotRecord<D>& h, double t
 }
 
 template <int D, class Queue>
-inline Vec<D> EventEngine<D, Queue>::velocity_at(const HotRecord<D>& h, double t) const {
+inline Vec<D> EventEngine<D, Queue>::flight_velocity(const HotRecord<D>& h, double t) const {
   if (!accelerated_) return h.vel;
   const double dt = t - h.time;
   Vec<D> v;

@@ -148,8 +148,8 @@ template <int D, class Queue>
 std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i, double t,
                                                                 double horizon) const {
   const HotRecord<D>& h = hot_[i];
-  return boundaries_.next_contact(position_at(h, t), velocity_at(h, t), radius_of(i), h.cell,
-                                  cells_.grid(), t, horizon);
+  return boundaries_.next_contact(flight_position(h, t), flight_velocity(h, t), radius_of(i),
+                                  h.cell, cells_.grid(), t, horizon);
 }
 
 // A particle meets a wall: the wall is a partner of infinite mass moving with its velocity
@@ -232,7 +232,7 @@ double EventEngine<D, Queue>::settle_after_contact(std::uint32_t i, const Vec<D>
 // sequence. (Called before the particle is advanced to t.)
 template <int D, class Queue>
 bool EventEngine<D, Queue>::wedged(std::uint32_t i, double t) const {
-  const double moved = (t - hot_[i].time) * std::sqrt(norm2(velocity_of(i, t)));
+  const double moved = (t - hot_[i].time) * std::sqrt(norm2(velocity(i, t)));
   return Resting::wedged(moved, radius_of(i));
 }
 
@@ -248,7 +248,7 @@ double EventEngine<D, Queue>::spin_energy(std::uint32_t i) const {
 template <int D, class Queue>
 bool EventEngine<D, Queue>::resting_on_support(std::uint32_t i, double t) {
   const double eps = resting_.support_distance(radius_of(i));
-  const Vec<D> x = position_of(i, t);
+  const Vec<D> x = position(i, t);
   for (int s = 0; s < boundaries_.surfaces(); ++s) {
     if (!boundaries_.is_surface(s) || !boundaries_.holds_still(s)) continue;
     if (resting_.holds_up(boundaries_.normal(s, x, t)) &&
@@ -311,16 +311,16 @@ void EventEngine<D, Queue>::collide_with_sleeper(std::uint32_t i, std::uint32_t 
 template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::scan_with_sleepers(const CandidateList& list, std::uint32_t i,
                                                         double t, double& best) const {
-  const Vec<D> xi = position_of(i, t), vi = velocity_of(i, t);
+  const Vec<D> xi = position(i, t), vi = velocity(i, t);
   const bool si = is_asleep(i);
   std::uint32_t found = kNoPartner;
   for (std::uint32_t k = 0; k < list.count; ++k) {
     const std::uint32_t j = list.ids[k];
     const bool sj = is_asleep(j);
     if (j == i || (si && sj)) continue;  // sleepers never meet each other
-    Vec<D> r = xi - position_of(j, t);
+    Vec<D> r = xi - position(j, t);
     if (list.n_shifts > 1) r = r - list.shifts[list.shift[k]];
-    const Vec<D> g = vi - velocity_of(j, t);
+    const Vec<D> g = vi - velocity(j, t);
     // Relative acceleration: gravity acts on the awake one of a mixed pair.
     const Vec<D> accel = sj ? env_.gravity : (si ? -1.0 * env_.gravity : Vec<D>{});
     const double sigma = radius_of(i) + radius_of(j);

@@ -69,12 +69,12 @@ void EventEngine<D, Queue>::gather_sheared(CellCode cell, CandidateList& list) {
 template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::scan_sheared(const CandidateList& list, std::uint32_t i,
                                                   double t, double& best) const {
-  const Vec<D> xi = position_at(hot_[i], t), vi = hot_[i].vel;
+  const Vec<D> xi = flight_position(hot_[i], t), vi = hot_[i].vel;
   std::uint32_t found = kNoPartner;
   for (std::uint32_t k = 0; k < list.count; ++k) {
     const std::uint32_t j = list.ids[k];
     const std::uint32_t tag = list.shift[k];
-    const Vec<D> r = xi - (position_at(hot_[j], t) + list.shifts[tag]);
+    const Vec<D> r = xi - (flight_position(hot_[j], t) + list.shifts[tag]);
     const Vec<D> g = vi - (hot_[j].vel + list.velocity_shifts[tag]);
     const double dt = pair_contact_time<D>(r.data(), g.data(), radius_of(i) + radius_of(j));
     if (dt < best) {
@@ -89,8 +89,7 @@ std::uint32_t EventEngine<D, Queue>::scan_sheared(const CandidateList& list, std
 template <int D, class Queue>
 Vec<D> EventEngine<D, Queue>::sheared_separation(std::uint32_t i, std::uint32_t j, double t,
                                                  Vec<D>& image_velocity) const {
-  return shear_.separation(position_of(i, t) - position_of(j, t), t, periodic_axes(),
-                           image_velocity);
+  return shear_.separation(position(i, t) - position(j, t), t, periodic_axes(), image_velocity);
 }
 
 // A collision under shear: the impulse is the ordinary one between i and the image of j it

@@ -134,7 +134,7 @@ void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
     const HotRecord<D>& h = hot_[k];
     out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};
     if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
-      out.kinematics[c] = {position_of(k, time_), frozen_velocity_of(k), time_, sh.radius};
+      out.kinematics[c] = {position(k, time_), frozen_velocity_of(k), time_, sh.radius};
     if (resting_.count() > 0) out.asleep[c] = resting_.flag(k);
   }
   if ((fields & Blocks::kIdentity) != 0) {
@@ -159,7 +159,7 @@ template <int D, class Queue>
 std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
   std::vector<Vec<D>> out(size());
   for (std::uint32_t i = 0; i < size(); ++i) {
-    Vec<D> x = position_of(i, time_);
+    Vec<D> x = position(i, time_);
     for (int a = 0; a < D; ++a)
       if (cells_.grid().periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
     out[id_[i]] = x;
@@ -180,11 +180,11 @@ void EventEngine<D, Queue>::for_each_block(const BlockVisitor& f, bool with_posi
       const std::uint32_t k = order.members[e];
       const std::size_t j = id_[k] - first;
       if (with_positions) {
-        x[j] = position_of(k, time_);  // as current_positions()
+        x[j] = position(k, time_);  // as current_positions()
         for (int a = 0; a < D; ++a)
           if (cells_.grid().periodic(a)) x[j][a] = wrap_into_box(x[j][a], box_[a]);
       }
-      v[j] = velocity_of(k, time_);
+      v[j] = velocity(k, time_);
       m[j] = mass_of(k);
     }
     f(first, {x.data(), with_positions ? count : 0}, {v.data(), count}, {m.data(), count});
@@ -194,7 +194,7 @@ void EventEngine<D, Queue>::for_each_block(const BlockVisitor& f, bool with_posi
 template <int D, class Queue>
 std::vector<Vec<D>> EventEngine<D, Queue>::current_velocities() const {
   std::vector<Vec<D>> out(size());
-  for (std::uint32_t i = 0; i < size(); ++i) out[id_[i]] = velocity_of(i, time_);
+  for (std::uint32_t i = 0; i < size(); ++i) out[id_[i]] = velocity(i, time_);
   return out;
 }
 

@@ -24,7 +24,7 @@ constexpr std::uint32_t kNoPartner = EventSlot::kNoPartner;
 
 template <int D, class Queue>
 Vec<D> EventEngine<D, Queue>::separation(std::uint32_t i, std::uint32_t j, double t) const {
-  Vec<D> r = position_of(i, t) - position_of(j, t);
+  Vec<D> r = position(i, t) - position(j, t);
   for (int a = 0; a < D; ++a)
     if (cells_.grid().periodic(a)) r[a] = minimum_image(r[a], box_[a]);
   return r;
@@ -86,7 +86,7 @@ void EventEngine<D, Queue>::init_zones(const ParticleSystem<D>& s, StartMode mod
   for (std::uint32_t i = 0; i < n; ++i) {
     gather(hot_[i].cell, cells_.list(0));
     const CandidateList& list = cells_.list(0);
-    const Vec<D> xi = position_of(i, time_);
+    const Vec<D> xi = position(i, time_);
     for (std::uint32_t k = 0; k < list.count; ++k) {
       const std::uint32_t j = list.ids[k];
       if (j <= i) continue;
@@ -95,7 +95,7 @@ void EventEngine<D, Queue>::init_zones(const ParticleSystem<D>& s, StartMode mod
           steps_.find(i, j, PairSteps::kHard).table != PairSteps::kHard)
         continue;  // no steps, or bonded
       const Vec<D>& shift = list.n_shifts > 1 ? list.shifts[list.shift[k]] : no_shift;
-      const double r2 = norm2(xi - (position_of(j, time_) + shift));
+      const double r2 = norm2(xi - (position(j, time_) + shift));
       const std::uint16_t zone = steps_.table(table).zone_at(r2);
       if (zone > 0) steps_.set(i, j, {table, zone});
     }
@@ -130,7 +130,7 @@ std::uint32_t EventEngine<D, Queue>::scan_stepped(const CandidateList& list, std
                       .table_offset = steps_.tables() > 1 ? steps_.table_offset() : nullptr,
                       .tables = &steps_.table(0)};
   const HotRecord<D>& h = hot_[i];
-  const Vec<D> xi = position_at(h, t), vi = velocity_at(h, t);
+  const Vec<D> xi = flight_position(h, t), vi = flight_velocity(h, t);
   std::uint32_t k;
   if (vector_scan_) {
     step_scratch_.hold(scan, list.count);

@@ -36,7 +36,7 @@ void EventEngine<D, Queue>::validate() {
   cells_.validate(hot_.data(), n, fail, name);  // the cell lists
   for (std::uint32_t i = 0; i < n; ++i) {
     const HotRecord<D>& h = hot_[i];
-    const Vec<D> x = position_of(i, t);
+    const Vec<D> x = position(i, t);
     for (int f = 0; f < boundaries_.surfaces(); ++f) {
       if (!boundaries_.is_surface(f)) continue;
       const double gap = boundaries_.gap(f, x, t);
@@ -44,7 +44,7 @@ void EventEngine<D, Queue>::validate() {
       // A soft contact overlaps its wall while frozen and after its release, leaving; turned
       // back towards the wall (by a third body), it meets the wall now.
       const double leaving =
-          dot(velocity_of(i, t) - boundaries_.velocity(f, x, t), boundaries_.normal(f, x, t));
+          dot(velocity(i, t) - boundaries_.velocity(f, x, t), boundaries_.normal(f, x, t));
       const bool soft_ok =
           soft_ && gap > 0.75 * radius_of(i) &&
           (soft_state_.partner(i) == wall_partner(f) || leaving >= 0.0 || queue_.time_of(i) <= t);
@@ -77,7 +77,7 @@ void EventEngine<D, Queue>::validate() {
       const HotRecord<D>& h = hot_[i];
       for (int f = 0; f < boundaries_.surfaces(); ++f) {
         if (!boundaries_.is_surface(f)) continue;
-        if (boundaries_.event_time(f, position_of(i, t), frozen_velocity_of(i), radius_of(i), t,
+        if (boundaries_.event_time(f, position(i, t), frozen_velocity_of(i), radius_of(i), t,
                                    h.time - t) < h.time - t)
           fail("particle " + name(i) + " meets wall " + std::to_string(f) +
                " inside its deferred soft contact");
@@ -91,7 +91,7 @@ void EventEngine<D, Queue>::validate() {
       }
       continue;
     }
-    const Vec<D> x = position_of(i, t), v = velocity_of(i, t);
+    const Vec<D> x = position(i, t), v = velocity(i, t);
     for (int f = 0; f < boundaries_.surfaces(); ++f) {
       if (!boundaries_.is_surface(f)) continue;
       const double due = t + boundaries_.event_time(f, x, v, radius_of(i), t, kNever);
@@ -203,7 +203,7 @@ void EventEngine<D, Queue>::validate() {
   auto check_covered = [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, const char* which,
                            const Vec<D>& image_velocity = Vec<D>{}) {
     if (is_asleep(i) && is_asleep(j)) return;  // neither moves
-    const Vec<D> g = velocity_of(i, t) - (velocity_of(j, t) + image_velocity);
+    const Vec<D> g = velocity(i, t) - (velocity(j, t) + image_velocity);
     Vec<D> accel{};
     if (is_asleep(j)) accel = env_.gravity;
     if (is_asleep(i)) accel = -1.0 * env_.gravity;
@@ -251,7 +251,7 @@ void EventEngine<D, Queue>::validate() {
     }
   };
   for (std::uint32_t i = 0; i < n; ++i) {
-    const Vec<D> xi = position_of(i, t);
+    const Vec<D> xi = position(i, t);
     const std::uint32_t ci = hot_[i].cell;
     for (std::uint32_t j = i + 1; j < n; ++j) {
       const double sigma = radius_of(i) + radius_of(j);
@@ -263,7 +263,7 @@ void EventEngine<D, Queue>::validate() {
         check_covered(i, j, r, "sheared image", u);
         continue;
       }
-      const Vec<D> raw = xi - position_of(j, t);
+      const Vec<D> raw = xi - position(j, t);
       // The image the engine tests (neighbouring cells).
       std::array<int, D> d;
       if (cells_.grid().neighbour_offset(ci, hot_[j].cell, d)) {
@@ -281,10 +281,9 @@ void EventEngine<D, Queue>::validate() {
       if (norm2(r) < sigma * sigma * (1.0 - 1e-9)) {
         // Soft spheres overlap while frozen in a contact and after its release, receding; an
         // approaching overlap must collide now (check_covered).
-        const bool soft_ok =
-            soft_ && norm2(r) > 0.5625 * sigma * sigma &&
-            (frozen_pair(i, j) || dot(r, velocity_of(i, t) - velocity_of(j, t)) >= 0.0 ||
-             std::min(queue_.time_of(i), queue_.time_of(j)) <= t);
+        const bool soft_ok = soft_ && norm2(r) > 0.5625 * sigma * sigma &&
+                             (frozen_pair(i, j) || dot(r, velocity(i, t) - velocity(j, t)) >= 0.0 ||
+                              std::min(queue_.time_of(i), queue_.time_of(j)) <= t);
         if (!soft_ok) fail("particles " + name(i) + " and " + name(j) + " overlap");
       }
       check_covered(i, j, r, "nearest image");
