@@ -4,12 +4,41 @@
 #pragma once
 
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/choices.hpp"
 #include "interactions/step_potential.hpp"
 
 namespace kairos {
+
+// The kinds of potentials, by the names potential[].kind / bond[].kind take (potential_kinds()).
+enum class PotentialKind {
+  kSquareWell,
+  kSquareShoulder,
+  kSteps,
+  kLennardJones,
+  kWca,
+  kYukawa,
+  kMorse,
+  kTabulated,
+  kSpringDashpot,
+  kTether,  // bonds: the pair can never part beyond the table
+  kSpring,
+};
+
+// Every kind; the nine of [[potential]] (pair potentials); the two of [[bond]].
+const Choices<PotentialKind>& potential_kinds();
+const Choices<PotentialKind>& pair_potential_kinds();
+const Choices<PotentialKind>& bond_potential_kinds();
+// potential[].placement and potential[].shell_energy.
+const Choices<StepPlacement>& step_placements();
+const Choices<StepEnergyRule>& step_energy_rules();
+
+bool is_bond(PotentialKind kind);        // tether, spring
+bool is_continuous(PotentialKind kind);  // stepped from a continuous U(r)
+bool uses_epsilon(PotentialKind kind);   // lennard_jones, wca, yukawa, morse
 
 struct PotentialSpec {
   // square_well | square_shoulder | steps | lennard_jones | wca | yukawa | morse | tabulated |
@@ -39,18 +68,20 @@ struct PotentialSpec {
   double max_length = 0.0;
   double stiffness = 0.0;
   double length = 0.0;
-  // Stepping of continuous potentials (formulas.md §4.1): number of steps (for ΔU placement:
-  // steps on the attractive branch, the repulsive branch continuing in the same ΔU down to the
-  // core), placement energy | distance | volume, shell energies midpoint | volume | mid_volume
-  // | virial (at `temperature`).
+  // Stepping of continuous potentials (Thomson, Lue and Bannerman's mapping; docs/config.md):
+  // number of steps (for ΔU placement: steps on the attractive branch, the repulsive branch
+  // continuing in the same ΔU down to the core), placement energy | distance | volume (names:
+  // step_placements()), shell energies midpoint | volume | mid_volume | virial (at
+  // `temperature`; step_energy_rules()).
   int steps = 10;
   std::string placement = "energy";
   std::string shell_energy = "volume";
   double temperature = 1.0;
-  // spring_dashpot (formulas.md §4.3): a repulsive spring (stiffness, from `length` in) in
-  // `steps` equal steps with a dashpot per step: damping gamma, or the head-on restitution e of
-  // the continuous spring-dashpot (> 0: gamma from the closed form of §2.1 for the pair's
-  // reduced mass); force_zero: no net attraction while separating (false: the naive dashpot).
+  // spring_dashpot (Bannerman et al., J. Comput. Chem. 32, 3329 (2011)): a repulsive spring
+  // (stiffness, from `length` in) in `steps` equal steps with a dashpot per step: damping gamma,
+  // or the head-on restitution e of the continuous spring-dashpot (> 0: gamma from its closed
+  // form, Schwager and Pöschel, Phys. Rev. E 78, 051304 (2008), for the pair's reduced mass);
+  // force_zero: no net attraction while separating (false: the naive dashpot).
   double damping = 0.0;
   double restitution = 0.0;  // 0: not given
   bool force_zero = true;
@@ -103,8 +134,8 @@ ContinuousPotential continuous_potential(const PotentialSpec& spec);
 // InputError like continuous_potential for the parameters it needs.
 double table_cutoff(const PotentialSpec& spec, double core);
 
-// "energy" | "distance" | "volume", and "midpoint" | "volume" | "mid_volume" | "virial"; throw
-// InputError listing the accepted names.
+// "energy" | "distance" | "volume", and "midpoint" | "volume" | "mid_volume" | "virial"
+// (step_placements(), step_energy_rules()); throw InputError listing the accepted names.
 StepPlacement parse_step_placement(const std::string& name);
 StepEnergyRule parse_step_energy_rule(const std::string& name);
 

@@ -1,7 +1,8 @@
 // Run configuration: TOML parsing, command-line overrides, validation and serialisation.
 //
-// The schema (kSchema) drives the unknown-key checks, the "did you mean" suggestions and the
-// override coercions; reading and range checks are spelled out per section below. Every error is
+// The declarations of io/config_keys.hpp drive the unknown-key checks, the "did you mean"
+// suggestions, the override coercions, the typed reading and range checks of every key with a
+// member, and the writing; the rules between keys are spelled out per section below. Every error is
 // an InputError with a one-line message "WHERE: KEY: PROBLEM", WHERE being "file:line:column",
 // "file" or "override 'key=value'".
 #include "io/config.hpp"
@@ -32,207 +33,21 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "io/config_choices.hpp"
+#include "io/config_keys.hpp"
 
 namespace kairos {
 namespace {
 
-// ---------------------------------------------------------------------------------------------
-// Schema
-
-// kArray: an array of values (numbers, strings or number pairs), read as a whole.
-enum class Kind { kTable, kTableArray, kInteger, kUnsigned, kFloat, kString, kBoolean, kArray };
-
-struct KeySpec {
-  std::string_view path;  // dotted; elements of an array of tables are written "[]"
-  Kind kind;
-};
-
-constexpr KeySpec kSchema[] = {
-    {"system", Kind::kTable},
-    {"system.dimension", Kind::kInteger},
-    {"system.particles", Kind::kUnsigned},
-    {"system.packing_fraction", Kind::kFloat},
-    {"system.lattice", Kind::kString},
-    {"system.temperature", Kind::kFloat},
-    {"system.seed", Kind::kUnsigned},
-    {"system.species", Kind::kTableArray},
-    {"system.species[]", Kind::kTable},
-    {"system.species[].name", Kind::kString},
-    {"system.species[].diameter", Kind::kFloat},
-    {"system.species[].mass", Kind::kFloat},
-    {"system.species[].fraction", Kind::kFloat},
-    {"system.species[].inertia_factor", Kind::kFloat},
-    {"system.initial_state", Kind::kString},
-    {"system.box_scale", Kind::kArray},
-    {"system.chain_length", Kind::kUnsigned},
-    {"system.chain_spacing", Kind::kFloat},
-    {"potential", Kind::kTableArray},
-    {"potential[]", Kind::kTable},
-    {"potential[].species", Kind::kArray},
-    {"potential[].kind", Kind::kString},
-    {"potential[].lambda", Kind::kFloat},
-    {"potential[].depth", Kind::kFloat},
-    {"potential[].boundaries", Kind::kArray},
-    {"potential[].energies", Kind::kArray},
-    {"potential[].epsilon", Kind::kFloat},
-    {"potential[].sigma", Kind::kFloat},
-    {"potential[].cutoff", Kind::kFloat},
-    {"potential[].shifted", Kind::kBoolean},
-    {"potential[].kappa", Kind::kFloat},
-    {"potential[].alpha", Kind::kFloat},
-    {"potential[].r_min", Kind::kFloat},
-    {"potential[].file", Kind::kString},
-    {"potential[].max_length", Kind::kFloat},
-    {"potential[].stiffness", Kind::kFloat},
-    {"potential[].length", Kind::kFloat},
-    {"potential[].steps", Kind::kInteger},
-    {"potential[].placement", Kind::kString},
-    {"potential[].shell_energy", Kind::kString},
-    {"potential[].temperature", Kind::kFloat},
-    {"bond", Kind::kTableArray},
-    {"bond[]", Kind::kTable},
-    {"bond[].type", Kind::kString},
-    {"bond[].kind", Kind::kString},
-    {"bond[].lambda", Kind::kFloat},
-    {"bond[].depth", Kind::kFloat},
-    {"bond[].boundaries", Kind::kArray},
-    {"bond[].energies", Kind::kArray},
-    {"bond[].epsilon", Kind::kFloat},
-    {"bond[].sigma", Kind::kFloat},
-    {"bond[].cutoff", Kind::kFloat},
-    {"bond[].shifted", Kind::kBoolean},
-    {"bond[].kappa", Kind::kFloat},
-    {"bond[].alpha", Kind::kFloat},
-    {"bond[].r_min", Kind::kFloat},
-    {"bond[].file", Kind::kString},
-    {"bond[].max_length", Kind::kFloat},
-    {"bond[].stiffness", Kind::kFloat},
-    {"bond[].length", Kind::kFloat},
-    {"bond[].steps", Kind::kInteger},
-    {"bond[].placement", Kind::kString},
-    {"bond[].shell_energy", Kind::kString},
-    {"bond[].temperature", Kind::kFloat},
-    {"contact", Kind::kTable},
-    {"contact.restitution", Kind::kFloat},
-    {"contact.restitution_model", Kind::kString},
-    {"contact.restitution_speed", Kind::kFloat},
-    {"contact.restitution_table", Kind::kArray},
-    {"contact.tangential_restitution", Kind::kFloat},
-    {"contact.friction", Kind::kFloat},
-    {"contact.elastic_below_speed", Kind::kFloat},
-    {"contact.tc", Kind::kFloat},
-    {"contact.sleep_speed", Kind::kFloat},
-    {"contact.pair", Kind::kTableArray},
-    {"contact.pair[]", Kind::kTable},
-    {"contact.pair[].species", Kind::kArray},
-    {"contact.pair[].restitution", Kind::kFloat},
-    {"contact.pair[].restitution_model", Kind::kString},
-    {"contact.pair[].restitution_speed", Kind::kFloat},
-    {"contact.pair[].restitution_table", Kind::kArray},
-    {"contact.pair[].tangential_restitution", Kind::kFloat},
-    {"contact.pair[].friction", Kind::kFloat},
-    {"contact.pair[].elastic_below_speed", Kind::kFloat},
-    {"boundary", Kind::kTable},
-    {"boundary.open", Kind::kArray},
-    {"boundary.shear_rate", Kind::kFloat},
-    {"boundary.wall", Kind::kTableArray},
-    {"boundary.wall[]", Kind::kTable},
-    {"boundary.wall[].face", Kind::kString},
-    {"boundary.wall[].restitution", Kind::kFloat},
-    {"boundary.wall[].restitution_model", Kind::kString},
-    {"boundary.wall[].restitution_speed", Kind::kFloat},
-    {"boundary.wall[].restitution_table", Kind::kArray},
-    {"boundary.wall[].tangential_restitution", Kind::kFloat},
-    {"boundary.wall[].friction", Kind::kFloat},
-    {"boundary.wall[].elastic_below_speed", Kind::kFloat},
-    {"boundary.wall[].velocity", Kind::kArray},
-    {"boundary.wall[].amplitude", Kind::kFloat},
-    {"boundary.wall[].frequency", Kind::kFloat},
-    {"boundary.wall[].phase", Kind::kFloat},
-    {"driving", Kind::kTable},
-    {"driving.kind", Kind::kString},
-    {"driving.rate", Kind::kFloat},
-    {"driving.temperature", Kind::kFloat},
-    {"driving.strength", Kind::kFloat},
-    {"field", Kind::kTable},
-    {"field.gravity", Kind::kArray},
-    {"run", Kind::kTable},
-    {"run.equilibration_collisions_per_particle", Kind::kFloat},
-    {"run.collisions_per_particle", Kind::kFloat},
-    {"run.time", Kind::kFloat},
-    {"run.equilibration_time", Kind::kFloat},
-    {"run.event_queue", Kind::kString},
-    {"run.max_wall_seconds", Kind::kFloat},
-    {"run.validate", Kind::kBoolean},
-    {"run.integrator", Kind::kString},
-    {"run.time_step", Kind::kFloat},
-    {"soft", Kind::kTable},
-    {"soft.collisions", Kind::kString},
-    {"soft.tables", Kind::kBoolean},
-    {"soft.table_tolerance", Kind::kFloat},
-    {"soft.table_cache", Kind::kString},
-    {"soft.defer_releases", Kind::kBoolean},
-    {"soft.model", Kind::kString},
-    {"soft.stiffness", Kind::kFloat},
-    {"soft.damping", Kind::kFloat},
-    {"soft.young", Kind::kFloat},
-    {"soft.poisson", Kind::kFloat},
-    {"soft.dissipation", Kind::kFloat},
-    {"soft.restitution", Kind::kFloat},
-    {"soft.restitution_speed", Kind::kFloat},
-    {"soft.friction", Kind::kFloat},
-    {"soft.tangential_stiffness", Kind::kFloat},
-    {"soft.tangential_damping", Kind::kFloat},
-    {"soft.pair", Kind::kTableArray},
-    {"soft.pair[]", Kind::kTable},
-    {"soft.pair[].species", Kind::kArray},
-    {"soft.pair[].model", Kind::kString},
-    {"soft.pair[].stiffness", Kind::kFloat},
-    {"soft.pair[].damping", Kind::kFloat},
-    {"soft.pair[].young", Kind::kFloat},
-    {"soft.pair[].poisson", Kind::kFloat},
-    {"soft.pair[].dissipation", Kind::kFloat},
-    {"soft.pair[].restitution", Kind::kFloat},
-    {"soft.pair[].restitution_speed", Kind::kFloat},
-    {"soft.pair[].friction", Kind::kFloat},
-    {"soft.pair[].tangential_stiffness", Kind::kFloat},
-    {"soft.pair[].tangential_damping", Kind::kFloat},
-    {"output", Kind::kTable},
-    {"output.directory", Kind::kString},
-    {"output.thermo_interval", Kind::kFloat},
-    {"output.trajectory_interval", Kind::kFloat},
-    {"output.restart_interval", Kind::kFloat},
-    {"output.interval_unit", Kind::kString},
-    {"output.trajectory", Kind::kBoolean},
-    {"output.progress", Kind::kString},
-    {"output.profile_axis", Kind::kString},
-    {"output.profile_bins", Kind::kInteger},
-    // After contact.* and soft.*: an unknown 'restitution' elsewhere is suggested those first.
-    {"potential[].damping", Kind::kFloat},
-    {"potential[].restitution", Kind::kFloat},
-    {"potential[].force_zero", Kind::kBoolean},
-};
-
 constexpr std::uint64_t kMaxParticles = (std::uint64_t{1} << 31) - 1;
-constexpr std::string_view kLattices3D[] = {"fcc", "sc", "bcc", "random"};
-constexpr std::string_view kLattices2D[] = {"hex", "square", "random"};
-constexpr std::string_view kEventQueues[] = {"calendar", "heap", "tree"};
-constexpr std::string_view kProgressModes[] = {"auto", "always", "never"};
-constexpr std::string_view kIntervalUnits[] = {"collisions", "time"};
-constexpr std::string_view kDrivingKinds[] = {"none", "andersen", "white_noise"};
-constexpr std::string_view kIntegrators[] = {"event", "dem"};
-constexpr std::string_view kSoftModels[] = {"dashpot", "hertz"};
-constexpr std::string_view kSoftCollisions[] = {"mapped", "instantaneous"};
-constexpr std::string_view kRestitutionModels[] = {"constant", "viscoelastic", "table"};
-// Box faces: 2k is the low face of axis k, 2k + 1 the high one.
-constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
-constexpr std::string_view kAxes[] = {"x", "y", "z"};
-constexpr std::string_view kPairPotentials[] = {
-    "square_well", "square_shoulder", "steps",     "lennard_jones", "wca",
-    "yukawa",      "morse",           "tabulated", "spring_dashpot"};
-constexpr std::string_view kBondPotentials[] = {"tether", "spring"};
-constexpr std::string_view kPlacements[] = {"energy", "distance", "volume"};
-constexpr std::string_view kShellEnergies[] = {"midpoint", "volume", "mid_volume", "virial"};
+
+// The name of face number f (2k: the low face of axis k, 2k + 1 the high one), and of axis k.
+std::string_view face_name(std::size_t f) {
+  return box_faces().entries()[f].name;
+}
+std::string_view axis_name(std::size_t k) {
+  return axes().entries()[k].name;
+}
 
 // A key or value as echoed in a message: at most kShownLength characters of it (a megabyte of
 // key would flood the terminal), with its length when cut.
@@ -259,6 +74,13 @@ bool contains(std::span<const std::string_view> words, std::string_view w) {
   return std::find(words.begin(), words.end(), w) != words.end();
 }
 
+template <class E>
+std::vector<std::string_view> choice_names(const Choices<E>& choices) {
+  std::vector<std::string_view> out;
+  for (const ChoiceEntry<E>& e : choices.entries()) out.push_back(e.name);
+  return out;
+}
+
 bool is_bare_key(std::string_view key) {
   return !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-';
@@ -269,26 +91,6 @@ bool is_digits(std::string_view s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
     return std::isdigit(static_cast<unsigned char>(c)) != 0;
   });
-}
-
-// "system.species[3].name" -> "system.species[].name"
-std::string schema_path(std::string_view path) {
-  std::string out;
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    out += path[i];
-    if (path[i] == '[') {
-      while (i + 1 < path.size() && path[i + 1] != ']') ++i;
-    }
-  }
-  return out;
-}
-
-const KeySpec* find_spec(std::string_view path) {
-  const std::string schema = schema_path(path);
-  for (const KeySpec& spec : kSchema) {
-    if (spec.path == schema) return &spec;
-  }
-  return nullptr;
 }
 
 bool same_ignoring_case(std::string_view a, std::string_view b) {
@@ -328,11 +130,11 @@ std::string suggestion(std::string_view unknown) {
   // ("contact.pair[2].x" -> "contact.pair[2].*"), else for element 0 ("system.species.name" ->
   // "system.species[0].name").
   std::vector<std::string> candidates;
-  for (const KeySpec& spec : kSchema) {
-    std::string candidate(spec.path);
+  for (const DeclaredKey& key : declared_keys()) {
+    std::string candidate = key.path;
     const auto brackets = candidate.find("[]");
     if (brackets != std::string::npos) {
-      const std::string_view array = spec.path.substr(0, brackets);
+      const std::string_view array = std::string_view(key.path).substr(0, brackets);
       std::string index = "[0]";
       if (unknown.starts_with(array) && unknown.size() > array.size() &&
           unknown[array.size()] == '[') {
@@ -537,7 +339,7 @@ AppliedOverride apply_override(toml::table& root, const std::string& text) {
     for (const PathToken& token : tokens) {
       prefix =
           token.is_index ? fmt::format("{}[{}]", prefix, token.key) : join_key(prefix, token.key);
-      if (find_spec(prefix) == nullptr) {
+      if (find_declared(prefix) == nullptr) {
         throw error(fmt::format("unknown key '{}'{}", shown(canonical), suggestion(canonical)));
       }
     }
@@ -552,7 +354,7 @@ AppliedOverride apply_override(toml::table& root, const std::string& text) {
   } catch (const toml::parse_error&) {
   }
   toml::node* parsed_value = parsed ? parsed->get("v") : nullptr;
-  if (parsed_value != nullptr && find_spec(canonical)->kind == Kind::kString &&
+  if (parsed_value != nullptr && find_declared(canonical)->type == KeyType::kString &&
       !parsed_value->is_string()) {
     parsed_value = nullptr;
   }
@@ -715,7 +517,7 @@ class Reader {
       return std::pair(a.begin.line, a.begin.column) < std::pair(b.begin.line, b.begin.column);
     };
     for (auto&& [key, node] : table) {
-      if (is_bare_key(key.str()) && find_spec(join_key(prefix, key.str())) != nullptr) continue;
+      if (is_bare_key(key.str()) && find_declared(join_key(prefix, key.str())) != nullptr) continue;
       if (unknown == nullptr || earlier(key.source(), unknown->source())) {
         unknown = &key;
         unknown_node = &node;
@@ -919,18 +721,8 @@ class Reader {
     if (!(value >= 0.0)) fail(node, path, fmt::format("{}: must be >= 0, got {}", path, value));
   }
 
-  // value in [lo, hi]; `why` (may be empty) says where the bounds come from.
-  void require_range(const toml::node* node, std::string_view path, double value, double lo,
-                     double hi, std::string_view why = {}) const {
-    if (!(value >= lo && value <= hi)) {
-      fail(node, path,
-           fmt::format("{}: must be in [{:g}, {:g}]{}{}, got {}", path, lo, hi,
-                       why.empty() ? "" : " ", why, value));
-    }
-  }
-
   void require_choice(const toml::node* node, std::string_view path, const std::string& value,
-                      std::span<const std::string_view> choices) const {
+                      const std::vector<std::string_view>& choices) const {
     if (!contains(choices, value)) {
       fail(node, path,
            fmt::format("{}: '{}' is not valid; valid values: {}", path, shown(value),
@@ -938,28 +730,113 @@ class Reader {
     }
   }
 
+  // A value against the declared range of its key: all of it for a dimensionless key, the sign
+  // for one measured in a scale of the start state (the rest: run/config_ranges.cpp). `shown`
+  // is how the value is echoed ("" = the double).
+  void check_range(const toml::node* node, std::string_view path, double v, const Range& r,
+                   const std::string& shown_value = {}) const {
+    if (r.by_rule || !r.bounded()) return;
+    const std::string value = shown_value.empty() ? fmt::format("{}", v) : shown_value;
+    const std::string why = r.why.empty() ? std::string() : fmt::format(" {}", r.why);
+    if (r.scale != Scale::kNone) {
+      if (r.lo < 0.0) return;
+      const bool strict = (r.lo > 0.0 || r.lo_open) && r.also != 0.0;
+      if (v == r.also || (strict ? v > 0.0 : v >= 0.0)) return;
+      fail(node, path,
+           fmt::format("{}: must be {} 0{}, got {}", path, strict ? ">" : ">=", why, value));
+    }
+    if (r.contains(v)) return;
+    if (!std::isfinite(r.hi)) {
+      fail(node, path,
+           fmt::format("{}: must be {} {:g}{}, got {}", path, r.lo_open ? ">" : ">=", r.lo, why,
+                       value));
+    }
+    fail(node, path,
+         fmt::format("{}: must be in {}{:g}, {:g}{}{}, got {}", path, r.lo_open ? "(" : "[", r.lo,
+                     r.hi, r.hi_open ? ")" : "]", why, value));
+  }
+
+  // The keys of `group` present in `t` (at `prefix`) read into `object` (the group's struct),
+  // each checked against its declared type, range and choices; keys without a member, and
+  // ranges and choices that depend on another key, are left to the section's rules. A vector
+  // of `*dimension` numbers equal to its fill everywhere is stored as the default, empty.
+  void read_group(const toml::table& t, const std::string& prefix, const KeyGroup& group,
+                  void* object, const int* dimension) const {
+    for (const KeyDecl& d : group.keys) {
+      const Field& f = d.member;
+      const toml::node* node = t.get(d.name);
+      if (!f || node == nullptr) continue;
+      const std::string path = join_key(prefix, d.name);
+      switch (f.cpp) {
+        case CppType::kInt:
+        case CppType::kInt64: {
+          std::int64_t v = 0;
+          get_integer(t, prefix, d.name, v);
+          check_range(node, path, static_cast<double>(v), d.range, fmt::format("{}", v));
+          if (f.cpp == CppType::kInt) {
+            f.of<int>(object) = static_cast<int>(v);
+          } else {
+            f.of<std::int64_t>(object) = v;
+          }
+          break;
+        }
+        case CppType::kUint64: {
+          std::uint64_t& v = f.of<std::uint64_t>(object);
+          get_unsigned(t, prefix, d.name, v);
+          check_range(node, path, static_cast<double>(v), d.range, fmt::format("{}", v));
+          break;
+        }
+        case CppType::kDouble: {
+          double& v = f.of<double>(object);
+          get_number(t, prefix, d.name, v, d.range.allow_infinity);
+          check_range(node, path, v, d.range);
+          break;
+        }
+        case CppType::kBool:
+          get_bool(t, prefix, d.name, f.of<bool>(object));
+          break;
+        case CppType::kString: {
+          std::string& v = f.of<std::string>(object);
+          get_string(t, prefix, d.name, v);
+          if (d.choices != nullptr && !d.range.by_rule)
+            require_choice(node, path, v, d.choices(dimension != nullptr ? *dimension : 3));
+          break;
+        }
+        case CppType::kStrings:
+          get_strings(t, prefix, d.name, f.of<std::vector<std::string>>(object));
+          break;
+        case CppType::kDoubles: {
+          std::vector<double> v;
+          if (d.type == KeyType::kVector) {
+            get_vector(t, prefix, d.name, dimension != nullptr ? *dimension : 3, v);
+          } else {
+            get_numbers(t, prefix, d.name, v);
+          }
+          for (std::size_t i = 0; i < v.size(); ++i) {
+            check_range(element_of(node, i), fmt::format("{}[{}]", path, i), v[i], d.range);
+          }
+          const bool all_fill =
+              std::all_of(v.begin(), v.end(), [&](double x) { return x == d.fill; });
+          if (d.type == KeyType::kVector && all_fill) v.clear();
+          f.of<std::vector<double>>(object) = std::move(v);
+          break;
+        }
+        case CppType::kSpeedTable:
+          get_restitution_table(t, prefix, f.of<std::vector<std::array<double, 2>>>(object));
+          break;
+      }
+    }
+  }
+
   // ----- sections
 
   void read_system(const toml::table& t, SystemConfig& s) const {
-    constexpr std::string_view p = "system";
-
-    std::int64_t dimension = s.dimension;
-    const toml::node* n_dimension = get_integer(t, p, "dimension", dimension);
-    if (dimension != 2 && dimension != 3) {
-      fail(n_dimension, "system.dimension",
-           fmt::format("system.dimension: must be 2 or 3, got {}", dimension));
-    }
-    s.dimension = static_cast<int>(dimension);
-
-    const toml::node* n_particles = get_unsigned(t, p, "particles", s.particles);
-    const toml::node* n_packing = get_number(t, p, "packing_fraction", s.packing_fraction);
-    const toml::node* n_lattice = get_string(t, p, "lattice", s.lattice);
-    const toml::node* n_temperature = get_number(t, p, "temperature", s.temperature);
-    get_unsigned(t, p, "seed", s.seed);
-    get_string(t, p, "initial_state", s.initial_state);
-    const toml::node* n_chain = get_unsigned(t, p, "chain_length", s.chain_length);
-    const toml::node* n_spacing = get_number(t, p, "chain_spacing", s.chain_spacing);
-    require_non_negative(n_spacing, "system.chain_spacing", s.chain_spacing);
+    read_group(t, "system", system_keys(), &s, &s.dimension);
+    const toml::node* n_particles = t.get("particles");
+    const toml::node* n_packing = t.get("packing_fraction");
+    const toml::node* n_lattice = t.get("lattice");
+    const toml::node* n_chain = t.get("chain_length");
+    const toml::node* n_spacing = t.get("chain_spacing");
     if (s.chain_length == 1) {
       fail(n_chain, "system.chain_length",
            "system.chain_length: a chain needs at least 2 beads (0: no chains)");
@@ -1011,44 +888,20 @@ class Reader {
 
     if (s.lattice.empty()) {
       s.lattice = default_lattice(s.dimension);
-    } else {
-      const std::span<const std::string_view> valid =
-          s.dimension == 2 ? std::span<const std::string_view>(kLattices2D)
-                           : std::span<const std::string_view>(kLattices3D);
-      if (!contains(valid, s.lattice)) {
-        fail(n_lattice, "system.lattice",
-             fmt::format("system.lattice: '{}' is not a valid lattice in {}D; valid values: {}",
-                         shown(s.lattice), s.dimension, join_words(valid)));
-      }
+    } else if (!lattices(s.dimension).contains(s.lattice)) {
+      fail(n_lattice, "system.lattice",
+           fmt::format("system.lattice: '{}' is not a valid lattice in {}D; valid values: {}",
+                       shown(s.lattice), s.dimension, lattices(s.dimension).names()));
     }
 
-    // kT is the unit of energy (and with the masses, of speed) that every other range refers to.
-    require_positive(n_temperature, "system.temperature", s.temperature);
-    require_range(n_temperature, "system.temperature", s.temperature, 1e-9, 1e9,
-                  "(the unit of energy kT: reduced units keep it near 1)");
     if (s.species.empty()) s.species.emplace_back();
     double largest = 0.0;
     for (const SpeciesConfig& sp : s.species) largest = std::max(largest, sp.diameter);
-    if (s.chain_spacing > 0.0) {
-      require_range(n_spacing, "system.chain_spacing", s.chain_spacing, 0.0, 1e6 * largest,
-                    "(0, or up to 1e6 times the largest diameter)");
-    }
-
-    std::vector<double> box_scale;
-    const toml::node* n_box_scale = get_vector(t, p, "box_scale", s.dimension, box_scale);
-    for (std::size_t i = 0; i < box_scale.size(); ++i) {
-      if (!(box_scale[i] >= 1.0)) {
-        fail(element_of(n_box_scale, i), "system.box_scale",
-             fmt::format("system.box_scale[{}]: must be >= 1, got {}", i, box_scale[i]));
-      }
-      if (!(box_scale[i] <= 1e6)) {
-        fail(element_of(n_box_scale, i), "system.box_scale",
-             fmt::format("system.box_scale[{}]: must be at most 1e6, got {}", i, box_scale[i]));
-      }
-    }
-    // All 1 is the same as no scaling: stored as the default, empty.
-    if (std::any_of(box_scale.begin(), box_scale.end(), [](double f) { return f != 1.0; })) {
-      s.box_scale = std::move(box_scale);
+    if (s.chain_spacing > 0.0 && !(s.chain_spacing <= 1e6 * largest)) {
+      fail(n_spacing, "system.chain_spacing",
+           fmt::format("system.chain_spacing: must be in [0, {:g}] (0, or up to 1e6 times the "
+                       "largest diameter), got {}",
+                       1e6 * largest, s.chain_spacing));
     }
   }
 
@@ -1060,12 +913,8 @@ class Reader {
       const std::string prefix = fmt::format("system.species[{}]", i);
 
       SpeciesConfig s;
-      const toml::node* n_name = get_string(*t, prefix, "name", s.name);
-      const toml::node* n_diameter = get_number(*t, prefix, "diameter", s.diameter);
-      const toml::node* n_mass = get_number(*t, prefix, "mass", s.mass);
-      const toml::node* n_fraction = get_number(*t, prefix, "fraction", s.fraction);
-      const toml::node* n_inertia = get_number(*t, prefix, "inertia_factor", s.inertia_factor);
-
+      read_group(*t, prefix, species_keys(), &s, nullptr);
+      const toml::node* n_name = t->get("name");
       const std::string name_key = prefix + ".name";
       if (s.name.empty()) fail(n_name, name_key, fmt::format("{}: must not be empty", name_key));
       for (std::size_t j = 0; j < out.size(); ++j) {
@@ -1076,26 +925,6 @@ class Reader {
                            n_name == nullptr ? "; give every species its own name" : ""));
         }
       }
-      // Diameter and mass are units (reduced units keep them near 1); a fraction is relative.
-      require_positive(n_diameter, prefix + ".diameter", s.diameter);
-      require_positive(n_mass, prefix + ".mass", s.mass);
-      require_positive(n_fraction, prefix + ".fraction", s.fraction);
-      require_range(n_diameter, prefix + ".diameter", s.diameter, 1e-9, 1e9);
-      require_range(n_mass, prefix + ".mass", s.mass, 1e-9, 1e9);
-      require_range(n_fraction, prefix + ".fraction", s.fraction, 1e-9, 1e9);
-      // I = q m R^2 with the mass inside the radius: q <= 1 (all of it at R: a ring).
-      if (!(s.inertia_factor >= 0.0)) {
-        fail(n_inertia, prefix + ".inertia_factor",
-             fmt::format("{}.inertia_factor: must be > 0 (or 0 for the default: 2/5 for spheres, "
-                         "1/2 for disks), got {}",
-                         prefix, s.inertia_factor));
-      }
-      if (!(s.inertia_factor == 0.0 || (s.inertia_factor >= 1e-9 && s.inertia_factor <= 1.0))) {
-        fail(n_inertia, prefix + ".inertia_factor",
-             fmt::format("{}.inertia_factor: must be in [1e-9, 1] (I = q m R^2 with the mass "
-                         "within R; or 0 for the default: 2/5 for spheres, 1/2 for disks), got {}",
-                         prefix, s.inertia_factor));
-      }
       out.push_back(std::move(s));
     }
   }
@@ -1105,30 +934,18 @@ class Reader {
   // replace its values.
   void read_contact(const toml::table& t, const std::string& prefix, ContactConfig& c) const {
     const auto path = [&](std::string_view key) { return join_key(prefix, key); };
-    const toml::node* n_restitution = get_number(t, prefix, "restitution", c.restitution);
-    const toml::node* n_model = get_string(t, prefix, "restitution_model", c.restitution_model);
-    const toml::node* n_speed = get_number(t, prefix, "restitution_speed", c.restitution_speed);
-    const toml::node* n_table = get_restitution_table(t, prefix, c.restitution_table);
-    const toml::node* n_beta =
-        get_number(t, prefix, "tangential_restitution", c.tangential_restitution);
-    const toml::node* n_friction =
-        get_number(t, prefix, "friction", c.friction, /*allow_infinity=*/true);
-    const toml::node* n_elastic =
-        get_number(t, prefix, "elastic_below_speed", c.elastic_below_speed);
-
-    if (!(c.restitution >= 0.0 && c.restitution <= 1.0)) {
-      fail(n_restitution, path("restitution"),
-           fmt::format("{}: must be in [0, 1], got {}", path("restitution"), c.restitution));
-    }
-    require_choice(n_model, path("restitution_model"), c.restitution_model, kRestitutionModels);
-    require_positive(n_speed, path("restitution_speed"), c.restitution_speed);
-    if (c.restitution_model == "viscoelastic" && !(c.restitution > 0.0)) {
+    read_group(t, prefix, contact_law_keys(), &c, nullptr);
+    const toml::node* n_restitution = t.get("restitution");
+    const toml::node* n_model = t.get("restitution_model");
+    const toml::node* n_table = t.get("restitution_table");
+    if (restitution_models().is(c.restitution_model, RestitutionModel::kViscoelastic) &&
+        !(c.restitution > 0.0)) {
       fail(n_restitution != nullptr ? n_restitution : n_model, path("restitution"),
            fmt::format("{}: must be in (0, 1] with restitution_model = \"viscoelastic\" (it is "
                        "e at restitution_speed), got {}",
                        path("restitution"), c.restitution));
     }
-    if (c.restitution_model == "table") {
+    if (restitution_models().is(c.restitution_model, RestitutionModel::kTable)) {
       if (n_table == nullptr && c.restitution_table.empty()) {
         fail(n_model, path("restitution_table"),
              fmt::format("missing required key '{}' (restitution_model = \"table\" needs "
@@ -1147,13 +964,6 @@ class Reader {
     } else {
       c.restitution_table.clear();  // an inherited table does not apply to another model
     }
-    if (!(c.tangential_restitution >= -1.0 && c.tangential_restitution <= 1.0)) {
-      fail(n_beta, path("tangential_restitution"),
-           fmt::format("{}: must be in [-1, 1], got {}", path("tangential_restitution"),
-                       c.tangential_restitution));
-    }
-    require_non_negative(n_friction, path("friction"), c.friction);
-    require_non_negative(n_elastic, path("elastic_below_speed"), c.elastic_below_speed);
   }
 
   // restitution_table: [[speed, e], ...], speeds >= 0 strictly increasing, e in [0, 1].
@@ -1203,14 +1013,7 @@ class Reader {
                          InteractionConfig& in) const {
     constexpr std::string_view p = "contact";
     read_contact(t, std::string(p), in.contact);
-    const toml::node* n_tc = get_number(t, p, "tc", in.tc);
-    require_non_negative(n_tc, "contact.tc", in.tc);
-    const toml::node* n_sleep = get_number(t, p, "sleep_speed", in.sleep_speed);
-    if (!(in.sleep_speed >= 0.0 || in.sleep_speed == -1.0)) {
-      fail(n_sleep, "contact.sleep_speed",
-           fmt::format("contact.sleep_speed: must be >= 0 (or -1 for automatic), got {}",
-                       in.sleep_speed));
-    }
+    read_group(t, std::string(p), contact_keys(), &in, nullptr);
 
     const std::vector<const toml::table*> tables = table_array(t, p, "pair");
     for (std::size_t i = 0; i < tables.size(); ++i) {
@@ -1267,20 +1070,19 @@ class Reader {
     return {names[0], names[1]};
   }
 
-  // The index in kFaces of a face name valid in `dimension`.
+  // The number (face_number()) of a face name valid in `dimension`.
   int face_index(const toml::node* node, const std::string& path, const std::string& face,
                  int dimension) const {
-    const std::span<const std::string_view> valid(kFaces, 2 * static_cast<std::size_t>(dimension));
-    const auto it = std::find(valid.begin(), valid.end(), face);
-    if (it == valid.end()) {
-      const bool other_dimension = contains(kFaces, face);
+    const Choices<BoxFace>& valid = box_faces(dimension);
+    if (!valid.contains(face)) {
+      const bool other_dimension = box_faces().contains(face);
       fail(node, path,
            fmt::format("{}: '{}' is not {}; valid values: {}", path, face,
                        other_dimension ? fmt::format("a face of a {}D box", dimension)
                                        : std::string("a valid face"),
-                       join_words(valid)));
+                       valid.names()));
     }
-    return static_cast<int>(it - valid.begin());
+    return face_number(valid.at(face));
   }
 
   void read_boundary(const toml::table& t, int dimension, const ContactConfig& contact,
@@ -1305,7 +1107,7 @@ class Reader {
       if (n_face == nullptr) {
         fail(tables[i], face_key,
              fmt::format("missing required key '{}' (one of {})", face_key,
-                         join_words(std::span(kFaces, 2 * static_cast<std::size_t>(dimension)))));
+                         box_faces(dimension).names()));
       }
       const int f = face_index(n_face, face_key, w.face, dimension);
       if (claims[static_cast<std::size_t>(f)].node != nullptr) {
@@ -1316,27 +1118,15 @@ class Reader {
       claims[static_cast<std::size_t>(f)] = {n_face, prefix, true};
 
       read_contact(wt, prefix, w.contact);
-
-      // In-plane components slide the wall, the normal one moves it as a piston; finite (the
-      // getter says so), and whether approaching walls leave room is checked as the run goes.
-      std::vector<double> velocity;
-      get_vector(wt, prefix, "velocity", dimension, velocity);
-      // At rest is stored as the default, empty.
-      if (std::any_of(velocity.begin(), velocity.end(), [](double v) { return v != 0.0; })) {
-        w.velocity = std::move(velocity);
-      }
-
-      const toml::node* n_amplitude = get_number(wt, prefix, "amplitude", w.amplitude);
-      const toml::node* n_frequency = get_number(wt, prefix, "frequency", w.frequency);
-      const toml::node* n_phase = get_number(wt, prefix, "phase", w.phase);
-      // Beyond 1e9 rad a double no longer resolves the phase to 1e-7.
-      require_range(n_phase, prefix + ".phase", w.phase, -1e9, 1e9, "(radians)");
-      require_non_negative(n_amplitude, prefix + ".amplitude", w.amplitude);
-      require_non_negative(n_frequency, prefix + ".frequency", w.frequency);
+      // In-plane components of the velocity slide the wall, the normal one moves it as a
+      // piston; whether approaching walls leave room is checked as the run goes. Beyond 1e9 rad
+      // a double no longer resolves the phase to 1e-7.
+      read_group(wt, prefix, wall_keys(), &w, &dimension);
       b.walls.push_back(std::move(w));
     }
 
-    const toml::node* n_open = get_strings(t, p, "open", b.open);
+    read_group(t, std::string(p), boundary_keys(), &b, &dimension);
+    const toml::node* n_open = t.get("open");
     for (std::size_t i = 0; i < b.open.size(); ++i) {
       const std::string& face = b.open[i];
       const toml::node* node = element_of(n_open, i);
@@ -1353,13 +1143,13 @@ class Reader {
       claims[f] = {node, key, false};
     }
 
-    const toml::node* n_shear = get_number(t, p, "shear_rate", b.shear_rate);
+    const toml::node* n_shear = t.get("shear_rate");
     for (std::size_t f = 0; n_shear != nullptr && b.shear_rate != 0.0 && f < 4; ++f) {
       if (claims[f].node != nullptr) {
         fail(n_shear, "boundary.shear_rate",
              fmt::format("boundary.shear_rate: Lees-Edwards shear needs periodic x (flow) and y "
                          "(gradient) axes, but face {} is {} ({})",
-                         kFaces[f], claims[f].wall ? "a wall" : "open", claims[f].key));
+                         face_name(f), claims[f].wall ? "a wall" : "open", claims[f].key));
       }
     }
 
@@ -1369,93 +1159,53 @@ class Reader {
         const Claim& here = claims[2 * axis + side];
         const Claim& there = claims[2 * axis + 1 - side];
         if (here.node == nullptr || there.node != nullptr) continue;
-        const std::string_view face = kFaces[2 * axis + side];
-        const std::string_view other = kFaces[2 * axis + 1 - side];
+        const std::string_view face = face_name(2 * axis + side);
+        const std::string_view other = face_name(2 * axis + 1 - side);
         fail(here.node, here.wall ? here.key + ".face" : std::string("boundary.open"),
              fmt::format(
                  "boundary: face {} is {} but {} is neither a wall nor in boundary.open; "
                  "add one (or {} to keep {} periodic)",
                  face, here.wall ? "a wall" : "open", other,
                  here.wall ? "remove the wall" : fmt::format("remove {} from boundary.open", face),
-                 kAxes[axis]));
+                 axis_name(axis)));
       }
     }
   }
 
   // The keys of a potential at `prefix` ("potential[i]", "bond[i]"), its kind among `kinds`.
   void read_potential_spec(const toml::table& t, const std::string& prefix,
-                           std::span<const std::string_view> kinds, PotentialSpec& spec) const {
+                           const Choices<PotentialKind>& kinds, PotentialSpec& spec) const {
     const toml::node* n_kind = get_string(t, prefix, "kind", spec.kind);
     if (n_kind == nullptr) {
       fail(&t, prefix + ".kind",
-           fmt::format("missing required key '{}.kind' (one of: {})", prefix, join_words(kinds)));
+           fmt::format("missing required key '{}.kind' (one of: {})", prefix, kinds.names()));
     }
-    require_choice(n_kind, prefix + ".kind", spec.kind, kinds);
-    for (const auto& [key, value] : {std::pair<std::string_view, double*>{"lambda", &spec.lambda},
-                                     {"depth", &spec.depth},
-                                     {"epsilon", &spec.epsilon},
-                                     {"sigma", &spec.sigma},
-                                     {"cutoff", &spec.cutoff},
-                                     {"kappa", &spec.kappa},
-                                     {"alpha", &spec.alpha},
-                                     {"r_min", &spec.r_min},
-                                     {"max_length", &spec.max_length},
-                                     {"stiffness", &spec.stiffness},
-                                     {"length", &spec.length},
-                                     {"temperature", &spec.temperature}}) {
-      get_number(t, prefix, key, *value);
-    }
-    get_numbers(t, prefix, "boundaries", spec.boundaries);
-    get_numbers(t, prefix, "energies", spec.energies);
-    get_bool(t, prefix, "shifted", spec.shifted);
-    get_string(t, prefix, "file", spec.file);
-    std::int64_t steps = spec.steps;
-    const toml::node* n_steps = get_integer(t, prefix, "steps", steps);
-    if (steps < 1 || steps > 100000) {
-      fail(n_steps, prefix + ".steps",
-           fmt::format("{}.steps: must be in [1, 100000], got {}", prefix, steps));
-    }
-    spec.steps = static_cast<int>(steps);
-    const toml::node* n_placement = get_string(t, prefix, "placement", spec.placement);
-    require_choice(n_placement, prefix + ".placement", spec.placement, kPlacements);
-    const toml::node* n_shell = get_string(t, prefix, "shell_energy", spec.shell_energy);
-    require_choice(n_shell, prefix + ".shell_energy", spec.shell_energy, kShellEnergies);
-    require_positive(t.get("temperature"), prefix + ".temperature", spec.temperature);
-    if (spec.kind == "spring_dashpot") {
+    require_choice(n_kind, prefix + ".kind", spec.kind, choice_names(kinds));
+    read_group(t, prefix, potential_keys(), &spec, nullptr);
+    const bool spring_dashpot = potential_kinds().is(spec.kind, PotentialKind::kSpringDashpot);
+    if (spring_dashpot) {
       // Equal steps with midpoint energies always: the dashpot per step assumes them.
-      for (const auto& [node, key] :
-           {std::pair{n_placement, "placement"}, std::pair{n_shell, "shell_energy"}}) {
-        if (node != nullptr) {
-          fail(node, prefix + "." + key,
+      for (const std::string_view key : {"placement", "shell_energy"}) {
+        if (const toml::node* node = t.get(key)) {
+          fail(node, join_key(prefix, key),
                fmt::format("{}.{}: spring_dashpot steps are always of equal width with the "
                            "spring's energy at each step's middle; remove the key",
                            prefix, key));
         }
       }
     }
-    const toml::node* n_damping = get_number(t, prefix, "damping", spec.damping);
-    const toml::node* n_restitution = get_number(t, prefix, "restitution", spec.restitution);
-    const toml::node* n_force_zero = get_bool(t, prefix, "force_zero", spec.force_zero);
-    for (const auto& [node, key] :
-         {std::pair{n_damping, "damping"}, std::pair{n_restitution, "restitution"},
-          std::pair{n_force_zero, "force_zero"}}) {
-      if (node != nullptr && spec.kind != "spring_dashpot") {
-        fail(node, prefix + "." + key,
-             fmt::format("{}.{}: applies to kind = \"spring_dashpot\" only", prefix, key));
+    for (const KeyDecl& d : spring_dashpot_keys().keys) {
+      const toml::node* node = t.get(d.name);
+      if (node != nullptr && !spring_dashpot) {
+        fail(node, join_key(prefix, d.name),
+             fmt::format("{}.{}: applies to kind = \"spring_dashpot\" only", prefix, d.name));
       }
     }
-    if (n_damping != nullptr && n_restitution != nullptr) {
-      fail(n_restitution, prefix + ".restitution",
+    if (t.get("damping") != nullptr && t.get("restitution") != nullptr) {
+      fail(t.get("restitution"), prefix + ".restitution",
            fmt::format("{}.restitution: give damping or restitution, not both", prefix));
     }
-    if (n_damping != nullptr && !(spec.damping >= 0.0)) {
-      fail(n_damping, prefix + ".damping",
-           fmt::format("{}.damping: must be at least 0, got {}", prefix, spec.damping));
-    }
-    if (n_restitution != nullptr && !(spec.restitution > 0.0 && spec.restitution <= 1.0)) {
-      fail(n_restitution, prefix + ".restitution",
-           fmt::format("{}.restitution: must be in (0, 1], got {}", prefix, spec.restitution));
-    }
+    read_group(t, prefix, spring_dashpot_keys(), &spec, nullptr);
   }
 
   void read_potentials(const toml::table& root, const std::vector<SpeciesConfig>& species,
@@ -1495,7 +1245,7 @@ class Reader {
                            pc.species.empty() ? "s (all)" : "", j));
         }
       }
-      read_potential_spec(*tables[i], prefix, kPairPotentials, pc.potential);
+      read_potential_spec(*tables[i], prefix, pair_potential_kinds(), pc.potential);
       out.push_back(std::move(pc));
     }
   }
@@ -1514,7 +1264,7 @@ class Reader {
         }
       }
       bc.potential.kind = "";
-      read_potential_spec(*tables[i], prefix, kBondPotentials, bc.potential);
+      read_potential_spec(*tables[i], prefix, bond_potential_kinds(), bc.potential);
       out.push_back(std::move(bc));
     }
   }
@@ -1525,34 +1275,22 @@ class Reader {
   void read_soft_law(const toml::table& t, const std::string& prefix, SoftLawConfig& law) const {
     const auto path = [&](std::string_view key) { return join_key(prefix, key); };
     const bool pair = prefix != "soft";
-    const toml::node* n_model = get_string(t, prefix, "model", law.model);
-    const toml::node* n_k = get_number(t, prefix, "stiffness", law.stiffness);
-    const toml::node* n_gamma = get_number(t, prefix, "damping", law.damping);
-    const toml::node* n_young = get_number(t, prefix, "young", law.young);
-    const toml::node* n_poisson = get_number(t, prefix, "poisson", law.poisson);
-    const toml::node* n_a = get_number(t, prefix, "dissipation", law.dissipation);
-    const toml::node* n_e = get_number(t, prefix, "restitution", law.restitution);
-    const toml::node* n_speed = get_number(t, prefix, "restitution_speed", law.restitution_speed);
-    const toml::node* n_mu = get_number(t, prefix, "friction", law.friction);
-    const toml::node* n_kt =
-        get_number(t, prefix, "tangential_stiffness", law.tangential_stiffness);
-    const toml::node* n_gt = get_number(t, prefix, "tangential_damping", law.tangential_damping);
-    require_non_negative(n_mu, path("friction"), law.friction);
-    require_range(n_mu, path("friction"), law.friction, 0.0, 1e9);
-    // Ratios to the normal law: a tangential spring much stiffer than the normal one would be
-    // unstable at the time step chosen for the normal one (physical ratios are 2/3 to 4/3).
-    require_positive(n_kt, path("tangential_stiffness"), law.tangential_stiffness);
-    require_range(n_kt, path("tangential_stiffness"), law.tangential_stiffness, 1e-9, 10.0);
-    require_non_negative(n_gt, path("tangential_damping"), law.tangential_damping);
-    require_range(n_gt, path("tangential_damping"), law.tangential_damping, 0.0, 1e3);
+    read_group(t, prefix, soft_law_keys(), &law, nullptr);
+    const toml::node* n_model = t.get("model");
+    const toml::node* n_k = t.get("stiffness");
+    const toml::node* n_gamma = t.get("damping");
+    const toml::node* n_young = t.get("young");
+    const toml::node* n_poisson = t.get("poisson");
+    const toml::node* n_a = t.get("dissipation");
+    const toml::node* n_e = t.get("restitution");
+    const toml::node* n_speed = t.get("restitution_speed");
     if (n_model == nullptr && law.model.empty()) {
       fail(&t, path("model"),
            fmt::format("missing required key '{}' (\"dashpot\" or \"hertz\"): [soft] makes every "
                        "contact soft",
                        path("model")));
     }
-    require_choice(n_model, path("model"), law.model, kSoftModels);
-    const bool dashpot = law.model == "dashpot";
+    const bool dashpot = soft_models().is(law.model, SoftModel::LinearDashpot);
     // Keys of the other model given here are an error (inherited ones are just not used).
     const std::pair<const toml::node*, std::string_view> foreign[] = {
         {n_young, "young"},   {n_poisson, "poisson"},
@@ -1615,24 +1353,8 @@ class Reader {
                  SoftConfig& soft) const {
     constexpr std::string_view p = "soft";
     read_soft_law(t, std::string(p), soft.law);
-    const toml::node* n_collisions = get_string(t, p, "collisions", soft.collisions);
-    require_choice(n_collisions, "soft.collisions", soft.collisions, kSoftCollisions);
-    get_bool(t, p, "tables", soft.tables);
-    const toml::node* n_tolerance = get_number(t, p, "table_tolerance", soft.table_tolerance);
-    require_positive(n_tolerance, "soft.table_tolerance", soft.table_tolerance);
-    if (n_tolerance != nullptr && !(soft.table_tolerance < 0.1)) {
-      fail(n_tolerance, "soft.table_tolerance",
-           fmt::format("soft.table_tolerance: must be below 0.1 (a relative error), got {}",
-                       soft.table_tolerance));
-    }
     // The nodes are integrated to 1e-13: below 1e-10 no table can be checked to its tolerance.
-    if (!(soft.table_tolerance >= 1e-10)) {
-      fail(n_tolerance, "soft.table_tolerance",
-           fmt::format("soft.table_tolerance: must be at least 1e-10, got {}",
-                       soft.table_tolerance));
-    }
-    get_string(t, p, "table_cache", soft.table_cache);
-    get_bool(t, p, "defer_releases", soft.defer_releases);
+    read_group(t, std::string(p), soft_keys(), &soft, nullptr);
     const std::vector<const toml::table*> tables = table_array(t, p, "pair");
     for (std::size_t i = 0; i < tables.size(); ++i) {
       const std::string prefix = fmt::format("soft.pair[{}]", i);
@@ -1697,7 +1419,7 @@ class Reader {
         conflict("boundary.shear_rate",
                  "Lees-Edwards shear is not supported with soft spheres yet");
       }
-      if (c.run.integrator != "dem") {
+      if (!integrators().is(c.run.integrator, Integrator::kDem)) {
         const auto rough = [&](const SoftLawConfig& law, const std::string& prefix) {
           if (law.friction > 0.0) {
             const std::string key = prefix + ".friction";
@@ -1713,13 +1435,13 @@ class Reader {
         for (std::size_t p = 0; p < c.soft.pairs.size(); ++p)
           rough(c.soft.pairs[p].law, fmt::format("soft.pair[{}]", p));
       }
-      if (!c.field.gravity.empty() && c.run.integrator != "dem") {
+      if (!c.field.gravity.empty() && !integrators().is(c.run.integrator, Integrator::kDem)) {
         conflict("field.gravity",
                  "the collision mapping is not defined under gravity (a soft contact under a "
                  "load does not end); use run.integrator = \"dem\"");
       }
     }
-    if (c.run.integrator != "dem") return;
+    if (!integrators().is(c.run.integrator, Integrator::kDem)) return;
     const toml::node* n_integrator = node_at(root, "run.integrator");
     const auto unsupported = [&](std::string_view key, std::string_view what) {
       const toml::node* n = node_at(root, key);
@@ -1733,80 +1455,42 @@ class Reader {
            "(model = \"dashpot\" or \"hertz\")");
     }
     if (!c.boundary.open.empty()) unsupported("boundary.open", "open faces are");
-    if (c.driving.kind != "none") unsupported("driving.kind", "driving is");
+    if (!driving_kinds().is(c.driving.kind, DrivingKind::kNone))
+      unsupported("driving.kind", "driving is");
     if (c.run.validate) unsupported("run.validate", "engine validation is");
   }
 
-  void read_field(const toml::table& t, int dimension, FieldConfig& f) const {
-    std::vector<double> gravity;
-    get_vector(t, "field", "gravity", dimension, gravity);
-    // No field is stored as the default, empty.
-    if (std::any_of(gravity.begin(), gravity.end(), [](double g) { return g != 0.0; })) {
-      f.gravity = std::move(gravity);
-    }
+  void read_field(const toml::table& t, const int& dimension, FieldConfig& f) const {
+    read_group(t, "field", field_keys(), &f, &dimension);  // no field: stored empty
   }
 
   void read_driving(const toml::table& t, DrivingConfig& d) const {
-    constexpr std::string_view p = "driving";
-    const toml::node* n_kind = get_string(t, p, "kind", d.kind);
-    const toml::node* n_rate = get_number(t, p, "rate", d.rate);
-    const toml::node* n_temperature = get_number(t, p, "temperature", d.temperature);
-    const toml::node* n_strength = get_number(t, p, "strength", d.strength);
-    require_choice(n_kind, "driving.kind", d.kind, kDrivingKinds);
-    require_positive(n_rate, "driving.rate", d.rate);
-    require_positive(n_temperature, "driving.temperature", d.temperature);
-    require_non_negative(n_strength, "driving.strength", d.strength);
-    if (d.kind == "white_noise" && !(d.strength > 0.0)) {
-      fail(n_strength != nullptr ? n_strength : n_kind, "driving.strength",
+    read_group(t, "driving", driving_keys(), &d, nullptr);
+    if (driving_kinds().is(d.kind, DrivingKind::kWhiteNoise) && !(d.strength > 0.0)) {
+      const toml::node* n_strength = t.get("strength");
+      fail(n_strength != nullptr ? n_strength : t.get("kind"), "driving.strength",
            "driving.strength: white_noise driving needs a strength > 0 (velocity variance per "
            "unit time)");
     }
   }
 
   void read_run(const toml::table& t, RunConfig& r) const {
-    constexpr std::string_view p = "run";
-    const toml::node* n_equilibration = get_number(t, p, "equilibration_collisions_per_particle",
-                                                   r.equilibration_collisions_per_particle);
-    const toml::node* n_production =
-        get_number(t, p, "collisions_per_particle", r.collisions_per_particle);
-    const toml::node* n_queue = get_string(t, p, "event_queue", r.event_queue);
-    const toml::node* n_wall = get_number(t, p, "max_wall_seconds", r.max_wall_seconds);
-    get_bool(t, p, "validate", r.validate);
-
-    const toml::node* n_time = get_number(t, p, "time", r.time);
-    const toml::node* n_equilibration_time =
-        get_number(t, p, "equilibration_time", r.equilibration_time);
     // Up to 1e9 collisions per particle: 1e18 collisions of the largest system still count in
     // 64 bits, and no run gets that far.
-    require_non_negative(n_equilibration, "run.equilibration_collisions_per_particle",
-                         r.equilibration_collisions_per_particle);
-    require_range(n_equilibration, "run.equilibration_collisions_per_particle",
-                  r.equilibration_collisions_per_particle, 0.0, 1e9);
-    require_positive(n_production, "run.collisions_per_particle", r.collisions_per_particle);
-    require_range(n_production, "run.collisions_per_particle", r.collisions_per_particle, 0.0, 1e9);
-    if (n_time != nullptr) require_positive(n_time, "run.time", r.time);
-    if (n_equilibration_time != nullptr)
-      require_non_negative(n_equilibration_time, "run.equilibration_time", r.equilibration_time);
+    read_group(t, "run", run_keys(), &r, nullptr);
     // One length per phase: in collisions per particle or in simulated time, not both.
-    if (n_time != nullptr && n_production != nullptr) {
-      fail(n_time, "run.time",
+    if (t.get("time") != nullptr && t.get("collisions_per_particle") != nullptr) {
+      fail(t.get("time"), "run.time",
            "run.time and run.collisions_per_particle both give the production length: keep one");
     }
-    if (n_equilibration_time != nullptr && n_equilibration != nullptr) {
-      fail(n_equilibration_time, "run.equilibration_time",
+    if (t.get("equilibration_time") != nullptr &&
+        t.get("equilibration_collisions_per_particle") != nullptr) {
+      fail(t.get("equilibration_time"), "run.equilibration_time",
            "run.equilibration_time and run.equilibration_collisions_per_particle both give the "
            "equilibration length: keep one");
     }
-    require_choice(n_queue, "run.event_queue", r.event_queue, kEventQueues);
-    require_non_negative(n_wall, "run.max_wall_seconds", r.max_wall_seconds);
-    require_range(n_wall, "run.max_wall_seconds", r.max_wall_seconds, 0.0, 1e9,
-                  "(seconds; 0: no limit)");
-    const toml::node* n_integrator = get_string(t, p, "integrator", r.integrator);
-    const toml::node* n_step = get_number(t, p, "time_step", r.time_step);
-    require_choice(n_integrator, "run.integrator", r.integrator, kIntegrators);
-    require_non_negative(n_step, "run.time_step", r.time_step);
-    if (r.time_step > 0.0 && r.integrator != "dem") {
-      fail(n_step, "run.time_step",
+    if (r.time_step > 0.0 && !integrators().is(r.integrator, Integrator::kDem)) {
+      fail(t.get("time_step"), "run.time_step",
            fmt::format("run.time_step: only used by the DEM integrator (run.integrator = \"dem\"; "
                        "it is \"{}\"), which has a time step",
                        r.integrator));
@@ -1814,37 +1498,16 @@ class Reader {
   }
 
   void read_output(const toml::table& t, int dimension, OutputConfig& o) const {
-    constexpr std::string_view p = "output";
-    const toml::node* n_directory = get_string(t, p, "directory", o.directory);
-    const toml::node* n_thermo = get_number(t, p, "thermo_interval", o.thermo_interval);
-    const toml::node* n_trajectory = get_number(t, p, "trajectory_interval", o.trajectory_interval);
-    const toml::node* n_restart = get_number(t, p, "restart_interval", o.restart_interval);
-    const toml::node* n_unit = get_string(t, p, "interval_unit", o.interval_unit);
-    if (n_unit != nullptr)
-      require_choice(n_unit, "output.interval_unit", o.interval_unit, kIntervalUnits);
-    get_bool(t, p, "trajectory", o.trajectory);
-    const toml::node* n_progress = get_string(t, p, "progress", o.progress);
-    const toml::node* n_axis = get_string(t, p, "profile_axis", o.profile_axis);
-    const toml::node* n_bins = get_integer(t, p, "profile_bins", o.profile_bins);
-    if (!(o.profile_axis.empty() || o.profile_axis == "x" || o.profile_axis == "y" ||
-          (o.profile_axis == "z" && dimension == 3))) {
-      fail(n_axis, "output.profile_axis",
+    read_group(t, "output", output_keys(), &o, &dimension);
+    if (!(o.profile_axis.empty() || axes(dimension).contains(o.profile_axis))) {
+      fail(t.get("profile_axis"), "output.profile_axis",
            fmt::format("output.profile_axis: '{}' is not an axis of a {}D box (x, y{}, or \"\" for "
                        "no profile)",
                        o.profile_axis, dimension, dimension == 3 ? ", z" : ""));
     }
-    if (o.profile_bins < 1 || o.profile_bins > 100000) {
-      fail(n_bins, "output.profile_bins",
-           fmt::format("output.profile_bins: must be in [1, 100000], got {}", o.profile_bins));
-    }
-
     if (o.directory.empty()) {
-      fail(n_directory, "output.directory", "output.directory: must not be empty");
+      fail(t.get("directory"), "output.directory", "output.directory: must not be empty");
     }
-    require_non_negative(n_thermo, "output.thermo_interval", o.thermo_interval);
-    require_non_negative(n_trajectory, "output.trajectory_interval", o.trajectory_interval);
-    require_non_negative(n_restart, "output.restart_interval", o.restart_interval);
-    require_choice(n_progress, "output.progress", o.progress, kProgressModes);
   }
 
   // The intervals' unit defaults to the production length's; automatic intervals (0) are
@@ -1890,78 +1553,75 @@ std::string toml_floats(const std::vector<double>& values) {
   return out + "]";
 }
 
-// The keys of a contact law, one per line (restitution_table only when there is one).
-std::string contact_toml(const ContactConfig& c) {
+// The keys of `group` that `object` (the group's struct) has, one per line "key = value", in
+// declaration order; a vector left empty (the default) is written with its effective value,
+// `dimension` components of its fill.
+std::string group_toml(const KeyGroup& group, const void* object, std::string_view prefix,
+                       std::size_t dimension) {
   std::string out;
-  out += fmt::format("restitution = {}\n", toml_float(c.restitution));
-  out += fmt::format("restitution_model = {}\n", toml_string(c.restitution_model));
-  out += fmt::format("restitution_speed = {}\n", toml_float(c.restitution_speed));
-  if (!c.restitution_table.empty()) {
-    out += "restitution_table = [";
-    for (std::size_t i = 0; i < c.restitution_table.size(); ++i) {
-      out += fmt::format("{}[{}, {}]", i == 0 ? "" : ", ", toml_float(c.restitution_table[i][0]),
-                         toml_float(c.restitution_table[i][1]));
+  for (const KeyDecl& d : group.keys) {
+    const Field& f = d.member;
+    if (!f || (d.written != nullptr && !d.written(object))) continue;
+    std::string value;
+    switch (f.cpp) {
+      case CppType::kInt:
+        value = fmt::format("{}", f.of<int>(object));
+        break;
+      case CppType::kInt64:
+        value = fmt::format("{}", f.of<std::int64_t>(object));
+        break;
+      case CppType::kUint64:
+        value = toml_unsigned(f.of<std::uint64_t>(object), join_key(prefix, d.name));
+        break;
+      case CppType::kDouble:
+        value = toml_float(f.of<double>(object));
+        break;
+      case CppType::kBool:
+        value = fmt::format("{}", f.of<bool>(object));
+        break;
+      case CppType::kString:
+        value = toml_string(f.of<std::string>(object));
+        break;
+      case CppType::kDoubles: {
+        const std::vector<double>& v = f.of<std::vector<double>>(object);
+        value = toml_floats(
+            d.type == KeyType::kVector && v.empty() ? std::vector<double>(dimension, d.fill) : v);
+        break;
+      }
+      case CppType::kStrings: {
+        const std::vector<std::string>& v = f.of<std::vector<std::string>>(object);
+        value = "[";
+        for (std::size_t i = 0; i < v.size(); ++i)
+          value += fmt::format("{}{}", i == 0 ? "" : ", ", toml_string(v[i]));
+        value += "]";
+        break;
+      }
+      case CppType::kSpeedTable: {
+        const std::vector<std::array<double, 2>>& rows =
+            f.of<std::vector<std::array<double, 2>>>(object);
+        value = "[";
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+          value += fmt::format("{}[{}, {}]", i == 0 ? "" : ", ", toml_float(rows[i][0]),
+                               toml_float(rows[i][1]));
+        }
+        value += "]";
+        break;
+      }
     }
-    out += "]\n";
+    out += fmt::format("{} = {}\n", d.name, value);
   }
-  out += fmt::format("tangential_restitution = {}\n", toml_float(c.tangential_restitution));
-  out += fmt::format("friction = {}\n", toml_float(c.friction));
-  out += fmt::format("elastic_below_speed = {}\n", toml_float(c.elastic_below_speed));
   return out;
 }
 
-// The keys of a soft law that its model uses, one per line: restitution when given, else the
-// damping (dissipation).
-std::string soft_law_toml(const SoftLawConfig& law) {
-  std::string out = fmt::format("model = {}\n", toml_string(law.model));
-  if (law.model == "dashpot") {
-    out += fmt::format("stiffness = {}\n", toml_float(law.stiffness));
-    out += law.restitution > 0.0 ? fmt::format("restitution = {}\n", toml_float(law.restitution))
-                                 : fmt::format("damping = {}\n", toml_float(law.damping));
-  } else {
-    out += fmt::format("young = {}\n", toml_float(law.young));
-    out += fmt::format("poisson = {}\n", toml_float(law.poisson));
-    out += law.restitution > 0.0 ? fmt::format("restitution = {}\n", toml_float(law.restitution))
-                                 : fmt::format("dissipation = {}\n", toml_float(law.dissipation));
-    out += fmt::format("restitution_speed = {}\n", toml_float(law.restitution_speed));
-  }
-  out += fmt::format("friction = {}\n", toml_float(law.friction));
-  out += fmt::format("tangential_stiffness = {}\n", toml_float(law.tangential_stiffness));
-  out += fmt::format("tangential_damping = {}\n", toml_float(law.tangential_damping));
-  return out;
+std::string species_pair_toml(const std::string& a, const std::string& b) {
+  return fmt::format("species = [{}, {}]\n", toml_string(a), toml_string(b));
 }
 
-// The keys of a potential, one per line.
-std::string potential_toml(const PotentialSpec& p) {
-  std::string out;
-  out += fmt::format("kind = {}\n", toml_string(p.kind));
-  for (const auto& [key, value] : {std::pair<const char*, double>{"lambda", p.lambda},
-                                   {"depth", p.depth},
-                                   {"epsilon", p.epsilon},
-                                   {"sigma", p.sigma},
-                                   {"cutoff", p.cutoff},
-                                   {"kappa", p.kappa},
-                                   {"alpha", p.alpha},
-                                   {"r_min", p.r_min},
-                                   {"max_length", p.max_length},
-                                   {"stiffness", p.stiffness},
-                                   {"length", p.length},
-                                   {"temperature", p.temperature}}) {
-    out += fmt::format("{} = {}\n", key, toml_float(value));
-  }
-  out += fmt::format("boundaries = {}\n", toml_floats(p.boundaries));
-  out += fmt::format("energies = {}\n", toml_floats(p.energies));
-  out += fmt::format("shifted = {}\n", p.shifted);
-  out += fmt::format("file = {}\n", toml_string(p.file));
-  out += fmt::format("steps = {}\n", p.steps);
-  if (p.kind != "spring_dashpot") {
-    out += fmt::format("placement = {}\n", toml_string(p.placement));
-    out += fmt::format("shell_energy = {}\n", toml_string(p.shell_energy));
-  } else {
-    out += p.restitution > 0.0 ? fmt::format("restitution = {}\n", toml_float(p.restitution))
-                               : fmt::format("damping = {}\n", toml_float(p.damping));
-    out += fmt::format("force_zero = {}\n", p.force_zero);
-  }
+// The keys of a potential after its species or type, one per line.
+std::string potential_toml(const PotentialSpec& p, std::string_view prefix) {
+  std::string out = fmt::format("kind = {}\n", toml_string(p.kind));
+  out += group_toml(potential_keys(), &p, prefix, 3);
+  out += group_toml(spring_dashpot_keys(), &p, prefix, 3);
   return out;
 }
 
@@ -2029,135 +1689,65 @@ Config load_config(const std::filesystem::path& path, const std::vector<std::str
 }
 
 std::string to_toml(const Config& config) {
-  const SystemConfig& s = config.system;
-  const RunConfig& r = config.run;
-  const OutputConfig& o = config.output;
-  const InteractionConfig& in = config.interactions;
-
-  std::string lattice = s.lattice;
-  if (lattice.empty() && (s.dimension == 2 || s.dimension == 3)) {
-    lattice = default_lattice(s.dimension);
+  SystemConfig s = config.system;
+  if (s.lattice.empty() && (s.dimension == 2 || s.dimension == 3)) {
+    s.lattice = default_lattice(s.dimension);
   }
-  std::vector<SpeciesConfig> species = s.species;
-  if (species.empty()) species.emplace_back();
+  if (s.species.empty()) s.species.emplace_back();
   // Vectors left empty (the defaults) are written with their effective values.
   const std::size_t dimension = s.dimension == 2 ? 2 : 3;
-  const auto vector_or = [&](const std::vector<double>& v, double fill) {
-    return toml_floats(v.empty() ? std::vector<double>(dimension, fill) : v);
+  const auto table = [&](std::string_view name, const KeyGroup& group, const void* object) {
+    return fmt::format("\n[{}]\n{}", name, group_toml(group, object, name, dimension));
   };
 
   std::string out;
   out += "# Kairos run configuration: the effective value of every key (see docs/config.md).\n";
-  out += "\n[system]\n";
-  out += fmt::format("dimension = {}\n", s.dimension);
-  out += fmt::format("particles = {}\n", toml_unsigned(s.particles, "system.particles"));
-  out += fmt::format("packing_fraction = {}\n", toml_float(s.packing_fraction));
-  out += fmt::format("lattice = {}\n", toml_string(lattice));
-  out += fmt::format("temperature = {}\n", toml_float(s.temperature));
-  out += fmt::format("seed = {}\n", toml_unsigned(s.seed, "system.seed"));
-  out += fmt::format("initial_state = {}\n", toml_string(s.initial_state));
-  out += fmt::format("box_scale = {}\n", vector_or(s.box_scale, 1.0));
-  out += fmt::format("chain_length = {}\n", toml_unsigned(s.chain_length, "system.chain_length"));
-  out += fmt::format("chain_spacing = {}\n", toml_float(s.chain_spacing));
-  for (const SpeciesConfig& sp : species) {
+  out += table("system", system_keys(), &s);
+  for (const SpeciesConfig& sp : s.species) {
     out += "\n[[system.species]]\n";
-    out += fmt::format("name = {}\n", toml_string(sp.name));
-    out += fmt::format("diameter = {}\n", toml_float(sp.diameter));
-    out += fmt::format("mass = {}\n", toml_float(sp.mass));
-    out += fmt::format("fraction = {}\n", toml_float(sp.fraction));
-    out += fmt::format("inertia_factor = {}\n", toml_float(sp.inertia_factor));
+    out += group_toml(species_keys(), &sp, "system.species", dimension);
   }
   for (const PairPotentialConfig& pc : config.potentials) {
     out += "\n[[potential]]\n";
-    if (!pc.species.empty()) {
-      out += fmt::format("species = [{}, {}]\n", toml_string(pc.species[0]),
-                         toml_string(pc.species[1]));
-    }
-    out += potential_toml(pc.potential);
+    if (!pc.species.empty()) out += species_pair_toml(pc.species[0], pc.species[1]);
+    out += potential_toml(pc.potential, "potential");
   }
   for (const BondConfig& bc : config.bonds) {
     out += "\n[[bond]]\n";
     out += fmt::format("type = {}\n", toml_string(bc.type));
-    out += potential_toml(bc.potential);
+    out += potential_toml(bc.potential, "bond");
   }
-  out += "\n[contact]\n";
-  out += contact_toml(in.contact);
-  out += fmt::format("tc = {}\n", toml_float(in.tc));
-  out += fmt::format("sleep_speed = {}\n", toml_float(in.sleep_speed));
+  const InteractionConfig& in = config.interactions;
+  out += table("contact", contact_law_keys(), &in.contact);
+  out += group_toml(contact_keys(), &in, "contact", dimension);
   for (const PairContactConfig& pair : in.pairs) {
     out += "\n[[contact.pair]]\n";
-    out += fmt::format("species = [{}, {}]\n", toml_string(pair.species[0]),
-                       toml_string(pair.species[1]));
-    out += contact_toml(pair.contact);
+    out += species_pair_toml(pair.species[0], pair.species[1]);
+    out += group_toml(contact_law_keys(), &pair.contact, "contact.pair", dimension);
   }
-  out += "\n[boundary]\n";
-  out += "open = [";
-  for (std::size_t i = 0; i < config.boundary.open.size(); ++i) {
-    out += fmt::format("{}{}", i == 0 ? "" : ", ", toml_string(config.boundary.open[i]));
-  }
-  out += "]\n";
-  out += fmt::format("shear_rate = {}\n", toml_float(config.boundary.shear_rate));
+  out += table("boundary", boundary_keys(), &config.boundary);
   for (const WallConfig& w : config.boundary.walls) {
     out += "\n[[boundary.wall]]\n";
     out += fmt::format("face = {}\n", toml_string(w.face));
-    out += contact_toml(w.contact);
-    out += fmt::format("velocity = {}\n", vector_or(w.velocity, 0.0));
-    out += fmt::format("amplitude = {}\n", toml_float(w.amplitude));
-    out += fmt::format("frequency = {}\n", toml_float(w.frequency));
-    out += fmt::format("phase = {}\n", toml_float(w.phase));
+    out += group_toml(contact_law_keys(), &w.contact, "boundary.wall", dimension);
+    out += group_toml(wall_keys(), &w, "boundary.wall", dimension);
   }
-  out += "\n[driving]\n";
-  out += fmt::format("kind = {}\n", toml_string(config.driving.kind));
-  out += fmt::format("rate = {}\n", toml_float(config.driving.rate));
-  out += fmt::format("temperature = {}\n", toml_float(config.driving.temperature));
-  out += fmt::format("strength = {}\n", toml_float(config.driving.strength));
-  out += "\n[field]\n";
-  out += fmt::format("gravity = {}\n", vector_or(config.field.gravity, 0.0));
+  out += table("driving", driving_keys(), &config.driving);
+  out += table("field", field_keys(), &config.field);
   const SoftConfig& soft = config.soft;
   if (soft.enabled()) {
-    out += "\n[soft]\n";
-    out += soft_law_toml(soft.law);
-    out += fmt::format("collisions = {}\n", toml_string(soft.collisions));
-    out += fmt::format("tables = {}\n", soft.tables);
-    out += fmt::format("table_tolerance = {}\n", toml_float(soft.table_tolerance));
-    out += fmt::format("table_cache = {}\n", toml_string(soft.table_cache));
-    out += fmt::format("defer_releases = {}\n", soft.defer_releases);
+    out += table("soft", soft_law_keys(), &soft.law);
+    out += group_toml(soft_keys(), &soft, "soft", dimension);
     for (const SoftPairConfig& pair : soft.pairs) {
       out += "\n[[soft.pair]]\n";
-      out += fmt::format("species = [{}, {}]\n", toml_string(pair.species[0]),
-                         toml_string(pair.species[1]));
-      out += soft_law_toml(pair.law);
+      out += species_pair_toml(pair.species[0], pair.species[1]);
+      out += group_toml(soft_law_keys(), &pair.law, "soft.pair", dimension);
     }
   }
-  out += "\n[run]\n";
-  // Each phase's length in its one unit (both would be refused when the file is read back).
-  if (r.equilibration_time >= 0.0) {
-    out += fmt::format("equilibration_time = {}\n", toml_float(r.equilibration_time));
-  } else {
-    out += fmt::format("equilibration_collisions_per_particle = {}\n",
-                       toml_float(r.equilibration_collisions_per_particle));
-  }
-  if (r.time > 0.0) {
-    out += fmt::format("time = {}\n", toml_float(r.time));
-  } else {
-    out += fmt::format("collisions_per_particle = {}\n", toml_float(r.collisions_per_particle));
-  }
-  out += fmt::format("event_queue = {}\n", toml_string(r.event_queue));
-  out += fmt::format("max_wall_seconds = {}\n", toml_float(r.max_wall_seconds));
-  out += fmt::format("validate = {}\n", r.validate);
-  out += fmt::format("integrator = {}\n", toml_string(r.integrator));
-  out += fmt::format("time_step = {}\n", toml_float(r.time_step));
-  out += "\n[output]\n";
-  out += fmt::format("directory = {}\n", toml_string(o.directory));
-  out += fmt::format("thermo_interval = {}\n", toml_float(o.thermo_interval));
-  out += fmt::format("trajectory_interval = {}\n", toml_float(o.trajectory_interval));
-  out += fmt::format("restart_interval = {}\n", toml_float(o.restart_interval));
-  if (!o.interval_unit.empty())  // "" (a config built in code): the reader's default
-    out += fmt::format("interval_unit = {}\n", toml_string(o.interval_unit));
-  out += fmt::format("trajectory = {}\n", o.trajectory);
-  out += fmt::format("progress = {}\n", toml_string(o.progress));
-  out += fmt::format("profile_axis = {}\n", toml_string(o.profile_axis));
-  out += fmt::format("profile_bins = {}\n", o.profile_bins);
+  // Each phase's length in its one unit (both would be refused when the file is read back), and
+  // interval_unit unless "" (a config built in code: the reader's default).
+  out += table("run", run_keys(), &config.run);
+  out += table("output", output_keys(), &config.output);
   return out;
 }
 
