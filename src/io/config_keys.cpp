@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdint>
 
 #include "interactions/potential_spec.hpp"
@@ -1016,28 +1017,45 @@ std::string range_text(const KeyDecl& d) {
   return out;
 }
 
+namespace {
+
+// The names a string key accepts, in a box of either dimension: "`fcc`, `sc`, ...".
+std::string choices_text(const KeyDecl& d) {
+  std::vector<std::string_view> names = d.choices(3);
+  for (const std::string_view name : d.choices(2))
+    if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  std::string out;
+  for (const std::string_view name : names)
+    out += fmt::format("{}`{}`", out.empty() ? "" : ", ", name);
+  return out;
+}
+
+}  // namespace
+
 std::string keys_text() {
   std::string out;
   for (const DeclaredKey& k : declared_keys()) {
     if (k.decl == nullptr) continue;
-    out += fmt::format("{}  {}  {}  {}  {}\n", k.path, type_text(*k.decl), default_text(k),
-                       range_text(*k.decl), k.decl->doc);
+    const KeyDecl& d = *k.decl;
+    out += fmt::format("{}  {}  default {}", k.path, type_text(d), default_text(k));
+    if (!range_text(d).empty()) out += fmt::format("  {}", range_text(d));
+    if (!d.unit.empty()) out += fmt::format("  [{}]", d.unit);
+    out += fmt::format("  {}", d.doc);
+    if (d.choices != nullptr) out += ": " + choices_text(d);
+    out += "\n";
   }
   return out;
 }
 
 std::string keys_markdown() {
-  std::string out = "| Key | Type | Default | Range | Meaning |\n|---|---|---|---|---|\n";
+  std::string out =
+      "| Key | Type | Default | Range | Unit | Meaning |\n|---|---|---|---|---|---|\n";
   for (const DeclaredKey& k : declared_keys()) {
     if (k.decl == nullptr) continue;
-    std::string choices;
-    if (k.decl->choices != nullptr) {
-      for (const std::string_view c : k.decl->choices(3))
-        choices += fmt::format("{}`{}`", choices.empty() ? "" : ", ", c);
-      choices = ": " + choices;
-    }
-    out += fmt::format("| `{}` | {} | {} | {} | {}{} |\n", k.path, type_text(*k.decl),
-                       default_text(k), range_text(*k.decl), k.decl->doc, choices);
+    const KeyDecl& d = *k.decl;
+    out += fmt::format("| `{}` | {} | {} | {} | {} | {}{} |\n", k.path, type_text(d),
+                       default_text(k), range_text(d), d.unit, d.doc,
+                       d.choices != nullptr ? ": " + choices_text(d) : std::string());
   }
   return out;
 }

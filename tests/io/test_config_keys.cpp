@@ -260,6 +260,20 @@ TEST(ConfigKeys, DocNumbers) {
   EXPECT_EQ(doc_number(100000.0), "100 000");
 }
 
+// `kairos config-keys [--markdown]`: one line, or one table row, per declared key.
+TEST(ConfigKeys, ListingsHaveEveryKey) {
+  const std::string markdown = keys_markdown();
+  const std::string text = keys_text();
+  EXPECT_TRUE(markdown.starts_with("| Key | Type | Default | Range | Unit | Meaning |"));
+  for (const DeclaredKey& key : declared_keys()) {
+    if (key.decl == nullptr) continue;
+    EXPECT_NE(markdown.find(fmt::format("| `{}` | ", key.path)), std::string::npos) << key.path;
+    EXPECT_NE(text.find(key.path + "  "), std::string::npos) << key.path;
+  }
+  EXPECT_NE(markdown.find("| `contact.restitution` | float | `1.0` | in [0, 1] |"),
+            std::string::npos);
+}
+
 // ----- docs/config.md
 
 struct DocRow {
