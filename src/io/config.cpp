@@ -559,21 +559,18 @@ class Reader : public KeyReader {
                          "\"dashpot\", > 0)",
                          path("stiffness")));
       }
-      require_positive(n_k, path("stiffness"), law.stiffness);
-      require_non_negative(n_gamma, path("damping"), law.damping);
+      check_rule_range(n_k, path("stiffness"), law.stiffness);
+      check_rule_range(n_gamma, path("damping"), law.damping);
     } else {
       if (n_young == nullptr && law.young == 0.0) {
         fail(n_model != nullptr ? n_model : &t, path("young"),
              fmt::format("missing required key '{}' (Young's modulus of model \"hertz\", > 0)",
                          path("young")));
       }
-      require_positive(n_young, path("young"), law.young);
-      if (!(law.poisson > -1.0 && law.poisson <= 0.5)) {
-        fail(n_poisson, path("poisson"),
-             fmt::format("{}: must be in (-1, 0.5], got {}", path("poisson"), law.poisson));
-      }
-      require_non_negative(n_a, path("dissipation"), law.dissipation);
-      require_positive(n_speed, path("restitution_speed"), law.restitution_speed);
+      check_rule_range(n_young, path("young"), law.young);
+      check_rule_range(n_poisson, path("poisson"), law.poisson);
+      check_rule_range(n_a, path("dissipation"), law.dissipation);
+      check_rule_range(n_speed, path("restitution_speed"), law.restitution_speed);
     }
     if (!(law.restitution == 0.0 || (law.restitution > 0.0 && law.restitution <= 1.0)) ||
         (n_e != nullptr && law.restitution == 0.0)) {

@@ -263,12 +263,12 @@ class KeyReader {
 
   // ----- range checks
 
-  void require_positive(const toml::node* node, std::string_view path, double value) const {
-    if (!(value > 0.0)) fail(node, path, fmt::format("{}: must be > 0, got {}", path, value));
-  }
-
-  void require_non_negative(const toml::node* node, std::string_view path, double value) const {
-    if (!(value >= 0.0)) fail(node, path, fmt::format("{}: must be >= 0, got {}", path, value));
+  // The declared range of a key that depends on another (Range::by_rule: a soft law's
+  // stiffness is checked for model "dashpot" only), checked by the rule that knows it applies.
+  void check_rule_range(const toml::node* node, const std::string& path, double value) const {
+    Range range = find_declared(path)->decl->range;
+    range.by_rule = false;
+    check_range(node, path, value, range);
   }
 
   void require_choice(const toml::node* node, std::string_view path, const std::string& value,

@@ -28,23 +28,27 @@ void within(const std::string& key, double value, double lo, double hi, const st
   if (!(value >= lo && value <= hi)) out_of_range(key, value, lo, hi, why);
 }
 
-// 1e9 as a message writes it.
+// A bound as a message writes it: 1e9, 1e-9, 1e3 (powers of ten from 1e3 up or 1e-3 down),
+// else as {:g} does (0.5, 10).
 std::string short_number(double v) {
-  std::string s = fmt::format("{:g}", v);
-  const auto e = s.find('e');
-  if (e == std::string::npos) return s;
-  std::string exponent = s.substr(e + 1);
-  const bool negative = exponent[0] == '-';
-  exponent = exponent.substr(exponent.find_first_not_of("+-0"));
-  return s.substr(0, e + 1) + (negative ? "-" : "") + exponent;
+  const std::string e = fmt::format("{:.0e}", v);  // "1e+09", "1e-09", "5e-01"
+  const int exponent = std::stoi(e.substr(e.find('e') + 1));
+  if (e.starts_with("1e") && std::stod(e) == v && std::abs(exponent) >= 3)
+    return fmt::format("1e{}", exponent);
+  return fmt::format("{:g}", v);
 }
 
-// `key` (a path, "contact.pair[0].tc") against the range declared for it (io/config_keys.cpp)
-// in units of `unit`, whose value and meaning `unit_text` gives: "KEY = V: out of range, must
-// be in [LO, HI] (up to 1e9 times UNIT_TEXT)". `also` (e.g. ", or -1 for automatic") is added.
+// The range declared for a key (io/config_keys.cpp), by its path ("contact.pair[0].tc").
+const Range& declared(const std::string& key) {
+  return find_declared(key)->decl->range;
+}
+
+// `key` against its declared range in units of `unit`, whose value and meaning `unit_text`
+// gives: "KEY = V: out of range, must be in [LO, HI] (up to 1e9 times UNIT_TEXT)". `also` (e.g.
+// ", or -1 for automatic") is added.
 void within_declared(const std::string& key, double value, double unit,
                      const std::string& unit_text, const std::string& also = {}) {
-  const Range& r = find_declared(key)->decl->range;
+  const Range& r = declared(key);
   const std::string span =
       r.lo == 0.0 ? fmt::format("up to {} times ", short_number(r.hi))
                   : fmt::format("{} to {} times ", short_number(r.lo), short_number(r.hi));
@@ -123,20 +127,24 @@ void check_wall(const WallConfig& w, std::size_t index, const RangeScales& s) {
   const std::string prefix = fmt::format("boundary.wall[{}]", index);
   check_contact(w.contact, prefix, s);
   const double v = s.speed();
+  const double fastest = declared(prefix + ".velocity").hi;
   for (std::size_t a = 0; a < w.velocity.size(); ++a) {
-    magnitude_within(fmt::format("{}.velocity[{}]", prefix, a), w.velocity[a], 1e9 * v,
-                     "1e9 times " + speed_unit(s));
+    magnitude_within(fmt::format("{}.velocity[{}]", prefix, a), w.velocity[a], fastest * v,
+                     short_number(fastest) + " times " + speed_unit(s));
   }
   const ChoiceEntry<BoxFace>* face = box_faces().find(w.face);
   const auto axis = face != nullptr ? static_cast<std::size_t>(face_axis(face->value)) : 3;
   if (axis < s.box.size()) {
     // Not half the edge: both walls of a shaken container (a damper) vibrate in phase and may
     // sweep further; walls that meet are an error when it happens. 1e300 broke the positions.
-    within(prefix + ".amplitude", w.amplitude, 0.0, 1e6 * s.box[axis],
-           fmt::format("up to 1e6 box edges along its axis, {:.6g}", s.box[axis]));
+    const double edges = declared(prefix + ".amplitude").hi;
+    within(
+        prefix + ".amplitude", w.amplitude, 0.0, edges * s.box[axis],
+        fmt::format("up to {} box edges along its axis, {:.6g}", short_number(edges), s.box[axis]));
   }
-  within(prefix + ".frequency", w.frequency, 0.0, 1e9 / s.time(),
-         "up to 1e9 / tau, " + time_unit(s));
+  const double fastest_vibration = declared(prefix + ".frequency").hi;
+  within(prefix + ".frequency", w.frequency, 0.0, fastest_vibration / s.time(),
+         "up to " + short_number(fastest_vibration) + " / tau, " + time_unit(s));
   const double peak = 2.0 * kPi * w.frequency * w.amplitude;
   if (!(peak <= 1e9 * v)) {
     throw InputError(fmt::format(
@@ -183,8 +191,9 @@ void check_boundary(const Config& c, const RangeScales& s) {
   for (std::size_t w = 0; w < c.boundary.walls.size(); ++w) check_wall(c.boundary.walls[w], w, s);
   // The images slide at gamma L_y; faster than 1e6 / tau the image shifts and the flow's heating
   // swamp every collision (and 1e300 overflows the positions).
-  magnitude_within("boundary.shear_rate", c.boundary.shear_rate, 1e6 / s.time(),
-                   "1e6 / tau, " + time_unit(s));
+  const double fastest = declared("boundary.shear_rate").hi;
+  magnitude_within("boundary.shear_rate", c.boundary.shear_rate, fastest / s.time(),
+                   short_number(fastest) + " / tau, " + time_unit(s));
   check_gravity(c, s);
 }
 
@@ -197,17 +206,16 @@ void check_driving(const DrivingConfig& d, const RangeScales& s) {
   if (omega > 0.0) {
     // Every kick is an event like a collision: more than 1000 per collision and the run is
     // nothing but kicks (1e300 made them 1e-300 apart, so that time no longer advanced).
-    within("driving.rate", d.rate, 1e-9 * omega, 1e3 * omega,
-           fmt::format("1e-9 to 1e3 times the collision rate per particle of the start state, "
-                       "{:.6g} (a dilute-gas estimate: Enskog with g = 1)",
-                       omega));
+    within_declared("driving.rate", d.rate, omega,
+                    fmt::format("the collision rate per particle of the start state, {:.6g} (a "
+                                "dilute-gas estimate: Enskog with g = 1)",
+                                omega));
   }
   if (kind == DrivingKind::kAndersen)
     within_declared("driving.temperature", d.temperature, s.kT, energy_unit(s));
   if (kind == DrivingKind::kWhiteNoise) {
     const double v2 = s.speed() * s.speed();
-    within("driving.strength", d.strength, 1e-9 * v2 / s.time(), 1e9 * v2 / s.time(),
-           "1e-9 to 1e9 times v^2 / tau, " + time_unit(s));
+    within_declared("driving.strength", d.strength, v2 / s.time(), "v^2 / tau, " + time_unit(s));
     // One kick changes a velocity by sqrt(strength / rate): beyond 1000 thermal speeds the
     // noise is no diffusion any more but a few huge blows.
     if (!(d.strength / d.rate <= 1e6 * v2)) {
@@ -384,10 +392,12 @@ void check_potential_ranges(const PotentialSpec& spec, const std::string& prefix
     magnitude_within(fmt::format("{}[{}]", key("energies"), k), spec.energies[k], 1e9 * s.kT,
                      "1e9 times " + energy_unit(s));
   if (kind(PotentialKind::kYukawa) && spec.kappa > 0.0)
-    within(key("kappa"), spec.kappa, 0.0, 1e9 / s.d_max, "up to 1e9 / d, " + length_unit(s));
+    within(key("kappa"), spec.kappa, 0.0, declared(key("kappa")).hi / s.d_max,
+           "up to " + short_number(declared(key("kappa")).hi) + " / d, " + length_unit(s));
   if (kind(PotentialKind::kMorse) && spec.alpha > 0.0) {
-    within(key("alpha"), spec.alpha, 1e-9 / s.d_max, 1e9 / s.d_max,
-           "1e-9 to 1e9 / d, " + length_unit(s));
+    const Range& r = declared(key("alpha"));
+    within(key("alpha"), spec.alpha, r.lo / s.d_max, r.hi / s.d_max,
+           fmt::format("{} to {} / d, {}", short_number(r.lo), short_number(r.hi), length_unit(s)));
   }
   if (kind(PotentialKind::kMorse) && spec.r_min > 0.0)
     within_declared(key("r_min"), spec.r_min, s.d_max, length_unit(s));
