@@ -27,6 +27,7 @@
 #include "interactions/potential_spec.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
+#include "io/config_keys.hpp"
 #include "io/progress.hpp"
 #include "run/config_ranges.hpp"
 #include "run/run.hpp"
@@ -246,6 +247,7 @@ int main(int argc, char** argv) {
       "[--overwrite]\n"
       "Usage of steps: kairos steps CONFIG.toml [--set key=value ...] [--temperature KT] [-o DIR]\n"
       "Usage of table: kairos table build|inspect|plot ... (soft-sphere collision map tables)\n"
+      "Usage of config-keys: kairos config-keys [--markdown] (every config key, declared once)\n"
       "  -o,--output OUTDIR   output directory (overrides output.directory)\n"
       "  --set key=value      override a config key (repeatable)\n"
       "  --restart FILE       continue from a restart file (OUTDIR/restart.gsd)\n"
@@ -297,6 +299,13 @@ int main(int argc, char** argv) {
                     "Also write each table and its continuous curve as TSV files in this directory "
                     "(for examples/plot/plot_steps.py)");
 
+  bool keys_markdown = false;
+  auto* config_keys = app.add_subcommand(
+      "config-keys", "List every config key: path, type, default, range and meaning.");
+  config_keys->add_flag(
+      "--markdown", keys_markdown,
+      "As one markdown table (the declarations docs/config.md is checked against)");
+
   const auto table_command = kairos::cli::add_table_command(app);
 
   // Usage errors are user errors too: one line "kairos: error: ...", exit status 2 (not CLI11's
@@ -326,6 +335,10 @@ int main(int argc, char** argv) {
       throw kairos::InputError("--restart: the restart file name must not be empty");
     }
     if (table_command->parsed()) return table_command->run();
+    if (config_keys->parsed()) {
+      std::fputs((keys_markdown ? kairos::keys_markdown() : kairos::keys_text()).c_str(), stdout);
+      return 0;
+    }
     if (steps->parsed()) {
       const kairos::Config config = kairos::load_config(steps_config, steps_overrides);
       if (steps_kT < 0.0 || !std::isfinite(steps_kT))

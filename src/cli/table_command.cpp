@@ -14,6 +14,7 @@
 #include "interactions/soft_map_table.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
+#include "io/config_choices.hpp"
 #include "run/environment_setup.hpp"
 #include "run/run_support.hpp"
 #include "run/soft_tables_setup.hpp"
@@ -232,7 +233,8 @@ void build_config_tables(const Config& config) {
   SoftTableSettings settings;
   settings.tolerance = config.soft.table_tolerance;
   settings.cache_dir = config.soft.table_cache;
-  if (config.driving.kind == "andersen") settings.driving_temperature = config.driving.temperature;
+  if (driving_kinds().is(config.driving.kind, DrivingKind::kAndersen))
+    settings.driving_temperature = config.driving.temperature;
   // A progress line on terminals only (as for a table from flags): a log gets no \r lines.
   const bool tell = ::isatty(STDERR_FILENO) != 0;
   const std::vector<SoftTableUse> used =

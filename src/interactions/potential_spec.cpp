@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <span>
 #include <utility>
 
 #include <fmt/format.h>
@@ -13,23 +15,50 @@ namespace kairos {
 
 namespace {
 
-bool is_bond(const std::string& kind) {
-  return kind == "tether" || kind == "spring";
+constexpr ChoiceEntry<PotentialKind> kKinds[] = {
+    {"square_well", PotentialKind::kSquareWell, "a square well of depth `depth` out to `lambda`"},
+    {"square_shoulder", PotentialKind::kSquareShoulder,
+     "a square shoulder of height `depth` out to `lambda`"},
+    {"steps", PotentialKind::kSteps, "a step table: `boundaries` and `energies` as given"},
+    {"lennard_jones", PotentialKind::kLennardJones, "Lennard-Jones, stepped"},
+    {"wca", PotentialKind::kWca, "the purely repulsive WCA potential, stepped"},
+    {"yukawa", PotentialKind::kYukawa, "screened Coulomb, stepped"},
+    {"morse", PotentialKind::kMorse, "Morse, stepped"},
+    {"tabulated", PotentialKind::kTabulated, "U(r) read from `file`, stepped"},
+    {"spring_dashpot", PotentialKind::kSpringDashpot,
+     "a repulsive spring in equal steps with a dashpot per step"},
+    {"tether", PotentialKind::kTether, "bond: free up to `max_length`"},
+    {"spring", PotentialKind::kSpring, "bond: a harmonic spring up to `max_length`, stepped"},
+};
+constexpr std::size_t kPairKinds = 9;  // the first nine; the bonds follow
+
+constexpr ChoiceEntry<StepPlacement> kPlacements[] = {
+    {"energy", StepPlacement::kEnergy, "steps of equal energy"},
+    {"distance", StepPlacement::kDistance, "steps of equal width"},
+    {"volume", StepPlacement::kVolume, "shells of equal volume"},
+};
+
+constexpr ChoiceEntry<StepEnergyRule> kEnergyRules[] = {
+    {"midpoint", StepEnergyRule::kMidpoint, "U at the middle of the shell"},
+    {"volume", StepEnergyRule::kVolumeAverage, "the volume average of U over the shell"},
+    {"mid_volume", StepEnergyRule::kMidVolume, "U at the radius halving the shell's volume"},
+    {"virial", StepEnergyRule::kVirial, "the shell's Boltzmann average at `temperature`"},
+};
+
+// The kind of a spec, if it is a registered name.
+std::optional<PotentialKind> kind_of(const PotentialSpec& spec) {
+  const ChoiceEntry<PotentialKind>* e = potential_kinds().find(spec.kind);
+  return e != nullptr ? std::optional(e->value) : std::nullopt;
 }
 
-bool is_continuous(const std::string& kind) {
-  return kind == "lennard_jones" || kind == "wca" || kind == "yukawa" || kind == "morse" ||
-         kind == "tabulated" || kind == "spring" || kind == "spring_dashpot";
-}
-
-bool is_known(const std::string& kind) {
-  return is_continuous(kind) || kind == "square_well" || kind == "square_shoulder" ||
-         kind == "steps" || kind == "tether";
+bool spec_is_bond(const PotentialSpec& spec) {
+  const std::optional<PotentialKind> kind = kind_of(spec);
+  return kind && is_bond(*kind);
 }
 
 // "potential lennard_jones: " or "bond spring: ".
 std::string prefix(const PotentialSpec& spec) {
-  return fmt::format("{} {}: ", is_bond(spec.kind) ? "bond" : "potential", spec.kind);
+  return fmt::format("{} {}: ", spec_is_bond(spec) ? "bond" : "potential", spec.kind);
 }
 
 [[noreturn]] void fail(const PotentialSpec& spec, const std::string& message) {
@@ -62,44 +91,85 @@ void check_core(const PotentialSpec& spec, double core) {
 
 }  // namespace
 
+const Choices<PotentialKind>& potential_kinds() {
+  static constexpr Choices<PotentialKind> kinds("potential kind", kKinds);
+  return kinds;
+}
+
+const Choices<PotentialKind>& pair_potential_kinds() {
+  static constexpr Choices<PotentialKind> kinds("pair potential kind",
+                                                std::span(kKinds).first(kPairKinds));
+  return kinds;
+}
+
+const Choices<PotentialKind>& bond_potential_kinds() {
+  static constexpr Choices<PotentialKind> kinds("bond kind", std::span(kKinds).subspan(kPairKinds));
+  return kinds;
+}
+
+const Choices<StepPlacement>& step_placements() {
+  static constexpr Choices<StepPlacement> placements("step placement", kPlacements);
+  return placements;
+}
+
+const Choices<StepEnergyRule>& step_energy_rules() {
+  static constexpr Choices<StepEnergyRule> rules("shell energy rule", kEnergyRules);
+  return rules;
+}
+
+bool is_bond(PotentialKind kind) {
+  return kind == PotentialKind::kTether || kind == PotentialKind::kSpring;
+}
+
+bool is_continuous(PotentialKind kind) {
+  switch (kind) {
+    case PotentialKind::kLennardJones:
+    case PotentialKind::kWca:
+    case PotentialKind::kYukawa:
+    case PotentialKind::kMorse:
+    case PotentialKind::kTabulated:
+    case PotentialKind::kSpring:
+    case PotentialKind::kSpringDashpot:
+      return true;
+    case PotentialKind::kSquareWell:
+    case PotentialKind::kSquareShoulder:
+    case PotentialKind::kSteps:
+    case PotentialKind::kTether:
+      break;
+  }
+  return false;
+}
+
+bool uses_epsilon(PotentialKind kind) {
+  return kind == PotentialKind::kLennardJones || kind == PotentialKind::kWca ||
+         kind == PotentialKind::kYukawa || kind == PotentialKind::kMorse;
+}
+
 StepPlacement parse_step_placement(const std::string& name) {
-  if (name == "energy") return StepPlacement::kEnergy;
-  if (name == "distance") return StepPlacement::kDistance;
-  if (name == "volume") return StepPlacement::kVolume;
-  throw InputError(fmt::format("unknown step placement '{}' (energy, distance or volume)", name));
+  return step_placements().at(name);
 }
 
 StepEnergyRule parse_step_energy_rule(const std::string& name) {
-  if (name == "midpoint") return StepEnergyRule::kMidpoint;
-  if (name == "volume") return StepEnergyRule::kVolumeAverage;
-  if (name == "mid_volume") return StepEnergyRule::kMidVolume;
-  if (name == "virial") return StepEnergyRule::kVirial;
-  throw InputError(
-      fmt::format("unknown shell energy rule '{}' (midpoint, volume, mid_volume or virial)", name));
+  return step_energy_rules().at(name);
 }
 
 ContinuousPotential continuous_potential(const PotentialSpec& spec) {
-  if (!is_known(spec.kind)) {
-    throw InputError(fmt::format(
-        "unknown potential kind '{}' (square_well, square_shoulder, steps, lennard_jones, wca, "
-        "yukawa, morse, tabulated, spring_dashpot, tether or spring)",
-        spec.kind));
-  }
-  if (!is_continuous(spec.kind)) return {};
+  const PotentialKind kind = potential_kinds().at(spec.kind);  // rejects an unknown kind
+  if (!is_continuous(kind)) return {};
   try {
-    if (spec.kind == "lennard_jones") {
+    if (kind == PotentialKind::kLennardJones) {
       positive(spec, "epsilon", spec.epsilon);
       positive(spec, "sigma", spec.sigma);
       return lennard_jones(spec.epsilon, spec.sigma, cutoff_or(spec, 2.5 * spec.sigma),
                            spec.shifted);
     }
-    if (spec.kind == "wca") {
+    if (kind == PotentialKind::kWca) {
       positive(spec, "epsilon", spec.epsilon);
       positive(spec, "sigma", spec.sigma);
       no_cutoff(spec, "2^(1/6) sigma");
       return wca(spec.epsilon, spec.sigma);
     }
-    if (spec.kind == "yukawa") {
+    if (kind == PotentialKind::kYukawa) {
       if (!(spec.epsilon != 0.0) || !std::isfinite(spec.epsilon))
         fail(spec, fmt::format("epsilon must be finite and non-zero, not {}", spec.epsilon));
       positive(spec, "sigma", spec.sigma);
@@ -108,7 +178,7 @@ ContinuousPotential continuous_potential(const PotentialSpec& spec) {
       return yukawa(spec.epsilon, spec.sigma, spec.kappa, cutoff_or(spec, 3.0 * spec.sigma),
                     spec.shifted);
     }
-    if (spec.kind == "morse") {
+    if (kind == PotentialKind::kMorse) {
       positive(spec, "epsilon", spec.epsilon);
       positive(spec, "alpha", spec.alpha);
       double r_min = spec.r_min;
@@ -123,12 +193,12 @@ ContinuousPotential continuous_potential(const PotentialSpec& spec) {
       }
       return morse(spec.epsilon, r_min, spec.alpha, rc, spec.shifted);
     }
-    if (spec.kind == "tabulated") {
+    if (kind == PotentialKind::kTabulated) {
       if (spec.file.empty()) fail(spec, "file must name the table of r and U");
       no_cutoff(spec, "the file's last r");
       return tabulated(spec.file, spec.shifted);
     }
-    if (spec.kind == "spring_dashpot") {
+    if (kind == PotentialKind::kSpringDashpot) {
       positive(spec, "stiffness", spec.stiffness);
       positive(spec, "length", spec.length);
       return repulsive_spring(spec.stiffness, spec.length);
@@ -154,10 +224,17 @@ StepTable make_step_table(const PotentialSpec& spec, double core) {
 }
 
 double table_cutoff(const PotentialSpec& spec, double core) {
-  if (spec.kind == "square_well" || spec.kind == "square_shoulder") return spec.lambda * core;
-  if (spec.kind == "steps") return spec.boundaries.empty() ? 0.0 : spec.boundaries.front();
-  if (spec.kind == "tether") return spec.max_length;
-  return continuous_potential(spec).cutoff;  // also rejects an unknown kind
+  switch (potential_kinds().at(spec.kind)) {  // rejects an unknown kind
+    case PotentialKind::kSquareWell:
+    case PotentialKind::kSquareShoulder:
+      return spec.lambda * core;
+    case PotentialKind::kSteps:
+      return spec.boundaries.empty() ? 0.0 : spec.boundaries.front();
+    case PotentialKind::kTether:
+      return spec.max_length;
+    default:
+      return continuous_potential(spec).cutoff;
+  }
 }
 
 namespace {
@@ -197,10 +274,11 @@ StepTable spring_dashpot_table(const PotentialSpec& spec, const ContinuousPotent
 StepTable make_step_table(const PotentialSpec& spec, double core, int dimension,
                           double reduced_mass) {
   const ContinuousPotential p = continuous_potential(spec);  // also rejects an unknown kind
+  const PotentialKind kind = potential_kinds().at(spec.kind);
   check_core(spec, core);
   if (dimension != 2 && dimension != 3)
     fail(spec, fmt::format("the dimension must be 2 or 3, not {}", dimension));
-  if (spec.kind != "spring_dashpot") {
+  if (kind != PotentialKind::kSpringDashpot) {
     for (const auto& [key, given] : {std::pair<const char*, bool>{"damping", spec.damping != 0.0},
                                      {"restitution", spec.restitution != 0.0},
                                      {"force_zero", !spec.force_zero}}) {
@@ -208,18 +286,18 @@ StepTable make_step_table(const PotentialSpec& spec, double core, int dimension,
     }
   }
   try {
-    if (spec.kind == "spring_dashpot")
+    if (kind == PotentialKind::kSpringDashpot)
       return spring_dashpot_table(spec, p, core, dimension, reduced_mass);
-    if (spec.kind == "square_well" || spec.kind == "square_shoulder") {
+    if (kind == PotentialKind::kSquareWell || kind == PotentialKind::kSquareShoulder) {
       if (!(spec.lambda > 1.0) || !std::isfinite(spec.lambda))
         fail(spec, fmt::format("lambda must be greater than 1, not {}", spec.lambda));
       positive(spec, "depth", spec.depth);
-      const double u = spec.kind == "square_well" ? -spec.depth : spec.depth;
+      const double u = kind == PotentialKind::kSquareWell ? -spec.depth : spec.depth;
       StepTable t{{spec.lambda * core, core}, {u}};
       t.check();
       return t;
     }
-    if (spec.kind == "steps") {
+    if (kind == PotentialKind::kSteps) {
       StepTable t{spec.boundaries, spec.energies};
       t.check();
       if (!(std::abs(t.core() - core) <= 1e-12 * core)) {
@@ -231,7 +309,7 @@ StepTable make_step_table(const PotentialSpec& spec, double core, int dimension,
       t.check();
       return t;
     }
-    if (spec.kind == "tether") {
+    if (kind == PotentialKind::kTether) {
       positive(spec, "max_length", spec.max_length);
       if (!(spec.max_length > core)) {
         fail(spec,
@@ -243,7 +321,7 @@ StepTable make_step_table(const PotentialSpec& spec, double core, int dimension,
       return t;
     }
     // The continuous kinds and spring.
-    if (spec.kind == "spring" && !(spec.length > core)) {
+    if (kind == PotentialKind::kSpring && !(spec.length > core)) {
       fail(spec, fmt::format("length {} must exceed the contact distance (sum of the radii) {}",
                              spec.length, core));
     }

@@ -4,12 +4,41 @@
 #pragma once
 
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/choices.hpp"
 #include "interactions/step_potential.hpp"
 
 namespace kairos {
+
+// The kinds of potentials, by the names potential[].kind / bond[].kind take (potential_kinds()).
+enum class PotentialKind {
+  kSquareWell,
+  kSquareShoulder,
+  kSteps,
+  kLennardJones,
+  kWca,
+  kYukawa,
+  kMorse,
+  kTabulated,
+  kSpringDashpot,
+  kTether,  // bonds: the pair can never part beyond the table
+  kSpring,
+};
+
+// Every kind; the nine of [[potential]] (pair potentials); the two of [[bond]].
+const Choices<PotentialKind>& potential_kinds();
+const Choices<PotentialKind>& pair_potential_kinds();
+const Choices<PotentialKind>& bond_potential_kinds();
+// potential[].placement and potential[].shell_energy.
+const Choices<StepPlacement>& step_placements();
+const Choices<StepEnergyRule>& step_energy_rules();
+
+bool is_bond(PotentialKind kind);        // tether, spring
+bool is_continuous(PotentialKind kind);  // stepped from a continuous U(r)
+bool uses_epsilon(PotentialKind kind);   // lennard_jones, wca, yukawa, morse
 
 struct PotentialSpec {
   // square_well | square_shoulder | steps | lennard_jones | wca | yukawa | morse | tabulated |
@@ -41,8 +70,9 @@ struct PotentialSpec {
   double length = 0.0;
   // Stepping of continuous potentials (docs/physics.md#stepping-continuous-potentials): number
   // of steps (for ΔU placement: steps on the attractive branch, the repulsive branch continuing
-  // in the same ΔU down to the core), placement energy | distance | volume, shell energies
-  // midpoint | volume | mid_volume | virial (at `temperature`).
+  // in the same ΔU down to the core), placement energy | distance | volume (names:
+  // step_placements()), shell energies midpoint | volume | mid_volume | virial (at
+  // `temperature`; step_energy_rules()).
   int steps = 10;
   std::string placement = "energy";
   std::string shell_energy = "volume";
@@ -104,8 +134,8 @@ ContinuousPotential continuous_potential(const PotentialSpec& spec);
 // InputError like continuous_potential for the parameters it needs.
 double table_cutoff(const PotentialSpec& spec, double core);
 
-// "energy" | "distance" | "volume", and "midpoint" | "volume" | "mid_volume" | "virial"; throw
-// InputError listing the accepted names.
+// "energy" | "distance" | "volume", and "midpoint" | "volume" | "mid_volume" | "virial"
+// (step_placements(), step_energy_rules()); throw InputError listing the accepted names.
 StepPlacement parse_step_placement(const std::string& name);
 StepEnergyRule parse_step_energy_rule(const std::string& name);
 

@@ -8,13 +8,14 @@
 
 #include "core/error.hpp"
 #include "interactions/soft_contact.hpp"
+#include "io/config_choices.hpp"
+#include "io/config_keys.hpp"
 
 namespace kairos {
 
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
 
 // "KEY = VALUE: out of range, must be in [LO, HI] (WHY)".
 [[noreturn]] void out_of_range(const std::string& key, double value, double lo, double hi,
@@ -25,6 +26,33 @@ constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
 
 void within(const std::string& key, double value, double lo, double hi, const std::string& why) {
   if (!(value >= lo && value <= hi)) out_of_range(key, value, lo, hi, why);
+}
+
+// A bound as a message writes it: 1e9, 1e-9, 1e3 (powers of ten from 1e3 up or 1e-3 down),
+// else as {:g} does (0.5, 10).
+std::string short_number(double v) {
+  const std::string e = fmt::format("{:.0e}", v);  // "1e+09", "1e-09", "5e-01"
+  const int exponent = std::stoi(e.substr(e.find('e') + 1));
+  if (e.starts_with("1e") && std::stod(e) == v && std::abs(exponent) >= 3)
+    return fmt::format("1e{}", exponent);
+  return fmt::format("{:g}", v);
+}
+
+// The range declared for a key (io/config_keys.cpp), by its path ("contact.pair[0].tc").
+const Range& declared(const std::string& key) {
+  return find_declared(key)->decl->range;
+}
+
+// `key` against its declared range in units of `unit`, whose value and meaning `unit_text`
+// gives: "KEY = V: out of range, must be in [LO, HI] (up to 1e9 times UNIT_TEXT)". `also` (e.g.
+// ", or -1 for automatic") is added.
+void within_declared(const std::string& key, double value, double unit,
+                     const std::string& unit_text, const std::string& also = {}) {
+  const Range& r = declared(key);
+  const std::string span =
+      r.lo == 0.0 ? fmt::format("up to {} times ", short_number(r.hi))
+                  : fmt::format("{} to {} times ", short_number(r.lo), short_number(r.hi));
+  within(key, value, r.lo * unit, r.hi * unit, span + unit_text + also);
 }
 
 // The same for a magnitude (a signed value, or 0 meaning off).
@@ -57,28 +85,26 @@ std::string length_unit(const RangeScales& s) {
 
 void check_contact(const ContactConfig& c, const std::string& prefix, const RangeScales& s) {
   const double v = s.speed();
-  if (c.restitution_model == "viscoelastic") {
+  if (restitution_models().at(c.restitution_model) == RestitutionModel::kViscoelastic) {
     // e(v) falls as (v / restitution_speed)^(1/5): far outside the run's speeds the fixed e says
     // nothing about the collisions that happen (every one elastic, or all e = 0).
-    within(prefix + ".restitution_speed", c.restitution_speed, 1e-6 * v, 1e6 * v,
-           "1e-6 to 1e6 times " + speed_unit(s));
+    within_declared(prefix + ".restitution_speed", c.restitution_speed, v, speed_unit(s));
   }
   for (std::size_t i = 0; i < c.restitution_table.size(); ++i) {
     within(fmt::format("{}.restitution_table[{}][0]", prefix, i), c.restitution_table[i][0], 0.0,
            1e9 * v, "up to 1e9 times " + speed_unit(s));
   }
-  within(prefix + ".elastic_below_speed", c.elastic_below_speed, 0.0, 1e9 * v,
-         "up to 1e9 times " + speed_unit(s));
+  within_declared(prefix + ".elastic_below_speed", c.elastic_below_speed, v, speed_unit(s));
 }
 
 void check_interactions(const InteractionConfig& in, const RangeScales& s) {
   check_contact(in.contact, "contact", s);
   for (std::size_t p = 0; p < in.pairs.size(); ++p)
     check_contact(in.pairs[p].contact, fmt::format("contact.pair[{}]", p), s);
-  within("contact.tc", in.tc, 0.0, 1e9 * s.time(), "up to 1e9 times " + time_unit(s));
+  within_declared("contact.tc", in.tc, s.time(), time_unit(s));
   if (in.sleep_speed != -1.0) {
-    within("contact.sleep_speed", in.sleep_speed, 0.0, 1e9 * s.speed(),
-           "up to 1e9 times " + speed_unit(s) + ", or -1 for automatic");
+    within_declared("contact.sleep_speed", in.sleep_speed, s.speed(), speed_unit(s),
+                    ", or -1 for automatic");
   }
 }
 
@@ -101,20 +127,24 @@ void check_wall(const WallConfig& w, std::size_t index, const RangeScales& s) {
   const std::string prefix = fmt::format("boundary.wall[{}]", index);
   check_contact(w.contact, prefix, s);
   const double v = s.speed();
+  const double fastest = declared(prefix + ".velocity").hi;
   for (std::size_t a = 0; a < w.velocity.size(); ++a) {
-    magnitude_within(fmt::format("{}.velocity[{}]", prefix, a), w.velocity[a], 1e9 * v,
-                     "1e9 times " + speed_unit(s));
+    magnitude_within(fmt::format("{}.velocity[{}]", prefix, a), w.velocity[a], fastest * v,
+                     short_number(fastest) + " times " + speed_unit(s));
   }
-  const auto face = std::find(std::begin(kFaces), std::end(kFaces), w.face);
-  const auto axis = static_cast<std::size_t>(face - std::begin(kFaces)) / 2;
+  const ChoiceEntry<BoxFace>* face = box_faces().find(w.face);
+  const auto axis = face != nullptr ? static_cast<std::size_t>(face_axis(face->value)) : 3;
   if (axis < s.box.size()) {
     // Not half the edge: both walls of a shaken container (a damper) vibrate in phase and may
     // sweep further; walls that meet are an error when it happens. 1e300 broke the positions.
-    within(prefix + ".amplitude", w.amplitude, 0.0, 1e6 * s.box[axis],
-           fmt::format("up to 1e6 box edges along its axis, {:.6g}", s.box[axis]));
+    const double edges = declared(prefix + ".amplitude").hi;
+    within(
+        prefix + ".amplitude", w.amplitude, 0.0, edges * s.box[axis],
+        fmt::format("up to {} box edges along its axis, {:.6g}", short_number(edges), s.box[axis]));
   }
-  within(prefix + ".frequency", w.frequency, 0.0, 1e9 / s.time(),
-         "up to 1e9 / tau, " + time_unit(s));
+  const double fastest_vibration = declared(prefix + ".frequency").hi;
+  within(prefix + ".frequency", w.frequency, 0.0, fastest_vibration / s.time(),
+         "up to " + short_number(fastest_vibration) + " / tau, " + time_unit(s));
   const double peak = 2.0 * kPi * w.frequency * w.amplitude;
   if (!(peak <= 1e9 * v)) {
     throw InputError(fmt::format(
@@ -134,8 +164,7 @@ void check_gravity(const Config& c, const RangeScales& s) {
   // An open face is for particles that gravity brings back: without a pull back (or with a push
   // out) they fly off for ever, and the clock and the positions grow without bound.
   for (const std::string& face : c.boundary.open) {
-    const auto f = static_cast<std::size_t>(std::find(std::begin(kFaces), std::end(kFaces), face) -
-                                            std::begin(kFaces));
+    const auto f = static_cast<std::size_t>(face_number(box_faces().at(face)));
     const std::size_t axis = f / 2;
     const double g = axis < c.field.gravity.size() ? c.field.gravity[axis] : 0.0;
     const double pull = f % 2 == 1 ? -g : g;  // towards the inside of the box
@@ -145,7 +174,7 @@ void check_gravity(const Config& c, const RangeScales& s) {
           "boundary.open: face {} is open but {} = {} does not pull the particles back from it, "
           "so they would fly off for ever; give gravity a component towards {} (or put a wall "
           "there)",
-          face, key, g, kFaces[f ^ 1u]));
+          face, key, g, box_faces().entries()[f ^ 1u].name));
     }
     if (axis < s.box.size() && !(s.kT / (s.mass * pull) <= 1e6 * s.box[axis])) {
       throw InputError(fmt::format(
@@ -162,32 +191,31 @@ void check_boundary(const Config& c, const RangeScales& s) {
   for (std::size_t w = 0; w < c.boundary.walls.size(); ++w) check_wall(c.boundary.walls[w], w, s);
   // The images slide at gamma L_y; faster than 1e6 / tau the image shifts and the flow's heating
   // swamp every collision (and 1e300 overflows the positions).
-  magnitude_within("boundary.shear_rate", c.boundary.shear_rate, 1e6 / s.time(),
-                   "1e6 / tau, " + time_unit(s));
+  const double fastest = declared("boundary.shear_rate").hi;
+  magnitude_within("boundary.shear_rate", c.boundary.shear_rate, fastest / s.time(),
+                   short_number(fastest) + " / tau, " + time_unit(s));
   check_gravity(c, s);
 }
 
 // ----- driving
 
 void check_driving(const DrivingConfig& d, const RangeScales& s) {
-  if (d.kind == "none") return;
+  const DrivingKind kind = driving_kinds().at(d.kind);
+  if (kind == DrivingKind::kNone) return;
   const double omega = s.dilute_collision_rate();
   if (omega > 0.0) {
     // Every kick is an event like a collision: more than 1000 per collision and the run is
     // nothing but kicks (1e300 made them 1e-300 apart, so that time no longer advanced).
-    within("driving.rate", d.rate, 1e-9 * omega, 1e3 * omega,
-           fmt::format("1e-9 to 1e3 times the collision rate per particle of the start state, "
-                       "{:.6g} (a dilute-gas estimate: Enskog with g = 1)",
-                       omega));
+    within_declared("driving.rate", d.rate, omega,
+                    fmt::format("the collision rate per particle of the start state, {:.6g} (a "
+                                "dilute-gas estimate: Enskog with g = 1)",
+                                omega));
   }
-  if (d.kind == "andersen") {
-    within("driving.temperature", d.temperature, 1e-9 * s.kT, 1e9 * s.kT,
-           "1e-9 to 1e9 times " + energy_unit(s));
-  }
-  if (d.kind == "white_noise") {
+  if (kind == DrivingKind::kAndersen)
+    within_declared("driving.temperature", d.temperature, s.kT, energy_unit(s));
+  if (kind == DrivingKind::kWhiteNoise) {
     const double v2 = s.speed() * s.speed();
-    within("driving.strength", d.strength, 1e-9 * v2 / s.time(), 1e9 * v2 / s.time(),
-           "1e-9 to 1e9 times v^2 / tau, " + time_unit(s));
+    within_declared("driving.strength", d.strength, v2 / s.time(), "v^2 / tau, " + time_unit(s));
     // One kick changes a velocity by sqrt(strength / rate): beyond 1000 thermal speeds the
     // noise is no diffusion any more but a few huge blows.
     if (!(d.strength / d.rate <= 1e6 * v2)) {
@@ -205,12 +233,9 @@ void check_driving(const DrivingConfig& d, const RangeScales& s) {
 
 void check_run(const Config& c, const RangeScales& s) {
   const double tau = s.time();
-  if (c.run.time > 0.0)
-    within("run.time", c.run.time, 0.0, 1e9 * tau, "up to 1e9 times " + time_unit(s));
-  if (c.run.equilibration_time >= 0.0) {
-    within("run.equilibration_time", c.run.equilibration_time, 0.0, 1e9 * tau,
-           "up to 1e9 times " + time_unit(s));
-  }
+  if (c.run.time > 0.0) within_declared("run.time", c.run.time, tau, time_unit(s));
+  if (c.run.equilibration_time >= 0.0)
+    within_declared("run.equilibration_time", c.run.equilibration_time, tau, time_unit(s));
   if (c.run.time_step > 0.0) {
     within("run.time_step", c.run.time_step, 1e-12 * tau, tau,
            "1e-12 to 1 times " + time_unit(s) + "; longer steps let particles pass each other");
@@ -219,7 +244,8 @@ void check_run(const Config& c, const RangeScales& s) {
 
 void check_outputs(const Config& c, const RangeScales& s) {
   const bool length_in_time = c.run.time > 0.0;
-  const bool in_time = c.output.interval_unit == "time";
+  const ChoiceEntry<IntervalUnit>* unit = interval_units().find(c.output.interval_unit);
+  const bool in_time = unit != nullptr && unit->value == IntervalUnit::kTime;
   const double length = length_in_time ? c.run.time : c.run.collisions_per_particle;
   for (const auto& [key, value] : {std::pair{"thermo_interval", c.output.thermo_interval},
                                    {"trajectory_interval", c.output.trajectory_interval},
@@ -243,12 +269,12 @@ void check_outputs(const Config& c, const RangeScales& s) {
 
 void check_soft_law(const SoftLawConfig& law, const std::string& prefix, const RangeScales& s) {
   const double mu = 0.5 * s.mass;  // two of the lightest particles
-  if (law.model == "dashpot") {
+  if (soft_models().at(law.model) == SoftModel::LinearDashpot) {
     // Softer and the particles interpenetrate at thermal speeds; stiffer and the overlap
     // (~ d sqrt(kT / (k d^2))) is below what doubles resolve within the box.
     const double k_unit = s.kT / (s.d_max * s.d_max);
-    within(prefix + ".stiffness", law.stiffness, 1e-9 * k_unit, 1e15 * k_unit,
-           fmt::format("1e-9 to 1e15 kT / d^2 with {}, {}", energy_unit(s), length_unit(s)));
+    within_declared(prefix + ".stiffness", law.stiffness, k_unit,
+                    fmt::format("kT / d^2 with {}, {}", energy_unit(s), length_unit(s)));
     const double c_dis = law.damping / std::sqrt(law.stiffness * mu);
     if (!(c_dis <= 1e6)) {
       throw InputError(fmt::format(
@@ -260,13 +286,12 @@ void check_soft_law(const SoftLawConfig& law, const std::string& prefix, const R
     return;
   }
   const double y_unit = s.kT / (s.d_max * s.d_max * s.d_max);
-  within(prefix + ".young", law.young, 1e-9 * y_unit, 1e15 * y_unit,
-         fmt::format("1e-9 to 1e15 kT / d^3 with {}, {}", energy_unit(s), length_unit(s)));
+  within_declared(prefix + ".young", law.young, y_unit,
+                  fmt::format("kT / d^3 with {}, {}", energy_unit(s), length_unit(s)));
   if (law.restitution > 0.0) {
     // A is solved from e at this speed; A grows as restitution_speed^(-1/5), so a speed far
     // below the run's makes every contact overdamped (1e-300 made the table build spin).
-    within(prefix + ".restitution_speed", law.restitution_speed, 1e-6 * s.speed(), 1e6 * s.speed(),
-           "1e-6 to 1e6 times " + speed_unit(s));
+    within_declared(prefix + ".restitution_speed", law.restitution_speed, s.speed(), speed_unit(s));
   }
   const double rho = hertz_rho_one_material(law.young, law.poisson, 0.25 * s.d_max);
   const double t = std::pow(mu * mu / (rho * rho * s.speed()), 0.2);  // Hertz's time at v
@@ -284,10 +309,6 @@ void check_soft(const SoftConfig& soft, const RangeScales& s) {
   check_soft_law(soft.law, "soft", s);
   for (std::size_t p = 0; p < soft.pairs.size(); ++p)
     check_soft_law(soft.pairs[p].law, fmt::format("soft.pair[{}]", p), s);
-}
-
-bool uses_epsilon(const std::string& kind) {
-  return kind == "lennard_jones" || kind == "wca" || kind == "yukawa" || kind == "morse";
 }
 
 }  // namespace
@@ -349,45 +370,49 @@ void check_potential_ranges(const PotentialSpec& spec, const std::string& prefix
                             const RangeScales& s) {
   const auto key = [&](std::string_view k) { return fmt::format("{}.{}", prefix, k); };
   const std::string energies = "1e-9 to 1e9 times " + energy_unit(s);
-  const std::string lengths = "1e-9 to 1e9 times " + length_unit(s);
+  // An unknown kind is none of them: table_cutoff below says so.
+  const auto kind = [&](PotentialKind k) { return potential_kinds().is(spec.kind, k); };
+  const bool square = kind(PotentialKind::kSquareWell) || kind(PotentialKind::kSquareShoulder);
+  const bool continuous = kind(PotentialKind::kLennardJones) || kind(PotentialKind::kWca) ||
+                          kind(PotentialKind::kYukawa) || kind(PotentialKind::kMorse);
   // Zero, negative and non-finite values have their own errors (make_step_table); here the
   // ranges of valid ones.
-  if (uses_epsilon(spec.kind) && spec.epsilon != 0.0) {
+  if (continuous && spec.epsilon != 0.0) {
     // |eps| / kT beyond 1e9: crossing a step gives speeds whose times the clock cannot resolve.
     within(key("epsilon") + " (magnitude)", std::abs(spec.epsilon), 1e-9 * s.kT, 1e9 * s.kT,
            energies);
   }
-  if (uses_epsilon(spec.kind) && (spec.kind != "morse" || spec.r_min == 0.0) && spec.sigma > 0.0)
-    within(key("sigma"), spec.sigma, 1e-9 * s.d_max, 1e9 * s.d_max, lengths);
-  if ((spec.kind == "square_well" || spec.kind == "square_shoulder") && spec.depth > 0.0)
-    within(key("depth"), spec.depth, 1e-9 * s.kT, 1e9 * s.kT, energies);
+  if (continuous && (!kind(PotentialKind::kMorse) || spec.r_min == 0.0) && spec.sigma > 0.0)
+    within_declared(key("sigma"), spec.sigma, s.d_max, length_unit(s));
+  if (square && spec.depth > 0.0) within_declared(key("depth"), spec.depth, s.kT, energy_unit(s));
   // A well narrower than 1e-9 of the core is below what the positions resolve.
-  if ((spec.kind == "square_well" || spec.kind == "square_shoulder") && spec.lambda > 1.0)
+  if (square && spec.lambda > 1.0)
     within(key("lambda"), spec.lambda, 1.0 + 1e-9, 1e6, "in units of the contact distance");
   for (std::size_t k = 0; k < spec.energies.size(); ++k)
     magnitude_within(fmt::format("{}[{}]", key("energies"), k), spec.energies[k], 1e9 * s.kT,
                      "1e9 times " + energy_unit(s));
-  if (spec.kind == "yukawa" && spec.kappa > 0.0)
-    within(key("kappa"), spec.kappa, 0.0, 1e9 / s.d_max, "up to 1e9 / d, " + length_unit(s));
-  if (spec.kind == "morse" && spec.alpha > 0.0) {
-    within(key("alpha"), spec.alpha, 1e-9 / s.d_max, 1e9 / s.d_max,
-           "1e-9 to 1e9 / d, " + length_unit(s));
+  if (kind(PotentialKind::kYukawa) && spec.kappa > 0.0)
+    within(key("kappa"), spec.kappa, 0.0, declared(key("kappa")).hi / s.d_max,
+           "up to " + short_number(declared(key("kappa")).hi) + " / d, " + length_unit(s));
+  if (kind(PotentialKind::kMorse) && spec.alpha > 0.0) {
+    const Range& r = declared(key("alpha"));
+    within(key("alpha"), spec.alpha, r.lo / s.d_max, r.hi / s.d_max,
+           fmt::format("{} to {} / d, {}", short_number(r.lo), short_number(r.hi), length_unit(s)));
   }
-  if (spec.kind == "morse" && spec.r_min > 0.0)
-    within(key("r_min"), spec.r_min, 1e-9 * s.d_max, 1e9 * s.d_max, lengths);
-  const bool spring = spec.kind == "spring" || spec.kind == "spring_dashpot";
+  if (kind(PotentialKind::kMorse) && spec.r_min > 0.0)
+    within_declared(key("r_min"), spec.r_min, s.d_max, length_unit(s));
+  const bool spring = kind(PotentialKind::kSpring) || kind(PotentialKind::kSpringDashpot);
   if (spring && spec.stiffness > 0.0) {
-    const double k_unit = s.kT / (s.d_max * s.d_max);
-    within(key("stiffness"), spec.stiffness, 1e-9 * k_unit, 1e15 * k_unit,
-           fmt::format("1e-9 to 1e15 kT / d^2 with {}, {}", energy_unit(s), length_unit(s)));
+    within_declared(key("stiffness"), spec.stiffness, s.kT / (s.d_max * s.d_max),
+                    fmt::format("kT / d^2 with {}, {}", energy_unit(s), length_unit(s)));
   }
-  if (spec.kind == "spring_dashpot" && spec.damping > 0.0 && spec.stiffness > 0.0) {
+  if (kind(PotentialKind::kSpringDashpot) && spec.damping > 0.0 && spec.stiffness > 0.0) {
     const double limit = 1e6 * std::sqrt(spec.stiffness * s.mass);
     within(key("damping"), spec.damping, 0.0, limit,
            fmt::format("gamma / sqrt(k m) up to 1e6, m = {:.6g} the smallest mass", s.mass));
   }
-  if (spec.shell_energy == "virial" && spec.temperature > 0.0)
-    within(key("temperature"), spec.temperature, 1e-9 * s.kT, 1e9 * s.kT, energies);
+  if (step_energy_rules().is(spec.shell_energy, StepEnergyRule::kVirial) && spec.temperature > 0.0)
+    within_declared(key("temperature"), spec.temperature, s.kT, energy_unit(s));
   // The table's outermost radius: a pair must meet one periodic image of its partner (and the
   // quadratures of the shell energies stay finite; a cut-off of 1e300 spun in them).
   double outer = 0.0;
@@ -401,7 +426,8 @@ void check_potential_ranges(const PotentialSpec& spec, const std::string& prefix
   if (!(outer <= limit)) {
     throw InputError(fmt::format(
         "{}: the table reaches out to r = {:.6g} (its cut-off{}), beyond {}: {:.6g}; shorten it",
-        prefix, outer, spec.kind == "tether" || spec.kind == "spring" ? ", max_length" : "",
+        prefix, outer,
+        kind(PotentialKind::kTether) || kind(PotentialKind::kSpring) ? ", max_length" : "",
         smallest != s.box.end() ? "half the smallest box edge (a pair must meet one periodic "
                                   "image of its partner)"
                                 : "1e6 times the largest diameter",

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "io/config_choices.hpp"
 #include "run/config_ranges.hpp"
 
 namespace kairos {
@@ -15,9 +16,7 @@ namespace kairos {
 namespace {
 
 int face_index(const std::string& face, int dimension) {
-  static const char* names[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
-  for (int f = 0; f < 2 * dimension; ++f)
-    if (face == names[f]) return f;
+  if (const ChoiceEntry<BoxFace>* f = box_faces(dimension).find(face)) return face_number(f->value);
   throw InputError(fmt::format("boundary: '{}' is not a face of a {}D box", face, dimension));
 }
 
@@ -185,16 +184,18 @@ std::vector<SpeciesShape> species_shapes(const Config& config, const ParticleSys
 // the pair in errors.
 SoftContactLaw make_soft_law(const SoftLawConfig& c, double mu, double r_eff,
                              const std::string& where, const std::string& what) {
+  const SoftModel model = soft_models().at(c.model);
   const auto need = [&](double value, const char* quantity) {
     if (std::isnan(value)) {
       throw InputError(fmt::format(
           "{}: {} needs one {} per species, but the particles of {} differ in size or mass; "
           "soft laws are set per species pair",
-          where, c.model == "hertz" ? "model = \"hertz\"" : "restitution", quantity, what));
+          where, model == SoftModel::ViscoelasticHertz ? "model = \"hertz\"" : "restitution",
+          quantity, what));
     }
   };
   try {
-    if (c.model == "dashpot") {
+    if (model == SoftModel::LinearDashpot) {
       double gamma = c.damping;
       if (c.restitution > 0.0) {
         need(mu, "mass");
@@ -266,8 +267,7 @@ void add_soft_laws(const Config& config, const ParticleSystem<D>& s, Environment
                                        fmt::format("species {} against a wall", name(a)));
     }
   }
-  env.soft_collisions =
-      soft.collisions == "instantaneous" ? SoftCollisions::kInstantaneous : SoftCollisions::kMapped;
+  env.soft_collisions = soft_collision_modes().at(soft.collisions);
 }
 
 }  // namespace
@@ -275,17 +275,22 @@ void add_soft_laws(const Config& config, const ParticleSystem<D>& s, Environment
 ContactModel make_contact_model(const ContactConfig& c, const std::string& where) {
   ContactModel m;
   try {
-    if (c.restitution_model == "viscoelastic") {
-      m.normal = NormalRestitution::viscoelastic_at(c.restitution, c.restitution_speed);
-    } else if (c.restitution_model == "table") {
-      std::vector<double> speeds, values;
-      for (const auto& row : c.restitution_table) {
-        speeds.push_back(row[0]);
-        values.push_back(row[1]);
+    switch (restitution_models().at(c.restitution_model)) {
+      case RestitutionModel::kViscoelastic:
+        m.normal = NormalRestitution::viscoelastic_at(c.restitution, c.restitution_speed);
+        break;
+      case RestitutionModel::kTable: {
+        std::vector<double> speeds, values;
+        for (const auto& row : c.restitution_table) {
+          speeds.push_back(row[0]);
+          values.push_back(row[1]);
+        }
+        m.normal = NormalRestitution::table(std::move(speeds), std::move(values));
+        break;
       }
-      m.normal = NormalRestitution::table(std::move(speeds), std::move(values));
-    } else {
-      m.normal = NormalRestitution::constant(c.restitution);
+      case RestitutionModel::kConstant:
+        m.normal = NormalRestitution::constant(c.restitution);
+        break;
     }
     m.tangential = std::isfinite(c.friction)
                        ? TangentialModel::walton(c.friction, c.tangential_restitution)

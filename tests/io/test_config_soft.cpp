@@ -217,8 +217,10 @@ TEST(ConfigSoft, MapTableKeys) {
   EXPECT_EQ(c.soft.table_tolerance, 1e-8);
   EXPECT_EQ(c.soft.table_cache, "/tmp/x");
   EXPECT_EQ(parse_config(to_toml(c), "round trip"), c);
-  expect_error(with(soft + "table_tolerance = 0.0\n"), {"soft.table_tolerance", "> 0"});
-  expect_error(with(soft + "table_tolerance = 0.5\n"), {"soft.table_tolerance", "below 0.1"});
+  expect_error(with(soft + "table_tolerance = 0.0\n"),
+               {"soft.table_tolerance", "must be in [1e-10, 0.1)"});
+  expect_error(with(soft + "table_tolerance = 0.5\n"),
+               {"soft.table_tolerance", "must be in [1e-10, 0.1)", "a relative error"});
   expect_error(with(soft + "tables = 1\n"), {"soft.tables"});
   expect_error(with(soft + "defer_releases = \"no\"\n"), {"soft.defer_releases"});
   expect_error(with(soft + "table_cach = \"x\"\n"), {"soft.table_cach", "soft.table_cache"});
@@ -237,9 +239,9 @@ TEST(ConfigSoft, FrictionIsTheDems) {
                     "species = [\"A\", \"B\"]\nfriction = 0.3\n"),
                {"soft.pair[0].friction", "run.integrator"});
   expect_error(with("[soft]\nmodel = \"dashpot\"\nstiffness = 1.0\nfriction = -1\n"),
-               {"soft.friction", ">= 0"});
+               {"soft.friction", "must be in [0, 1e+09]"});
   expect_error(with("[soft]\nmodel = \"dashpot\"\nstiffness = 1.0\ntangential_stiffness = 0\n"),
-               {"soft.tangential_stiffness", "> 0"});
+               {"soft.tangential_stiffness", "must be in [1e-09, 10]"});
 }
 
 TEST(ConfigSoft, RoundTripIsExact) {

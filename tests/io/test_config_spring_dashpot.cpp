@@ -58,7 +58,7 @@ TEST(ConfigSpringDashpot, ErrorsNameTheKey) {
                 .find("potential[0].restitution: must be in (0, 1]"),
             std::string::npos);
   EXPECT_NE(error_of(with("stiffness = 1e4\nlength = 1\ndamping = -1"))
-                .find("potential[0].damping: must be at least 0"),
+                .find("potential[0].damping: must be >= 0"),
             std::string::npos);
   EXPECT_NE(error_of(with("stiffness = 1e4\nlength = 1\nplacement = \"energy\""))
                 .find("potential[0].placement: spring_dashpot steps are always of equal width"),

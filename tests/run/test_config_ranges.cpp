@@ -55,7 +55,13 @@ TEST(ConfigRanges, KeysOutOfRangeNameKeyValueAndRange) {
   expect_range_error("[[potential]]\nkind = \"lennard_jones\"\nepsilon = 1e300\n",
                      {"potential[0].epsilon", "must be in [1e-09, 1e+09]", "kT = 1"});
   expect_range_error("[driving]\nkind = \"andersen\"\nrate = 1e300\n",
-                     {"driving.rate = 1e+300", "collision rate"});
+                     {"driving.rate = 1e+300", "1e-9 to 1e3 times the collision rate"});
+  expect_range_error("[driving]\nkind = \"white_noise\"\nstrength = 1e300\n",
+                     {"driving.strength = 1e+300", "1e-9 to 1e9 times v^2 / tau"});
+  expect_range_error(
+      "[[boundary.wall]]\nface = \"z-\"\nfrequency = 1e300\n[[boundary.wall]]\n"
+      "face = \"z+\"\n",
+      {"boundary.wall[0].frequency", "up to 1e9 / tau"});
   expect_range_error("[driving]\nkind = \"andersen\"\ntemperature = 1e300\n",
                      {"driving.temperature = 1e+300", "[1e-09, 1e+09]"});
   expect_range_error(
