@@ -41,7 +41,7 @@
 #include <fmt/format.h>
 
 #include "analysis/granular_theory.hpp"
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "core/periodic.hpp"
 #include "dem/dem_integrator.hpp"
 #include "engine/event_engine.hpp"

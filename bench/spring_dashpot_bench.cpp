@@ -30,7 +30,7 @@
 #include <fmt/format.h>
 
 #include "analysis/granular_theory.hpp"
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
 #include "interactions/potential_spec.hpp"

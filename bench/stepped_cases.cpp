@@ -31,7 +31,7 @@
 
 #include <fmt/format.h>
 
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
 #include "interactions/potential_spec.hpp"

@@ -26,7 +26,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "core/particle_system.hpp"
 #include "dem/dem_integrator.hpp"
 #include "engine/event_engine.hpp"

@@ -17,7 +17,6 @@
 #include <utility>
 
 #include "boundaries/face_wall.hpp"
-#include "core/environment.hpp"
 #include "core/vec.hpp"
 #include "dynamics/collision_time.hpp"
 #include "interactions/granular_contact.hpp"
@@ -38,15 +37,12 @@ class FaceWalls {
   FaceWalls() = default;
   // The faces (only kWall ones are walls), the box and the uniform acceleration particles feel.
   FaceWalls(const std::array<Face<D>, 2 * D>& faces, const Vec<D>& box, const Vec<D>& gravity);
-  // The walls of a run's model (its faces and gravity).
-  FaceWalls(const Environment<D>& environment, const Vec<D>& box)
-      : FaceWalls(environment.faces, box, environment.gravity) {}
 
   bool any() const { return any_; }
   bool is_wall(int f) const { return faces_[f].kind == FaceKind::kWall; }
   const Wall<D>& wall(int f) const { return faces_[f].wall; }
 
-  // The boundary interface (boundaries/boundaries.hpp): the surfaces are the 2D faces, a
+  // The boundary interface (model/boundaries.hpp): the surfaces are the 2D faces, a
   // surface exists where the face is a wall.
   static constexpr int surfaces() { return 2 * D; }
   bool is_surface(int f) const { return is_wall(f); }

@@ -64,7 +64,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "core/particle_system.hpp"
 #include "interactions/granular_contact.hpp"
 #include "interactions/soft_contact.hpp"

@@ -35,9 +35,9 @@
 #include <string>
 #include <vector>
 
-#include "boundaries/boundaries.hpp"
+#include "model/boundaries.hpp"
 #include "boundaries/lees_edwards.hpp"
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
 #include "core/state_blocks.hpp"
@@ -456,7 +456,7 @@ class EventEngine {
   bool soft_ = false;
   SoftContactState<D> soft_state_;
 
-  Boundaries<D> boundaries_;  // every wall (boundaries/boundaries.hpp: the face walls so far)
+  Boundaries<D> boundaries_;  // every wall (model/boundaries.hpp: the face walls so far)
   LeesEdwards<D> shear_;      // Lees-Edwards images (boundaries/lees_edwards.hpp)
   Environment<D> env_;        // last: the hot members above share fewer cache lines
 };

@@ -9,7 +9,7 @@
 #include <string_view>
 
 #include "core/choices.hpp"
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "interactions/soft_contact.hpp"
 
 namespace kairos {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "core/particle_system.hpp"
 #include "io/config.hpp"
 

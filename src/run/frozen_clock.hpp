@@ -19,7 +19,7 @@
 
 #include <fmt/format.h>
 
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "core/vec.hpp"
 
 namespace kairos {

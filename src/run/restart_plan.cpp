@@ -106,7 +106,7 @@ std::string whole_part(const std::string& key, const Flat& other) {
 }
 
 // The plane of a wall along its axis at time t, less its face's rest position (0 or L): the
-// normal velocity's drift and the vibration (core/environment.hpp).
+// normal velocity's drift and the vibration (model/environment.hpp).
 double plane_offset(const WallConfig& w, int dimension, double t) {
   const int axis = w.face[0] - 'x';
   const double u =

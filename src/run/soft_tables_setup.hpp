@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "core/particle_system.hpp"
 #include "interactions/soft_map_table.hpp"
 

@@ -1,14 +1,14 @@
 // The face walls as a boundary component (boundaries/face_walls.hpp) and the registry that holds
-// the boundary components (boundaries/boundaries.hpp): event times against closed forms, the
+// the boundary components (model/boundaries.hpp): event times against closed forms, the
 // response and its energy split, the cells a wall reaches, start checks and the squeeze time.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
-#include "boundaries/boundaries.hpp"
+#include "model/boundaries.hpp"
 #include "boundaries/face_walls.hpp"
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "core/error.hpp"
 
 namespace kairos {
@@ -22,10 +22,14 @@ Environment<3> box_with_floor_and_lid(double lid_speed = 0.0) {
   return env;
 }
 
+FaceWalls<3> walls_of(const Environment<3>& env) {
+  return FaceWalls<3>(env.faces, {10.0, 10.0, 10.0}, env.gravity);
+}
+
 TEST(FaceWalls, FallOntoTheFloorTakesTheFreeFallTime) {
   Environment<3> env = box_with_floor_and_lid();
   env.gravity = {0.0, 0.0, -2.0};
-  const FaceWalls<3> walls(env, {10.0, 10.0, 10.0});
+  const FaceWalls<3> walls = walls_of(env);
   // Centre at height 3, radius 0.5, at rest: the gap 2.5 closes as g t^2 / 2.
   const double dt = walls.event_time(4, {5.0, 5.0, 3.0}, {0.0, 0.0, 0.0}, 0.5, 0.0, kNever);
   EXPECT_NEAR(dt, std::sqrt(2.0 * 2.5 / 2.0), 1e-12);
@@ -37,7 +41,7 @@ TEST(FaceWalls, FallOntoTheFloorTakesTheFreeFallTime) {
 }
 
 TEST(FaceWalls, PistonMeetsAParticleAtTheClosingSpeed) {
-  const FaceWalls<3> walls(box_with_floor_and_lid(-0.5), {10.0, 10.0, 10.0});
+  const FaceWalls<3> walls = walls_of(box_with_floor_and_lid(-0.5));
   // The lid starts at 10 and moves down at 0.5; the particle (radius 0.5, at 4) rises at 1.
   // The gap 10 - 4 - 0.5 closes at 1.5; at t0 = 2 the lid is already at 9.
   const double dt = walls.event_time(5, {1.0, 1.0, 4.0}, {0.0, 0.0, 1.0}, 0.5, 2.0, kNever);
@@ -49,7 +53,7 @@ TEST(FaceWalls, PistonMeetsAParticleAtTheClosingSpeed) {
 }
 
 TEST(FaceWalls, ElasticContactReflectsTheRelativeNormalVelocityAndCountsTheWork) {
-  const FaceWalls<3> walls(box_with_floor_and_lid(-0.5), {10.0, 10.0, 10.0});
+  const FaceWalls<3> walls = walls_of(box_with_floor_and_lid(-0.5));
   Vec<3> v{0.3, -0.2, 1.0};
   Spin<3> w{};
   const ContactResult<3> r = walls.resolve(5, 1.0, 2.0, 0.5, 0.4, false, v, w);
@@ -65,7 +69,7 @@ TEST(FaceWalls, ElasticContactReflectsTheRelativeNormalVelocityAndCountsTheWork)
 TEST(FaceWalls, InelasticFloorDissipatesWhatTheParticleLoses) {
   Environment<3> env = box_with_floor_and_lid();
   env.faces[4].wall.contact.normal = NormalRestitution::constant(0.5);
-  const FaceWalls<3> walls(env, {10.0, 10.0, 10.0});
+  const FaceWalls<3> walls = walls_of(env);
   Vec<3> v{0.0, 0.0, -2.0};
   Spin<3> w{};
   const ContactResult<3> r = walls.resolve(4, 0.0, 1.0, 0.5, 0.4, false, v, w);
@@ -78,7 +82,7 @@ TEST(FaceWalls, OnlyTheLayersAWallReachesTestIt) {
   Environment<3> env = box_with_floor_and_lid();
   env.faces[4].wall.amplitude = 1.2;  // a vibrating floor reaches further up
   env.faces[4].wall.angular_frequency = 3.0;
-  const FaceWalls<3> bare(env, {10.0, 10.0, 10.0});
+  const FaceWalls<3> bare = walls_of(env);
   FaceWalls<3> walls = bare;
   const CellGrid<3> grid({10.0, 10.0, 10.0}, Vec<3>{1.0, 1.0, 1.0}, {true, true, false}, 1000);
   walls.set_reach(grid, 0.5);
@@ -97,7 +101,7 @@ TEST(FaceWalls, OnlyTheLayersAWallReachesTestIt) {
 }
 
 TEST(FaceWalls, StartChecksNameTheParticleAndAcceptRoundOffContacts) {
-  const FaceWalls<3> walls(box_with_floor_and_lid(), {10.0, 10.0, 10.0});
+  const FaceWalls<3> walls = walls_of(box_with_floor_and_lid());
   EXPECT_NO_THROW(walls.check_start({5.0, 5.0, 0.5 * (1.0 - 1e-13)}, 0.5, 0.0, 7));
   try {
     walls.check_start({5.0, 5.0, 9.7}, 0.5, 0.0, 42);
@@ -114,7 +118,7 @@ TEST(FaceWalls, StartChecksNameTheParticleAndAcceptRoundOffContacts) {
 TEST(FaceWalls, ApproachingWallsLeaveNoRoomAtTheSqueezeTime) {
   Environment<3> env = box_with_floor_and_lid(-0.25);
   env.faces[4].wall.velocity = {0.0, 0.0, 0.25};
-  FaceWalls<3> walls(env, {10.0, 10.0, 10.0});
+  FaceWalls<3> walls = walls_of(env);
   walls.find_squeeze_time(0.5, 1.0, true);
   // Few particles: the largest diameter (1 + 1e-3) is the room needed; closing at 0.5.
   EXPECT_NEAR(walls.squeeze_time(), (10.0 - 1.0 * (1.0 + 1e-3)) / 0.5, 1e-12);

@@ -27,7 +27,8 @@
 //   void check_start(x, radius, t, id) const;   throws InputError naming particle and surface
 //   double squeeze_time() const;                when moving surfaces leave no room (kNever)
 //
-// is made from the model as C(environment, box), and has no per-particle state (FaceWalls needs
+// is made from the run's model (Environment) in the constructor below, and has no per-particle
+// state (FaceWalls needs
 // none: its planes are functions of the time); a component with state (a wall with mass) adds its
 // restart data to ParticleSystem and its part of EventEngine::validate(). Dispatch is static (the
 // tuple below): no virtual call.
@@ -38,7 +39,7 @@
 #include <utility>
 
 #include "boundaries/face_walls.hpp"
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "scheduler/cell_grid.hpp"
 
 namespace kairos {
@@ -46,13 +47,13 @@ namespace kairos {
 template <int D>
 class Boundaries {
  public:
-  // The registry: one line per boundary geometry.
+  // The registry: one entry per boundary geometry, here and in the constructor below.
   using Components = std::tuple<FaceWalls<D>>;
 
   Boundaries() = default;
-  // Every component made from the run's model: C(environment, box).
+  // Every component made from the run's model (its specification lives in Environment).
   Boundaries(const Environment<D>& environment, const Vec<D>& box)
-      : components_(make(environment, box, static_cast<Components*>(nullptr))) {
+      : components_(FaceWalls<D>(environment.faces, box, environment.gravity)) {
     for_each([&](const auto& c) {
       any_ = any_ || c.any();
       surfaces_ += c.surfaces();
@@ -147,11 +148,6 @@ class Boundaries {
   }
 
  private:
-  template <class... C>
-  static std::tuple<C...> make(const Environment<D>& environment, const Vec<D>& box,
-                               std::tuple<C...>*) {
-    return std::tuple<C...>(C(environment, box)...);
-  }
   template <std::size_t I, class G>
   decltype(auto) dispatch(int s, G&& g) const {
     const auto& c = std::get<I>(components_);

@@ -1,4 +1,4 @@
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 
 #include <cmath>
 #include <string>
