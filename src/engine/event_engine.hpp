@@ -35,9 +35,7 @@
 #include <string>
 #include <vector>
 
-#include "model/boundaries.hpp"
 #include "boundaries/lees_edwards.hpp"
-#include "model/environment.hpp"
 #include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
 #include "core/state_blocks.hpp"
@@ -49,6 +47,8 @@
 #include "engine/pair_steps.hpp"
 #include "engine/resting_particles.hpp"
 #include "engine/soft_contact_state.hpp"
+#include "model/boundaries.hpp"
+#include "model/environment.hpp"
 #include "scheduler/cell_grid.hpp"
 
 namespace kairos {

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/huge_page_allocator.hpp"
@@ -121,6 +122,18 @@ class RestingParticles {
     if (!asleep_.empty()) permute_in_place(asleep_, order, done);
   }
   double bytes_per_particle() const { return asleep_.empty() ? 0.0 : 1.0; }
+  // The count matches the flags, and a sleeper is at rest: velocity(k) is the velocity its
+  // record holds; fail(message) otherwise.
+  template <class Velocity, class Fail, class Name>
+  void validate(Velocity&& velocity, Fail&& fail, Name&& name) const {
+    std::uint32_t n = 0;
+    for (std::uint32_t k = 0; k < asleep_.size(); ++k) {
+      if (asleep_[k] == 0) continue;
+      ++n;
+      if (norm2(velocity(k)) != 0.0) fail("sleeping particle " + name(k) + " moves");
+    }
+    if (n != count_) fail("the count of sleepers is not the number of sleeping particles");
+  }
 
  private:
   HugeVector<std::uint8_t> asleep_;  // per particle, 1 asleep; empty unless on()

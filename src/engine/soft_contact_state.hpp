@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/huge_page_allocator.hpp"
@@ -104,6 +105,21 @@ class SoftContactState {
     if (!partner_.empty()) rebuild_awaiting_release();
   }
   std::size_t size() const { return partner_.size(); }
+  // Pairs are mutual (a particle's partner names it back, unless the contact is a deferred one
+  // that is over, `ended(k)`), and a release bit is set exactly for the frozen contacts that wait
+  // for a release event; fail(message) otherwise. Partners from `first_code` on are walls.
+  template <class Ended, class Fail, class Name>
+  void validate(std::uint32_t first_code, Ended&& ended, Fail&& fail, Name&& name) const {
+    for (std::uint32_t k = 0; k < partner_.size(); ++k) {
+      const std::uint32_t p = partner_[k];
+      const bool live = p != kNone && !ended(k);
+      if (live && p < first_code && (p >= partner_.size() || partner_[p] != k))
+        fail("particle " + name(k) + " is in a soft contact its partner is not in");
+      const bool waits = p != kNone && !deferred(k);
+      if (awaits_release(k) != waits)
+        fail("particle " + name(k) + " has a release bit that does not match its contact");
+    }
+  }
   double bytes_per_particle() const {
     if (partner_.empty()) return 0.0;
     return static_cast<double>(sizeof(std::uint32_t) + sizeof(double) + sizeof(Vec<D>) +

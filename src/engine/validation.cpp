@@ -34,6 +34,13 @@ void EventEngine<D, Queue>::validate() {
   };
   auto name = [&](std::uint32_t i) { return std::to_string(id_[i]); };
   cells_.validate(hot_.data(), n, fail, name);  // the cell lists
+  resting_.validate([&](std::uint32_t k) { return hot_[k].vel; }, fail, name);
+  if (soft_) {
+    soft_state_.validate(
+        kFirstCode,
+        [&](std::uint32_t k) { return soft_state_.deferred(k) && !in_deferred_contact(k, t); },
+        fail, name);
+  }
   for (std::uint32_t i = 0; i < n; ++i) {
     const HotRecord<D>& h = hot_[i];
     const Vec<D> x = position(i, t);

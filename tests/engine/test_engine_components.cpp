@@ -266,3 +266,34 @@ TEST(CellNeighbourhood, TheVectorGatherListsTheSameCandidates) {
 
 }  // namespace
 }  // namespace kairos
+
+namespace kairos {
+namespace {
+
+TEST(ComponentValidation, EachComponentChecksItsOwnState) {
+  int failures = 0;
+  auto fail = [&](const std::string&) { ++failures; };
+  auto name = [](std::uint32_t k) { return std::to_string(k); };
+  RestingParticles<3> rest(3, 0.1, {0.0, 0.0, -1.0});
+  rest.fall_asleep(1);
+  rest.validate([](std::uint32_t) { return Vec<3>{}; }, fail, name);
+  EXPECT_EQ(failures, 0);
+  rest.validate([](std::uint32_t k) { return Vec<3>{k == 1 ? 1e-9 : 0.0, 0.0, 0.0}; }, fail, name);
+  EXPECT_EQ(failures, 1);  // a sleeper that moves
+
+  failures = 0;
+  auto live = [](std::uint32_t) { return false; };
+  SoftContactState<3> soft(4, true);
+  soft.begin(0, 2);
+  soft.begin(2, 0);
+  soft.schedule_release(0, 1.0, {});
+  soft.schedule_release(2, 1.0, {});
+  soft.validate(0x80000000u, live, fail, name);
+  EXPECT_EQ(failures, 0);
+  soft.begin(3, 1);  // one-sided, and no release bit for a frozen contact
+  soft.validate(0x80000000u, live, fail, name);
+  EXPECT_EQ(failures, 2);
+}
+
+}  // namespace
+}  // namespace kairos
