@@ -42,7 +42,7 @@
 #include "dynamics/collision_time.hpp"
 #include "engine/candidate_scan.hpp"
 #include "engine/cell_neighbourhood.hpp"
-#include "engine/event_code.hpp"
+#include "core/event_code.hpp"
 #include "engine/hot_record.hpp"
 #include "engine/pair_steps.hpp"
 #include "engine/resting_particles.hpp"

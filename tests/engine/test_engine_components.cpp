@@ -13,7 +13,7 @@
 
 #include "dynamics/collision_time.hpp"
 #include "engine/cell_neighbourhood.hpp"
-#include "engine/event_code.hpp"
+#include "core/event_code.hpp"
 #include "engine/relative_motion.hpp"
 #include "engine/resting_particles.hpp"
 #include "engine/soft_contact_state.hpp"

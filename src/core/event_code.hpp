@@ -1,5 +1,5 @@
-// What a particle's pending event is, in 32 bits: a typed code with named constructors and
-// predicates, so that a new kind of event is a change in this one file.
+// What a particle's pending event is, in 32 bits (EventSlot::partner): a typed code with named
+// constructors and predicates, so that a new kind of event is a change in this one file.
 //
 // The bits are those restart files store (EventSlot::partner, format 7), so they are fixed:
 //
