@@ -16,6 +16,7 @@
 #include "core/stop_flag.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
+#include "init/initial_state_file.hpp"
 #include "io/atomic_file.hpp"
 #include "io/gsd_snapshot.hpp"
 #include "io/progress.hpp"
@@ -192,7 +193,7 @@ ParticleSystem<D> build_start_state(const Config& config,
     if (!fs::exists(*restart_file)) {
       throw InputError("restart file '" + restart_file->string() + "' does not exist");
     }
-    return read_restart<D>(*restart_file, rng, &progress, kind);  // plan_continuation says the rest
+    return read_restart_file<D>(*restart_file, rng, progress, kind);  // plan_continuation: the rest
   }
   if (!config.system.initial_state.empty()) {
     const fs::path path = config.system.initial_state;
@@ -452,7 +453,7 @@ class RunDriver {
   }
 
   void write_restart_file() const {
-    write_restart(dir_ / "restart.gsd", engine_->state_blocks(), rng_, progress_now());
+    kairos::write_restart_file(dir_ / "restart.gsd", engine_->state_blocks(), rng_, progress_now());
   }
 
   // Equilibration still owed if the run stops now (a restart file records it).

@@ -36,6 +36,7 @@
 #include "run/output_directory.hpp"
 #include "run/restart_plan.hpp"
 #include "run/run.hpp"
+#include "run/run_progress.hpp"
 
 namespace kairos::run_detail {
 
@@ -632,7 +633,7 @@ void write_dem_restart(const fs::path& path, const DemIntegrator<D>& dem,
   s.events.assign(n, EventSlot{});  // a DEM state has no scheduler: empty event slots, never read
   s.cell.assign(n, 0);
   s.collision_count.resize(n, 0);
-  write_restart(path, s, rng, progress);
+  kairos::write_restart_file(path, s, rng, progress);
 }
 
 // The ideal-gas estimate of how far and how long a particle flies between collisions, from the

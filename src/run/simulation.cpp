@@ -166,7 +166,7 @@ ParticleSystem<D> Simulation<D>::state() const {
 }
 template <int D>
 void Simulation<D>::save(const std::filesystem::path& path) const {
-  write_restart(path, engine_->state_blocks(), rng_, progress_);
+  write_restart_file(path, engine_->state_blocks(), rng_, progress_);
 }
 
 template class Simulation<2>;

@@ -17,7 +17,7 @@
 #include "core/particle_system.hpp"
 #include "core/vec.hpp"
 #include "io/config.hpp"
-#include "io/gsd_snapshot.hpp"
+#include "run/run_progress.hpp"
 
 namespace kairos {
 
