@@ -20,17 +20,6 @@ namespace fs = std::filesystem;
 
 constexpr std::uint64_t kNoTarget = ~std::uint64_t{0};
 
-// The output files in `dir` after the run, summary.json (about to be written) first
-// (summary.json's "outputs").
-nlohmann::json outputs_present(const fs::path& dir) {
-  nlohmann::json list = nlohmann::json::array({"summary.json"});
-  std::error_code ec;
-  for (const char* name :
-       {"thermo.tsv", "trajectory.gsd", "restart.gsd", "profile.tsv", "config.toml"})
-    if (fs::exists(dir / name, ec)) list.push_back(name);
-  return list;
-}
-
 // The whole process's peak (getrusage), sampled after the restart file and the summary's own
 // checks: the kernel's figure for the run (tests/python/test_memory.py).
 std::uint64_t peak_rss_bytes() {
@@ -150,7 +139,7 @@ RunOutcome RunDriver<D>::run() {
   outcome.error = error_;
   for (const auto& o : observers_) o->summarize(outcome.summary, *this);
   outcome.summary["peak_rss_bytes"] = peak_rss_bytes();
-  outcome.summary["outputs"] = outputs_present(directory_->path());
+  outcome.summary["outputs"] = outputs_present();
   failures_.attempt("summary.json", [&] {
     write_text_atomically(directory_->path() / "summary.json", outcome.summary.dump(2) + "\n");
   });
@@ -281,6 +270,18 @@ bool RunDriver<D>::write_due(const std::vector<std::size_t>& due) {
     owed_ &= ~o.owed_bit();
   }
   return true;
+}
+
+// The output files in the directory after the run, summary.json (about to be written) first,
+// config.toml last (summary.json's "outputs").
+template <int D>
+nlohmann::json RunDriver<D>::outputs_present() const {
+  nlohmann::json list = nlohmann::json::array({"summary.json"});
+  std::error_code ec;
+  for (const auto& o : observers_)
+    if (o->writes_file() && fs::exists(directory() / o->name(), ec)) list.push_back(o->name());
+  if (fs::exists(directory() / "config.toml", ec)) list.push_back("config.toml");
+  return list;
 }
 
 template <int D>

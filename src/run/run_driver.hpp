@@ -87,6 +87,7 @@ class RunDriver final : public RunContext<D> {
   // The run stops: why (stop_reason_), true.
   bool stopped_because(const char* reason);
   bool wall_time_exceeded() const;
+  nlohmann::json outputs_present() const;
 
   Clock::time_point created_ = Clock::now();  // the start of the set-up
   Config config_;

@@ -16,6 +16,7 @@ class DemSummary final : public Observer<D> {
  public:
   explicit DemSummary(const DemAdapter<D>& dem) : dem_(dem) {}
   std::string name() const override { return "summary.json (dem)"; }
+  bool writes_file() const override { return false; }
   void open(const RunContext<D>&) override;
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 

@@ -16,6 +16,7 @@ class EventSummary final : public Observer<D> {
  public:
   explicit EventSummary(const EventIntegrator<D>& engine) : engine_(engine) {}
   std::string name() const override { return "summary.json (event engine)"; }
+  bool writes_file() const override { return false; }
   void open(const RunContext<D>&) override;
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 

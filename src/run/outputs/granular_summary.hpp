@@ -17,6 +17,7 @@ class GranularSummary final : public Observer<D> {
  public:
   explicit GranularSummary(const EventIntegrator<D>& engine) : engine_(engine) {}
   std::string name() const override { return "summary.json (granular)"; }
+  bool writes_file() const override { return false; }
   void open(const RunContext<D>&) override {
     start_ = engine_.counters();
     energy_start_ = engine_.total_energy();

@@ -75,6 +75,9 @@ class Observer {
   // The file it writes in the output directory (or, for an analysis, what it is called): the
   // name of its writes in OutputFailures and in error messages.
   virtual std::string name() const = 0;
+  // Whether name() is a file in the output directory (summary.json's "outputs" lists those
+  // that exist at the end); false for parts of summary.json and other analyses.
+  virtual bool writes_file() const { return true; }
   // Its interval in collisions per particle or in simulated time (output.interval_unit), given
   // the production's length in that unit; 0: no trigger (write() is never called).
   virtual double interval(const Config& /*config*/, double /*production_length*/) const {

@@ -23,6 +23,7 @@ class PressureTensor final : public Observer<D> {
   PressureTensor(const EventIntegrator<D>& engine, const ThermoOutput<D>& thermo)
       : engine_(engine), thermo_(thermo) {}
   std::string name() const override { return "summary.json (pressure tensor)"; }
+  bool writes_file() const override { return false; }
   void production_starts(const RunContext<D>&) override;
   void sample(const RunContext<D>&) override;
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;

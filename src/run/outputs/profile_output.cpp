@@ -8,6 +8,7 @@ namespace kairos {
 template <int D>
 void ProfileOutput<D>::open(const RunContext<D>& run) {
   const Config& config = run.config();
+  if (config.output.profile_axis.empty()) return;
   const int axis = config.output.profile_axis[0] - 'x';
   const Vec<D>& box = run.integrator().box();
   double cross = 1.0;
@@ -18,6 +19,7 @@ void ProfileOutput<D>::open(const RunContext<D>& run) {
 
 template <int D>
 void ProfileOutput<D>::sample(const RunContext<D>& run) {
+  if (!profile_) return;
   const ParticleSample<D> p = run.integrator().particles();
   std::vector<double> volume(p.radius.size());
   for (std::size_t i = 0; i < volume.size(); ++i) {

@@ -30,15 +30,18 @@ T& add(ObserverList<D>& list, Args&&... args) {
 
 }  // namespace
 
+// `config`: for an output registered only under some configuration (every one here decides for
+// itself at open(), so that summary.json lists a file an earlier run left).
 template <int D>
-ObserverList<D> make_observers(const Config& config, const Integrator<D>& integrator) {
+ObserverList<D> make_observers([[maybe_unused]] const Config& config,
+                               const Integrator<D>& integrator) {
   ObserverList<D> list;
   // The order matters where one output records another: the row and the frame due at one
   // moment come before the restart file that records them, and every file before summary.json.
   const ThermoOutput<D>& thermo = add<ThermoOutput<D>>(list);
   add<TrajectoryOutput<D>>(list);
   add<RestartOutput<D>>(list);
-  if (!config.output.profile_axis.empty()) add<ProfileOutput<D>>(list);
+  add<ProfileOutput<D>>(list);
   // summary.json's parts.
   add<RunSummary<D>>(list);
   if (const EventIntegrator<D>* engine = integrator.as_event()) {

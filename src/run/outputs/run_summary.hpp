@@ -13,6 +13,7 @@ template <int D>
 class RunSummary final : public Observer<D> {
  public:
   std::string name() const override { return "summary.json"; }
+  bool writes_file() const override { return false; }
   void open(const RunContext<D>& run) override { momentum_start_ = run.integrator().momentum(); }
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 

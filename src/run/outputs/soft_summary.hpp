@@ -15,6 +15,7 @@ class SoftSummary final : public Observer<D> {
  public:
   explicit SoftSummary(const EventIntegrator<D>& engine) : engine_(engine) {}
   std::string name() const override { return "summary.json (soft)"; }
+  bool writes_file() const override { return false; }
   void open(const RunContext<D>&) override { start_ = engine_.counters(); }
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 

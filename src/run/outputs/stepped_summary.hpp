@@ -16,6 +16,7 @@ class SteppedSummary final : public Observer<D> {
  public:
   explicit SteppedSummary(const EventIntegrator<D>& engine) : engine_(engine) {}
   std::string name() const override { return "summary.json (stepped)"; }
+  bool writes_file() const override { return false; }
   void open(const RunContext<D>&) override { start_ = engine_.counters(); }
   void sample(const RunContext<D>&) override {
     potential_rows_.push_back(engine_.potential_energy());
