@@ -125,7 +125,6 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   EventEngine<D, Queue>& engine() { return engine_; }
   const EventEngine<D, Queue>& engine() const { return engine_; }
   FrozenClockWatch& clock_watch() { return watch_; }
-  std::mt19937_64& rng() { return rng_; }
 
  private:
   // Stochastic driving ([driving]): Poisson events at rate N * rate, each on one random

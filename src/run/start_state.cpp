@@ -173,7 +173,7 @@ ParticleSystem<D> build_start_state(const Config& config,
     if (!fs::exists(*restart_file)) {
       throw InputError("restart file '" + restart_file->string() + "' does not exist");
     }
-    return read_restart_file<D>(*restart_file, rng, progress, kind);  // plan_continuation: the rest
+    return read_restart_file<D>(*restart_file, rng, progress, kind);  // the restart plan: the rest
   }
   if (!config.system.initial_state.empty()) {
     const fs::path path = config.system.initial_state;
