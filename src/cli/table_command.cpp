@@ -14,9 +14,8 @@
 #include "interactions/soft_map_table.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
-#include "io/config_choices.hpp"
 #include "run/environment_setup.hpp"
-#include "run/run_support.hpp"
+#include "run/setup_chain.hpp"
 #include "run/soft_tables_setup.hpp"
 
 namespace kairos::cli {
@@ -221,24 +220,17 @@ void write_plot_files(const SoftMapTable& t, const std::filesystem::path& dir, i
 }
 
 // The tables `kairos run CONFIG` would use (same state, same speed range, same cache), built now or
-// read from the cache; one report each.
+// read from the cache; one report each. The setup chain's first steps (run/setup_chain.hpp).
 template <int D>
 void build_config_tables(const Config& config) {
   if (!config.soft.enabled()) throw InputError("the config has no [soft] table");
-  std::mt19937_64 rng(config.system.seed);
-  RunProgress progress;
-  const ParticleSystem<D> start =
-      run_detail::build_start_state<D>(config, std::nullopt, rng, progress);
-  Environment<D> env = make_environment<D>(config, start);
-  SoftTableSettings settings;
-  settings.tolerance = config.soft.table_tolerance;
-  settings.cache_dir = config.soft.table_cache;
-  if (driving_kinds().is(config.driving.kind, DrivingKind::kAndersen))
-    settings.driving_temperature = config.driving.temperature;
+  const RunStart<D> start = start_run<D>(config, std::nullopt, config.run.integrator);
+  Environment<D> env = make_environment<D>(start.config, start.state);
   // A progress line on terminals only (as for a table from flags): a log gets no \r lines.
   const bool tell = ::isatty(STDERR_FILENO) != 0;
-  const std::vector<SoftTableUse> used =
-      attach_soft_tables(env, start, settings, [tell](const std::string& contact, double f) {
+  const std::vector<SoftTableUse> used = attach_soft_tables(
+      env, start.state, soft_table_settings(start.config, start.resumed),
+      [tell](const std::string& contact, double f) {
         if (!tell) return;
         std::fprintf(stderr, "\rbuilding the table of %s: %5.1f %%", contact.c_str(), 100.0 * f);
         std::fflush(stderr);

@@ -12,10 +12,17 @@
 #include "core/memory_budget.hpp"
 #include "core/periodic.hpp"
 #include "io/atomic_file.hpp"
+#include "io/gsd_reading.hpp"
 
 namespace kairos {
 
 namespace {
+
+using gsd_read::check_positions_stored;
+using gsd_read::check_rectangular_box;
+using gsd_read::read_latest;
+using gsd_read::require;
+using gsd_read::unpack_type_names;
 
 // 2: one event time per particle, order; 3: granular counters, spins, TC times, sleepers;
 // 4: bonds, pair zones, step counters; 5: soft contacts in progress and soft counters (a
@@ -39,17 +46,6 @@ std::vector<std::int8_t> pack_type_names(const std::vector<std::string>& names, 
       out[t * m + c] = static_cast<std::int8_t>(names[t][c]);
   }
   return out;
-}
-
-std::vector<std::string> unpack_type_names(const std::vector<std::int8_t>& raw, std::uint32_t m) {
-  std::vector<std::string> names;
-  for (std::size_t t = 0; m > 0 && t < raw.size() / m; ++t) {
-    std::string s;
-    for (std::size_t c = 0; c < m && raw[t * m + c] != 0; ++c)
-      s.push_back(static_cast<char>(raw[t * m + c]));
-    names.push_back(s);
-  }
-  return names;
 }
 
 // x as a float32 coordinate in HOOMD's centred box [-L/2, L/2). A coordinate just below L/2
@@ -185,57 +181,6 @@ void write_standard_chunks(gsd::Writer& w, const StateBlocks<D>& s, bool with_st
   w.write_chunk("log/events", 1, 1, &sys.counters.events);
 }
 
-template <class T>
-std::optional<std::vector<T>> read_latest(const gsd::Reader& r, std::uint64_t frame,
-                                          std::string_view name) {
-  if (r.find(frame, name)) return r.read<T>(frame, name);
-  if (r.find(0, name)) return r.read<T>(0, name);
-  return std::nullopt;
-}
-
-template <class T>
-std::vector<T> require(const gsd::Reader& r, std::uint64_t frame, std::string_view name,
-                       const std::filesystem::path& path, std::size_t expected) {
-  auto v = read_latest<T>(r, frame, name);
-  if (!v) throw InputError("'" + path.string() + "' has no chunk '" + std::string(name) + "'");
-  if (v->size() != expected) {
-    throw InputError("'" + path.string() + "': chunk '" + std::string(name) + "' holds " +
-                     std::to_string(v->size()) + " values, expected " + std::to_string(expected));
-  }
-  return std::move(*v);
-}
-
-// Before anything is allocated for the n particles that particles/N claims, the chunk holding
-// their positions (`positions`, n rows of `width` values, in frame f or 0) must hold them: a
-// damaged or hand-made file can claim any number, while the stored chunks are bounded by the
-// file's size (gsd::Reader). `who` names the file in messages.
-void check_positions_stored(const gsd::Reader& r, std::uint64_t f, std::size_t n,
-                            std::string_view positions, std::uint64_t width,
-                            const std::string& who) {
-  const auto info = r.find(f, positions) ? r.find(f, positions) : r.find(0, positions);
-  const std::string claim = who + ": particles/N = " + std::to_string(n) + " but ";
-  if (!info) throw InputError(claim + "the file has no chunk '" + std::string(positions) + "'");
-  if (info->N * info->M != n * width) {
-    throw InputError(claim + "chunk '" + std::string(positions) + "' holds " +
-                     std::to_string(info->N) + " x " + std::to_string(info->M) + " values, not " +
-                     std::to_string(n) + " x " + std::to_string(width) + ": the file is damaged");
-  }
-}
-
-// Kairos simulates rectangular boxes: a HOOMD box with tilt factors (configuration/box entries
-// xy, xz, yz) would otherwise be run as the rectangular box of its edges, silently another
-// system. `who` names the file in messages.
-void check_rectangular_box(const gsd::Reader& r, std::uint64_t f, const std::string& who) {
-  const auto box = read_latest<float>(r, f, "configuration/box");
-  if (!box || box->size() != 6) return;  // (a missing or short box is reported where it is read)
-  const float xy = (*box)[3], xz = (*box)[4], yz = (*box)[5];
-  if (xy == 0.0f && xz == 0.0f && yz == 0.0f) return;
-  throw InputError(fmt::format(
-      "{}: configuration/box has tilt factors xy = {}, xz = {}, yz = {}, a triclinic box; Kairos "
-      "simulates rectangular boxes only: give a state in a box with xy = xz = yz = 0",
-      who, xy, xz, yz));
-}
-
 // A restart file of `format` carries kairos/checksum from format 7 on (older ones may not); when
 // present it must match the frame's other chunks. A mismatch means the file was changed after
 // Kairos wrote it (a flipped bit, a bad copy, an edit): its state cannot be trusted, even when
@@ -291,53 +236,6 @@ void check_float32_copies(const gsd::Reader& r, std::uint64_t f, const std::file
   }
 }
 
-// Default name of the one bond type of a file that has bonds but no bonds/types chunk (as
-// HOOMD files written without types): that of generated chains.
-constexpr const char* kDefaultBondType = "backbone";
-
-struct BondData {
-  std::vector<Bond> bonds;
-  std::vector<std::string> types;
-};
-
-// The bonds of frame f (or frame 0) in HOOMD's schema. `what` names the file in messages.
-// InputError when a chunk has the wrong size, a bond names a particle >= n or the same
-// particle twice, or a typeid has no entry in bonds/types.
-BondData read_bonds(const gsd::Reader& r, std::uint64_t f, const std::filesystem::path& path,
-                    std::size_t n, const std::string& what) {
-  BondData out;
-  const auto bad = [&](const std::string& why) { return InputError(what + ": " + why); };
-  const std::uint64_t types_frame = r.find(f, "bonds/types") ? f : 0;
-  if (const auto info = r.find(types_frame, "bonds/types")) {
-    out.types = unpack_type_names(r.read<std::int8_t>(types_frame, "bonds/types"), info->M);
-  }
-  const auto count = read_latest<std::uint32_t>(r, f, "bonds/N");
-  const std::size_t nb = count && !count->empty() ? (*count)[0] : 0;
-  if (nb == 0) return out;
-  const auto group = require<std::uint32_t>(r, f, "bonds/group", path, 2 * nb);
-  std::vector<std::uint32_t> type_id(nb, 0);
-  if (r.find(f, "bonds/typeid") || r.find(0, "bonds/typeid"))
-    type_id = require<std::uint32_t>(r, f, "bonds/typeid", path, nb);
-  if (out.types.empty()) out.types = {kDefaultBondType};
-  out.bonds.resize(nb);
-  for (std::size_t b = 0; b < nb; ++b) {
-    const Bond bond{group[2 * b], group[2 * b + 1], type_id[b]};
-    const std::string who = "bond " + std::to_string(b) + " (" + std::to_string(bond.i) + ", " +
-                            std::to_string(bond.j) + ")";
-    if (bond.i >= n || bond.j >= n) {
-      throw bad(who + " names a particle beyond the " + std::to_string(n) +
-                " particles (bonds/group)");
-    }
-    if (bond.i == bond.j) throw bad(who + " bonds a particle to itself (bonds/group)");
-    if (bond.type >= out.types.size()) {
-      throw bad(who + " has typeid " + std::to_string(bond.type) +
-                ", which has no entry in bonds/types");
-    }
-    out.bonds[b] = bond;
-  }
-  return out;
-}
-
 // A restart file is trusted to index arrays (partners, types); reject a damaged one with an
 // InputError instead of crashing. Cell indices are left to the engine: their meaning depends on
 // the grid it builds.
@@ -391,26 +289,6 @@ void validate_restart(const ParticleSystem<D>& s, const std::filesystem::path& p
   }
 }
 
-// A per-particle property from the exact float64 chunk (times `scale`) when present, else from
-// the HOOMD float32 chunk, else HOOMD's default of 1.
-std::vector<double> per_particle_property(const gsd::Reader& r, std::uint64_t f,
-                                          const std::filesystem::path& path, std::size_t n,
-                                          std::string_view exact, double scale,
-                                          std::string_view hoomd) {
-  std::vector<double> out;
-  if (auto v = read_latest<double>(r, f, exact); v && v->size() == n) {
-    for (double x : *v) out.push_back(scale * x);
-  } else if (auto w = read_latest<float>(r, f, hoomd)) {
-    if (w->size() != n) {
-      throw InputError("'" + path.string() + "': " + std::string(hoomd) + " has the wrong size");
-    }
-    out.assign(w->begin(), w->end());
-  } else {
-    out.assign(n, 1.0);
-  }
-  return out;
-}
-
 }  // namespace
 
 template <int D>
@@ -426,13 +304,13 @@ void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& syste
 
 template <int D>
 void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& full_state,
-                   const std::mt19937_64& rng, const RunProgress& progress) {
-  write_restart(path, StateBlocks<D>::of(full_state), rng, progress);
+                   const std::mt19937_64& rng, const RestartChunks& more) {
+  write_restart(path, StateBlocks<D>::of(full_state), rng, more);
 }
 
 template <int D>
 void write_restart(const std::filesystem::path& path, const StateBlocks<D>& blocks,
-                   const std::mt19937_64& rng, const RunProgress& progress) {
+                   const std::mt19937_64& rng, const RestartChunks& more) {
   replace_file_atomically(path, [&](const std::filesystem::path& tmp) {
     auto w = gsd::Writer::create(tmp, "kairos " KAIROS_VERSION);
     w.enable_checksums();
@@ -561,7 +439,6 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& bloc
         w.write_chunk("kairos/state/frozen_deferred", nf, 1 + 2 * D, deferred.data());
       }
     }
-    w.write_chunk("kairos/run/next_kick_time", 1, 1, &progress.next_kick_time);
     if (!has.angular_velocity.empty()) {
       constexpr std::uint32_t kSpin = D == 3 ? 3 : 1;
       write_particle_chunk<double>(w, "kairos/state/angular_velocity", kSpin, blocks,
@@ -593,65 +470,19 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& bloc
           [](Part p, std::size_t j, std::uint8_t* out) { *out = p.asleep[j]; });
     }
     w.write_chunk("kairos/state/rng", rng_bytes.size(), 1, rng_bytes.data());
-    w.write_chunk("kairos/run/equilibration_remaining", 1, 1, &progress.equilibration_remaining);
-    if (std::isfinite(progress.equilibration_end_time)) {
-      w.write_chunk("kairos/run/equilibration_end_time", 1, 1, &progress.equilibration_end_time);
-    }
-    if (progress.soft_table_max_speed > 0.0) {
-      w.write_chunk("kairos/run/soft_table_max_speed", 1, 1, &progress.soft_table_max_speed);
-    }
-    if (!progress.config.empty()) {
-      const std::vector<std::int8_t> text(progress.config.begin(), progress.config.end());
-      w.write_chunk("kairos/run/config", text.size(), 1, text.data());
-    }
-    if (!progress.run_id.empty()) {
-      const std::vector<std::int8_t> id(progress.run_id.begin(), progress.run_id.end());
-      w.write_chunk("kairos/run/id", id.size(), 1, id.data());
-    }
-    if (progress.thermo_rows >= 0 || progress.trajectory_frames >= 0) {
-      const std::int64_t outputs[2] = {progress.thermo_rows, progress.trajectory_frames};
-      w.write_chunk("kairos/run/outputs", 2, 1, outputs);
-    }
-    if (progress.owed_outputs != 0) {
-      const auto owed = static_cast<std::uint8_t>(progress.owed_outputs);
-      w.write_chunk("kairos/run/owed", 1, 1, &owed);
-    }
-    if (progress.has_frame_mark) {
-      w.write_chunk("kairos/run/frame_mark", 1, 1, &progress.frame_time);
-      w.write_chunk("kairos/run/frame_mark_collisions", 1, 1, &progress.frame_collisions);
-    }
-    if (progress.has_thermo_mark) {
-      const double mark[2] = {progress.mark_time, progress.mark_virial};
-      const std::uint64_t counts[2] = {progress.mark_events, progress.mark_collisions};
-      w.write_chunk("kairos/run/thermo_mark", 2, 1, mark);
-      w.write_chunk("kairos/run/thermo_mark_counts", 2, 1, counts);
-    }
-    if (progress.schedule_phase >= 0) {
-      std::uint64_t schedule[7];
-      schedule[0] = static_cast<std::uint64_t>(progress.schedule_phase);
-      for (int k = 0; k < 3; ++k) {
-        schedule[1 + k] = progress.schedule_step[k];
-        schedule[4 + k] = progress.schedule_next[k];
-      }
-      w.write_chunk("kairos/run/schedule", 7, 1, schedule);
-    }
-    if (progress.production_target > 0)
-      w.write_chunk("kairos/run/production_target", 1, 1, &progress.production_target);
-    if (std::isfinite(progress.production_end_time))
-      w.write_chunk("kairos/run/production_end_time", 1, 1, &progress.production_end_time);
-    if (progress.integrator != "event") {
-      const std::vector<std::int8_t> name(progress.integrator.begin(), progress.integrator.end());
-      w.write_chunk("kairos/run/integrator", name.size(), 1, name.data());
-      w.write_chunk("kairos/run/dem_time_step", 1, 1, &progress.dem_time_step);
-      w.write_chunk("kairos/run/dem_collision_mark", 1, 1, &progress.dem_collision_mark);
-      if (std::isfinite(progress.dem_time_mark))
-        w.write_chunk("kairos/run/dem_time_mark", 1, 1, &progress.dem_time_mark);
-    }
+    if (more) more(w);  // the run's bookkeeping (run/run_progress.hpp)
     const std::uint32_t checksum = w.frame_checksum();  // of every chunk above: keep it last
     w.write_chunk(kChecksumChunk, 1, 1, &checksum);
     w.end_frame();
     w.close();
   });
+}
+
+void verify_restart_checksum(const gsd::Reader& r, std::uint64_t frame,
+                             const std::filesystem::path& path, const std::string& who) {
+  if (!r.find(frame, "kairos/format")) return;  // not a Kairos restart file: nothing to verify
+  const auto format = require<std::uint32_t>(r, frame, "kairos/format", path, 1);
+  verify_checksum(r, frame, format[0], who);
 }
 
 int gsd_dimension(const std::filesystem::path& path) {
@@ -663,7 +494,7 @@ int gsd_dimension(const std::filesystem::path& path) {
 
 template <int D>
 ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_64& rng,
-                               RunProgress* progress, RunKind kind) {
+                               RunKind kind, const RestartChunkReader<D>& more) {
   const gsd::Reader r(path);
   const std::uint64_t f = r.frame_count() == 0 ? 0 : r.frame_count() - 1;
   if (r.frame_count() == 0 || !r.find(f, "kairos/format")) {
@@ -683,8 +514,11 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
                      "D state but system.dimension = " + std::to_string(D));
   }
   const std::size_t n = require<std::uint32_t>(r, f, "particles/N", path, 1)[0];
-  check_positions_stored(r, f, n, "kairos/state/position", D, "'" + path.string() + "'");
-  check_rectangular_box(r, f, "'" + path.string() + "'");
+  std::string quoted = "'";  // (not "'" + ...: a GCC 12 -Wrestrict false positive)
+  quoted += path.string();
+  quoted += '\'';
+  check_positions_stored(r, f, n, "kairos/state/position", D, quoted);
+  check_rectangular_box(r, f, quoted);
   require_memory(estimated_run_bytes(n, D, kind),
                  fmt::format("restart file '{}' ({} particles)", path.string(), n));
   ParticleSystem<D> s;
@@ -782,10 +616,7 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
     }
   }
   {
-    std::string what = "'";  // (not "'" + ...: a GCC 12 -Wrestrict false positive)
-    what += path.string();
-    what += '\'';
-    BondData bonds = read_bonds(r, f, path, n, what);
+    gsd_read::BondData bonds = gsd_read::read_bonds(r, f, path, n, quoted);
     s.bonds = std::move(bonds.bonds);
     s.bond_types = std::move(bonds.types);
   }
@@ -828,226 +659,7 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   std::istringstream rng_text(std::string(rng_bytes.begin(), rng_bytes.end()));
   rng_text >> rng;
   if (!rng_text) throw InputError("'" + path.string() + "': corrupt RNG state");
-  if (progress != nullptr) {
-    *progress = {};
-    if (r.find(f, "kairos/run/equilibration_remaining")) {
-      const double left = require<double>(r, f, "kairos/run/equilibration_remaining", path, 1)[0];
-      if (!std::isfinite(left) || left < 0.0) {
-        throw InputError("'" + path.string() + "': kairos/run/equilibration_remaining is " +
-                         std::to_string(left));
-      }
-      progress->equilibration_remaining = left;
-    }
-    if (r.find(f, "kairos/run/equilibration_end_time")) {
-      const double end = require<double>(r, f, "kairos/run/equilibration_end_time", path, 1)[0];
-      if (!std::isfinite(end))
-        throw InputError("'" + path.string() +
-                         "': kairos/run/equilibration_end_time is not finite");
-      progress->equilibration_end_time = end;
-    }
-    if (r.find(f, "kairos/run/next_kick_time"))
-      progress->next_kick_time = require<double>(r, f, "kairos/run/next_kick_time", path, 1)[0];
-    if (r.find(f, "kairos/run/soft_table_max_speed")) {
-      const double v = require<double>(r, f, "kairos/run/soft_table_max_speed", path, 1)[0];
-      if (!(v > 0.0) || !std::isfinite(v)) {
-        throw InputError("'" + path.string() + "': kairos/run/soft_table_max_speed is " +
-                         std::to_string(v));
-      }
-      progress->soft_table_max_speed = v;
-    }
-    if (r.find(f, "kairos/run/config")) {
-      const auto text = r.read<std::int8_t>(f, "kairos/run/config");
-      progress->config.assign(text.begin(), text.end());
-    }
-    if (r.find(f, "kairos/run/id")) {  // optional (files written before run ids)
-      const auto id = r.read<std::int8_t>(f, "kairos/run/id");
-      progress->run_id.assign(id.begin(), id.end());
-      const bool plain = !progress->run_id.empty() && progress->run_id.size() <= 64 &&
-                         std::all_of(progress->run_id.begin(), progress->run_id.end(), [](char c) {
-                           return std::isalnum(static_cast<unsigned char>(c));
-                         });
-      if (!plain) throw InputError("'" + path.string() + "': corrupt kairos/run/id (not a run id)");
-    }
-    if (r.find(f, "kairos/run/outputs")) {
-      const auto outputs = require<std::int64_t>(r, f, "kairos/run/outputs", path, 2);
-      progress->thermo_rows = std::max<std::int64_t>(-1, outputs[0]);
-      progress->trajectory_frames = std::max<std::int64_t>(-1, outputs[1]);
-    }
-    if (r.find(f, "kairos/run/owed")) {
-      const auto owed = require<std::uint8_t>(r, f, "kairos/run/owed", path, 1)[0];
-      if (owed > (RunProgress::kOwedRow | RunProgress::kOwedFrame))
-        throw InputError("'" + path.string() + "': kairos/run/owed is not a set of outputs");
-      progress->owed_outputs = owed;
-    }
-    if (r.find(f, "kairos/run/frame_mark")) {
-      const auto time = require<double>(r, f, "kairos/run/frame_mark", path, 1);
-      const auto count = require<std::uint64_t>(r, f, "kairos/run/frame_mark_collisions", path, 1);
-      if (!std::isfinite(time[0]) || time[0] > s.time || count[0] > s.counters.collisions)
-        throw InputError("'" + path.string() + "': kairos/run/frame_mark lies after the state");
-      progress->has_frame_mark = true;
-      progress->frame_time = time[0];
-      progress->frame_collisions = count[0];
-    }
-    if (r.find(f, "kairos/run/thermo_mark")) {
-      const auto mark = require<double>(r, f, "kairos/run/thermo_mark", path, 2);
-      const auto counts = require<std::uint64_t>(r, f, "kairos/run/thermo_mark_counts", path, 2);
-      if (!std::isfinite(mark[0]) || !std::isfinite(mark[1]) || mark[0] > s.time ||
-          counts[1] > s.counters.collisions)
-        throw InputError("'" + path.string() + "': kairos/run/thermo_mark lies after the state");
-      progress->has_thermo_mark = true;
-      progress->mark_time = mark[0];
-      progress->mark_virial = mark[1];
-      progress->mark_events = counts[0];
-      progress->mark_collisions = counts[1];
-    }
-    if (r.find(f, "kairos/run/schedule")) {
-      const auto schedule = require<std::uint64_t>(r, f, "kairos/run/schedule", path, 7);
-      if (schedule[0] > 1) throw InputError("'" + path.string() + "': corrupt kairos/run/schedule");
-      progress->schedule_phase = static_cast<int>(schedule[0]);
-      for (int k = 0; k < 3; ++k) {
-        progress->schedule_step[k] = schedule[1 + k];
-        progress->schedule_next[k] = schedule[4 + k];
-      }
-    }
-    if (r.find(f, "kairos/run/production_target"))
-      progress->production_target =
-          require<std::uint64_t>(r, f, "kairos/run/production_target", path, 1)[0];
-    if (r.find(f, "kairos/run/production_end_time")) {
-      progress->production_end_time =
-          require<double>(r, f, "kairos/run/production_end_time", path, 1)[0];
-      if (!std::isfinite(progress->production_end_time))
-        throw InputError("'" + path.string() + "': kairos/run/production_end_time is not finite");
-    }
-    if (r.find(f, "kairos/run/integrator")) {
-      const auto name = r.read<std::int8_t>(f, "kairos/run/integrator");
-      progress->integrator.assign(name.begin(), name.end());
-      progress->dem_time_step = require<double>(r, f, "kairos/run/dem_time_step", path, 1)[0];
-      if (r.find(f, "kairos/run/dem_collision_mark")) {
-        progress->dem_collision_mark =
-            require<std::uint64_t>(r, f, "kairos/run/dem_collision_mark", path, 1)[0];
-      }
-      if (r.find(f, "kairos/run/dem_time_mark")) {
-        progress->dem_time_mark = require<double>(r, f, "kairos/run/dem_time_mark", path, 1)[0];
-        if (!std::isfinite(progress->dem_time_mark))
-          throw InputError("'" + path.string() + "': kairos/run/dem_time_mark is not finite");
-      }
-      if (!(progress->dem_time_step > 0.0) || !std::isfinite(progress->dem_time_step)) {
-        throw InputError("'" + path.string() + "': kairos/run/dem_time_step is " +
-                         std::to_string(progress->dem_time_step));
-      }
-    }
-  }
-  return s;
-}
-
-template <int D>
-InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_velocities,
-                                   RunKind kind) {
-  const gsd::Reader r(path);
-  if (r.frame_count() == 0) throw InputError("'" + path.string() + "' holds no frame");
-  const std::uint64_t f = r.frame_count() - 1;
-  const std::string who = "system.initial_state '" + path.string() + "'";
-  if (r.find(f, "kairos/format")) {  // a Kairos restart file: damaged?
-    const auto format = require<std::uint32_t>(r, f, "kairos/format", path, 1);
-    verify_checksum(r, f, format[0], who);
-  }
-  const int dim = gsd_dimension(path);
-  if (dim != D) {
-    throw InputError("system.initial_state '" + path.string() + "' is " + std::to_string(dim) +
-                     "D but system.dimension = " + std::to_string(D));
-  }
-  const auto nv = read_latest<std::uint32_t>(r, f, "particles/N");
-  const std::size_t n = nv && !nv->empty() ? (*nv)[0] : 0;
-  if (n < 2)
-    throw InputError("system.initial_state '" + path.string() + "' holds fewer than 2 particles");
-  const bool exact = r.find(f, "kairos/position").has_value();
-  check_positions_stored(r, f, n, exact ? "kairos/position" : "particles/position", exact ? D : 3,
-                         who);
-  check_rectangular_box(r, f, who);
-  require_memory(estimated_run_bytes(n, D, kind), fmt::format("{} ({} particles)", who, n));
-  InitialState<D> s;
-  if (exact) {
-    const auto box = require<double>(r, f, "kairos/box", path, D);
-    for (int a = 0; a < D; ++a) s.box[a] = box[a];
-  } else {
-    const auto box = require<float>(r, f, "configuration/box", path, 6);
-    for (int a = 0; a < D; ++a) s.box[a] = box[a];
-  }
-  for (int a = 0; a < D; ++a) {
-    if (!(s.box[a] > 0.0) || !std::isfinite(s.box[a])) {
-      throw InputError("system.initial_state '" + path.string() + "': box edge " +
-                       std::to_string(a) + " is not a positive number");
-    }
-  }
-  s.position.resize(n);
-  s.velocity.assign(n, Vec<D>{});
-  auto check_finite = [&](double v, const char* what, std::size_t i) {
-    if (!std::isfinite(v)) {
-      throw InputError("system.initial_state '" + path.string() + "': " + what + " of particle " +
-                       std::to_string(i) + " is not finite");
-    }
-  };
-  if (exact) {
-    const auto pos = require<double>(r, f, "kairos/position", path, n * D);
-    for (std::size_t i = 0; i < n; ++i)
-      for (int a = 0; a < D; ++a) s.position[i][a] = pos[i * D + a];
-  } else {
-    const auto pos = require<float>(r, f, "particles/position", path, n * 3);
-    for (std::size_t i = 0; i < n; ++i)
-      for (int a = 0; a < D; ++a) s.position[i][a] = pos[i * 3 + a] + 0.5 * s.box[a];
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    for (int a = 0; a < D; ++a) {
-      check_finite(s.position[i][a], "position", i);
-      double& x = s.position[i][a];
-      x -= s.box[a] * std::floor(x / s.box[a]);
-      if (x >= s.box[a]) x = 0.0;
-    }
-  }
-  has_velocities = false;
-  if (r.find(f, "kairos/velocity")) {
-    const auto vel = require<double>(r, f, "kairos/velocity", path, n * D);
-    for (std::size_t i = 0; i < n; ++i)
-      for (int a = 0; a < D; ++a) s.velocity[i][a] = vel[i * D + a];
-    has_velocities = true;
-  } else if (auto vel = read_latest<float>(r, f, "particles/velocity")) {
-    if (vel->size() != n * 3)
-      throw InputError("'" + path.string() + "': particles/velocity has the wrong size");
-    for (std::size_t i = 0; i < n; ++i)
-      for (int a = 0; a < D; ++a) s.velocity[i][a] = (*vel)[i * 3 + a];
-    has_velocities = true;
-  }
-  for (std::size_t i = 0; i < n; ++i)
-    for (int a = 0; a < D; ++a) check_finite(s.velocity[i][a], "velocity", i);
-  s.diameter = per_particle_property(r, f, path, n, "kairos/radius", 2.0, "particles/diameter");
-  s.mass = per_particle_property(r, f, path, n, "kairos/mass", 1.0, "particles/mass");
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!(s.diameter[i] > 0.0) || !std::isfinite(s.diameter[i]))
-      throw InputError("system.initial_state '" + path.string() + "': diameter of particle " +
-                       std::to_string(i) + " is not a positive number");
-    if (!(s.mass[i] > 0.0) || !std::isfinite(s.mass[i]))
-      throw InputError("system.initial_state '" + path.string() + "': mass of particle " +
-                       std::to_string(i) + " is not a positive number");
-  }
-  if (r.find(f, "particles/typeid") || r.find(0, "particles/typeid")) {
-    s.species = require<std::uint32_t>(r, f, "particles/typeid", path, n);
-  } else {
-    s.species.assign(n, 0);
-  }
-  if (auto info = r.find(f, "particles/types") ? r.find(f, "particles/types")
-                                               : r.find(0, "particles/types")) {
-    const std::uint64_t frame = r.find(f, "particles/types") ? f : 0;
-    s.species_names = unpack_type_names(r.read<std::int8_t>(frame, "particles/types"), info->M);
-  }
-  if (s.species_names.empty()) s.species_names = {"A"};
-  for (std::size_t i = 0; i < n; ++i) {
-    if (s.species[i] >= s.species_names.size())
-      throw InputError("system.initial_state '" + path.string() + "': typeid of particle " +
-                       std::to_string(i) + " has no entry in particles/types");
-  }
-  BondData bonds = read_bonds(r, f, path, n, "system.initial_state '" + path.string() + "'");
-  s.bonds = std::move(bonds.bonds);
-  s.bond_types = std::move(bonds.types);
+  if (more) more(r, f, s);  // the run's bookkeeping (run/run_progress.hpp)
   return s;
 }
 
@@ -1056,18 +668,16 @@ template void append_trajectory_frame<3>(gsd::Writer&, const ParticleSystem<3>&)
 template void append_trajectory_frame<2>(gsd::Writer&, const StateBlocks<2>&);
 template void append_trajectory_frame<3>(gsd::Writer&, const StateBlocks<3>&);
 template void write_restart<2>(const std::filesystem::path&, const StateBlocks<2>&,
-                               const std::mt19937_64&, const RunProgress&);
+                               const std::mt19937_64&, const RestartChunks&);
 template void write_restart<3>(const std::filesystem::path&, const StateBlocks<3>&,
-                               const std::mt19937_64&, const RunProgress&);
+                               const std::mt19937_64&, const RestartChunks&);
 template void write_restart<2>(const std::filesystem::path&, const ParticleSystem<2>&,
-                               const std::mt19937_64&, const RunProgress&);
+                               const std::mt19937_64&, const RestartChunks&);
 template void write_restart<3>(const std::filesystem::path&, const ParticleSystem<3>&,
-                               const std::mt19937_64&, const RunProgress&);
-template ParticleSystem<2> read_restart<2>(const std::filesystem::path&, std::mt19937_64&,
-                                           RunProgress*, RunKind);
-template ParticleSystem<3> read_restart<3>(const std::filesystem::path&, std::mt19937_64&,
-                                           RunProgress*, RunKind);
-template InitialState<2> read_initial_state<2>(const std::filesystem::path&, bool&, RunKind);
-template InitialState<3> read_initial_state<3>(const std::filesystem::path&, bool&, RunKind);
+                               const std::mt19937_64&, const RestartChunks&);
+template ParticleSystem<2> read_restart<2>(const std::filesystem::path&, std::mt19937_64&, RunKind,
+                                           const RestartChunkReader<2>&);
+template ParticleSystem<3> read_restart<3>(const std::filesystem::path&, std::mt19937_64&, RunKind,
+                                           const RestartChunkReader<3>&);
 
 }  // namespace kairos

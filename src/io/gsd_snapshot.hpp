@@ -26,24 +26,24 @@
 // Format 4 files are read with no soft contacts. Format 6 adds frozen_deferred; format 7 adds
 //   kairos/checksum  uint32 x 1: CRC-32 (zlib) of every other chunk of the frame, over their
 //                    canonical serialisation (gsd_file.hpp, "Frame checksums"), written last
-// and verified by read_restart and read_initial_state before anything else is read; a mismatch
-// (or a format-7 file without it) is an InputError "... is damaged: checksum mismatch". Files of
-// formats 3 to 6 have no checksum and are read unverified. Format 7 files may hold
-//   kairos/run/id    int8 text: the run id (RunProgress::run_id), optional: files without it
+// and verified by read_restart and read_initial_state (init/initial_state_file.hpp) before
+// anything else is read; a mismatch (or a format-7 file without it) is an InputError "... is
+// damaged: checksum mismatch". Files of formats 3 to 6 have no checksum and are read
+// unverified. Format 7 files may hold
+//   kairos/run/id    int8 text: the run id (run/run_progress.hpp), optional: files without it
 //                    (written before run ids) still load; a reader that ignores it loses only
 //                    the lineage check, so the format number did not change
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <filesystem>
-#include <limits>
+#include <functional>
 #include <random>
 #include <string>
 
+#include "core/memory_budget.hpp"
 #include "core/particle_system.hpp"
 #include "core/state_blocks.hpp"
-#include "init/initial_state.hpp"
 #include "io/gsd_file.hpp"
 
 namespace kairos {
@@ -57,88 +57,39 @@ void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& syste
 template <int D>
 void append_trajectory_frame(gsd::Writer& writer, const StateBlocks<D>& state);
 
-// Where the run that wrote a restart file stood, beyond the physical state.
-struct RunProgress {
-  double equilibration_remaining = 0.0;  // collisions per particle (or time) still to equilibrate
-  // An unfinished equilibration in time (run.equilibration_time): when it ends. NaN otherwise.
-  double equilibration_end_time = std::numeric_limits<double>::quiet_NaN();
-  double next_kick_time = -1.0;  // driving: when the next random event is due (< 0: draw)
-  // The integrator that wrote the state (run.integrator: "event" or "dem"; files without the
-  // chunk are "event"), and the DEM's time step (0 for the event integrator).
-  std::string integrator = "event";
-  double dem_time_step = 0.0;
-  // DEM: the collision count the saved run had nominally reached (the target of the phase it
-  // completed; several pairs may enter contact in one step, so the count itself may be past
-  // it). A continued run counts its lengths from here, as one uninterrupted run would.
-  std::uint64_t dem_collision_mark = 0;
-  // The same in simulated time, for lengths in time (run.time, run.equilibration_time): the
-  // end time of the phase it completed (a step may end past it). NaN: none recorded.
-  double dem_time_mark = std::numeric_limits<double>::quiet_NaN();
-  // Soft spheres: the fastest normal impact speed the run's map tables cover (0: no tables), so
-  // that a continued run uses the same tables (and stays bit-identical).
-  double soft_table_max_speed = 0.0;
-  // The configuration the state was run under (to_toml; kairos/run/config), so that a continued
-  // run knows which of its keys changed (run/restart_plan.hpp). Empty: not recorded (older files).
-  std::string config;
-  // The run's id (kairos/run/id, 32 hex digits), the lineage of its outputs: kept by every run
-  // continued from this file (run/output_directory.hpp). Empty: not recorded (older files).
-  std::string run_id;
-  // The run's outputs up to this state (kairos/run/outputs), so that a run continued into the
-  // same directory leaves them as one uninterrupted run would: rows and frames written after
-  // this state (before an interruption) are dropped. -1: not recorded.
-  std::int64_t thermo_rows = -1, trajectory_frames = -1;
-  // The point the next thermo row is measured from (the last kept row's; kairos/run/thermo_mark).
-  bool has_thermo_mark = false;
-  double mark_time = 0.0, mark_virial = 0.0;
-  std::uint64_t mark_events = 0, mark_collisions = 0;
-  // The thermo row and trajectory frame due at this state whose writing failed
-  // (kairos/run/owed, uint8): a run continued in the same directory writes them first.
-  static constexpr unsigned kOwedRow = 1, kOwedFrame = 2;
-  unsigned owed_outputs = 0;
-  // The last kept trajectory frame's state (kairos/run/frame_mark): a continued run writes no
-  // second frame of it.
-  bool has_frame_mark = false;
-  double frame_time = 0.0;
-  std::uint64_t frame_collisions = 0;
-  // Output schedules in collisions (kairos/run/schedule) of the phase the state is in (0:
-  // equilibration, 1: production, -1: not recorded): thermo, trajectory, restart; a step of 0:
-  // not scheduled. A continued run in that phase with the same steps keeps them.
-  int schedule_phase = -1;
-  std::array<std::uint64_t, 3> schedule_step{}, schedule_next{};
-  // An unfinished production (kairos/run/production_end): the collision count (0: none) or
-  // the time (NaN: none) it was to end at; a continued run completes it.
-  std::uint64_t production_target = 0;
-  double production_end_time = std::numeric_limits<double>::quiet_NaN();
-};
+// More chunks for a restart file's frame, written after the state and before the checksum that
+// covers them: the run's bookkeeping (run/run_progress.hpp, the kairos/run/ chunks), which this
+// layer stores without knowing what it means.
+using RestartChunks = std::function<void(gsd::Writer&)>;
+// Reads such chunks back from frame `frame` of the file, given the state read from it.
+template <int D>
+using RestartChunkReader =
+    std::function<void(const gsd::Reader&, std::uint64_t frame, const ParticleSystem<D>&)>;
 
 // Writes the restart file atomically (temporary file + rename).
 template <int D>
 void write_restart(const std::filesystem::path& path, const ParticleSystem<D>& full_state,
-                   const std::mt19937_64& rng, const RunProgress& progress = {});
+                   const std::mt19937_64& rng, const RestartChunks& more = {});
 // The same from a state read in blocks (the file holds the same bytes).
 template <int D>
 void write_restart(const std::filesystem::path& path, const StateBlocks<D>& state,
-                   const std::mt19937_64& rng, const RunProgress& progress = {});
+                   const std::mt19937_64& rng, const RestartChunks& more = {});
 
 // Reads a restart file written by write_restart; InputError if it is not one or if its
-// dimension differs from D. `progress` (optional) receives the run's progress.
+// dimension differs from D. `kind`: the integrator that will run the state, for the memory
+// estimate checked first. `more` reads the chunks write_restart's `more` wrote.
 template <int D>
-// `kind`: the integrator that will run the state, for the memory estimate checked first.
 ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_64& rng,
-                               RunProgress* progress = nullptr, RunKind kind = RunKind::kDem);
+                               RunKind kind = RunKind::kDem,
+                               const RestartChunkReader<D>& more = {});
+
+// A frame of a Kairos restart file (one with kairos/format) must carry a matching checksum
+// (kairos/checksum, from format 7 on): InputError "`who` is damaged" otherwise. Frames of other
+// files are not checked.
+void verify_restart_checksum(const gsd::Reader& r, std::uint64_t frame,
+                             const std::filesystem::path& path, const std::string& who);
 
 // The spatial dimension stored in a GSD file's last frame (configuration/dimensions).
 int gsd_dimension(const std::filesystem::path& path);
-
-// Reads the last frame of any HOOMD-schema GSD file as an initial state: float64 `kairos/`
-// positions and velocities when present, else the float32 standard chunks. `has_velocities`
-// tells whether the file held velocities. Bonds come from bonds/* (of that frame, else frame 0;
-// typeid defaults to 0 and, when there are bonds but no bonds/types, the one type is named
-// "backbone"). InputError on a missing file, missing positions, particles/N disagreeing with
-// them, a box too small or tilted (nonzero xy, xz, yz: Kairos boxes are rectangular), particles
-// outside the box, or a bond naming a particle out of range (or twice) or an unknown type.
-template <int D>
-InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_velocities,
-                                   RunKind kind = RunKind::kDem);
 
 }  // namespace kairos

@@ -5,8 +5,9 @@
 // event loop reaches only after infinitely many events), for resting grains under gravity that
 // may not sleep, for a gas squeezed by a piston, and for particles that start exactly in
 // contact. A run in collisions per particle would then "complete" at a frozen time and a run in
-// time would never end. The drivers watch the clock (FrozenClockWatch) and stop with an error
-// naming the particles or the wall and the remedies (describe_frozen_clock).
+// time would never end. The event engine's adapter (run/event_adapter.cpp) and the Python
+// module's Simulation watch the clock after every event (FrozenClockWatch) and stop with an
+// error naming the particles or the wall and the remedies (describe()).
 #pragma once
 
 #include <algorithm>

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -184,6 +185,28 @@ OutputDirectory::OutputDirectory(OutputDirectory&& other) noexcept
 
 OutputDirectory::~OutputDirectory() {
   release();  // releases the lock
+}
+
+std::string new_run_id() {
+  std::random_device device;
+  std::string id;
+  for (int k = 0; k < 4; ++k) id += fmt::format("{:08x}", static_cast<std::uint32_t>(device()));
+  return id;
+}
+
+std::string lineage_run_id(const std::optional<std::filesystem::path>& restart_file,
+                           const RunProgress& resumed) {
+  return restart_file && !resumed.run_id.empty() ? resumed.run_id : new_run_id();
+}
+
+OutputContinuation output_continuation(bool continues_outputs, const RunProgress& resumed) {
+  OutputContinuation c;
+  c.same_directory = continues_outputs;
+  if (!c.same_directory) return c;
+  if (resumed.thermo_rows >= 0) c.thermo_rows = static_cast<std::uint64_t>(resumed.thermo_rows);
+  if (resumed.trajectory_frames >= 0)
+    c.trajectory_frames = static_cast<std::uint64_t>(resumed.trajectory_frames);
+  return c;
 }
 
 }  // namespace kairos

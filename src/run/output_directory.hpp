@@ -10,9 +10,12 @@
 // overwritten, so that the files of two runs are never mixed.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
+
+#include "run/run_progress.hpp"
 
 namespace kairos {
 
@@ -50,5 +53,25 @@ class OutputDirectory {
   int lock_fd_ = -1;
   bool continues_ = false;
 };
+
+// A new run's id: 128 random bits as 32 hex digits (kept by every run continued from its restart
+// files).
+std::string new_run_id();
+
+// The run id of a run: the restart file's (its lineage), else a new one (a new run, or an older
+// restart file that records none).
+std::string lineage_run_id(const std::optional<std::filesystem::path>& restart_file,
+                           const RunProgress& resumed);
+
+// Where a run continued from a restart file picks up its outputs: in a directory holding its
+// own lineage's outputs (OutputDirectory::continues_outputs), thermo.tsv and trajectory.gsd are
+// cut back to the rows and frames the state had written (those after it came from a run
+// interrupted later: a continued run leaves the files as one uninterrupted run would), and the
+// next row is measured from the last kept one; elsewhere (no outputs there) they start afresh.
+struct OutputContinuation {
+  bool same_directory = false;  // the lineage's outputs are continued
+  std::optional<std::uint64_t> thermo_rows, trajectory_frames;
+};
+OutputContinuation output_continuation(bool continues_outputs, const RunProgress& resumed);
 
 }  // namespace kairos

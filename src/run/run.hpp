@@ -1,4 +1,5 @@
-// One invocation of `kairos run`: configuration -> initial state -> engine -> outputs.
+// One invocation of `kairos run`: configuration -> initial state -> integrator -> outputs (the
+// run driver, run/run_driver.hpp, for either integrator).
 //
 // Phases: equilibration (skipped on restart), then production, each measured in collisions per
 // particle c = 2 N_coll / N or in simulated time (run.time, run.equilibration_time). Outputs in the

@@ -7,11 +7,9 @@
 
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
-#include "engine/event_engine.hpp"
-#include "run/environment_setup.hpp"
-#include "run/frozen_clock.hpp"
-#include "run/run_support.hpp"
-#include "run/soft_tables_setup.hpp"
+#include "run/event_adapter.hpp"
+#include "run/output_directory.hpp"
+#include "run/setup_chain.hpp"
 #include "scheduler/calendar_queue.hpp"
 
 namespace kairos {
@@ -19,7 +17,7 @@ namespace kairos {
 template <int D>
 Simulation<D>::Simulation(const Config& config,
                           const std::optional<std::filesystem::path>& restart_file)
-    : config_(config), rng_(config.system.seed) {
+    : config_(config) {
   if (config.run.integrator != "event") {
     throw InputError(fmt::format(
         "run.integrator = \"{}\": an in-memory simulation drives the event integrator; run the "
@@ -31,45 +29,23 @@ Simulation<D>::Simulation(const Config& config,
         "[driving]: an in-memory simulation applies no driving kicks; run driven systems with "
         "`kairos run` (kairos.run in Python)");
   }
-  ParticleSystem<D> start = run_detail::build_start_state<D>(config, restart_file, rng_, progress_);
-  run_detail::check_restart_integrator(restart_file, progress_, "event");
-  std::optional<RestartPlan> plan;
-  if (restart_file) {
-    plan = run_detail::plan_continuation<D>(config, start, progress_, restart_file->string());
-    config_ = plan->used;
-  }
-  const bool resume = plan && !plan->repredict;
-  n_ = start.size();
-  mass_ = start.mass;
+  RunStart<D> start = start_run<D>(config, restart_file, "event");
+  config_ = start.config;
+  progress_ = start.resumed;
+  const std::optional<RestartPlan> plan = start.plan;
+  n_ = start.state.size();
+  mass_ = start.state.mass;
   radius_.resize(n_);
-  for (std::size_t i = 0; i < n_; ++i) radius_[i] = start.kinematics[i].radius;
-  species_ = start.species;
-  species_names_ = start.species_names;
-  for (int a = 0; a < D; ++a) volume_ *= start.box[a];
-  try {
-    Environment<D> environment = make_environment<D>(config_, start);
-    if (environment.soft_spheres() && config_.soft.tables) {
-      // The tables `kairos run` would use (the same speeds covered: the same maps, bit for bit).
-      SoftTableSettings settings;
-      settings.tolerance = config_.soft.table_tolerance;
-      settings.cache_dir = config_.soft.table_cache;
-      settings.max_speed = progress_.soft_table_max_speed;
-      const std::vector<SoftTableUse> tables = attach_soft_tables(environment, start, settings);
-      if (!tables.empty()) progress_.soft_table_max_speed = tables.front().spec.max_normal_speed;
-    }
-    EngineOptions options;
-    options.defer_soft_releases = config_.soft.defer_releases;
-    engine_ = std::make_unique<EventEngine<D, CalendarQueue>>(
-        std::move(start), resume ? StartMode::kResume : StartMode::kPredict, options, environment);
-    progress_.config = to_toml(config_);
-    progress_.run_id = run_detail::lineage_run_id(restart_file, progress_);
-    if (plan && plan->repredict) run_detail::check_no_overlap_after_new_physics(*engine_);
-  } catch (const InputError& e) {
-    if (!plan) throw;
-    throw run_detail::restart_setup_error(e, *restart_file, *plan);
-  }
-  if (plan) run_detail::print_restart_note(*plan, restart_file->string());
-  clock_watch_ = std::make_unique<FrozenClockWatch>(*engine_);
+  for (std::size_t i = 0; i < n_; ++i) radius_[i] = start.state.kinematics[i].radius;
+  species_ = start.state.species;
+  species_names_ = start.state.species_names;
+  // The tables `kairos run` would use (the same speeds covered: the same maps, bit for bit).
+  engine_ = start_event_engine<D, CalendarQueue>(std::move(start));
+  const std::vector<SoftTableUse>& tables = engine_->tables();
+  if (!tables.empty()) progress_.soft_table_max_speed = tables.front().spec.max_normal_speed;
+  progress_.config = to_toml(config_);
+  progress_.run_id = lineage_run_id(restart_file, progress_);
+  if (plan) print_restart_note(*plan, restart_file->string());
   // A saved state continues with production.
   progress_.equilibration_remaining = 0.0;
   progress_.equilibration_end_time = std::numeric_limits<double>::quiet_NaN();
@@ -80,26 +56,28 @@ Simulation<D>::~Simulation() = default;
 
 template <int D>
 bool Simulation<D>::run_while(const std::function<bool()>& more, const KeepGoing& keep_going) {
+  EventEngine<D, CalendarQueue>& engine = engine_->engine();
+  FrozenClockWatch& watch = engine_->clock_watch();
   while (more()) {
-    if (engine_->step() == EventKind::kNone) return false;
-    if (clock_watch_->frozen(*engine_)) throw InputError(clock_watch_->describe(*engine_));
-    if ((engine_->counters().events & 0x3fffu) == 0 && keep_going && !keep_going()) return false;
+    if (engine.step() == EventKind::kNone) return false;
+    if (watch.frozen(engine)) throw InputError(watch.describe(engine));
+    if ((engine.counters().events & 0x3fffu) == 0 && keep_going && !keep_going()) return false;
   }
   return true;
 }
 
 template <int D>
 bool Simulation<D>::advance_to_time(double t, const KeepGoing& keep_going) {
-  if (!(t >= engine_->time()) || !std::isfinite(t)) {
+  if (!(t >= engine_->engine().time()) || !std::isfinite(t)) {
     throw InputError(
         fmt::format("advance to time {}: the simulation is at time {} already (or "
                     "the time is not finite)",
-                    t, engine_->time()));
+                    t, engine_->engine().time()));
   }
-  if (!run_while([&] { return engine_->next_event_time() <= t; }, keep_going)) {
-    if (engine_->next_event_time() <= t) return false;  // stopped by keep_going
+  if (!run_while([&] { return engine_->engine().next_event_time() <= t; }, keep_going)) {
+    if (engine_->engine().next_event_time() <= t) return false;  // stopped by keep_going
   }
-  engine_->advance_clock(t);
+  engine_->engine().advance_clock(t);
   return true;
 }
 
@@ -112,61 +90,60 @@ std::uint64_t target_after(std::uint64_t now, std::uint64_t count) {
 
 template <int D>
 bool Simulation<D>::advance_events(std::uint64_t count, const KeepGoing& keep_going) {
-  const std::uint64_t target = target_after(engine_->counters().events, count);
-  return run_while([&] { return engine_->counters().events < target; }, keep_going);
+  const std::uint64_t target = target_after(engine_->engine().counters().events, count);
+  return run_while([&] { return engine_->engine().counters().events < target; }, keep_going);
 }
 
 template <int D>
 bool Simulation<D>::advance_collisions(std::uint64_t count, const KeepGoing& keep_going) {
-  const std::uint64_t target = target_after(engine_->counters().collisions, count);
-  return run_while([&] { return engine_->counters().collisions < target; }, keep_going);
+  const std::uint64_t target = target_after(engine_->engine().counters().collisions, count);
+  return run_while([&] { return engine_->engine().counters().collisions < target; }, keep_going);
 }
 
 template <int D>
 double Simulation<D>::time() const {
-  return engine_->time();
+  return engine_->engine().time();
 }
 template <int D>
 std::uint64_t Simulation<D>::events() const {
-  return engine_->counters().events;
+  return engine_->engine().counters().events;
 }
 template <int D>
 std::uint64_t Simulation<D>::collisions() const {
-  return engine_->counters().collisions;
+  return engine_->engine().counters().collisions;
 }
 template <int D>
 const Vec<D>& Simulation<D>::box() const {
-  return engine_->box();
+  return engine_->engine().box();
 }
 template <int D>
 std::vector<Vec<D>> Simulation<D>::positions() const {
-  return engine_->current_positions();
+  return engine_->engine().current_positions();
 }
 template <int D>
 std::vector<Vec<D>> Simulation<D>::velocities() const {
-  return engine_->current_velocities();
+  return engine_->engine().current_velocities();
 }
 template <int D>
 double Simulation<D>::kinetic_energy() const {
-  return engine_->kinetic_energy();
+  return engine_->engine().kinetic_energy();
 }
 template <int D>
 double Simulation<D>::temperature() const {
-  const double ke = engine_->environment().sheared() ? engine_->peculiar_kinetic_energy()
-                                                     : engine_->kinetic_energy();
-  return Thermodynamics(D, n_, volume_).temperature(ke);
+  // kT as thermo.tsv gives it (under shear: of the velocities relative to the flow).
+  return Thermodynamics(D, n_, engine_->volume()).temperature(engine_->thermal_energy());
 }
 template <int D>
 double Simulation<D>::potential_energy() const {
-  return engine_->potential_energy();
+  return engine_->engine().potential_energy();
 }
 template <int D>
 ParticleSystem<D> Simulation<D>::state() const {
-  return engine_->export_state();
+  return engine_->engine().export_state();
 }
 template <int D>
 void Simulation<D>::save(const std::filesystem::path& path) const {
-  write_restart(path, engine_->state_blocks(), rng_, progress_);
+  engine_->write_restart(path, progress_);
 }
 
 template class Simulation<2>;

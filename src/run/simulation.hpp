@@ -1,8 +1,8 @@
 // An event-driven simulation held in memory and advanced on request: the engine of `kairos run`
 // without its output files, for scripts (the Python module, python/kairos_module.cpp) and
-// tests. It starts as `kairos run` does (the same start state, contact laws, soft-sphere tables
-// and engine), so its trajectory is the CLI's bit for bit, and save() writes a restart file that
-// `kairos run --restart` continues.
+// tests. It starts through the same setup chain as `kairos run` (run/setup_chain.hpp: the same
+// start state, contact laws, soft-sphere tables and engine), so its trajectory is the CLI's bit
+// for bit, and save() writes a restart file that `kairos run --restart` continues.
 #pragma once
 
 #include <cstdint>
@@ -10,21 +10,19 @@
 #include <functional>
 #include <memory>
 #include <optional>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "core/particle_system.hpp"
 #include "core/vec.hpp"
 #include "io/config.hpp"
-#include "io/gsd_snapshot.hpp"
+#include "run/run_progress.hpp"
 
 namespace kairos {
 
 template <int D, class Queue>
-class EventEngine;
+class EventEngineAdapter;
 class CalendarQueue;
-class FrozenClockWatch;
 
 template <int D>
 class Simulation {
@@ -76,15 +74,12 @@ class Simulation {
   bool run_while(const std::function<bool()>& more, const KeepGoing& keep_going);
 
   Config config_;
-  std::unique_ptr<EventEngine<D, CalendarQueue>> engine_;
-  std::unique_ptr<FrozenClockWatch> clock_watch_;
-  std::mt19937_64 rng_;
+  std::unique_ptr<EventEngineAdapter<D, CalendarQueue>> engine_;
   RunProgress progress_;
   std::size_t n_ = 0;
   std::vector<double> mass_, radius_;
   std::vector<std::uint32_t> species_;
   std::vector<std::string> species_names_;
-  double volume_ = 1.0;
 };
 
 }  // namespace kairos

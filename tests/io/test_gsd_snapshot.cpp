@@ -18,6 +18,7 @@
 
 #include "core/error.hpp"
 #include "init/initial_state.hpp"
+#include "init/initial_state_file.hpp"
 #include "io/gsd_file.hpp"
 
 namespace fs = std::filesystem;

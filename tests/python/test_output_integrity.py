@@ -5,7 +5,8 @@
   and frame for frame (the rows and frames written after the restart point are dropped, the
   unfinished production is completed);
 - a failed write (a file size limit: RLIMIT_FSIZE) stops the run with an error naming the file,
-  a non-zero exit, no torn row, and the restart file still written;
+  a non-zero exit, no torn row, and the restart file still written; a run continued from it
+  writes the row that failed first, under either integrator;
 - two runs never share an output directory, and a new run never overwrites an earlier run's
   outputs unless asked (--overwrite).
 """
@@ -176,6 +177,40 @@ class FailedWrites(kt.KairosTestCase):
                                 preexec_fn=limit_file_size)
         self.assertNotEqual(result.returncode, 0, kt.describe(result))
         self.assertIn("stopped early (write_failed)", result.stdout)
+        self.run_ok("run", cfg, "--restart", os.path.join(out, "restart.gsd"), "-o", out,
+                    timeout=300)
+        with open(os.path.join(out, "thermo.tsv")) as f, \
+                open(os.path.join(whole, "thermo.tsv")) as g:
+            self.assertEqual(f.read(), g.read(), "thermo.tsv differs from one uninterrupted run's")
+
+    def test_a_dem_run_continued_after_a_failed_write_writes_the_failed_row(self):
+        # The DEM runs in the same driver as the event engine: its restart file records the
+        # row whose write failed (kairos/run/owed), and the continued run writes it first.
+        config = kt.base_config(particles=300, packing_fraction=0.2, lattice="random", seed=4,
+                                production=40.0)
+        config["soft"] = {"model": "dashpot", "stiffness": 1e4, "restitution": 0.9}
+        config["run"]["integrator"] = "dem"
+        config["output"].update({"thermo_interval": 0.05, "trajectory": False})
+        cfg = self.write_config(config)
+        whole = self.path("whole")
+        self.run_ok("run", cfg, "-o", whole, timeout=300)
+        # thermo.tsv (~800 rows of ~200 bytes) grows past the limit; the restart file is smaller.
+        limit = 100000
+        self.assertLess(os.path.getsize(os.path.join(whole, "restart.gsd")), limit)
+        self.assertGreater(os.path.getsize(os.path.join(whole, "thermo.tsv")), limit)
+
+        def limit_file_size():
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+        out = self.path("out")
+        result = subprocess.run([kt.KAIROS, "run", cfg, "-o", out], cwd=self.tmp,
+                                capture_output=True, text=True, timeout=300,
+                                preexec_fn=limit_file_size)
+        self.assertNotEqual(result.returncode, 0, kt.describe(result))
+        self.assertIn("stopped early (write_failed)", result.stdout)
+        owed = kt.restart_chunk(os.path.join(out, "restart.gsd"), "kairos/run/owed")
+        self.assertEqual(int(owed[0]), 1)  # the row
         self.run_ok("run", cfg, "--restart", os.path.join(out, "restart.gsd"), "-o", out,
                     timeout=300)
         with open(os.path.join(out, "thermo.tsv")) as f, \

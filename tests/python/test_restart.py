@@ -105,8 +105,11 @@ class RestartBookkeeping(kt.KairosTestCase):
         # A wall-time limit of 0.3 s, far beyond the setup (a limit reached during the setup
         # is an error, test_signals.py), stops the run deep inside 20000 collisions per particle
         # of equilibration (several seconds).
+        # No trajectory: at the default interval it would be 40 000 frames, each made durable
+        # (fsync) before the next, which on a busy disk took the run past its time limit.
         cfg = kt.base_config(particles=500, packing_fraction=0.4, equilibration=20000.0,
-                             production=5.0, run={"max_wall_seconds": 0.3})
+                             production=5.0, run={"max_wall_seconds": 0.3},
+                             output={"trajectory": False})
         first = self.write_config(cfg, "first.toml")
         self.run_ok("run", first, "-o", self.path("a"))
         stopped = self.summary(self.path("a"))
@@ -116,8 +119,9 @@ class RestartBookkeeping(kt.KairosTestCase):
         self.assertGreater(left, 0.0)
         cfg["run"]["max_wall_seconds"] = 0.0
         second = self.write_config(cfg, "second.toml")
+        # Some 5 * 10^6 collisions: a minute under the sanitizers alone, more beside other tests.
         self.run_ok("run", second, "--restart", self.path("a", "restart.gsd"),
-                    "-o", self.path("b"))
+                    "-o", self.path("b"), timeout=kt.RUN_TIMEOUT * kt.SLOWDOWN)
         done = self.summary(self.path("b"))
         # The rest of the equilibration, then the whole production.
         self.assertEqual(done["event_counts"]["total_collisions_since_start"], (20000 + 5) * 250)

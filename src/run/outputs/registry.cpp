@@ -1,0 +1,61 @@
+#include "run/outputs/registry.hpp"
+
+#include <utility>
+
+#include "run/dem_adapter.hpp"
+#include "run/event_adapter.hpp"
+#include "run/outputs/dem_summary.hpp"
+#include "run/outputs/event_summary.hpp"
+#include "run/outputs/granular_summary.hpp"
+#include "run/outputs/pressure_tensor.hpp"
+#include "run/outputs/profile_output.hpp"
+#include "run/outputs/restart_output.hpp"
+#include "run/outputs/run_summary.hpp"
+#include "run/outputs/soft_summary.hpp"
+#include "run/outputs/stepped_summary.hpp"
+#include "run/outputs/thermo_output.hpp"
+#include "run/outputs/trajectory_output.hpp"
+
+namespace kairos {
+
+namespace {
+
+template <class T, int D, class... Args>
+T& add(ObserverList<D>& list, Args&&... args) {
+  auto observer = std::make_unique<T>(std::forward<Args>(args)...);
+  T& added = *observer;
+  list.push_back(std::move(observer));
+  return added;
+}
+
+}  // namespace
+
+// `config`: for an output registered only under some configuration (every one here decides for
+// itself at open(), so that summary.json lists a file an earlier run left).
+template <int D>
+ObserverList<D> make_observers([[maybe_unused]] const Config& config,
+                               const Integrator<D>& integrator) {
+  ObserverList<D> list;
+  // The order matters where one output records another: the row and the frame due at one
+  // moment come before the restart file that records them, and every file before summary.json.
+  const ThermoOutput<D>& thermo = add<ThermoOutput<D>>(list);
+  add<TrajectoryOutput<D>>(list);
+  add<RestartOutput<D>>(list);
+  add<ProfileOutput<D>>(list);
+  // summary.json's parts.
+  add<RunSummary<D>>(list);
+  if (const EventIntegrator<D>* engine = integrator.as_event()) {
+    add<EventSummary<D>>(list, *engine);
+    add<PressureTensor<D>>(list, *engine, thermo);
+    if (engine->stepped()) add<SteppedSummary<D>>(list, *engine);
+    if (engine->soft()) add<SoftSummary<D>>(list, *engine);
+    if (engine->kind().granular) add<GranularSummary<D>>(list, *engine);
+  }
+  if (const DemAdapter<D>* dem = integrator.as_dem()) add<DemSummary<D>>(list, *dem);
+  return list;
+}
+
+template ObserverList<2> make_observers<2>(const Config&, const Integrator<2>&);
+template ObserverList<3> make_observers<3>(const Config&, const Integrator<3>&);
+
+}  // namespace kairos

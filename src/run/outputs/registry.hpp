@@ -1,0 +1,22 @@
+// The one list of a run's outputs and analyses (HOOMD's operations list): the run driver calls
+// them in this order at every moment of the run (outputs/observer.hpp). A new output is one
+// file pair in src/run/outputs/ and one line in make_observers (docs/extending.md).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "io/config.hpp"
+#include "run/integrator.hpp"
+#include "run/outputs/observer.hpp"
+
+namespace kairos {
+
+template <int D>
+using ObserverList = std::vector<std::unique_ptr<Observer<D>>>;
+
+// The observers of a run of `config` by `integrator` (which they read; it outlives them).
+template <int D>
+ObserverList<D> make_observers(const Config& config, const Integrator<D>& integrator);
+
+}  // namespace kairos

@@ -1,0 +1,41 @@
+// How the parts of summary.json report a value a run defines only sometimes (docs/outputs.md,
+// "Summary values mean what they say").
+#pragma once
+
+#include <cmath>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace kairos {
+
+// `value` under `key` of `where` (summary itself or one of its parts), or null and, in
+// summary["undefined"][name], the reason (never NaN as a number).
+inline void set_or_explain(nlohmann::json& summary, nlohmann::json& where, const std::string& key,
+                           double value, std::string reason, const std::string& name) {
+  if (reason.empty() && !std::isfinite(value)) reason = "not finite in this run";
+  if (reason.empty()) {
+    where[key] = value;
+    return;
+  }
+  where[key] = nullptr;
+  summary["undefined"][name] = reason;
+}
+
+// The same for a sonine coefficient (granular parts): undefined for an inhomogeneous gas.
+inline void set_sonine_a2(nlohmann::json& summary, nlohmann::json& where, double a2, bool bulk) {
+  set_or_explain(summary, where, "sonine_a2", a2,
+                 !bulk                ? "walls, open faces or a field: the gas is not homogeneous"
+                 : !std::isfinite(a2) ? "every particle at rest"
+                                      : "",
+                 "granular.sonine_a2");
+}
+
+// a2 = d/(d+2) <c^4>/<c^2>^2 - 1 from the sums of c^2 and c^4 over n particles (NaN at rest).
+template <int D>
+double sonine_a2(double sum_c2, double sum_c4, double n) {
+  const double m2 = sum_c2 / n, m4 = sum_c4 / n;
+  return m2 > 0.0 ? D / (D + 2.0) * m4 / (m2 * m2) - 1.0 : std::nan("");
+}
+
+}  // namespace kairos

@@ -1,0 +1,158 @@
+#include "run/outputs/thermo_output.hpp"
+
+#include <fmt/format.h>
+
+#include "analysis/block_average.hpp"
+#include "run/outputs/summary_values.hpp"
+
+namespace kairos {
+
+template <int D>
+void ThermoOutput<D>::open(const RunContext<D>& run) {
+  const Integrator<D>& integrator = run.integrator();
+  const std::filesystem::path path = run.directory() / name();
+  // A new file, or (a continued run) the existing one cut to the rows the continued state had
+  // written (all complete rows when not recorded).
+  file_.emplace(run.restarted() ? LineFile(path, kHeader, run.continuation().thermo_rows)
+                                : LineFile::create(path, kHeader));
+  rows_kept_ = file_->rows();
+  stats_.emplace(D, integrator.size(), integrator.volume());
+  events_start_ = integrator.events();
+  collisions_start_ = integrator.collisions();
+  // Continued in its own directory: the next row covers the interval from the last kept one.
+  const RunProgress& resumed = run.resumed();
+  kept_mark_ = run.continuation().same_directory && resumed.has_thermo_mark
+                   ? ThermoPoint{resumed.mark_time, resumed.mark_virial, resumed.mark_events,
+                                 resumed.mark_collisions}
+                   : integrator.point();
+  stats_->mark(kept_mark_);
+}
+
+template <int D>
+bool ThermoOutput<D>::pending(const RunContext<D>& run) const {
+  const Integrator<D>& integrator = run.integrator();
+  return integrator.collisions() > stats_->last().collisions ||
+         (run.timed() && integrator.time() > stats_->last().time);
+}
+
+// One row per line. Granular columns: rotational temperature per rotational degree of freedom
+// (3 for spheres, 1 for disks; 0 without spins), and the energy dissipated and the work done by
+// moving walls since the start of the simulation (zero for elastic hard spheres);
+// potential_energy: of the stepped potentials (0 for hard spheres), or the elastic energy of
+// the overlapping soft pairs (DEM).
+template <int D>
+void ThermoOutput<D>::write_row(const RunContext<D>& run, const std::string& phase, bool kept) {
+  const Integrator<D>& integrator = run.integrator();
+  const bool production = phase == "production";
+  if (production) run.sample_production_row();
+  const ThermoRow r = stats_->row(integrator.point(), integrator.thermal_energy(), production);
+  if (production) production_temperatures_.push_back(r.temperature);
+  const double rotational_temperature =
+      2.0 * integrator.rotational_energy() /
+      ((D == 3 ? 3.0 : 1.0) * static_cast<double>(integrator.size()));
+  file_->append(fmt::format(
+      "{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t"
+      "{:.17g}\t{:.17g}\t{:.17g}\n",
+      phase, r.at.time, r.at.events, r.at.collisions, r.collisions_per_particle, r.temperature,
+      r.pressure, r.compressibility, r.kinetic_energy, r.mean_free_time, rotational_temperature,
+      integrator.dissipated_energy(), integrator.work_by_walls(), integrator.potential_energy()));
+  if (kept) {
+    rows_kept_ = file_->rows();
+    kept_mark_ = r.at;
+  }
+}
+
+template <int D>
+void ThermoOutput<D>::equilibration_ends(const RunContext<D>& run, bool stopped) {
+  if (pending(run)) write_row(run, "equilibration", !stopped);
+}
+
+template <int D>
+void ThermoOutput<D>::production_starts(const RunContext<D>& run) {
+  production_start_ = run.integrator().point();
+  production_ke_ = run.integrator().thermal_energy();
+}
+
+template <int D>
+void ThermoOutput<D>::close(const RunContext<D>& run, bool stopped) {
+  if (pending(run)) write_row(run, run.phase(), !stopped);
+}
+
+template <int D>
+void ThermoOutput<D>::record(RunProgress& progress) const {
+  progress.thermo_rows = static_cast<std::int64_t>(rows_kept_);
+  progress.has_thermo_mark = true;
+  progress.mark_time = kept_mark_.time;
+  progress.mark_virial = kept_mark_.virial;
+  progress.mark_events = kept_mark_.events;
+  progress.mark_collisions = kept_mark_.collisions;
+}
+
+template <int D>
+double ThermoOutput<D>::production_temperature(const Integrator<D>& integrator) const {
+  if (integrator.temperature_from_rows() && !production_temperatures_.empty())
+    return block_average(production_temperatures_).mean;
+  return stats_->temperature(production_ke_);
+}
+
+// summary.json's run totals (docs/outputs.md): counts and rates of this invocation, the times,
+// the temperature, Z with its blocked error, the pressure and the mean free time. Z and the
+// pressure are bulk values: undefined with walls, open faces or a field.
+template <int D>
+void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) const {
+  const Integrator<D>& integrator = run.integrator();
+  const Thermodynamics& th = *stats_;
+  const double wall = run.wall_seconds();
+  const std::uint64_t events = integrator.events() - events_start_;
+  const std::uint64_t collisions = integrator.collisions() - collisions_start_;
+  const double production_time = integrator.time() - production_start_.time;
+  const std::uint64_t production_collisions =
+      integrator.collisions() - production_start_.collisions;
+  const double ke = integrator.thermal_energy();
+  const double kT_production = production_temperature(integrator);
+  const double z_mean = th.compressibility(integrator.virial() - production_start_.virial,
+                                           kT_production, production_time);
+  const BlockAverage z_blocks = th.compressibility_blocks();
+  j["events"] = events;
+  j["collisions"] = collisions;
+  j["sim_time"] = integrator.time();
+  j["production_time"] = production_time;
+  j["production_collisions_per_particle"] = run.per_particle(production_collisions);
+  j["wall_seconds"] = wall;
+  j["events_per_second"] = wall > 0 ? static_cast<double>(events) / wall : 0.0;
+  j["collisions_per_second"] = wall > 0 ? static_cast<double>(collisions) / wall : 0.0;
+  j["temperature"] = th.temperature(ke);
+  j["kinetic_energy"] = ke;
+  std::string why;
+  if (!integrator.bulk())
+    why = "walls, open faces or a field: the pressure is not uniform in the box";
+  else if (!(production_time > 0.0))
+    why = "no production time elapsed";
+  else if (!(kT_production > 0.0))
+    why = "the particles are at rest (kT = 0)";
+  nlohmann::json z = {{"blocks", z_blocks.samples},
+                      {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
+  set_or_explain(j, z, "mean", z_mean, why, "compressibility");
+  set_or_explain(j, z, "stderr", z_blocks.stderr_,
+                 !why.empty()           ? why
+                 : z_blocks.samples < 2 ? "fewer than 2 production thermo rows"
+                                        : "",
+                 "compressibility_stderr");
+  j["compressibility"] = z;
+  set_or_explain(j, j, "pressure", th.pressure(z_mean, kT_production), why, "pressure");
+  j["production_temperature"] = kT_production;
+  const std::string no_collision =
+      production_collisions == 0 ? "no collision in the production" : "";
+  set_or_explain(j, j, "mean_free_time", th.mean_free_time(production_time, production_collisions),
+                 no_collision, "mean_free_time");
+  set_or_explain(j, j, "mean_free_time_stderr", th.mean_free_time_blocks().stderr_,
+                 !no_collision.empty()                    ? no_collision
+                 : th.mean_free_time_blocks().samples < 2 ? "fewer than 2 production thermo rows"
+                                                          : "",
+                 "mean_free_time_stderr");
+}
+
+template class ThermoOutput<2>;
+template class ThermoOutput<3>;
+
+}  // namespace kairos

@@ -1,0 +1,224 @@
+#include "run/start_state.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "core/periodic.hpp"
+#include "init/initial_state.hpp"
+#include "init/initial_state_file.hpp"
+#include "io/gsd_file.hpp"
+
+namespace kairos {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The axes with a wall or an open face (not periodic) in the config.
+template <int D>
+std::array<bool, D> periodic_axes(const Config& config) {
+  std::array<bool, D> periodic;
+  periodic.fill(true);
+  const auto bound = [&](const std::string& face) {
+    if (face.size() == 2 && face[0] - 'x' < D) periodic[face[0] - 'x'] = false;
+  };
+  for (const WallConfig& w : config.boundary.walls) bound(w.face);
+  for (const std::string& f : config.boundary.open) bound(f);
+  return periodic;
+}
+
+// The box of a state to check: finite edges > 0.
+template <int D>
+void check_box(const InitialState<D>& init, const std::string& source) {
+  for (int a = 0; a < D; ++a) {
+    if (!std::isfinite(init.box[a]) || !(init.box[a] > 0.0)) {
+      throw InputError(
+          fmt::format("{}: the box edge {} is {}: check system.particles, "
+                      "system.packing_fraction and the species diameters",
+                      source, a, init.box[a]));
+    }
+  }
+}
+
+// No pair overlaps by more than round-off. `exact`: float64 positions from a Kairos file, whose
+// last event may have left a pair in contact to within round-off (relative 1e-12 of the contact
+// distance): a contact, not an overlap. `why`: what the message says of overlaps.
+template <int D>
+void check_no_overlap(const InitialState<D>& init, const std::array<bool, D>& periodic,
+                      const std::string& source, bool exact = false,
+                      std::string_view why = "hard particles must not overlap") {
+  check_box(init, source);
+  std::uint32_t i = 0, j = 0;
+  const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, &i, &j,
+                                      /*interruptible=*/true);
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const double d : init.diameter) smallest = std::min(smallest, d);
+  const double round_off = exact ? 1e-12 * smallest : 0.0;
+  if (worst > round_off) {
+    throw InputError(
+        fmt::format("{}: particles {} and {} overlap by {:.6g} ({})", source, i, j, worst, why));
+  }
+}
+
+// Soft spheres under the DEM may start overlapping (the force law pushes the pairs apart), by
+// at most half the smaller radius of each pair: a deeper overlap is no contact the force laws
+// are meant for (the spheres would be more inside each other than touching).
+template <int D>
+void check_soft_overlaps(const InitialState<D>& init, const std::array<bool, D>& periodic,
+                         const std::string& source) {
+  check_box(init, source);
+  std::uint32_t i = 0, j = 0;
+  const double worst = max_relative_overlap<D>(init.box, periodic, init.position, init.diameter, &i,
+                                               &j, /*interruptible=*/true);
+  if (worst > 0.5) {
+    const double smaller = 0.5 * std::min(init.diameter[i], init.diameter[j]);
+    throw InputError(fmt::format(
+        "{}: particles {} and {} overlap by {:.6g}, more than half the smaller radius ({:.6g}): "
+        "soft spheres may start overlapping by at most that; separate them further",
+        source, i, j, worst * smaller, 0.5 * smaller));
+  }
+}
+
+// A HOOMD file stores float32 positions. A frame written at a collision (Kairos writes its
+// trajectory frames right after one) holds a pair in exact contact, which the rounding to float32
+// turns into an overlap of ~1e-7 about half of the time. Overlaps within that round-off are
+// removed by expanding the box and all positions uniformly by the smallest factor that clears
+// them: every distance grows by that factor, the packing fraction shrinks by ~1e-7 relative, less
+// than the file's precision. Larger overlaps are left for check_no_overlap to report.
+template <int D>
+void expand_away_rounding_overlaps(InitialState<D>& init, const std::array<bool, D>& periodic) {
+  double edge = 0.0;
+  for (int a = 0; a < D; ++a) edge = std::max(edge, init.box[a]);
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const double d : init.diameter) smallest = std::min(smallest, d);
+  const double tolerance =
+      std::min(8.0 * std::numeric_limits<float>::epsilon() * edge, 1e-3 * smallest);
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, nullptr,
+                                        nullptr, /*interruptible=*/true);
+    if (worst == 0.0 || worst > tolerance) return;
+    // Every overlapping pair has r >= sigma - worst with sigma >= smallest.
+    const double factor =
+        (1.0 + 8.0 * std::numeric_limits<double>::epsilon()) / (1.0 - worst / smallest);
+    for (int a = 0; a < D; ++a) init.box[a] *= factor;
+    for (auto& x : init.position) {
+      for (int a = 0; a < D; ++a) {
+        x[a] *= factor;
+        if (x[a] >= init.box[a]) x[a] -= init.box[a];
+        if (x[a] < 0.0) x[a] = 0.0;
+      }
+    }
+  }
+}
+
+// True when the last frame of a GSD file holds Kairos' float64 positions (a restart file).
+bool holds_exact_positions(const fs::path& path) {
+  const gsd::Reader r(path);
+  return r.frame_count() > 0 && r.find(r.frame_count() - 1, "kairos/position").has_value();
+}
+
+// When the state comes from a file, the generating keys do not apply; say so if they disagree.
+void note_ignored_system_keys(const Config& config, std::size_t n, const std::string& source) {
+  if (config.system.particles != 0 && config.system.particles != n) {
+    fmt::print(stderr,
+               "kairos: note: {} holds {} particles; system.particles = {} and the other "
+               "generating keys (packing_fraction, lattice, species) are not used\n",
+               source, n, config.system.particles);
+  }
+}
+
+// A generated state fills a periodic box. Along an axis with walls (or open faces) the box
+// grows by the largest diameter, half on each side, so that no particle touches a wall; then
+// system.box_scale stretches the box, leaving empty space at the high end of each axis.
+template <int D>
+void make_room_for_walls(const Config& config, InitialState<D>& init) {
+  double dmax = 0.0;
+  for (const double d : init.diameter) dmax = std::max(dmax, d);
+  const std::array<bool, D> periodic = periodic_axes<D>(config);
+  for (int a = 0; a < D; ++a) {
+    if (periodic[a]) continue;
+    init.box[a] += dmax;
+    for (auto& x : init.position) x[a] += 0.5 * dmax;
+  }
+  for (int a = 0; a < D && a < static_cast<int>(config.system.box_scale.size()); ++a)
+    init.box[a] *= config.system.box_scale[a];
+}
+
+// Velocities drawn from the temperature are peculiar: under Lees-Edwards shear the mean flow
+// u_x = shear_rate (y - L_y / 2) is added, so the run starts in the shear flow.
+template <int D>
+void add_shear_flow(const Config& config, InitialState<D>& init) {
+  const double rate = config.boundary.shear_rate;
+  if (rate == 0.0) return;
+  for (std::size_t i = 0; i < init.position.size(); ++i)
+    init.velocity[i][0] += rate * (init.position[i][1] - 0.5 * init.box[1]);
+}
+
+}  // namespace
+
+template <int D>
+ParticleSystem<D> build_start_state(const Config& config,
+                                    const std::optional<fs::path>& restart_file,
+                                    std::mt19937_64& rng, RunProgress& progress) {
+  // The memory estimate checked before the state is built or read: the DEM's layout is larger.
+  const RunKind kind = config.run.integrator == "dem" ? RunKind::kDem : RunKind::kEventDriven;
+  if (restart_file) {
+    if (!fs::exists(*restart_file)) {
+      throw InputError("restart file '" + restart_file->string() + "' does not exist");
+    }
+    return read_restart_file<D>(*restart_file, rng, progress, kind);  // the restart plan: the rest
+  }
+  if (!config.system.initial_state.empty()) {
+    const fs::path path = config.system.initial_state;
+    if (!fs::exists(path)) {
+      throw InputError("system.initial_state: file '" + path.string() + "' does not exist");
+    }
+    bool has_velocities = false;
+    InitialState<D> init = read_initial_state<D>(path, has_velocities, kind);
+    const std::array<bool, D> periodic = periodic_axes<D>(config);
+    const bool exact = holds_exact_positions(path);
+    if (!exact) expand_away_rounding_overlaps<D>(init, periodic);
+    const std::string source = "system.initial_state '" + path.string() + "'";
+    if (config.soft.enabled() && config.run.integrator == "dem") {
+      check_soft_overlaps<D>(init, periodic, source);
+    } else if (config.soft.enabled()) {
+      // The event integrator maps a soft contact from its first touch (Müller and Pöschel, Phys.
+      // Rev. E 87, 033301 (2013)): a pair that starts inside one has no first touch, and would
+      // collide instantaneously (its overlap's elastic energy lost), not as the force law says.
+      check_no_overlap<D>(init, periodic, source, exact,
+                          "the event integrator maps soft contacts from their first touch and "
+                          "cannot start inside one: use run.integrator = \"dem\", which accepts "
+                          "overlaps of up to half the smaller radius, or a state without overlaps");
+    } else {
+      check_no_overlap<D>(init, periodic, source, exact);
+    }
+    note_ignored_system_keys(config, init.position.size(), "system.initial_state");
+    if (!has_velocities) {
+      assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
+      add_shear_flow(config, init);
+    }
+    return to_particle_system<D>(std::move(init));
+  }
+  InitialState<D> init = make_initial_state<D>(config.system, rng, kind);
+  std::array<bool, D> periodic;
+  periodic.fill(true);  // generated in a periodic box; make_room_for_walls then adds the gaps
+  // A lattice at its close packing has its neighbours in contact to within round-off.
+  check_no_overlap<D>(init, periodic, "generated initial state", /*exact=*/true);
+  make_room_for_walls(config, init);
+  add_shear_flow(config, init);
+  return to_particle_system<D>(std::move(init));
+}
+
+template ParticleSystem<2> build_start_state<2>(const Config&, const std::optional<fs::path>&,
+                                                std::mt19937_64&, RunProgress&);
+template ParticleSystem<3> build_start_state<3>(const Config&, const std::optional<fs::path>&,
+                                                std::mt19937_64&, RunProgress&);
+
+}  // namespace kairos
