@@ -14,7 +14,7 @@
 #include <random>
 #include <string>
 
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "dem/dem_integrator.hpp"
 #include "io/config.hpp"
 #include "run/integrator.hpp"

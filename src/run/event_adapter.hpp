@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "core/particle_system.hpp"
 #include "engine/event_engine.hpp"
 #include "io/config.hpp"

@@ -20,7 +20,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/environment.hpp"
+#include "model/environment.hpp"
 #include "core/error.hpp"
 #include "core/particle_system.hpp"
 #include "io/config.hpp"
