@@ -15,6 +15,7 @@
 
 #include "core/vec.hpp"
 #include "dynamics/collision_time.hpp"
+#include "engine/hot_record.hpp"
 #include "engine/pair_steps.hpp"
 #include "engine/relative_motion.hpp"
 
@@ -261,31 +262,41 @@ template <int D, bool kAccelerated = false>
 std::uint32_t scan_stepped_scalar(const SteppedScan<D>& s, double t, const Vec<D>& xi,
                                   const Vec<D>& vi, double& best) {
   const CandidateScan<D>& c = s.base;
+  // Read once: the loop's stores to `best` could alias them for the compiler.
+  const std::uint32_t* candidates = c.candidates;
+  const std::uint64_t* stamps = s.stamps;
+  const std::uint16_t* shape = s.shape;
+  const double* row_reach2 = s.row_reach2;
+  const ZoneTable* tables = s.tables;
+  const std::uint32_t self = s.self, epoch = s.epoch, count = c.count;
+  // The engine's records (HotRecord<D>: its stride known here, as the engine's own loops had).
+  constexpr std::size_t kStride = sizeof(HotRecord<D>) / sizeof(double);
   std::uint32_t found = kNoCandidate;
+  double soonest = best;
   const Vec<D> no_shift{};
-  for (std::uint32_t k = 0; k < c.count; ++k) {
-    const std::uint32_t j = c.candidates[k];
-    if (j == s.self) continue;
+  for (std::uint32_t k = 0; k < count; ++k) {
+    const std::uint32_t j = candidates[k];
+    if (j == self) continue;
     const Vec<D>& shift = c.any_shift ? c.shifts[c.shift_index[k]] : no_shift;
-    const double* rec =
-        c.records + static_cast<std::size_t>(j) * static_cast<std::size_t>(c.stride);
+    const double* rec = c.records + static_cast<std::size_t>(j) * kStride;
     const double dtj = t - rec[2 * D];
     const RelativeMotion p =
         relative_motion_at<D, kAccelerated>(xi, vi, rec, dtj, shift, c.half_accel, c.accel);
-    const std::uint16_t sj = s.shape != nullptr ? s.shape[j] : 0;
-    const std::uint64_t stamp = s.stamps[j];
+    const std::uint16_t sj = shape != nullptr ? shape[j] : 0;
+    const std::uint64_t stamp = stamps[j];
     double dt;
-    if ((stamp >> 32) != s.epoch || static_cast<std::uint16_t>(stamp) == 0) {  // zone 0
-      if (!contact_before(p, s.row_reach2[sj], best, dt)) continue;
+    if ((stamp >> 32) != epoch || static_cast<std::uint16_t>(stamp) == 0) {  // zone 0
+      if (!contact_before(p, row_reach2[sj], soonest, dt)) continue;
     } else {
-      const ZoneTable& table = s.tables[static_cast<std::uint16_t>(stamp >> 16)];
+      const ZoneTable& table = tables[static_cast<std::uint16_t>(stamp >> 16)];
       dt = table.event_time(static_cast<std::uint16_t>(stamp), p.r2, p.rg, p.g2);
     }
-    if (dt < best) {
-      best = dt;
+    if (dt < soonest) {
+      soonest = dt;
       found = k;
     }
   }
+  best = soonest;
   return found;
 }
 

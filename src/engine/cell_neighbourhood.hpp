@@ -113,8 +113,8 @@ class CellNeighbourhood {
                       std::uint32_t*& cand, std::uint32_t& cap);
 
   CellGrid<D> grid_;
-  CandidateList<D> lists_[2];
   bool vector_gather_ = false;
+  CandidateList<D> lists_[2];  // last: large (their shift arrays), touched less than the grid
 };
 
 // Appends the members of the list starting at p to cand[n...]: walk_lists' rest of a crowded

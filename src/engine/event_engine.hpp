@@ -36,13 +36,13 @@
 #include <vector>
 
 #include "boundaries/lees_edwards.hpp"
+#include "core/event_code.hpp"
 #include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
 #include "core/state_blocks.hpp"
 #include "dynamics/collision_time.hpp"
 #include "engine/candidate_scan.hpp"
 #include "engine/cell_neighbourhood.hpp"
-#include "core/event_code.hpp"
 #include "engine/hot_record.hpp"
 #include "engine/pair_steps.hpp"
 #include "engine/resting_particles.hpp"
@@ -440,11 +440,13 @@ class EventEngine {
   HugeVector<double> last_collision_;    // TC model only
   using Resting = RestingParticles<D>;
   Resting resting_;  // who sleeps (gravity with walls only; engine/resting_particles.hpp)
-  Cells cells_;      // the cell grid and the neighbourhood walk (engine/cell_neighbourhood.hpp)
   Queue queue_;
   std::uint64_t renumber_period_ = 0, next_renumber_ = 0;  // in collisions
   bool sheared_ = false;                                   // shear_.on()
   bool stepped_ = false;  // some pair has a step potential, or there are bonds
+  // The cell grid and the neighbourhood walk (engine/cell_neighbourhood.hpp); its large
+  // candidate lists come last in it, so the hot members above share fewer cache lines.
+  Cells cells_;
   PairSteps steps_;
   std::uint64_t step_captures_ = 0;      // see step_captures()
   std::uint64_t incremental_scans_ = 0;  // see incremental_crossing_scans()
