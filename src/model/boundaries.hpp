@@ -6,6 +6,7 @@
 // code names its surface (EventCode::wall). Each component provides, for its own surfaces s
 // (0 .. surfaces() - 1):
 //
+//   bool any() const;                           it has a surface in this run
 //   int surfaces() const;                       how many it owns (some may be absent: is_surface)
 //   bool is_surface(int s) const;               surface s exists in this run
 //   double event_time(int s, x, v, radius, t, horizon) const;
@@ -44,16 +45,15 @@
 
 namespace kairos {
 
-template <int D>
-class Boundaries {
+// Surfaces over a set of components, numbered in the order the components are given. The run's
+// registry is Boundaries below; a test can put other sets together.
+template <int D, class... C>
+class BoundarySet {
  public:
-  // The registry: one entry per boundary geometry, here and in the constructor below.
-  using Components = std::tuple<FaceWalls<D>>;
+  using Components = std::tuple<C...>;
 
-  Boundaries() = default;
-  // Every component made from the run's model (its specification lives in Environment).
-  Boundaries(const Environment<D>& environment, const Vec<D>& box)
-      : components_(FaceWalls<D>(environment.faces, box, environment.gravity)) {
+  BoundarySet() = default;
+  explicit BoundarySet(C... components) : components_(std::move(components)...) {
     for_each([&](const auto& c) {
       any_ = any_ || c.any();
       surfaces_ += c.surfaces();
@@ -62,8 +62,14 @@ class Boundaries {
 
   bool any() const { return any_; }
   int surfaces() const { return surfaces_; }
-  const FaceWalls<D>& faces() const { return std::get<FaceWalls<D>>(components_); }
-  FaceWalls<D>& faces() { return std::get<FaceWalls<D>>(components_); }
+  template <class Component>
+  const Component& get() const {
+    return std::get<Component>(components_);
+  }
+  template <class Component>
+  Component& get() {
+    return std::get<Component>(components_);
+  }
 
   // f(component, first surface) for each component, in registry order.
   template <class F>
@@ -151,7 +157,7 @@ class Boundaries {
   template <std::size_t I, class G>
   decltype(auto) dispatch(int s, G&& g) const {
     const auto& c = std::get<I>(components_);
-    if constexpr (I + 1 == std::tuple_size_v<Components>) {
+    if constexpr (I + 1 == sizeof...(C)) {
       return g(c, s);
     } else {
       if (s < c.surfaces()) return g(c, s);
@@ -162,6 +168,20 @@ class Boundaries {
   Components components_;
   bool any_ = false;
   int surfaces_ = 0;
+};
+
+// The registry of the run's boundary geometries: one entry per geometry, in the base's list and
+// in the constructor, which makes each from the run's model (its specification lives in the
+// Environment).
+template <int D>
+class Boundaries : public BoundarySet<D, FaceWalls<D>> {
+ public:
+  Boundaries() = default;
+  Boundaries(const Environment<D>& environment, const Vec<D>& box)
+      : BoundarySet<D, FaceWalls<D>>(FaceWalls<D>(environment.faces, box, environment.gravity)) {}
+
+  const FaceWalls<D>& faces() const { return this->template get<FaceWalls<D>>(); }
+  FaceWalls<D>& faces() { return this->template get<FaceWalls<D>>(); }
 };
 
 }  // namespace kairos

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <string>
 
-#include "model/boundaries.hpp"
 #include "boundaries/face_walls.hpp"
-#include "model/environment.hpp"
 #include "core/error.hpp"
+#include "model/boundaries.hpp"
+#include "model/environment.hpp"
 
 namespace kairos {
 namespace {
