@@ -377,7 +377,7 @@ void write_lammps_data(const std::filesystem::path& file, const ParticleSystem<3
   const double density = kMass / (std::numbers::pi / 6.0 * kDiameter * kDiameter * kDiameter);
   text += "\nAtoms # sphere\n\n";
   for (std::size_t i = 0; i < s.size(); ++i) {
-    Vec<3> x = s.position_at(i, s.time);
+    Vec<3> x = s.position(i, s.time);
     for (int a = 0; a < 3; ++a) x[a] = wrap_into_box(x[a], s.box[a]);
     text += fmt::format("{} 1 {:g} {:.17g} {:.17g} {:.17g} {:.17g}\n", i + 1, kDiameter, density,
                         x[0], x[1], x[2]);

@@ -255,7 +255,7 @@ inline GasRun run_gas_divergence(const GasSpec& spec, const GasRunOptions& optio
     }
     const ParticleSystem<3> s = e.export_state(false);
     std::vector<Vec<3>> x(n);
-    for (std::size_t i = 0; i < n; ++i) x[i] = s.position_at(i, t);
+    for (std::size_t i = 0; i < n; ++i) x[i] = s.position(i, t);
     frozen.assign(n, 0);
     for (const auto& f : s.frozen) {
       frozen[f.i] = 1;

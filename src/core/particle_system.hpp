@@ -184,13 +184,13 @@ struct ParticleSystem {
 
   std::size_t size() const { return kinematics.size(); }
   bool is_asleep(std::size_t i) const { return !asleep.empty() && asleep[i] != 0; }
-  Vec<D> position_at(std::size_t i, double t) const {
+  Vec<D> position(std::size_t i, double t) const {
     const auto& k = kinematics[i];
     const double dt = t - k.time;
     if (is_asleep(i)) return k.pos;
     return k.pos + dt * k.vel + (0.5 * dt * dt) * gravity;
   }
-  Vec<D> velocity_at(std::size_t i, double t) const {
+  Vec<D> velocity(std::size_t i, double t) const {
     const auto& k = kinematics[i];
     if (is_asleep(i)) return Vec<D>{};
     return k.vel + (t - k.time) * gravity;

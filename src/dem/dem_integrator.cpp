@@ -310,8 +310,8 @@ void DemIntegrator<D>::init(const DemOptions& options) {
       if (!std::isfinite(system.kinematics[i].pos[k]))
         throw InputError(fmt::format("DEM: position of particle {} is not finite", i));
     }
-    const Vec<D> p = system.position_at(i, system.time);
-    const Vec<D> v = system.velocity_at(i, system.time);
+    const Vec<D> p = system.position(i, system.time);
+    const Vec<D> v = system.velocity(i, system.time);
     double v2 = 0.0;
     for (int k = 0; k < D; ++k) {
       if (!std::isfinite(p[k]))

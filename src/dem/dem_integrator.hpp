@@ -95,7 +95,7 @@ class DemIntegrator {
   // and velocities, masses and radii > 0, box > 2 (d_max + skin) on every periodic axis (> d_max
   // between walls), no pair or wall contact overlapping by more than half the smaller radius.
   // InputError naming the problem otherwise. Each particle's position is taken at system.time
-  // (position_at).
+  // (position).
   DemIntegrator(const ParticleSystem<D>& system, const SoftContactLaw& law,
                 const DemOptions& options = {});
   // One law per species pair: laws.size() == species * species, symmetric, every particle's

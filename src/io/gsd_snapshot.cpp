@@ -137,13 +137,13 @@ void write_standard_chunks(gsd::Writer& w, const StateBlocks<D>& s, bool with_st
   w.write_chunk("particles/N", 1, 1, &n);
   write_particle_chunk<float>(w, "particles/position", 3, s,
                               [](const ParticleSystem<D>& p, std::size_t j, float* out) {
-                                const Vec<D> x = p.position_at(j, p.time);
+                                const Vec<D> x = p.position(j, p.time);
                                 for (int a = 0; a < D; ++a)
                                   out[a] = hoomd_coordinate(x[a], p.box[a], p.periodic[a]);
                               });
   write_particle_chunk<float>(w, "particles/velocity", 3, s,
                               [](const ParticleSystem<D>& p, std::size_t j, float* out) {
-                                const Vec<D> v = p.velocity_at(j, p.time);
+                                const Vec<D> v = p.velocity(j, p.time);
                                 for (int a = 0; a < D; ++a) out[a] = static_cast<float>(v[a]);
                               });
   if (!probe(s).angular_velocity.empty()) {
@@ -332,7 +332,7 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& bloc
     using Part = const ParticleSystem<D>&;
     write_particle_chunk<double>(w, "kairos/position", D, blocks,  // at kairos/time, wrapped
                                  [](Part p, std::size_t j, double* out) {
-                                   const Vec<D> x = p.position_at(j, p.time);
+                                   const Vec<D> x = p.position(j, p.time);
                                    for (int a = 0; a < D; ++a)
                                      out[a] = p.periodic[a] ? wrap_into_box(x[a], p.box[a]) : x[a];
                                  });

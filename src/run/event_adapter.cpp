@@ -282,10 +282,10 @@ ParticleSample<D> EventEngineAdapter<D, Queue>::particles() const {
   out.velocity.resize(n);
   out.radius.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    out.position[i] = s.position_at(i, s.time);
+    out.position[i] = s.position(i, s.time);
     for (int a = 0; a < D; ++a)
       if (s.periodic[a]) out.position[i][a] = wrap_into_box(out.position[i][a], s.box[a]);
-    out.velocity[i] = s.velocity_at(i, s.time);
+    out.velocity[i] = s.velocity(i, s.time);
     out.radius[i] = s.kinematics[i].radius;
   }
   out.mass = s.mass;
@@ -300,7 +300,7 @@ void EventEngineAdapter<D, Queue>::peculiar_velocities(std::vector<Vec<D>>& c,
     c = engine_.current_velocities();
     const ParticleSystem<D> s = engine_.export_state(/*with_zones=*/false);
     for (std::size_t i = 0; i < n; ++i)
-      c[i] = c[i] - engine_.environment().streaming_velocity(s.position_at(i, s.time), s.box);
+      c[i] = c[i] - engine_.environment().streaming_velocity(s.position(i, s.time), s.box);
     m = s.mass;
     return;
   }

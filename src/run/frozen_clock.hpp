@@ -198,7 +198,7 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
     for (std::size_t k = 0; k < named; ++k) {
       const std::uint32_t i = busy[k].second;
       for (const int f : frozen_clock_detail::touched_walls<D>(
-               engine.environment(), state.box, state.position_at(i, state.time),
+               engine.environment(), state.box, state.position(i, state.time),
                state.kinematics[i].radius, state.time))
         if (std::find(walls.begin(), walls.end(), f) == walls.end()) walls.push_back(f);
     }

@@ -69,7 +69,7 @@ RestartPlan plan_continuation(const Config& config, ParticleSystem<D>& state,
     for (int a = 0; a < D && a < static_cast<int>(plan.stored_gravity.size()); ++a)
       state.gravity[a] = plan.stored_gravity[a];
     for (std::size_t i = 0; i < state.size(); ++i) {
-      const Vec<D> x = state.position_at(i, state.time), v = state.velocity_at(i, state.time);
+      const Vec<D> x = state.position(i, state.time), v = state.velocity(i, state.time);
       state.kinematics[i].pos = x;
       state.kinematics[i].vel = v;  // a sleeper's is zero
       state.kinematics[i].time = state.time;

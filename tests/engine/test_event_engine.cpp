@@ -182,7 +182,7 @@ void expect_current_velocities_exported(const ParticleSystem<D>& start, const En
     const std::vector<Vec<D>> v = engine.current_velocities();
     ASSERT_EQ(v.size(), s.size());
     for (std::size_t i = 0; i < s.size(); ++i) {
-      const Vec<D> expected = s.velocity_at(i, s.time);
+      const Vec<D> expected = s.velocity(i, s.time);
       for (int a = 0; a < D; ++a) {
         ASSERT_EQ(v[i][a], expected[a]) << "particle " << i;
       }
@@ -393,7 +393,7 @@ void expect_incremental_and_full_scans_agree(const ParticleSystem<D>& start, dou
   const auto sa = a.export_state(), sb = b.export_state();
   double worst = 0.0;
   for (std::size_t i = 0; i < sa.size(); ++i) {
-    const Vec<D> xa = sa.position_at(i, until), xb = sb.position_at(i, until);
+    const Vec<D> xa = sa.position(i, until), xb = sb.position(i, until);
     for (int k = 0; k < D; ++k) worst = std::max(worst, std::abs(xa[k] - xb[k]));
   }
   EXPECT_LT(worst, 1e-9);

@@ -63,7 +63,7 @@ void expect_bounces(Engine& engine, const std::vector<Bounce>& expected, double 
     const double t = engine.time();
     ASSERT_NEAR(t, b.time, 1e-12 * (1.0 + b.time)) << "bounce " << k;
     const ParticleSystem<3> s = engine.export_state();
-    const Vec<3> v = s.velocity_at(b.particle, t);
+    const Vec<3> v = s.velocity(b.particle, t);
     ASSERT_NEAR(v[2], b.velocity, 1e-12 * scale) << "bounce " << k << " at t = " << t;
     EXPECT_EQ(v[0], 0.0);
     ++k;

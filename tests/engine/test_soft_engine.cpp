@@ -104,7 +104,7 @@ TEST_P(SoftBinary, ObliqueUnequalPairEndsWhereNewtonPutsIt) {
   const double t0 = 0.2, t_end = 0.45;
   PairState at_contact;
   for (int k = 0; k < 2; ++k) {
-    (k == 0 ? at_contact.r_i : at_contact.r_j) = start.position_at(k, t0);
+    (k == 0 ? at_contact.r_i : at_contact.r_j) = start.position(k, t0);
     (k == 0 ? at_contact.v_i : at_contact.v_j) = start.kinematics[k].vel;
   }
   const SoftPair pair{1.0, 2.3, 0.5, 0.7};
@@ -121,8 +121,8 @@ TEST_P(SoftBinary, ObliqueUnequalPairEndsWhereNewtonPutsIt) {
     return d;
   };
   // The map is good to its integration tolerance: 1e-10 of the size and of the speed.
-  EXPECT_LT(std::sqrt(norm2(image(after.position_at(0, t_end) - xi))), 1e-10);
-  EXPECT_LT(std::sqrt(norm2(image(after.position_at(1, t_end) - xj))), 1e-10);
+  EXPECT_LT(std::sqrt(norm2(image(after.position(0, t_end) - xi))), 1e-10);
+  EXPECT_LT(std::sqrt(norm2(image(after.position(1, t_end) - xj))), 1e-10);
   EXPECT_LT(std::sqrt(norm2(after.kinematics[0].vel - direct.state.v_i)), 1e-10 * g0);
   EXPECT_LT(std::sqrt(norm2(after.kinematics[1].vel - direct.state.v_j)), 1e-10 * g0);
 
@@ -136,7 +136,7 @@ TEST_P(SoftBinary, ObliqueUnequalPairEndsWhereNewtonPutsIt) {
   ASSERT_NEAR(dem.time(), t_end, 1e-12);
   const double l = 1.2;
   for (int k = 0; k < 2; ++k) {
-    const double dx = std::sqrt(norm2(image(dem.position(k) - after.position_at(k, t_end))));
+    const double dx = std::sqrt(norm2(image(dem.position(k) - after.position(k, t_end))));
     const double dv = std::sqrt(norm2(dem.velocity(k) - after.kinematics[k].vel));
     EXPECT_LT(dx / l, 1e-6) << "particle " << k;
     EXPECT_LT(dv / g0, 1e-6) << "particle " << k;
@@ -169,7 +169,7 @@ TEST_P(SoftBinary, LookupTableGivesTheMappedStateToItsTolerance) {
   const double g0 = std::sqrt(norm2(start.kinematics[0].vel - start.kinematics[1].vel));
   for (int k = 0; k < 2; ++k) {
     // Positions move by at most the end overlap and the rotation: 1e-6 of those, far below.
-    EXPECT_LT(std::sqrt(norm2(after.position_at(k, 0.45) - exact.position_at(k, 0.45))), 1e-7);
+    EXPECT_LT(std::sqrt(norm2(after.position(k, 0.45) - exact.position(k, 0.45))), 1e-7);
     EXPECT_LT(std::sqrt(norm2(after.kinematics[k].vel - exact.kinematics[k].vel)), 1e-6 * g0);
   }
 }
@@ -184,7 +184,7 @@ TEST_P(SoftBinary, InstantaneousModeIsTheHardSphereWithTheHeadOnRestitution) {
   EXPECT_EQ(after.counters.soft_contacts, 0u);
   EXPECT_DOUBLE_EQ(after.time, 0.2);
   // Normal relative velocity reversed and scaled by the head-on map's e, tangential kept.
-  const Vec<3> r = after.position_at(0, 0.2) - after.position_at(1, 0.2);
+  const Vec<3> r = after.position(0, 0.2) - after.position(1, 0.2);
   const Vec<3> n = (1.0 / std::sqrt(norm2(r))) * r;
   const Vec<3> g0 = start.kinematics[0].vel - start.kinematics[1].vel;
   const Vec<3> g1 = after.kinematics[0].vel - after.kinematics[1].vel;
@@ -287,7 +287,7 @@ TEST(SoftGas, DeferredReleasesFollowTheFrozenContactsTrajectories) {
   const ParticleSystem<3> a = deferred.export_state(), b = frozen.export_state();
   double worst = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) {
-    worst = std::max(worst, std::sqrt(norm2(a.position_at(i, t_end) - b.position_at(i, t_end))));
+    worst = std::max(worst, std::sqrt(norm2(a.position(i, t_end) - b.position(i, t_end))));
     worst =
         std::max(worst, std::sqrt(norm2(deferred.velocity(static_cast<std::uint32_t>(i), t_end) -
                                         frozen.velocity(static_cast<std::uint32_t>(i), t_end))));
@@ -514,7 +514,7 @@ TEST(SoftWalls, WallContactMatchesTheClosedFormDashpot) {
   EXPECT_EQ(after.kinematics[0].vel[0], v[0]);
   EXPECT_EQ(after.kinematics[0].vel[1], v[1]);
   const double t = engine.time();
-  const Vec<3> x = after.position_at(0, t);
+  const Vec<3> x = after.position(0, t);
   EXPECT_NEAR(x[2], 0.5 - dashpot_end_overlap(m, k, gamma, 1.3), 1e-10);
   EXPECT_NEAR(x[0], 5.0 + v[0] * t, 1e-10);
   EXPECT_NEAR(x[1], 5.0 + v[1] * t, 1e-10);
@@ -565,7 +565,7 @@ TEST(SoftWalls, PistonContactIsTheMapInTheWallsFrame) {
   options.dt = map.eps_t * units.time_unit / 20000.0;
   DemIntegrator<3> dem(s, env, options);
   dem.step(static_cast<long>((engine.time() + 0.05) / options.dt));
-  const Vec<3> x = after.position_at(0, dem.time());
+  const Vec<3> x = after.position(0, dem.time());
   for (int a = 0; a < 3; ++a) {
     EXPECT_NEAR(dem.position(0)[a], x[a], 1e-6) << a;
     EXPECT_NEAR(dem.velocity(0)[a], after.kinematics[0].vel[a], 1e-6) << a;

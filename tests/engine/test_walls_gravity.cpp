@@ -77,7 +77,7 @@ TEST(WallsAndGravity, BouncingBallFollowsTheAnalyticSequenceAndComesToRest) {
     if (s.is_asleep(0)) break;           // the last bounce put it to sleep
     if (engine.time() == 0.0) continue;  // B settling at t = 0
     speed *= e;
-    const Vec<D> v = s.velocity_at(0, engine.time());
+    const Vec<D> v = s.velocity(0, engine.time());
     ASSERT_NEAR(engine.time(), expected_time, 1e-12 * (1.0 + expected_time))
         << "bounce " << bounces;
     ASSERT_NEAR(v[2], speed, 1e-12 * v0) << "bounce " << bounces;
@@ -116,7 +116,7 @@ TEST(WallsAndGravity, ElasticGasUnderGravityConservesEnergyAndKeepsInvariants) {
     double e = engine.kinetic_energy();
     const ParticleSystem<D> now = engine.export_state();
     for (std::size_t i = 0; i < now.size(); ++i)
-      e += now.mass[i] * 1.0 * now.position_at(i, engine.time())[2];  // only g_z: z is bounded
+      e += now.mass[i] * 1.0 * now.position(i, engine.time())[2];  // only g_z: z is bounded
     return e;
   };
   // The x component of gravity does work on an unbounded coordinate: compare with the
