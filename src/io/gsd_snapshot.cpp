@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/event_code.hpp"
 #include "core/memory_budget.hpp"
 #include "core/periodic.hpp"
 #include "io/atomic_file.hpp"
@@ -267,12 +268,9 @@ void validate_restart(const ParticleSystem<D>& s, const std::filesystem::path& p
       throw bad("mass" + who + " is not positive");
     if (s.species[i] >= s.species_names.size()) throw bad("typeid" + who + " out of range");
     if (std::isnan(e.time)) throw bad("pending event time" + who + " is NaN");
-    // Codes above the particle indices name walls (the 2D faces below kNoPartner), just below
-    // those a soft contact's release, below that a crossing that kept no contact; from
-    // kKeptBase on, a crossing that kept the contact with particle partner - kKeptBase.
-    const bool code = e.partner >= EventSlot::kNoPartner - 2 * D - 2;
-    const bool kept = e.partner >= EventSlot::kKeptBase && e.partner - EventSlot::kKeptBase < n;
-    if (!code && !kept && e.partner >= n) throw bad("collision partner" + who + " out of range");
+    // The partner code (core/event_code.hpp): a particle it names must exist.
+    if (!EventCode<D>::valid_bits(e.partner, static_cast<std::uint32_t>(n)))
+      throw bad("collision partner" + who + " out of range");
   }
   std::vector<char> seen(n, 0);
   for (std::uint32_t k : s.order) {
