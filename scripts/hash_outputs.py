@@ -6,20 +6,25 @@ time), plus the benchmark cases and a few paths the examples miss (other queues,
 continued, a run that is resumed with changed physics, profiles), with the given kairos
 binary, and prints one SHA-256 per case over what a refactor must not change: the exact state
 of restart.gsd (every kairos/state chunk, positions, velocities, time, counters; not the run's
-bookkeeping such as the stored configuration or the checksum), the positions and velocities of
-every trajectory frame, thermo.tsv, profile.tsv, and every value of summary.json except the
-timings, the memory figures and the run id. Compare two builds with
+bookkeeping such as the stored configuration or the checksum, the run's id and
+stored configuration), every chunk of every trajectory frame, thermo.tsv, profile.tsv, and
+every value of summary.json except the timings, the memory figures and the run id. A case whose
+run fails is reported as FAILED (and the script exits with status 1). Compare two builds with
 
     scripts/hash_outputs.py OLD/build/kairos > old.txt
     scripts/hash_outputs.py NEW/build/kairos > new.txt
     diff old.txt new.txt
 
-(run from anywhere; takes a few minutes). `--only SUBSTRING` runs the cases whose name
+or against the stored hashes of the last accepted build with
+`scripts/hash_outputs.py build/kairos --check scripts/output_hashes.txt` (regenerate that file
+with `> scripts/output_hashes.txt` when a change of the outputs is intended, and say so in the
+commit). Run from anywhere; takes a minute. `--only SUBSTRING` runs the cases whose name
 contains it. Use /usr/bin/python3 (python3-gsd).
 """
 
 import glob
 import hashlib
+import io
 import json
 import os
 import subprocess
@@ -34,8 +39,9 @@ SHORT = ["run.equilibration_collisions_per_particle=1", "run.collisions_per_part
          "output.restart_interval=0"]
 # Examples too large to run whole in a few seconds: fewer particles.
 SMALLER = {"granular_clustering_2d.toml": ["system.particles=20000"]}
-STATE_PREFIXES = ("kairos/state/", "kairos/position", "kairos/velocity", "kairos/time",
-                  "kairos/box", "kairos/mass", "kairos/radius", "kairos/dem/")
+# Restart chunks that are the run's bookkeeping rather than its state: the run's id, the stored
+# configuration (it names the output directory), the checksum over both.
+RESTART_SKIPPED = ("kairos/run/id", "kairos/run/config", "kairos/checksum")
 # summary.json keys that differ between two runs of one binary, or that a layout change may
 # move without changing a trajectory (the engine's own bytes per particle).
 VOLATILE = {"wall_seconds", "collisions_per_second", "events_per_second", "steps_per_second",
@@ -67,6 +73,13 @@ EXTRA = [
      None),
     ("driven_andersen", None, HARD.format(eta=0.3),
      ['driving.kind="andersen"', "driving.rate=0.5"], None),
+    # Lengths and outputs in simulated time (the clock stops at every output).
+    ("in_time_hs", None, HARD.format(eta=0.3),
+     ["run.time=0.5", "run.equilibration_time=0.1", 'output.interval_unit="time"',
+      "output.thermo_interval=0.05", "output.trajectory_interval=0.1"], None),
+    ("in_time_continued_pile", "examples/granular_pile_3d.toml", None,
+     ["run.time=1.0", "run.equilibration_time=0", 'output.interval_unit="time"',
+      "output.thermo_interval=0.1", "output.trajectory_interval=0.5"], ["run.time=1.5"]),
     # Long enough to renumber (every 32 collisions per particle) a few times.
     ("long_hs_renumbered", None, "[system]\nparticles = 500\npacking_fraction = 0.4\n",
      ["run.collisions_per_particle=100"], None),
@@ -83,16 +96,18 @@ def hash_restart(path, h):
     with gsd.fl.open(name=path, mode="rb") as f:
         frame = f.nframes - 1
         for name in sorted(f.find_matching_chunk_names("kairos/")):
-            if name.startswith(STATE_PREFIXES) and f.chunk_exists(frame=frame, name=name):
+            if name not in RESTART_SKIPPED and f.chunk_exists(frame=frame, name=name):
                 h.update(name.encode())
                 h.update(f.read_chunk(frame=frame, name=name).tobytes())
 
 
 def hash_trajectory(path, h):
     with gsd.fl.open(name=path, mode="rb") as f:
+        names = sorted(f.find_matching_chunk_names(""))
         for frame in range(f.nframes):
-            for name in ("particles/position", "particles/velocity", "log/time"):
+            for name in names:
                 if f.chunk_exists(frame=frame, name=name):
+                    h.update(name.encode())
                     h.update(f.read_chunk(frame=frame, name=name).tobytes())
 
 
@@ -126,20 +141,33 @@ def run_case(kairos, config, overrides, out, cwd, extra=()):
     return subprocess.run(args, capture_output=True, text=True, cwd=cwd)
 
 
+FAILED = []
+
+
 def report(name, h, result):
+    if result.returncode != 0:
+        FAILED.append(name)
     print("%s %s%s" % (h.hexdigest()[:16], name,
                        "" if result.returncode == 0 else
-                       "  (exit %d: %s)" % (result.returncode, result.stderr.strip()[-200:])))
+                       "  FAILED (exit %d: %s)" % (result.returncode,
+                                                  result.stderr.strip()[-200:])))
     sys.stdout.flush()
 
 
 def main():
     args = sys.argv[1:]
     only = ""
+    check = None
     if "--only" in args:
         k = args.index("--only")
         only = args[k + 1]
         del args[k:k + 2]
+    if "--check" in args:
+        k = args.index("--check")
+        check = args[k + 1]
+        del args[k:k + 2]
+        out = io.StringIO()
+        real_stdout, sys.stdout = sys.stdout, out
     if len(args) < 1:
         sys.exit(__doc__)
     kairos = os.path.abspath(args[0])
@@ -167,7 +195,8 @@ def main():
                     f.write(text)
             out = os.path.join(tmp, name)
             first = SHORT + overrides
-            if continuation is not None:  # stop after 2 collisions per particle, continue to 3
+            in_time = any(o.startswith("run.time") for o in overrides)
+            if continuation is not None and not in_time:  # 2 collisions per particle, then 3
                 first = first + ["run.collisions_per_particle=2"]
             result = run_case(kairos, config, first, out, tmp)
             h = hashlib.sha256()
@@ -179,6 +208,22 @@ def main():
             if result.returncode == 0:
                 hash_outputs(out, h)
             report(name, h, result)
+    if check is not None:
+        sys.stdout = real_stdout
+        got = out.getvalue().splitlines()
+        with open(check, encoding="utf-8") as f:
+            want = [l for l in f.read().splitlines() if not only or only in l.split()[-1]]
+        differ = [w for w, g in zip(want, got) if w != g]
+        if len(want) != len(got) or differ:
+            print("outputs differ from %s:" % check)
+            for w, g in zip(want, got):
+                if w != g:
+                    print("  expected %s\n  got      %s" % (w, g))
+            sys.exit(1)
+        print("all %d cases identical to %s" % (len(got), check))
+    if FAILED:
+        print("FAILED: " + ", ".join(FAILED))
+        sys.exit(1)
 
 
 if __name__ == "__main__":
