@@ -166,8 +166,8 @@ def main():
         k = args.index("--check")
         check = args[k + 1]
         del args[k:k + 2]
-        out = io.StringIO()
-        real_stdout, sys.stdout = sys.stdout, out
+        captured = io.StringIO()
+        real_stdout, sys.stdout = sys.stdout, captured
     if len(args) < 1:
         sys.exit(__doc__)
     kairos = os.path.abspath(args[0])
@@ -210,7 +210,7 @@ def main():
             report(name, h, result)
     if check is not None:
         sys.stdout = real_stdout
-        got = out.getvalue().splitlines()
+        got = captured.getvalue().splitlines()
         with open(check, encoding="utf-8") as f:
             want = [l for l in f.read().splitlines() if not only or only in l.split()[-1]]
         differ = [w for w, g in zip(want, got) if w != g]
