@@ -177,9 +177,9 @@ template <int D>
 [[gnu::always_inline]] inline __m512d contact_distance2(const CandidateScan<D>& s, __m256i ids,
                                                         __mmask8 live, __m512d vradius_i) {
   const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(live),
-                                                  _mm512_castsi256_si512(ids), s.shape, 2);
+                                                  _mm512_castsi256_si512(ids), s.kind, 2);
   const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
-  const __m512d rj = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live, shp, s.shape_radius, 8);
+  const __m512d rj = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live, shp, s.kind_radius, 8);
   const __m512d sigma = _mm512_add_pd(vradius_i, rj);
   return _mm512_mul_pd(sigma, sigma);
 }
@@ -410,9 +410,9 @@ std::uint32_t scan_stepped_avx512(const SteppedScan<D>& s, double t, const Vec<D
     // Zone 0: the approach to the outermost boundary, after the cheap bound.
     const __mmask8 outside = static_cast<__mmask8>(live & ~inside);
     __m512d reach2 = reach2_one;
-    if (s.shape != nullptr) {
+    if (s.kind != nullptr) {
       const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(outside),
-                                                      _mm512_castsi256_si512(ids), s.shape, 2);
+                                                      _mm512_castsi256_si512(ids), s.kind, 2);
       const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
       reach2 = _mm512_mask_i32gather_pd(zero, outside, shp, s.row_reach2, 8);
     }

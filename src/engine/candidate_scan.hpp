@@ -36,12 +36,12 @@ struct CandidateScan {
   const Vec<D>* shifts = nullptr;
   bool any_shift = false;  // false: shift_index is not read, no candidate is shifted
   std::uint32_t count = 0;
-  // Contact distance: sigma_i + radius of the candidate (radius from its shape), or a constant.
+  // Contact distance: sigma_i + radius of the candidate (radius from its kind), or a constant.
   bool uniform = true;
-  double sigma = 0.0;                    // uniform: the pair contact distance
-  double radius_i = 0.0;                 // non-uniform: this particle's radius
-  const std::uint16_t* shape = nullptr;  // non-uniform: per particle
-  const double* shape_radius = nullptr;  // non-uniform: per shape
+  double sigma = 0.0;                   // uniform: the pair contact distance
+  double radius_i = 0.0;                // non-uniform: this particle's radius
+  const std::uint16_t* kind = nullptr;  // non-uniform: per particle
+  const double* kind_radius = nullptr;  // non-uniform: per kind
   // Uniform acceleration (gravity) felt by every candidate: their positions and velocities at
   // time t gain g dt^2/2 and g dt. The pair's relative motion stays a straight line.
   const double* accel = nullptr;       // g (kAccelerated loops only)
@@ -88,7 +88,7 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
     const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
     const RelativeMotion p =
         relative_motion_at<D, kAccelerated>(xi, vi, rec, dtj, shift, s.half_accel, s.accel);
-    const double sigma = s.uniform ? s.sigma : s.radius_i + s.shape_radius[s.shape[j]];
+    const double sigma = s.uniform ? s.sigma : s.radius_i + s.kind_radius[s.kind[j]];
     double dt;
     if (!contact_before(p, sigma * sigma, best, dt)) continue;
     if (dt < best) {
@@ -138,7 +138,7 @@ ContactProbeResult probe_contact_scalar(const CandidateScan<D>& s, double t,
     // The placed particle, frozen, and its motion after the release.
     const RelativeMotion placed =
         relative_motion_at<D>(probe.placed, probe.frozen_velocity, rec, dtj, shift);
-    const double sigma = s.uniform ? s.sigma : s.radius_i + s.shape_radius[s.shape[j]];
+    const double sigma = s.uniform ? s.sigma : s.radius_i + s.kind_radius[s.kind[j]];
     const double sigma2 = sigma * sigma;
     const double gap_placed = placed.r2 - sigma2;
     if (gap_placed < 0.0) {
@@ -207,16 +207,16 @@ std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const 
 // particle (skipped), and the capture map as PairSteps::load() left it. A candidate whose stamp
 // carries `epoch` is listed, in the zone and table the stamp names; any other sits in zone 0 of
 // its species pair's table, where only an approach to the outermost boundary (squared distance
-// row_reach2[its shape], the contact distance for a pair without steps) counts.
+// row_reach2[its kind], the contact distance for a pair without steps) counts.
 template <int D>
 struct SteppedScan {
   CandidateScan<D> base;
   std::uint32_t self = 0;
   const std::uint64_t* stamps = nullptr;  // per particle: epoch << 32 | table << 16 | zone
   std::uint32_t epoch = 0;
-  const std::uint16_t* shape = nullptr;  // per particle (padded by one), null: a single shape
-  const double* row_reach2 = nullptr;    // per shape
-  const double* flat_r2 = nullptr;       // every table's squared boundaries, back to back
+  const std::uint16_t* kind = nullptr;          // per particle (padded by one), null: a single kind
+  const double* row_reach2 = nullptr;           // per kind
+  const double* flat_r2 = nullptr;              // every table's squared boundaries, back to back
   const std::uint32_t* table_offset = nullptr;  // per table, into flat_r2; null: one table
   // Scratch for the listed candidates, held back and tested together after the others: room
   // for base.count + 8 entries each (r.r, r.g, g.g, stamp, index into base.candidates).
@@ -265,7 +265,7 @@ std::uint32_t scan_stepped_scalar(const SteppedScan<D>& s, double t, const Vec<D
   // Read once: the loop's stores to `best` could alias them for the compiler.
   const std::uint32_t* candidates = c.candidates;
   const std::uint64_t* stamps = s.stamps;
-  const std::uint16_t* shape = s.shape;
+  const std::uint16_t* kind = s.kind;
   const double* row_reach2 = s.row_reach2;
   const ZoneTable* tables = s.tables;
   const std::uint32_t self = s.self, epoch = s.epoch, count = c.count;
@@ -282,7 +282,7 @@ std::uint32_t scan_stepped_scalar(const SteppedScan<D>& s, double t, const Vec<D
     const double dtj = t - rec[2 * D];
     const RelativeMotion p =
         relative_motion_at<D, kAccelerated>(xi, vi, rec, dtj, shift, c.half_accel, c.accel);
-    const std::uint16_t sj = shape != nullptr ? shape[j] : 0;
+    const std::uint16_t sj = kind != nullptr ? kind[j] : 0;
     const std::uint64_t stamp = stamps[j];
     double dt;
     if ((stamp >> 32) != epoch || static_cast<std::uint16_t>(stamp) == 0) {  // zone 0

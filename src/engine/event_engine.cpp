@@ -46,8 +46,8 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   if (s.mass.size() != n || s.species.size() != n) {
     throw InputError("the state needs a mass and a species for every particle");
   }
-  build_shapes(s);
-  std::vector<double>().swap(s.mass);  // in shapes_ now
+  build_kinds(s);
+  std::vector<double>().swap(s.mass);  // in kinds_ now
   std::vector<std::uint32_t>().swap(s.species);
   bonds_ = s.bonds;
   bond_types_ = s.bond_types;
@@ -76,19 +76,19 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
     if (!ok) throw InputError("cannot resume: the stored particle order is not a permutation");
     id_.assign(s.order.begin(), s.order.end());
   }
-  HugeVector<std::uint16_t> shape_by_id = std::move(shape_);
-  if (!shape_by_id.empty()) {
-    shape_.resize(n + 1);  // one spare entry: the vector loop reads shapes 4 bytes at a time
-    for (std::size_t k = 0; k < n; ++k) shape_[k] = shape_by_id[id_[k]];
+  HugeVector<std::uint16_t> kind_by_id = std::move(kind_);
+  if (!kind_by_id.empty()) {
+    kind_.resize(n + 1);  // one spare entry: the vector loop reads kinds 4 bytes at a time
+    for (std::size_t k = 0; k < n; ++k) kind_[k] = kind_by_id[id_[k]];
   }
-  for (const ParticleKind& sh : shapes_) shape_radius_.push_back(sh.radius);
+  for (const ParticleKind& sh : kinds_) kind_radius_.push_back(sh.radius);
   const bool has_counts = s.collision_count.size() == n;
   hot_.resize(n);
   for (std::uint32_t k = 0; k < n; ++k) {
     const Kinematics<D>& kin = s.kinematics[id_[k]];
     hot_[k] = {kin.pos, kin.vel, kin.time, has_counts ? s.collision_count[id_[k]] : 0u, 0u};
   }
-  // Read (shapes_ hold the radii): released before the queue and the renumbering take their
+  // Read (kinds_ hold the radii): released before the queue and the renumbering take their
   // memory (docs/performance.md, "Memory").
   std::vector<Kinematics<D>>().swap(s.kinematics);
   restore_frozen(s, mode);
@@ -111,7 +111,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   }
   if (accelerated_ && walls_ && !moving && !stepped_) {
     double dmin = kNever;
-    for (const ParticleKind& sh : shapes_) dmin = std::min(dmin, 2.0 * sh.radius);
+    for (const ParticleKind& sh : kinds_) dmin = std::min(dmin, 2.0 * sh.radius);
     const double speed = Resting::speed_for(env_.sleep_speed, env_.gravity, dmin);
     if (speed > 0.0) {
       resting_ = Resting(n, speed, env_.gravity);
@@ -182,9 +182,9 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
 
 // Distinct (radius, mass, species) triples; particles store a 2-byte index into them.
 template <int D, class Queue>
-void EventEngine<D, Queue>::build_shapes(const ParticleSystem<D>& s) {
+void EventEngine<D, Queue>::build_kinds(const ParticleSystem<D>& s) {
   std::map<std::tuple<double, double, std::uint32_t>, std::uint16_t> index;
-  HugeVector<std::uint16_t> shape(s.size());
+  HugeVector<std::uint16_t> kind(s.size());
   for (std::size_t i = 0; i < s.size(); ++i) {
     const double r = s.kinematics[i].radius, m = s.mass[i];
     if (!(r > 0.0) || !std::isfinite(r) || !(m > 0.0) || !std::isfinite(m)) {
@@ -194,20 +194,20 @@ void EventEngine<D, Queue>::build_shapes(const ParticleSystem<D>& s) {
     const auto key = std::make_tuple(r, m, s.species[i]);
     auto it = index.find(key);
     if (it == index.end()) {
-      if (shapes_.size() == 0x10000) {
+      if (kinds_.size() == 0x10000) {
         throw InputError(
             "more than 65536 distinct (diameter, mass, species) combinations: Kairos keeps a "
-            "2-byte shape index per particle; round the diameters to fewer distinct values");
+            "2-byte kind index per particle; round the diameters to fewer distinct values");
       }
-      it = index.emplace(key, static_cast<std::uint16_t>(shapes_.size())).first;
-      shapes_.push_back({r, m, s.species[i]});
+      it = index.emplace(key, static_cast<std::uint16_t>(kinds_.size())).first;
+      kinds_.push_back({r, m, s.species[i]});
     }
-    shape[i] = it->second;
+    kind[i] = it->second;
   }
-  uniform_radius_ = std::all_of(shapes_.begin(), shapes_.end(), [&](const ParticleKind& sh) {
-    return sh.radius == shapes_[0].radius;
+  uniform_radius_ = std::all_of(kinds_.begin(), kinds_.end(), [&](const ParticleKind& sh) {
+    return sh.radius == kinds_[0].radius;
   });
-  if (shapes_.size() > 1) shape_ = std::move(shape);  // caller's numbering; permuted by caller
+  if (kinds_.size() > 1) kind_ = std::move(kind);  // caller's numbering; permuted by caller
 }
 
 // Checks the environment against the particles and sizes the cell grid for it: periodic axes
@@ -217,7 +217,7 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   env_.check();
   std::uint32_t species = 1;
-  for (const ParticleKind& sh : shapes_) species = std::max(species, sh.species + 1);
+  for (const ParticleKind& sh : kinds_) species = std::max(species, sh.species + 1);
   if (!env_.contact.empty() && env_.species < species) {
     throw InputError("the contact laws cover " + std::to_string(env_.species) +
                      " species but particles use " + std::to_string(species));
@@ -232,7 +232,7 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   walls_ = boundaries_.any();
   granular_contacts_ = !env_.plain() || env_.tc > 0.0;
   double rmax = 0.0;
-  for (const ParticleKind& sh : shapes_) rmax = std::max(rmax, sh.radius);
+  for (const ParticleKind& sh : kinds_) rmax = std::max(rmax, sh.radius);
   if (!bonds_.empty() && env_.bond_table.empty())
     throw InputError("the state has bonds but no bond potential is given ([bond])");
   stepped_ = env_.stepped();
@@ -280,7 +280,7 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
 template <int D, class Queue>
 void EventEngine<D, Queue>::throw_squeezed(double t) const {
   double dmax = 0.0;
-  for (const ParticleKind& sh : shapes_) dmax = std::max(dmax, 2.0 * sh.radius);
+  for (const ParticleKind& sh : kinds_) dmax = std::max(dmax, 2.0 * sh.radius);
   boundaries_.faces().throw_squeezed(t, dmax, uniform_radius_);
 }
 
@@ -308,7 +308,7 @@ std::uint64_t EventEngine<D, Queue>::next_renumber_after(std::uint64_t collision
 }
 
 // Renumbers particles along the Morton order of their cells, so that the members of
-// neighbouring cells sit close together in memory. Partners, ids, shapes and queue keys follow;
+// neighbouring cells sit close together in memory. Partners, ids, kinds and queue keys follow;
 // the caller's numbering stays available through id_.
 template <int D, class Queue>
 void EventEngine<D, Queue>::renumber(bool queue_filled) {
@@ -351,7 +351,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(hot_);
   permute(pending_);
   permute(id_);
-  permute(shape_);  // its spare last entry stays
+  permute(kind_);  // its spare last entry stays
   permute(spin_);
   permute(last_collision_);
   resting_.permute(order, done);
@@ -458,8 +458,8 @@ CandidateScan<D> EventEngine<D, Queue>::scan_of(const CandidateList& list, std::
                           .uniform = uniform_radius_,
                           .sigma = 2.0 * r,
                           .radius_i = r,
-                          .shape = shape_.data(),
-                          .shape_radius = shape_radius_.data(),
+                          .kind = kind_.data(),
+                          .kind_radius = kind_radius_.data(),
                           .accel = accelerated_ ? env_.gravity.data() : nullptr,
                           .half_accel = accelerated_ ? half_gravity_.data() : nullptr,
                           .delayed = soft_ ? list.delayed.data() : nullptr,
@@ -835,12 +835,12 @@ Vec<D> EventEngine<D, Queue>::momentum() const {
 template <int D, class Queue>
 double EventEngine<D, Queue>::bytes_per_particle() const {
   // Per-particle arrays plus the grid's and the queue's own (cells and buckets included,
-  // divided by N); the shape table is a few bytes in all.
-  const double shapes =
-      static_cast<double>(shapes_.size() * sizeof(ParticleKind)) / static_cast<double>(size());
+  // divided by N); the kind table is a few bytes in all.
+  const double kinds =
+      static_cast<double>(kinds_.size() * sizeof(ParticleKind)) / static_cast<double>(size());
   return static_cast<double>(sizeof(HotRecord<D>) + sizeof(PendingEvent) + sizeof(std::uint32_t) +
-                             (shape_.empty() ? 0 : sizeof(std::uint16_t))) +
-         shapes + cells_.grid().bytes_per_particle() +
+                             (kind_.empty() ? 0 : sizeof(std::uint16_t))) +
+         kinds + cells_.grid().bytes_per_particle() +
          static_cast<double>(queue_.bytes_per_particle());
 }
 

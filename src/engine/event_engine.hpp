@@ -22,7 +22,7 @@
 // (partner and its counter snapshot) is 8 bytes; the queue keeps the event time; the cell grid
 // a link per particle; the particle's id (outputs keep the caller's numbering while the engine
 // renumbers particles along a space-filling curve) 4 bytes; radius, mass and species live in a
-// small table of shapes indexed by a 2-byte shape number (absent for a single shape).
+// small table of kinds indexed by a 2-byte kind number (absent for a single kind).
 #pragma once
 
 #include <algorithm>
@@ -237,10 +237,10 @@ class EventEngine {
   // Cells per particle allowed when some axis has walls or open faces (see setup_environment).
   static constexpr double kBoundedCellsPerParticle = 8.0;
 
-  void build_shapes(const ParticleSystem<D>& s);
+  void build_kinds(const ParticleSystem<D>& s);
   void setup_environment(const ParticleSystem<D>& s);
   std::uint32_t species_of(std::uint32_t i) const {
-    return shapes_[shape_.empty() ? 0 : shape_[i]].species;
+    return kinds_[kind_.empty() ? 0 : kind_[i]].species;
   }
   // Where a record's free flight (a straight line, or a parabola under gravity) is at time t:
   // the record alone, whether the particle sleeps or sits in a deferred contact or not.
@@ -271,8 +271,8 @@ class EventEngine {
   void resolve_pair(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
   void collide_granular(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
   void separate(std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2);
-  double radius_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].radius; }
-  double mass_of(std::uint32_t i) const { return shapes_[shape_.empty() ? 0 : shape_[i]].mass; }
+  double radius_of(std::uint32_t i) const { return kinds_[kind_.empty() ? 0 : kind_[i]].radius; }
+  double mass_of(std::uint32_t i) const { return kinds_[kind_.empty() ? 0 : kind_[i]].mass; }
   void advance_to(std::uint32_t i, double t);
   Crossing next_crossing(const HotRecord<D>& h) const;
   [[gnu::noinline]] Crossing next_crossing_general(const HotRecord<D>& h) const;
@@ -422,11 +422,11 @@ class EventEngine {
   HugeVector<PendingEvent> pending_;
   // Incremental crossings (see cross()): on unless a feature needs every crossing's full scan.
   bool incremental_crossings_ = false;
-  bool three_cell_axis_ = false;     // some periodic axis is 3 cells wide: kept contacts unused
-  HugeVector<std::uint16_t> shape_;  // per particle; empty when there is a single shape
-  std::vector<ParticleKind> shapes_;
+  bool three_cell_axis_ = false;    // some periodic axis is 3 cells wide: kept contacts unused
+  HugeVector<std::uint16_t> kind_;  // per particle; empty when there is a single kind
+  std::vector<ParticleKind> kinds_;
   bool uniform_radius_ = true;
-  std::vector<double> shape_radius_;  // radius per shape, for the candidate loops
+  std::vector<double> kind_radius_;  // radius per kind, for the candidate loops
   bool vector_scan_ = false;
   bool vector_gather_ = false;    // gather_lists_avx512 for the cell lists (cpu_gathers_fast)
   bool row_loads_ = false;        // CandidateScan::row_loads (RecordLoads, cpu_gathers_fast)

@@ -44,7 +44,7 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
     return;
   }
   std::uint32_t species = 1;
-  for (const ParticleKind& sh : shapes_) species = std::max(species, sh.species + 1);
+  for (const ParticleKind& sh : kinds_) species = std::max(species, sh.species + 1);
   const std::size_t pairs = static_cast<std::size_t>(env_.species) * env_.species;
   if (env_.species < species || env_.soft.size() != pairs) {
     throw InputError("the soft contact laws cover " + std::to_string(env_.species) + " species (" +

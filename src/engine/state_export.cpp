@@ -129,7 +129,7 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
                                             ParticleSystem<D>& out, unsigned fields) const {
   using Blocks = StateBlocks<D>;
-  const ParticleKind& sh = shapes_[shape_.empty() ? 0 : shape_[k]];
+  const ParticleKind& sh = kinds_[kind_.empty() ? 0 : kind_[k]];
   if ((fields & Blocks::kKinematics) != 0) {
     const HotRecord<D>& h = hot_[k];
     out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};

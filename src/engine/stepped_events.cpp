@@ -112,11 +112,11 @@ std::uint32_t EventEngine<D, Queue>::scan_stepped(const CandidateList& list, std
   // (the contact distance of a pair without steps).
   const std::uint32_t si = species_of(i);
   const double ri = radius_of(i);
-  const std::size_t kinds = shapes_.size();
+  const std::size_t kinds = kinds_.size();
   step_scratch_.row_reach2.resize(kinds);
   for (std::size_t k = 0; k < kinds; ++k) {
-    const std::uint16_t table = steps_.pair_table(si, shapes_[k].species);
-    const double sigma = ri + shapes_[k].radius;
+    const std::uint16_t table = steps_.pair_table(si, kinds_[k].species);
+    const double sigma = ri + kinds_[k].radius;
     step_scratch_.row_reach2[k] =
         table == PairSteps::kHard ? sigma * sigma : steps_.table(table).r2[0];
   }
@@ -124,7 +124,7 @@ std::uint32_t EventEngine<D, Queue>::scan_stepped(const CandidateList& list, std
                       .self = i,
                       .stamps = steps_.stamps(),
                       .epoch = steps_.epoch(),
-                      .shape = shape_.empty() ? nullptr : shape_.data(),
+                      .kind = kind_.empty() ? nullptr : kind_.data(),
                       .row_reach2 = step_scratch_.row_reach2.data(),
                       .flat_r2 = steps_.flat_r2(),
                       .table_offset = steps_.tables() > 1 ? steps_.table_offset() : nullptr,

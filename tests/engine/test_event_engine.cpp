@@ -85,7 +85,7 @@ void expect_vector_and_scalar_loops_agree(const ParticleSystem<D>& start, int ev
 
 TEST(EventEngine, VectorAndScalarCandidateLoopsGiveBitIdenticalRuns) {
   if (!cpu_has_avx512()) GTEST_SKIP() << "this CPU has no AVX-512: only the scalar loop runs";
-  // Mono (uniform contact distance), a mixture (radii gathered per shape), 2D, and a box three
+  // Mono (uniform contact distance), a mixture (radii gathered per kind), 2D, and a box three
   // cells wide (every neighbour cell shifted by a periodic image).
   expect_vector_and_scalar_loops_agree(testing::lattice_system<3>(8, 0.45, 20), 100000);
   expect_vector_and_scalar_loops_agree(testing::lattice_system<3>(6, 0.3, 21, 2.0, 1.4), 50000);
@@ -141,7 +141,7 @@ void expect_record_loads_agree(const ParticleSystem<D>& start, const Environment
 
 TEST(EventEngine, RecordRowLoadsAndGathersGiveBitIdenticalRuns) {
   if (!cpu_has_avx512()) GTEST_SKIP() << "this CPU has no AVX-512: the scalar loop runs";
-  // The hard-sphere loop: mono, a mixture (radii per shape), 2D (48-byte records), a box three
+  // The hard-sphere loop: mono, a mixture (radii per kind), 2D (48-byte records), a box three
   // cells wide (shifted neighbours).
   expect_record_loads_agree(testing::lattice_system<3>(8, 0.45, 40), {}, 50000);
   expect_record_loads_agree(testing::lattice_system<3>(6, 0.3, 41, 2.0, 1.4), {}, 50000);

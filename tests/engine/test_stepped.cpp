@@ -312,7 +312,7 @@ TEST(Stepped, ExactResumeHeap) {
 
 // The AVX-512 stepped loop (scan_stepped_avx512) against the scalar one: bit-identical runs
 // (positions, velocities, zones, counters) for a square well, a many-zone table with shoulders,
-// hard pairs of another size mixed in (per-shape rows), bonds (a second table), a box of three
+// hard pairs of another size mixed in (per-kind rows), bonds (a second table), a box of three
 // cells (periodic shifts), 2D, and gravity with walls (the accelerated loop).
 template <int D>
 void expect_stepped_loops_agree(const ParticleSystem<D>& start, const Environment<D>& env,
