@@ -94,6 +94,12 @@ class FaceWalls {
   // overlaps (round-off contacts, 1e-12 of the radius, are contacts).
   void check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const;
 
+  // The boundary interface's setup: the cells each wall reaches and the squeeze time, for
+  // particles up to radius rmax, of total volume particle_volume, of `uniform` sizes.
+  void prepare(const CellGrid<D>& grid, double rmax, double particle_volume, bool uniform) {
+    set_reach(grid, rmax);
+    find_squeeze_time(rmax, particle_volume, uniform);
+  }
   // Walls approaching each other: the first time they leave no room for the particles (the
   // largest radius rmax, their total volume, `uniform` sizes), kNever if never.
   void find_squeeze_time(double rmax, double particle_volume, bool uniform);

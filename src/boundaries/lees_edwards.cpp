@@ -69,6 +69,18 @@ int LeesEdwards<D>::cross_face(Vec<D>& position, Vec<D>& velocity, int side, dou
                     grid.cells_along(0) - 1);
 }
 
+template <int D>
+std::string LeesEdwards<D>::check(double t) const {
+  if (!on()) return "";
+  if (!(next_shift_ >= t)) return "an image shift is overdue";
+  const std::int64_t k = step_ - floor_div(step_, cells_x_) * cells_x_;
+  const double offset = image_offset(t), tol = 1e-9 * box_[0];
+  if (offset < static_cast<double>(k) * cell_width_ - tol ||
+      offset > static_cast<double>(k + 1) * cell_width_ + tol)
+    return "the image offset is not in the cell its step says";
+  return "";
+}
+
 template class LeesEdwards<2>;
 template class LeesEdwards<3>;
 

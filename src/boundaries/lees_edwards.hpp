@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <string>
 
 #include "core/periodic.hpp"
 #include "core/vec.hpp"
@@ -57,6 +58,10 @@ class LeesEdwards {
   // closer than a third of the box along y, so the image is unambiguous.
   Vec<D> separation(Vec<D> r, double t, const std::array<bool, D>& periodic,
                     Vec<D>& image_velocity) const;
+
+  // The images' own consistency at time t (no shift is overdue, and the offset sits in the
+  // cell its step says): "" if so, else what is wrong.
+  std::string check(double t) const;
 
   // A particle leaves through the high (side +1) or low (-1) y face at time t, its y already
   // wrapped: its x and v_x become its image's. Returns its new column along x.

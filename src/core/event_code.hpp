@@ -27,7 +27,10 @@ class EventCode {
  public:
   static constexpr std::uint32_t kNoPartner = EventSlot::kNoPartner;
   static constexpr std::uint32_t kKeptBase = EventSlot::kKeptBase;
-  static constexpr std::uint32_t kFirstWall = kNoPartner - 2 * D;
+  // Room for this many wall surfaces (the box faces); a boundary registry with more surfaces
+  // needs a wider range first (a restart-format change; docs/extending.md).
+  static constexpr int kWallCodes = 2 * D;
+  static constexpr std::uint32_t kFirstWall = kNoPartner - kWallCodes;
   static constexpr std::uint32_t kRelease = kFirstWall - 1;
   static constexpr std::uint32_t kNoneKept = kRelease - 1;
   // Codes from here on are not particles.

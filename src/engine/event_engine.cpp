@@ -229,6 +229,11 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   accelerated_ = env_.has_gravity();
   half_gravity_ = 0.5 * env_.gravity;
   boundaries_ = Boundaries<D>(env_, box_);
+  if (boundaries_.surfaces() > Code::kWallCodes) {
+    throw std::logic_error(
+        "the boundary registry has more surfaces than EventCode has wall codes: widen them "
+        "first (docs/extending.md, \"Adding a boundary geometry\")");
+  }
   walls_ = boundaries_.any();
   granular_contacts_ = !env_.plain() || env_.tc > 0.0;
   double rmax = 0.0;
@@ -261,14 +266,13 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   cells_ =
       Cells(CellGrid<D>(box_, min_width, periodic, s.size(), cells_per_particle), vector_gather_);
   bounded_ = bounded;
-  boundaries_.faces().set_reach(cells_.grid(), rmax);
   shear_ = LeesEdwards<D>(env_.shear_rate, box_, cells_.grid(), time_);
   sheared_ = shear_.on();
   double particle_volume = 0.0;
   for (const Kinematics<D>& k : s.kinematics)
     particle_volume +=
         D == 3 ? 4.0 / 3.0 * M_PI * k.radius * k.radius * k.radius : M_PI * k.radius * k.radius;
-  boundaries_.faces().find_squeeze_time(rmax, particle_volume, uniform_radius_);
+  boundaries_.prepare(cells_.grid(), rmax, particle_volume, uniform_radius_);
   if (time_ >= boundaries_.squeeze_time()) throw_squeezed(time_);
   // Shear (sliding images) and steps (zones) keep full scans.
   incremental_crossings_ = options_.incremental_crossings && !stepped_ && !sheared_;
@@ -281,7 +285,7 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::throw_squeezed(double t) const {
   double dmax = 0.0;
   for (const ParticleKind& sh : kinds_) dmax = std::max(dmax, 2.0 * sh.radius);
-  boundaries_.faces().throw_squeezed(t, dmax, uniform_radius_);
+  boundaries_.throw_squeezed(t, dmax, uniform_radius_);
 }
 
 // A restored cell must exist and contain the particle's position (up to round-off): a damaged
@@ -696,7 +700,7 @@ void EventEngine<D, Queue>::set_velocity(std::uint32_t k, double t, const Vec<D>
   if (is_asleep(k)) wake(k, t);
   if (soft_) {  // a kick ends a soft contact in progress (exception B)
     const std::uint32_t partner = release(k, t, /*early=*/true);
-    if (partner < kFirstCode) queue_.update(partner, predict(partner, t));
+    if (is_particle(partner)) queue_.update(partner, predict(partner, t));
   }
   advance_to(k, t);
   HotRecord<D>& h = hot_[k];

@@ -120,10 +120,6 @@ class EventEngine {
   // When the next event happens (kNever if nothing ever will).
   double next_event_time() { return std::min(queue_.top_time(), shear_.next_shift_time()); }
 
-  // Driving (thermostats, random kicks) acts between events: it sets the velocity of particle k
-  // at time t, with time() <= t <= next_event_time(), wakes it if it sleeps, invalidates
-  // predictions made against it and re-predicts it. k is the engine's internal index: any
-  // numbering serves a uniform random choice, and it is restored on resume.
   // Where particle i (the engine's numbering) is and how it moves at time t (not before its local
   // time, unless it sits in a deferred soft contact: then the frozen motion until the release).
   Vec<D> position(std::uint32_t i, double t) const {
@@ -137,6 +133,10 @@ class EventEngine {
     return is_asleep(i) ? Vec<D>{} : flight_velocity(hot_[i], t);
   }
   double particle_mass(std::uint32_t k) const { return mass_of(k); }
+  // Driving (thermostats, random kicks) acts between events: it sets the velocity of particle k
+  // at time t, with time() <= t <= next_event_time(), wakes it if it sleeps, invalidates
+  // predictions made against it and re-predicts it. k is the engine's internal index: any
+  // numbering serves a uniform random choice, and it is restored on resume.
   void set_velocity(std::uint32_t k, double t, const Vec<D>& v);
   // Moves the present to t without an event (time() <= t <= next_event_time()), for outputs at
   // given times: exports, energies and velocities then describe the system at t. No record

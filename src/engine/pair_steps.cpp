@@ -129,6 +129,37 @@ void PairSteps::renumber(const std::vector<std::uint32_t>& new_index) {
   epoch_ = 0;
 }
 
+std::string PairSteps::check() const {
+  std::vector<std::vector<std::uint64_t>> counted(count_.size());
+  for (std::size_t t = 0; t < count_.size(); ++t) counted[t].assign(count_[t].size(), 0);
+  const auto pair = [](std::uint32_t i, std::uint32_t j) {
+    return "pair " + std::to_string(i) + "," + std::to_string(j);
+  };
+  for (std::uint32_t i = 0; i < n_; ++i) {
+    const Entry* slab = slab_of(i);
+    const std::uint32_t n = slab[0].partner;
+    if (n + 1 > stride_) return "particle " + std::to_string(i) + " lists more pairs than fit";
+    for (std::uint32_t k = 1; k <= n; ++k) {
+      const std::uint32_t j = slab[k].partner;
+      const Zone z = slab[k].zone;
+      if (j >= n_ || j == i) return "particle " + std::to_string(i) + " lists a bad partner";
+      for (std::uint32_t m = 1; m < k; ++m)
+        if (slab[m].partner == j) return pair(i, j) + " is listed twice";
+      if (z.table >= tables_.size() || z.zone > tables_[z.table].core_zone)
+        return pair(i, j) + " has a zone outside its table";
+      if (z.zone == 0 && !bonded(z.table)) return pair(i, j) + " is listed beyond its cut-off";
+      const std::uint32_t back = slot(j, i);
+      if (back == 0) return pair(i, j) + " is listed under one particle only";
+      const Zone mirrored = slab_of(j)[back].zone;
+      if (mirrored.table != z.table || mirrored.zone != z.zone)
+        return pair(i, j) + " has two different zones";
+      if (i < j) ++counted[z.table][z.zone];
+    }
+  }
+  if (counted != count_) return "the counts of pairs per zone (the potential energy) are off";
+  return "";
+}
+
 // In the caller's order (by i, then j) without a global sort: particles visited in caller
 // order, each one's short list sorted.
 std::vector<PairZone> PairSteps::export_zones(const std::uint32_t* id) const {

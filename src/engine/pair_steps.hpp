@@ -21,6 +21,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/huge_page_allocator.hpp"
@@ -141,6 +142,11 @@ class PairSteps {
   void renumber(const std::vector<std::uint32_t>& new_index);
   // Every listed pair once, in the numbering given by id (internal -> caller's), i < j.
   std::vector<PairZone> export_zones(const std::uint32_t* id) const;
+  // The map's own consistency: every entry mirrored under its partner with the same zone, no
+  // pair with itself or listed twice, zones inside their tables, a non-bonded pair never listed
+  // in zone 0, and the counts per (table, zone) those of the lists. "" if so, else the first
+  // fault (particles in the engine's numbering).
+  std::string check() const;
 
  private:
   // Position of j in i's slab (1..count), 0 if absent.

@@ -277,7 +277,7 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
       soft_state_.forget(k);
     };
     give_back(i);
-    if (p < kFirstCode) give_back(p);
+    if (is_particle(p)) give_back(p);
     if (early) ++counters_.soft_early_releases;
     return p;
   }
@@ -291,7 +291,7 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
     soft_state_.end_release(k);
   };
   give_back(i);
-  if (p < kFirstCode) give_back(p);
+  if (is_particle(p)) give_back(p);
   if (early) ++counters_.soft_early_releases;
   return p;
 }
@@ -391,7 +391,7 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
 template <int D, class Queue>
 void EventEngine<D, Queue>::release_event(std::uint32_t i, double t) {
   const std::uint32_t p = release(i, t, /*early=*/false);
-  if (p < kFirstCode) {
+  if (is_particle(p)) {
     predict_pair(i, p, t);
   } else {
     queue_.update(i, predict(i, t));
@@ -408,7 +408,7 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
   HotRecord<D>& hj = hot_[j];
   auto predict_released = [&] {
     for (const std::uint32_t p : released)
-      if (p < kFirstCode && p != i && p != j) queue_.update(p, predict(p, t));
+      if (is_particle(p) && p != i && p != j) queue_.update(p, predict(p, t));
   };
   Vec<D> r;
   for (int a = 0; a < D; ++a) {
@@ -513,7 +513,7 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
 template <int D, class Queue>
 void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   const std::uint32_t partner = release(i, t, true);
-  if (partner < kFirstCode) queue_.update(partner, predict(partner, t));
+  if (is_particle(partner)) queue_.update(partner, predict(partner, t));
   advance_to(i, t);
   HotRecord<D>& h = hot_[i];
   const int a = face / 2;

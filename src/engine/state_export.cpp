@@ -90,7 +90,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_globals(bool with_zones) const {
   if (stepped_ && with_zones) out.zones = steps_.export_zones(id_.data());
   for (std::uint32_t k = 0; soft_ && k < size(); ++k) {
     const std::uint32_t p = soft_state_.partner(k);
-    if (p == kNoPartner || (p < kFirstCode && p < k)) continue;  // each pair once
+    if (p == kNoPartner || (is_particle(p) && p < k)) continue;  // each pair once
     if (soft_state_.deferred(k) && !in_deferred_contact(k, time_)) continue;
     FrozenContact<D> c;
     c.i = id_[k];
@@ -98,7 +98,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_globals(bool with_zones) const {
     c.release_time = c.deferred ? hot_[k].time : soft_state_.release_time(k);
     c.velocity_i = c.deferred ? hot_[k].vel : soft_state_.release_velocity(k);
     if (c.deferred) c.release_position_i = hot_[k].pos;
-    if (p < kFirstCode) {
+    if (is_particle(p)) {
       c.j = id_[p];
       c.velocity_j = c.deferred ? hot_[p].vel : soft_state_.release_velocity(p);
       if (c.deferred) c.release_position_j = hot_[p].pos;

@@ -1,6 +1,8 @@
 // EventEngine::validate(): the engine's state checked against brute force (debug, O(N^2);
-// run.validate and the engine tests). Each component checks its own part (the cell lists, the
-// walls' reach) and this file the prediction invariant of docs/architecture.md over every pair.
+// run.validate and the engine tests). Each component with state checks its own part (the cell
+// lists, the sleepers, the soft contacts, the capture map, the shear images); this file checks
+// what spans them: every particle against every wall surface (through the boundary interface)
+// and the prediction invariant of docs/architecture.md over every pair.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -35,6 +37,14 @@ void EventEngine<D, Queue>::validate() {
   auto name = [&](std::uint32_t i) { return std::to_string(id_[i]); };
   cells_.validate(hot_.data(), n, fail, name);  // the cell lists
   resting_.validate([&](std::uint32_t k) { return hot_[k].vel; }, fail, name);
+  if (stepped_) {
+    const std::string bad = steps_.check();
+    if (!bad.empty()) fail("capture map: " + bad);
+  }
+  if (sheared_) {
+    const std::string bad = shear_.check(t);
+    if (!bad.empty()) fail("Lees-Edwards images: " + bad);
+  }
   if (soft_) {
     soft_state_.validate(
         kFirstCode,

@@ -115,7 +115,7 @@ struct RunConfig {
   // and equilibration `equilibration_time` (>= 0; < 0 = in collisions per particle).
   double time = 0.0;
   double equilibration_time = -1.0;
-  std::string event_queue = "calendar";  // calendar | heap
+  std::string event_queue = "calendar";  // calendar | heap | tree
   double max_wall_seconds = 0.0;         // 0 = no limit; stop cleanly when exceeded
   bool validate = false;  // debug: check neighbour structure and queue against brute force
   // event: the event-driven engine; dem: the force-based velocity Verlet integrator (needs

@@ -27,6 +27,11 @@
 //   bool overlaps(x, radius, t) const;          a particle overlaps one of its surfaces
 //   void check_start(x, radius, t, id) const;   throws InputError naming particle and surface
 //   double squeeze_time() const;                when moving surfaces leave no room (kNever)
+//   [[noreturn]] void throw_squeezed(t, dmax, uniform) const;
+//                                               the InputError of a run that reached it
+//   void prepare(grid, rmax, particle_volume, uniform);
+//                                               set-up once the cells and particles are known
+//                                               (which cells each surface reaches, the squeeze)
 //
 // is made from the run's model (Environment) in the constructor below, and has no per-particle
 // state (FaceWalls needs
@@ -36,6 +41,7 @@
 #pragma once
 
 #include <cstdint>
+#include <stdexcept>
 #include <tuple>
 #include <utility>
 
@@ -151,6 +157,17 @@ class BoundarySet {
     double t = kNever;
     for_each([&](const auto& c) { t = std::min(t, c.squeeze_time()); });
     return t;
+  }
+  void prepare(const CellGrid<D>& grid, double rmax, double particle_volume, bool uniform) {
+    for_each([&](auto& c) { c.prepare(grid, rmax, particle_volume, uniform); });
+  }
+  // The error of the component whose surfaces leave no room first (squeeze_time() <= t).
+  [[noreturn]] void throw_squeezed(double t, double dmax, bool uniform) const {
+    const double when = squeeze_time();
+    for_each([&](const auto& c) {
+      if (c.squeeze_time() == when) c.throw_squeezed(t, dmax, uniform);
+    });
+    throw std::logic_error("Boundaries::throw_squeezed: no surface leaves no room");
   }
 
  private:

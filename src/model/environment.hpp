@@ -112,7 +112,8 @@ struct Environment {
     return faces[f].kind == FaceKind::kWall && faces[f].wall.plane_moves(f);
   }
   // Where the plane of wall face f lies along its axis at time t (box: the box's edges): the
-  // plane of the header comment. The event engine and the outputs read walls through this.
+  // plane of boundaries/face_wall.hpp (the frozen-clock watch reads walls through this; the
+  // event engine through its boundary components).
   double wall_position(int f, const Vec<D>& box, double t) const {
     return faces[f].wall.plane_position(f, box, t);
   }

@@ -106,7 +106,9 @@ std::string whole_part(const std::string& key, const Flat& other) {
 }
 
 // The plane of a wall along its axis at time t, less its face's rest position (0 or L): the
-// normal velocity's drift and the vibration (model/environment.hpp).
+// normal velocity's drift and the vibration, as Wall::plane_position (boundaries/face_wall.hpp)
+// has them, from the configuration's keys (both configurations are compared before any
+// Environment exists).
 double plane_offset(const WallConfig& w, int dimension, double t) {
   const int axis = w.face[0] - 'x';
   const double u =

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -76,6 +77,10 @@ class PlaneWalls {
         throw InputError("particle " + std::to_string(id) + " overlaps plane " + std::to_string(s));
   }
   double squeeze_time() const { return kNever; }
+  [[noreturn]] void throw_squeezed(double, double, bool) const {
+    throw std::logic_error("fixed planes never leave no room");
+  }
+  void prepare(const CellGrid<D>&, double, double, bool) {}  // every plane is tested anywhere
 
  private:
   std::vector<Plane> planes_;

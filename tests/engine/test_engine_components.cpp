@@ -11,9 +11,11 @@
 #include <string>
 #include <vector>
 
+#include "boundaries/lees_edwards.hpp"
+#include "core/event_code.hpp"
 #include "dynamics/collision_time.hpp"
 #include "engine/cell_neighbourhood.hpp"
-#include "core/event_code.hpp"
+#include "engine/pair_steps.hpp"
 #include "engine/relative_motion.hpp"
 #include "engine/resting_particles.hpp"
 #include "engine/soft_contact_state.hpp"
@@ -264,12 +266,6 @@ TEST(CellNeighbourhood, TheVectorGatherListsTheSameCandidates) {
   gathers_exactly_the_neighbour_cells<true>();
 }
 
-}  // namespace
-}  // namespace kairos
-
-namespace kairos {
-namespace {
-
 TEST(ComponentValidation, EachComponentChecksItsOwnState) {
   int failures = 0;
   auto fail = [&](const std::string&) { ++failures; };
@@ -293,6 +289,55 @@ TEST(ComponentValidation, EachComponentChecksItsOwnState) {
   soft.begin(3, 1);  // one-sided, and no release bit for a frozen contact
   soft.validate(0x80000000u, live, fail, name);
   EXPECT_EQ(failures, 2);
+}
+
+// --- stepped zones: the capture map ---------------------------------------------------------
+
+TEST(PairSteps, TheMapListsPairsUnderBothParticlesAndCountsTheEnergyExactly) {
+  // One species, a square well of depth 1 from 1 to 1.5: zone 1 is inside the well.
+  const PairSteps fresh({square_well(1.0, 1.5, 1.0)}, {0}, 1, 6);
+  PairSteps steps = fresh;
+  EXPECT_EQ(steps.check(), "");
+  steps.set(0, 3, {0, 1});
+  steps.set(2, 3, {0, 1});
+  steps.set(4, 5, {0, 1});
+  EXPECT_EQ(steps.check(), "");
+  EXPECT_DOUBLE_EQ(steps.energy(), -3.0);
+  EXPECT_EQ(steps.find(3, 0, PairSteps::kHard).zone, 1);
+  EXPECT_EQ(steps.entry_count(3), 2u);
+  // Leaving the well unlists the pair under both particles.
+  steps.set(3, 0, {0, 0});
+  EXPECT_EQ(steps.entry_count(0), 0u);
+  EXPECT_EQ(steps.entry_count(3), 1u);
+  EXPECT_DOUBLE_EQ(steps.energy(), -2.0);
+  EXPECT_EQ(steps.check(), "");
+  // Renumbered (reversed), the same pairs under their new numbers.
+  steps.renumber({5, 4, 3, 2, 1, 0});
+  EXPECT_EQ(steps.check(), "");
+  EXPECT_EQ(steps.find(3, 2, PairSteps::kHard).zone, 1);  // was (2, 3)
+  EXPECT_EQ(steps.find(1, 0, PairSteps::kHard).zone, 1);  // was (4, 5)
+  steps.load(1);
+  EXPECT_EQ(steps.lookup(0, PairSteps::kHard).zone, 1);
+  EXPECT_EQ(steps.lookup(2, 0).zone, 0);  // not listed: zone 0 of the given table
+  // Exported under the original numbers (internal k was particle 5 - k), sorted by them.
+  const std::uint32_t id[6] = {5, 4, 3, 2, 1, 0};
+  const std::vector<PairZone> zones = steps.export_zones(id);
+  ASSERT_EQ(zones.size(), 2u);
+  EXPECT_EQ(zones[0].i, 2u);
+  EXPECT_EQ(zones[0].j, 3u);
+  EXPECT_EQ(zones[1].i, 4u);
+  EXPECT_EQ(zones[1].j, 5u);
+}
+
+TEST(LeesEdwards, ChecksItsOwnStep) {
+  const Vec<3> box{8.0, 6.0, 4.0};
+  const CellGrid<3> grid(box, Vec<3>{1.0, 1.0, 1.0}, {true, true, true}, 1000);
+  LeesEdwards<3> le(0.1, box, grid, 0.0);
+  EXPECT_EQ(le.check(0.0), "");
+  EXPECT_EQ(le.check(le.next_shift_time()), "");
+  EXPECT_NE(le.check(le.next_shift_time() + 1e-6), "");  // a shift overdue
+  le.shift();
+  EXPECT_EQ(le.check(le.next_shift_time() - 1e-9), "");
 }
 
 }  // namespace
