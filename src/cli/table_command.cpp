@@ -14,6 +14,7 @@
 #include "interactions/soft_map_table.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
+#include "io/config_choices.hpp"
 #include "run/environment_setup.hpp"
 #include "run/setup_chain.hpp"
 #include "run/soft_tables_setup.hpp"
@@ -35,8 +36,7 @@ struct SpecFlags {
   CLI::Option* model_option = nullptr;
 
   void add_to(CLI::App* app) {
-    model_option = app->add_option("--model", model, "Contact law: dashpot or hertz")
-                       ->check(CLI::IsMember({"dashpot", "hertz"}));
+    model_option = app->add_option("--model", model, "Contact law: dashpot or hertz");
     app->add_option("--stiffness", stiffness,
                     "dashpot: spring constant k; hertz: prefactor rho (F = rho xi^(3/2))");
     app->add_option("--damping", damping,
@@ -71,7 +71,7 @@ struct SpecFlags {
     require(min_speed, "--min-speed");
     require(max_speed, "--max-speed");
     SoftTableSpec s;
-    s.law.model = model == "hertz" ? SoftModel::ViscoelasticHertz : SoftModel::LinearDashpot;
+    s.law.model = soft_models().at(model);
     s.law.stiffness = stiffness;
     s.law.damping = damping;
     s.reduced_mass = reduced_mass;

@@ -651,7 +651,7 @@ class Reader : public KeyReader {
         conflict("boundary.shear_rate",
                  "Lees-Edwards shear is not supported with soft spheres yet");
       }
-      if (!integrators().is(c.run.integrator, Integrator::kDem)) {
+      if (!integrators().is(c.run.integrator, IntegratorKind::kDem)) {
         const auto rough = [&](const SoftLawConfig& law, const std::string& prefix) {
           if (law.friction > 0.0) {
             const std::string key = prefix + ".friction";
@@ -667,13 +667,13 @@ class Reader : public KeyReader {
         for (std::size_t p = 0; p < c.soft.pairs.size(); ++p)
           rough(c.soft.pairs[p].law, fmt::format("soft.pair[{}]", p));
       }
-      if (!c.field.gravity.empty() && !integrators().is(c.run.integrator, Integrator::kDem)) {
+      if (!c.field.gravity.empty() && !integrators().is(c.run.integrator, IntegratorKind::kDem)) {
         conflict("field.gravity",
                  "the collision mapping is not defined under gravity (a soft contact under a "
                  "load does not end); use run.integrator = \"dem\"");
       }
     }
-    if (!integrators().is(c.run.integrator, Integrator::kDem)) return;
+    if (!integrators().is(c.run.integrator, IntegratorKind::kDem)) return;
     const toml::node* n_integrator = node_at(root, "run.integrator");
     const auto unsupported = [&](std::string_view key, std::string_view what) {
       const toml::node* n = node_at(root, key);
@@ -721,7 +721,7 @@ class Reader : public KeyReader {
            "run.equilibration_time and run.equilibration_collisions_per_particle both give the "
            "equilibration length: keep one");
     }
-    if (r.time_step > 0.0 && !integrators().is(r.integrator, Integrator::kDem)) {
+    if (r.time_step > 0.0 && !integrators().is(r.integrator, IntegratorKind::kDem)) {
       fail(t.get("time_step"), "run.time_step",
            fmt::format("run.time_step: only used by the DEM integrator (run.integrator = \"dem\"; "
                        "it is \"{}\"), which has a time step",

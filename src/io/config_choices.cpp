@@ -22,14 +22,14 @@ constexpr ChoiceEntry<EventQueue> kEventQueues[] = {
     {"heap", EventQueue::kHeap, "binary heap"},
     {"tree", EventQueue::kTree, "complete binary tournament tree"},
 };
-constexpr ChoiceEntry<Integrator> kIntegrators[] = {
-    {"event", Integrator::kEvent, "the event-driven engine"},
-    {"dem", Integrator::kDem, "the force-based velocity Verlet integrator (needs [soft])"},
+constexpr ChoiceEntry<IntegratorKind> kIntegrators[] = {
+    {"event", IntegratorKind::kEvent, "the event-driven engine"},
+    {"dem", IntegratorKind::kDem, "the force-based velocity Verlet integrator (needs [soft])"},
 };
 constexpr ChoiceEntry<ProgressMode> kProgressModes[] = {
     {"auto", ProgressMode::kAuto, "when stderr is a terminal"},
     {"always", ProgressMode::kAlways, "always"},
-    {"never", ProgressMode::kNever, "never"},
+    {"never", ProgressMode::kOff, "never"},
 };
 constexpr ChoiceEntry<IntervalUnit> kIntervalUnits[] = {
     {"collisions", IntervalUnit::kCollisions, "collisions per particle"},
@@ -78,8 +78,8 @@ const Choices<EventQueue>& event_queues() {
   return choices;
 }
 
-const Choices<Integrator>& integrators() {
-  static constexpr Choices<Integrator> choices("integrator", kIntegrators);
+const Choices<IntegratorKind>& integrators() {
+  static constexpr Choices<IntegratorKind> choices("integrator", kIntegrators);
   return choices;
 }
 

@@ -9,15 +9,15 @@
 #include <string_view>
 
 #include "core/choices.hpp"
-#include "model/environment.hpp"
 #include "interactions/soft_contact.hpp"
+#include "model/environment.hpp"
 
 namespace kairos {
 
 enum class Lattice { kFcc, kSc, kBcc, kHex, kSquare, kRandom };
 enum class EventQueue { kCalendar, kHeap, kTree };
-enum class Integrator { kEvent, kDem };
-enum class ProgressMode { kAuto, kAlways, kNever };
+enum class IntegratorKind { kEvent, kDem };
+enum class ProgressMode { kAuto, kAlways, kOff };  // auto, always, never
 enum class IntervalUnit { kCollisions, kTime };
 enum class DrivingKind { kNone, kAndersen, kWhiteNoise };
 enum class RestitutionModel { kConstant, kViscoelastic, kTable };
@@ -28,7 +28,7 @@ enum class Axis { kX, kY, kZ };
 // system.lattice in a 3D or 2D box (dimension 2 or 3).
 const Choices<Lattice>& lattices(int dimension);
 const Choices<EventQueue>& event_queues();              // run.event_queue
-const Choices<Integrator>& integrators();               // run.integrator
+const Choices<IntegratorKind>& integrators();           // run.integrator
 const Choices<ProgressMode>& progress_modes();          // output.progress
 const Choices<IntervalUnit>& interval_units();          // output.interval_unit
 const Choices<DrivingKind>& driving_kinds();            // driving.kind

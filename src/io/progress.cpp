@@ -16,9 +16,9 @@ std::string format_duration(double seconds) {
                    : fmt::format("{:02}:{:02}", s / 60, s % 60);
 }
 
-ProgressLine::ProgressLine(const std::string& mode) {
+ProgressLine::ProgressLine(ProgressMode mode) {
   tty_ = ::isatty(STDERR_FILENO) != 0;
-  enabled_ = mode == "always" || (mode == "auto" && tty_);
+  enabled_ = mode == ProgressMode::kAlways || (mode == ProgressMode::kAuto && tty_);
 }
 
 void ProgressLine::update(const ProgressInfo& info, bool force) {

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <string>
 
+#include "io/config_choices.hpp"
+
 namespace kairos {
 
 struct ProgressInfo {
@@ -21,8 +23,8 @@ struct ProgressInfo {
 
 class ProgressLine {
  public:
-  // mode: "auto" (only on a terminal), "always" or "never".
-  explicit ProgressLine(const std::string& mode);
+  // output.progress: auto (only on a terminal), always or never.
+  explicit ProgressLine(ProgressMode mode);
   bool enabled() const { return enabled_; }
   // Draws if enough wall time has passed since the last draw, or always when `force` is set
   // (the end of a phase).

@@ -14,9 +14,9 @@
 #include <random>
 #include <string>
 
-#include "model/environment.hpp"
 #include "dem/dem_integrator.hpp"
 #include "io/config.hpp"
+#include "model/environment.hpp"
 #include "run/integrator.hpp"
 #include "run/setup_chain.hpp"
 

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "model/environment.hpp"
 #include "core/particle_system.hpp"
 #include "io/config.hpp"
+#include "model/environment.hpp"
 
 namespace kairos {
 

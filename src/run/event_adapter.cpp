@@ -86,6 +86,7 @@ EventEngineAdapter<D, Queue>::EventEngineAdapter(RunStart<D>&& start,
                                                  std::vector<SoftTableUse> tables)
     : EventIntegrator<D>(start.state),
       driving_(start.config.driving),
+      driving_kind_(driving_kinds().at(driving_.kind)),
       validate_(start.config.run.validate),
       rng_(start.rng),
       tables_(std::move(tables)),
@@ -94,7 +95,7 @@ EventEngineAdapter<D, Queue>::EventEngineAdapter(RunStart<D>&& start,
       watch_(engine_) {
   if (start.restarted() && !start.resumes()) check_no_overlap_after_new_physics(engine_);
   auto& kind = this->kind_;
-  kind.driven = driving_.kind != "none";
+  kind.driven = driving_kind_ != DrivingKind::kNone;
   kind.sheared = environment.sheared();
   kind.granular = !environment.plain() || environment.has_gravity() || kind.driven ||
                   environment.sheared() || environment.soft_spheres() ||
@@ -131,7 +132,7 @@ void EventEngineAdapter<D, Queue>::apply_due_kicks(double limit) {
                                                       static_cast<std::uint32_t>(this->size() - 1));
     const std::uint32_t k = pick(rng_);
     Vec<D> v{};
-    if (driving_.kind == "andersen") {
+    if (driving_kind_ == DrivingKind::kAndersen) {
       std::normal_distribution<double> maxwell(
           0.0, std::sqrt(driving_.temperature / engine_.particle_mass(k)));
       for (int a = 0; a < D; ++a) v[a] = maxwell(rng_);

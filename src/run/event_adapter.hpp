@@ -13,10 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "model/environment.hpp"
 #include "core/particle_system.hpp"
 #include "engine/event_engine.hpp"
 #include "io/config.hpp"
+#include "io/config_choices.hpp"
+#include "model/environment.hpp"
 #include "run/frozen_clock.hpp"
 #include "run/integrator.hpp"
 #include "run/setup_chain.hpp"
@@ -134,6 +135,7 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   void apply_due_kicks(double limit);
 
   DrivingConfig driving_;
+  DrivingKind driving_kind_;
   bool validate_ = false;
   std::mt19937_64 rng_;
   std::vector<SoftTableUse> tables_;

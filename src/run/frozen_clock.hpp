@@ -20,8 +20,8 @@
 
 #include <fmt/format.h>
 
-#include "model/environment.hpp"
 #include "core/vec.hpp"
+#include "model/environment.hpp"
 
 namespace kairos {
 

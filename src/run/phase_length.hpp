@@ -14,6 +14,7 @@
 
 #include "core/error.hpp"
 #include "io/config.hpp"
+#include "io/config_choices.hpp"
 #include "run/restart_plan.hpp"
 #include "run/run_progress.hpp"
 
@@ -49,7 +50,8 @@ inline PhaseLength resumed_equilibration(const RunConfig& r, const RunProgress& 
 // Whether the output intervals are in simulated time (the reader resolves the unit; a config
 // built in code may leave it "", the production length's unit).
 inline bool intervals_in_time(const Config& c) {
-  return c.output.interval_unit == "time" || (c.output.interval_unit.empty() && c.run.time > 0.0);
+  if (c.output.interval_unit.empty()) return c.run.time > 0.0;
+  return interval_units().at(c.output.interval_unit) == IntervalUnit::kTime;
 }
 
 inline PhaseLength production_length(const RunConfig& r) {

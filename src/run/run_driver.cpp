@@ -10,6 +10,7 @@
 
 #include "core/stop_flag.hpp"
 #include "io/atomic_file.hpp"
+#include "io/config_choices.hpp"
 #include "run/setup_chain.hpp"
 
 namespace kairos {
@@ -34,14 +35,15 @@ template <int D>
 RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& restart_file,
                         const RunOptions& options) {
   RunStart<D> start =
-      start_run<D>(config, restart_file, config.run.integrator == "dem" ? "dem" : "event");
+      start_run<D>(config, restart_file,
+                   integrators().is(config.run.integrator, IntegratorKind::kDem) ? "dem" : "event");
   config_ = start.config;
   restart_file_ = start.restart_file;
   resumed_ = start.resumed;
   plan_ = start.plan;
   const std::string restart_name = start.restart_name();
   // Soft spheres: the lookup tables of the collision map, built now or read from the cache.
-  const bool tell = config_.output.progress != "never";
+  const bool tell = progress_modes().at(config_.output.progress) != ProgressMode::kOff;
   std::string building;
   integrator_ = start_integrator<D>(std::move(start), [&](const std::string& contact, double) {
     if (tell && contact != building) {
@@ -92,7 +94,7 @@ RunOutcome RunDriver<D>::run() {
   const auto wall_start = Clock::now();
   continuation_ = output_continuation(directory_->continues_outputs(), resumed_);
   for (auto& o : observers_) o->open(*this);
-  ProgressLine progress(config_.output.progress);
+  ProgressLine progress(progress_modes().at(config_.output.progress));
 
   // A restart continues an interrupted equilibration, otherwise goes straight to production.
   const PhaseLength equilibration =

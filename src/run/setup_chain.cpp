@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/periodic.hpp"
+#include "io/config_choices.hpp"
 #include "io/gsd_file.hpp"
 #include "run/dem_adapter.hpp"
 #include "run/environment_setup.hpp"
@@ -126,7 +127,8 @@ SoftTableSettings soft_table_settings(const Config& config, const RunProgress& r
   settings.tolerance = config.soft.table_tolerance;
   settings.cache_dir = config.soft.table_cache;
   settings.max_speed = resumed.soft_table_max_speed;  // 0 (from the state) for a new run
-  if (config.driving.kind == "andersen") settings.driving_temperature = config.driving.temperature;
+  if (driving_kinds().is(config.driving.kind, DrivingKind::kAndersen))
+    settings.driving_temperature = config.driving.temperature;
   return settings;
 }
 
@@ -153,16 +155,20 @@ template <int D>
 std::unique_ptr<Integrator<D>> start_integrator(RunStart<D>&& start,
                                                 const TableProgress& progress) {
   const RunConfig& run = start.config.run;
-  if (run.integrator == "dem") {
+  if (integrators().at(run.integrator) == IntegratorKind::kDem) {
     return named_restart_errors(start, [&]() -> std::unique_ptr<Integrator<D>> {
       const Environment<D> environment = make_environment<D>(start.config, start.state);
       return std::make_unique<DemAdapter<D>>(std::move(start), environment);
     });
   }
-  if (run.event_queue == "heap")
-    return start_event_engine<D, BinaryHeapQueue>(std::move(start), progress);
-  if (run.event_queue == "tree")
-    return start_event_engine<D, TournamentTreeQueue>(std::move(start), progress);
+  switch (event_queues().at(run.event_queue)) {
+    case EventQueue::kHeap:
+      return start_event_engine<D, BinaryHeapQueue>(std::move(start), progress);
+    case EventQueue::kTree:
+      return start_event_engine<D, TournamentTreeQueue>(std::move(start), progress);
+    case EventQueue::kCalendar:
+      break;
+  }
   return start_event_engine<D, CalendarQueue>(std::move(start), progress);
 }
 

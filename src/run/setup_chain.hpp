@@ -20,10 +20,10 @@
 #include <string_view>
 #include <vector>
 
-#include "model/environment.hpp"
 #include "core/error.hpp"
 #include "core/particle_system.hpp"
 #include "io/config.hpp"
+#include "model/environment.hpp"
 #include "run/integrator.hpp"
 #include "run/restart_plan.hpp"
 #include "run/run_progress.hpp"

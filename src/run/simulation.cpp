@@ -7,6 +7,7 @@
 
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
+#include "io/config_choices.hpp"
 #include "run/event_adapter.hpp"
 #include "run/output_directory.hpp"
 #include "run/setup_chain.hpp"
@@ -18,13 +19,13 @@ template <int D>
 Simulation<D>::Simulation(const Config& config,
                           const std::optional<std::filesystem::path>& restart_file)
     : config_(config) {
-  if (config.run.integrator != "event") {
+  if (integrators().at(config.run.integrator) != IntegratorKind::kEvent) {
     throw InputError(fmt::format(
         "run.integrator = \"{}\": an in-memory simulation drives the event integrator; run the "
         "DEM with `kairos run` (kairos.run in Python)",
         config.run.integrator));
   }
-  if (config.driving.kind != "none") {
+  if (driving_kinds().at(config.driving.kind) != DrivingKind::kNone) {
     throw InputError(
         "[driving]: an in-memory simulation applies no driving kicks; run driven systems with "
         "`kairos run` (kairos.run in Python)");

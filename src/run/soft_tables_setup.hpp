@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "model/environment.hpp"
 #include "core/particle_system.hpp"
 #include "interactions/soft_map_table.hpp"
+#include "model/environment.hpp"
 
 namespace kairos {
 

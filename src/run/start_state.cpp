@@ -13,6 +13,7 @@
 #include "core/periodic.hpp"
 #include "init/initial_state.hpp"
 #include "init/initial_state_file.hpp"
+#include "io/config_choices.hpp"
 #include "io/gsd_file.hpp"
 
 namespace kairos {
@@ -168,7 +169,9 @@ ParticleSystem<D> build_start_state(const Config& config,
                                     const std::optional<fs::path>& restart_file,
                                     std::mt19937_64& rng, RunProgress& progress) {
   // The memory estimate checked before the state is built or read: the DEM's layout is larger.
-  const RunKind kind = config.run.integrator == "dem" ? RunKind::kDem : RunKind::kEventDriven;
+  const RunKind kind = integrators().is(config.run.integrator, IntegratorKind::kDem)
+                           ? RunKind::kDem
+                           : RunKind::kEventDriven;
   if (restart_file) {
     if (!fs::exists(*restart_file)) {
       throw InputError("restart file '" + restart_file->string() + "' does not exist");
@@ -186,7 +189,7 @@ ParticleSystem<D> build_start_state(const Config& config,
     const bool exact = holds_exact_positions(path);
     if (!exact) expand_away_rounding_overlaps<D>(init, periodic);
     const std::string source = "system.initial_state '" + path.string() + "'";
-    if (config.soft.enabled() && config.run.integrator == "dem") {
+    if (config.soft.enabled() && kind == RunKind::kDem) {
       check_soft_overlaps<D>(init, periodic, source);
     } else if (config.soft.enabled()) {
       // The event integrator maps a soft contact from its first touch (Müller and Pöschel, Phys.
