@@ -75,6 +75,8 @@ class Reader : public KeyReader {
     read_run(section(root, "run", empty), config.run);
     read_output(section(root, "output", empty), config.system.dimension, config.output);
     resolve_interval_unit(section(root, "output", empty), config.run, config.output);
+    read_group(section(root, "analysis", empty), "analysis", analysis_keys(), &config.analysis,
+               nullptr);
     read_potentials(root, config.system.species, config.potentials);
     read_bonds(root, config.bonds);
     if (root.contains("soft")) {

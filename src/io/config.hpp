@@ -145,6 +145,24 @@ struct OutputConfig {
   bool operator==(const OutputConfig&) const = default;
 };
 
+// [analysis]: structure analyses sampled over the production (docs/outputs.md,
+// "Structure analyses"), each written at the end to its own file and to summary.json.
+struct AnalysisConfig {
+  bool rdf = false;                    // rdf.tsv: g(r) per species pair, contact values
+  std::int64_t rdf_bins = 200;         // bins of g(r) over [0, rdf_max_distance]
+  double rdf_max_distance = 0.0;       // 0: automatic, min(5 d, half the shortest box edge)
+  bool structure_factor = false;       // sk.tsv: S(k) on the box's wave vectors (periodic boxes)
+  double sk_max = 0.0;                 // the largest |k|; 0: automatic, 15 / d
+  bool bond_order = false;             // bond_order.tsv: Steinhardt q4, q6 (3D), psi6 (2D)
+  double bond_cutoff = 1.4;            // neighbours: closer than this many contact distances
+  bool velocity_distribution = false;  // velocity_distribution.tsv
+  // Between samples, in output.interval_unit; 0: at every production thermo row.
+  double interval = 0.0;
+
+  bool any() const { return rdf || structure_factor || bond_order || velocity_distribution; }
+  bool operator==(const AnalysisConfig&) const = default;
+};
+
 // Stochastic driving: random events at `rate` per particle per unit time, each acting on one
 // random particle. andersen: a new Maxwell-Boltzmann velocity at `temperature` (a thermostat);
 // white_noise: a Gaussian velocity kick whose variance per component is strength / rate, so
@@ -235,6 +253,7 @@ struct Config {
   FieldConfig field;               // [field]
   DrivingConfig driving;           // [driving]
   SoftConfig soft;                 // [soft]
+  AnalysisConfig analysis;         // [analysis]
 
   bool operator==(const Config&) const = default;  // memberwise (exact doubles)
 };

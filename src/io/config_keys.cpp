@@ -434,6 +434,57 @@ constexpr KeyDecl kOutput[] = {
      .doc = "slabs of the profile"},
 };
 
+// ----- [analysis]
+
+const AnalysisConfig kAnalysisDefaults{};
+constexpr KeyDecl kAnalysis[] = {
+    {.name = "rdf",
+     .type = KeyType::kBoolean,
+     .member = field<&AnalysisConfig::rdf>,
+     .doc = "rdf.tsv: g(r) per species pair, contact values"},
+    {.name = "rdf_bins",
+     .type = KeyType::kInteger,
+     .member = field<&AnalysisConfig::rdf_bins>,
+     .range = counted,
+     .doc = "bins of g(r)"},
+    {.name = "rdf_max_distance",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::rdf_max_distance>,
+     .range = up_to(0.5, Scale::kBoxEdge),
+     .unit = "length",
+     .doc = "g(r) up to this distance (0: automatic)"},
+    {.name = "structure_factor",
+     .type = KeyType::kBoolean,
+     .member = field<&AnalysisConfig::structure_factor>,
+     .doc = "sk.tsv: S(k) on the box's wave vectors"},
+    {.name = "sk_max",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::sk_max>,
+     .range = up_to(100.0, Scale::kInverseLength),
+     .unit = "1 / length",
+     .doc = "S(k) up to this wave number (0: automatic)"},
+    {.name = "bond_order",
+     .type = KeyType::kBoolean,
+     .member = field<&AnalysisConfig::bond_order>,
+     .doc = "bond_order.tsv: Steinhardt q4, q6 (3D) or psi6 (2D)"},
+    {.name = "bond_cutoff",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::bond_cutoff>,
+     .range = {.lo = 1.0, .hi = 3.0},
+     .unit = "contact distances",
+     .doc = "neighbours of the bond order: closer than this"},
+    {.name = "velocity_distribution",
+     .type = KeyType::kBoolean,
+     .member = field<&AnalysisConfig::velocity_distribution>,
+     .doc = "velocity_distribution.tsv: one component in units of sqrt(kT / m)"},
+    {.name = "interval",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::interval>,
+     .range = non_negative,
+     .unit = "interval_unit",
+     .doc = "between samples (0: every production thermo row)"},
+};
+
 // ----- [[potential]], [[bond]]
 
 bool is_spring_dashpot(const void* p) {
@@ -756,6 +807,7 @@ constexpr KeyGroup kPotentialGroup{"potential", kPotential, &kPotentialDefaults}
 constexpr KeyGroup kSpringDashpotGroup{"spring_dashpot", kSpringDashpot, &kPotentialDefaults};
 constexpr KeyGroup kSoftLawGroup{"soft law", kSoftLaw, &kSoftLawDefaults};
 constexpr KeyGroup kSoftGroup{"soft", kSoft, &kSoftDefaults};
+constexpr KeyGroup kAnalysisGroup{"analysis", kAnalysis, &kAnalysisDefaults};
 constexpr KeyGroup kPairSpeciesGroup{"pair", kPairSpecies, nullptr};
 constexpr KeyGroup kPotentialSpeciesGroup{"potential species", kPotentialSpecies, nullptr};
 constexpr KeyGroup kWallFaceGroup{"wall face", kWallFace, nullptr};
@@ -796,6 +848,7 @@ std::vector<DeclaredKey> build() {
       {"soft", KeyType::kTable, {{&kSoftGroup}, {&kSoftLawGroup}}},
       {"soft.pair", KeyType::kTableArray, {{&kPairSpeciesGroup}, {&kSoftLawGroup, "soft"}}},
       {"output", KeyType::kTable, {{&kOutputGroup}}},
+      {"analysis", KeyType::kTable, {{&kAnalysisGroup}}},
   };
   std::vector<DeclaredKey> out, last;
   for (const Placement& p : placements) {
@@ -944,6 +997,9 @@ const KeyGroup& soft_law_keys() {
 }
 const KeyGroup& soft_keys() {
   return kSoftGroup;
+}
+const KeyGroup& analysis_keys() {
+  return kAnalysisGroup;
 }
 
 std::string type_text(const KeyDecl& d) {

@@ -247,11 +247,12 @@ void check_outputs(const Config& c, const RangeScales& s) {
   const ChoiceEntry<IntervalUnit>* unit = interval_units().find(c.output.interval_unit);
   const bool in_time = unit != nullptr && unit->value == IntervalUnit::kTime;
   const double length = length_in_time ? c.run.time : c.run.collisions_per_particle;
-  for (const auto& [key, value] : {std::pair{"thermo_interval", c.output.thermo_interval},
-                                   {"trajectory_interval", c.output.trajectory_interval},
-                                   {"restart_interval", c.output.restart_interval}}) {
+  for (const auto& [key, value] : {std::pair{"output.thermo_interval", c.output.thermo_interval},
+                                   {"output.trajectory_interval", c.output.trajectory_interval},
+                                   {"output.restart_interval", c.output.restart_interval},
+                                   {"analysis.interval", c.analysis.interval}}) {
     if (value == 0.0) continue;  // automatic, or none
-    const std::string path = std::string("output.") + key;
+    const std::string path = key;
     if (in_time == length_in_time) {
       // A million outputs per production at most: more is no sampling but a log of every event.
       within(path, value, 1e-6 * length, 1e9 * (in_time ? s.time() : 1.0),
@@ -263,6 +264,19 @@ void check_outputs(const Config& c, const RangeScales& s) {
       within(path, value, 1e-9, 1e9, "collisions per particle");
     }
   }
+}
+
+// The analyses' lengths against the box (minimum images) and the diameters.
+void check_analysis(const AnalysisConfig& a, const RangeScales& s) {
+  if (!s.box.empty() && a.rdf_max_distance > 0.0) {
+    const double shortest = *std::min_element(s.box.begin(), s.box.end());
+    const double edges = declared("analysis.rdf_max_distance").hi;
+    within("analysis.rdf_max_distance", a.rdf_max_distance, 0.0, edges * shortest,
+           fmt::format("up to {} times the shortest box edge, {:.6g}: beyond, a pair has more "
+                       "than one image within the distance",
+                       short_number(edges), shortest));
+  }
+  within_declared("analysis.sk_max", a.sk_max, 1.0 / s.d_max, "1 / d, " + length_unit(s));
 }
 
 // ----- soft laws
@@ -441,6 +455,7 @@ void check_ranges(const Config& config, const RangeScales& scales) {
   check_driving(config.driving, scales);
   check_run(config, scales);
   check_outputs(config, scales);
+  check_analysis(config.analysis, scales);
   check_soft(config.soft, scales);
   for (std::size_t p = 0; p < config.potentials.size(); ++p)
     check_potential_ranges(config.potentials[p].potential, fmt::format("potential[{}]", p), scales);
