@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -131,6 +132,54 @@ TEST_P(Outputs, TheSummaryHasThePartsOfItsIntegrator) {
   // The files written, in the list's order (no profile.tsv without a profile axis).
   EXPECT_EQ(s["outputs"], nlohmann::json({"summary.json", "thermo.tsv", "trajectory.gsd",
                                           "restart.gsd", "config.toml"}));
+}
+
+// The structure analyses of [analysis] sample the production only: at its 8 thermo rows, or
+// at their own interval; each writes its file and its part of summary.json (contact values
+// only for the hard spheres of the event engine, the DEM's being soft).
+TEST_P(Outputs, AnalysesSampleTheProductionAndWriteTheirFiles) {
+  const std::vector<std::string> all = {"analysis.rdf=true", "analysis.structure_factor=true",
+                                        "analysis.bond_order=true",
+                                        "analysis.velocity_distribution=true"};
+  const RunOutcome outcome = run(all);
+  ASSERT_TRUE(outcome.error.empty()) << outcome.error;
+  const nlohmann::json& s = outcome.summary;
+  const nlohmann::json& a = s["analysis"];
+  for (const char* key : {"rdf", "structure_factor", "bond_order", "velocity_distribution"})
+    EXPECT_EQ(a[key]["samples"], 8) << key;
+  EXPECT_EQ(a["covers"], "the production");
+  EXPECT_EQ(s["outputs"], nlohmann::json({"summary.json", "thermo.tsv", "trajectory.gsd",
+                                          "restart.gsd", "rdf.tsv", "sk.tsv", "bond_order.tsv",
+                                          "velocity_distribution.tsv", "config.toml"}));
+  const bool dem = std::string(GetParam()) == "dem";
+  EXPECT_EQ(a["rdf"]["contact"].is_null(), dem);
+  EXPECT_EQ(a["rdf"]["compressibility_from_contact"]["mean"].is_null(), dem);
+  if (dem) {
+    EXPECT_TRUE(s["undefined"].contains("analysis.rdf.contact"));
+  }
+  EXPECT_TRUE(a["bond_order"]["q6"]["global"].is_number());
+  EXPECT_TRUE(a["structure_factor"]["s_k_min"].is_number());
+  EXPECT_NEAR(a["velocity_distribution"]["kurtosis"].get<double>(), 3.0, 0.5);
+  std::ifstream rdf(dir_ / "rdf.tsv");
+  std::string line;
+  std::getline(rdf, line);
+  EXPECT_EQ(line.rfind("# 8 samples;", 0), 0u) << line;
+  // Every 1.5 collisions per particle of the production (from 1.0 to 5.0: 2.5 and 4.0).
+  fs::remove_all(dir_);
+  std::vector<std::string> timed = all;
+  timed.push_back("analysis.interval=1.5");
+  const RunOutcome every = run(timed);
+  ASSERT_TRUE(every.error.empty()) << every.error;
+  EXPECT_EQ(every.summary["analysis"]["rdf"]["samples"], 2);
+  EXPECT_EQ(every.summary["analysis"]["velocity_distribution"]["samples"], 2);
+}
+
+TEST_P(Outputs, NoAnalysisNoTableNoFilesNoSummaryPart) {
+  ASSERT_TRUE(run().error.empty());
+  std::ifstream in(dir_ / "config.toml");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("[analysis]"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ / "rdf.tsv"));
 }
 
 INSTANTIATE_TEST_SUITE_P(BothIntegrators, Outputs, ::testing::Values("event", "dem"));

@@ -4,17 +4,22 @@
 
 #include "run/dem_adapter.hpp"
 #include "run/event_adapter.hpp"
+#include "run/outputs/bond_order_output.hpp"
 #include "run/outputs/dem_summary.hpp"
 #include "run/outputs/event_summary.hpp"
 #include "run/outputs/granular_summary.hpp"
 #include "run/outputs/pressure_tensor.hpp"
 #include "run/outputs/profile_output.hpp"
+#include "run/outputs/rdf_output.hpp"
 #include "run/outputs/restart_output.hpp"
 #include "run/outputs/run_summary.hpp"
 #include "run/outputs/soft_summary.hpp"
 #include "run/outputs/stepped_summary.hpp"
+#include "run/outputs/structure_factor_output.hpp"
+#include "run/outputs/structure_snapshot.hpp"
 #include "run/outputs/thermo_output.hpp"
 #include "run/outputs/trajectory_output.hpp"
+#include "run/outputs/velocity_distribution_output.hpp"
 
 namespace kairos {
 
@@ -42,6 +47,13 @@ ObserverList<D> make_observers([[maybe_unused]] const Config& config,
   add<TrajectoryOutput<D>>(list);
   add<RestartOutput<D>>(list);
   add<ProfileOutput<D>>(list);
+  // The structure analyses of [analysis]: the three of the configuration share one read of the
+  // state per sample; rdf.tsv's part of summary.json reads thermo.tsv's Z.
+  const auto snapshot = std::make_shared<StructureSnapshot<D>>();
+  add<RdfOutput<D>>(list, snapshot, thermo);
+  add<StructureFactorOutput<D>>(list, snapshot);
+  add<BondOrderOutput<D>>(list, snapshot);
+  add<VelocityDistributionOutput<D>>(list);
   // summary.json's parts.
   add<RunSummary<D>>(list);
   if (const EventIntegrator<D>* engine = integrator.as_event()) {

@@ -95,6 +95,15 @@ double ThermoOutput<D>::production_temperature(const Integrator<D>& integrator) 
   return stats_->temperature(production_ke_);
 }
 
+template <int D>
+BlockAverage ThermoOutput<D>::production_compressibility(const Integrator<D>& integrator) const {
+  BlockAverage z = stats_->compressibility_blocks();
+  z.mean = stats_->compressibility(integrator.virial() - production_start_.virial,
+                                   production_temperature(integrator),
+                                   integrator.time() - production_start_.time);
+  return z;
+}
+
 // summary.json's run totals (docs/outputs.md): counts and rates of this invocation, the times,
 // the temperature, Z with its blocked error, the pressure and the mean free time. Z and the
 // pressure are bulk values: undefined with walls, open faces or a field.
@@ -110,9 +119,8 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
       integrator.collisions() - production_start_.collisions;
   const double ke = integrator.thermal_energy();
   const double kT_production = production_temperature(integrator);
-  const double z_mean = th.compressibility(integrator.virial() - production_start_.virial,
-                                           kT_production, production_time);
-  const BlockAverage z_blocks = th.compressibility_blocks();
+  const BlockAverage z_blocks = production_compressibility(integrator);
+  const double z_mean = z_blocks.mean;
   j["events"] = events;
   j["collisions"] = collisions;
   j["sim_time"] = integrator.time();

@@ -49,6 +49,10 @@ class ThermoOutput final : public Observer<D> {
   // the mean over the production rows where kinetic energy is exchanged or set
   // (Integrator::temperature_from_rows).
   double production_temperature(const Integrator<D>& integrator) const;
+  // Z over this invocation's production, as summary.json's `compressibility` gives it: the mean
+  // is the total virial over the total time, stderr and samples come from blocking the
+  // production rows' values (NaN mean without production time or at kT = 0).
+  BlockAverage production_compressibility(const Integrator<D>& integrator) const;
   const Thermodynamics& statistics() const { return *stats_; }
 
  private:
