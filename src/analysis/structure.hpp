@@ -1,10 +1,10 @@
 // Structure of a configuration of particles, averaged over samples (docs/physics.md#structure):
 //
 //   PairCorrelation       g(r) per species pair (Allen & Tildesley, Computer Simulation of
-//                         Liquids, 2nd ed. (2017), §2.6 and §8.2), with the contact values
+//                         Liquids, 2nd ed. (2017), §2.6 and chapter 8), with the contact values
 //                         g(σ⁺) and the compressibility factor they give by the contact theorem
 //   StructureFactor       S(k) = <|Σ_j exp(-i k·r_j)|²> / N on the box's wave vectors,
-//                         averaged over shells of |k| (Allen & Tildesley §2.6, §8.2)
+//                         averaged over shells of |k| (Allen & Tildesley §2.6)
 //   BondOrder             Steinhardt's q4, q6 (3D; Steinhardt, Nelson & Ronchetti, Phys. Rev. B
 //                         28, 784 (1983)) or ψ6 (2D; Halperin & Nelson, Phys. Rev. Lett. 41, 121
 //                         (1978); Nelson & Halperin, Phys. Rev. B 19, 2457 (1979)), local and
@@ -89,7 +89,7 @@ class PairCorrelation {
   // g(σ⁺) of pair p (samples = 0 where it has no contact distance).
   BlockAverage contact(std::size_t pair) const { return contact_value_[pair].result(); }
   // The contact theorem (hard spheres and disks; Hansen & McDonald, Theory of Simple Liquids,
-  // 4th ed. (2013), §2.5): Z = 1 + (2π/3) ρ Σ_ab x_a x_b σ_ab³ g_ab(σ⁺) in 3D,
+  // 4th ed. (2013)): Z = 1 + (2π/3) ρ Σ_ab x_a x_b σ_ab³ g_ab(σ⁺) in 3D,
   // 1 + (π/2) ρ Σ_ab x_a x_b σ_ab² g_ab(σ⁺) in 2D (ordered pairs; 4η g(σ⁺) and 2η g(σ⁺) for one
   // species). samples = 0 unless every pair has a contact distance.
   BlockAverage contact_compressibility() const { return contact_z_.result(); }

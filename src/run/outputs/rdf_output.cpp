@@ -33,12 +33,13 @@ void RdfOutput<D>::begin(const RunContext<D>& run) {
       const std::size_t p = species_pair_index(a, b, species);
       pair_names_[p] = names[a] + "-" + names[b];
       const double sigma = snapshot_->species_radius()[a] + snapshot_->species_radius()[b];
-      if (no_contact_.empty()) contact[p] = sigma;
+      const bool present = snapshot_->counts()[a] > 0 && snapshot_->counts()[b] > 0;
+      if (no_contact_.empty() && present) {
+        if (std::isnan(sigma)) no_contact_ = "the radii of a species differ";
+        contact[p] = sigma;
+      }
     }
   }
-  if (no_contact_.empty() &&
-      std::any_of(contact.begin(), contact.end(), [](double s) { return std::isnan(s); }))
-    no_contact_ = "the radii of a species differ";
   if (!no_contact_.empty()) std::fill(contact.begin(), contact.end(), std::nan(""));
   if (!no_contact_.empty()) {
     no_theorem_ = no_contact_;
@@ -122,9 +123,10 @@ void RdfOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>& run) 
     nlohmann::json& contact = j["contact"];
     for (std::size_t p = 0; p < pair_names_.size(); ++p) {
       const BlockAverage c = g.contact(p);
-      nlohmann::json entry = {{"sigma", g.contact_distance(p)}};
+      nlohmann::json entry;
       const std::string name = "analysis.rdf.contact." + pair_names_[p];
       const std::string none = c.samples == 0 ? "no pair of this species pair" : "";
+      set_or_explain(summary, entry, "sigma", g.contact_distance(p), none, name + ".sigma");
       set_or_explain(summary, entry, "g", c.mean, none, name + ".g");
       set_or_explain(summary, entry, "stderr", c.stderr_, none.empty() ? few : none,
                      name + ".stderr");
