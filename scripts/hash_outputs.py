@@ -7,7 +7,8 @@ continued, a run that is resumed with changed physics, profiles), with the given
 binary, and prints one SHA-256 per case over what a refactor must not change: the exact state
 of restart.gsd (every kairos/state chunk, positions, velocities, time, counters; not the run's
 bookkeeping such as the stored configuration or the checksum, the run's id and
-stored configuration), every chunk of every trajectory frame, thermo.tsv, profile.tsv, and
+stored configuration), every chunk of every trajectory frame, thermo.tsv, profile.tsv, the
+structure analyses' files (rdf.tsv, sk.tsv, bond_order.tsv, velocity_distribution.tsv), and
 every value of summary.json except the timings, the memory figures and the run id. A case whose
 run fails is reported as FAILED (and the script exits with status 1). Compare two builds with
 
@@ -67,6 +68,10 @@ EXTRA = [
     ("continued_shear", "examples/shear_flow_2d.toml", None, [], []),
     ("continued_vibrated", "examples/vibrated_bed_2d.toml", None, [], []),
     ("continued_dem", "examples/dem_pile_3d.toml", None, [], []),
+    # The structure analyses of a continued run (its averages start afresh), with their own
+    # interval in the continuation.
+    ("continued_structure", "examples/hard_spheres_structure.toml", None,
+     ["system.particles=500"], ["analysis.interval=0.5"]),
     ("repredicted_pile_gravity", "examples/granular_pile_3d.toml", None, [],
      ["field.gravity=[0.0, 0.0, -2.0]"]),
     ("profile_vibrated", "examples/vibrated_bed_3d.toml", None, ['output.profile_axis="z"'],
@@ -124,7 +129,8 @@ def hash_outputs(out, h):
     traj = os.path.join(out, "trajectory.gsd")
     if os.path.exists(traj):
         hash_trajectory(traj, h)
-    for name in ("thermo.tsv", "profile.tsv"):
+    for name in ("thermo.tsv", "profile.tsv", "rdf.tsv", "sk.tsv", "bond_order.tsv",
+                 "velocity_distribution.tsv"):
         path = os.path.join(out, name)
         if os.path.exists(path):
             with open(path, "rb") as f:
