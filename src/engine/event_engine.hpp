@@ -44,6 +44,7 @@
 #include "engine/candidate_scan.hpp"
 #include "engine/cell_neighbourhood.hpp"
 #include "engine/hot_record.hpp"
+#include "engine/image_counters.hpp"
 #include "engine/pair_steps.hpp"
 #include "engine/resting_particles.hpp"
 #include "engine/soft_contact_state.hpp"
@@ -95,6 +96,9 @@ struct EngineOptions {
   // keep the soonest contact its last prediction found beyond the crossing (not under shear or
   // with steps). Same physics; false rescans every neighbour (for comparison).
   bool incremental_crossings = true;
+  // Keep image counters (engine/image_counters.hpp: 4 D bytes per particle) so that exported
+  // states can be unwrapped; a state that carries counters keeps them either way.
+  bool track_images = false;
   // Needs vector_scan (and AVX-512) for kVector.
   ListGather list_gather = ListGather::kAuto;
   // Used by the AVX-512 loops only.
@@ -460,7 +464,8 @@ class EventEngine {
 
   Boundaries<D> boundaries_;  // every wall (model/boundaries.hpp: the face walls so far)
   LeesEdwards<D> shear_;      // Lees-Edwards images (boundaries/lees_edwards.hpp)
-  Environment<D> env_;        // last: the hot members above share fewer cache lines
+  Environment<D> env_;        // the hot members above share fewer cache lines
+  ImageCounters<D> images_;   // cold: written at wraps, read at export
 };
 
 // Small members every event path uses, visible to each of the engine's files.

@@ -120,6 +120,7 @@ void EventEngine<D, Queue>::size_particle_arrays(ParticleSystem<D>& out, std::si
   out.events.resize(n);
   out.cell.resize(n);
   out.asleep.assign(resting_.count() > 0 ? n : 0, 0);
+  out.image.resize(images_.on() ? n : 0);
   out.angular_velocity.resize(spin_.empty() ? 0 : n);
   out.last_collision_time.resize(last_collision_.empty() ? 0 : n);
 }
@@ -136,6 +137,7 @@ void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
     if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
       out.kinematics[c] = {position(k, time_), frozen_velocity_of(k), time_, sh.radius};
     if (resting_.count() > 0) out.asleep[c] = resting_.flag(k);
+    if (images_.on()) out.image[c] = images_.of(k);
   }
   if ((fields & Blocks::kIdentity) != 0) {
     out.mass[c] = sh.mass;
