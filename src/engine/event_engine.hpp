@@ -156,6 +156,10 @@ class EventEngine {
   // resumed from it continues bit-identically. Without zones (stepped potentials' capture map,
   // the costly part), enough for outputs but not for a resume.
   ParticleSystem<D> export_state(bool with_zones = true) const;
+  // Unwrapped positions now (position + image * box; needs track_images) of the particles with
+  // slot[id] != kNotFollowed (id: the caller's number), into out[slot[id]].
+  static constexpr std::uint32_t kNotFollowed = ~0u;
+  void unwrapped_positions(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const;
   // The same state read in blocks of particles: outputs of a large system without a copy of
   // the whole state (4 bytes per particle, the caller's numbering's map to the engine's). Valid
   // until the engine changes.

@@ -4,6 +4,7 @@
 // engine only through these (docs/architecture.md).
 #include <algorithm>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "core/periodic.hpp"
@@ -154,6 +155,19 @@ void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
     const PendingEvent& e = pending_[k];
     const Code code = e.code.renumbered([&](std::uint32_t p) { return id_[p]; });
     out.events[c] = {queue_.time_of(k), code.bits(), e.partner_count};
+  }
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::unwrapped_positions(const std::vector<std::uint32_t>& slot,
+                                                std::vector<Vec<D>>& out) const {
+  if (!images_.on()) throw std::logic_error("unwrapped_positions: images are not tracked");
+  for (std::uint32_t k = 0; k < size(); ++k) {
+    const std::uint32_t s = slot[id_[k]];
+    if (s == kNotFollowed) continue;
+    Vec<D> x = position(k, time_);
+    for (int a = 0; a < D; ++a) x[a] += images_.of(k)[a] * box_[a];
+    out[s] = x;
   }
 }
 

@@ -145,6 +145,21 @@ struct OutputConfig {
   bool operator==(const OutputConfig&) const = default;
 };
 
+// [analysis]: analyses of the production (docs/outputs.md), each written at the end to its own
+// file and to summary.json.
+struct AnalysisConfig {
+  // msd.tsv: the mean-square displacement on log-spaced lags (analysis/msd.hpp), sampled every
+  // msd_interval of simulated time (0: automatic), of msd_particles particles at most; D fitted
+  // over lags [msd_fit_from, msd_fit_to] (0: automatic).
+  bool msd = false;
+  double msd_interval = 0.0;
+  std::int64_t msd_particles = 10000;
+  double msd_fit_from = 0.0;
+  double msd_fit_to = 0.0;
+
+  bool operator==(const AnalysisConfig&) const = default;
+};
+
 // Stochastic driving: random events at `rate` per particle per unit time, each acting on one
 // random particle. andersen: a new Maxwell-Boltzmann velocity at `temperature` (a thermostat);
 // white_noise: a Gaussian velocity kick whose variance per component is strength / rate, so
@@ -235,6 +250,7 @@ struct Config {
   FieldConfig field;               // [field]
   DrivingConfig driving;           // [driving]
   SoftConfig soft;                 // [soft]
+  AnalysisConfig analysis;         // [analysis]
 
   bool operator==(const Config&) const = default;  // memberwise (exact doubles)
 };

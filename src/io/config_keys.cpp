@@ -434,6 +434,39 @@ constexpr KeyDecl kOutput[] = {
      .doc = "slabs of the profile"},
 };
 
+// ----- [analysis]
+
+const AnalysisConfig kAnalysisDefaults{};
+constexpr KeyDecl kAnalysis[] = {
+    {.name = "msd",
+     .type = KeyType::kBoolean,
+     .member = field<&AnalysisConfig::msd>,
+     .doc = "msd.tsv: mean-square displacement per species, self-diffusion coefficients"},
+    {.name = "msd_interval",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::msd_interval>,
+     .range = up_to(1e9, Scale::kTime),
+     .unit = "time",
+     .doc = "between MSD samples, in simulated time (0: half the estimated mean free time)"},
+    {.name = "msd_particles",
+     .type = KeyType::kInteger,
+     .member = field<&AnalysisConfig::msd_particles>,
+     .range = counted,
+     .doc = "particles the MSD follows (evenly by number; all when fewer)"},
+    {.name = "msd_fit_from",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::msd_fit_from>,
+     .range = up_to(1e9, Scale::kTime),
+     .unit = "time",
+     .doc = "shortest lag of the diffusion fit (0: automatic)"},
+    {.name = "msd_fit_to",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::msd_fit_to>,
+     .range = up_to(1e9, Scale::kTime),
+     .unit = "time",
+     .doc = "longest lag of the diffusion fit (0: automatic)"},
+};
+
 // ----- [[potential]], [[bond]]
 
 bool is_spring_dashpot(const void* p) {
@@ -756,6 +789,7 @@ constexpr KeyGroup kPotentialGroup{"potential", kPotential, &kPotentialDefaults}
 constexpr KeyGroup kSpringDashpotGroup{"spring_dashpot", kSpringDashpot, &kPotentialDefaults};
 constexpr KeyGroup kSoftLawGroup{"soft law", kSoftLaw, &kSoftLawDefaults};
 constexpr KeyGroup kSoftGroup{"soft", kSoft, &kSoftDefaults};
+constexpr KeyGroup kAnalysisGroup{"analysis", kAnalysis, &kAnalysisDefaults};
 constexpr KeyGroup kPairSpeciesGroup{"pair", kPairSpecies, nullptr};
 constexpr KeyGroup kPotentialSpeciesGroup{"potential species", kPotentialSpecies, nullptr};
 constexpr KeyGroup kWallFaceGroup{"wall face", kWallFace, nullptr};
@@ -796,6 +830,7 @@ std::vector<DeclaredKey> build() {
       {"soft", KeyType::kTable, {{&kSoftGroup}, {&kSoftLawGroup}}},
       {"soft.pair", KeyType::kTableArray, {{&kPairSpeciesGroup}, {&kSoftLawGroup, "soft"}}},
       {"output", KeyType::kTable, {{&kOutputGroup}}},
+      {"analysis", KeyType::kTable, {{&kAnalysisGroup}}},
   };
   std::vector<DeclaredKey> out, last;
   for (const Placement& p : placements) {
@@ -944,6 +979,9 @@ const KeyGroup& soft_law_keys() {
 }
 const KeyGroup& soft_keys() {
   return kSoftGroup;
+}
+const KeyGroup& analysis_keys() {
+  return kAnalysisGroup;
 }
 
 std::string type_text(const KeyDecl& d) {

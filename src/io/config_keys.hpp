@@ -192,6 +192,7 @@ const KeyGroup& potential_keys();       // [[potential]] and [[bond]], after spe
 const KeyGroup& spring_dashpot_keys();  // [[potential]] with kind = "spring_dashpot"
 const KeyGroup& soft_law_keys();        // [soft] and [[soft.pair]]
 const KeyGroup& soft_keys();            // [soft] alone
+const KeyGroup& analysis_keys();        // [analysis]
 
 // How docs/config.md writes a key's type, default and range ("float", "`1.0`", "in [0, 1]").
 std::string type_text(const KeyDecl& decl);

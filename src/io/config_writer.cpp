@@ -155,6 +155,10 @@ std::string to_toml(const Config& config) {
   // interval_unit unless "" (a config built in code: the reader's default).
   out += table("run", run_keys(), &config.run);
   out += table("output", output_keys(), &config.output);
+  // Only when some key differs from its default: a run without analyses writes the file it
+  // wrote before [analysis] existed.
+  if (config.analysis != AnalysisConfig{})
+    out += table("analysis", analysis_keys(), &config.analysis);
   return out;
 }
 

@@ -82,7 +82,8 @@ Effect effect_of(const std::string& key) {
     return Effect::kRefuse;  // name, diameter, mass: the particles as stored
   }
   if (starts_with(k, "system.")) return Effect::kIgnore;
-  if (starts_with(k, "run.") || starts_with(k, "output.") || starts_with(k, "driving."))
+  if (starts_with(k, "run.") || starts_with(k, "output.") || starts_with(k, "driving.") ||
+      starts_with(k, "analysis."))
     return Effect::kResume;
   if (k == "contact.sleep_speed") return Effect::kRepredict;  // sleepers predict nothing
   if (starts_with(k, "contact.")) return Effect::kResume;

@@ -87,6 +87,9 @@ class Observer {
   // trajectory, 2 restart), so that a continued run keeps them; -1: not recorded (a continued
   // run counts the interval afresh from its start).
   virtual int schedule_slot() const { return -1; }
+  // Its interval is in simulated time whatever output.interval_unit says: an analysis that
+  // samples at regular times (a time correlator); the clock stops at its samples.
+  virtual bool samples_in_time() const { return false; }
   // Its bit in RunProgress::owed_outputs when a write of it failed (kOwedRow, kOwedFrame): a
   // continued run writes it first. 0: nothing owed (written again at the next trigger).
   virtual unsigned owed_bit() const { return 0; }
