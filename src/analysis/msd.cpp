@@ -8,10 +8,11 @@ namespace kairos {
 
 template <int D>
 MsdCorrelator<D>::MsdCorrelator(std::vector<std::uint32_t> group, std::uint32_t groups,
-                                double interval, int max_levels)
+                                double interval, Statistic statistic, int max_levels)
     : group_(std::move(group)),
       groups_(groups),
       interval_(interval),
+      statistic_(statistic),
       max_levels_(max_levels),
       group_size_(static_cast<std::size_t>(groups) * kSubsets, 0) {
   if (!(interval > 0.0)) throw std::invalid_argument("MsdCorrelator: interval must be > 0");
@@ -28,14 +29,19 @@ void MsdCorrelator<D>::correlate(Level& level, const std::vector<Vec<D>>& x, int
   for (int j = first_j; j < kPoints; ++j) {
     if (level.kept < static_cast<std::uint64_t>(j)) break;
     const std::size_t back = (level.kept - static_cast<std::uint64_t>(j)) % kPoints;
-    const Vec<D>* then = &level.ring[back * n];
+    const Vec<D>* then = j == 0 ? x.data() : &level.ring[back * n];
+    const bool product = statistic_ == Statistic::kProduct;
     double* s2 = &level.sum2[static_cast<std::size_t>(j) * per_j];
     double* s4 = &level.sum4[static_cast<std::size_t>(j) * per_j];
     for (std::size_t k = 0; k < n; ++k) {
       double r2 = 0.0;
       for (int a = 0; a < D; ++a) {
-        const double d = x[k][a] - then[k][a];
-        r2 += d * d;
+        if (product) {
+          r2 += x[k][a] * then[k][a];
+        } else {
+          const double d = x[k][a] - then[k][a];
+          r2 += d * d;
+        }
       }
       const std::size_t at = slot(group_[k], static_cast<int>(k % kSubsets));
       s2[at] += r2;
@@ -71,7 +77,7 @@ void MsdCorrelator<D>::add(const std::vector<Vec<D>>& position) {
       levels_.push_back(std::move(level));
     }
     Level& level = levels_[static_cast<std::size_t>(l)];
-    correlate(level, position, l == 0 ? 1 : kPoints / kRatio);
+    correlate(level, position, first_lag(l));
     std::copy(position.begin(), position.end(),
               level.ring.begin() + static_cast<std::ptrdiff_t>((level.kept % kPoints) * n));
     ++level.kept;
@@ -86,15 +92,15 @@ std::vector<typename MsdCorrelator<D>::Lag> MsdCorrelator<D>::lags() const {
   double spacing = 1.0;
   for (std::size_t l = 0; l < levels_.size(); ++l, spacing *= kRatio) {
     const Level& level = levels_[l];
-    for (int j = l == 0 ? 1 : kPoints / kRatio; j < kPoints; ++j) {
+    for (int j = first_lag(static_cast<int>(l)); j < kPoints; ++j) {
       const std::uint64_t origins = level.count[static_cast<std::size_t>(j)];
       if (origins == 0) continue;
       Lag lag;
       lag.lag = j * spacing * interval_;
       lag.origins = origins;
-      lag.msd.assign(groups_, 0.0);
+      lag.mean.assign(groups_, 0.0);
       lag.non_gaussian.assign(groups_, 0.0);
-      lag.subset_msd.assign(groups_, {});
+      lag.subset_mean.assign(groups_, {});
       const double* s2 = &level.sum2[static_cast<std::size_t>(j) * per_j];
       const double* s4 = &level.sum4[static_cast<std::size_t>(j) * per_j];
       for (std::uint32_t g = 0; g < groups_; ++g) {
@@ -102,7 +108,7 @@ std::vector<typename MsdCorrelator<D>::Lag> MsdCorrelator<D>::lags() const {
         for (int s = 0; s < kSubsets; ++s) {
           const std::size_t at = slot(g, s);
           const auto size = static_cast<double>(group_size_[at]);
-          lag.subset_msd[g][s] = size > 0 ? s2[at] / (size * static_cast<double>(origins)) : 0.0;
+          lag.subset_mean[g][s] = size > 0 ? s2[at] / (size * static_cast<double>(origins)) : 0.0;
           a2 += s2[at];
           a4 += s4[at];
           members += size;
@@ -110,8 +116,9 @@ std::vector<typename MsdCorrelator<D>::Lag> MsdCorrelator<D>::lags() const {
         if (members == 0) continue;
         const double m2 = a2 / (members * static_cast<double>(origins));
         const double m4 = a4 / (members * static_cast<double>(origins));
-        lag.msd[g] = m2;
-        lag.non_gaussian[g] = m2 > 0.0 ? D * m4 / ((D + 2.0) * m2 * m2) - 1.0 : 0.0;
+        lag.mean[g] = m2;
+        if (statistic_ == Statistic::kDisplacement)
+          lag.non_gaussian[g] = m2 > 0.0 ? D * m4 / ((D + 2.0) * m2 * m2) - 1.0 : 0.0;
       }
       out.push_back(std::move(lag));
     }
@@ -152,8 +159,8 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
     for (const Lag& lag : all) {
       if (lag.lag < from || lag.lag > to) continue;
       t.push_back(lag.lag);
-      y.push_back(lag.msd[g]);
-      for (int s = 0; s < kSubsets; ++s) ys[s].push_back(lag.subset_msd[g][s]);
+      y.push_back(lag.mean[g]);
+      for (int s = 0; s < kSubsets; ++s) ys[s].push_back(lag.subset_mean[g][s]);
     }
     if (t.size() < 3) continue;
     Diffusion d;
@@ -175,6 +182,43 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
     } else {
       d.stderr_ = std::nan("");
     }
+    out[g] = d;
+  }
+  return out;
+}
+
+template <int D>
+std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D>::green_kubo(
+    double to) const {
+  const std::vector<Lag> all = lags();
+  std::vector<std::optional<Diffusion>> out(groups_);
+  if (statistic_ != Statistic::kProduct) return out;
+  for (std::uint32_t g = 0; g < groups_; ++g) {
+    double total = 0.0;
+    std::array<double, kSubsets> part{};
+    int used_lags = 0;
+    for (std::size_t k = 1; k < all.size() && all[k].lag <= to; ++k) {
+      const double h = 0.5 * (all[k].lag - all[k - 1].lag);
+      total += h * (all[k].mean[g] + all[k - 1].mean[g]);
+      for (int s = 0; s < kSubsets; ++s)
+        part[s] += h * (all[k].subset_mean[g][s] + all[k - 1].subset_mean[g][s]);
+      ++used_lags;
+    }
+    if (used_lags < 2 || all.empty() || all[0].lag != 0.0) continue;
+    Diffusion d;
+    d.lags = used_lags + 1;
+    d.coefficient = total / D;
+    double sum = 0.0, squares = 0.0;
+    int used = 0;
+    for (int s = 0; s < kSubsets; ++s) {
+      if (group_size_[slot(g, s)] == 0) continue;
+      sum += part[s] / D;
+      squares += (part[s] / D) * (part[s] / D);
+      ++used;
+    }
+    d.stderr_ = used >= 2
+                    ? std::sqrt(std::max(0.0, (squares - sum * sum / used) / (used - 1)) / used)
+                    : std::nan("");
     out[g] = d;
   }
   return out;

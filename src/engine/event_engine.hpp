@@ -160,6 +160,8 @@ class EventEngine {
   // slot[id] != kNotFollowed (id: the caller's number), into out[slot[id]].
   static constexpr std::uint32_t kNotFollowed = ~0u;
   void unwrapped_positions(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const;
+  // Their velocities now, likewise.
+  void velocities(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const;
   // The same state read in blocks of particles: outputs of a large system without a copy of
   // the whole state (4 bytes per particle, the caller's numbering's map to the engine's). Valid
   // until the engine changes.

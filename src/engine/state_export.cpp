@@ -172,6 +172,15 @@ void EventEngine<D, Queue>::unwrapped_positions(const std::vector<std::uint32_t>
 }
 
 template <int D, class Queue>
+void EventEngine<D, Queue>::velocities(const std::vector<std::uint32_t>& slot,
+                                       std::vector<Vec<D>>& out) const {
+  for (std::uint32_t k = 0; k < size(); ++k) {
+    const std::uint32_t s = slot[id_[k]];
+    if (s != kNotFollowed) out[s] = velocity(k, time_);
+  }
+}
+
+template <int D, class Queue>
 std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
   std::vector<Vec<D>> out(size());
   for (std::uint32_t i = 0; i < size(); ++i) {

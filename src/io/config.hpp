@@ -156,6 +156,8 @@ struct AnalysisConfig {
   std::int64_t msd_particles = 10000;
   double msd_fit_from = 0.0;
   double msd_fit_to = 0.0;
+  // vacf.tsv: the velocity autocorrelation on the same lags, and D by Green-Kubo.
+  bool vacf = false;
 
   bool operator==(const AnalysisConfig&) const = default;
 };

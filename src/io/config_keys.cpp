@@ -465,6 +465,10 @@ constexpr KeyDecl kAnalysis[] = {
      .range = up_to(1e9, Scale::kTime),
      .unit = "time",
      .doc = "longest lag of the diffusion fit (0: automatic)"},
+    {.name = "vacf",
+     .type = KeyType::kBoolean,
+     .member = field<&AnalysisConfig::vacf>,
+     .doc = "vacf.tsv: velocity autocorrelation on the MSD's lags, D by Green-Kubo"},
 };
 
 // ----- [[potential]], [[bond]]

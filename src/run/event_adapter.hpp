@@ -58,6 +58,8 @@ class EventIntegrator : public Integrator<D> {
   // (engine/image_counters.hpp; the run keeps image counters when an analysis needs them).
   virtual void unwrapped_positions(const std::vector<std::uint32_t>& slot,
                                    std::vector<Vec<D>>& out) const = 0;
+  virtual void velocities(const std::vector<std::uint32_t>& slot,
+                          std::vector<Vec<D>>& out) const = 0;
   // Kinetic (translational and rotational) plus the stepped potentials' energy plus the
   // potential energy in the gravity field; NaN when the field has a component along a periodic
   // axis (unbounded there).
@@ -127,6 +129,9 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   void unwrapped_positions(const std::vector<std::uint32_t>& slot,
                            std::vector<Vec<D>>& out) const override {
     engine_.unwrapped_positions(slot, out);
+  }
+  void velocities(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const override {
+    engine_.velocities(slot, out);
   }
   double total_energy() const override;
 

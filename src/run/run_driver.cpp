@@ -283,8 +283,11 @@ template <int D>
 nlohmann::json RunDriver<D>::outputs_present() const {
   nlohmann::json list = nlohmann::json::array({"summary.json"});
   std::error_code ec;
-  for (const auto& o : observers_)
+  for (const auto& o : observers_) {
     if (o->writes_file() && fs::exists(directory() / o->name(), ec)) list.push_back(o->name());
+    for (const std::string& more : o->more_files())
+      if (fs::exists(directory() / more, ec)) list.push_back(more);
+  }
   if (fs::exists(directory() / "config.toml", ec)) list.push_back("config.toml");
   return list;
 }

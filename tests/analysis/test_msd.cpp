@@ -47,7 +47,7 @@ TEST(MsdCorrelator, EveryLagIsTheBruteForceAverageOverItsOrigins) {
     }
     EXPECT_EQ(lag.origins, origins) << "lag " << steps;
     for (int g = 0; g < 2; ++g)
-      EXPECT_NEAR(lag.msd[g], sum[g] / count[g], 1e-12 * lag.msd[g]) << "lag " << steps;
+      EXPECT_NEAR(lag.mean[g], sum[g] / count[g], 1e-12 * lag.mean[g]) << "lag " << steps;
   }
 }
 
@@ -65,7 +65,7 @@ TEST(MsdCorrelator, BallisticMotionGivesSpeedSquaredTimesLagSquared) {
     c.add(x);
   }
   for (const auto& lag : c.lags())
-    EXPECT_NEAR(lag.msd[0], v2 * lag.lag * lag.lag, 1e-9 * lag.msd[0]);
+    EXPECT_NEAR(lag.mean[0], v2 * lag.lag * lag.lag, 1e-9 * lag.mean[0]);
   // Lags reach beyond a tenth of the run with memory for a few levels only.
   EXPECT_GT(c.lags().back().lag, 0.1 * 5000 * 0.1);
   EXPECT_LT(c.bytes(), 20u * MsdCorrelator<2>::kPoints * n * sizeof(Vec<2>) + 100000u);
@@ -120,6 +120,67 @@ TEST(MsdCorrelator, ARandomWalkGivesBackItsDiffusionCoefficientWithinItsErrorBar
   EXPECT_LT(error, scatter * 1.7);
   // About 68 % inside one error bar: at least 8 of 20 (binomial, p = 0.68: P(< 8) < 0.1 %).
   EXPECT_GE(within, 8);
+}
+
+TEST(MsdCorrelator, ProductsAreTheBruteForceVelocityAutocorrelation) {
+  constexpr int n = 7, samples = 200;
+  std::mt19937_64 rng(8);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<std::vector<Vec<2>>> v(samples, std::vector<Vec<2>>(n));
+  for (int s = 0; s < samples; ++s)
+    for (int k = 0; k < n; ++k)
+      for (int a = 0; a < 2; ++a) v[s][k][a] = (s > 0 ? 0.9 * v[s - 1][k][a] : 0.0) + noise(rng);
+  using C = MsdCorrelator<2>;
+  C c(std::vector<std::uint32_t>(n, 0), 1, 1.0, C::Statistic::kProduct);
+  for (const auto& x : v) c.add(x);
+  const auto lags = c.lags();
+  ASSERT_EQ(lags.front().lag, 0.0);  // C(0) = <v^2>
+  for (const auto& lag : lags) {
+    const auto steps = static_cast<int>(std::lround(lag.lag));
+    int spacing = 1;
+    while (steps / spacing >= C::kPoints) spacing *= C::kRatio;
+    double sum = 0.0;
+    int count = 0;
+    for (int s = steps; s < samples; s += 1) {
+      if (s % spacing != 0) continue;
+      for (int k = 0; k < n; ++k) {
+        sum += v[s][k][0] * v[s - steps][k][0] + v[s][k][1] * v[s - steps][k][1];
+        ++count;
+      }
+    }
+    EXPECT_NEAR(lag.mean[0], sum / count, 1e-12 * std::abs(sum / count) + 1e-14) << steps;
+  }
+}
+
+TEST(MsdCorrelator, GreenKuboOfAnOrnsteinUhlenbeckVelocityGivesItsDiffusionCoefficient) {
+  // v(t + dt) = phi v(t) + noise: <v_x(t) v_x(0)> = s2 phi^(t / dt), s2 = q / (1 - phi^2), and
+  // D = s2 dt (1 / 2 + phi / (1 - phi)) exactly for the trapezoid rule on the sample grid; the
+  // log-spaced lags beyond 7 samples add a small quadrature error (here < 1 %).
+  constexpr int n = 300, samples = 6000;
+  const double phi = 0.95, q = 0.1, dt = 0.1;
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> noise(0.0, std::sqrt(q));
+  using C = MsdCorrelator<3>;
+  C c(std::vector<std::uint32_t>(n, 0), 1, dt, C::Statistic::kProduct);
+  const double s2 = q / (1.0 - phi * phi);
+  std::normal_distribution<double> start(0.0, std::sqrt(s2));
+  std::vector<Vec<3>> v(n);
+  for (auto& w : v)
+    for (int a = 0; a < 3; ++a) w[a] = start(rng);
+  for (int s = 0; s < samples; ++s) {
+    c.add(v);
+    for (auto& w : v)
+      for (int a = 0; a < 3; ++a) w[a] = phi * w[a] + noise(rng);
+  }
+  const double exact = s2 * dt * (0.5 + phi / (1.0 - phi));
+  const auto d = c.green_kubo(200.0 * dt);
+  ASSERT_TRUE(d[0].has_value());
+  EXPECT_LT(d[0]->stderr_, 0.05 * exact);
+  EXPECT_NEAR(d[0]->coefficient, exact, 3.0 * d[0]->stderr_ + 0.01 * exact);
+  // Displacements give no Green-Kubo integral.
+  C msd(std::vector<std::uint32_t>(n, 0), 1, dt);
+  msd.add(v);
+  EXPECT_FALSE(msd.green_kubo(1.0)[0].has_value());
 }
 
 }  // namespace

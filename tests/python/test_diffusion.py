@@ -1,6 +1,6 @@
 """Self-diffusion from the mean-square displacement ([analysis] msd = true) end to end: a dilute
-hard-sphere gas against the Chapman-Enskog coefficient, the ballistic short-time limit, the
-unwrapped trajectory against msd.tsv, and the input errors.
+hard-sphere gas against the Chapman-Enskog coefficient, Green-Kubo (vacf = true) against Einstein,
+the ballistic short-time limit, the unwrapped trajectory against msd.tsv, and the input errors.
 """
 
 import json
@@ -32,7 +32,8 @@ class Diffusion(kt.KairosTestCase):
         eta = 0.01
         config = kt.base_config(particles=2000, packing_fraction=eta, lattice="random", seed=3,
                                 equilibration=10.0, production=400.0,
-                                output={"trajectory": False}, analysis={"msd": True})
+                                output={"trajectory": False},
+                                analysis={"msd": True, "vacf": True})
         out = self.path("dilute")
         self.run_ok("run", self.write_config(config), "-o", out)
         d = self.summary(out)["diffusion"]
@@ -43,6 +44,16 @@ class Diffusion(kt.KairosTestCase):
         self.assertLess(err, 0.05)  # the measurement means something
         # Finite size (Yeh-Hummer, ~0.2 % here) and the fit window: 2 % beside the statistics.
         self.assertAlmostEqual(fit["coefficient"] / reference, 1.0, delta=3 * err + 0.02)
+        # Green-Kubo from the velocity autocorrelation: the same coefficient.
+        gk, gk_err = fit["green_kubo_coefficient"], fit["green_kubo_coefficient_stderr"]
+        both = math.hypot(gk_err, fit["coefficient_stderr"])
+        self.assertLess(gk_err / reference, 0.1)
+        self.assertAlmostEqual(gk, fit["coefficient"], delta=3 * both + 0.02 * reference)
+        header, rows = read_msd(os.path.join(out, "vacf.tsv"))
+        self.assertEqual(header[:4], ["lag", "origins", "vacf_A", "integral_A"])
+        self.assertEqual(rows[0, 0], 0.0)
+        self.assertAlmostEqual(rows[0, 2] / (3 * self.summary(out)["temperature"]), 1.0, delta=0.05)
+        self.assertIn("vacf.tsv", self.summary(out)["outputs"])
         self.assertGreater(d["samples"], 100)
         self.assertEqual(d["particles_followed"], 2000)
 

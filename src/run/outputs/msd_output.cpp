@@ -66,7 +66,9 @@ MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
 
 template <int D>
 void MsdOutput<D>::production_starts(const RunContext<D>&) {
-  correlator_.emplace(group_, static_cast<std::uint32_t>(species_names_.size()), interval_);
+  const auto groups = static_cast<std::uint32_t>(species_names_.size());
+  correlator_.emplace(group_, groups, interval_);
+  if (config_.vacf) vacf_.emplace(group_, groups, interval_, MsdCorrelator<D>::Statistic::kProduct);
   start_time_ = engine_.time();
   start_collisions_ = engine_.collisions();
 }
@@ -79,6 +81,10 @@ void MsdOutput<D>::write(const RunContext<D>& run) {
   if (correlator_->samples() == 0) first_sample_ = engine_.time();
   last_sample_ = engine_.time();
   correlator_->add(sample_);
+  if (vacf_) {
+    engine_.velocities(slot_, sample_);
+    vacf_->add(sample_);
+  }
 }
 
 template <int D>
@@ -110,10 +116,29 @@ void MsdOutput<D>::close(const RunContext<D>& run, bool) {
   for (const auto& lag : correlator_->lags()) {
     text += fmt::format("{:.10g}\t{}", lag.lag, lag.origins);
     for (std::size_t g = 0; g < species_names_.size(); ++g)
-      text += fmt::format("\t{:.10g}\t{:.6g}", lag.msd[g], lag.non_gaussian[g]);
+      text += fmt::format("\t{:.10g}\t{:.6g}", lag.mean[g], lag.non_gaussian[g]);
     text += "\n";
   }
   write_text_atomically(run.directory() / name(), text);
+  if (!vacf_) return;
+  // The velocity autocorrelation and its running Green-Kubo integral (1/d) int_0^lag.
+  text = "lag\torigins";
+  for (const std::string& s : species_names_) text += fmt::format("\tvacf_{0}\tintegral_{0}", s);
+  text += "\n";
+  const auto lags = vacf_->lags();
+  std::vector<double> integral(species_names_.size(), 0.0);
+  for (std::size_t k = 0; k < lags.size(); ++k) {
+    text += fmt::format("{:.10g}\t{}", lags[k].lag, lags[k].origins);
+    for (std::size_t g = 0; g < species_names_.size(); ++g) {
+      if (k > 0) {
+        integral[g] +=
+            0.5 * (lags[k].lag - lags[k - 1].lag) * (lags[k].mean[g] + lags[k - 1].mean[g]) / D;
+      }
+      text += fmt::format("\t{:.10g}\t{:.10g}", lags[k].mean[g], integral[g]);
+    }
+    text += "\n";
+  }
+  write_text_atomically(run.directory() / "vacf.tsv", text);
 }
 
 template <int D>
@@ -123,7 +148,7 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
   d["interval_automatic"] = automatic_interval_;
   d["particles_followed"] = group_.size();
   d["samples"] = correlator_ ? correlator_->samples() : 0;
-  d["memory_bytes"] = correlator_ ? correlator_->bytes() : 0;
+  d["memory_bytes"] = (correlator_ ? correlator_->bytes() : 0) + (vacf_ ? vacf_->bytes() : 0);
   d["sampled_from"] = first_sample_;
   d["sampled_to"] = last_sample_;
   const double mft = mean_free_time();
@@ -132,6 +157,10 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
   d["fit_from"] = from;
   d["fit_to"] = to;
   nlohmann::json species = nlohmann::json::object();
+  const auto gk =
+      vacf_
+          ? vacf_->green_kubo(to)
+          : std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>>(species_names_.size());
   const auto fits =
       correlator_
           ? correlator_->diffusion(from, to)
@@ -149,6 +178,11 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
           "fewer than 3 lags in the fit window [{:.4g}, {:.4g}]: the production is too short "
           "for the diffusive regime (or set analysis.msd_fit_from / msd_fit_to)",
           from, to);
+    }
+    if (g < gk.size() && gk[g]) {
+      s["green_kubo_coefficient"] = gk[g]->coefficient;
+      s["green_kubo_coefficient_stderr"] =
+          std::isfinite(gk[g]->stderr_) ? nlohmann::json(gk[g]->stderr_) : nullptr;
     }
     species[species_names_[g]] = s;
   }

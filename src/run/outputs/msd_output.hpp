@@ -1,7 +1,7 @@
-// msd.tsv and summary.json's `diffusion` (analysis.msd): the mean-square displacement of the
-// unwrapped positions (engine/image_counters.hpp) on log-spaced lags with many time origins
-// (analysis/msd.hpp), sampled at regular simulated times during the production, and each
-// species' self-diffusion coefficient from its long-time slope (docs/outputs.md).
+// msd.tsv, vacf.tsv (analysis.vacf) and summary.json's `diffusion` (analysis.msd): the mean-square
+// displacement of the unwrapped positions (engine/image_counters.hpp) on log-spaced lags with many
+// time origins (analysis/msd.hpp), sampled at regular simulated times during the production, and
+// each species' self-diffusion coefficient from its long-time slope (docs/outputs.md).
 #pragma once
 
 #include <memory>
@@ -20,6 +20,9 @@ class MsdOutput final : public Observer<D> {
  public:
   MsdOutput(const Config& config, const EventIntegrator<D>& engine);
   std::string name() const override { return "msd.tsv"; }
+  std::vector<std::string> more_files() const override {
+    return config_.vacf ? std::vector<std::string>{"vacf.tsv"} : std::vector<std::string>{};
+  }
   bool samples_in_time() const override { return true; }
   double interval(const Config&, double) const override { return interval_; }
   void production_starts(const RunContext<D>& run) override;
@@ -42,6 +45,7 @@ class MsdOutput final : public Observer<D> {
   std::vector<std::string> species_names_;
   std::vector<Vec<D>> sample_;
   std::optional<MsdCorrelator<D>> correlator_;
+  std::optional<MsdCorrelator<D>> vacf_;  // analysis.vacf
   double first_sample_ = 0.0, last_sample_ = 0.0;
   double start_time_ = 0.0;
   std::uint64_t start_collisions_ = 0;

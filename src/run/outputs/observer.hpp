@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -78,6 +79,8 @@ class Observer {
   // Whether name() is a file in the output directory (summary.json's "outputs" lists those
   // that exist at the end); false for parts of summary.json and other analyses.
   virtual bool writes_file() const { return true; }
+  // Other files it writes in the output directory (listed in summary.json's "outputs" too).
+  virtual std::vector<std::string> more_files() const { return {}; }
   // Its interval in collisions per particle or in simulated time (output.interval_unit), given
   // the production's length in that unit; 0: no trigger (write() is never called).
   virtual double interval(const Config& /*config*/, double /*production_length*/) const {
