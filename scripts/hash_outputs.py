@@ -20,7 +20,8 @@ or against the stored hashes of the last accepted build with
 `scripts/hash_outputs.py build/kairos --check scripts/output_hashes.txt` (regenerate that file
 with `> scripts/output_hashes.txt` when a change of the outputs is intended, and say so in the
 commit). Run from anywhere; takes a minute. `--only SUBSTRING` runs the cases whose name
-contains it. Use /usr/bin/python3 (python3-gsd).
+contains it; `--skip-chunk NAME` (repeatable) leaves a chunk out of every hash, to show that a
+change which adds chunks leaves all the others identical. Use /usr/bin/python3 (python3-gsd).
 """
 
 import glob
@@ -42,7 +43,10 @@ SHORT = ["run.equilibration_collisions_per_particle=1", "run.collisions_per_part
 SMALLER = {"granular_clustering_2d.toml": ["system.particles=20000"]}
 # Restart chunks that are the run's bookkeeping rather than its state: the run's id, the stored
 # configuration (it names the output directory), the checksum over both.
-RESTART_SKIPPED = ("kairos/run/id", "kairos/run/config", "kairos/checksum")
+RESTART_SKIPPED = ["kairos/run/id", "kairos/run/config", "kairos/checksum"]
+# Chunks left out of every hash (--skip-chunk NAME, repeatable): to show that a change which
+# adds chunks leaves every other one identical before the stored hashes are renewed.
+SKIPPED_CHUNKS = []
 # summary.json keys that differ between two runs of one binary, or that a layout change may
 # move without changing a trajectory (the engine's own bytes per particle).
 VOLATILE = {"wall_seconds", "collisions_per_second", "events_per_second", "steps_per_second",
@@ -101,7 +105,9 @@ def hash_restart(path, h):
     with gsd.fl.open(name=path, mode="rb") as f:
         frame = f.nframes - 1
         for name in sorted(f.find_matching_chunk_names("kairos/")):
-            if name not in RESTART_SKIPPED and f.chunk_exists(frame=frame, name=name):
+            if name in RESTART_SKIPPED or name in SKIPPED_CHUNKS:
+                continue
+            if f.chunk_exists(frame=frame, name=name):
                 h.update(name.encode())
                 h.update(f.read_chunk(frame=frame, name=name).tobytes())
 
@@ -111,7 +117,7 @@ def hash_trajectory(path, h):
         names = sorted(f.find_matching_chunk_names(""))
         for frame in range(f.nframes):
             for name in names:
-                if f.chunk_exists(frame=frame, name=name):
+                if name not in SKIPPED_CHUNKS and f.chunk_exists(frame=frame, name=name):
                     h.update(name.encode())
                     h.update(f.read_chunk(frame=frame, name=name).tobytes())
 
@@ -167,6 +173,10 @@ def main():
     if "--only" in args:
         k = args.index("--only")
         only = args[k + 1]
+        del args[k:k + 2]
+    while "--skip-chunk" in args:
+        k = args.index("--skip-chunk")
+        SKIPPED_CHUNKS.append(args[k + 1])
         del args[k:k + 2]
     if "--check" in args:
         k = args.index("--check")

@@ -171,6 +171,10 @@ struct ParticleSystem {
   std::array<bool, D> periodic = all_periodic();
   // Sleeping particles (empty: none) rest where they are and feel no gravity.
   std::vector<std::uint8_t> asleep;
+  // Image counters (empty: not tracked): the unwrapped position at a particle's local time is
+  // kinematics.pos + image * box on the periodic axes (under Lees-Edwards shear, x also adds
+  // image[1] * shear_rate * L_y * t: engine/image_counters.hpp).
+  std::vector<std::array<std::int32_t, D>> image;
   // Molecules: the bonds (topology, not scheduler state) and the names of their types.
   std::vector<Bond> bonds;
   std::vector<std::string> bond_types;

@@ -18,7 +18,7 @@ struct StateBlocks {
   // Which per-particle arrays a reader needs (fill may leave the others unset): a chunk of
   // positions need not read the scheduler's arrays.
   enum Fields : unsigned {
-    kKinematics = 1,  // kinematics, asleep
+    kKinematics = 1,  // kinematics, asleep, image
     kIdentity = 2,    // mass, species
     kScheduler = 4,   // collision_count, events, cell, order
     kExtras = 8,      // angular_velocity, last_collision_time
@@ -60,6 +60,7 @@ struct StateBlocks {
       range(whole.cell, out.cell);
       range(whole.order, out.order);
       range(whole.asleep, out.asleep);
+      range(whole.image, out.image);
       range(whole.angular_velocity, out.angular_velocity);
       range(whole.last_collision_time, out.last_collision_time);
     };

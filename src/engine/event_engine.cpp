@@ -101,6 +101,10 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
     if (!s.angular_velocity.empty())
       for (std::uint32_t k = 0; k < n; ++k) spin_[k] = s.angular_velocity[id_[k]];
   }
+  if (options_.track_images || !s.image.empty()) {
+    images_ = ImageCounters<D>(n);
+    images_.restore(s.image, id_);
+  }
   // Sleepers predict no events of their own, so a wall moving along its normal (vibrating or a
   // piston) could move into one unseen: then nothing sleeps (resting piles need the TC model).
   const bool moving = boundaries_.any_surface_moves();
@@ -157,8 +161,12 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   } else {
     for (std::uint32_t k = 0; k < n; ++k) {
       advance_to(k, time_);
-      for (int a = 0; a < D; ++a)
-        if (cells_.grid().periodic(a)) hot_[k].pos[a] = wrap_into_box(hot_[k].pos[a], box_[a]);
+      for (int a = 0; a < D; ++a) {
+        if (!cells_.grid().periodic(a)) continue;
+        const double x = hot_[k].pos[a];
+        hot_[k].pos[a] = wrap_into_box(x, box_[a]);
+        if (images_.on()) images_.wrapped(k, a, x, hot_[k].pos[a], box_[a]);
+      }
       hot_[k].cell = cells_.grid().locate(hot_[k].pos);
       if (walls_ && !(soft_ && soft_state_.partner(k) != kNoPartner))  // a soft contact: pressed in
         boundaries_.check_start(hot_[k].pos, radius_of(k), time_, id_[k]);
@@ -358,6 +366,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(kind_);  // its spare last entry stays
   permute(spin_);
   permute(last_collision_);
+  images_.permute(order, done);
   resting_.permute(order, done);
   soft_state_.permute(order, done);
   cells_.insert_all(hot_.data(), static_cast<std::uint32_t>(size()));
@@ -734,10 +743,12 @@ void EventEngine<D, Queue>::cross(std::uint32_t i, double t) {
   } else if (c[x.axis] < 0) {
     c[x.axis] += cells_.grid().cells_along(x.axis);
     h.pos[x.axis] += box_[x.axis];
+    if (images_.on()) images_.wrapped(i, x.axis, 1);
     if (sheared_ && x.axis == 1) cross_shear_face(i, -1, t, c);
   } else if (c[x.axis] >= cells_.grid().cells_along(x.axis)) {
     c[x.axis] -= cells_.grid().cells_along(x.axis);
     h.pos[x.axis] -= box_[x.axis];
+    if (images_.on()) images_.wrapped(i, x.axis, -1);
     if (sheared_ && x.axis == 1) cross_shear_face(i, 1, t, c);
   }
   const CellCode entered = cells_.grid().code_at(c);
@@ -844,7 +855,7 @@ double EventEngine<D, Queue>::bytes_per_particle() const {
       static_cast<double>(kinds_.size() * sizeof(ParticleKind)) / static_cast<double>(size());
   return static_cast<double>(sizeof(HotRecord<D>) + sizeof(PendingEvent) + sizeof(std::uint32_t) +
                              (kind_.empty() ? 0 : sizeof(std::uint16_t))) +
-         kinds + cells_.grid().bytes_per_particle() +
+         kinds + cells_.grid().bytes_per_particle() + images_.bytes_per_particle() +
          static_cast<double>(queue_.bytes_per_particle());
 }
 

@@ -44,6 +44,7 @@
 #include "engine/candidate_scan.hpp"
 #include "engine/cell_neighbourhood.hpp"
 #include "engine/hot_record.hpp"
+#include "engine/image_counters.hpp"
 #include "engine/pair_steps.hpp"
 #include "engine/resting_particles.hpp"
 #include "engine/soft_contact_state.hpp"
@@ -95,6 +96,9 @@ struct EngineOptions {
   // keep the soonest contact its last prediction found beyond the crossing (not under shear or
   // with steps). Same physics; false rescans every neighbour (for comparison).
   bool incremental_crossings = true;
+  // Keep image counters (engine/image_counters.hpp: 4 D bytes per particle) so that exported
+  // states can be unwrapped; a state that carries counters keeps them either way.
+  bool track_images = false;
   // Needs vector_scan (and AVX-512) for kVector.
   ListGather list_gather = ListGather::kAuto;
   // Used by the AVX-512 loops only.
@@ -152,6 +156,12 @@ class EventEngine {
   // resumed from it continues bit-identically. Without zones (stepped potentials' capture map,
   // the costly part), enough for outputs but not for a resume.
   ParticleSystem<D> export_state(bool with_zones = true) const;
+  // Unwrapped positions now (position + image * box; needs track_images) of the particles with
+  // slot[id] != kNotFollowed (id: the caller's number), into out[slot[id]].
+  static constexpr std::uint32_t kNotFollowed = ~0u;
+  void unwrapped_positions(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const;
+  // Their velocities now, likewise.
+  void velocities(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const;
   // The same state read in blocks of particles: outputs of a large system without a copy of
   // the whole state (4 bytes per particle, the caller's numbering's map to the engine's). Valid
   // until the engine changes.
@@ -460,7 +470,8 @@ class EventEngine {
 
   Boundaries<D> boundaries_;  // every wall (model/boundaries.hpp: the face walls so far)
   LeesEdwards<D> shear_;      // Lees-Edwards images (boundaries/lees_edwards.hpp)
-  Environment<D> env_;        // last: the hot members above share fewer cache lines
+  Environment<D> env_;        // the hot members above share fewer cache lines
+  ImageCounters<D> images_;   // cold: written at wraps, read at export
 };
 
 // Small members every event path uses, visible to each of the engine's files.

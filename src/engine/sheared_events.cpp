@@ -122,7 +122,11 @@ void EventEngine<D, Queue>::cross_shear_face(std::uint32_t i, int side, double t
                                              std::array<int, D>& c) {
   HotRecord<D>& h = hot_[i];
   const double ke = norm2(h.vel);
+  const double x = h.pos[0];
   c[0] = shear_.cross_face(h.pos, h.vel, side, t, cells_.grid());
+  // The x shift by the images' whole displacement, less the boxes it was wrapped by
+  // (engine/image_counters.hpp: the lab-frame unwrapped x stays continuous).
+  if (images_.on()) images_.wrapped(i, 0, x - side * shear_.image_speed() * t, h.pos[0], box_[0]);
   counters_.work_by_shear += 0.5 * mass_of(i) * (norm2(h.vel) - ke);
 }
 

@@ -159,8 +159,12 @@ CollisionMap EventEngine<D, Queue>::soft_map(const SoftMapTable* table,
 template <int D, class Queue>
 void EventEngine<D, Queue>::relocate(std::uint32_t i) {
   HotRecord<D>& h = hot_[i];
-  for (int a = 0; a < D; ++a)
-    if (cells_.grid().periodic(a)) h.pos[a] = wrap_into_box(h.pos[a], box_[a]);
+  for (int a = 0; a < D; ++a) {
+    if (!cells_.grid().periodic(a)) continue;
+    const double x = h.pos[a];
+    h.pos[a] = wrap_into_box(x, box_[a]);
+    if (images_.on()) images_.wrapped(i, a, x, h.pos[a], box_[a]);
+  }
   const CellCode c = cells_.grid().locate(h.pos);
   if (c == h.cell) return;
   cells_.move(i, h.cell, c);

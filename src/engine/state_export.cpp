@@ -4,6 +4,7 @@
 // engine only through these (docs/architecture.md).
 #include <algorithm>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "core/periodic.hpp"
@@ -120,6 +121,7 @@ void EventEngine<D, Queue>::size_particle_arrays(ParticleSystem<D>& out, std::si
   out.events.resize(n);
   out.cell.resize(n);
   out.asleep.assign(resting_.count() > 0 ? n : 0, 0);
+  out.image.resize(images_.on() ? n : 0);
   out.angular_velocity.resize(spin_.empty() ? 0 : n);
   out.last_collision_time.resize(last_collision_.empty() ? 0 : n);
 }
@@ -136,6 +138,7 @@ void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
     if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
       out.kinematics[c] = {position(k, time_), frozen_velocity_of(k), time_, sh.radius};
     if (resting_.count() > 0) out.asleep[c] = resting_.flag(k);
+    if (images_.on()) out.image[c] = images_.of(k);
   }
   if ((fields & Blocks::kIdentity) != 0) {
     out.mass[c] = sh.mass;
@@ -152,6 +155,28 @@ void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
     const PendingEvent& e = pending_[k];
     const Code code = e.code.renumbered([&](std::uint32_t p) { return id_[p]; });
     out.events[c] = {queue_.time_of(k), code.bits(), e.partner_count};
+  }
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::unwrapped_positions(const std::vector<std::uint32_t>& slot,
+                                                std::vector<Vec<D>>& out) const {
+  if (!images_.on()) throw std::logic_error("unwrapped_positions: images are not tracked");
+  for (std::uint32_t k = 0; k < size(); ++k) {
+    const std::uint32_t s = slot[id_[k]];
+    if (s == kNotFollowed) continue;
+    Vec<D> x = position(k, time_);
+    for (int a = 0; a < D; ++a) x[a] += images_.of(k)[a] * box_[a];
+    out[s] = x;
+  }
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::velocities(const std::vector<std::uint32_t>& slot,
+                                       std::vector<Vec<D>>& out) const {
+  for (std::uint32_t k = 0; k < size(); ++k) {
+    const std::uint32_t s = slot[id_[k]];
+    if (s != kNotFollowed) out[s] = velocity(k, time_);
   }
 }
 

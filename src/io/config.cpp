@@ -675,6 +675,12 @@ class Reader : public KeyReader {
                  "load does not end); use run.integrator = \"dem\"");
       }
     }
+    if (c.analysis.msd && c.boundary.shear_rate != 0.0) {
+      fail(node_at(root, "analysis.msd"), "analysis.msd",
+           "analysis.msd: the mean-square displacement under Lees-Edwards shear is not measured "
+           "yet (the streaming displacement would need subtracting); remove boundary.shear_rate "
+           "or analysis.msd");
+    }
     if (!integrators().is(c.run.integrator, IntegratorKind::kDem)) return;
     const toml::node* n_integrator = node_at(root, "run.integrator");
     const auto unsupported = [&](std::string_view key, std::string_view what) {
@@ -692,6 +698,8 @@ class Reader : public KeyReader {
     if (!driving_kinds().is(c.driving.kind, DrivingKind::kNone))
       unsupported("driving.kind", "driving is");
     if (c.run.validate) unsupported("run.validate", "engine validation is");
+    if (c.analysis.msd)
+      unsupported("analysis.msd", "the mean-square displacement (image counters) is");
   }
 
   void read_field(const toml::table& t, const int& dimension, FieldConfig& f) const {

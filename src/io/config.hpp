@@ -145,9 +145,21 @@ struct OutputConfig {
   bool operator==(const OutputConfig&) const = default;
 };
 
-// [analysis]: structure analyses sampled over the production (docs/outputs.md,
-// "Structure analyses"), each written at the end to its own file and to summary.json.
+// [analysis]: analyses of the production (docs/outputs.md), each written at the end to its own
+// file and to summary.json.
 struct AnalysisConfig {
+  // msd.tsv: the mean-square displacement on log-spaced lags (analysis/msd.hpp), sampled every
+  // msd_interval of simulated time (0: automatic), of msd_particles particles at most; D fitted
+  // over lags [msd_fit_from, msd_fit_to] (0: automatic).
+  bool msd = false;
+  double msd_interval = 0.0;
+  std::int64_t msd_particles = 10000;
+  double msd_fit_from = 0.0;
+  double msd_fit_to = 0.0;
+  // vacf.tsv: the velocity autocorrelation on the same lags, and D by Green-Kubo.
+  bool vacf = false;
+  // The structure analyses (analysis/structure.hpp): rdf.tsv, sk.tsv, bond_order.tsv,
+  // velocity_distribution.tsv, sampled over the production.
   bool rdf = false;                    // rdf.tsv: g(r) per species pair, contact values
   std::int64_t rdf_bins = 200;         // bins of g(r) over [0, rdf_max_distance]
   double rdf_max_distance = 0.0;       // 0: automatic, min(5 d, half the shortest box edge)
@@ -156,10 +168,9 @@ struct AnalysisConfig {
   bool bond_order = false;             // bond_order.tsv: Steinhardt q4, q6 (3D), psi6 (2D)
   double bond_cutoff = 1.4;            // neighbours: closer than this many contact distances
   bool velocity_distribution = false;  // velocity_distribution.tsv
-  // Between samples, in output.interval_unit; 0: at every production thermo row.
+  // Between their samples, in output.interval_unit; 0: at every production thermo row.
   double interval = 0.0;
 
-  bool any() const { return rdf || structure_factor || bond_order || velocity_distribution; }
   bool operator==(const AnalysisConfig&) const = default;
 };
 

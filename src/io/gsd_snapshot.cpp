@@ -147,6 +147,23 @@ void write_standard_chunks(gsd::Writer& w, const StateBlocks<D>& s, bool with_st
                                 const Vec<D> v = p.velocity(j, p.time);
                                 for (int a = 0; a < D; ++a) out[a] = static_cast<float>(v[a]);
                               });
+  if (!probe(s).image.empty()) {
+    // HOOMD's image flags for the float32 coordinate written above: unwrapped = position +
+    // image * box (the engine's counters for its own coordinate, plus the box the coordinate
+    // was wrapped by here). Under Lees-Edwards shear, x also needs image_y * shear_rate L_y t.
+    write_particle_chunk<std::int32_t>(
+        w, "particles/image", 3, s,
+        [](const ParticleSystem<D>& p, std::size_t j, std::int32_t* out) {
+          const Vec<D> x = p.position(j, p.time);
+          for (int a = 0; a < D; ++a) {
+            out[a] = p.image[j][a];
+            if (!p.periodic[a]) continue;
+            const double c = hoomd_coordinate(x[a], p.box[a]);
+            out[a] +=
+                static_cast<std::int32_t>(std::lround((x[a] - 0.5 * p.box[a] - c) / p.box[a]));
+          }
+        });
+  }
   if (!probe(s).angular_velocity.empty()) {
     // Per-particle log data: OVITO and python-gsd read log/particles/* as particle
     // properties. In 2D the spin is the z component.
@@ -462,6 +479,12 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& bloc
       put("kairos/dem/list", d.list);
       put("kairos/dem/springs", d.springs);
     }
+    if (!has.image.empty()) {  // the engine's counters for kairos/state/position
+      write_particle_chunk<std::int32_t>(w, "kairos/state/image", D, blocks,
+                                         [](Part p, std::size_t j, std::int32_t* out) {
+                                           for (int a = 0; a < D; ++a) out[a] = p.image[j][a];
+                                         });
+    }
     if (!has.asleep.empty()) {
       write_particle_chunk<std::uint8_t>(
           w, "kairos/state/asleep", 1, blocks,
@@ -641,6 +664,12 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   }
   if (r.find(f, "kairos/state/asleep"))
     s.asleep = require<std::uint8_t>(r, f, "kairos/state/asleep", path, n);
+  if (r.find(f, "kairos/state/image")) {
+    const auto image = require<std::int32_t>(r, f, "kairos/state/image", path, n * D);
+    s.image.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < D; ++a) s.image[i][a] = image[i * D + a];
+  }
   s.kinematics.resize(n);
   s.events.resize(n);
   for (std::size_t i = 0; i < n; ++i) {

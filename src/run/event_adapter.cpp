@@ -75,6 +75,8 @@ void check_no_overlap_after_new_physics(const Engine& engine) {
 EngineOptions engine_options(const Config& config) {
   EngineOptions options;
   options.defer_soft_releases = config.soft.defer_releases;
+  // Trajectory frames carry particles/image (and so does the restart file, for the next run).
+  options.track_images = config.output.trajectory || config.analysis.msd;
   return options;
 }
 

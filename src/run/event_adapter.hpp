@@ -54,6 +54,12 @@ class EventIntegrator : public Integrator<D> {
   // Every particle's velocity relative to the mean (the centre-of-mass velocity, or under shear
   // the flow at its position) into `c`, and its mass into `m`, in the caller's numbering.
   virtual void peculiar_velocities(std::vector<Vec<D>>& c, std::vector<double>& m) const = 0;
+  // The unwrapped positions now of the particles with slot[id] != ~0u, into out[slot[id]]
+  // (engine/image_counters.hpp; the run keeps image counters when an analysis needs them).
+  virtual void unwrapped_positions(const std::vector<std::uint32_t>& slot,
+                                   std::vector<Vec<D>>& out) const = 0;
+  virtual void velocities(const std::vector<std::uint32_t>& slot,
+                          std::vector<Vec<D>>& out) const = 0;
   // Kinetic (translational and rotational) plus the stepped potentials' energy plus the
   // potential energy in the gravity field; NaN when the field has a component along a periodic
   // axis (unbounded there).
@@ -120,6 +126,13 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   std::uint32_t sleeping() const override { return engine_.sleeping(); }
   const std::vector<SoftTableUse>& tables() const override { return tables_; }
   void peculiar_velocities(std::vector<Vec<D>>& c, std::vector<double>& m) const override;
+  void unwrapped_positions(const std::vector<std::uint32_t>& slot,
+                           std::vector<Vec<D>>& out) const override {
+    engine_.unwrapped_positions(slot, out);
+  }
+  void velocities(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const override {
+    engine_.velocities(slot, out);
+  }
   double total_energy() const override;
 
   // The engine and its watch, for callers that step it themselves (run/simulation.hpp).

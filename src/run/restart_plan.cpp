@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <map>
-#include <regex>
 #include <sstream>
 #include <string_view>
 
@@ -49,8 +48,19 @@ enum class Effect { kResume, kRepredict, kIgnore, kRefuse };
 
 // The key without its array indices: boundary.wall[2].restitution -> boundary.wall.restitution.
 std::string generic(const std::string& key) {
-  static const std::regex index(R"(\[[0-9]+\])");
-  return std::regex_replace(key, index, "");
+  std::string out;
+  for (std::size_t k = 0; k < key.size(); ++k) {
+    if (key[k] == '[') {
+      std::size_t e = k + 1;
+      while (e < key.size() && key[e] >= '0' && key[e] <= '9') ++e;
+      if (e > k + 1 && e < key.size() && key[e] == ']') {
+        k = e;  // skip "[digits]"
+        continue;
+      }
+    }
+    out += key[k];
+  }
+  return out;
 }
 
 bool starts_with(std::string_view s, std::string_view prefix) {

@@ -194,7 +194,9 @@ bool RunDriver<D>::run_phase(const std::string& phase, PhaseLength length, Progr
   AdvanceLimits limits;
   limits.phase_end_time = end_time;
   limits.phase_in_time = length.in_time;
-  limits.clock_stops = length.in_time || intervals_in_time(config_);
+  limits.clock_stops = length.in_time || intervals_in_time(config_) ||
+                       std::any_of(observers_.begin(), observers_.end(),
+                                   [](const auto& o) { return o->samples_in_time(); });
   std::vector<std::size_t> due;
   while (length.in_time ? !integrator.reached(end_time) : integrator.collisions() < target) {
     limits.collisions = target;
@@ -245,9 +247,10 @@ void RunDriver<D>::start_triggers(std::uint64_t begin, double begin_time) {
   for (std::size_t k = 0; k < observers_.size(); ++k) {
     const double interval = observers_[k]->interval(config_, production);
     if (!(interval > 0.0)) continue;
-    triggers_[k] = in_time ? Trigger::every_time(interval, begin_time)
-                           : Trigger::every_collisions(
-                                 std::max<std::uint64_t>(1, collisions_for(interval)), begin);
+    triggers_[k] = in_time || observers_[k]->samples_in_time()
+                       ? Trigger::every_time(interval, begin_time)
+                       : Trigger::every_collisions(
+                             std::max<std::uint64_t>(1, collisions_for(interval)), begin);
   }
   // The first phase of a continued run keeps the stored schedule of the same phase (the rows
   // an uninterrupted run would write), if its steps are unchanged.
@@ -280,8 +283,11 @@ template <int D>
 nlohmann::json RunDriver<D>::outputs_present() const {
   nlohmann::json list = nlohmann::json::array({"summary.json"});
   std::error_code ec;
-  for (const auto& o : observers_)
+  for (const auto& o : observers_) {
     if (o->writes_file() && fs::exists(directory() / o->name(), ec)) list.push_back(o->name());
+    for (const std::string& more : o->more_files())
+      if (fs::exists(directory() / more, ec)) list.push_back(more);
+  }
   if (fs::exists(directory() / "config.toml", ec)) list.push_back("config.toml");
   return list;
 }

@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -78,6 +79,8 @@ class Observer {
   // Whether name() is a file in the output directory (summary.json's "outputs" lists those
   // that exist at the end); false for parts of summary.json and other analyses.
   virtual bool writes_file() const { return true; }
+  // Other files it writes in the output directory (listed in summary.json's "outputs" too).
+  virtual std::vector<std::string> more_files() const { return {}; }
   // Its interval in collisions per particle or in simulated time (output.interval_unit), given
   // the production's length in that unit; 0: no trigger (write() is never called).
   virtual double interval(const Config& /*config*/, double /*production_length*/) const {
@@ -87,6 +90,9 @@ class Observer {
   // trajectory, 2 restart), so that a continued run keeps them; -1: not recorded (a continued
   // run counts the interval afresh from its start).
   virtual int schedule_slot() const { return -1; }
+  // Its interval is in simulated time whatever output.interval_unit says: an analysis that
+  // samples at regular times (a time correlator); the clock stops at its samples.
+  virtual bool samples_in_time() const { return false; }
   // Its bit in RunProgress::owed_outputs when a write of it failed (kOwedRow, kOwedFrame): a
   // continued run writes it first. 0: nothing owed (written again at the next trigger).
   virtual unsigned owed_bit() const { return 0; }

@@ -8,6 +8,7 @@
 #include "run/outputs/dem_summary.hpp"
 #include "run/outputs/event_summary.hpp"
 #include "run/outputs/granular_summary.hpp"
+#include "run/outputs/msd_output.hpp"
 #include "run/outputs/pressure_tensor.hpp"
 #include "run/outputs/profile_output.hpp"
 #include "run/outputs/rdf_output.hpp"
@@ -38,8 +39,7 @@ T& add(ObserverList<D>& list, Args&&... args) {
 // `config`: for an output registered only under some configuration (every one here decides for
 // itself at open(), so that summary.json lists a file an earlier run left).
 template <int D>
-ObserverList<D> make_observers([[maybe_unused]] const Config& config,
-                               const Integrator<D>& integrator) {
+ObserverList<D> make_observers(const Config& config, const Integrator<D>& integrator) {
   ObserverList<D> list;
   // The order matters where one output records another: the row and the frame due at one
   // moment come before the restart file that records them, and every file before summary.json.
@@ -47,6 +47,9 @@ ObserverList<D> make_observers([[maybe_unused]] const Config& config,
   add<TrajectoryOutput<D>>(list);
   add<RestartOutput<D>>(list);
   add<ProfileOutput<D>>(list);
+  // Analyses that write their own file (before summary.json, which lists it).
+  if (const EventIntegrator<D>* engine = integrator.as_event(); engine && config.analysis.msd)
+    add<MsdOutput<D>>(list, config, *engine);
   // The structure analyses of [analysis]: the three of the configuration share one read of the
   // state per sample; rdf.tsv's part of summary.json reads thermo.tsv's Z.
   const auto snapshot = std::make_shared<StructureSnapshot<D>>();

@@ -1,0 +1,240 @@
+#include "analysis/msd.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace kairos {
+
+template <int D>
+MsdCorrelator<D>::MsdCorrelator(std::vector<std::uint32_t> group, std::uint32_t groups,
+                                double interval, Statistic statistic, int max_levels)
+    : group_(std::move(group)),
+      groups_(groups),
+      interval_(interval),
+      statistic_(statistic),
+      max_levels_(max_levels),
+      group_size_(static_cast<std::size_t>(groups) * kSubsets, 0) {
+  if (!(interval > 0.0)) throw std::invalid_argument("MsdCorrelator: interval must be > 0");
+  for (std::size_t k = 0; k < group_.size(); ++k) {
+    if (group_[k] >= groups_) throw std::invalid_argument("MsdCorrelator: group out of range");
+    ++group_size_[slot(group_[k], static_cast<int>(k % kSubsets))];
+  }
+}
+
+template <int D>
+void MsdCorrelator<D>::correlate(Level& level, const std::vector<Vec<D>>& x, int first_j) {
+  const std::size_t n = group_.size();
+  const std::size_t per_j = static_cast<std::size_t>(groups_) * kSubsets;
+  for (int j = first_j; j < kPoints; ++j) {
+    if (level.kept < static_cast<std::uint64_t>(j)) break;
+    const std::size_t back = (level.kept - static_cast<std::uint64_t>(j)) % kPoints;
+    const Vec<D>* then = j == 0 ? x.data() : &level.ring[back * n];
+    const bool product = statistic_ == Statistic::kProduct;
+    double* s2 = &level.sum2[static_cast<std::size_t>(j) * per_j];
+    double* s4 = &level.sum4[static_cast<std::size_t>(j) * per_j];
+    for (std::size_t k = 0; k < n; ++k) {
+      double r2 = 0.0;
+      for (int a = 0; a < D; ++a) {
+        if (product) {
+          r2 += x[k][a] * then[k][a];
+        } else {
+          const double d = x[k][a] - then[k][a];
+          r2 += d * d;
+        }
+      }
+      const std::size_t at = slot(group_[k], static_cast<int>(k % kSubsets));
+      s2[at] += r2;
+      s4[at] += r2 * r2;
+    }
+    ++level.count[static_cast<std::size_t>(j)];
+  }
+}
+
+template <int D>
+void MsdCorrelator<D>::add(const std::vector<Vec<D>>& position) {
+  const std::size_t n = group_.size();
+  if (position.size() != n) throw std::invalid_argument("MsdCorrelator: wrong particle count");
+  std::uint64_t spacing = 1;
+  for (int l = 0; l < max_levels_; ++l, spacing *= kRatio) {
+    if (samples_ % spacing != 0) break;
+    if (levels_.size() <= static_cast<std::size_t>(l)) {
+      // Level l begins at sample m^l (the first multiple after 0), with sample 0 taken from
+      // the level below, which still keeps it (m <= kPoints).
+      if (samples_ == 0 && l > 0) break;
+      Level level;
+      level.ring.resize(static_cast<std::size_t>(kPoints) * n);
+      const std::size_t cells = static_cast<std::size_t>(kPoints) * groups_ * kSubsets;
+      level.sum2.assign(cells, 0.0);
+      level.sum4.assign(cells, 0.0);
+      level.count.assign(kPoints, 0);
+      if (l > 0) {
+        const Level& below = levels_[static_cast<std::size_t>(l - 1)];
+        std::copy(below.ring.begin(), below.ring.begin() + static_cast<std::ptrdiff_t>(n),
+                  level.ring.begin());
+        level.kept = 1;
+      }
+      levels_.push_back(std::move(level));
+    }
+    Level& level = levels_[static_cast<std::size_t>(l)];
+    correlate(level, position, first_lag(l));
+    std::copy(position.begin(), position.end(),
+              level.ring.begin() + static_cast<std::ptrdiff_t>((level.kept % kPoints) * n));
+    ++level.kept;
+  }
+  ++samples_;
+}
+
+template <int D>
+std::vector<typename MsdCorrelator<D>::Lag> MsdCorrelator<D>::lags() const {
+  std::vector<Lag> out;
+  const std::size_t per_j = static_cast<std::size_t>(groups_) * kSubsets;
+  double spacing = 1.0;
+  for (std::size_t l = 0; l < levels_.size(); ++l, spacing *= kRatio) {
+    const Level& level = levels_[l];
+    for (int j = first_lag(static_cast<int>(l)); j < kPoints; ++j) {
+      const std::uint64_t origins = level.count[static_cast<std::size_t>(j)];
+      if (origins == 0) continue;
+      Lag lag;
+      lag.lag = j * spacing * interval_;
+      lag.origins = origins;
+      lag.mean.assign(groups_, 0.0);
+      lag.non_gaussian.assign(groups_, 0.0);
+      lag.subset_mean.assign(groups_, {});
+      const double* s2 = &level.sum2[static_cast<std::size_t>(j) * per_j];
+      const double* s4 = &level.sum4[static_cast<std::size_t>(j) * per_j];
+      for (std::uint32_t g = 0; g < groups_; ++g) {
+        double a2 = 0.0, a4 = 0.0, members = 0.0;
+        for (int s = 0; s < kSubsets; ++s) {
+          const std::size_t at = slot(g, s);
+          const auto size = static_cast<double>(group_size_[at]);
+          lag.subset_mean[g][s] = size > 0 ? s2[at] / (size * static_cast<double>(origins)) : 0.0;
+          a2 += s2[at];
+          a4 += s4[at];
+          members += size;
+        }
+        if (members == 0) continue;
+        const double m2 = a2 / (members * static_cast<double>(origins));
+        const double m4 = a4 / (members * static_cast<double>(origins));
+        lag.mean[g] = m2;
+        if (statistic_ == Statistic::kDisplacement)
+          lag.non_gaussian[g] = m2 > 0.0 ? D * m4 / ((D + 2.0) * m2 * m2) - 1.0 : 0.0;
+      }
+      out.push_back(std::move(lag));
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// Least-squares slope of y against x.
+double slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const auto n = static_cast<double>(x.size());
+  double mx = 0.0, my = 0.0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    mx += x[k];
+    my += y[k];
+  }
+  mx /= n;
+  my /= n;
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    sxy += (x[k] - mx) * (y[k] - my);
+    sxx += (x[k] - mx) * (x[k] - mx);
+  }
+  return sxy / sxx;
+}
+
+}  // namespace
+
+template <int D>
+std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D>::diffusion(
+    double from, double to) const {
+  const std::vector<Lag> all = lags();
+  std::vector<std::optional<Diffusion>> out(groups_);
+  for (std::uint32_t g = 0; g < groups_; ++g) {
+    std::vector<double> t, y;
+    std::array<std::vector<double>, kSubsets> ys;
+    for (const Lag& lag : all) {
+      if (lag.lag < from || lag.lag > to) continue;
+      t.push_back(lag.lag);
+      y.push_back(lag.mean[g]);
+      for (int s = 0; s < kSubsets; ++s) ys[s].push_back(lag.subset_mean[g][s]);
+    }
+    if (t.size() < 3) continue;
+    Diffusion d;
+    d.lags = static_cast<int>(t.size());
+    d.coefficient = slope(t, y) / (2.0 * D);
+    double sum = 0.0, squares = 0.0;
+    int used = 0;
+    for (int s = 0; s < kSubsets; ++s) {
+      if (group_size_[slot(g, s)] == 0) continue;
+      const double c = slope(t, ys[s]) / (2.0 * D);
+      sum += c;
+      squares += c * c;
+      ++used;
+    }
+    if (used >= 2) {
+      const double mean = sum / used;
+      const double variance = std::max(0.0, (squares - used * mean * mean) / (used - 1));
+      d.stderr_ = std::sqrt(variance / used);
+    } else {
+      d.stderr_ = std::nan("");
+    }
+    out[g] = d;
+  }
+  return out;
+}
+
+template <int D>
+std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D>::green_kubo(
+    double to) const {
+  const std::vector<Lag> all = lags();
+  std::vector<std::optional<Diffusion>> out(groups_);
+  if (statistic_ != Statistic::kProduct) return out;
+  for (std::uint32_t g = 0; g < groups_; ++g) {
+    double total = 0.0;
+    std::array<double, kSubsets> part{};
+    int used_lags = 0;
+    for (std::size_t k = 1; k < all.size() && all[k].lag <= to; ++k) {
+      const double h = 0.5 * (all[k].lag - all[k - 1].lag);
+      total += h * (all[k].mean[g] + all[k - 1].mean[g]);
+      for (int s = 0; s < kSubsets; ++s)
+        part[s] += h * (all[k].subset_mean[g][s] + all[k - 1].subset_mean[g][s]);
+      ++used_lags;
+    }
+    if (used_lags < 2 || all.empty() || all[0].lag != 0.0) continue;
+    Diffusion d;
+    d.lags = used_lags + 1;
+    d.coefficient = total / D;
+    double sum = 0.0, squares = 0.0;
+    int used = 0;
+    for (int s = 0; s < kSubsets; ++s) {
+      if (group_size_[slot(g, s)] == 0) continue;
+      sum += part[s] / D;
+      squares += (part[s] / D) * (part[s] / D);
+      ++used;
+    }
+    d.stderr_ = used >= 2
+                    ? std::sqrt(std::max(0.0, (squares - sum * sum / used) / (used - 1)) / used)
+                    : std::nan("");
+    out[g] = d;
+  }
+  return out;
+}
+
+template <int D>
+std::size_t MsdCorrelator<D>::bytes() const {
+  std::size_t b = 0;
+  for (const Level& l : levels_) {
+    b += l.ring.size() * sizeof(Vec<D>) + (l.sum2.size() + l.sum4.size()) * sizeof(double) +
+         l.count.size() * sizeof(std::uint64_t);
+  }
+  return b;
+}
+
+template class MsdCorrelator<2>;
+template class MsdCorrelator<3>;
+
+}  // namespace kairos

@@ -1,0 +1,102 @@
+// Mean-square displacement on logarithmically spaced lags with many time origins, in memory
+// that grows only with the logarithm of the run's length: a multiple-tau correlator (Ramírez,
+// Sukumaran, Vorselaars and Likhtman, J. Chem. Phys. 133, 154103 (2010)) in its subsampling
+// form. Level l keeps the last `points` samples taken m^l apart (every m^l-th sample, not block
+// averages, so every displacement it reports is exact); a new sample at level l is paired with
+// each kept one at lags j m^l, j = 1 .. points - 1 on level 0 and points / m .. points - 1
+// above, so that the lags run 1, 2, ..., 7, 8, 10, 12, 14, 16, 20, ... sample intervals (m = 2,
+// 8 points: four lags per octave). Every pair (sample, kept sample) is a time origin.
+//
+// The same correlator gives the velocity autocorrelation <v(t + lag) . v(t)> (Statistic::kProduct,
+// lag 0 included) and its Green-Kubo integral.
+//
+// Particles are split into `groups` (species) and, for the error bar, into kSubsets interleaved
+// subsets (particle k in subset k mod kSubsets): self-diffusion of different particles is
+// nearly independent, so the scatter of the subsets' D gives its standard error.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/vec.hpp"
+
+namespace kairos {
+
+template <int D>
+class MsdCorrelator {
+ public:
+  // kDisplacement: <|x(t + lag) - x(t)|^2> of positions; kProduct: <x(t + lag) . x(t)> of
+  // velocities.
+  enum class Statistic { kDisplacement, kProduct };
+  static constexpr int kSubsets = 8;
+  static constexpr int kRatio = 2;   // m: lags grow by this factor per level
+  static constexpr int kPoints = 8;  // samples kept per level
+
+  // group[k]: the group (species) of followed particle k, < groups; samples `interval` apart;
+  // at most max_levels levels (lags up to kPoints kRatio^(max_levels - 1) intervals).
+  MsdCorrelator(std::vector<std::uint32_t> group, std::uint32_t groups, double interval,
+                Statistic statistic = Statistic::kDisplacement, int max_levels = 40);
+
+  // The next sample (the unwrapped positions of the followed particles), `interval` after the
+  // previous one.
+  void add(const std::vector<Vec<D>>& position);
+
+  struct Lag {
+    double lag = 0.0;                  // in time
+    std::uint64_t origins = 0;         // pairs of samples averaged
+    std::vector<double> mean;  // per group: <|dr|^2>, or <v(t + lag) . v(t)>
+    std::vector<double> non_gaussian;  // per group: alpha_2 = D <dr^4> / ((D + 2) <dr^2>^2) - 1
+    // per group and subset: the mean of the subset (for error bars)
+    std::vector<std::array<double, kSubsets>> subset_mean;
+  };
+  // Every lag with at least one origin, in increasing order.
+  std::vector<Lag> lags() const;
+
+  // The self-diffusion coefficient of each group from the slope of <|dr|^2> = 2 D_dim D t + c
+  // (least squares over the lags in [from, to]), with the standard error from the subsets'
+  // slopes; nothing when fewer than 3 lags fall in the window.
+  struct Diffusion {
+    double coefficient = 0.0, stderr_ = 0.0;
+    int lags = 0;  // lags in the fit
+  };
+  std::vector<std::optional<Diffusion>> diffusion(double from, double to) const;
+  // kProduct: the Green-Kubo self-diffusion coefficient (1 / D_dim) integral_0^to <v(lag) . v(0)>
+  // by the trapezoid rule over the lags, with the standard error from the subsets.
+  std::vector<std::optional<Diffusion>> green_kubo(double to) const;
+
+  std::uint64_t samples() const { return samples_; }
+  double interval() const { return interval_; }
+  std::size_t particles() const { return group_.size(); }
+  std::size_t bytes() const;
+
+ private:
+  struct Level {
+    std::vector<Vec<D>> ring;  // kPoints samples of all particles: ring[slot * n + k]
+    std::uint64_t kept = 0;    // samples taken into this level so far
+    // Per lag index j (0 .. kPoints - 1), per group and subset: sums of |dr|^2, |dr|^4, count.
+    std::vector<double> sum2, sum4;
+    std::vector<std::uint64_t> count;
+  };
+  std::size_t slot(std::uint32_t g, int subset) const { return g * kSubsets + subset; }
+  // The first lag index of level l: 1 on level 0 (0 too for products: C(0)), above it the lags
+  // the level below does not reach.
+  int first_lag(int l) const {
+    if (l > 0) return kPoints / kRatio;
+    return statistic_ == Statistic::kProduct ? 0 : 1;
+  }
+  void correlate(Level& level, const std::vector<Vec<D>>& x, int first_j);
+
+  std::vector<std::uint32_t> group_;
+  std::uint32_t groups_;
+  double interval_;
+  Statistic statistic_;
+  int max_levels_;
+  std::vector<std::uint64_t> group_size_;  // per (group, subset)
+  std::vector<Level> levels_;
+  std::uint64_t samples_ = 0;
+};
+
+}  // namespace kairos
