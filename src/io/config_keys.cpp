@@ -469,6 +469,12 @@ constexpr KeyDecl kAnalysis[] = {
      .type = KeyType::kBoolean,
      .member = field<&AnalysisConfig::vacf>,
      .doc = "vacf.tsv: velocity autocorrelation on the MSD's lags, D by Green-Kubo"},
+    {.name = "msd_viscosity",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::msd_viscosity>,
+     .range = up_to(1e9, Scale::kNone),
+     .unit = "viscosity",
+     .doc = "shear viscosity for the Yeh-Hummer finite-size correction of D (0: none)"},
 };
 
 // ----- [[potential]], [[bond]]
