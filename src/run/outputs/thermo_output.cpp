@@ -130,14 +130,18 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
     why = "no production time elapsed";
   else if (!(kT_production > 0.0))
     why = "the particles are at rest (kT = 0)";
-  nlohmann::json z = {{"blocks", z_blocks.samples},
-                      {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
+  nlohmann::json z = {
+      {"blocks", z_blocks.samples},
+      {"method", "blocking over thermo rows (Flyvbjerg-Petersen, level by Jonsson's test)"}};
   set_or_explain(j, z, "mean", z_mean, why, "compressibility");
-  set_or_explain(j, z, "stderr", z_blocks.stderr_,
-                 !why.empty()           ? why
-                 : z_blocks.samples < 2 ? "fewer than 2 production thermo rows"
-                                        : "",
-                 "compressibility_stderr");
+  const std::string z_stderr_why = !why.empty()           ? why
+                                   : z_blocks.samples < 2 ? "fewer than 2 production thermo rows"
+                                                          : "";
+  set_or_explain(j, z, "stderr", z_blocks.stderr_, z_stderr_why, "compressibility_stderr");
+  z["stderr_blocks"] = z_blocks.blocks;
+  z["stderr_reliable"] = z_stderr_why.empty() && z_blocks.reliable;
+  set_or_explain(j, z, "correlation_time_rows", z_blocks.correlation_time, z_stderr_why,
+                 "compressibility.correlation_time_rows");
   j["compressibility"] = z;
   set_or_explain(j, j, "pressure", th.pressure(z_mean, kT_production), why, "pressure");
   j["production_temperature"] = kT_production;
@@ -145,11 +149,15 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
       production_collisions == 0 ? "no collision in the production" : "";
   set_or_explain(j, j, "mean_free_time", th.mean_free_time(production_time, production_collisions),
                  no_collision, "mean_free_time");
-  set_or_explain(j, j, "mean_free_time_stderr", th.mean_free_time_blocks().stderr_,
-                 !no_collision.empty()                    ? no_collision
-                 : th.mean_free_time_blocks().samples < 2 ? "fewer than 2 production thermo rows"
-                                                          : "",
+  const BlockAverage mft_blocks = th.mean_free_time_blocks();
+  const std::string mft_stderr_why = !no_collision.empty() ? no_collision
+                                     : mft_blocks.samples < 2
+                                         ? "fewer than 2 production thermo rows"
+                                         : "";
+  set_or_explain(j, j, "mean_free_time_stderr", mft_blocks.stderr_, mft_stderr_why,
                  "mean_free_time_stderr");
+  j["mean_free_time_stderr_blocks"] = mft_blocks.blocks;
+  j["mean_free_time_stderr_reliable"] = mft_stderr_why.empty() && mft_blocks.reliable;
 }
 
 template class ThermoOutput<2>;
