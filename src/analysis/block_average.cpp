@@ -59,7 +59,7 @@ double chi_square_upper_tail(double x, std::size_t dof) {
   const double density = std::exp(-0.5 * x);  // sqrt(2 pi) times the normal density at chi
   double sum = 0.0, term = 0.0;
   if (dof % 2 == 0) {
-    // A&S 26.4.5: Q = e^{-x/2} [1 + sum_{r=1}^{(dof-2)/2} x^r / (2 4 ... 2r)].
+    // Even dof: Q = e^{-x/2} [1 + sum_{r=1}^{(dof-2)/2} x^r / (2 4 ... 2r)].
     term = 1.0;
     sum = 1.0;
     for (std::size_t r = 1; r < dof / 2; ++r) {
@@ -68,7 +68,7 @@ double chi_square_upper_tail(double x, std::size_t dof) {
     }
     return std::min(1.0, density * sum);
   }
-  // A&S 26.4.4: Q = 2 Q_normal(chi) + 2 Z(chi) sum_{r=1}^{(dof-1)/2} chi^{2r-1} / (1 3 ... (2r-1)).
+  // Odd dof: Q = 2 Q_normal(chi) + 2 Z(chi) sum_{r=1}^{(dof-1)/2} chi^{2r-1} / (1 3 ... (2r-1)).
   term = chi;
   for (std::size_t r = 1; r <= (dof - 1) / 2; ++r) {
     if (r > 1) term *= x / (2.0 * static_cast<double>(r) - 1.0);

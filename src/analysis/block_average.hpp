@@ -1,17 +1,17 @@
 // Standard error of the mean of a correlated time series by blocking (Flyvbjerg & Petersen,
 // J. Chem. Phys. 91, 461 (1989)), the level chosen automatically by the hypothesis test of
-// M. Jonsson, Phys. Rev. E 98, 043304 (2018). docs/physics.md, "Error bars of correlated
-// averages", gives the formulas; docs/validation.md the check on AR(1) series.
+// M. Jonsson, Phys. Rev. E 98, 043304 (2018). docs/physics.md, "Statistical errors", gives the
+// formulas; docs/validation.md the check on AR(1) series.
 //
 // The series is averaged pairwise again and again (level k: n_k blocks of 2^k samples). At
 // each level the variance s_k^2 and the lag-1 autocovariance g_k of the blocks are measured;
 // for uncorrelated blocks of levels j, j+1, ... Jonsson's statistic
 //   M_j = sum_{k >= j} n_k (g_k / s_k^2)^2
-// is chi-square distributed with as many degrees of freedom as it has terms, and the first
+// is asymptotically chi-square with as many degrees of freedom as it has terms, and the first
 // level j whose M_j stays below the 99 % quantile is taken as the plateau. Since the test
 // cannot see a lag-1 correlation r below about sqrt(6.6 / n_j), which leaves Flyvbjerg &
-// Petersen's estimate s_j^2 / (n_j - 1) low by about 2r, the lag-1 term of their truncation
-// error is kept: var(mean) = (s_j^2 + 2 max(g_j, 0)) / (n_j - 1).
+// Petersen's estimate s_j^2 / (n_j - 1) of the variance of the mean low by about 2r, the
+// lag-1 term of their truncation error is kept: var(mean) = (s_j^2 + 2 max(g_j, 0)) / (n_j - 1).
 #pragma once
 
 #include <cstddef>
@@ -49,7 +49,8 @@ inline constexpr double kReliableSamples = 64.0;
 BlockAverage block_average(const std::vector<double>& samples);
 
 // Upper tail P(X > x) of the chi-square distribution with `dof` >= 1 degrees of freedom
-// (closed forms for integer dof: Abramowitz & Stegun 26.4.4 and 26.4.5).
+// (the closed forms for integer dof: Abramowitz & Stegun, Handbook of Mathematical Functions
+// (1964), ch. 26).
 double chi_square_upper_tail(double x, std::size_t dof);
 
 }  // namespace kairos
