@@ -13,6 +13,8 @@ namespace {
 constexpr double kAlpha = 0.01;
 // Levels with fewer blocks give the estimate of an unreliable error bar no say.
 constexpr std::size_t kFallbackMinBlocks = 8;
+// A series whose spread is below this fraction of its mean is constant up to round-off.
+constexpr double kConstant = 1e-12;
 
 // One blocking level: its variance and lag-1 autocovariance (1/n normalisation, both about the
 // level's own mean).
@@ -98,6 +100,17 @@ BlockAverage block_average(const std::vector<double>& samples) {
     x.swap(next);
   }
   out.levels = levels.size();
+  out.level = 0;
+  out.blocks = samples.size();
+  out.correlation_time = 1.0;
+  const double naive = levels[0].plain();  // var(x) / n
+  if (levels[0].variance <= kConstant * kConstant * out.mean * out.mean) {
+    // Constant to round-off (the temperature of elastic hard spheres, the potential energy of
+    // particles without potentials): the mean is exact.
+    out.stderr_ = std::sqrt(naive);
+    out.reliable = true;
+    return out;
+  }
 
   // Jonsson's test: the first level j at which M_j = sum_{k >= j} n_k r_k^2 is compatible with
   // chi-square(levels - j). The last level (2 blocks, r = -1/2) always passes.
@@ -110,12 +123,11 @@ BlockAverage block_average(const std::vector<double>& samples) {
       break;
     }
   }
-  const double naive = levels[0].plain();  // var(x) / n
   double variance_of_mean = levels[chosen].corrected();
   // Relative error of the error: var(s^2 + 2g) = 6 s^4 / n for uncorrelated blocks, half of
   // that relative spread for the square root.
   double relative_error = std::sqrt(1.5 / levels[chosen].blocks_minus_one());
-  const double tau = naive > 0.0 ? variance_of_mean / naive : 1.0;
+  const double tau = variance_of_mean / naive;
   out.reliable = levels[chosen].n >= kReliableBlocks &&
                  static_cast<double>(samples.size()) >= kReliableSamples * tau;
   if (!out.reliable) {
@@ -133,7 +145,7 @@ BlockAverage block_average(const std::vector<double>& samples) {
   out.blocks = levels[chosen].n;
   out.stderr_ = std::sqrt(variance_of_mean);
   out.stderr_error = out.stderr_ * relative_error;
-  out.correlation_time = naive > 0.0 ? variance_of_mean / naive : 1.0;
+  out.correlation_time = variance_of_mean / naive;
   return out;
 }
 

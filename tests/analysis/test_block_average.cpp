@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -77,6 +78,11 @@ TEST_P(Ar1Ensemble, ErrorsMatchTheScatterOfTheMeans) {
   const double scatter = std::sqrt(sum_mean2 / kSeries);
   const double reported = std::sqrt(sum_err2 / kSeries);
   const double exact = std::sqrt(ar1_variance_of_mean(phi, kSamples));
+  std::printf(
+      "AR(1) phi = %g, %d series of %zu: exact %.5g, scatter %.5g, rms reported %.5g "
+      "(/scatter %.3f, /exact %.3f), within 1 error %d, reliable %d, mean tau %.4g\n",
+      phi, kSeries, kSamples, exact, scatter, reported, reported / scatter, reported / exact,
+      covered, reliable, sum_tau / kSeries);
   // The scatter of 400 means about the true one is known to 1 / sqrt(2 * 400) = 3.5 %, the rms
   // of the reported errors to <= 1.5 %: 3 combined sigma = 11.5 %.
   EXPECT_NEAR(reported / scatter, 1.0, 0.115) << "reported " << reported << " scatter " << scatter;
@@ -142,10 +148,21 @@ TEST(BlockAverage, EmptyTinyAndConstantSeries) {
   EXPECT_DOUBLE_EQ(b.stderr_, 1.0);  // sample sd sqrt(2) / sqrt(2)
   EXPECT_EQ(b.blocks, 2u);
   EXPECT_FALSE(b.reliable);
-  const BlockAverage c = block_average(std::vector<double>(100, 7.0));
-  EXPECT_DOUBLE_EQ(c.mean, 7.0);
-  EXPECT_DOUBLE_EQ(c.stderr_, 0.0);
+  // Constant series (to round-off) have an exact mean: reliable, whatever their length.
+  const BlockAverage c = block_average(std::vector<double>(100, 7.1));
+  EXPECT_NEAR(c.mean, 7.1, 1e-13);
+  EXPECT_LT(c.stderr_, 1e-14);
   EXPECT_DOUBLE_EQ(c.correlation_time, 1.0);
+  EXPECT_TRUE(c.reliable);
+  EXPECT_TRUE(block_average(std::vector<double>(5, 0.0)).reliable);
+  std::vector<double> drift(1000);  // a round-off random walk (the energy of elastic spheres)
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> gauss(0.0, 1e-16);
+  double v = 1.5;
+  for (double& d : drift) d = v += gauss(rng);
+  EXPECT_TRUE(block_average(drift).reliable);
+  for (std::size_t k = 0; k < drift.size(); ++k) drift[k] += 1e-9 * static_cast<double>(k);
+  EXPECT_FALSE(block_average(drift).reliable);  // a drift, no longer round-off
 }
 
 }  // namespace
