@@ -33,10 +33,9 @@ struct BlockAverage {
   // A plateau was found at a level with at least kReliableBlocks blocks, and the series holds
   // at least kReliableSamples independent ones (samples / tau); or the series is constant to
   // round-off (>= 2 samples whose spread is below 1e-12 of their mean, or all zero: the mean
-  // is exact, tau is reported as 1). When false the series is too
-  // short for its correlation time (or too short altogether): stderr_ is then the largest of
-  // the estimates at the test's level and at the later levels with >= 8 blocks, at best a
-  // lower bound of the true error.
+  // is exact, tau is reported as 1). When false the series is too short for its correlation
+  // time (or too short altogether): stderr_ is then the largest of the estimates at the test's
+  // level and at the later levels with >= 8 blocks, at best a lower bound of the true error.
   bool reliable = false;
 };
 
