@@ -63,6 +63,12 @@ void print_summary(const kairos::RunOutcome& outcome) {
     return u.contains(name) ? fmt::format("n/a ({})", u[name].get<std::string>())
                             : std::string("n/a");
   };
+  // A blocked error bar whose run was too short for the correlation time (docs/outputs.md).
+  auto unreliable = [](const nlohmann::json& where, const char* key) {
+    return where.contains(key) && where[key].is_boolean() && !where[key].get<bool>()
+               ? std::string(" (error bar unreliable: run too short)")
+               : std::string();
+  };
   const bool dem = s.value("integrator", "event") == "dem";
   const bool early = outcome.interrupted || !outcome.error.empty();
   fmt::print("\nKairos run {} ({})\n", early ? "stopped early" : "finished",
@@ -81,8 +87,9 @@ void print_summary(const kairos::RunOutcome& outcome) {
   const auto& z = s["compressibility"];
   if (const auto zm = number(z, "mean")) {
     const auto ze = number(z, "stderr");
-    fmt::print("  compressibility Z    {:.5f} +- {}\n", *zm,
-               ze ? fmt::format("{:.5f}", *ze) : std::string("n/a"));
+    fmt::print("  compressibility Z    {:.5f} +- {}{}\n", *zm,
+               ze ? fmt::format("{:.5f}", *ze) : std::string("n/a"),
+               ze ? unreliable(z, "stderr_reliable") : std::string());
   } else {
     fmt::print("  compressibility Z    {}\n", why("compressibility"));
   }
@@ -112,22 +119,25 @@ void print_summary(const kairos::RunOutcome& outcome) {
       fmt::print("  energy balance       {}\n", why("granular.energy_balance_relative"));
     if (s.contains("shear")) {
       const auto& sh = s["shear"];
-      fmt::print("  shear stress P_xy    {:.6g} +- {:.2g} at shear rate {:.6g}\n",
+      fmt::print("  shear stress P_xy    {:.6g} +- {:.2g} at shear rate {:.6g}{}\n",
                  number(sh, "shear_stress").value_or(std::nan("")),
                  number(sh, "shear_stress_stderr").value_or(std::nan("")),
-                 number(sh, "shear_rate").value_or(std::nan("")));
-      fmt::print("  viscosity            {:.6g} +- {:.2g}\n",
+                 number(sh, "shear_rate").value_or(std::nan("")),
+                 unreliable(sh, "shear_stress_stderr_reliable"));
+      fmt::print("  viscosity            {:.6g} +- {:.2g}{}\n",
                  number(sh, "viscosity").value_or(std::nan("")),
-                 number(sh, "viscosity_stderr").value_or(std::nan("")));
+                 number(sh, "viscosity_stderr").value_or(std::nan("")),
+                 unreliable(sh, "shear_stress_stderr_reliable"));
     }
   } else {
     fmt::print("  energy drift (rel.)  {:.3g}\n", num("energy_drift_relative"));
   }
   if (s.contains("stepped")) {
     const auto& st = s["stepped"];
-    fmt::print("  potential energy/N   {:.6g} +- {:.2g}\n",
+    fmt::print("  potential energy/N   {:.6g} +- {:.2g}{}\n",
                number(st, "potential_energy_per_particle_mean").value_or(std::nan("")),
-               number(st, "potential_energy_per_particle_stderr").value_or(std::nan("")));
+               number(st, "potential_energy_per_particle_stderr").value_or(std::nan("")),
+               unreliable(st, "potential_energy_per_particle_stderr_reliable"));
     fmt::print("  pair events          {} core, {} step crossings, {} step bounces\n",
                st["core_collisions"].get<std::uint64_t>(),
                st["step_crossings"].get<std::uint64_t>(), st["step_bounces"].get<std::uint64_t>());

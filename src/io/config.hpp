@@ -158,6 +158,8 @@ struct AnalysisConfig {
   double msd_fit_to = 0.0;
   // vacf.tsv: the velocity autocorrelation on the same lags, and D by Green-Kubo.
   bool vacf = false;
+  // The shear viscosity, when known (0: not): D is also corrected to an infinite system.
+  double msd_viscosity = 0.0;
   // The structure analyses (analysis/structure.hpp): rdf.tsv, sk.tsv, bond_order.tsv,
   // velocity_distribution.tsv, sampled over the production.
   bool rdf = false;                    // rdf.tsv: g(r) per species pair, contact values

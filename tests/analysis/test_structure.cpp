@@ -64,18 +64,30 @@ Configuration<D> lattice(const std::vector<Vec<D>>& basis, const Vec<D>& cell,
 TEST(StreamingBlocks, EqualsBlockAverageOfTheWholeSeries) {
   std::mt19937_64 rng(3);
   std::normal_distribution<double> gauss(5.0, 0.3);
-  for (const std::size_t n : {1, 2, 7, 8, 100, 1023, 4096}) {
-    std::vector<double> x(n);
-    double v = 0.0;
-    for (double& s : x) s = 5.0 + (v = 0.8 * v + gauss(rng) - 5.0);  // correlated
-    StreamingBlocks s;
-    for (const double value : x) s.add(value);
-    const BlockAverage want = block_average(x), got = s.result();
-    EXPECT_EQ(got.samples, want.samples);
-    EXPECT_EQ(got.levels, want.levels) << n;
-    EXPECT_NEAR(got.mean, want.mean, 1e-12);
-    EXPECT_NEAR(got.stderr_, want.stderr_, 1e-12 + 1e-9 * want.stderr_) << n;
+  for (const double a : {0.0, 0.8, 0.98}) {
+    for (const std::size_t n : {1, 2, 7, 8, 100, 1023, 4096, 20000}) {
+      std::vector<double> x(n);
+      double v = 0.0;
+      for (double& s : x) s = 5.0 + (v = a * v + gauss(rng) - 5.0);  // AR(1)
+      StreamingBlocks s;
+      for (const double value : x) s.add(value);
+      const BlockAverage want = block_average(x), got = s.result();
+      SCOPED_TRACE(::testing::Message() << "a = " << a << ", n = " << n);
+      EXPECT_EQ(got.samples, want.samples);
+      EXPECT_EQ(got.levels, want.levels);
+      EXPECT_EQ(got.level, want.level);
+      EXPECT_EQ(got.blocks, want.blocks);
+      EXPECT_EQ(got.reliable, want.reliable);
+      EXPECT_NEAR(got.mean, want.mean, 1e-12);
+      EXPECT_NEAR(got.stderr_, want.stderr_, 1e-12 + 1e-9 * want.stderr_);
+      EXPECT_NEAR(got.correlation_time, want.correlation_time, 1e-9 * want.correlation_time);
+    }
   }
+  // A constant series: exact mean, reliable.
+  StreamingBlocks constant;
+  for (int k = 0; k < 50; ++k) constant.add(2.5);
+  EXPECT_TRUE(constant.result().reliable);
+  EXPECT_EQ(constant.result().mean, 2.5);
 }
 
 TEST(Structure, SpeciesPairsAreNumberedOnce) {

@@ -33,7 +33,7 @@ class Diffusion(kt.KairosTestCase):
         config = kt.base_config(particles=2000, packing_fraction=eta, lattice="random", seed=3,
                                 equilibration=10.0, production=400.0,
                                 output={"trajectory": False},
-                                analysis={"msd": True, "vacf": True})
+                                analysis={"msd": True, "vacf": True, "msd_viscosity": 0.2})
         out = self.path("dilute")
         self.run_ok("run", self.write_config(config), "-o", out)
         d = self.summary(out)["diffusion"]
@@ -44,6 +44,11 @@ class Diffusion(kt.KairosTestCase):
         self.assertLess(err, 0.05)  # the measurement means something
         # Finite size (Yeh-Hummer, ~0.2 % here) and the fit window: 2 % beside the statistics.
         self.assertAlmostEqual(fit["coefficient"] / reference, 1.0, delta=3 * err + 0.02)
+        # The Yeh-Hummer correction for the given viscosity, in this cubic box.
+        box = (2000 * math.pi / 6 / eta) ** (1 / 3)
+        kT = fit["infinite_size_temperature"]
+        self.assertAlmostEqual(fit["coefficient_infinite_size"] - fit["coefficient"],
+                               2.837297 * kT / (6 * math.pi * 0.2 * box), delta=1e-9)
         # Green-Kubo from the velocity autocorrelation: the same coefficient.
         gk, gk_err = fit["green_kubo_coefficient"], fit["green_kubo_coefficient_stderr"]
         both = math.hypot(gk_err, fit["coefficient_stderr"])

@@ -302,6 +302,46 @@ class RunOutputs(OutputChecks):
             self.assertIn(field, result.stdout)
 
 
+class ErrorBars(OutputChecks):
+    """The blocked error bars say how many independent blocks they rest on and whether the run
+    was long enough for them (docs/physics.md, "Statistical errors")."""
+
+    def run_rows(self, name, production, interval):
+        cfg = self.write_config(kt.base_config(particles=500, packing_fraction=0.3,
+                                               equilibration=20.0, production=production,
+                                               directory=name,
+                                               output={"thermo_interval": interval}))
+        result = self.kairos("run", cfg, "-o", self.path(name))
+        self.assertEqual(result.returncode, 0, kt.describe(result))
+        return self.summary(self.path(name)), result.stdout
+
+    def test_ten_rows_are_too_few(self):
+        s, stdout = self.run_rows("few", 20.0, 2.0)
+        z = s["compressibility"]
+        self.assertEqual(z["blocks"], 10)  # rows
+        self.assertLessEqual(z["stderr_blocks"], 10)
+        self.assertIs(z["stderr_reliable"], False)
+        self.assertGreater(z["stderr"], 0.0)
+        self.assertGreaterEqual(z["correlation_time_rows"], 1.0)
+        self.assertIs(s["mean_free_time_stderr_reliable"], False)
+        self.assertLessEqual(s["mean_free_time_stderr_blocks"], 10)
+        self.assertIn("(error bar unreliable: run too short)", stdout)
+
+    def test_three_hundred_short_rows_are_enough(self):
+        # Rows of 1 collision per particle in a fluid at eta = 0.3: Z hardly correlated from
+        # one row to the next, so the test accepts level 0 (a block per row).
+        s, stdout = self.run_rows("many", 300.0, 1.0)
+        z = s["compressibility"]
+        self.assertEqual(z["blocks"], 300)
+        self.assertIs(z["stderr_reliable"], True)
+        self.assertGreaterEqual(z["stderr_blocks"], 32)
+        self.assertLess(z["correlation_time_rows"], 300 / 64)
+        self.assertIs(s["mean_free_time_stderr_reliable"], True)
+        self.assertGreaterEqual(s["mean_free_time_stderr_blocks"], 32)
+        self.assertNotIn("unreliable", stdout)
+        self.assertIn("compressibility Z", stdout)
+
+
 class InitialStateFromGsd(OutputChecks):
     def test_from_kairos_trajectory(self):
         n = 500

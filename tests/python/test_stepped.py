@@ -1,7 +1,8 @@
 """Stepped potentials end to end: the low-density equation of state Z = 1 + B2 rho of a square
 well and of a stepped Lennard-Jones table (B2 summed over the table's own shells at the run's
-temperature), the low-density energy of the square well, exact restarts that carry the capture
-map, tethered chains that keep their bonds in every frame, `kairos steps`, and the input errors.
+temperature), the low-density energy of the square well, the unreliable error bars of an
+unsettled liquid, exact restarts that carry the capture map, tethered chains that keep their
+bonds in every frame, `kairos steps`, and the input errors.
 """
 
 import math
@@ -100,6 +101,30 @@ class LowDensity(kt.KairosTestCase):
         t = s["production_temperature"]
         self.assertLess(abs(t - 1.5), 0.03)
         self.check_z(s, table_b2(shells, t), "stepped LJ")
+
+
+class ErrorBars(kt.KairosTestCase):
+    def test_unsettled_liquid_flags_z_through_its_energy(self):
+        # The stepped LJ example with 100 collisions per particle of equilibration: the FCC start
+        # has not melted, U is still falling and Z is far below the liquid's 3.7. Z's own 100
+        # rows look uncorrelated (a block per row), so only U's rows, which Z follows, show that
+        # the run is too short (docs/physics.md, "Statistical errors").
+        result = self.run_ok("run", kt.example("stepped_lj_liquid_3d.toml"), "-o", self.path("lj"),
+                             "--set", "run.equilibration_collisions_per_particle=100",
+                             "--set", "run.collisions_per_particle=100",
+                             "--set", "output.thermo_interval=0", "--set", "output.trajectory=false")
+        s = self.summary(self.path("lj"))
+        z, st = s["compressibility"], s["stepped"]
+        self.assertLess(z["mean"], 3.0)
+        self.assertEqual(z["blocks"], 100)
+        self.assertGreaterEqual(z["stderr_blocks"], 32)  # Z's own test found a plateau ...
+        self.assertLess(z["correlation_time_rows"], 100 / 64)
+        self.assertIs(st["potential_energy_per_particle_stderr_reliable"], False)  # ... U's not
+        self.assertIs(z["stderr_reliable"], False)
+        self.assertIs(s["mean_free_time_stderr_reliable"], False)
+        self.assertIn("compressibility Z", result.stdout)
+        z_line = [l for l in result.stdout.splitlines() if "compressibility Z" in l][0]
+        self.assertIn("(error bar unreliable: run too short)", z_line)
 
 
 class Restarts(kt.KairosTestCase):

@@ -179,6 +179,23 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
           "for the diffusive regime (or set analysis.msd_fit_from / msd_fit_to)",
           from, to);
     }
+    if (fits.size() > g && fits[g] && config_.msd_viscosity > 0.0) {
+      // Yeh and Hummer, J. Phys. Chem. B 108, 15873 (2004): a cubic periodic box in 3D.
+      const Vec<D>& box = engine_.box();
+      bool cubic = D == 3;
+      for (int a = 1; a < D; ++a) cubic = cubic && box[a] == box[0];
+      if (cubic) {
+        constexpr double kXi = 2.837297;
+        const double kt =
+            2.0 * engine_.thermal_energy() / (D * (static_cast<double>(engine_.size()) - 1.0));
+        s["coefficient_infinite_size"] =
+            fits[g]->coefficient + kXi * kt / (6.0 * M_PI * config_.msd_viscosity * box[0]);
+        s["infinite_size_temperature"] = kt;
+      } else {
+        s["coefficient_infinite_size"] = nullptr;
+        s["infinite_size_why"] = "the Yeh-Hummer correction is for a cubic periodic box in 3D";
+      }
+    }
     if (g < gk.size() && gk[g]) {
       s["green_kubo_coefficient"] = gk[g]->coefficient;
       s["green_kubo_coefficient_stderr"] =

@@ -62,6 +62,8 @@ void PressureTensor<D>::summarize(nlohmann::json& j, const RunContext<D>&) const
   s["shear_rate"] = rate;
   s["shear_stress"] = p.mean;  // P_xy
   s["shear_stress_stderr"] = p.stderr_;
+  s["shear_stress_stderr_blocks"] = p.blocks;  // also those of viscosity_stderr
+  s["shear_stress_stderr_reliable"] = p.reliable;
   s["viscosity"] = -p.mean / rate;
   s["viscosity_stderr"] = p.stderr_ / std::abs(rate);
   s["samples"] = p.samples;

@@ -15,6 +15,8 @@ void SteppedSummary<D>::summarize(nlohmann::json& j, const RunContext<D>&) const
   s["potential_energy"] = engine_.potential_energy();
   s["potential_energy_per_particle_mean"] = u.mean / n;
   s["potential_energy_per_particle_stderr"] = u.stderr_ / n;
+  s["potential_energy_per_particle_stderr_blocks"] = u.blocks;
+  s["potential_energy_per_particle_stderr_reliable"] = u.reliable;
   s["potential_energy_rows"] = potential_rows_.size();
   s["total_energy"] = engine_.kinetic_energy() + engine_.potential_energy();
   s["step_crossings"] = c.step_crossings - start_.step_crossings;

@@ -46,7 +46,10 @@ void ThermoOutput<D>::write_row(const RunContext<D>& run, const std::string& pha
   const bool production = phase == "production";
   if (production) run.sample_production_row();
   const ThermoRow r = stats_->row(integrator.point(), integrator.thermal_energy(), production);
-  if (production) production_temperatures_.push_back(r.temperature);
+  if (production) {
+    production_temperatures_.push_back(r.temperature);
+    production_potential_energies_.push_back(integrator.potential_energy());
+  }
   const double rotational_temperature =
       2.0 * integrator.rotational_energy() /
       ((D == 3 ? 3.0 : 1.0) * static_cast<double>(integrator.size()));
@@ -121,6 +124,11 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
   const double kT_production = production_temperature(integrator);
   const BlockAverage z_blocks = production_compressibility(integrator);
   const double z_mean = z_blocks.mean;
+  // Z and the mean free time of a system with potentials follow its configurational energy,
+  // whose slow relaxation the rows' fast collisional noise hides from their own blocking (a
+  // lag-1 correlation of a few per cent): their error bars are reliable only when U's is (U is
+  // constant, so reliable, for hard particles). docs/physics.md, "Statistical errors".
+  const bool u_steady = block_average(production_potential_energies_).reliable;
   j["events"] = events;
   j["collisions"] = collisions;
   j["sim_time"] = integrator.time();
@@ -138,14 +146,18 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
     why = "no production time elapsed";
   else if (!(kT_production > 0.0))
     why = "the particles are at rest (kT = 0)";
-  nlohmann::json z = {{"blocks", z_blocks.samples},
-                      {"method", "Flyvbjerg-Petersen blocking over thermo rows"}};
+  nlohmann::json z = {
+      {"blocks", z_blocks.samples},
+      {"method", "blocking over thermo rows (Flyvbjerg-Petersen, level by Jonsson's test)"}};
   set_or_explain(j, z, "mean", z_mean, why, "compressibility");
-  set_or_explain(j, z, "stderr", z_blocks.stderr_,
-                 !why.empty()           ? why
-                 : z_blocks.samples < 2 ? "fewer than 2 production thermo rows"
-                                        : "",
-                 "compressibility_stderr");
+  const std::string z_stderr_why = !why.empty()           ? why
+                                   : z_blocks.samples < 2 ? "fewer than 2 production thermo rows"
+                                                          : "";
+  set_or_explain(j, z, "stderr", z_blocks.stderr_, z_stderr_why, "compressibility_stderr");
+  z["stderr_blocks"] = z_blocks.blocks;
+  z["stderr_reliable"] = z_stderr_why.empty() && z_blocks.reliable && u_steady;
+  set_or_explain(j, z, "correlation_time_rows", z_blocks.correlation_time, z_stderr_why,
+                 "compressibility.correlation_time_rows");
   j["compressibility"] = z;
   set_or_explain(j, j, "pressure", th.pressure(z_mean, kT_production), why, "pressure");
   j["production_temperature"] = kT_production;
@@ -153,11 +165,15 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
       production_collisions == 0 ? "no collision in the production" : "";
   set_or_explain(j, j, "mean_free_time", th.mean_free_time(production_time, production_collisions),
                  no_collision, "mean_free_time");
-  set_or_explain(j, j, "mean_free_time_stderr", th.mean_free_time_blocks().stderr_,
-                 !no_collision.empty()                    ? no_collision
-                 : th.mean_free_time_blocks().samples < 2 ? "fewer than 2 production thermo rows"
-                                                          : "",
+  const BlockAverage mft_blocks = th.mean_free_time_blocks();
+  const std::string mft_stderr_why = !no_collision.empty() ? no_collision
+                                     : mft_blocks.samples < 2
+                                         ? "fewer than 2 production thermo rows"
+                                         : "";
+  set_or_explain(j, j, "mean_free_time_stderr", mft_blocks.stderr_, mft_stderr_why,
                  "mean_free_time_stderr");
+  j["mean_free_time_stderr_blocks"] = mft_blocks.blocks;
+  j["mean_free_time_stderr_reliable"] = mft_stderr_why.empty() && mft_blocks.reliable && u_steady;
 }
 
 template class ThermoOutput<2>;

@@ -71,6 +71,9 @@ class ThermoOutput final : public Observer<D> {
   ThermoPoint production_start_;
   double production_ke_ = 0.0;  // thermal energy at the start of production
   std::vector<double> production_temperatures_;
+  // U at each production row: the slow variable Z's and the mean free time's rows may hide
+  // under their fast noise, so their error bars are reliable only when its own is.
+  std::vector<double> production_potential_energies_;
   std::uint64_t events_start_ = 0, collisions_start_ = 0;  // of this invocation
 };
 
