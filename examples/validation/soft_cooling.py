@@ -58,6 +58,9 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cached_runs  # noqa: E402
+
 ETA = 0.05          # packing fraction
 T0 = 1.0            # initial temperature (m = sigma = 1)
 RESTITUTION = 0.8   # Hertz: e at the impact speed RESTITUTION_SPEED
@@ -227,20 +230,7 @@ def read_thermo(path):
     return out
 
 
-def run_one(kairos, outdir, text):
-    """Runs kairos on `text` into outdir unless a finished run with the same config is there."""
-    cfg = os.path.join(outdir, "input.toml")
-    summary = os.path.join(outdir, "summary.json")
-    if os.path.exists(summary) and os.path.exists(cfg) and open(cfg).read() == text:
-        return outdir, 0.0
-    os.makedirs(outdir, exist_ok=True)
-    with open(cfg, "w") as f:
-        f.write(text)
-    t = time.time()
-    result = subprocess.run([kairos, "run", cfg, "-o", outdir], capture_output=True, text=True)
-    if result.returncode != 0:
-        raise RuntimeError("kairos failed in %s:\n%s" % (outdir, result.stderr[-3000:]))
-    return outdir, time.time() - t
+run_one = cached_runs.run_one
 
 
 class RunSet:

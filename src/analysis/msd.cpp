@@ -23,7 +23,8 @@ MsdCorrelator<D>::MsdCorrelator(std::vector<std::uint32_t> group, std::uint32_t 
 }
 
 template <int D>
-void MsdCorrelator<D>::correlate(Level& level, const std::vector<Vec<D>>& x, int first_j) {
+void MsdCorrelator<D>::correlate(Level& level, const std::vector<Vec<D>>& x, int first_j,
+                                 std::size_t epoch) {
   const std::size_t n = group_.size();
   const std::size_t per_j = static_cast<std::size_t>(groups_) * kSubsets;
   for (int j = first_j; j < kPoints; ++j) {
@@ -33,6 +34,8 @@ void MsdCorrelator<D>::correlate(Level& level, const std::vector<Vec<D>>& x, int
     const bool product = statistic_ == Statistic::kProduct;
     double* s2 = &level.sum2[static_cast<std::size_t>(j) * per_j];
     double* s4 = &level.sum4[static_cast<std::size_t>(j) * per_j];
+    const std::size_t je = static_cast<std::size_t>(j) * kEpochs + epoch;
+    double* in_epoch = &level.epoch_sum[je * groups_];
     for (std::size_t k = 0; k < n; ++k) {
       double r2 = 0.0;
       for (int a = 0; a < D; ++a) {
@@ -46,8 +49,10 @@ void MsdCorrelator<D>::correlate(Level& level, const std::vector<Vec<D>>& x, int
       const std::size_t at = slot(group_[k], static_cast<int>(k % kSubsets));
       s2[at] += r2;
       s4[at] += r2 * r2;
+      in_epoch[group_[k]] += r2;
     }
     ++level.count[static_cast<std::size_t>(j)];
+    ++level.epoch_count[je];
   }
 }
 
@@ -55,6 +60,8 @@ template <int D>
 void MsdCorrelator<D>::add(const std::vector<Vec<D>>& position) {
   const std::size_t n = group_.size();
   if (position.size() != n) throw std::invalid_argument("MsdCorrelator: wrong particle count");
+  if (samples_ / epoch_length_ >= static_cast<std::uint64_t>(kEpochs)) merge_epochs();
+  const auto epoch = static_cast<std::size_t>(samples_ / epoch_length_);
   std::uint64_t spacing = 1;
   for (int l = 0; l < max_levels_; ++l, spacing *= kRatio) {
     if (samples_ % spacing != 0) break;
@@ -68,6 +75,8 @@ void MsdCorrelator<D>::add(const std::vector<Vec<D>>& position) {
       level.sum2.assign(cells, 0.0);
       level.sum4.assign(cells, 0.0);
       level.count.assign(kPoints, 0);
+      level.epoch_sum.assign(static_cast<std::size_t>(kPoints) * kEpochs * groups_, 0.0);
+      level.epoch_count.assign(static_cast<std::size_t>(kPoints) * kEpochs, 0);
       if (l > 0) {
         const Level& below = levels_[static_cast<std::size_t>(l - 1)];
         std::copy(below.ring.begin(), below.ring.begin() + static_cast<std::ptrdiff_t>(n),
@@ -77,12 +86,34 @@ void MsdCorrelator<D>::add(const std::vector<Vec<D>>& position) {
       levels_.push_back(std::move(level));
     }
     Level& level = levels_[static_cast<std::size_t>(l)];
-    correlate(level, position, first_lag(l));
+    correlate(level, position, first_lag(l), epoch);
     std::copy(position.begin(), position.end(),
               level.ring.begin() + static_cast<std::ptrdiff_t>((level.kept % kPoints) * n));
     ++level.kept;
   }
   ++samples_;
+}
+
+// Epochs 2e and 2e + 1 become epoch e: the run's origins in half as many, twice as long.
+template <int D>
+void MsdCorrelator<D>::merge_epochs() {
+  for (Level& level : levels_) {
+    for (int j = 0; j < kPoints; ++j) {
+      const std::size_t base = static_cast<std::size_t>(j) * kEpochs;
+      for (int e = 0; e < kEpochs / 2; ++e) {
+        const std::size_t to = base + e, a = base + 2 * e, b = a + 1;
+        level.epoch_count[to] = level.epoch_count[a] + level.epoch_count[b];
+        for (std::uint32_t g = 0; g < groups_; ++g)
+          level.epoch_sum[to * groups_ + g] =
+              level.epoch_sum[a * groups_ + g] + level.epoch_sum[b * groups_ + g];
+      }
+      for (int e = kEpochs / 2; e < kEpochs; ++e) {
+        level.epoch_count[base + e] = 0;
+        for (std::uint32_t g = 0; g < groups_; ++g) level.epoch_sum[(base + e) * groups_ + g] = 0.0;
+      }
+    }
+  }
+  epoch_length_ *= 2;
 }
 
 template <int D>
@@ -101,6 +132,7 @@ std::vector<typename MsdCorrelator<D>::Lag> MsdCorrelator<D>::lags() const {
       lag.mean.assign(groups_, 0.0);
       lag.non_gaussian.assign(groups_, 0.0);
       lag.subset_mean.assign(groups_, {});
+      lag.epoch_mean.assign(groups_, {});
       const double* s2 = &level.sum2[static_cast<std::size_t>(j) * per_j];
       const double* s4 = &level.sum4[static_cast<std::size_t>(j) * per_j];
       for (std::uint32_t g = 0; g < groups_; ++g) {
@@ -114,6 +146,12 @@ std::vector<typename MsdCorrelator<D>::Lag> MsdCorrelator<D>::lags() const {
           members += size;
         }
         if (members == 0) continue;
+        for (int e = 0; e < kEpochs; ++e) {
+          const std::size_t je = static_cast<std::size_t>(j) * kEpochs + e;
+          const auto n_e = static_cast<double>(level.epoch_count[je]);
+          lag.epoch_mean[g][e] =
+              n_e > 0 ? level.epoch_sum[je * groups_ + g] / (members * n_e) : std::nan("");
+        }
         const double m2 = a2 / (members * static_cast<double>(origins));
         const double m4 = a4 / (members * static_cast<double>(origins));
         lag.mean[g] = m2;
@@ -146,6 +184,17 @@ double slope(const std::vector<double>& x, const std::vector<double>& y) {
   return sxy / sxx;
 }
 
+// The standard error of the mean of independent estimates (NaN for fewer than 2).
+double standard_error(const std::vector<double>& x) {
+  if (x.size() < 2) return std::nan("");
+  const auto n = static_cast<double>(x.size());
+  double mean = 0.0;
+  for (double v : x) mean += v / n;
+  double squares = 0.0;
+  for (double v : x) squares += (v - mean) * (v - mean);
+  return std::sqrt(squares / (n - 1.0) / n);
+}
+
 }  // namespace
 
 template <int D>
@@ -166,22 +215,24 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
     Diffusion d;
     d.lags = static_cast<int>(t.size());
     d.coefficient = slope(t, y) / (2.0 * D);
-    double sum = 0.0, squares = 0.0;
-    int used = 0;
-    for (int s = 0; s < kSubsets; ++s) {
-      if (group_size_[slot(g, s)] == 0) continue;
-      const double c = slope(t, ys[s]) / (2.0 * D);
-      sum += c;
-      squares += c * c;
-      ++used;
+    std::vector<double> by_subset, by_epoch;
+    for (int s = 0; s < kSubsets; ++s)
+      if (group_size_[slot(g, s)] > 0) by_subset.push_back(slope(t, ys[s]) / (2.0 * D));
+    for (int e = 0; e < kEpochs; ++e) {
+      std::vector<double> te, ye;
+      for (const Lag& lag : all) {
+        if (lag.lag < from || lag.lag > to || std::isnan(lag.epoch_mean[g][e])) continue;
+        te.push_back(lag.lag);
+        ye.push_back(lag.epoch_mean[g][e]);
+      }
+      if (te.size() >= 3) by_epoch.push_back(slope(te, ye) / (2.0 * D));
     }
-    if (used >= 2) {
-      const double mean = sum / used;
-      const double variance = std::max(0.0, (squares - used * mean * mean) / (used - 1));
-      d.stderr_ = std::sqrt(variance / used);
-    } else {
-      d.stderr_ = std::nan("");
-    }
+    d.particle_stderr = standard_error(by_subset);
+    d.epoch_stderr = standard_error(by_epoch);
+    d.epochs = static_cast<int>(by_epoch.size());
+    d.stderr_ = std::isnan(d.epoch_stderr)      ? d.particle_stderr
+                : std::isnan(d.particle_stderr) ? d.epoch_stderr
+                                                : std::max(d.particle_stderr, d.epoch_stderr);
     out[g] = d;
   }
   return out;

@@ -10,9 +10,11 @@
 // The same correlator gives the velocity autocorrelation <v(t + lag) . v(t)> (Statistic::kProduct,
 // lag 0 included) and its Green-Kubo integral.
 //
-// Particles are split into `groups` (species) and, for the error bar, into kSubsets interleaved
-// subsets (particle k in subset k mod kSubsets): self-diffusion of different particles is
-// nearly independent, so the scatter of the subsets' D gives its standard error.
+// Particles are split into `groups` (species). Two error bars are kept, and the larger is
+// reported: the scatter of D over kSubsets interleaved particle subsets (particle k in subset
+// k mod kSubsets), and over time epochs (the origins of 8 to 16 consecutive stretches of the
+// run, the stretches doubling as the run grows). The particles' scatter misses the motion all
+// particles share (the box's slow shear modes carry them together); the epochs' include it.
 #pragma once
 
 #include <array>
@@ -32,8 +34,9 @@ class MsdCorrelator {
   // velocities.
   enum class Statistic { kDisplacement, kProduct };
   static constexpr int kSubsets = 8;
-  static constexpr int kRatio = 2;   // m: lags grow by this factor per level
-  static constexpr int kPoints = 8;  // samples kept per level
+  static constexpr int kRatio = 2;    // m: lags grow by this factor per level
+  static constexpr int kPoints = 8;   // samples kept per level
+  static constexpr int kEpochs = 16;  // time epochs at most (merged pairwise when full)
 
   // group[k]: the group (species) of followed particle k, < groups; samples `interval` apart;
   // at most max_levels levels (lags up to kPoints kRatio^(max_levels - 1) intervals).
@@ -47,10 +50,12 @@ class MsdCorrelator {
   struct Lag {
     double lag = 0.0;                  // in time
     std::uint64_t origins = 0;         // pairs of samples averaged
-    std::vector<double> mean;  // per group: <|dr|^2>, or <v(t + lag) . v(t)>
+    std::vector<double> mean;          // per group: <|dr|^2>, or <v(t + lag) . v(t)>
     std::vector<double> non_gaussian;  // per group: alpha_2 = D <dr^4> / ((D + 2) <dr^2>^2) - 1
     // per group and subset: the mean of the subset (for error bars)
     std::vector<std::array<double, kSubsets>> subset_mean;
+    // per group and epoch: the mean over the epoch's origins (NaN: none at this lag)
+    std::vector<std::array<double, kEpochs>> epoch_mean;
   };
   // Every lag with at least one origin, in increasing order.
   std::vector<Lag> lags() const;
@@ -59,8 +64,11 @@ class MsdCorrelator {
   // (least squares over the lags in [from, to]), with the standard error from the subsets'
   // slopes; nothing when fewer than 3 lags fall in the window.
   struct Diffusion {
-    double coefficient = 0.0, stderr_ = 0.0;
-    int lags = 0;  // lags in the fit
+    double coefficient = 0.0;
+    double stderr_ = 0.0;                              // the larger of the two below
+    double particle_stderr = 0.0, epoch_stderr = 0.0;  // NaN: fewer than 2 subsets / epochs
+    int lags = 0;                                      // lags in the fit
+    int epochs = 0;                                    // epochs with a slope in the window
   };
   std::vector<std::optional<Diffusion>> diffusion(double from, double to) const;
   // kProduct: the Green-Kubo self-diffusion coefficient (1 / D_dim) integral_0^to <v(lag) . v(0)>
@@ -79,7 +87,12 @@ class MsdCorrelator {
     // Per lag index j (0 .. kPoints - 1), per group and subset: sums of |dr|^2, |dr|^4, count.
     std::vector<double> sum2, sum4;
     std::vector<std::uint64_t> count;
+    // Per lag index j and epoch e, per group: the sum of |dr|^2 (epoch_sum[(j kEpochs + e) G +
+    // g]) and the origins (epoch_count[j kEpochs + e]).
+    std::vector<double> epoch_sum;
+    std::vector<std::uint64_t> epoch_count;
   };
+  void merge_epochs();
   std::size_t slot(std::uint32_t g, int subset) const { return g * kSubsets + subset; }
   // The first lag index of level l: 1 on level 0 (0 too for products: C(0)), above it the lags
   // the level below does not reach.
@@ -87,7 +100,7 @@ class MsdCorrelator {
     if (l > 0) return kPoints / kRatio;
     return statistic_ == Statistic::kProduct ? 0 : 1;
   }
-  void correlate(Level& level, const std::vector<Vec<D>>& x, int first_j);
+  void correlate(Level& level, const std::vector<Vec<D>>& x, int first_j, std::size_t epoch);
 
   std::vector<std::uint32_t> group_;
   std::uint32_t groups_;
@@ -97,6 +110,7 @@ class MsdCorrelator {
   std::vector<std::uint64_t> group_size_;  // per (group, subset)
   std::vector<Level> levels_;
   std::uint64_t samples_ = 0;
+  std::uint64_t epoch_length_ = 1;  // samples per epoch
 };
 
 }  // namespace kairos

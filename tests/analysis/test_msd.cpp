@@ -122,6 +122,46 @@ TEST(MsdCorrelator, ARandomWalkGivesBackItsDiffusionCoefficientWithinItsErrorBar
   EXPECT_GE(within, 8);
 }
 
+// Walkers that also share one random displacement per step (as the particles of a box share its
+// slow flows): subsets of particles all see it, so only the epochs' scatter measures it.
+TEST(MsdCorrelator, MotionTheParticlesShareIsInTheErrorBar) {
+  constexpr int n = 400, samples = 2000;
+  constexpr double dt = 0.05, own = 0.1, shared = 0.3;
+  std::vector<double> values, errors, particle_errors;
+  for (std::uint64_t seed = 1; seed <= 16; ++seed) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> step(0.0, 1.0);
+    MsdCorrelator<3> c(std::vector<std::uint32_t>(n, 0), 1, dt);
+    std::vector<Vec<3>> x(n);
+    for (int s = 0; s < samples; ++s) {
+      c.add(x);
+      Vec<3> common{};
+      for (int a = 0; a < 3; ++a) common[a] = std::sqrt(2.0 * shared * dt) * step(rng);
+      for (auto& p : x)
+        for (int a = 0; a < 3; ++a) p[a] += common[a] + std::sqrt(2.0 * own * dt) * step(rng);
+    }
+    const auto d = c.diffusion(1.0, 20.0);
+    ASSERT_TRUE(d[0].has_value());
+    EXPECT_GE(d[0]->epochs, 8);
+    values.push_back(d[0]->coefficient);
+    errors.push_back(d[0]->stderr_);
+    particle_errors.push_back(d[0]->particle_stderr);
+  }
+  const auto runs = static_cast<double>(values.size());
+  double mean = 0.0, scatter = 0.0, error = 0.0, particle_error = 0.0;
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    mean += values[k] / runs;
+    error += errors[k] / runs;
+    particle_error += particle_errors[k] / runs;
+  }
+  for (double v : values) scatter += (v - mean) * (v - mean) / (runs - 1.0);
+  scatter = std::sqrt(scatter);
+  EXPECT_NEAR(mean, own + shared, 4.0 * scatter / std::sqrt(runs));
+  EXPECT_LT(particle_error, scatter / 3.0);  // the subsets cannot see the shared motion
+  EXPECT_GT(error, scatter / 2.0);           // the epochs do (16 runs: the scatter to ~20 %)
+  EXPECT_LT(error, scatter * 2.0);
+}
+
 TEST(MsdCorrelator, ProductsAreTheBruteForceVelocityAutocorrelation) {
   constexpr int n = 7, samples = 200;
   std::mt19937_64 rng(8);

@@ -59,6 +59,11 @@ class Diffusion(kt.KairosTestCase):
         self.assertEqual(rows[0, 0], 0.0)
         self.assertAlmostEqual(rows[0, 2] / (3 * self.summary(out)["temperature"]), 1.0, delta=0.05)
         self.assertIn("vacf.tsv", self.summary(out)["outputs"])
+        # A quarter of the run as the longest lag: too few windows for a reliable error bar.
+        self.assertFalse(fit["coefficient_stderr_reliable"])
+        self.assertGreaterEqual(fit["coefficient_stderr"], fit["coefficient_stderr_particles"])
+        self.assertGreaterEqual(fit["coefficient_stderr"], fit["coefficient_stderr_epochs"])
+        self.assertGreaterEqual(fit["epochs_fitted"], 8)
         self.assertGreater(d["samples"], 100)
         self.assertEqual(d["particles_followed"], 2000)
 

@@ -172,6 +172,14 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
       s["coefficient_stderr"] =
           std::isfinite(fits[g]->stderr_) ? nlohmann::json(fits[g]->stderr_) : nullptr;
       s["lags_fitted"] = fits[g]->lags;
+      const auto finite = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nullptr; };
+      s["coefficient_stderr_particles"] = finite(fits[g]->particle_stderr);
+      s["coefficient_stderr_epochs"] = finite(fits[g]->epoch_stderr);
+      s["epochs_fitted"] = fits[g]->epochs;
+      // Runs hold few independent windows of the fit's longest lag: the error bars of the
+      // subsets and epochs then miss the scatter between runs (docs/validation.md found up to
+      // 3x with the automatic window, fit_to = a quarter of the run).
+      s["coefficient_stderr_reliable"] = last_sample_ - first_sample_ >= 20.0 * to;
     } else {
       s["coefficient"] = nullptr;
       s["why"] = fmt::format(
