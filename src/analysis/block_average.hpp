@@ -11,7 +11,8 @@
 // level j whose M_j stays below the 99 % quantile is taken as the plateau. Since the test
 // cannot see a lag-1 correlation r below about sqrt(6.6 / n_j), which leaves Flyvbjerg &
 // Petersen's estimate s_j^2 / (n_j - 1) of the variance of the mean low by about 2r, the
-// lag-1 term of their truncation error is kept: var(mean) = (s_j^2 + 2 max(g_j, 0)) / (n_j - 1).
+// lag-1 term of their truncation error is kept (Kairos's addition, checked on AR(1) series):
+// var(mean) = (s_j^2 + 2 max(g_j, 0)) / (n_j - 1).
 #pragma once
 
 #include <cstddef>
