@@ -153,7 +153,7 @@ struct AnalysisConfig {
   // over lags [msd_fit_from, msd_fit_to] (0: automatic).
   bool msd = false;
   double msd_interval = 0.0;
-  std::int64_t msd_particles = 10000;
+  std::int64_t msd_particles = 4096;
   double msd_fit_from = 0.0;
   double msd_fit_to = 0.0;
   // vacf.tsv: the velocity autocorrelation on the same lags, and D by Green-Kubo.
