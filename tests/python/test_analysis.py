@@ -110,6 +110,12 @@ class Analysis(kt.KairosTestCase):
         # The mixture's Z from its three contact values agrees with the virial's.
         rdf = a["rdf"]
         self.assertLess(abs(rdf["compressibility_difference_in_stderr"]), 4.0)
+        # Every blocked error bar says how many blocks it had and whether it can be trusted.
+        for pair in ("A-A", "A-B", "B-B"):
+            entry = rdf["contact"][pair]
+            self.assertIsInstance(entry["stderr_reliable"], bool)
+            self.assertGreaterEqual(entry["stderr_blocks"], 1)
+        self.assertIsInstance(a["bond_order"]["psi6"]["global_stderr_reliable"], bool)
 
     def test_walls_have_g_of_r_but_no_structure_factor(self):
         config = kt.base_config(particles=500, packing_fraction=0.2, production=10.0,

@@ -72,6 +72,10 @@ void BondOrderOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&
     set_or_explain(summary, entry, "local_mean", local.mean, none, base + ".local_mean");
     set_or_explain(summary, entry, "local_mean_stderr", local.stderr_, none.empty() ? few : none,
                    base + ".local_mean_stderr");
+    if (none.empty()) {
+      set_error_quality(entry, "global_stderr", global);
+      set_error_quality(entry, "local_mean_stderr", local);
+    }
     j[n] = entry;
   }
 }

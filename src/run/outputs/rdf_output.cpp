@@ -130,6 +130,7 @@ void RdfOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>& run) 
       set_or_explain(summary, entry, "g", c.mean, none, name + ".g");
       set_or_explain(summary, entry, "stderr", c.stderr_, none.empty() ? few : none,
                      name + ".stderr");
+      if (none.empty()) set_error_quality(entry, "stderr", c);
       contact[pair_names_[p]] = entry;
     }
     j["overlapping_pairs_last_sample"] = g.overlapping();
@@ -144,6 +145,7 @@ void RdfOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>& run) 
                  "analysis.rdf.compressibility_from_contact.mean");
   set_or_explain(summary, from_contact, "stderr", z.stderr_, why.empty() ? few : why,
                  "analysis.rdf.compressibility_from_contact.stderr");
+  if (why.empty()) set_error_quality(from_contact, "stderr", z);
   j["compressibility_from_contact"] = from_contact;
   if (!why.empty()) return;
   // Z measured by the collision virial over the same production (summary.json's

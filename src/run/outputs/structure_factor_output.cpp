@@ -57,6 +57,7 @@ void StructureFactorOutput<D>::summarize(nlohmann::json& summary, const RunConte
   set_or_explain(summary, j, "s_k_min", shells[0].s.mean, "", "analysis.structure_factor.s_k_min");
   set_or_explain(summary, j, "s_k_min_stderr", shells[0].s.stderr_, few,
                  "analysis.structure_factor.s_k_min_stderr");
+  set_error_quality(j, "s_k_min_stderr", shells[0].s);
   j["s_zero_method"] = fmt::format(
       "S = a + b k^2 + c k^4 fitted to the shells with k <= {:.6g} (each weighted by its "
       "vectors), a",
@@ -66,6 +67,7 @@ void StructureFactorOutput<D>::summarize(nlohmann::json& summary, const RunConte
   set_or_explain(summary, j, "s_zero", s.s_zero().mean, no_fit, "analysis.structure_factor.s_zero");
   set_or_explain(summary, j, "s_zero_stderr", s.s_zero().stderr_, no_fit.empty() ? few : no_fit,
                  "analysis.structure_factor.s_zero_stderr");
+  if (no_fit.empty()) set_error_quality(j, "s_zero_stderr", s.s_zero());
 }
 
 template class StructureFactorOutput<2>;

@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/block_average.hpp"
+
 namespace kairos {
 
 // `value` under `key` of `where` (summary itself or one of its parts), or null and, in
@@ -23,6 +25,14 @@ inline void set_or_explain(nlohmann::json& summary, nlohmann::json& where, const
 }
 
 // The same for a sonine coefficient (granular parts): undefined for an inhomogeneous gas.
+// Beside a blocked error bar `KEY`: how many effectively independent blocks it had and whether
+// it can be trusted (analysis/block_average.hpp), as KEY_blocks and KEY_reliable.
+inline void set_error_quality(nlohmann::json& where, const std::string& key,
+                              const BlockAverage& b) {
+  where[key + "_blocks"] = b.blocks;
+  where[key + "_reliable"] = b.reliable;
+}
+
 inline void set_sonine_a2(nlohmann::json& summary, nlohmann::json& where, double a2, bool bulk) {
   set_or_explain(summary, where, "sonine_a2", a2,
                  !bulk                ? "walls, open faces or a field: the gas is not homogeneous"
