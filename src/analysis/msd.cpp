@@ -259,17 +259,10 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
     Diffusion d;
     d.lags = used_lags + 1;
     d.coefficient = total / D;
-    double sum = 0.0, squares = 0.0;
-    int used = 0;
-    for (int s = 0; s < kSubsets; ++s) {
-      if (group_size_[slot(g, s)] == 0) continue;
-      sum += part[s] / D;
-      squares += (part[s] / D) * (part[s] / D);
-      ++used;
-    }
-    d.stderr_ = used >= 2
-                    ? std::sqrt(std::max(0.0, (squares - sum * sum / used) / (used - 1)) / used)
-                    : std::nan("");
+    std::vector<double> by_subset;
+    for (int s = 0; s < kSubsets; ++s)
+      if (group_size_[slot(g, s)] > 0) by_subset.push_back(part[s] / D);
+    d.stderr_ = d.particle_stderr = standard_error(by_subset);
     out[g] = d;
   }
   return out;

@@ -675,6 +675,7 @@ class Reader : public KeyReader {
                  "load does not end); use run.integrator = \"dem\"");
       }
     }
+    check_msd_keys(root, c.analysis);
     if (c.analysis.msd && c.boundary.shear_rate != 0.0) {
       fail(node_at(root, "analysis.msd"), "analysis.msd",
            "analysis.msd: the mean-square displacement under Lees-Edwards shear is not measured "
@@ -700,6 +701,31 @@ class Reader : public KeyReader {
     if (c.run.validate) unsupported("run.validate", "engine validation is");
     if (c.analysis.msd)
       unsupported("analysis.msd", "the mean-square displacement (image counters) is");
+  }
+
+  // The MSD's keys act only with analysis.msd = true, and its fit window must be a window.
+  void check_msd_keys(const toml::table& root, const AnalysisConfig& a) const {
+    const AnalysisConfig defaults;
+    const std::pair<const char*, bool> set[] = {
+        {"analysis.vacf", a.vacf},
+        {"analysis.msd_interval", a.msd_interval != defaults.msd_interval},
+        {"analysis.msd_particles", a.msd_particles != defaults.msd_particles},
+        {"analysis.msd_fit_from", a.msd_fit_from != defaults.msd_fit_from},
+        {"analysis.msd_fit_to", a.msd_fit_to != defaults.msd_fit_to},
+        {"analysis.msd_viscosity", a.msd_viscosity != defaults.msd_viscosity}};
+    for (const auto& [key, given] : set) {
+      if (given && !a.msd) {
+        fail(node_at(root, key), key,
+             fmt::format("{}: acts on the mean-square displacement only; set analysis.msd = true",
+                         key));
+      }
+    }
+    if (a.msd_fit_from > 0.0 && a.msd_fit_to > 0.0 && !(a.msd_fit_from < a.msd_fit_to)) {
+      fail(node_at(root, "analysis.msd_fit_to"), "analysis.msd_fit_to",
+           fmt::format("analysis.msd_fit_to = {}: the fit window must end after it starts "
+                       "(analysis.msd_fit_from = {})",
+                       a.msd_fit_to, a.msd_fit_from));
+    }
   }
 
   void read_field(const toml::table& t, const int& dimension, FieldConfig& f) const {

@@ -102,8 +102,10 @@ std::string concrete(const std::string& path) {
 }
 
 std::string base_for(const std::string& path) {
-  return path.starts_with("soft") || path == "run.time_step" ? std::string(kEveryTableSoft)
-                                                             : std::string(kEveryTableHard);
+  if (path.starts_with("soft") || path == "run.time_step") return std::string(kEveryTableSoft);
+  // The MSD's own keys act only with the MSD on.
+  const bool msd = path.starts_with("analysis.msd_") || path == "analysis.vacf";
+  return std::string(kEveryTableHard) + (msd ? "\n[analysis]\nmsd = true\n" : "");
 }
 
 // A value inside the key's range (and valid with the configs above), as --set writes it.

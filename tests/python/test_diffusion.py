@@ -109,6 +109,12 @@ class Diffusion(kt.KairosTestCase):
         sheared = kt.base_config(analysis={"msd": True}, boundary={"shear_rate": 0.5})
         self.assert_user_error(self.kairos("run", self.write_config(sheared, "s.toml"), "-o",
                                            self.path("s")), "analysis.msd", "Lees-Edwards")
+        alone = kt.base_config(analysis={"vacf": True})
+        self.assert_user_error(self.kairos("run", self.write_config(alone, "a.toml"), "-o",
+                                           self.path("a")), "analysis.vacf", "analysis.msd = true")
+        window = kt.base_config(analysis={"msd": True, "msd_fit_from": 5.0, "msd_fit_to": 2.0})
+        self.assert_user_error(self.kairos("run", self.write_config(window, "w.toml"), "-o",
+                                           self.path("w")), "analysis.msd_fit_to")
         bad = kt.base_config(analysis={"msd": True, "msd_particles": 0})
         self.assert_user_error(self.kairos("run", self.write_config(bad, "b.toml"), "-o",
                                            self.path("b")), "analysis.msd_particles")

@@ -5,29 +5,16 @@
 
 #include <fmt/format.h>
 
+#include "analysis/granular_theory.hpp"
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "run/collision_estimate.hpp"
 
 namespace kairos {
 
-namespace {
-
-// The contact value of the pair distribution of hard spheres (Carnahan and Starling, J. Chem.
-// Phys. 51, 635 (1969)) or disks (Henderson, Mol. Phys. 30, 971 (1975)): the Enskog factor
-// that shortens the ideal-gas mean free time at packing fraction eta.
-template <int D>
-double contact_value(double eta) {
-  if (!(eta > 0.0 && eta < 0.9)) return 1.0;
-  return D == 3 ? (1.0 - 0.5 * eta) / std::pow(1.0 - eta, 3)
-                : (1.0 - 7.0 * eta / 16.0) / std::pow(1.0 - eta, 2);
-}
-
-}  // namespace
-
 template <int D>
 MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
-    : engine_(engine), config_(config.analysis) {
+    : engine_(engine), config_(config.analysis), stats_(D, engine.size(), engine.volume()) {
   const std::size_t n = engine.size();
   const auto wanted = static_cast<std::size_t>(config_.msd_particles);
   const std::size_t step = n <= wanted ? 1 : (n + wanted - 1) / wanted;
@@ -55,7 +42,9 @@ MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
     const double sigma = mean_volume_diameter<D>(engine.particle_volume(), static_cast<double>(n));
     const FlightEstimate flight = estimate_flight<D>(static_cast<double>(n), engine.volume(), sigma,
                                                      std::sqrt(v2 / static_cast<double>(n)));
-    interval_ = 0.5 * flight.mean_free_time / contact_value<D>(eta);
+    // The Enskog factor (the contact value) that shortens the ideal-gas flight.
+    const double enskog = eta > 0.0 && eta < 0.9 ? contact_value(D, eta) : 1.0;
+    interval_ = 0.5 * flight.mean_free_time / enskog;
     if (!std::isfinite(interval_) || !(interval_ > 0.0)) {
       throw InputError(
           "analysis.msd: the particles do not move, so no sampling interval follows from their "
@@ -89,10 +78,8 @@ void MsdOutput<D>::write(const RunContext<D>& run) {
 
 template <int D>
 double MsdOutput<D>::mean_free_time() const {
-  const std::uint64_t collisions = engine_.collisions() - start_collisions_;
-  if (collisions == 0) return std::nan("");
-  return (engine_.time() - start_time_) * static_cast<double>(engine_.size()) /
-         (2.0 * static_cast<double>(collisions));
+  return stats_.mean_free_time(engine_.time() - start_time_,
+                               engine_.collisions() - start_collisions_);
 }
 
 template <int D>
@@ -194,8 +181,7 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
       for (int a = 1; a < D; ++a) cubic = cubic && box[a] == box[0];
       if (cubic) {
         constexpr double kXi = 2.837297;
-        const double kt =
-            2.0 * engine_.thermal_energy() / (D * (static_cast<double>(engine_.size()) - 1.0));
+        const double kt = stats_.temperature(engine_.thermal_energy());
         s["coefficient_infinite_size"] =
             fits[g]->coefficient + kXi * kt / (6.0 * M_PI * config_.msd_viscosity * box[0]);
         s["infinite_size_temperature"] = kt;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analysis/msd.hpp"
+#include "analysis/thermodynamics.hpp"
 #include "run/event_adapter.hpp"
 #include "run/outputs/observer.hpp"
 
@@ -38,6 +39,7 @@ class MsdOutput final : public Observer<D> {
 
   const EventIntegrator<D>& engine_;
   AnalysisConfig config_;
+  Thermodynamics stats_;  // the temperature and mean free time, as thermo.tsv defines them
   double interval_ = 0.0;
   bool automatic_interval_ = false;
   std::vector<std::uint32_t> slot_;  // per particle: its place among the followed, or ~0u
