@@ -675,7 +675,7 @@ class Reader : public KeyReader {
                  "load does not end); use run.integrator = \"dem\"");
       }
     }
-    check_msd_keys(root, c.analysis);
+    check_analysis_keys(root, c.analysis);
     if (c.analysis.msd && c.boundary.shear_rate != 0.0) {
       fail(node_at(root, "analysis.msd"), "analysis.msd",
            "analysis.msd: the mean-square displacement under Lees-Edwards shear is not measured "
@@ -703,22 +703,37 @@ class Reader : public KeyReader {
       unsupported("analysis.msd", "the mean-square displacement (image counters) is");
   }
 
-  // The MSD's keys act only with analysis.msd = true, and its fit window must be a window.
-  void check_msd_keys(const toml::table& root, const AnalysisConfig& a) const {
-    const AnalysisConfig defaults;
-    const std::pair<const char*, bool> set[] = {
-        {"analysis.vacf", a.vacf},
-        {"analysis.msd_interval", a.msd_interval != defaults.msd_interval},
-        {"analysis.msd_particles", a.msd_particles != defaults.msd_particles},
-        {"analysis.msd_fit_from", a.msd_fit_from != defaults.msd_fit_from},
-        {"analysis.msd_fit_to", a.msd_fit_to != defaults.msd_fit_to},
-        {"analysis.msd_viscosity", a.msd_viscosity != defaults.msd_viscosity}};
-    for (const auto& [key, given] : set) {
-      if (given && !a.msd) {
-        fail(node_at(root, key), key,
-             fmt::format("{}: acts on the mean-square displacement only; set analysis.msd = true",
-                         key));
-      }
+  // An analysis's own keys act only with that analysis on (an error naming the key, never a key
+  // silently ignored), and the MSD's fit window must be a window.
+  void check_analysis_keys(const toml::table& root, const AnalysisConfig& a) const {
+    const AnalysisConfig d;
+    const bool structure = a.rdf || a.structure_factor || a.bond_order || a.velocity_distribution;
+    struct Needs {
+      const char* key;
+      bool given, on;
+      const char* what;
+    };
+    const Needs keys[] = {
+        {"analysis.vacf", a.vacf, a.msd, "analysis.msd = true"},
+        {"analysis.msd_interval", a.msd_interval != d.msd_interval, a.msd, "analysis.msd = true"},
+        {"analysis.msd_particles", a.msd_particles != d.msd_particles, a.msd,
+         "analysis.msd = true"},
+        {"analysis.msd_fit_from", a.msd_fit_from != d.msd_fit_from, a.msd, "analysis.msd = true"},
+        {"analysis.msd_fit_to", a.msd_fit_to != d.msd_fit_to, a.msd, "analysis.msd = true"},
+        {"analysis.msd_viscosity", a.msd_viscosity != d.msd_viscosity, a.msd,
+         "analysis.msd = true"},
+        {"analysis.rdf_bins", a.rdf_bins != d.rdf_bins, a.rdf, "analysis.rdf = true"},
+        {"analysis.rdf_max_distance", a.rdf_max_distance != d.rdf_max_distance, a.rdf,
+         "analysis.rdf = true"},
+        {"analysis.sk_max", a.sk_max != d.sk_max, a.structure_factor,
+         "analysis.structure_factor = true"},
+        {"analysis.bond_cutoff", a.bond_cutoff != d.bond_cutoff, a.bond_order,
+         "analysis.bond_order = true"},
+        {"analysis.interval", a.interval != d.interval, structure,
+         "a structure analysis (rdf, structure_factor, bond_order or velocity_distribution)"}};
+    for (const Needs& k : keys) {
+      if (k.given && !k.on)
+        fail(node_at(root, k.key), k.key, fmt::format("{}: acts only with {}", k.key, k.what));
     }
     if (a.msd_fit_from > 0.0 && a.msd_fit_to > 0.0 && !(a.msd_fit_from < a.msd_fit_to)) {
       fail(node_at(root, "analysis.msd_fit_to"), "analysis.msd_fit_to",

@@ -103,9 +103,12 @@ std::string concrete(const std::string& path) {
 
 std::string base_for(const std::string& path) {
   if (path.starts_with("soft") || path == "run.time_step") return std::string(kEveryTableSoft);
-  // The MSD's own keys act only with the MSD on.
-  const bool msd = path.starts_with("analysis.msd_") || path == "analysis.vacf";
-  return std::string(kEveryTableHard) + (msd ? "\n[analysis]\nmsd = true\n" : "");
+  // An analysis's own keys act only with that analysis on.
+  const bool analysis = path.starts_with("analysis.");
+  return std::string(kEveryTableHard) +
+         (analysis ? "\n[analysis]\nmsd = true\nrdf = true\nstructure_factor = true\n"
+                     "bond_order = true\n"
+                   : "");
 }
 
 // A value inside the key's range (and valid with the configs above), as --set writes it.

@@ -112,6 +112,10 @@ class Diffusion(kt.KairosTestCase):
         alone = kt.base_config(analysis={"vacf": True})
         self.assert_user_error(self.kairos("run", self.write_config(alone, "a.toml"), "-o",
                                            self.path("a")), "analysis.vacf", "analysis.msd = true")
+        lonely = kt.base_config(analysis={"rdf_bins": 50})
+        self.assert_user_error(self.kairos("run", self.write_config(lonely, "l.toml"), "-o",
+                                           self.path("l")), "analysis.rdf_bins",
+                               "analysis.rdf = true")
         window = kt.base_config(analysis={"msd": True, "msd_fit_from": 5.0, "msd_fit_to": 2.0})
         self.assert_user_error(self.kairos("run", self.write_config(window, "w.toml"), "-o",
                                            self.path("w")), "analysis.msd_fit_to")
