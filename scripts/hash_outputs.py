@@ -51,7 +51,7 @@ SKIPPED_CHUNKS = []
 # move without changing a trajectory (the engine's own bytes per particle).
 VOLATILE = {"wall_seconds", "collisions_per_second", "events_per_second", "steps_per_second",
             "peak_rss_bytes", "run_id", "bytes_per_particle", "kairos_version",
-            "setup_seconds", "timing", "ns_per_particle_step"}
+            "setup_wall_seconds", "timing", "ns_per_particle_step"}
 
 # Cases beyond the examples: (name, config file relative to the repository or None for
 # inline TOML, inline TOML, overrides, a continuation's overrides or None).

@@ -10,6 +10,8 @@
 // the front ends turn into a one-line message (the CLI: exit status 128 + signal).
 #pragma once
 
+#include <chrono>
+
 namespace kairos {
 
 // Asks the run (or its setup) to stop; async-signal-safe.
@@ -29,8 +31,15 @@ class ScopedStopDeadline {
 
  private:
   long long previous_deadline_;
+  long long previous_origin_;
   double previous_seconds_;
 };
+
+// When the wall-time limit's clock started: the construction of the innermost live
+// ScopedStopDeadline with a limit, or now if there is none. The run driver measures
+// run.max_wall_seconds and the setup's wall time from here, so the limit and the reported times
+// share one origin.
+std::chrono::steady_clock::time_point wall_limit_origin() noexcept;
 
 // Throws Interrupted (core/error.hpp) if a stop was requested or the setup deadline has passed.
 // Cheap (an atomic load, and a clock read only while a deadline is set), but meant for loops

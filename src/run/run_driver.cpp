@@ -92,6 +92,7 @@ std::uint64_t RunDriver<D>::collisions_for(double per_particle) const {
 template <int D>
 RunOutcome RunDriver<D>::run() {
   const auto wall_start = Clock::now();
+  setup_wall_seconds_ = std::chrono::duration<double>(wall_start - created_).count();
   continuation_ = output_continuation(directory_->continues_outputs(), resumed_);
   for (auto& o : observers_) o->open(*this);
   ProgressLine progress(progress_modes().at(config_.output.progress));

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "core/stop_flag.hpp"
 #include "io/config.hpp"
 #include "io/progress.hpp"
 #include "run/integrator.hpp"
@@ -71,6 +72,7 @@ class RunDriver final : public RunContext<D> {
   const std::string& stop_reason() const override { return stop_reason_; }
   const std::string& error() const override { return error_; }
   double wall_seconds() const override { return wall_seconds_; }
+  double setup_wall_seconds() const override { return setup_wall_seconds_; }
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -89,7 +91,9 @@ class RunDriver final : public RunContext<D> {
   bool wall_time_exceeded() const;
   nlohmann::json outputs_present() const;
 
-  Clock::time_point created_ = Clock::now();  // the start of the set-up
+  // The start of the set-up: the origin of run.max_wall_seconds (the front end's
+  // ScopedStopDeadline, which also covers table builds before the driver exists).
+  Clock::time_point created_ = wall_limit_origin();
   Config config_;
   std::optional<std::filesystem::path> restart_file_;
   RunProgress resumed_;
@@ -114,6 +118,7 @@ class RunDriver final : public RunContext<D> {
   std::string stop_reason_ = "completed";
   std::string error_;  // why the run could not go on (RunOutcome::error)
   double wall_seconds_ = 0.0;
+  double setup_wall_seconds_ = 0.0;
 };
 
 }  // namespace kairos

@@ -63,10 +63,12 @@ class RunContext {
   // The run's progress now, as the restart file records it (every observer's record()).
   virtual RunProgress progress_now() const = 0;
   // For summarize(): why the run stopped ("completed", "signal", ...), its error ("": none),
-  // and the wall-clock seconds of the run (the setup not counted).
+  // the wall-clock seconds of the run (the setup not counted) and of the setup before it
+  // (from the origin of run.max_wall_seconds: their sum is what the limit compares).
   virtual const std::string& stop_reason() const = 0;
   virtual const std::string& error() const = 0;
   virtual double wall_seconds() const = 0;
+  virtual double setup_wall_seconds() const = 0;
 };
 
 template <int D>

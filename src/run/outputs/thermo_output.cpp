@@ -135,6 +135,7 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
   j["production_time"] = production_time;
   j["production_collisions_per_particle"] = run.per_particle(production_collisions);
   j["wall_seconds"] = wall;
+  j["setup_wall_seconds"] = run.setup_wall_seconds();
   j["events_per_second"] = wall > 0 ? static_cast<double>(events) / wall : 0.0;
   j["collisions_per_second"] = wall > 0 ? static_cast<double>(collisions) / wall : 0.0;
   j["temperature"] = th.temperature(ke);
