@@ -24,29 +24,54 @@ MsdCorrelator<D>::MsdCorrelator(std::vector<std::uint32_t> group, std::uint32_t 
 
 template <int D>
 void MsdCorrelator<D>::correlate(Level& level, const std::vector<Vec<D>>& x, int first_j,
-                                 std::size_t epoch) {
+                                 std::size_t epoch, double spacing) {
   const std::size_t n = group_.size();
   const std::size_t per_j = static_cast<std::size_t>(groups_) * kSubsets;
+  const bool flux = statistic_ == Statistic::kFluxProduct;
+  const bool product = statistic_ != Statistic::kDisplacement;
+  // A flux needs the sample before: the level's last kept one (none yet: nothing to pair).
+  if (flux && level.kept == 0) return;
+  const auto kept_at = [&](std::uint64_t back) {  // the sample `back` before the current one
+    return &level.ring[((level.kept - back) % kPoints) * n];
+  };
+  const double per_time = 1.0 / (spacing * interval_);
+  if (flux) {
+    flux_now_.resize(n);
+    const Vec<D>* before = kept_at(1);
+    for (std::size_t k = 0; k < n; ++k)
+      for (int a = 0; a < D; ++a) flux_now_[k][a] = (x[k][a] - before[k][a]) * per_time;
+  }
+  const Vec<D>* now = flux ? flux_now_.data() : x.data();
   for (int j = first_j; j < kPoints; ++j) {
-    if (level.kept < static_cast<std::uint64_t>(j)) break;
-    const std::size_t back = (level.kept - static_cast<std::uint64_t>(j)) % kPoints;
-    const Vec<D>* then = j == 0 ? x.data() : &level.ring[back * n];
-    const bool product = statistic_ == Statistic::kProduct;
+    // The sample j before, and for a flux the one before it too, still in the ring.
+    const auto needed = static_cast<std::uint64_t>(flux ? j + 1 : j);
+    if (level.kept < needed) break;
+    const Vec<D>* then = j == 0 ? x.data() : kept_at(static_cast<std::uint64_t>(j));
+    const Vec<D>* then_before = flux ? kept_at(static_cast<std::uint64_t>(j) + 1) : nullptr;
     double* s2 = &level.sum2[static_cast<std::size_t>(j) * per_j];
     double* s4 = &level.sum4[static_cast<std::size_t>(j) * per_j];
     const std::size_t je = static_cast<std::size_t>(j) * kEpochs + epoch;
     double* in_epoch = &level.epoch_sum[je * groups_];
+    double* s1 = &level.sum1[static_cast<std::size_t>(j) * per_j * D];
+    double* in_epoch1 = &level.epoch_sum1[je * groups_ * D];
     for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t at = slot(group_[k], static_cast<int>(k % kSubsets));
       double r2 = 0.0;
       for (int a = 0; a < D; ++a) {
+        double first;
         if (product) {
-          r2 += x[k][a] * then[k][a];
+          const double earlier =
+              flux ? (j == 0 ? now[k][a] : (then[k][a] - then_before[k][a]) * per_time)
+                   : then[k][a];
+          r2 += now[k][a] * earlier;
+          first = now[k][a] + earlier;
         } else {
-          const double d = x[k][a] - then[k][a];
-          r2 += d * d;
+          first = x[k][a] - then[k][a];
+          r2 += first * first;
         }
+        s1[at * D + a] += first;
+        in_epoch1[group_[k] * D + a] += first;
       }
-      const std::size_t at = slot(group_[k], static_cast<int>(k % kSubsets));
       s2[at] += r2;
       s4[at] += r2 * r2;
       in_epoch[group_[k]] += r2;
@@ -74,8 +99,10 @@ void MsdCorrelator<D>::add(const std::vector<Vec<D>>& position) {
       const std::size_t cells = static_cast<std::size_t>(kPoints) * groups_ * kSubsets;
       level.sum2.assign(cells, 0.0);
       level.sum4.assign(cells, 0.0);
+      level.sum1.assign(cells * D, 0.0);
       level.count.assign(kPoints, 0);
       level.epoch_sum.assign(static_cast<std::size_t>(kPoints) * kEpochs * groups_, 0.0);
+      level.epoch_sum1.assign(static_cast<std::size_t>(kPoints) * kEpochs * groups_ * D, 0.0);
       level.epoch_count.assign(static_cast<std::size_t>(kPoints) * kEpochs, 0);
       if (l > 0) {
         const Level& below = levels_[static_cast<std::size_t>(l - 1)];
@@ -86,7 +113,7 @@ void MsdCorrelator<D>::add(const std::vector<Vec<D>>& position) {
       levels_.push_back(std::move(level));
     }
     Level& level = levels_[static_cast<std::size_t>(l)];
-    correlate(level, position, first_lag(l), epoch);
+    correlate(level, position, first_lag(l), epoch, static_cast<double>(spacing));
     std::copy(position.begin(), position.end(),
               level.ring.begin() + static_cast<std::ptrdiff_t>((level.kept % kPoints) * n));
     ++level.kept;
@@ -106,10 +133,15 @@ void MsdCorrelator<D>::merge_epochs() {
         for (std::uint32_t g = 0; g < groups_; ++g)
           level.epoch_sum[to * groups_ + g] =
               level.epoch_sum[a * groups_ + g] + level.epoch_sum[b * groups_ + g];
+        for (std::size_t c = 0; !level.epoch_sum1.empty() && c < groups_ * D; ++c)
+          level.epoch_sum1[to * groups_ * D + c] =
+              level.epoch_sum1[a * groups_ * D + c] + level.epoch_sum1[b * groups_ * D + c];
       }
       for (int e = kEpochs / 2; e < kEpochs; ++e) {
         level.epoch_count[base + e] = 0;
         for (std::uint32_t g = 0; g < groups_; ++g) level.epoch_sum[(base + e) * groups_ + g] = 0.0;
+        for (std::size_t c = 0; !level.epoch_sum1.empty() && c < groups_ * D; ++c)
+          level.epoch_sum1[(base + e) * groups_ * D + c] = 0.0;
       }
     }
   }
@@ -133,17 +165,30 @@ std::vector<typename MsdCorrelator<D>::Lag> MsdCorrelator<D>::lags() const {
       lag.non_gaussian.assign(groups_, 0.0);
       lag.subset_mean.assign(groups_, {});
       lag.epoch_mean.assign(groups_, {});
+      const bool linear = !level.sum1.empty();
+      if (linear) {
+        lag.mean_linear.assign(groups_, Vec<D>{});
+        lag.subset_mean_linear.assign(groups_, {});
+        lag.epoch_mean_linear.assign(groups_, {});
+      }
       const double* s2 = &level.sum2[static_cast<std::size_t>(j) * per_j];
       const double* s4 = &level.sum4[static_cast<std::size_t>(j) * per_j];
+      const double* s1 = linear ? &level.sum1[static_cast<std::size_t>(j) * per_j * D] : nullptr;
       for (std::uint32_t g = 0; g < groups_; ++g) {
         double a2 = 0.0, a4 = 0.0, members = 0.0;
+        Vec<D> a1{};
         for (int s = 0; s < kSubsets; ++s) {
           const std::size_t at = slot(g, s);
           const auto size = static_cast<double>(group_size_[at]);
-          lag.subset_mean[g][s] = size > 0 ? s2[at] / (size * static_cast<double>(origins)) : 0.0;
+          const double per = size > 0 ? 1.0 / (size * static_cast<double>(origins)) : 0.0;
+          lag.subset_mean[g][s] = s2[at] * per;
           a2 += s2[at];
           a4 += s4[at];
           members += size;
+          for (int a = 0; linear && a < D; ++a) {
+            lag.subset_mean_linear[g][s][a] = s1[at * D + a] * per;
+            a1[a] += s1[at * D + a];
+          }
         }
         if (members == 0) continue;
         for (int e = 0; e < kEpochs; ++e) {
@@ -151,7 +196,14 @@ std::vector<typename MsdCorrelator<D>::Lag> MsdCorrelator<D>::lags() const {
           const auto n_e = static_cast<double>(level.epoch_count[je]);
           lag.epoch_mean[g][e] =
               n_e > 0 ? level.epoch_sum[je * groups_ + g] / (members * n_e) : std::nan("");
+          for (int a = 0; linear && a < D; ++a) {
+            lag.epoch_mean_linear[g][e][a] =
+                n_e > 0 ? level.epoch_sum1[(je * groups_ + g) * D + a] / (members * n_e)
+                        : std::nan("");
+          }
         }
+        for (int a = 0; linear && a < D; ++a)
+          lag.mean_linear[g][a] = a1[a] / (members * static_cast<double>(origins));
         const double m2 = a2 / (members * static_cast<double>(origins));
         const double m4 = a4 / (members * static_cast<double>(origins));
         lag.mean[g] = m2;
@@ -200,16 +252,34 @@ double standard_error(const std::vector<double>& x) {
 template <int D>
 std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D>::diffusion(
     double from, double to) const {
+  return diffusion(from, to, {}, 0.0);
+}
+
+template <int D>
+std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D>::diffusion(
+    double from, double to, const std::vector<Vec<D>>& drift, double span) const {
   const std::vector<Lag> all = lags();
   std::vector<std::optional<Diffusion>> out(groups_);
   for (std::uint32_t g = 0; g < groups_; ++g) {
+    // <|dx - u lag|^2> = <|dx|^2> - 2 lag u.<dx> + lag^2 |u|^2, over the bias 1 - lag / span.
+    const bool drifts = g < drift.size() && statistic_ == Statistic::kDisplacement;
+    const auto about_drift = [&](double lag, double square, const Vec<D>& mean) {
+      if (!drifts) return square;
+      const Vec<D>& u = drift[g];
+      const double value = square - 2.0 * lag * dot(u, mean) + lag * lag * dot(u, u);
+      return span > 0.0 ? value / (1.0 - lag / span) : value;
+    };
+    const auto mean_of = [&](const Lag& lag) { return drifts ? lag.mean_linear[g] : Vec<D>{}; };
     std::vector<double> t, y;
     std::array<std::vector<double>, kSubsets> ys;
     for (const Lag& lag : all) {
       if (lag.lag < from || lag.lag > to) continue;
+      if (drifts && span > 0.0 && !(lag.lag < span)) continue;
       t.push_back(lag.lag);
-      y.push_back(lag.mean[g]);
-      for (int s = 0; s < kSubsets; ++s) ys[s].push_back(lag.subset_mean[g][s]);
+      y.push_back(about_drift(lag.lag, lag.mean[g], mean_of(lag)));
+      for (int s = 0; s < kSubsets; ++s)
+        ys[s].push_back(about_drift(lag.lag, lag.subset_mean[g][s],
+                                    drifts ? lag.subset_mean_linear[g][s] : Vec<D>{}));
     }
     if (t.size() < 3) continue;
     Diffusion d;
@@ -222,8 +292,10 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
       std::vector<double> te, ye;
       for (const Lag& lag : all) {
         if (lag.lag < from || lag.lag > to || std::isnan(lag.epoch_mean[g][e])) continue;
+        if (drifts && span > 0.0 && !(lag.lag < span)) continue;
         te.push_back(lag.lag);
-        ye.push_back(lag.epoch_mean[g][e]);
+        ye.push_back(about_drift(lag.lag, lag.epoch_mean[g][e],
+                                 drifts ? lag.epoch_mean_linear[g][e] : Vec<D>{}));
       }
       if (te.size() >= 3) by_epoch.push_back(slope(te, ye) / (2.0 * D));
     }
@@ -241,18 +313,35 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
 template <int D>
 std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D>::green_kubo(
     double to) const {
+  return green_kubo(to, {});
+}
+
+template <int D>
+std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D>::green_kubo(
+    double to, const std::vector<Vec<D>>& mean) const {
   const std::vector<Lag> all = lags();
   std::vector<std::optional<Diffusion>> out(groups_);
-  if (statistic_ != Statistic::kProduct) return out;
+  if (statistic_ == Statistic::kDisplacement) return out;
   for (std::uint32_t g = 0; g < groups_; ++g) {
+    const bool about_mean = g < mean.size();
+    const auto c = [&](double product, const Vec<D>& linear) {
+      if (!about_mean) return product;
+      return product - dot(mean[g], linear) + dot(mean[g], mean[g]);
+    };
+    const auto at = [&](const Lag& lag) {
+      return c(lag.mean[g], about_mean ? lag.mean_linear[g] : Vec<D>{});
+    };
+    const auto subset_at = [&](const Lag& lag, int s) {
+      return c(lag.subset_mean[g][s], about_mean ? lag.subset_mean_linear[g][s] : Vec<D>{});
+    };
     double total = 0.0;
     std::array<double, kSubsets> part{};
     int used_lags = 0;
     for (std::size_t k = 1; k < all.size() && all[k].lag <= to; ++k) {
       const double h = 0.5 * (all[k].lag - all[k - 1].lag);
-      total += h * (all[k].mean[g] + all[k - 1].mean[g]);
+      total += h * (at(all[k]) + at(all[k - 1]));
       for (int s = 0; s < kSubsets; ++s)
-        part[s] += h * (all[k].subset_mean[g][s] + all[k - 1].subset_mean[g][s]);
+        part[s] += h * (subset_at(all[k], s) + subset_at(all[k - 1], s));
       ++used_lags;
     }
     if (used_lags < 2 || all.empty() || all[0].lag != 0.0) continue;
@@ -272,12 +361,16 @@ template <int D>
 std::size_t MsdCorrelator<D>::bytes() const {
   std::size_t b = 0;
   for (const Level& l : levels_) {
-    b += l.ring.size() * sizeof(Vec<D>) + (l.sum2.size() + l.sum4.size()) * sizeof(double) +
-         l.count.size() * sizeof(std::uint64_t);
+    b +=
+        l.ring.size() * sizeof(Vec<D>) +
+        (l.sum2.size() + l.sum4.size() + l.sum1.size() + l.epoch_sum.size() + l.epoch_sum1.size()) *
+            sizeof(double) +
+        (l.count.size() + l.epoch_count.size()) * sizeof(std::uint64_t);
   }
   return b;
 }
 
+template class MsdCorrelator<1>;  // collective moments (run/outputs/transport_output.hpp)
 template class MsdCorrelator<2>;
 template class MsdCorrelator<3>;
 

@@ -31,8 +31,11 @@ template <int D>
 class MsdCorrelator {
  public:
   // kDisplacement: <|x(t + lag) - x(t)|^2> of positions; kProduct: <x(t + lag) . x(t)> of
-  // velocities.
-  enum class Statistic { kDisplacement, kProduct };
+  // velocities; kFluxProduct: <J(t + lag) . J(t)> of the fluxes J of the samples x (moments,
+  // integrals of J), each J the increment of x over the level's own spacing divided by it: the
+  // block averages of a multiple-tau correlator, so that a noisy flux is averaged at long lags
+  // rather than picked (a lag of j spacings sees the correlation smoothed over one spacing).
+  enum class Statistic { kDisplacement, kProduct, kFluxProduct };
   static constexpr int kSubsets = 8;
   static constexpr int kRatio = 2;    // m: lags grow by this factor per level
   static constexpr int kPoints = 8;   // samples kept per level
@@ -56,6 +59,11 @@ class MsdCorrelator {
     std::vector<std::array<double, kSubsets>> subset_mean;
     // per group and epoch: the mean over the epoch's origins (NaN: none at this lag)
     std::vector<std::array<double, kEpochs>> epoch_mean;
+    // The linear terms a drift or a mean brings in, likewise: the mean of x(t + lag) - x(t)
+    // (kDisplacement) or of x(t + lag) + x(t) (the products).
+    std::vector<Vec<D>> mean_linear;
+    std::vector<std::array<Vec<D>, kSubsets>> subset_mean_linear;
+    std::vector<std::array<Vec<D>, kEpochs>> epoch_mean_linear;
   };
   // Every lag with at least one origin, in increasing order.
   std::vector<Lag> lags() const;
@@ -71,9 +79,23 @@ class MsdCorrelator {
     int epochs = 0;                                    // epochs with a slope in the window
   };
   std::vector<std::optional<Diffusion>> diffusion(double from, double to) const;
+  // The same about a steady drift (per group: a velocity; a collective moment that grows on
+  // average, such as the time integral of the pressure): the slope of <|dx - drift lag|^2>,
+  // from the mean square and the mean of the displacements at each lag. With the drift
+  // measured over the sampled span T itself (drift = (x(T) - x(0)) / T), each lag's value is
+  // divided by 1 - lag / T, the bias that estimate leaves in a random walk (pass span = T;
+  // span = 0: a drift known exactly).
+  std::vector<std::optional<Diffusion>> diffusion(double from, double to,
+                                                  const std::vector<Vec<D>>& drift,
+                                                  double span) const;
   // kProduct: the Green-Kubo self-diffusion coefficient (1 / D_dim) integral_0^to <v(lag) . v(0)>
   // by the trapezoid rule over the lags, with the standard error from the subsets.
   std::vector<std::optional<Diffusion>> green_kubo(double to) const;
+  // The same of the fluctuations about a mean (per group; a flux with a non-zero mean such as
+  // the pressure's): <(x(t + lag) - m).(x(t) - m)> = <x(t + lag).x(t)> - m.<x(t + lag) + x(t)>
+  // + m.m at each lag.
+  std::vector<std::optional<Diffusion>> green_kubo(double to,
+                                                   const std::vector<Vec<D>>& mean) const;
 
   std::uint64_t samples() const { return samples_; }
   double interval() const { return interval_; }
@@ -86,10 +108,12 @@ class MsdCorrelator {
     std::uint64_t kept = 0;    // samples taken into this level so far
     // Per lag index j (0 .. kPoints - 1), per group and subset: sums of |dr|^2, |dr|^4, count.
     std::vector<double> sum2, sum4;
+    std::vector<double> sum1;  // kDisplacement: the displacements' D components, likewise
     std::vector<std::uint64_t> count;
     // Per lag index j and epoch e, per group: the sum of |dr|^2 (epoch_sum[(j kEpochs + e) G +
     // g]) and the origins (epoch_count[j kEpochs + e]).
     std::vector<double> epoch_sum;
+    std::vector<double> epoch_sum1;  // the displacements' components: [(..) G + g] D + a
     std::vector<std::uint64_t> epoch_count;
   };
   void merge_epochs();
@@ -98,9 +122,10 @@ class MsdCorrelator {
   // the level below does not reach.
   int first_lag(int l) const {
     if (l > 0) return kPoints / kRatio;
-    return statistic_ == Statistic::kProduct ? 0 : 1;
+    return statistic_ == Statistic::kDisplacement ? 1 : 0;
   }
-  void correlate(Level& level, const std::vector<Vec<D>>& x, int first_j, std::size_t epoch);
+  void correlate(Level& level, const std::vector<Vec<D>>& x, int first_j, std::size_t epoch,
+                 double spacing);
 
   std::vector<std::uint32_t> group_;
   std::uint32_t groups_;
@@ -111,6 +136,7 @@ class MsdCorrelator {
   std::vector<Level> levels_;
   std::uint64_t samples_ = 0;
   std::uint64_t epoch_length_ = 1;  // samples per epoch
+  std::vector<Vec<D>> flux_now_;    // kFluxProduct: the current sample's fluxes (scratch)
 };
 
 }  // namespace kairos

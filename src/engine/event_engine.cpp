@@ -186,6 +186,31 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
                                                                   static_cast<double>(n) / 2.0))
           : 0;
   next_renumber_ = next_renumber_after(counters_.collisions);
+  if (options_.track_helfand) start_helfand();
+}
+
+// The Helfand moments from now (engine/helfand_moments.hpp): the centre of mass's velocity,
+// each particle's share of its pairs' energies (half of each listed pair's zone energy), then
+// every particle's rates.
+template <int D, class Queue>
+void EventEngine<D, Queue>::start_helfand() {
+  const auto n = static_cast<std::uint32_t>(size());
+  Vec<D> momentum{};
+  double total = 0.0;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    momentum = momentum + mass_of(k) * hot_[k].vel;
+    total += mass_of(k);
+  }
+  helfand_.start(time_, (1.0 / total) * momentum, n);
+  for (std::uint32_t k = 0; stepped_ && k < n; ++k) {
+    const PairSteps::Entry* e = steps_.entries_begin(k);
+    for (std::uint32_t m = 0; m < steps_.entry_count(k); ++m)
+      helfand_.add_potential_share(k, 0.5 * steps_.table(e[m].zone.table).energy[e[m].zone.zone]);
+  }
+  // Velocities are constant in free flight (no field here): no record is advanced, so the
+  // run's bits do not depend on whether the moments are kept.
+  for (std::uint32_t k = 0; k < n; ++k)
+    helfand_.add_particle(mass_of(k), hot_[k].vel, helfand_energy(k));
 }
 
 // Distinct (radius, mass, species) triples; particles store a 2-byte index into them.
@@ -367,6 +392,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(spin_);
   permute(last_collision_);
   images_.permute(order, done);
+  helfand_.permute(order, done);
   resting_.permute(order, done);
   soft_state_.permute(order, done);
   cells_.insert_all(hot_.data(), static_cast<std::uint32_t>(size()));
@@ -681,6 +707,8 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
     r2 += d * d;
     g_dot_r += (hi.vel[a] - hj.vel[a]) * d;
   }
+  if (helfand_.on()) [[unlikely]]
+    helfand_before(i, j, t);
   if (granular_contacts_) {
     collide_granular(i, j, t, r, r2);
   } else {
@@ -693,6 +721,8 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
     counters_.virial += s * r2;
     add_virial_tensor(r, s * r);
   }
+  if (helfand_.on()) [[unlikely]]
+    helfand_after(i, j, r);
   ++counters_.collisions;
   ++hi.collisions;
   ++hj.collisions;
@@ -856,7 +886,7 @@ double EventEngine<D, Queue>::bytes_per_particle() const {
   return static_cast<double>(sizeof(HotRecord<D>) + sizeof(PendingEvent) + sizeof(std::uint32_t) +
                              (kind_.empty() ? 0 : sizeof(std::uint16_t))) +
          kinds + cells_.grid().bytes_per_particle() + images_.bytes_per_particle() +
-         static_cast<double>(queue_.bytes_per_particle());
+         helfand_.bytes_per_particle() + static_cast<double>(queue_.bytes_per_particle());
 }
 
 template class EventEngine<2, BinaryHeapQueue>;

@@ -43,6 +43,7 @@
 #include "dynamics/collision_time.hpp"
 #include "engine/candidate_scan.hpp"
 #include "engine/cell_neighbourhood.hpp"
+#include "engine/helfand_moments.hpp"
 #include "engine/hot_record.hpp"
 #include "engine/image_counters.hpp"
 #include "engine/pair_steps.hpp"
@@ -99,6 +100,9 @@ struct EngineOptions {
   // Keep image counters (engine/image_counters.hpp: 4 D bytes per particle) so that exported
   // states can be unwrapped; a state that carries counters keeps them either way.
   bool track_images = false;
+  // Keep the Helfand moments of momentum and energy (engine/helfand_moments.hpp) for the
+  // Einstein-Helfand transport coefficients: a conservative periodic system only.
+  bool track_helfand = false;
   // Needs vector_scan (and AVX-512) for kVector.
   ListGather list_gather = ListGather::kAuto;
   // Used by the AVX-512 loops only.
@@ -160,6 +164,9 @@ class EventEngine {
   // slot[id] != kNotFollowed (id: the caller's number), into out[slot[id]].
   static constexpr std::uint32_t kNotFollowed = ~0u;
   void unwrapped_positions(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const;
+  // The Helfand moments now (options track_helfand; their collisional momentum part is
+  // counters().virial_tensor).
+  typename HelfandMoments<D>::Moments helfand_moments() const { return helfand_.at(time_); }
   // Their velocities now, likewise.
   void velocities(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const;
   // The same state read in blocks of particles: outputs of a large system without a copy of
@@ -264,6 +271,11 @@ class EventEngine {
   // Sleeping particles (gravity with walls): see Environment::sleep_speed.
   bool is_asleep(std::uint32_t i) const { return resting_.asleep(i); }
   void add_virial_tensor(const Vec<D>& r, const Vec<D>& impulse);
+  // A pair event's velocities before and after, for the Helfand moments (when helfand_.on()).
+  void start_helfand();
+  double helfand_energy(std::uint32_t k) const;
+  void helfand_before(std::uint32_t i, std::uint32_t j, double t);
+  void helfand_after(std::uint32_t i, std::uint32_t j, const Vec<D>& r);
   void fall_asleep(std::uint32_t i, double t);
   void wake(std::uint32_t i, double t);
   // Leaves a resting contact (normal n, gravity into it) asleep or with at least the sleep
@@ -468,10 +480,11 @@ class EventEngine {
   bool soft_ = false;
   SoftContactState<D> soft_state_;
 
-  Boundaries<D> boundaries_;  // every wall (model/boundaries.hpp: the face walls so far)
-  LeesEdwards<D> shear_;      // Lees-Edwards images (boundaries/lees_edwards.hpp)
-  Environment<D> env_;        // the hot members above share fewer cache lines
-  ImageCounters<D> images_;   // cold: written at wraps, read at export
+  Boundaries<D> boundaries_;   // every wall (model/boundaries.hpp: the face walls so far)
+  LeesEdwards<D> shear_;       // Lees-Edwards images (boundaries/lees_edwards.hpp)
+  Environment<D> env_;         // the hot members above share fewer cache lines
+  ImageCounters<D> images_;    // cold: written at wraps, read at export
+  HelfandMoments<D> helfand_;  // cold: pair events only, when a transport analysis asks
 };
 
 // Small members every event path uses, visible to each of the engine's files.
@@ -518,6 +531,24 @@ template <int D, class Queue>
 inline void EventEngine<D, Queue>::add_virial_tensor(const Vec<D>& r, const Vec<D>& impulse) {
   for (int a = 0; a < D; ++a)
     for (int b = 0; b < D; ++b) counters_.virial_tensor[a * D + b] += r[a] * impulse[b];
+}
+
+template <int D, class Queue>
+inline double EventEngine<D, Queue>::helfand_energy(std::uint32_t k) const {
+  return helfand_.energy(k, mass_of(k), hot_[k].vel, spin_.empty() ? 0.0 : spin_energy(k));
+}
+
+template <int D, class Queue>
+inline void EventEngine<D, Queue>::helfand_before(std::uint32_t i, std::uint32_t j, double t) {
+  helfand_.before_pair(t, mass_of(i), hot_[i].vel, helfand_energy(i), mass_of(j), hot_[j].vel,
+                       helfand_energy(j));
+}
+
+template <int D, class Queue>
+inline void EventEngine<D, Queue>::helfand_after(std::uint32_t i, std::uint32_t j,
+                                                 const Vec<D>& r) {
+  helfand_.after_pair(r, mass_of(i), hot_[i].vel, helfand_energy(i), mass_of(j), hot_[j].vel,
+                      helfand_energy(j));
 }
 
 // New events for both partners of a collision. Both neighbourhoods are gathered (and their

@@ -183,6 +183,8 @@ bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t
     out = step_event(mi * mj / (mi + mj), rg / distance, table.energy[next] - table.energy[z.zone]);
   }
   const Vec<D> impulse = (out.impulse / distance) * r;
+  if (helfand_.on()) [[unlikely]]
+    helfand_before(i, j, t);
   hi.vel = hi.vel + (1.0 / mi) * impulse;
   hj.vel = hj.vel - (1.0 / mj) * impulse;
   counters_.virial += out.impulse * distance;
@@ -191,9 +193,13 @@ bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t
     steps_.set(i, j, {z.table, next});
     ++counters_.step_crossings;
     step_captures_ += z.zone == 0 ? 1u : 0u;
+    if (helfand_.on()) [[unlikely]]
+      helfand_.pair_energy_changed(i, j, table.energy[next] - table.energy[z.zone]);
   } else {
     ++counters_.step_bounces;
   }
+  if (helfand_.on()) [[unlikely]]
+    helfand_after(i, j, r);
   ++counters_.collisions;
   ++hi.collisions;
   ++hj.collisions;

@@ -676,6 +676,7 @@ class Reader : public KeyReader {
       }
     }
     check_analysis_keys(root, c.analysis);
+    check_transport(root, c);
     if (c.analysis.msd && c.boundary.shear_rate != 0.0) {
       fail(node_at(root, "analysis.msd"), "analysis.msd",
            "analysis.msd: the mean-square displacement under Lees-Edwards shear is not measured "
@@ -701,6 +702,49 @@ class Reader : public KeyReader {
     if (c.run.validate) unsupported("run.validate", "engine validation is");
     if (c.analysis.msd)
       unsupported("analysis.msd", "the mean-square displacement (image counters) is");
+  }
+
+  // The Einstein-Helfand moments (engine/helfand_moments.hpp) need a conservative,
+  // translation-invariant system; each obstacle is named by its key.
+  void check_transport(const toml::table& root, const Config& c) const {
+    if (!c.analysis.transport) return;
+    const toml::node* n_transport = node_at(root, "analysis.transport");
+    const auto refuse = [&](std::string_view key, std::string_view why) {
+      const toml::node* n = node_at(root, key);
+      fail(n != nullptr ? n : n_transport, std::string(key),
+           fmt::format("analysis.transport: {} ({}): the Einstein-Helfand moments need a "
+                       "conservative periodic system; remove {} or analysis.transport",
+                       why, key, key));
+    };
+    if (integrators().is(c.run.integrator, IntegratorKind::kDem))
+      refuse("run.integrator", "the DEM integrator is not event-driven");
+    if (c.boundary.shear_rate != 0.0)
+      refuse("boundary.shear_rate", "Lees-Edwards shear is a non-equilibrium state");
+    if (!c.boundary.walls.empty()) refuse("boundary.wall", "walls do not conserve momentum");
+    if (!c.boundary.open.empty()) refuse("boundary.open", "open faces lose particles' momentum");
+    if (!c.field.gravity.empty()) {
+      bool any = false;
+      for (double g : c.field.gravity) any = any || g != 0.0;
+      if (any) refuse("field.gravity", "a field does not conserve momentum");
+    }
+    if (!driving_kinds().is(c.driving.kind, DrivingKind::kNone))
+      refuse("driving.kind", "driving does not conserve energy");
+    if (c.soft.enabled())
+      refuse("soft.model", "soft contacts move particles while they last (not supported yet)");
+    const auto conservative = [](const ContactConfig& k) {
+      const bool elastic = k.restitution_model == "constant" && k.restitution == 1.0;
+      const bool tangential = k.tangential_restitution == -1.0 || k.friction == 0.0 ||
+                              (k.tangential_restitution == 1.0 && std::isinf(k.friction));
+      return elastic && tangential;
+    };
+    for (const PairPotentialConfig& p : c.potentials)
+      if (p.potential.kind == "spring_dashpot")
+        refuse("potential.kind", "a spring-dashpot by steps dissipates energy");
+    if (!conservative(c.interactions.contact))
+      refuse("contact.restitution", "inelastic or frictional contacts dissipate energy");
+    for (const PairContactConfig& p : c.interactions.pairs)
+      if (!conservative(p.contact))
+        refuse("contact.pair", "inelastic or frictional contacts dissipate energy");
   }
 
   // An analysis's own keys act only with that analysis on (an error naming the key, never a key
@@ -730,17 +774,27 @@ class Reader : public KeyReader {
         {"analysis.bond_cutoff", a.bond_cutoff != d.bond_cutoff, a.bond_order,
          "analysis.bond_order = true"},
         {"analysis.interval", a.interval != d.interval, structure,
-         "a structure analysis (rdf, structure_factor, bond_order or velocity_distribution)"}};
+         "a structure analysis (rdf, structure_factor, bond_order or velocity_distribution)"},
+        {"analysis.transport_interval", a.transport_interval != d.transport_interval, a.transport,
+         "analysis.transport = true"},
+        {"analysis.transport_fit_from", a.transport_fit_from != d.transport_fit_from, a.transport,
+         "analysis.transport = true"},
+        {"analysis.transport_fit_to", a.transport_fit_to != d.transport_fit_to, a.transport,
+         "analysis.transport = true"}};
     for (const Needs& k : keys) {
       if (k.given && !k.on)
         fail(node_at(root, k.key), k.key, fmt::format("{}: acts only with {}", k.key, k.what));
     }
-    if (a.msd_fit_from > 0.0 && a.msd_fit_to > 0.0 && !(a.msd_fit_from < a.msd_fit_to)) {
-      fail(node_at(root, "analysis.msd_fit_to"), "analysis.msd_fit_to",
-           fmt::format("analysis.msd_fit_to = {}: the fit window must end after it starts "
-                       "(analysis.msd_fit_from = {})",
-                       a.msd_fit_to, a.msd_fit_from));
-    }
+    const auto window = [&](const char* from_key, double from, const char* to_key, double to) {
+      if (from > 0.0 && to > 0.0 && !(from < to)) {
+        fail(node_at(root, to_key), to_key,
+             fmt::format("{} = {}: the fit window must end after it starts ({} = {})", to_key, to,
+                         from_key, from));
+      }
+    };
+    window("analysis.msd_fit_from", a.msd_fit_from, "analysis.msd_fit_to", a.msd_fit_to);
+    window("analysis.transport_fit_from", a.transport_fit_from, "analysis.transport_fit_to",
+           a.transport_fit_to);
   }
 
   void read_field(const toml::table& t, const int& dimension, FieldConfig& f) const {

@@ -172,6 +172,14 @@ struct AnalysisConfig {
   bool velocity_distribution = false;  // velocity_distribution.tsv
   // Between their samples, in output.interval_unit; 0: at every production thermo row.
   double interval = 0.0;
+  // helfand.tsv, green_kubo.tsv: the Einstein-Helfand shear and bulk viscosities and thermal
+  // conductivity (engine/helfand_moments.hpp), Green-Kubo beside them, sampled every
+  // transport_interval of simulated time (0: automatic), fitted over lags [transport_fit_from,
+  // transport_fit_to] (0: automatic).
+  bool transport = false;
+  double transport_interval = 0.0;
+  double transport_fit_from = 0.0;
+  double transport_fit_to = 0.0;
 
   bool operator==(const AnalysisConfig&) const = default;
 };

@@ -520,6 +520,30 @@ constexpr KeyDecl kAnalysis[] = {
      .range = non_negative,
      .unit = "interval_unit",
      .doc = "between samples of rdf, S(k), bond order, velocities (0: every thermo row)"},
+    {.name = "transport",
+     .type = KeyType::kBoolean,
+     .member = field<&AnalysisConfig::transport>,
+     .doc =
+         "helfand.tsv: Einstein-Helfand viscosities and thermal conductivity, Green-Kubo beside"},
+    {.name = "transport_interval",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::transport_interval>,
+     .range = up_to(1e9, Scale::kTime),
+     .unit = "time",
+     .doc = "between samples of the Helfand moments, in simulated time (0: as the MSD's)"},
+    {.name = "transport_fit_from",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::transport_fit_from>,
+     .range = up_to(1e9, Scale::kTime),
+     .unit = "time",
+     .doc = "shortest lag of the Einstein-Helfand fits (0: automatic)"},
+    {.name = "transport_fit_to",
+     .type = KeyType::kFloat,
+     .member = field<&AnalysisConfig::transport_fit_to>,
+     .range = up_to(1e9, Scale::kTime),
+     .unit = "time",
+     .doc =
+         "longest lag of the Einstein-Helfand fits and of the Green-Kubo integrals (0: automatic)"},
 };
 
 // ----- [[potential]], [[bond]]

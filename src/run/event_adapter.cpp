@@ -77,6 +77,7 @@ EngineOptions engine_options(const Config& config) {
   options.defer_soft_releases = config.soft.defer_releases;
   // Trajectory frames carry particles/image (and so does the restart file, for the next run).
   options.track_images = config.output.trajectory || config.analysis.msd;
+  options.track_helfand = config.analysis.transport;
   return options;
 }
 

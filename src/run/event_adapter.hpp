@@ -60,6 +60,9 @@ class EventIntegrator : public Integrator<D> {
                                    std::vector<Vec<D>>& out) const = 0;
   virtual void velocities(const std::vector<std::uint32_t>& slot,
                           std::vector<Vec<D>>& out) const = 0;
+  // The Helfand moments now (engine/helfand_moments.hpp; the run keeps them for
+  // analysis.transport).
+  virtual typename HelfandMoments<D>::Moments helfand_moments() const = 0;
   // Kinetic (translational and rotational) plus the stepped potentials' energy plus the
   // potential energy in the gravity field; NaN when the field has a component along a periodic
   // axis (unbounded there).
@@ -132,6 +135,9 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   }
   void velocities(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const override {
     engine_.velocities(slot, out);
+  }
+  typename HelfandMoments<D>::Moments helfand_moments() const override {
+    return engine_.helfand_moments();
   }
   double total_energy() const override;
 

@@ -8,7 +8,7 @@
 #include "analysis/granular_theory.hpp"
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
-#include "run/collision_estimate.hpp"
+#include "run/outputs/sampling_interval.hpp"
 
 namespace kairos {
 
@@ -19,13 +19,11 @@ MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
   const auto wanted = static_cast<std::size_t>(config_.msd_particles);
   const std::size_t step = n <= wanted ? 1 : (n + wanted - 1) / wanted;
   slot_.assign(n, ~0u);  // not followed
-  double v2 = 0.0;
   const StateBlocks<D> state = engine.state_blocks();
   species_names_ = state.globals().species_names;
   state.for_each(
       [&](const ParticleSystem<D>& part, std::size_t first) {
         for (std::size_t j = 0; j < part.size(); ++j) {
-          v2 += norm2(part.velocity(j, part.time));
           const std::size_t id = first + j;
           if (id % step != 0) continue;
           slot_[id] = static_cast<std::uint32_t>(group_.size());
@@ -38,18 +36,7 @@ MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
   interval_ = config_.msd_interval;
   if (interval_ == 0.0) {
     automatic_interval_ = true;
-    const double eta = engine.particle_volume() / engine.volume();
-    const double sigma = mean_volume_diameter<D>(engine.particle_volume(), static_cast<double>(n));
-    const FlightEstimate flight = estimate_flight<D>(static_cast<double>(n), engine.volume(), sigma,
-                                                     std::sqrt(v2 / static_cast<double>(n)));
-    // The Enskog factor (the contact value) that shortens the ideal-gas flight.
-    const double enskog = eta > 0.0 && eta < 0.9 ? contact_value(D, eta) : 1.0;
-    interval_ = 0.5 * flight.mean_free_time / enskog;
-    if (!std::isfinite(interval_) || !(interval_ > 0.0)) {
-      throw InputError(
-          "analysis.msd: the particles do not move, so no sampling interval follows from their "
-          "mean free time; give analysis.msd_interval");
-    }
+    interval_ = half_enskog_mean_free_time(engine, "analysis.msd_interval");
   }
 }
 

@@ -20,6 +20,7 @@
 #include "run/outputs/structure_snapshot.hpp"
 #include "run/outputs/thermo_output.hpp"
 #include "run/outputs/trajectory_output.hpp"
+#include "run/outputs/transport_output.hpp"
 #include "run/outputs/velocity_distribution_output.hpp"
 
 namespace kairos {
@@ -50,6 +51,8 @@ ObserverList<D> make_observers(const Config& config, const Integrator<D>& integr
   // Analyses that write their own file (before summary.json, which lists it).
   if (const EventIntegrator<D>* engine = integrator.as_event(); engine && config.analysis.msd)
     add<MsdOutput<D>>(list, config, *engine);
+  if (const EventIntegrator<D>* engine = integrator.as_event(); engine && config.analysis.transport)
+    add<TransportOutput<D>>(list, config, *engine);
   // The structure analyses of [analysis]: the three of the configuration share one read of the
   // state per sample; rdf.tsv's part of summary.json reads thermo.tsv's Z.
   const auto snapshot = std::make_shared<StructureSnapshot<D>>();
