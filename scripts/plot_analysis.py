@@ -1,7 +1,10 @@
 #!/usr/bin/python3
-"""Draws the structure analyses of a Kairos run ([analysis], docs/outputs.md) as one PNG.
+"""Draws the analyses of a Kairos run ([analysis], docs/outputs.md) as one PNG.
 
-One panel per file the run wrote: rdf.tsv (g(r) of every species pair, with its standard error
+One panel per file the run wrote: msd.tsv (the mean-square displacement per species on log
+axes, with the fitted diffusive line), helfand.tsv (the running Einstein-Helfand coefficients
+against the lag, each over its fitted value, with the Green-Kubo running integrals of
+green_kubo.tsv dashed: the plateaus at 1 are the coefficients), rdf.tsv (g(r) of every species pair, with its standard error
 as a band and the extrapolated contact values g(sigma+) as points), sk.tsv (S(k) with error
 bars, and S(0) extrapolated at k = 0), bond_order.tsv (the distributions of the local q4, q6
 or |psi6|, the global values in the legend) and velocity_distribution.tsv (on a log scale
@@ -113,7 +116,50 @@ def plot_velocity(ax, path, summary):
     ax.legend(fontsize=8)
 
 
-PANELS = [("rdf.tsv", plot_rdf), ("sk.tsv", plot_sk), ("bond_order.tsv", plot_bond_order),
+def plot_msd(ax, path, summary):
+    _, t = read_tsv(path)
+    lag = t["lag"]
+    fits = (summary.get("diffusion") or {}).get("species", {})
+    for name in t:
+        if not name.startswith("msd_"):
+            continue
+        species = name[4:]
+        ax.loglog(lag, t[name], "o", ms=2.5, label=species)
+        d = (fits.get(species) or {}).get("coefficient")
+        if d:
+            dim = summary.get("dimension", 3)
+            ax.loglog(lag, 2 * dim * d * lag, lw=0.8, label="2dDt, D = %.4g" % d)
+    ax.set_xlabel("lag")
+    ax.set_ylabel("MSD")
+    ax.set_title("mean-square displacement", fontsize=9)
+    ax.legend(fontsize=8)
+
+
+def plot_helfand(ax, path, summary):
+    _, t = read_tsv(path)
+    gk_path = os.path.join(os.path.dirname(path), "green_kubo.tsv")
+    gk = read_tsv(gk_path)[1] if os.path.exists(gk_path) else None
+    transport = summary.get("transport") or {}
+    for name, colour in (("shear_viscosity", "C0"), ("bulk_viscosity", "C1"),
+                         ("thermal_conductivity", "C2")):
+        value = (transport.get(name) or {}).get("value")
+        if not value:
+            continue
+        ax.semilogx(t["lag"], t[name] / value, "-", color=colour, lw=1.0,
+                    label="%s %.4g" % (name.replace("_", " "), value))
+        if gk is not None:
+            keep = gk["lag"] > 0
+            ax.semilogx(gk["lag"][keep], gk[name][keep] / value, "--", color=colour, lw=0.8)
+    if "fit_from" in transport:
+        ax.axvspan(transport["fit_from"], transport["fit_to"], color="0.9")
+    ax.set_ylim(0.0, 1.6)
+    ax.set_xlabel("lag")
+    ax.set_ylabel("running coefficient / fitted")
+    ax.set_title("Einstein-Helfand (solid), Green-Kubo (dashed)", fontsize=9)
+    ax.legend(fontsize=7)
+
+
+PANELS = [("msd.tsv", plot_msd), ("helfand.tsv", plot_helfand), ("rdf.tsv", plot_rdf), ("sk.tsv", plot_sk), ("bond_order.tsv", plot_bond_order),
           ("velocity_distribution.tsv", plot_velocity)]
 
 
@@ -131,7 +177,11 @@ def main():
     path = os.path.join(args.outdir, "summary.json")
     if os.path.exists(path):
         with open(path, encoding="utf-8") as f:
-            summary = json.load(f).get("analysis", {})
+            whole = json.load(f)
+        summary = dict(whole.get("analysis", {}))
+        for key in ("diffusion", "transport", "dimension"):
+            if key in whole:
+                summary[key] = whole[key]
     columns = min(2, len(present))
     rows = math.ceil(len(present) / columns)
     fig, axes = plt.subplots(rows, columns, figsize=(5.0 * columns, 3.8 * rows), squeeze=False)

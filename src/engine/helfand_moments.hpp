@@ -1,5 +1,6 @@
 // The Helfand moments of momentum and energy, kept exactly from the event stream for the
-// Einstein-Helfand transport coefficients (analysis.transport; docs/physics.md#einstein-helfand).
+// Einstein-Helfand transport coefficients (analysis.transport;
+// docs/physics.md#einstein-helfand-transport-coefficients).
 //
 // For a periodic box the moment of the momentum flux is
 //   G_ab(t) = integral_0^t sum_i m_i c_ia c_ib dt'  +  sum_{pair events <= t} r_ij,a dp_i,b

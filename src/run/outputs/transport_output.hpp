@@ -3,8 +3,9 @@
 // periodic system from the exact Helfand moments (engine/helfand_moments.hpp plus the engine's
 // virial tensor), sampled at regular simulated times during the production and correlated on
 // log-spaced lags with many time origins (analysis/msd.hpp, one "particle" per moment
-// component); Green-Kubo from the same samples (the autocorrelation of the fluxes averaged over
-// each sampling interval) as the cross-check. docs/physics.md#einstein-helfand.
+// component); Green-Kubo from the same samples (the autocorrelation of the fluxes, block-averaged
+// over each level's spacing) as the cross-check.
+// docs/physics.md#einstein-helfand-transport-coefficients.
 #pragma once
 
 #include <array>
@@ -61,7 +62,7 @@ class TransportOutput final : public Observer<D> {
   bool automatic_interval_ = false;
   std::vector<std::uint32_t> group_;  // per component
   std::optional<Correlator> helfand_;
-  std::optional<Correlator> fluxes_;  // the interval-averaged fluxes, correlated as products
+  std::optional<Correlator> fluxes_;  // the same samples as fluxes (kFluxProduct)
   std::vector<Vec<1>> sample_;
   Components first_{}, last_{};
   double pressure_offset_ = 0.0;  // the pressure's moment's rate in the first interval

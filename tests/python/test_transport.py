@@ -1,0 +1,149 @@
+"""Transport coefficients by Einstein-Helfand ([analysis] transport = true) end to end: a
+hard-sphere fluid against Enskog's shear viscosity, bulk viscosity and thermal conductivity,
+Green-Kubo against Einstein-Helfand for hard spheres, a square-well fluid (step-crossing
+impulses and the pair energies in the heat flux) and perfectly rough spheres (the spin in the
+energy), and the input errors (docs/physics.md#einstein-helfand-transport-coefficients).
+"""
+
+import json
+import math
+import os
+
+import numpy as np
+
+import kairos_testlib as kt
+
+
+def enskog(eta):
+    """Enskog's eta_s, kappa, lambda of hard spheres (sigma = m = kT = 1) with the higher Sonine
+    factors 1.016, 1.002, 1.025 (Chapman and Cowling, The Mathematical Theory of Non-uniform
+    Gases, 3rd ed., ch. 16): b rho = 4 eta, chi of Carnahan-Starling."""
+    chi = (1 - eta / 2) / (1 - eta) ** 3
+    brho = 4 * eta
+    eta0 = 1.016 * 5 / 16 / math.sqrt(math.pi)
+    lambda0 = 1.025 * 75 / 64 / math.sqrt(math.pi)
+    shear = eta0 * brho * (1 / (brho * chi) + 0.8 + 0.7614 * brho * chi)
+    bulk = 1.002 * eta0 * brho ** 2 * chi
+    conductivity = lambda0 * brho * (1 / (brho * chi) + 1.2 + 0.7574 * brho * chi)
+    return {"shear_viscosity": shear, "bulk_viscosity": bulk,
+            "thermal_conductivity": conductivity}
+
+
+def read_table(path):
+    with open(path, encoding="utf-8") as f:
+        header = f.readline().split()
+        rows = np.array([[float(x) for x in line.split()] for line in f if line.strip()])
+    return header, rows
+
+
+NAMES = ("shear_viscosity", "bulk_viscosity", "thermal_conductivity")
+
+
+class Transport(kt.KairosTestCase):
+    def run_transport(self, name, text_or_config):
+        out = self.path(name)
+        self.run_ok("run", self.write_config(text_or_config, name + ".toml"), "-o", out)
+        return out, self.summary(out)["transport"]
+
+    def assert_green_kubo_agrees(self, t, names=NAMES, slack=0.05):
+        for name in names:
+            c = t[name]
+            self.assertIsNotNone(c["value"], c)
+            # The Green-Kubo bulk viscosity has no error of its own (one component).
+            err = math.hypot(c["stderr"], c["green_kubo_stderr"] or c["stderr"])
+            self.assertAlmostEqual(c["green_kubo"], c["value"],
+                                   delta=3 * err + slack * abs(c["value"]), msg=name)
+
+    def test_hard_spheres_have_the_enskog_coefficients(self):
+        eta = 0.3
+        config = kt.base_config(particles=500, packing_fraction=eta, seed=11, equilibration=100,
+                                production=8000, output={"trajectory": False},
+                                analysis={"transport": True, "transport_fit_to": 4.0})
+        out, t = self.run_transport("hs", config)
+        reference = enskog(eta)
+        # Enskog underestimates the correlated dynamics of a dense fluid a little: the MD/Enskog
+        # ratios at eta = 0.3 are about 1.0-1.05 (docs/validation.md, "Transport
+        # coefficients"); the tolerance is 3 standard errors and 8 % beside them.
+        for name in NAMES:
+            c = t[name]
+            self.assertIsNotNone(c["value"], c)
+            self.assertLess(c["stderr"] / reference[name], 0.12, name)  # it measures something
+            self.assertAlmostEqual(c["value"] / reference[name], 1.0,
+                                   delta=3 * c["stderr"] / reference[name] + 0.08, msg=name)
+            self.assertGreaterEqual(c["epochs_fitted"], 8)
+        self.assert_green_kubo_agrees(t)
+        self.assertAlmostEqual(t["temperature"], 1.0, delta=1e-9)  # kT of the motion, exact
+        self.assertTrue(t["shear_viscosity"]["stderr_reliable"])
+        # The files: the running coefficients' plateau is the fitted value.
+        header, rows = read_table(os.path.join(out, "helfand.tsv"))
+        self.assertEqual(header[:3], ["lag", "origins", "shear_moment"])
+        at = np.searchsorted(rows[:, 0], 4.0) - 1
+        column = header.index("shear_viscosity")
+        self.assertAlmostEqual(rows[at, column] / t["shear_viscosity"]["value"], 1.0, delta=0.15)
+        header, rows = read_table(os.path.join(out, "green_kubo.tsv"))
+        self.assertEqual(rows[0, 0], 0.0)
+        for f in ("helfand.tsv", "green_kubo.tsv"):
+            self.assertIn(f, self.summary(out)["outputs"])
+
+    def test_square_well_fluid_green_kubo_equals_einstein_helfand(self):
+        config = kt.base_config(particles=400, packing_fraction=0.25, seed=12, equilibration=50,
+                                production=4000, output={"trajectory": False},
+                                analysis={"transport": True, "transport_fit_from": 0.5,
+                                          "transport_fit_to": 3.0})
+        text = kt.toml_text(config) + (
+            '\n[[potential]]\nkind = "square_well"\nlambda = 1.5\ndepth = 0.5\n')
+        _, t = self.run_transport("sw", text)
+        self.assert_green_kubo_agrees(t)
+        # An attractive well slows momentum and heat transfer less than it adds collisions:
+        # the coefficients exceed the hard-sphere gas's at the same density (a sanity check of
+        # magnitude, not a reference value).
+        for name in ("shear_viscosity", "thermal_conductivity"):
+            self.assertGreater(t[name]["value"], 0.5 * enskog(0.25)[name], name)
+
+    def test_rough_spheres_carry_their_spin_energy(self):
+        config = kt.base_config(particles=400, packing_fraction=0.25, seed=13, equilibration=50,
+                                production=4000, output={"trajectory": False},
+                                contact={"restitution": 1.0, "tangential_restitution": 1.0},
+                                analysis={"transport": True, "transport_fit_from": 0.5,
+                                          "transport_fit_to": 3.0})
+        _, t = self.run_transport("rough", config)
+        self.assert_green_kubo_agrees(t)
+
+    def test_a_mixture_says_why_it_has_no_conductivity(self):
+        config = kt.base_config(particles=300, packing_fraction=0.2, lattice="random", seed=14,
+                                production=300, output={"trajectory": False},
+                                analysis={"transport": True})
+        text = kt.toml_text(config) + (
+            '\n[[system.species]]\nname = "A"\nfraction = 0.5\n'
+            '\n[[system.species]]\nname = "B"\nfraction = 0.5\ndiameter = 1.2\nmass = 2.0\n')
+        _, t = self.run_transport("mix", text)
+        self.assertIsNone(t["thermal_conductivity"]["value"])
+        self.assertIn("mixture", t["thermal_conductivity"]["why"])
+        self.assertIsNotNone(t["shear_viscosity"]["value"])
+
+    def test_input_errors(self):
+        cases = {
+            "wall": ({"boundary": {"wall": [{"face": "z-"}, {"face": "z+"}]}}, "boundary.wall"),
+            "gravity": ({"field": {"gravity": [0.0, 0.0, -1.0]}}, "field.gravity"),
+            "inelastic": ({"contact": {"restitution": 0.9}}, "contact.restitution"),
+            "friction": ({"contact": {"tangential_restitution": 0.5}}, "contact.restitution"),
+            "driving": ({"driving": {"kind": "andersen", "rate": 1.0}}, "driving.kind"),
+            "shear": ({"boundary": {"shear_rate": 0.1}}, "boundary.shear_rate"),
+        }
+        for name, (sections, key) in cases.items():
+            config = kt.base_config(analysis={"transport": True}, **sections)
+            result = self.kairos("run", self.write_config(config, name + ".toml"), "-o",
+                                 self.path(name))
+            self.assert_user_error(result, key, "analysis.transport")
+        alone = kt.base_config(analysis={"transport_fit_to": 3.0})
+        self.assert_user_error(self.kairos("run", self.write_config(alone, "a.toml"), "-o",
+                                           self.path("a")), "analysis.transport_fit_to",
+                               "analysis.transport = true")
+        window = kt.base_config(analysis={"transport": True, "transport_fit_from": 5.0,
+                                          "transport_fit_to": 2.0})
+        self.assert_user_error(self.kairos("run", self.write_config(window, "w.toml"), "-o",
+                                           self.path("w")), "analysis.transport_fit_to")
+
+
+if __name__ == "__main__":
+    kt.main()
