@@ -58,7 +58,8 @@ class Transport(kt.KairosTestCase):
         eta = 0.3
         config = kt.base_config(particles=500, packing_fraction=eta, seed=11, equilibration=100,
                                 production=8000, output={"trajectory": False},
-                                analysis={"transport": True, "transport_fit_to": 4.0})
+                                analysis={"transport": True, "transport_fit_to": 4.0,
+                                          "msd": True})
         out, t = self.run_transport("hs", config)
         reference = enskog(eta)
         # Enskog underestimates the correlated dynamics of a dense fluid a little: the MD/Enskog
@@ -74,6 +75,13 @@ class Transport(kt.KairosTestCase):
         self.assert_green_kubo_agrees(t)
         self.assertAlmostEqual(t["temperature"], 1.0, delta=1e-9)  # kT of the motion, exact
         self.assertTrue(t["shear_viscosity"]["stderr_reliable"])
+        # The MSD's finite-size correction takes the viscosity measured in the same run.
+        d = self.summary(out)["diffusion"]["species"]["A"]
+        self.assertEqual(d["infinite_size_viscosity"], t["shear_viscosity"]["value"])
+        box = (500 * math.pi / 6 / eta) ** (1 / 3)
+        self.assertAlmostEqual(d["coefficient_infinite_size"] - d["coefficient"],
+                               2.837297 * d["infinite_size_temperature"] /
+                               (6 * math.pi * t["shear_viscosity"]["value"] * box), delta=1e-9)
         # The files: the running coefficients' plateau is the fitted value.
         header, rows = read_table(os.path.join(out, "helfand.tsv"))
         self.assertEqual(header[:3], ["lag", "origins", "shear_moment"])

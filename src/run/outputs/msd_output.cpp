@@ -139,6 +139,13 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
       correlator_
           ? correlator_->diffusion(from, to)
           : std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>>(species_names_.size());
+  // The Yeh-Hummer correction's viscosity: the one given, or the one analysis.transport
+  // measured in this run (its part of the summary comes first).
+  double viscosity = config_.msd_viscosity;
+  if (viscosity == 0.0 && summary.contains("transport")) {
+    const nlohmann::json& eta = summary["transport"]["shear_viscosity"]["value"];
+    if (eta.is_number()) viscosity = eta.get<double>();
+  }
   for (std::size_t g = 0; g < species_names_.size(); ++g) {
     nlohmann::json s;
     if (g < fits.size() && fits[g]) {
@@ -161,7 +168,7 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
           "for the diffusive regime (or set analysis.msd_fit_from / msd_fit_to)",
           from, to);
     }
-    if (fits.size() > g && fits[g] && config_.msd_viscosity > 0.0) {
+    if (fits.size() > g && fits[g] && viscosity > 0.0) {
       // Yeh and Hummer, J. Phys. Chem. B 108, 15873 (2004): a cubic periodic box in 3D.
       const Vec<D>& box = engine_.box();
       bool cubic = D == 3;
@@ -170,8 +177,9 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
         constexpr double kXi = 2.837297;
         const double kt = stats_.temperature(engine_.thermal_energy());
         s["coefficient_infinite_size"] =
-            fits[g]->coefficient + kXi * kt / (6.0 * M_PI * config_.msd_viscosity * box[0]);
+            fits[g]->coefficient + kXi * kt / (6.0 * M_PI * viscosity * box[0]);
         s["infinite_size_temperature"] = kt;
+        s["infinite_size_viscosity"] = viscosity;
       } else {
         s["coefficient_infinite_size"] = nullptr;
         s["infinite_size_why"] = "the Yeh-Hummer correction is for a cubic periodic box in 3D";

@@ -49,10 +49,12 @@ ObserverList<D> make_observers(const Config& config, const Integrator<D>& integr
   add<RestartOutput<D>>(list);
   add<ProfileOutput<D>>(list);
   // Analyses that write their own file (before summary.json, which lists it).
-  if (const EventIntegrator<D>* engine = integrator.as_event(); engine && config.analysis.msd)
-    add<MsdOutput<D>>(list, config, *engine);
+  // The transport part of summary.json before the MSD's, whose finite-size correction uses the
+  // shear viscosity measured in the same run.
   if (const EventIntegrator<D>* engine = integrator.as_event(); engine && config.analysis.transport)
     add<TransportOutput<D>>(list, config, *engine);
+  if (const EventIntegrator<D>* engine = integrator.as_event(); engine && config.analysis.msd)
+    add<MsdOutput<D>>(list, config, *engine);
   // The structure analyses of [analysis]: the three of the configuration share one read of the
   // state per sample; rdf.tsv's part of summary.json reads thermo.tsv's Z.
   const auto snapshot = std::make_shared<StructureSnapshot<D>>();
