@@ -679,7 +679,7 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
     return;
   }
   if (sheared_) [[unlikely]] {
-    collide_sheared(i, j, t);
+    if (!(stepped_ && step_pair(i, j, t))) collide_sheared(i, j, t);
     return;
   }
   if (resting_.count() > 0 && (is_asleep(i) || is_asleep(j))) [[unlikely]] {

@@ -333,6 +333,8 @@ class EventEngine {
   bool step_pair(std::uint32_t i, std::uint32_t j, double t);
   // The pair's separation i - j under the box's boundaries (nearest image on periodic axes).
   Vec<D> separation(std::uint32_t i, std::uint32_t j, double t) const;
+  std::uint32_t scan_stepped_sheared(const CandidateList& list, std::uint32_t i, double t,
+                                     double& best) const;
   void predict_pair(std::uint32_t i, std::uint32_t j, double t);
   // Lees-Edwards shear (boundaries/lees_edwards.hpp).
   void shift_images();

@@ -24,6 +24,10 @@ constexpr std::uint32_t kNoPartner = EventSlot::kNoPartner;
 
 template <int D, class Queue>
 Vec<D> EventEngine<D, Queue>::separation(std::uint32_t i, std::uint32_t j, double t) const {
+  if (sheared_) {  // through the sliding images (a bonded pair across a y face)
+    Vec<D> image_velocity;
+    return sheared_separation(i, j, t, image_velocity);
+  }
   Vec<D> r = position(i, t) - position(j, t);
   for (int a = 0; a < D; ++a)
     if (cells_.grid().periodic(a)) r[a] = minimum_image(r[a], box_[a]);
@@ -108,6 +112,8 @@ template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::scan_stepped(const CandidateList& list, std::uint32_t i,
                                                   double t, double& best) {
   steps_.load(i);
+  if (list.sheared) [[unlikely]]
+    return scan_stepped_sheared(list, i, t, best);
   // Per kind of the candidate: the squared distance of its pair's outermost boundary with i
   // (the contact distance of a pair without steps).
   const std::uint32_t si = species_of(i);
@@ -156,8 +162,12 @@ bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t
   advance_to(j, t);
   HotRecord<D>& hi = hot_[i];
   HotRecord<D>& hj = hot_[j];
-  const Vec<D> r = separation(i, j, t);
-  const double r2 = norm2(r), rg = dot(r, hi.vel - hj.vel);
+  // Under shear i meets an image of j, which moves with j's velocity plus u (boundaries/
+  // lees_edwards.hpp): the step acts on the relative motion with that image, as a collision.
+  Vec<D> u{};
+  const Vec<D> r = sheared_ ? sheared_separation(i, j, t, u) : separation(i, j, t);
+  const Vec<D> vj_before = hj.vel;
+  const double r2 = norm2(r), rg = dot(r, hi.vel - (hj.vel + u));
   const ZoneTable& table = steps_.table(z.table);
   std::uint16_t next;
   if (rg < 0.0) {
@@ -187,6 +197,8 @@ bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t
     helfand_before(i, j, t);
   hi.vel = hi.vel + (1.0 / mi) * impulse;
   hj.vel = hj.vel - (1.0 / mj) * impulse;
+  // The kinetic energy the image's extra velocity adds in the box frame: work by the shear.
+  if (sheared_) counters_.work_by_shear -= mj * dot(u, hj.vel - vj_before);
   counters_.virial += out.impulse * distance;
   add_virial_tensor(r, impulse);
   if (out.crosses) {
@@ -205,6 +217,41 @@ bool EventEngine<D, Queue>::step_pair(std::uint32_t i, std::uint32_t j, double t
   ++hj.collisions;
   predict_pair(i, j, t);
   return true;
+}
+
+// The stepped candidate loop for a list next to a sheared face (after steps_.load(i)): each
+// candidate's image moves with its own velocity shift. A listed pair meets its zone's
+// boundaries through the image within its cut-off; another image of it (a narrow box repeats
+// columns) lies beyond its zone and is skipped. Scalar: only the face rows take it.
+template <int D, class Queue>
+std::uint32_t EventEngine<D, Queue>::scan_stepped_sheared(const CandidateList& list,
+                                                          std::uint32_t i, double t,
+                                                          double& best) const {
+  const Vec<D> xi = flight_position(hot_[i], t), vi = hot_[i].vel;
+  const std::uint32_t si = species_of(i);
+  std::uint32_t found = kNoPartner;
+  for (std::uint32_t k = 0; k < list.count; ++k) {
+    const std::uint32_t j = list.ids[k];
+    if (j == i) continue;
+    const std::uint32_t tag = list.shift[k];
+    const Vec<D> r = xi - (flight_position(hot_[j], t) + list.shifts[tag]);
+    const Vec<D> g = vi - (hot_[j].vel + list.velocity_shifts[tag]);
+    const PairSteps::Zone z = steps_.lookup(j, steps_.pair_table(si, species_of(j)));
+    double dt;
+    if (z.table == PairSteps::kHard) {
+      dt = pair_contact_time<D>(r.data(), g.data(), radius_of(i) + radius_of(j));
+    } else {
+      const ZoneTable& table = steps_.table(z.table);
+      const double r2 = norm2(r);
+      if (z.zone > 0 && r2 > 4.0 * table.r2[0]) continue;  // another image of a listed pair
+      dt = table.event_time(z.zone, r2, dot(r, g), norm2(g));
+    }
+    if (dt < best) {
+      best = dt;
+      found = j;
+    }
+  }
+  return found;
 }
 
 template class EventEngine<2, BinaryHeapQueue>;

@@ -161,7 +161,11 @@ void EventEngine<D, Queue>::validate() {
       if (boundary - closest < 1e-9 * boundary) return;
     }
     const double normal_speed = std::abs(dot(r + dt * g, g)) / boundary;
-    const double bound = std::min(queue_.time_of(i), queue_.time_of(j));
+    double bound = std::min(queue_.time_of(i), queue_.time_of(j));
+    // Under shear the next image shift predicts the particles next to the y faces again.
+    if (sheared_ && (shear_.next_to_face(hot_[i].cell, cells_.grid()) ||
+                     shear_.next_to_face(hot_[j].cell, cells_.grid())))
+      bound = std::min(bound, shear_.next_shift_time());
     if (late(bound, t + dt, normal_speed)) {
       std::ostringstream os;
       os.precision(17);
@@ -229,7 +233,9 @@ void EventEngine<D, Queue>::validate() {
       if (z.table != PairSteps::kHard) {
         // Within a cut-off (never more than a cell width) the nearest image is the one the
         // loops test; another image of a listed pair lies beyond its zone.
-        if (std::string_view(which) == "nearest image") check_step_covered(i, j, r, g, z);
+        if (std::string_view(which) == "nearest image" ||
+            std::string_view(which) == "sheared image")
+          check_step_covered(i, j, r, g, z);
         return;
       }
     }

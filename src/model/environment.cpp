@@ -75,8 +75,6 @@ void Environment<D>::check() const {
     }
   }
   for (const StepTable& t : tables) t.check();
-  if (stepped() && sheared())
-    throw InputError("boundary.shear_rate: shear with stepped potentials is not supported yet");
   if (!(tc >= 0.0) || !std::isfinite(tc)) throw InputError("tc must be finite and >= 0");
   if (!std::isfinite(shear_rate)) throw InputError("boundary.shear_rate must be finite");
   if (sheared()) {
