@@ -46,7 +46,7 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
     const auto box = require<double>(r, f, "kairos/box", path, D);
     for (int a = 0; a < D; ++a) s.box[a] = box[a];
   } else {
-    const auto box = require<float>(r, f, "configuration/box", path, 6);
+    const auto box = gsd_read::require_real(r, f, "configuration/box", path, 6);
     for (int a = 0; a < D; ++a) s.box[a] = box[a];
   }
   for (int a = 0; a < D; ++a) {
@@ -68,7 +68,7 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
     for (std::size_t i = 0; i < n; ++i)
       for (int a = 0; a < D; ++a) s.position[i][a] = pos[i * D + a];
   } else {
-    const auto pos = require<float>(r, f, "particles/position", path, n * 3);
+    const auto pos = gsd_read::require_real(r, f, "particles/position", path, n * 3);
     for (std::size_t i = 0; i < n; ++i)
       for (int a = 0; a < D; ++a) s.position[i][a] = pos[i * 3 + a] + 0.5 * s.box[a];
   }
@@ -86,7 +86,7 @@ InitialState<D> read_initial_state(const std::filesystem::path& path, bool& has_
     for (std::size_t i = 0; i < n; ++i)
       for (int a = 0; a < D; ++a) s.velocity[i][a] = vel[i * D + a];
     has_velocities = true;
-  } else if (auto vel = read_latest<float>(r, f, "particles/velocity")) {
+  } else if (auto vel = gsd_read::read_latest_real(r, f, "particles/velocity")) {
     if (vel->size() != n * 3)
       throw InputError("'" + path.string() + "': particles/velocity has the wrong size");
     for (std::size_t i = 0; i < n; ++i)

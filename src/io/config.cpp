@@ -83,6 +83,7 @@ class Reader : public KeyReader {
       read_soft(section(root, "soft", empty), config.system.species, config.soft);
     }
     check_soft_and_dem(root, config);
+    check_trajectory_keys(root, config);
     if (config.system.chain_length > 0 && config.bonds.empty()) {
       fail(nullptr, "system.chain_length",
            "system.chain_length: chains need a bond potential ([[bond]] with kind = \"tether\" "
@@ -745,6 +746,71 @@ class Reader : public KeyReader {
     for (const PairContactConfig& p : c.interactions.pairs)
       if (!conservative(p.contact))
         refuse("contact.pair", "inelastic or frictional contacts dissipate energy");
+  }
+
+  // trajectory.gsd's options (docs/outputs.md): the fields are HOOMD's names, each once, with
+  // the positions, and what the integrator has; log-spaced frames need their first lag, and
+  // their own keys act only with them.
+  void check_trajectory_keys(const toml::table& root, const Config& c) const {
+    const OutputConfig& o = c.output;
+    const toml::node* n_fields = node_at(root, "output.trajectory_fields");
+    std::vector<std::string_view> seen;
+    for (std::size_t i = 0; i < o.trajectory_fields.size(); ++i) {
+      const std::string& name = o.trajectory_fields[i];
+      const std::string path = fmt::format("output.trajectory_fields[{}]", i);
+      const toml::node* n =
+          n_fields != nullptr && n_fields->is_array() ? n_fields->as_array()->get(i) : n_fields;
+      if (!trajectory_fields().contains(name)) {
+        const bool hoomd = name == "orientation" || name == "angmom" || name == "charge" ||
+                           name == "body" || name == "moment_inertia";
+        fail(
+            n, path,
+            fmt::format("{}: '{}' is not a trajectory field{}; valid values: {}", path, shown(name),
+                        hoomd ? " (a HOOMD field Kairos's spheres do not have: their spin is "
+                                "angular_velocity)"
+                              : "",
+                        trajectory_fields().names()));
+      }
+      if (std::find(seen.begin(), seen.end(), name) != seen.end())
+        fail(n, path, fmt::format("{}: '{}' is listed twice", path, name));
+      seen.push_back(name);
+      if (integrators().is(c.run.integrator, IntegratorKind::kDem) &&
+          trajectory_fields().is(name, TrajectoryField::kImage)) {
+        fail(n, path,
+             fmt::format("{}: \"image\" is not written by the DEM integrator (run.integrator = "
+                         "\"dem\"), which counts no periodic images yet",
+                         path));
+      }
+    }
+    if (!o.trajectory_fields.empty() &&
+        std::find(seen.begin(), seen.end(), "position") == seen.end()) {
+      fail(n_fields, "output.trajectory_fields",
+           "output.trajectory_fields: must include \"position\" (a frame without positions is "
+           "no trajectory frame)");
+    }
+    const bool log = trajectory_spacings().is(o.trajectory_spacing, TrajectorySpacing::kLog);
+    for (const char* key :
+         {"output.trajectory_frames_per_decade", "output.trajectory_log_period"}) {
+      if (!log && node_at(root, key) != nullptr) {
+        fail(node_at(root, key), key,
+             fmt::format("{}: acts only with output.trajectory_spacing = \"log\"", key));
+      }
+    }
+    if (!log) return;
+    if (!(o.trajectory_interval > 0.0)) {
+      const toml::node* n = node_at(root, "output.trajectory_interval");
+      fail(n != nullptr ? n : node_at(root, "output.trajectory_spacing"),
+           "output.trajectory_interval",
+           "output.trajectory_interval: log-spaced frames (output.trajectory_spacing = \"log\") "
+           "need their first lag: give trajectory_interval (0, automatic, is for linear frames)");
+    }
+    if (o.trajectory_log_period > 0.0 && !(o.trajectory_log_period > o.trajectory_interval)) {
+      fail(node_at(root, "output.trajectory_log_period"), "output.trajectory_log_period",
+           fmt::format("output.trajectory_log_period = {}: the period of the log-spaced "
+                       "sequence must be longer than its first lag (output.trajectory_interval "
+                       "= {})",
+                       o.trajectory_log_period, o.trajectory_interval));
+    }
   }
 
   // An analysis's own keys act only with that analysis on (an error naming the key, never a key

@@ -135,7 +135,19 @@ struct OutputConfig {
   // outputs at the multiples of the interval). The reader resolves "" to the production
   // length's unit.
   std::string interval_unit;
-  bool trajectory = true;         // write trajectory.gsd at all
+  bool trajectory = true;  // write trajectory.gsd at all
+  // What trajectory.gsd holds (run/outputs/trajectory_output.hpp, docs/outputs.md): the frames
+  // of every phase ("all") or of the production only ("production"); the per-particle fields
+  // of each frame (empty: every field the state has, static ones in frame 0 only); "single"
+  // (float32) or "double" (float64) floating-point chunks; frames every trajectory_interval
+  // ("linear") or at the phase's start + trajectory_interval * 10^(k / frames_per_decade)
+  // ("log"), that sequence started again every trajectory_log_period (0: never).
+  std::string trajectory_phases = "all";
+  std::vector<std::string> trajectory_fields;
+  std::string trajectory_precision = "single";
+  std::string trajectory_spacing = "linear";
+  std::int64_t trajectory_frames_per_decade = 10;
+  double trajectory_log_period = 0.0;
   std::string progress = "auto";  // auto (when stderr is a terminal) | always | never
   // Profiles along an axis (profile.tsv), sampled at every production thermo row: "" = none,
   // else x, y or z, in profile_bins slabs.

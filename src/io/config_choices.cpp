@@ -35,6 +35,30 @@ constexpr ChoiceEntry<IntervalUnit> kIntervalUnits[] = {
     {"collisions", IntervalUnit::kCollisions, "collisions per particle"},
     {"time", IntervalUnit::kTime, "simulated time"},
 };
+constexpr ChoiceEntry<TrajectoryPhases> kTrajectoryPhases[] = {
+    {"all", TrajectoryPhases::kAll, "frames from the start of the run, equilibration included"},
+    {"production", TrajectoryPhases::kProduction, "frames from the start of the production"},
+};
+constexpr ChoiceEntry<TrajectoryPrecision> kTrajectoryPrecisions[] = {
+    {"single", TrajectoryPrecision::kSingle, "float32, as HOOMD writes by default"},
+    {"double", TrajectoryPrecision::kDouble, "float64 box, positions, velocities, sizes, masses"},
+};
+constexpr ChoiceEntry<TrajectorySpacing> kTrajectorySpacings[] = {
+    {"linear", TrajectorySpacing::kLinear, "every trajectory_interval"},
+    {"log", TrajectorySpacing::kLog,
+     "at trajectory_interval x 10^(k / trajectory_frames_per_decade) from the phase's start"},
+};
+// HOOMD's names (particles/*), and Kairos's log/particles/angular_velocity.
+constexpr ChoiceEntry<TrajectoryField> kTrajectoryFields[] = {
+    {"position", TrajectoryField::kPosition, "particles/position (required)"},
+    {"velocity", TrajectoryField::kVelocity, "particles/velocity"},
+    {"image", TrajectoryField::kImage, "particles/image (the event integrator)"},
+    {"angular_velocity", TrajectoryField::kAngularVelocity,
+     "log/particles/angular_velocity (rough particles)"},
+    {"typeid", TrajectoryField::kTypeid, "particles/typeid in every frame"},
+    {"diameter", TrajectoryField::kDiameter, "particles/diameter in every frame"},
+    {"mass", TrajectoryField::kMass, "particles/mass in every frame"},
+};
 constexpr ChoiceEntry<DrivingKind> kDrivingKinds[] = {
     {"none", DrivingKind::kNone, "no driving"},
     {"andersen", DrivingKind::kAndersen, "Andersen thermostat at `temperature`"},
@@ -90,6 +114,27 @@ const Choices<ProgressMode>& progress_modes() {
 
 const Choices<IntervalUnit>& interval_units() {
   static constexpr Choices<IntervalUnit> choices("interval unit", kIntervalUnits);
+  return choices;
+}
+
+const Choices<TrajectoryPhases>& trajectory_phases() {
+  static constexpr Choices<TrajectoryPhases> choices("trajectory phases", kTrajectoryPhases);
+  return choices;
+}
+
+const Choices<TrajectoryPrecision>& trajectory_precisions() {
+  static constexpr Choices<TrajectoryPrecision> choices("trajectory precision",
+                                                        kTrajectoryPrecisions);
+  return choices;
+}
+
+const Choices<TrajectorySpacing>& trajectory_spacings() {
+  static constexpr Choices<TrajectorySpacing> choices("trajectory spacing", kTrajectorySpacings);
+  return choices;
+}
+
+const Choices<TrajectoryField>& trajectory_fields() {
+  static constexpr Choices<TrajectoryField> choices("trajectory field", kTrajectoryFields);
   return choices;
 }
 

@@ -19,6 +19,18 @@ enum class EventQueue { kCalendar, kHeap, kTree };
 enum class IntegratorKind { kEvent, kDem };
 enum class ProgressMode { kAuto, kAlways, kOff };  // auto, always, never
 enum class IntervalUnit { kCollisions, kTime };
+enum class TrajectoryPhases { kAll, kProduction };
+enum class TrajectoryPrecision { kSingle, kDouble };
+enum class TrajectorySpacing { kLinear, kLog };
+enum class TrajectoryField {
+  kPosition,
+  kVelocity,
+  kImage,
+  kAngularVelocity,
+  kTypeid,
+  kDiameter,
+  kMass
+};
 enum class DrivingKind { kNone, kAndersen, kWhiteNoise };
 enum class RestitutionModel { kConstant, kViscoelastic, kTable };
 // Box faces: 2k is the low face of axis k, 2k + 1 the high one (face_number()).
@@ -35,6 +47,12 @@ const Choices<DrivingKind>& driving_kinds();            // driving.kind
 const Choices<RestitutionModel>& restitution_models();  // contact.restitution_model
 const Choices<SoftModel>& soft_models();                // soft.model
 const Choices<SoftCollisions>& soft_collision_modes();  // soft.collisions
+// trajectory.gsd's options: output.trajectory_phases, trajectory_precision, trajectory_spacing
+// and the names of output.trajectory_fields.
+const Choices<TrajectoryPhases>& trajectory_phases();
+const Choices<TrajectoryPrecision>& trajectory_precisions();
+const Choices<TrajectorySpacing>& trajectory_spacings();
+const Choices<TrajectoryField>& trajectory_fields();
 // boundary.wall[].face and boundary.open: the faces of a box of `dimension` (2 or 3), or all
 // six (dimension 0).
 const Choices<BoxFace>& box_faces(int dimension = 0);

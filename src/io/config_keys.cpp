@@ -381,6 +381,11 @@ bool has_interval_unit(const void* o) {
   return !static_cast<const OutputConfig*>(o)->interval_unit.empty();
 }
 
+// The keys of log-spaced frames are written (and act) only with them.
+bool log_spaced(const void* o) {
+  return static_cast<const OutputConfig*>(o)->trajectory_spacing == "log";
+}
+
 const OutputConfig kOutputDefaults{};
 constexpr KeyDecl kOutput[] = {
     {.name = "directory",
@@ -416,6 +421,41 @@ constexpr KeyDecl kOutput[] = {
      .type = KeyType::kBoolean,
      .member = field<&OutputConfig::trajectory>,
      .doc = "write trajectory.gsd"},
+    {.name = "trajectory_phases",
+     .type = KeyType::kString,
+     .member = field<&OutputConfig::trajectory_phases>,
+     .choices = &choices_of<&trajectory_phases>,
+     .doc = "trajectory frames of every phase, or of the production only"},
+    {.name = "trajectory_fields",
+     .type = KeyType::kStrings,
+     .member = field<&OutputConfig::trajectory_fields>,
+     .range = {.by_rule = true},  // position required, no name twice, what the state has
+     .choices = &choices_of<&trajectory_fields>,
+     .default_text = "`[]`",
+     .doc = "per-particle fields of every frame ([]: every field the state has)"},
+    {.name = "trajectory_precision",
+     .type = KeyType::kString,
+     .member = field<&OutputConfig::trajectory_precision>,
+     .choices = &choices_of<&trajectory_precisions>,
+     .doc = "float32 or float64 floating-point chunks in trajectory.gsd"},
+    {.name = "trajectory_spacing",
+     .type = KeyType::kString,
+     .member = field<&OutputConfig::trajectory_spacing>,
+     .choices = &choices_of<&trajectory_spacings>,
+     .doc = "trajectory frames evenly or logarithmically spaced"},
+    {.name = "trajectory_frames_per_decade",
+     .type = KeyType::kInteger,
+     .member = field<&OutputConfig::trajectory_frames_per_decade>,
+     .range = {.lo = 1.0, .hi = 1000.0},
+     .doc = "log-spaced frames: frames per factor 10 of the lag",
+     .written = &log_spaced},
+    {.name = "trajectory_log_period",
+     .type = KeyType::kFloat,
+     .member = field<&OutputConfig::trajectory_log_period>,
+     .range = non_negative,
+     .unit = "interval_unit",
+     .doc = "log-spaced frames: the sequence starts again every period (0: never)",
+     .written = &log_spaced},
     {.name = "progress",
      .type = KeyType::kString,
      .member = field<&OutputConfig::progress>,

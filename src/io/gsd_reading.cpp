@@ -29,14 +29,21 @@ void check_positions_stored(const gsd::Reader& r, std::uint64_t f, std::size_t n
 }
 
 void check_rectangular_box(const gsd::Reader& r, std::uint64_t f, const std::string& who) {
-  const auto box = read_latest<float>(r, f, "configuration/box");
+  const auto box = read_latest_real(r, f, "configuration/box");
   if (!box || box->size() != 6) return;  // (a missing or short box is reported where it is read)
-  const float xy = (*box)[3], xz = (*box)[4], yz = (*box)[5];
-  if (xy == 0.0f && xz == 0.0f && yz == 0.0f) return;
+  const double xy = (*box)[3], xz = (*box)[4], yz = (*box)[5];
+  if (xy == 0.0 && xz == 0.0 && yz == 0.0) return;
+  // Shown as stored (a float32 0.1 as 0.1).
+  const auto info = r.find(f, "configuration/box") ? r.find(f, "configuration/box")
+                                                   : r.find(0, "configuration/box");
+  const auto shown = [&](double v) {
+    return info->type == gsd::Type::float64 ? fmt::format("{}", v)
+                                            : fmt::format("{}", static_cast<float>(v));
+  };
   throw InputError(fmt::format(
       "{}: configuration/box has tilt factors xy = {}, xz = {}, yz = {}, a triclinic box; Kairos "
       "simulates rectangular boxes only: give a state in a box with xy = xz = yz = 0",
-      who, xy, xz, yz));
+      who, shown(xy), shown(xz), shown(yz)));
 }
 
 // Default name of the one bond type of a file that has bonds but no bonds/types chunk (as
@@ -87,7 +94,7 @@ std::vector<double> per_particle_property(const gsd::Reader& r, std::uint64_t f,
   std::vector<double> out;
   if (auto v = read_latest<double>(r, f, exact); v && v->size() == n) {
     for (double x : *v) out.push_back(scale * x);
-  } else if (auto w = read_latest<float>(r, f, hoomd)) {
+  } else if (auto w = read_latest_real(r, f, hoomd)) {
     if (w->size() != n) {
       throw InputError("'" + path.string() + "': " + std::string(hoomd) + " has the wrong size");
     }

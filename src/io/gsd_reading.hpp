@@ -40,6 +40,33 @@ std::vector<T> require(const gsd::Reader& r, std::uint64_t frame, std::string_vi
   return std::move(*v);
 }
 
+// A floating-point chunk of frame `frame` (else of frame 0) as doubles, whether stored as
+// float32 or float64 (HOOMD's precision "single" or "double", Kairos's
+// output.trajectory_precision); InputError for another type.
+inline std::optional<std::vector<double>> read_latest_real(const gsd::Reader& r,
+                                                           std::uint64_t frame,
+                                                           std::string_view name) {
+  const std::uint64_t at = r.find(frame, name) ? frame : 0;
+  const auto info = r.find(at, name);
+  if (!info) return std::nullopt;
+  if (info->type == gsd::Type::float64) return r.read<double>(at, name);
+  const std::vector<float> single = r.read<float>(at, name);
+  return std::vector<double>(single.begin(), single.end());
+}
+
+// As require, for a floating-point chunk of either precision.
+inline std::vector<double> require_real(const gsd::Reader& r, std::uint64_t frame,
+                                        std::string_view name, const std::filesystem::path& path,
+                                        std::size_t expected) {
+  auto v = read_latest_real(r, frame, name);
+  if (!v) throw InputError("'" + path.string() + "' has no chunk '" + std::string(name) + "'");
+  if (v->size() != expected) {
+    throw InputError("'" + path.string() + "': chunk '" + std::string(name) + "' holds " +
+                     std::to_string(v->size()) + " values, expected " + std::to_string(expected));
+  }
+  return std::move(*v);
+}
+
 // Before anything is allocated for the n particles that particles/N claims, the chunk holding
 // their positions (`positions`, n rows of `width` values, in frame f or 0) must hold them: a
 // damaged or hand-made file can claim any number, while the stored chunks are bounded by the
@@ -68,7 +95,7 @@ BondData read_bonds(const gsd::Reader& r, std::uint64_t f, const std::filesystem
                     std::size_t n, const std::string& what);
 
 // A per-particle property from the exact float64 chunk (times `scale`) when present, else from
-// the HOOMD float32 chunk, else HOOMD's default of 1.
+// the HOOMD chunk (float32 or float64), else HOOMD's default of 1.
 std::vector<double> per_particle_property(const gsd::Reader& r, std::uint64_t f,
                                           const std::filesystem::path& path, std::size_t n,
                                           std::string_view exact, double scale,

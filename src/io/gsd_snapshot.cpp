@@ -52,10 +52,13 @@ std::vector<std::int8_t> pack_type_names(const std::vector<std::string>& names, 
 // x as a float32 coordinate in HOOMD's centred box [-L/2, L/2). A coordinate just below L/2
 // can round up to L/2 in float32; that point is the periodic image of -L/2. Along a
 // non-periodic axis (walls, open faces) the coordinate is shifted, never wrapped.
-float hoomd_coordinate(double x, double L, bool periodic = true) {
-  if (!periodic) return static_cast<float>(x - 0.5 * L);
-  const float half = static_cast<float>(0.5 * L);
-  const float c = static_cast<float>(wrap_into_box(x, L) - 0.5 * L);
+// The same in float64 (output.trajectory_precision = "double"): the engine's wrapped
+// coordinate less L/2, correctly rounded.
+template <class T = float>
+T hoomd_coordinate(double x, double L, bool periodic = true) {
+  if (!periodic) return static_cast<T>(x - 0.5 * L);
+  const T half = static_cast<T>(0.5 * L);
+  const T c = static_cast<T>(wrap_into_box(x, L) - 0.5 * L);
   return c >= half ? -half : c;
 }
 
@@ -120,83 +123,95 @@ ParticleSystem<D> probe(const StateBlocks<D>& s) {
   return s.block(0, s.particles == 0 ? 0 : 1);
 }
 
-template <int D>
-void write_standard_chunks(gsd::Writer& w, const StateBlocks<D>& s, bool with_static) {
+// The standard chunks of a frame of `layout`'s fields, floating-point values as T (float or
+// double); with_static: the file's first frame (types, typeid, diameter, mass, bonds).
+template <class T, int D>
+void write_standard_chunks(gsd::Writer& w, const StateBlocks<D>& s, bool with_static,
+                           const TrajectoryLayout& layout) {
   const ParticleSystem<D>& sys = s.globals();
   const auto n = static_cast<std::uint32_t>(s.particles);
   const std::uint64_t step = sys.counters.events;
   const std::uint8_t dims = D;
-  const float box[6] = {static_cast<float>(sys.box[0]),
-                        static_cast<float>(sys.box[1]),
-                        D == 3 ? static_cast<float>(sys.box[D - 1]) : 0.0f,
-                        0.0f,
-                        0.0f,
-                        0.0f};
+  const T box[6] = {static_cast<T>(sys.box[0]),
+                    static_cast<T>(sys.box[1]),
+                    D == 3 ? static_cast<T>(sys.box[D - 1]) : T{0},
+                    T{0},
+                    T{0},
+                    T{0}};
+  using Part = const ParticleSystem<D>&;
   w.write_chunk("configuration/step", 1, 1, &step);
   w.write_chunk("configuration/dimensions", 1, 1, &dims);
   w.write_chunk("configuration/box", 6, 1, box);
   w.write_chunk("particles/N", 1, 1, &n);
-  write_particle_chunk<float>(w, "particles/position", 3, s,
-                              [](const ParticleSystem<D>& p, std::size_t j, float* out) {
-                                const Vec<D> x = p.position(j, p.time);
-                                for (int a = 0; a < D; ++a)
-                                  out[a] = hoomd_coordinate(x[a], p.box[a], p.periodic[a]);
-                              });
-  write_particle_chunk<float>(w, "particles/velocity", 3, s,
-                              [](const ParticleSystem<D>& p, std::size_t j, float* out) {
-                                const Vec<D> v = p.velocity(j, p.time);
-                                for (int a = 0; a < D; ++a) out[a] = static_cast<float>(v[a]);
-                              });
-  if (!probe(s).image.empty()) {
-    // HOOMD's image flags for the float32 coordinate written above: unwrapped = position +
-    // image * box (the engine's counters for its own coordinate, plus the box the coordinate
-    // was wrapped by here). Under Lees-Edwards shear, x also needs image_y * shear_rate L_y t.
+  write_particle_chunk<T>(w, "particles/position", 3, s, [](Part p, std::size_t j, T* out) {
+    const Vec<D> x = p.position(j, p.time);
+    for (int a = 0; a < D; ++a) out[a] = hoomd_coordinate<T>(x[a], p.box[a], p.periodic[a]);
+  });
+  if (layout.velocity) {
+    write_particle_chunk<T>(w, "particles/velocity", 3, s, [](Part p, std::size_t j, T* out) {
+      const Vec<D> v = p.velocity(j, p.time);
+      for (int a = 0; a < D; ++a) out[a] = static_cast<T>(v[a]);
+    });
+  }
+  if (layout.image && !probe(s).image.empty()) {
+    // HOOMD's image flags for the coordinate written above: unwrapped = position + image *
+    // box (the engine's counters for its own coordinate, plus the box the coordinate was
+    // wrapped by here). Under Lees-Edwards shear, x also needs image_y * shear_rate L_y t.
     write_particle_chunk<std::int32_t>(
-        w, "particles/image", 3, s,
-        [](const ParticleSystem<D>& p, std::size_t j, std::int32_t* out) {
+        w, "particles/image", 3, s, [](Part p, std::size_t j, std::int32_t* out) {
           const Vec<D> x = p.position(j, p.time);
           for (int a = 0; a < D; ++a) {
             out[a] = p.image[j][a];
             if (!p.periodic[a]) continue;
-            const double c = hoomd_coordinate(x[a], p.box[a]);
+            const double c = hoomd_coordinate<T>(x[a], p.box[a]);
             out[a] +=
                 static_cast<std::int32_t>(std::lround((x[a] - 0.5 * p.box[a] - c) / p.box[a]));
           }
         });
   }
-  if (!probe(s).angular_velocity.empty()) {
+  if (layout.angular_velocity && !probe(s).angular_velocity.empty()) {
     // Per-particle log data: OVITO and python-gsd read log/particles/* as particle
     // properties. In 2D the spin is the z component.
-    write_particle_chunk<float>(w, "log/particles/angular_velocity", 3, s,
-                                [](const ParticleSystem<D>& p, std::size_t j, float* out) {
-                                  const auto& om = p.angular_velocity[j];
-                                  if constexpr (D == 3) {
-                                    for (int a = 0; a < 3; ++a) out[a] = static_cast<float>(om[a]);
-                                  } else {
-                                    out[2] = static_cast<float>(om[0]);
-                                  }
-                                });
+    write_particle_chunk<T>(w, "log/particles/angular_velocity", 3, s,
+                            [](Part p, std::size_t j, T* out) {
+                              const auto& om = p.angular_velocity[j];
+                              if constexpr (D == 3) {
+                                for (int a = 0; a < 3; ++a) out[a] = static_cast<T>(om[a]);
+                              } else {
+                                out[2] = static_cast<T>(om[0]);
+                              }
+                            });
   }
   if (with_static) {
     std::uint32_t m = 0;
     const auto names = pack_type_names(sys.species_names, m);
     w.write_chunk("particles/types", sys.species_names.size(), m, names.data());
+  }
+  if (with_static || layout.typeid_every_frame) {
     write_particle_chunk<std::uint32_t>(
         w, "particles/typeid", 1, s,
-        [](const ParticleSystem<D>& p, std::size_t j, std::uint32_t* out) { *out = p.species[j]; });
-    write_particle_chunk<float>(w, "particles/diameter", 1, s,
-                                [](const ParticleSystem<D>& p, std::size_t j, float* out) {
-                                  *out = static_cast<float>(2.0 * p.kinematics[j].radius);
-                                });
-    write_particle_chunk<float>(w, "particles/mass", 1, s,
-                                [](const ParticleSystem<D>& p, std::size_t j, float* out) {
-                                  *out = static_cast<float>(p.mass[j]);
-                                });
-    write_bonds(w, sys);
+        [](Part p, std::size_t j, std::uint32_t* out) { *out = p.species[j]; });
   }
+  if (with_static || layout.diameter_every_frame) {
+    write_particle_chunk<T>(w, "particles/diameter", 1, s, [](Part p, std::size_t j, T* out) {
+      *out = static_cast<T>(2.0 * p.kinematics[j].radius);
+    });
+  }
+  if (with_static || layout.mass_every_frame) {
+    write_particle_chunk<T>(w, "particles/mass", 1, s, [](Part p, std::size_t j, T* out) {
+      *out = static_cast<T>(p.mass[j]);
+    });
+  }
+  if (with_static) write_bonds(w, sys);
   w.write_chunk("log/time", 1, 1, &sys.time);
   w.write_chunk("log/collisions", 1, 1, &sys.counters.collisions);
   w.write_chunk("log/events", 1, 1, &sys.counters.events);
+}
+
+// Every field the state has, in float32 (restart files: HOOMD's view of the state).
+template <int D>
+void write_standard_chunks(gsd::Writer& w, const StateBlocks<D>& s, bool with_static) {
+  write_standard_chunks<float>(w, s, with_static, TrajectoryLayout{});
 }
 
 // A restart file of `format` carries kairos/checksum from format 7 on (older ones may not); when
@@ -307,14 +322,21 @@ void validate_restart(const ParticleSystem<D>& s, const std::filesystem::path& p
 }  // namespace
 
 template <int D>
-void append_trajectory_frame(gsd::Writer& writer, const StateBlocks<D>& state) {
-  write_standard_chunks(writer, state, writer.frame_count() == 0);
+void append_trajectory_frame(gsd::Writer& writer, const StateBlocks<D>& state,
+                             const TrajectoryLayout& layout) {
+  const bool first = writer.frame_count() == 0;
+  if (layout.double_precision) {
+    write_standard_chunks<double>(writer, state, first, layout);
+  } else {
+    write_standard_chunks<float>(writer, state, first, layout);
+  }
   writer.end_frame();
 }
 
 template <int D>
-void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& system) {
-  append_trajectory_frame(writer, StateBlocks<D>::of(system));
+void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& system,
+                             const TrajectoryLayout& layout) {
+  append_trajectory_frame(writer, StateBlocks<D>::of(system), layout);
 }
 
 template <int D>
@@ -690,10 +712,14 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
   return s;
 }
 
-template void append_trajectory_frame<2>(gsd::Writer&, const ParticleSystem<2>&);
-template void append_trajectory_frame<3>(gsd::Writer&, const ParticleSystem<3>&);
-template void append_trajectory_frame<2>(gsd::Writer&, const StateBlocks<2>&);
-template void append_trajectory_frame<3>(gsd::Writer&, const StateBlocks<3>&);
+template void append_trajectory_frame<2>(gsd::Writer&, const ParticleSystem<2>&,
+                                         const TrajectoryLayout&);
+template void append_trajectory_frame<3>(gsd::Writer&, const ParticleSystem<3>&,
+                                         const TrajectoryLayout&);
+template void append_trajectory_frame<2>(gsd::Writer&, const StateBlocks<2>&,
+                                         const TrajectoryLayout&);
+template void append_trajectory_frame<3>(gsd::Writer&, const StateBlocks<3>&,
+                                         const TrajectoryLayout&);
 template void write_restart<2>(const std::filesystem::path&, const StateBlocks<2>&,
                                const std::mt19937_64&, const RestartChunks&);
 template void write_restart<3>(const std::filesystem::path&, const StateBlocks<3>&,

@@ -48,14 +48,31 @@
 
 namespace kairos {
 
-// Appends one trajectory frame of the state at its current time. Static per-particle data
-// (types, diameters, masses) is written only into the file's first frame (HOOMD readers take
-// missing chunks from frame 0).
+// What a trajectory frame holds (output.trajectory_fields and trajectory_precision; the
+// default: every per-particle field the state has, in float32). Every frame holds
+// configuration/step, dimensions and box, particles/N, particles/position and the log/
+// scalars; the file's first frame also holds particles/types, typeid, diameter and mass and the
+// bonds (HOOMD readers take a chunk missing from a later frame from frame 0).
+struct TrajectoryLayout {
+  bool velocity = true;          // particles/velocity
+  bool image = true;             // particles/image, when the state counts images
+  bool angular_velocity = true;  // log/particles/angular_velocity, when the particles spin
+  // particles/typeid, diameter, mass in every frame, not only in frame 0.
+  bool typeid_every_frame = false, diameter_every_frame = false, mass_every_frame = false;
+  // float64 instead of float32: configuration/box, particles/position (in HOOMD's centred box,
+  // correctly rounded from the engine's position), velocity (the engine's, exactly), diameter,
+  // mass and log/particles/angular_velocity.
+  bool double_precision = false;
+};
+
+// Appends one trajectory frame of the state at its current time.
 template <int D>
-void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& system);
+void append_trajectory_frame(gsd::Writer& writer, const ParticleSystem<D>& system,
+                             const TrajectoryLayout& layout = {});
 // The same from a state read in blocks (an engine's, without a copy of its whole state).
 template <int D>
-void append_trajectory_frame(gsd::Writer& writer, const StateBlocks<D>& state);
+void append_trajectory_frame(gsd::Writer& writer, const StateBlocks<D>& state,
+                             const TrajectoryLayout& layout = {});
 
 // More chunks for a restart file's frame, written after the state and before the checksum that
 // covers them: the run's bookkeeping (run/run_progress.hpp, the kairos/run/ chunks), which this

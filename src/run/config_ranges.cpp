@@ -242,6 +242,33 @@ void check_run(const Config& c, const RangeScales& s) {
   }
 }
 
+// Log-spaced frames (output.trajectory_spacing = "log") over the production: a million at most,
+// as for the intervals (counted when the intervals are in the production length's unit).
+void check_log_frames(const Config& c, bool in_time) {
+  const OutputConfig& o = c.output;
+  if (!trajectory_spacings().is(o.trajectory_spacing, TrajectorySpacing::kLog)) return;
+  const bool length_in_time = c.run.time > 0.0;
+  if (in_time != length_in_time || !(o.trajectory_interval > 0.0)) return;
+  const double length = length_in_time ? c.run.time : c.run.collisions_per_particle;
+  const auto per_sequence = [&](double span) {
+    return 1.0 +
+           std::floor(static_cast<double>(o.trajectory_frames_per_decade) *
+                      std::log10(std::max(1.0, span / o.trajectory_interval))) +
+           1.0;
+  };
+  const double period = o.trajectory_log_period;
+  const double frames =
+      period > 0.0 ? std::ceil(length / period) * per_sequence(period) : per_sequence(length);
+  if (frames <= 1e6) return;
+  throw InputError(fmt::format(
+      "output.trajectory_frames_per_decade = {}{}: about {:.3g} log-spaced frames over the "
+      "production (first lag output.trajectory_interval = {}); at most 1e6: fewer frames per "
+      "decade{}",
+      o.trajectory_frames_per_decade,
+      period > 0.0 ? fmt::format(" with output.trajectory_log_period = {}", period) : "", frames,
+      o.trajectory_interval, period > 0.0 ? " or a longer period" : " or a longer first lag"));
+}
+
 void check_outputs(const Config& c, const RangeScales& s) {
   const bool length_in_time = c.run.time > 0.0;
   const ChoiceEntry<IntervalUnit>* unit = interval_units().find(c.output.interval_unit);
@@ -250,6 +277,7 @@ void check_outputs(const Config& c, const RangeScales& s) {
   for (const auto& [key, value] : {std::pair{"output.thermo_interval", c.output.thermo_interval},
                                    {"output.trajectory_interval", c.output.trajectory_interval},
                                    {"output.restart_interval", c.output.restart_interval},
+                                   {"output.trajectory_log_period", c.output.trajectory_log_period},
                                    {"analysis.interval", c.analysis.interval}}) {
     if (value == 0.0) continue;  // automatic, or none
     const std::string path = key;
@@ -264,6 +292,7 @@ void check_outputs(const Config& c, const RangeScales& s) {
       within(path, value, 1e-9, 1e9, "collisions per particle");
     }
   }
+  check_log_frames(c, in_time);
 }
 
 // The analyses' lengths against the box (minimum images) and the diameters.

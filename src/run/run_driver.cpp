@@ -177,7 +177,9 @@ bool RunDriver<D>::run_phase(const std::string& phase, PhaseLength length, Progr
   phase_target_ = target;
   phase_end_time_ = end_time;
   schedule_phase_ = phase == "production" ? 1 : 0;
-  start_triggers(begin, begin_time);
+  // The phase the restart file was written in, resumed (else it starts now).
+  const bool continued = restarted() && first_phase_ && resumed_.schedule_phase == schedule_phase_;
+  start_triggers(begin, begin_time, continued);
   // Continued in its own directory from a state whose row or frame could not be written: they
   // come first.
   if (restarted() && first_phase_ && continuation_.same_directory && resumed_.owed_outputs != 0) {
@@ -187,6 +189,16 @@ bool RunDriver<D>::run_phase(const std::string& phase, PhaseLength length, Progr
     if (!write_due(owed)) return stopped_because("write_failed");
   }
   first_phase_ = false;
+  // The writes at the start of a phase (the first production frame, the origin of log-spaced
+  // frames), unless a continued run resumes the phase.
+  if (!continued) {
+    std::vector<std::size_t> at_start;
+    for (std::size_t k = 0; k < observers_.size(); ++k) {
+      const OutputSpacing spacing = observers_[k]->spacing(config_, phase);
+      if (spacing.in_phase && spacing.at_start) at_start.push_back(k);
+    }
+    if (!write_due(at_start)) return stopped_because("write_failed");
+  }
   const auto report = [&](double done, bool force) {
     progress.update(
         {phase, done, length.value, integrator.time(), integrator.events(), length.in_time}, force);
@@ -241,21 +253,44 @@ bool RunDriver<D>::run_phase(const std::string& phase, PhaseLength length, Progr
 }
 
 template <int D>
-void RunDriver<D>::start_triggers(std::uint64_t begin, double begin_time) {
+void RunDriver<D>::start_triggers(std::uint64_t begin, double begin_time, bool continued) {
   const double production = production_length(config_.run).value;
   const bool in_time = intervals_in_time(config_);
   triggers_.assign(observers_.size(), Trigger{});
+  // Log-spaced writes count from the phase's start, or from the start a continued run's
+  // restart file recorded for the phase it resumes.
+  const bool resumed_origin = continued && std::isfinite(resumed_.frame_origin_time);
+  const double origin_time = resumed_origin ? resumed_.frame_origin_time : begin_time;
+  const std::uint64_t origin = resumed_origin ? resumed_.frame_origin_collisions : begin;
+  log_origin_time_ = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t k = 0; k < observers_.size(); ++k) {
     const double interval = observers_[k]->interval(config_, production);
-    if (!(interval > 0.0)) continue;
-    triggers_[k] = in_time || observers_[k]->samples_in_time()
-                       ? Trigger::every_time(interval, begin_time)
-                       : Trigger::every_collisions(
-                             std::max<std::uint64_t>(1, collisions_for(interval)), begin);
+    const OutputSpacing spacing = observers_[k]->spacing(config_, phase_);
+    if (!(interval > 0.0) || !spacing.in_phase) continue;
+    const bool timed = in_time || observers_[k]->samples_in_time();
+    if (spacing.per_decade > 0.0) {
+      // In collisions: the lags at their exact collision counts (the first count at or after
+      // each), the period a whole number of collisions as a step is.
+      const double per_collision = static_cast<double>(integrator_->size()) / 2.0;
+      LogSpacing log{.first = timed ? interval : interval * per_collision,
+                     .per_decade = spacing.per_decade,
+                     .period = spacing.period > 0.0 && !timed
+                                   ? static_cast<double>(
+                                         std::max<std::uint64_t>(1, collisions_for(spacing.period)))
+                                   : spacing.period};
+      triggers_[k] = timed ? Trigger::log_time(log, origin_time, integrator_->trigger_time())
+                           : Trigger::log_collisions(log, origin, integrator_->collisions());
+      log_origin_time_ = origin_time;
+      log_origin_collisions_ = origin;
+      continue;
+    }
+    triggers_[k] = timed ? Trigger::every_time(interval, begin_time)
+                         : Trigger::every_collisions(
+                               std::max<std::uint64_t>(1, collisions_for(interval)), begin);
   }
   // The first phase of a continued run keeps the stored schedule of the same phase (the rows
   // an uninterrupted run would write), if its steps are unchanged.
-  if (!restarted() || !first_phase_ || resumed_.schedule_phase != schedule_phase_) return;
+  if (!continued) return;
   for (std::size_t k = 0; k < observers_.size(); ++k) {
     const int slot = observers_[k]->schedule_slot();
     if (slot < 0) continue;
@@ -305,6 +340,8 @@ RunProgress RunDriver<D>::progress_now() const {
   RunProgress p;
   for (const auto& o : observers_) o->record(p);
   p.owed_outputs = owed_;
+  p.frame_origin_time = log_origin_time_;
+  p.frame_origin_collisions = log_origin_collisions_;
   if (schedule_phase_ >= 0) {
     p.schedule_phase = schedule_phase_;
     for (std::size_t k = 0; k < observers_.size(); ++k) {

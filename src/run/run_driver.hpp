@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -81,8 +82,9 @@ class RunDriver final : public RunContext<D> {
   // Runs a phase of `length`; true if the run stopped early (stop_reason_ says why).
   bool run_phase(const std::string& phase, PhaseLength length, ProgressLine& progress);
   // The observers' triggers for a phase starting at `begin` collisions, `begin_time`, and, in
-  // the first phase of a continued run, the schedules its restart file recorded.
-  void start_triggers(std::uint64_t begin, double begin_time);
+  // a phase a continued run resumes (`continued`), the schedules and the origin of log-spaced
+  // frames its restart file recorded.
+  void start_triggers(std::uint64_t begin, double begin_time, bool continued);
   // Writes the observers due now (their indices), in order: false when one could not be
   // written (the run then stops). What is due and not written is owed (RunProgress::owed).
   bool write_due(const std::vector<std::size_t>& due);
@@ -114,6 +116,10 @@ class RunDriver final : public RunContext<D> {
   std::uint64_t phase_target_ = 0, equilibration_target_ = 0;
   double phase_end_time_ = AdvanceLimits::kNoTime, equilibration_end_time_ = 0.0;
   int schedule_phase_ = -1;
+  // The origin of the log-spaced writes of the phase running (RunProgress::frame_origin_*);
+  // NaN time: none.
+  double log_origin_time_ = std::numeric_limits<double>::quiet_NaN();
+  std::uint64_t log_origin_collisions_ = 0;
   unsigned owed_ = 0;  // RunProgress::owed_outputs of the present state
   std::string stop_reason_ = "completed";
   std::string error_;  // why the run could not go on (RunOutcome::error)

@@ -45,6 +45,10 @@ void write_progress(gsd::Writer& w, const RunProgress& progress) {
     w.write_chunk("kairos/run/frame_mark", 1, 1, &progress.frame_time);
     w.write_chunk("kairos/run/frame_mark_collisions", 1, 1, &progress.frame_collisions);
   }
+  if (std::isfinite(progress.frame_origin_time)) {
+    w.write_chunk("kairos/run/frame_origin", 1, 1, &progress.frame_origin_time);
+    w.write_chunk("kairos/run/frame_origin_collisions", 1, 1, &progress.frame_origin_collisions);
+  }
   if (progress.has_thermo_mark) {
     const double mark[2] = {progress.mark_time, progress.mark_virial};
     const std::uint64_t counts[2] = {progress.mark_events, progress.mark_collisions};
@@ -136,6 +140,14 @@ void read_progress(const gsd::Reader& r, std::uint64_t f, const std::filesystem:
     progress.has_frame_mark = true;
     progress.frame_time = time[0];
     progress.frame_collisions = count[0];
+  }
+  if (r.find(f, "kairos/run/frame_origin")) {
+    const auto time = require<double>(r, f, "kairos/run/frame_origin", path, 1);
+    const auto count = require<std::uint64_t>(r, f, "kairos/run/frame_origin_collisions", path, 1);
+    if (!std::isfinite(time[0]) || time[0] > s.time || count[0] > s.counters.collisions)
+      throw InputError(file + ": kairos/run/frame_origin lies after the state");
+    progress.frame_origin_time = time[0];
+    progress.frame_origin_collisions = count[0];
   }
   if (r.find(f, "kairos/run/thermo_mark")) {
     const auto mark = require<double>(r, f, "kairos/run/thermo_mark", path, 2);

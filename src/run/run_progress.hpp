@@ -61,6 +61,12 @@ struct RunProgress {
   bool has_frame_mark = false;
   double frame_time = 0.0;
   std::uint64_t frame_collisions = 0;
+  // Log-spaced trajectory frames (output.trajectory_spacing = "log"; kairos/run/frame_origin
+  // and frame_origin_collisions): the origin of the sequence of the phase in schedule_phase, its
+  // start's time and collision count, so that a continued run writes the frames an
+  // uninterrupted run would. NaN: not recorded.
+  double frame_origin_time = std::numeric_limits<double>::quiet_NaN();
+  std::uint64_t frame_origin_collisions = 0;
   // Output schedules in collisions (kairos/run/schedule) of the phase the state is in (0:
   // equilibration, 1: production, -1: not recorded): thermo, trajectory, restart; a step of 0:
   // not scheduled. A continued run in that phase with the same steps keeps them.

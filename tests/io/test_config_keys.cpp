@@ -103,12 +103,17 @@ std::string concrete(const std::string& path) {
 
 std::string base_for(const std::string& path) {
   if (path.starts_with("soft") || path == "run.time_step") return std::string(kEveryTableSoft);
-  // An analysis's own keys act only with that analysis on.
+  // An analysis's own keys act only with that analysis on; those of log-spaced frames with
+  // them.
   const bool analysis = path.starts_with("analysis.");
+  const bool log_frames =
+      path == "output.trajectory_frames_per_decade" || path == "output.trajectory_log_period";
   return std::string(kEveryTableHard) +
          (analysis ? "\n[analysis]\nmsd = true\nrdf = true\nstructure_factor = true\n"
                      "bond_order = true\n"
-                   : "");
+                   : "") +
+         (log_frames ? "\n[output]\ntrajectory_spacing = \"log\"\ntrajectory_interval = 0.01\n"
+                     : "");
 }
 
 // A value inside the key's range (and valid with the configs above), as --set writes it.

@@ -6,7 +6,8 @@
 // it is):
 //   open                  the run begins (files opened, a continued run's files cut back)
 //   write                 its trigger fired: every interval() collisions per particle or unit
-//                         of simulated time (output.interval_unit), counted per phase
+//                         of simulated time (output.interval_unit), counted per phase, or
+//                         as spacing() says (log-spaced, at a phase's start)
 //   sample                a production thermo row is written: analyses averaged over rows
 //   equilibration_ends    the equilibration is over (or was stopped)
 //   production_starts     production begins (also after an equilibration that was stopped)
@@ -32,6 +33,7 @@
 #include "run/output_directory.hpp"
 #include "run/restart_plan.hpp"
 #include "run/run_progress.hpp"
+#include "run/trigger.hpp"
 
 namespace kairos {
 
@@ -87,6 +89,11 @@ class Observer {
   // the production's length in that unit; 0: no trigger (write() is never called).
   virtual double interval(const Config& /*config*/, double /*production_length*/) const {
     return 0.0;
+  }
+  // How its writes are spaced in `phase` ("equilibration" or "production"): in it at all, once
+  // at its start, log-spaced (run/trigger.hpp). The default: every interval() in every phase.
+  virtual OutputSpacing spacing(const Config& /*config*/, const std::string& /*phase*/) const {
+    return {};
   }
   // The restart file records the schedules of three outputs (kairos/run/schedule: 0 thermo, 1
   // trajectory, 2 restart), so that a continued run keeps them; -1: not recorded (a continued
