@@ -248,10 +248,11 @@ void RunDriver<D>::start_triggers(std::uint64_t begin, double begin_time) {
   for (std::size_t k = 0; k < observers_.size(); ++k) {
     const double interval = observers_[k]->interval(config_, production);
     if (!(interval > 0.0)) continue;
-    triggers_[k] = in_time || observers_[k]->samples_in_time()
-                       ? Trigger::every_time(interval, begin_time)
-                       : Trigger::every_collisions(
-                             std::max<std::uint64_t>(1, collisions_for(interval)), begin);
+    const bool timed =
+        !observers_[k]->samples_in_collisions() && (in_time || observers_[k]->samples_in_time());
+    triggers_[k] = timed ? Trigger::every_time(interval, begin_time)
+                         : Trigger::every_collisions(
+                               std::max<std::uint64_t>(1, collisions_for(interval)), begin);
   }
   // The first phase of a continued run keeps the stored schedule of the same phase (the rows
   // an uninterrupted run would write), if its steps are unchanged.
