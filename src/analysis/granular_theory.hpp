@@ -31,6 +31,34 @@ double temperature_ratio_after_collisions(int d, double e, double collisions_per
 // van Noije–Ernst Sonine coefficient a2 of the homogeneous cooling state.
 double sonine_a2(int d, double e);
 
+// Self-diffusion in the homogeneous cooling state of equal smooth inelastic spheres/disks
+// (constant e in [0.6, 1], number density n, diameter sigma; Enskog's kinetic theory;
+// docs/physics.md#self-diffusion-in-the-homogeneous-cooling-state). D(t) = (T/m) / (nu_D -
+// zeta/2) decays with sqrt(T), but against the collisions per particle s (ds = omega dt, omega
+// the collision frequency) the mean-square displacement grows linearly, <|r(s) - r(0)|^2> ->
+// 2 d D_s s, with the constant D_s = D / omega. In the first Sonine approximation, with
+// nu_D = (1 + e) omega_E (1 - a2/32) / d, zeta = (1 - e^2) omega_E (1 + 3 a2/16) / d and
+// omega = omega_E (1 - a2/16) (omega_E the Enskog collision frequency of the Maxwellian, a2 van
+// Noije–Ernst's),
+//   D_s = d (T/m) / (omega_E^2 (1 - a2/16) (1 + e) [(1 + e)/2 - a2 (4 - 3e)/32]),
+// independent of T; for e = 1 Enskog's D over omega_E. The higher Sonine orders multiply it by
+// hcs_sonine_factor(d, e) (1.019 for elastic spheres, Chapman and Cowling's factor).
+struct HcsSelfDiffusion {
+  double per_collision = 0.0;  // D_s: length^2 per collision per particle (all Sonine orders)
+  double reduced = 0.0;        // D_s (n sigma^(d-1))^2: a function of e and the packing fraction
+  double first_sonine = 0.0;   // D_s in the first Sonine approximation
+  double maxwellian = 0.0;     // the same with a2 = 0
+  double sonine_factor = 0.0;  // per_collision / first_sonine
+  double a2 = 0.0;             // van Noije–Ernst
+  double contact_value = 0.0;  // g(sigma) of the Enskog collision frequency
+};
+HcsSelfDiffusion hcs_self_diffusion(int d, double e, double number_density, double sigma);
+// The factor of the Sonine orders beyond the first for D_s (e in [0.6, 1]): the fifth-order
+// Galerkin solution of the Boltzmann–Lorentz equation of a tagged particle in a Maxwellian gas at
+// e = 0.60, 0.65, ..., 1.00 (examples/validation/hcs_sonine.py), interpolated linearly.
+double hcs_sonine_factor(int d, double e);
+constexpr double kHcsTheoryMinRestitution = 0.6;
+
 // Rough spheres/disks with constant e in [0, 1], beta in [-1, 1] and q > 0.
 //
 // Mean kinetic-energy change of one collision (of the pair), for Maxwellian translational and

@@ -678,6 +678,12 @@ class Reader : public KeyReader {
     }
     check_analysis_keys(root, c.analysis);
     check_transport(root, c);
+    if (c.analysis.mutual_diffusion && c.system.species.size() < 2 &&
+        c.system.initial_state.empty()) {
+      fail(node_at(root, "analysis.mutual_diffusion"), "analysis.mutual_diffusion",
+           "analysis.mutual_diffusion: interdiffusion needs a mixture (two or more "
+           "[[system.species]])");
+    }
     if (c.analysis.msd && c.boundary.shear_rate != 0.0) {
       fail(node_at(root, "analysis.msd"), "analysis.msd",
            "analysis.msd: the mean-square displacement under Lees-Edwards shear is not measured "
@@ -825,6 +831,8 @@ class Reader : public KeyReader {
     };
     const Needs keys[] = {
         {"analysis.vacf", a.vacf, a.msd, "analysis.msd = true"},
+        {"analysis.msd_time", a.msd_time != d.msd_time, a.msd, "analysis.msd = true"},
+        {"analysis.mutual_diffusion", a.mutual_diffusion, a.msd, "analysis.msd = true"},
         {"analysis.msd_interval", a.msd_interval != d.msd_interval, a.msd, "analysis.msd = true"},
         {"analysis.msd_particles", a.msd_particles != d.msd_particles, a.msd,
          "analysis.msd = true"},
@@ -850,6 +858,19 @@ class Reader : public KeyReader {
     for (const Needs& k : keys) {
       if (k.given && !k.on)
         fail(node_at(root, k.key), k.key, fmt::format("{}: acts only with {}", k.key, k.what));
+    }
+    // In collisions per particle: no velocity autocorrelation (the velocities of a cooling gas
+    // decay) and no finite-size correction (a viscosity is per unit time).
+    if (a.msd && msd_time_scales().at(a.msd_time) == MsdTime::kCollisions) {
+      for (const auto& [key, given] : {std::pair{"analysis.vacf", a.vacf},
+                                       {"analysis.msd_viscosity", a.msd_viscosity != 0.0}}) {
+        if (given) {
+          fail(node_at(root, key), key,
+               fmt::format("{}: not with analysis.msd_time = \"collisions\" (the MSD against "
+                           "collisions per particle); use msd_time = \"time\"",
+                           key));
+        }
+      }
     }
     const auto window = [&](const char* from_key, double from, const char* to_key, double to) {
       if (from > 0.0 && to > 0.0 && !(from < to)) {

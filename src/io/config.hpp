@@ -161,9 +161,11 @@ struct OutputConfig {
 // file and to summary.json.
 struct AnalysisConfig {
   // msd.tsv: the mean-square displacement on log-spaced lags (analysis/msd.hpp), sampled every
-  // msd_interval of simulated time (0: automatic), of msd_particles particles at most; D fitted
-  // over lags [msd_fit_from, msd_fit_to] (0: automatic).
+  // msd_interval (0: automatic) of the MSD's clock, msd_time: simulated time, or collisions per
+  // particle ("auto": collisions for a freely cooling gas, whose D(t) decays); of msd_particles
+  // particles at most; D fitted over lags [msd_fit_from, msd_fit_to] (0: automatic).
   bool msd = false;
+  std::string msd_time = "auto";  // auto | time | collisions
   double msd_interval = 0.0;
   std::int64_t msd_particles = 4096;
   double msd_fit_from = 0.0;
@@ -172,6 +174,9 @@ struct AnalysisConfig {
   bool vacf = false;
   // The shear viscosity, when known (0: not): D is also corrected to an infinite system.
   double msd_viscosity = 0.0;
+  // mutual_diffusion.tsv: the interdiffusion (Maxwell-Stefan) coefficient of each species against
+  // the rest of the mixture from its collective Helfand moment, on the MSD's samples and lags.
+  bool mutual_diffusion = false;
   // The structure analyses (analysis/structure.hpp): rdf.tsv, sk.tsv, bond_order.tsv,
   // velocity_distribution.tsv, sampled over the production.
   bool rdf = false;                    // rdf.tsv: g(r) per species pair, contact values

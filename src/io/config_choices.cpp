@@ -78,6 +78,11 @@ constexpr ChoiceEntry<SoftCollisions> kSoftCollisions[] = {
     {"mapped", SoftCollisions::kMapped, "the Mueller-Poeschel collision map"},
     {"instantaneous", SoftCollisions::kInstantaneous, "a hard-sphere collision with e(v_n)"},
 };
+constexpr ChoiceEntry<MsdTime> kMsdTimes[] = {
+    {"auto", MsdTime::kAuto, "collisions for a freely cooling gas, time otherwise"},
+    {"time", MsdTime::kTime, "simulated time"},
+    {"collisions", MsdTime::kCollisions, "collisions per particle"},
+};
 constexpr ChoiceEntry<BoxFace> kFaces[] = {
     {"x-", BoxFace::kXLow, "x = 0"},      {"x+", BoxFace::kXHigh, "x = L_x"},
     {"y-", BoxFace::kYLow, "y = 0"},      {"y+", BoxFace::kYHigh, "y = L_y"},
@@ -155,6 +160,11 @@ const Choices<SoftModel>& soft_models() {
 
 const Choices<SoftCollisions>& soft_collision_modes() {
   static constexpr Choices<SoftCollisions> choices("soft collision mode", kSoftCollisions);
+  return choices;
+}
+
+const Choices<MsdTime>& msd_time_scales() {
+  static constexpr Choices<MsdTime> choices("MSD time scale", kMsdTimes);
   return choices;
 }
 

@@ -36,6 +36,8 @@ enum class RestitutionModel { kConstant, kViscoelastic, kTable };
 // Box faces: 2k is the low face of axis k, 2k + 1 the high one (face_number()).
 enum class BoxFace { kXLow, kXHigh, kYLow, kYHigh, kZLow, kZHigh };
 enum class Axis { kX, kY, kZ };
+// analysis.msd_time: the MSD's clock (auto: collisions for a freely cooling gas, else time).
+enum class MsdTime { kAuto, kTime, kCollisions };
 
 // system.lattice in a 3D or 2D box (dimension 2 or 3).
 const Choices<Lattice>& lattices(int dimension);
@@ -53,6 +55,7 @@ const Choices<TrajectoryPhases>& trajectory_phases();
 const Choices<TrajectoryPrecision>& trajectory_precisions();
 const Choices<TrajectorySpacing>& trajectory_spacings();
 const Choices<TrajectoryField>& trajectory_fields();
+const Choices<MsdTime>& msd_time_scales();              // analysis.msd_time
 // boundary.wall[].face and boundary.open: the faces of a box of `dimension` (2 or 3), or all
 // six (dimension 0).
 const Choices<BoxFace>& box_faces(int dimension = 0);

@@ -267,7 +267,8 @@ void RunDriver<D>::start_triggers(std::uint64_t begin, double begin_time, bool c
     const double interval = observers_[k]->interval(config_, production);
     const OutputSpacing spacing = observers_[k]->spacing(config_, phase_);
     if (!(interval > 0.0) || !spacing.in_phase) continue;
-    const bool timed = in_time || observers_[k]->samples_in_time();
+    const bool timed =
+        !observers_[k]->samples_in_collisions() && (in_time || observers_[k]->samples_in_time());
     if (spacing.per_decade > 0.0) {
       // In collisions: the lags at their exact collision counts (the first count at or after
       // each), the period a whole number of collisions as a step is.

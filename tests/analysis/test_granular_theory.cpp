@@ -58,6 +58,65 @@ TEST(GranularTheory, HaffLawShapeAndScaling) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Self-diffusion in the homogeneous cooling state
+// (docs/physics.md#self-diffusion-in-the-homogeneous-cooling-state).
+
+TEST(GranularTheory, CoolingStateDiffusionIsEnskogsPerCollisionWhenElastic) {
+  // e = 1: a2 = 0, and D_s is Enskog's D (first Sonine: 3 / (8 n sigma^2 g) sqrt(T / (pi m)) in
+  // 3D, 1 / (2 n sigma g) sqrt(T / (pi m)) in 2D) over omega_E, times Chapman and Cowling's
+  // factor for the higher orders (1.019 for spheres).
+  for (const double n : {0.02, 0.2}) {
+    const double sigma = 1.3;
+    const HcsSelfDiffusion s3 = hcs_self_diffusion(3, 1.0, n, sigma);
+    const double g3 = contact_value(3, packing_fraction(3, n, sigma));
+    const double d3 = 3.0 / (8.0 * n * sigma * sigma * g3) * std::sqrt(1.0 / M_PI);
+    EXPECT_NEAR(s3.first_sonine / (d3 / enskog_collision_frequency(3, n, sigma, 1.0, 1.0)), 1.0,
+                1e-13);
+    EXPECT_EQ(s3.a2, 0.0);
+    EXPECT_NEAR(s3.per_collision / s3.first_sonine, 1.019, 0.0005);
+    const HcsSelfDiffusion s2 = hcs_self_diffusion(2, 1.0, n, sigma);
+    const double g2 = contact_value(2, packing_fraction(2, n, sigma));
+    const double d2 = 1.0 / (2.0 * n * sigma * g2) * std::sqrt(1.0 / M_PI);
+    EXPECT_NEAR(s2.first_sonine / (d2 / enskog_collision_frequency(2, n, sigma, 1.0, 1.0)), 1.0,
+                1e-13);
+    EXPECT_NEAR(s2.reduced, s2.per_collision * n * sigma * n * sigma, 1e-15);
+  }
+}
+
+TEST(GranularTheory, CoolingStateDiffusionReferenceValues) {
+  // Without a2 the first Sonine approximation scales as 4 / (1 + e)^2 from the elastic value:
+  // nu_D - zeta/2 = (1 + e)^2 omega_E / (2d).
+  for (const int d : {2, 3}) {
+    const double elastic = hcs_self_diffusion(d, 1.0, 0.01, 1.0).maxwellian;
+    for (const double e : {0.6, 0.75, 0.9}) {
+      EXPECT_NEAR(hcs_self_diffusion(d, e, 0.01, 1.0).maxwellian / elastic,
+                  4.0 / ((1.0 + e) * (1.0 + e)), 1e-13);
+    }
+  }
+  struct Row {
+    int d;
+    double e, n, first, factor, total;
+  };
+  // docs/physics.md's values (sigma = 1).
+  // docs/physics.md's values: packing fraction 0.01, sigma = 1.
+  for (const Row& r : {Row{3, 0.9, 6 * 0.01 / M_PI, 86.07381969, 1.00661, 86.64276764},
+                       Row{3, 0.8, 6 * 0.01 / M_PI, 95.90782261, 0.99506, 95.43403797},
+                       Row{3, 0.7, 6 * 0.01 / M_PI, 107.7012818, 0.98407, 105.9856004},
+                       Row{3, 1.0, 6 * 0.01 / M_PI, 77.80072686, 1.01892, 79.27271661},
+                       Row{2, 0.8, 4 * 0.01 / M_PI, 585.7468427, 0.99306, 581.6817596}}) {
+    const HcsSelfDiffusion s = hcs_self_diffusion(r.d, r.e, r.n, 1.0);
+    EXPECT_NEAR(s.sonine_factor, r.factor, 1e-12);
+    EXPECT_NEAR(s.first_sonine / r.first, 1.0, 1e-9);
+    EXPECT_NEAR(s.per_collision / r.total, 1.0, 1e-9);
+  }
+  // Between the table's points, linear.
+  EXPECT_NEAR(hcs_sonine_factor(3, 0.825), 0.5 * (0.99506 + 1.00063), 1e-12);
+  EXPECT_THROW(hcs_self_diffusion(3, 0.5, 0.01, 1.0), std::invalid_argument);
+  EXPECT_THROW(hcs_self_diffusion(3, 0.9, 0.0, 1.0), std::invalid_argument);
+  EXPECT_THROW(hcs_sonine_factor(4, 0.9), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Rough spheres: limits of the mean-field theory.
 
 TEST(GranularTheory, SmoothLimitHasNoRotationalCoupling) {

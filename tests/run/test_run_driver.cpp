@@ -66,10 +66,11 @@ class Recorder final : public Observer<D> {
     std::vector<double> times;
     int samples = 0, closes = 0, opens = 0, production_starts = 0;
   };
-  Recorder(Calls& calls, double interval, int fail_at = -1)
-      : calls_(calls), interval_(interval), fail_at_(fail_at) {}
+  Recorder(Calls& calls, double interval, int fail_at = -1, bool in_collisions = false)
+      : calls_(calls), interval_(interval), fail_at_(fail_at), in_collisions_(in_collisions) {}
   std::string name() const override { return "recorder.tsv"; }
   double interval(const Config&, double) const override { return interval_; }
+  bool samples_in_collisions() const override { return in_collisions_; }
   void open(const RunContext<D>&) override { ++calls_.opens; }
   void write(const RunContext<D>& run) override {
     if (static_cast<int>(calls_.collisions.size()) == fail_at_) {
@@ -90,6 +91,7 @@ class Recorder final : public Observer<D> {
   Calls& calls_;
   double interval_;
   int fail_at_;
+  bool in_collisions_;
 };
 
 // Rows of thermo.tsv by phase.
@@ -132,6 +134,26 @@ TEST_F(RunDriverTest, ATriggerInTimeFiresAtTheMultiplesOfItsInterval) {
   ASSERT_TRUE(driver.run().error.empty());
   // The event engine stops its clock at each (no event needs to happen there).
   EXPECT_EQ(calls.times, (std::vector<double>{0.25, 0.5, 0.75, 1.0}));
+}
+
+TEST_F(RunDriverTest, AnObserverOnTheCollisionClockCountsCollisionsInARunMeasuredInTime) {
+  // Phases and output intervals in time, the observer's interval in collisions per particle
+  // (the MSD of a cooling gas): 0.5 per particle = 64 collisions, met exactly, from the
+  // production's start.
+  const Config c =
+      config("event", "equilibration_time = 0.0\ntime = 2.0", "interval_unit = \"time\"");
+  Recorder<3>::Calls calls;
+  RunDriver<3> driver(c, std::nullopt, {});
+  driver.add_observer(std::make_unique<Recorder<3>>(calls, 0.5, -1, /*in_collisions=*/true));
+  const RunOutcome outcome = driver.run();
+  ASSERT_TRUE(outcome.error.empty()) << outcome.error;
+  ASSERT_GE(calls.collisions.size(), 3u);
+  for (std::size_t k = 0; k < calls.collisions.size(); ++k)
+    EXPECT_EQ(calls.collisions[k], 64 * (k + 1));
+  // Every threshold the run passed: the last one within 64 collisions of the end.
+  const auto total = static_cast<std::uint64_t>(
+      std::llround(outcome.summary["production_collisions_per_particle"].get<double>() * 128.0));
+  EXPECT_LT(total - calls.collisions.back(), 64u);
 }
 
 TEST_F(RunDriverTest, TheDemCallsTheSameObserversAtTheStepThatReachesTheirTriggers) {

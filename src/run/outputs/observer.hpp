@@ -102,6 +102,9 @@ class Observer {
   // Its interval is in simulated time whatever output.interval_unit says: an analysis that
   // samples at regular times (a time correlator); the clock stops at its samples.
   virtual bool samples_in_time() const { return false; }
+  // Its interval is in collisions per particle whatever output.interval_unit says: an analysis
+  // whose clock is the collision count (the MSD of a freely cooling gas, analysis.msd_time).
+  virtual bool samples_in_collisions() const { return false; }
   // Its bit in RunProgress::owed_outputs when a write of it failed (kOwedRow, kOwedFrame): a
   // continued run writes it first. 0: nothing owed (written again at the next trigger).
   virtual unsigned owed_bit() const { return 0; }
