@@ -370,6 +370,15 @@ std::size_t MsdCorrelator<D>::bytes() const {
   return b;
 }
 
+std::pair<double, double> correlation_fit_window(double sampled, double from, double to,
+                                                 double mean_free_time) {
+  if (!(to > 0.0)) to = 0.25 * sampled;
+  if (!(from > 0.0)) {
+    from = std::max(0.1 * to, std::isfinite(mean_free_time) ? 10.0 * mean_free_time : 0.0);
+  }
+  return {from, to};
+}
+
 template class MsdCorrelator<1>;  // collective moments (run/outputs/transport_output.hpp)
 template class MsdCorrelator<2>;
 template class MsdCorrelator<3>;

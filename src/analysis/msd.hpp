@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/vec.hpp"
@@ -138,5 +139,11 @@ class MsdCorrelator {
   std::uint64_t epoch_length_ = 1;  // samples per epoch
   std::vector<Vec<D>> flux_now_;    // kFluxProduct: the current sample's fluxes (scratch)
 };
+
+// The fit window [from, to] of a correlator's slope (analysis.msd, analysis.transport and the
+// Python module's): `to` as given (> 0) or a quarter of the sampled span, `from` as given (> 0)
+// or the larger of a tenth of `to` and ten mean free times (NaN: not known).
+std::pair<double, double> correlation_fit_window(double sampled, double from, double to,
+                                                 double mean_free_time);
 
 }  // namespace kairos

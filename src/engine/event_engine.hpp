@@ -164,6 +164,10 @@ class EventEngine {
   // slot[id] != kNotFollowed (id: the caller's number), into out[slot[id]].
   static constexpr std::uint32_t kNotFollowed = ~0u;
   void unwrapped_positions(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const;
+  // Whether image counters (track_images, or a state that carried them) and the Helfand
+  // moments (track_helfand) are kept.
+  bool tracks_images() const { return images_.on(); }
+  bool tracks_helfand() const { return helfand_.on(); }
   // The Helfand moments now (options track_helfand; their collisional momentum part is
   // counters().virial_tensor).
   typename HelfandMoments<D>::Moments helfand_moments() const { return helfand_.at(time_); }

@@ -712,46 +712,16 @@ class Reader : public KeyReader {
   }
 
   // The Einstein-Helfand moments (engine/helfand_moments.hpp) need a conservative,
-  // translation-invariant system; each obstacle is named by its key.
+  // translation-invariant system; the obstacle is named by its key.
   void check_transport(const toml::table& root, const Config& c) const {
     if (!c.analysis.transport) return;
-    const toml::node* n_transport = node_at(root, "analysis.transport");
-    const auto refuse = [&](std::string_view key, std::string_view why) {
-      const toml::node* n = node_at(root, key);
-      fail(n != nullptr ? n : n_transport, std::string(key),
-           fmt::format("analysis.transport: {} ({}): the Einstein-Helfand moments need a "
-                       "conservative periodic system; remove {} or analysis.transport",
-                       why, key, key));
-    };
-    if (integrators().is(c.run.integrator, IntegratorKind::kDem))
-      refuse("run.integrator", "the DEM integrator is not event-driven");
-    if (c.boundary.shear_rate != 0.0)
-      refuse("boundary.shear_rate", "Lees-Edwards shear is a non-equilibrium state");
-    if (!c.boundary.walls.empty()) refuse("boundary.wall", "walls do not conserve momentum");
-    if (!c.boundary.open.empty()) refuse("boundary.open", "open faces lose particles' momentum");
-    if (!c.field.gravity.empty()) {
-      bool any = false;
-      for (double g : c.field.gravity) any = any || g != 0.0;
-      if (any) refuse("field.gravity", "a field does not conserve momentum");
-    }
-    if (!driving_kinds().is(c.driving.kind, DrivingKind::kNone))
-      refuse("driving.kind", "driving does not conserve energy");
-    if (c.soft.enabled())
-      refuse("soft.model", "soft contacts move particles while they last (not supported yet)");
-    const auto conservative = [](const ContactConfig& k) {
-      const bool elastic = k.restitution_model == "constant" && k.restitution == 1.0;
-      const bool tangential = k.tangential_restitution == -1.0 || k.friction == 0.0 ||
-                              (k.tangential_restitution == 1.0 && std::isinf(k.friction));
-      return elastic && tangential;
-    };
-    for (const PairPotentialConfig& p : c.potentials)
-      if (p.potential.kind == "spring_dashpot")
-        refuse("potential.kind", "a spring-dashpot by steps dissipates energy");
-    if (!conservative(c.interactions.contact))
-      refuse("contact.restitution", "inelastic or frictional contacts dissipate energy");
-    for (const PairContactConfig& p : c.interactions.pairs)
-      if (!conservative(p.contact))
-        refuse("contact.pair", "inelastic or frictional contacts dissipate energy");
+    const std::optional<TransportObstacle> obstacle = transport_obstacle(c);
+    if (!obstacle) return;
+    const toml::node* n = node_at(root, obstacle->key);
+    fail(n != nullptr ? n : node_at(root, "analysis.transport"), obstacle->key,
+         fmt::format("analysis.transport: {} ({}): the Einstein-Helfand moments need a "
+                     "conservative periodic system; remove {} or analysis.transport",
+                     obstacle->why, obstacle->key, obstacle->key));
   }
 
   // trajectory.gsd's options (docs/outputs.md): the fields are HOOMD's names, each once, with
@@ -955,6 +925,40 @@ class Reader : public KeyReader {
 };
 
 }  // namespace
+
+std::optional<TransportObstacle> transport_obstacle(const Config& c) {
+  const auto refuse = [](std::string key, std::string why) {
+    return TransportObstacle{std::move(key), std::move(why)};
+  };
+  if (integrators().is(c.run.integrator, IntegratorKind::kDem))
+    return refuse("run.integrator", "the DEM integrator is not event-driven");
+  if (c.boundary.shear_rate != 0.0)
+    return refuse("boundary.shear_rate", "Lees-Edwards shear is a non-equilibrium state");
+  if (!c.boundary.walls.empty()) return refuse("boundary.wall", "walls do not conserve momentum");
+  if (!c.boundary.open.empty())
+    return refuse("boundary.open", "open faces lose particles' momentum");
+  for (double g : c.field.gravity)
+    if (g != 0.0) return refuse("field.gravity", "a field does not conserve momentum");
+  if (!driving_kinds().is(c.driving.kind, DrivingKind::kNone))
+    return refuse("driving.kind", "driving does not conserve energy");
+  if (c.soft.enabled())
+    return refuse("soft.model", "soft contacts move particles while they last (not supported yet)");
+  const auto conservative = [](const ContactConfig& k) {
+    const bool elastic = k.restitution_model == "constant" && k.restitution == 1.0;
+    const bool tangential = k.tangential_restitution == -1.0 || k.friction == 0.0 ||
+                            (k.tangential_restitution == 1.0 && std::isinf(k.friction));
+    return elastic && tangential;
+  };
+  for (const PairPotentialConfig& p : c.potentials)
+    if (p.potential.kind == "spring_dashpot")
+      return refuse("potential.kind", "a spring-dashpot by steps dissipates energy");
+  if (!conservative(c.interactions.contact))
+    return refuse("contact.restitution", "inelastic or frictional contacts dissipate energy");
+  for (const PairContactConfig& p : c.interactions.pairs)
+    if (!conservative(p.contact))
+      return refuse("contact.pair", "inelastic or frictional contacts dissipate energy");
+  return std::nullopt;
+}
 
 Config parse_config(std::string_view toml_text, std::string_view source_name,
                     const std::vector<std::string>& overrides) {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -316,6 +317,15 @@ Config load_config(const std::filesystem::path& path,
 // exceed 2^63 - 1 (not representable in TOML). Written as OUTDIR/config.toml so a run documents
 // itself.
 std::string to_toml(const Config& config);
+
+// What keeps the Einstein-Helfand moments (engine/helfand_moments.hpp) from being measured in
+// a system: they need a conservative, translation-invariant one. The first obstacle found, by
+// its key ("boundary.wall", "contact.restitution", ...) and why; nothing for a system that has
+// none. analysis.transport is refused for it (and so are the Python module's moments).
+struct TransportObstacle {
+  std::string key, why;
+};
+std::optional<TransportObstacle> transport_obstacle(const Config& config);
 
 // Default lattice for a dimension: "fcc" in 3D, "hex" in 2D; std::invalid_argument otherwise.
 std::string default_lattice(int dimension);

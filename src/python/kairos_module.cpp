@@ -1,6 +1,8 @@
-// The Python module `kairos` (pybind11): kairos.run, the CLI's `kairos run` as a function, and
+// The Python module `kairos` (pybind11): kairos.run, the CLI's `kairos run` as a function,
 // kairos.Simulation, an event-driven simulation held in memory (run/simulation.hpp) whose state
-// comes back as NumPy arrays. docs/python.md is its user guide.
+// and analyses (run/simulation_analyses.hpp) come back as NumPy arrays, and kairos.Correlator,
+// the multiple-tau correlator of analysis.msd (analysis/msd.hpp) fed by the user.
+// docs/python.md is its user guide.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -9,20 +11,26 @@
 #include <fmt/format.h>
 #include <signal.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <variant>
 #include <vector>
 
+#include "analysis/msd.hpp"
 #include "core/error.hpp"
 #include "core/stop_flag.hpp"
 #include "io/config.hpp"
 #include "run/run.hpp"
 #include "run/simulation.hpp"
+#include "run/simulation_analyses.hpp"
 
 namespace py = pybind11;
 namespace fs = std::filesystem;
@@ -136,19 +144,159 @@ py::array_t<double> as_array(const auto& rows, int dimension) {
   return out;
 }
 
+// ----- arguments of the analyses: a wrong type is a TypeError, a wrong value an InputError,
+// each naming the argument ("msd: interval").
+
+// A number (int, float or a NumPy scalar; not bool).
+double number_from(const py::object& value, const std::string& name) {
+  const bool number = !py::isinstance<py::bool_>(value) && !py::isinstance<py::str>(value) &&
+                      (py::hasattr(value, "__float__") || py::hasattr(value, "__index__"));
+  if (!number) {
+    throw py::type_error(fmt::format("{} must be a number, not {}", name, type_name(value)));
+  }
+  return py::float_(value).cast<double>();
+}
+
+// A positive finite number, or None (0: automatic, as `none_means` says) where one is allowed.
+double positive_from(const py::object& value, const std::string& name,
+                     const char* none_means = nullptr) {
+  if (none_means != nullptr && value.is_none()) return 0.0;
+  const double x = number_from(value, name);
+  if (!(x > 0.0) || !std::isfinite(x)) {
+    throw InputError(fmt::format(
+        "{} must be a positive finite number{}, not {}", name,
+        none_means != nullptr ? fmt::format(" (or None: {})", none_means) : std::string(), x));
+  }
+  return x;
+}
+
+double non_negative_from(const py::object& value, const std::string& name) {
+  const double x = number_from(value, name);
+  if (!(x >= 0.0) || !std::isfinite(x))
+    throw InputError(fmt::format("{} must be a finite number >= 0, not {}", name, x));
+  return x;
+}
+
+long long integer_from(const py::object& value, const std::string& name) {
+  if (py::isinstance<py::bool_>(value) || !py::hasattr(value, "__index__")) {
+    throw py::type_error(fmt::format("{} must be an integer, not {}", name, type_name(value)));
+  }
+  const py::int_ i(value);
+  try {
+    return i.cast<long long>();
+  } catch (const py::cast_error&) {
+    throw InputError(
+        fmt::format("{} is out of range: {}", name, py::str(py::handle(i)).cast<std::string>()));
+  }
+}
+
+// A fit window [from, to] (None: the automatic one, as analysis.msd_fit_from / msd_fit_to).
+std::pair<double, double> fit_window_from(const py::object& from_arg, const py::object& to_arg,
+                                          const std::string& where) {
+  const double from = positive_from(from_arg, where + ": fit_from", "automatic");
+  const double to = positive_from(to_arg, where + ": fit_to", "automatic");
+  if (from > 0.0 && to > 0.0 && !(to > from)) {
+    throw InputError(
+        fmt::format("{}: fit_to ({}) must be greater than fit_from ({})", where, to, from));
+  }
+  return {from, to};
+}
+
+// ----- results as NumPy arrays
+
+template <class T>
+py::array_t<T> array_of(const std::vector<T>& v) {
+  return py::array_t<T>(static_cast<py::ssize_t>(v.size()), v.data());
+}
+
+// rows x cols, element (i, j) = at(i, j).
+template <class T = double, class F>
+py::array_t<T> matrix_of(std::size_t rows, std::size_t cols, F&& at) {
+  py::array_t<T> out({static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols)});
+  auto view = out.template mutable_unchecked<2>();
+  for (std::size_t i = 0; i < rows; ++i)
+    for (std::size_t j = 0; j < cols; ++j)
+      view(static_cast<py::ssize_t>(i), static_cast<py::ssize_t>(j)) = at(i, j);
+  return out;
+}
+
+// A correlator's fits, one entry per group (NaN, 0 where a group has none).
+template <class Fit>
+py::dict fits_dict(const std::vector<std::optional<Fit>>& fits) {
+  const double nan = std::nan("");
+  std::vector<double> coefficient, stderr_, particles, epochs;
+  std::vector<std::int64_t> lags, epoch_count;
+  for (const auto& f : fits) {
+    coefficient.push_back(f ? f->coefficient : nan);
+    stderr_.push_back(f ? f->stderr_ : nan);
+    particles.push_back(f ? f->particle_stderr : nan);
+    epochs.push_back(f ? f->epoch_stderr : nan);
+    lags.push_back(f ? f->lags : 0);
+    epoch_count.push_back(f ? f->epochs : 0);
+  }
+  py::dict out;
+  out["coefficient"] = array_of(coefficient);
+  out["stderr"] = array_of(stderr_);
+  out["stderr_particles"] = array_of(particles);
+  out["stderr_epochs"] = array_of(epochs);
+  out["lags_fitted"] = array_of(lags);
+  out["epochs_fitted"] = array_of(epoch_count);
+  return out;
+}
+
+// A correlator's lags: lag, origins and the mean per group (and for displacements the
+// non-Gaussian parameter).
+template <int D>
+py::dict lags_dict(const MsdCorrelator<D>& c, bool displacement, const char* mean_name) {
+  const auto lags = c.lags();
+  std::vector<double> lag;
+  std::vector<std::uint64_t> origins;
+  for (const auto& l : lags) {
+    lag.push_back(l.lag);
+    origins.push_back(l.origins);
+  }
+  const std::size_t groups = lags.empty() ? 0 : lags[0].mean.size();
+  py::dict out;
+  out["lag"] = array_of(lag);
+  out["origins"] = array_of(origins);
+  out[mean_name] = matrix_of(lags.size(), groups, [&](auto i, auto g) { return lags[i].mean[g]; });
+  if (displacement) {
+    out["non_gaussian"] =
+        matrix_of(lags.size(), groups, [&](auto i, auto g) { return lags[i].non_gaussian[g]; });
+  }
+  return out;
+}
+
+// What a measurement in time sampled, into `out`.
+void span_into(py::dict& out, const SampledSpan& span, std::uint64_t samples, double first,
+               double last) {
+  out["interval"] = span.interval;
+  out["interval_automatic"] = span.interval_automatic;
+  out["samples"] = samples;
+  out["sampled_from"] = samples > 0 ? first : std::nan("");
+  out["sampled_to"] = samples > 0 ? last : std::nan("");
+  out["mean_free_time"] = span.mean_free_time;
+  out["fit_from"] = span.fit_from;
+  out["fit_to"] = span.fit_to;
+}
+
 // kairos.Simulation: one of the two dimensions behind one Python class.
 class PySimulation {
  public:
-  PySimulation(const py::object& config, const py::object& set, const py::object& restart_arg) {
+  PySimulation(const py::object& config, const py::object& set, const py::object& restart_arg,
+               const py::object& images_arg, const py::object& helfand_arg) {
     const std::optional<fs::path> restart = path_from(restart_arg, "restart");
+    EngineTracking tracking;
+    tracking.images = flag_from(images_arg, "images");
+    tracking.helfand = flag_from(helfand_arg, "helfand");
     const Config c = config_from(config, set);
     // The start may build soft-sphere tables (seconds): without the GIL, and Ctrl-C ends it.
     SigintStopsRun sigint;
     py::gil_scoped_release release;
     if (c.system.dimension == 2) {
-      sim_ = std::make_unique<Simulation<2>>(c, restart);
+      sim_ = std::make_unique<Simulation<2>>(c, restart, tracking);
     } else {
-      sim_ = std::make_unique<Simulation<3>>(c, restart);
+      sim_ = std::make_unique<Simulation<3>>(c, restart, tracking);
     }
   }
 
@@ -165,6 +313,19 @@ class PySimulation {
     return std::visit([&](auto& s) { return f(*s); }, sim_);
   }
 
+  // Runs f() without the GIL (the simulation advances: other Python threads go on, and any
+  // other use of this Simulation from them is refused until it returns).
+  template <class F>
+  auto advancing(F&& f) {
+    busy_ = true;
+    struct Idle {
+      std::atomic<bool>& busy;
+      ~Idle() { busy = false; }
+    } idle{busy_};
+    py::gil_scoped_release release;
+    return f();
+  }
+
   int dimension() const {
     return visit([](const auto& s) { return dimension_of(s); });
   }
@@ -173,15 +334,11 @@ class PySimulation {
     const int given = (time ? 1 : 0) + (events ? 1 : 0) + (collisions ? 1 : 0);
     if (given != 1) throw InputError("advance: give exactly one of time=, events= or collisions=");
     return visit([&](auto& s) {
-      busy_ = true;
-      struct Idle {
-        std::atomic<bool>& busy;
-        ~Idle() { busy = false; }
-      } idle{busy_};
-      py::gil_scoped_release release;
-      if (time) return s.advance_to_time(*time, python_keeps_going);
-      if (events) return s.advance_events(*events, python_keeps_going);
-      return s.advance_collisions(*collisions, python_keeps_going);
+      return advancing([&] {
+        if (time) return s.advance_to_time(*time, python_keeps_going);
+        if (events) return s.advance_events(*events, python_keeps_going);
+        return s.advance_collisions(*collisions, python_keeps_going);
+      });
     });
   }
   py::array_t<double> positions() const {
@@ -229,6 +386,247 @@ class PySimulation {
   double potential_energy() const {
     return visit([](const auto& s) { return s.potential_energy(); });
   }
+  bool tracks_images() const {
+    return visit([](const auto& s) { return s.tracks_images(); });
+  }
+  bool tracks_helfand() const {
+    return visit([](const auto& s) { return s.tracks_helfand(); });
+  }
+  py::array_t<double> unwrapped_positions() const {
+    return visit([](const auto& s) { return as_array(s.unwrapped_positions(), dimension_of(s)); });
+  }
+  py::array_t<std::int32_t> images() const {
+    return visit([](const auto& s) {
+      const auto images = s.images();
+      return matrix_of<std::int32_t>(images.size(), static_cast<std::size_t>(dimension_of(s)),
+                                     [&](auto i, auto a) { return images[i][a]; });
+    });
+  }
+
+  py::dict rdf(const py::object& bins_arg, const py::object& r_max_arg) const {
+    const long long bins = integer_from(bins_arg, "rdf: bins");
+    if (bins < 1 || bins > 10'000'000)
+      throw InputError(fmt::format("rdf: bins must be between 1 and 10^7, not {}", bins));
+    const double r_max = positive_from(
+        r_max_arg, "rdf: r_max", "5 of the largest diameters, at most half the shortest edge");
+    return visit([&](const auto& s) {
+      const auto g = rdf_now(s, static_cast<int>(bins), r_max);
+      py::dict out, per_pair, contact, sigma;
+      out["r"] = array_of(g.r);
+      for (std::size_t p = 0; p < g.pairs.size(); ++p) {
+        per_pair[py::str(g.pairs[p])] = array_of(g.g[p]);
+        contact[py::str(g.pairs[p])] = g.contact[p];
+        sigma[py::str(g.pairs[p])] = g.sigma[p];
+      }
+      out["g"] = per_pair;
+      out["g_all"] = array_of(g.g_all);
+      out["contact"] = contact;
+      out["sigma"] = sigma;
+      out["no_contact"] = g.no_contact.empty() ? py::object(py::none()) : py::str(g.no_contact);
+      out["r_max"] = g.max_distance;
+      out["bin_width"] = g.max_distance / g.bins;
+      out["overlapping_pairs"] = g.overlapping;
+      out["pairs_at_contact"] = g.at_contact;
+      return out;
+    });
+  }
+
+  py::dict structure_factor(const py::object& k_max_arg) const {
+    const double k_max = positive_from(k_max_arg, "structure_factor: k_max", "15 / d");
+    return visit([&](const auto& s) {
+      double d = 0.0;
+      for (const double r : s.radii()) d = std::max(d, 2.0 * r);
+      if (k_max > 100.0 / d) {
+        throw InputError(fmt::format(
+            "structure_factor: k_max must be at most 100 / d = {:.6g} (d = {:.6g}, the largest "
+            "diameter; as analysis.sk_max), not {}",
+            100.0 / d, d, k_max));
+      }
+      const StructureFactorNow sk = structure_factor_now(s, k_max);
+      py::dict out;
+      out["k"] = array_of(sk.k);
+      out["S"] = array_of(sk.s);
+      out["vectors"] = array_of(sk.vectors);
+      out["available"] = array_of(sk.available);
+      out["s_zero"] = sk.s_zero;
+      out["fit_max"] = sk.fit_max;
+      out["fit_shells"] = sk.fit_shells;
+      out["k_max"] = sk.k_max;
+      return out;
+    });
+  }
+
+  py::dict bond_order(const py::object& cutoff_arg) const {
+    const double cutoff = number_from(cutoff_arg, "bond_order: cutoff");
+    if (!(cutoff >= 1.0 && cutoff <= 3.0)) {
+      throw InputError(
+          fmt::format("bond_order: cutoff must be between 1 and 3 contact distances (as "
+                      "analysis.bond_cutoff), not {}",
+                      cutoff));
+    }
+    return visit([&](const auto& s) {
+      const auto b = bond_order_now(s, cutoff, "bond_order: cutoff");
+      py::dict out;
+      for (std::size_t ch = 0; ch < b.names.size(); ++ch) {
+        out[py::str(b.names[ch])] = array_of(b.local[ch]);
+        out[py::str(b.names[ch] + "_global")] = b.global[ch];
+      }
+      out["bonds"] = b.bonds;
+      out["isolated"] = b.isolated;
+      out["cutoff"] = cutoff;
+      return out;
+    });
+  }
+
+  py::dict velocity_distribution() const {
+    return visit([&](const auto& s) {
+      const auto v = velocity_distribution_now(s);
+      using V = std::decay_t<decltype(v)>;
+      if (v.samples() == 0) throw InputError("velocity_distribution: the particles are at rest");
+      const int dimension = dimension_of(s);
+      std::vector<double> w, p, maxwellian;
+      for (int k = 0; k < V::kBins; ++k) {
+        w.push_back(0.5 * (v.bin_low(k) + v.bin_low(k + 1)));
+        p.push_back(v.density(k).mean);
+        maxwellian.push_back(v.maxwellian(k));
+      }
+      py::dict out;
+      out["w"] = array_of(w);
+      out["p"] = array_of(p);
+      out["p_axis"] = matrix_of(
+          static_cast<std::size_t>(V::kBins), static_cast<std::size_t>(dimension),
+          [&](auto k, auto a) { return v.density(static_cast<int>(k), static_cast<int>(a)).mean; });
+      out["maxwellian"] = array_of(maxwellian);
+      out["kurtosis"] = v.kurtosis().mean;
+      out["sonine_a2"] = v.sonine_a2().mean;
+      out["tail_ratio"] = v.tail_ratio().mean;
+      out["outside"] = v.outside();
+      return out;
+    });
+  }
+
+  py::dict msd(const py::object& interval_arg, const py::object& duration_arg,
+               const py::object& fit_from_arg, const py::object& fit_to_arg,
+               const py::object& vacf_arg) {
+    CorrelationRequest request =
+        correlation_request(interval_arg, duration_arg, fit_from_arg, fit_to_arg, "msd");
+    const bool vacf = flag_from(vacf_arg, "msd: vacf");
+    return visit([&](auto& s) {
+      const auto m = advancing([&] { return measure_msd(s, request, vacf, python_keeps_going); });
+      py::dict out = lags_dict(*m.msd, true, "msd");
+      out["species"] = m.species;
+      py::dict fits = fits_dict(m.diffusion);
+      out["diffusion"] = fits["coefficient"];
+      out["diffusion_stderr"] = fits["stderr"];
+      out["diffusion_stderr_particles"] = fits["stderr_particles"];
+      out["diffusion_stderr_epochs"] = fits["stderr_epochs"];
+      out["lags_fitted"] = fits["lags_fitted"];
+      out["epochs_fitted"] = fits["epochs_fitted"];
+      span_into(out, m.span, m.msd->samples(), m.sampled_from, m.sampled_to);
+      if (m.vacf) {
+        out["vacf"] = lags_dict(*m.vacf, false, "vacf");
+        py::dict gk = fits_dict(m.green_kubo);
+        out["green_kubo"] = gk["coefficient"];
+        out["green_kubo_stderr"] = gk["stderr"];
+      }
+      return out;
+    });
+  }
+
+  py::dict helfand_moments() const {
+    return visit([](const auto& s) {
+      const int d = dimension_of(s);
+      const auto m = s.helfand_moments();
+      const std::array<double, 9>& virial = s.virial_tensor();
+      const auto dd = static_cast<std::size_t>(d);
+      const auto at = [d](const std::array<double, 9>& t) {
+        return [&t, d](std::size_t a, std::size_t b) { return t[a * d + b]; };
+      };
+      py::dict out;
+      out["time"] = s.time();
+      out["kinetic_stress"] = matrix_of(dd, dd, at(m.kinetic_stress));
+      out["virial"] = matrix_of(dd, dd, at(virial));
+      out["stress"] = matrix_of(dd, dd, [&](std::size_t a, std::size_t b) {
+        return m.kinetic_stress[a * dd + b] + virial[a * dd + b];
+      });
+      std::vector<double> kinetic, collisional, energy;
+      for (int a = 0; a < d; ++a) {
+        kinetic.push_back(m.kinetic_energy_flux[a]);
+        collisional.push_back(m.collisional_energy_flux[a]);
+        energy.push_back(m.kinetic_energy_flux[a] + m.collisional_energy_flux[a]);
+      }
+      out["energy_kinetic"] = array_of(kinetic);
+      out["energy_collisional"] = array_of(collisional);
+      out["energy"] = array_of(energy);
+      return out;
+    });
+  }
+
+  py::dict transport(const py::object& interval_arg, const py::object& duration_arg,
+                     const py::object& fit_from_arg, const py::object& fit_to_arg) {
+    CorrelationRequest request =
+        correlation_request(interval_arg, duration_arg, fit_from_arg, fit_to_arg, "transport");
+    return visit([&](auto& s) {
+      const auto m = advancing([&] { return measure_transport(s, request, python_keeps_going); });
+      using T = typename std::decay_t<decltype(*m.transport)>;
+      const T& t = *m.transport;
+      py::dict out;
+      span_into(out, m.span, t.samples(), t.first_time(), t.last_time());
+      out["temperature"] = t.temperature();
+      out["volume"] = t.volume();
+      const char* names[3] = {"shear_viscosity", "bulk_viscosity", "thermal_conductivity"};
+      for (int g = 0; g < 3; ++g) {
+        const double scale = t.scale(g);
+        const bool none = g == T::kHeatGroup && !m.no_conductivity.empty();
+        const auto& eh = m.einstein_helfand[g];
+        const auto& gk = m.green_kubo[g];
+        const double nan = std::nan("");
+        const auto value = [&](const auto& fit, double of) {
+          return none || !fit ? nan : of / scale;
+        };
+        py::dict c;
+        c["value"] = value(eh, eh ? eh->coefficient : nan);
+        c["stderr"] = value(eh, eh ? eh->stderr_ : nan);
+        c["stderr_epochs"] = value(eh, eh ? eh->epoch_stderr : nan);
+        c["stderr_components"] = value(eh, eh ? eh->particle_stderr : nan);
+        c["lags_fitted"] = eh && !none ? eh->lags : 0;
+        c["epochs_fitted"] = eh && !none ? eh->epochs : 0;
+        c["green_kubo"] = value(gk, gk ? gk->coefficient : nan);
+        c["green_kubo_stderr"] = value(gk, gk ? gk->stderr_ : nan);
+        c["why"] = none ? py::object(py::str(m.no_conductivity)) : py::object(py::none());
+        out[names[g]] = c;
+      }
+      const auto rows_dict = [](const std::vector<typename T::Row>& rows,
+                                const std::array<const char*, 3>& value_names) {
+        std::vector<double> lag;
+        std::vector<std::uint64_t> origins;
+        std::array<std::vector<double>, 3> value, coefficient;
+        for (const auto& r : rows) {
+          lag.push_back(r.lag);
+          origins.push_back(r.origins);
+          for (int g = 0; g < 3; ++g) {
+            value[g].push_back(r.value[g]);
+            coefficient[g].push_back(r.coefficient[g]);
+          }
+        }
+        py::dict d;
+        d["lag"] = array_of(lag);
+        d["origins"] = array_of(origins);
+        const char* coefficient_names[3] = {"shear_viscosity", "bulk_viscosity",
+                                            "thermal_conductivity"};
+        for (int g = 0; g < 3; ++g) {
+          d[value_names[g]] = array_of(value[g]);
+          d[coefficient_names[g]] = array_of(coefficient[g]);
+        }
+        return d;
+      };
+      out["helfand"] = rows_dict(t.helfand_rows(), {"shear_moment", "bulk_moment", "heat_moment"});
+      out["green_kubo"] =
+          rows_dict(t.green_kubo_rows(), {"shear_flux_acf", "bulk_flux_acf", "heat_flux_acf"});
+      return out;
+    });
+  }
+
   std::string repr() const {
     return visit([](const auto& s) {
       return fmt::format("<kairos.Simulation: {} particles in {}D, t = {:.6g}, {} collisions>",
@@ -240,6 +638,19 @@ class PySimulation {
   }
 
  private:
+  static CorrelationRequest correlation_request(const py::object& interval,
+                                                const py::object& duration,
+                                                const py::object& fit_from,
+                                                const py::object& fit_to,
+                                                const std::string& where) {
+    CorrelationRequest r;
+    r.interval = positive_from(interval, where + ": interval",
+                               "half the Enskog mean free time now, as analysis.msd_interval = 0");
+    r.interval_name = "interval";
+    r.duration = non_negative_from(duration, where + ": duration");
+    std::tie(r.fit_from, r.fit_to) = fit_window_from(fit_from, fit_to, where);
+    return r;
+  }
   template <int D>
   static int dimension_of(const Simulation<D>&) {
     return D;
@@ -248,10 +659,255 @@ class PySimulation {
   std::atomic<bool> busy_{false};
 };
 
+// kairos.Correlator: analysis/msd.hpp's multiple-tau correlator fed by the user, with 1, 2 or
+// 3 components per particle (fixed by the first sample).
+template <class C>
+struct CorrelatorDimension;
+template <int D>
+struct CorrelatorDimension<MsdCorrelator<D>> {
+  static constexpr int value = D;
+};
+
+class PyCorrelator {
+ private:
+  static constexpr std::array<const char*, 3> kStatistics = {"displacement", "product", "flux"};
+  template <int D>
+  MsdCorrelator<D> make() const {
+    return MsdCorrelator<D>(group_, groups_, interval_,
+                            static_cast<typename MsdCorrelator<D>::Statistic>(statistic_),
+                            max_levels_);
+  }
+  void start() {
+    if (dimension_ == 1) correlator_.emplace(make<1>());
+    if (dimension_ == 2) correlator_.emplace(make<2>());
+    if (dimension_ == 3) correlator_.emplace(make<3>());
+  }
+  // f(correlator); before the first sample, of an empty one.
+  template <class F>
+  auto with(F&& f) const {
+    if (correlator_) return std::visit([&](const auto& c) { return f(c); }, *correlator_);
+    return f(make<1>());
+  }
+  double sampled() const {
+    const std::uint64_t n = samples();
+    return n > 1 ? static_cast<double>(n - 1) * interval_ : 0.0;
+  }
+
+ public:
+  PyCorrelator(const py::object& interval, const py::object& groups, const py::object& statistic,
+               const py::object& max_levels) {
+    interval_ = positive_from(interval, "Correlator: interval");
+    if (!py::isinstance<py::str>(statistic)) {
+      throw py::type_error(
+          fmt::format("Correlator: statistic must be 'displacement', 'product' or 'flux', not {}",
+                      type_name(statistic)));
+    }
+    const auto name = statistic.cast<std::string>();
+    const auto known = std::find(kStatistics.begin(), kStatistics.end(), name);
+    if (known == kStatistics.end()) {
+      throw InputError(fmt::format(
+          "Correlator: statistic must be 'displacement', 'product' or 'flux', not '{}'", name));
+    }
+    statistic_ = static_cast<int>(known - kStatistics.begin());
+    const long long levels = integer_from(max_levels, "Correlator: max_levels");
+    if (levels < 1 || levels > 48) {
+      throw InputError(
+          fmt::format("Correlator: max_levels must be between 1 and 48, not {}", levels));
+    }
+    max_levels_ = static_cast<int>(levels);
+    if (!groups.is_none()) set_groups(groups);
+  }
+
+  void add(const py::object& x) {
+    const py::array_t<double> a = float_array(x, "Correlator.add: x");
+    if (a.ndim() != 1 && a.ndim() != 2) {
+      throw InputError(fmt::format(
+          "Correlator.add: x must be an (n, d) array (or (n,) for d = 1), not {}-dimensional",
+          a.ndim()));
+    }
+    const auto n = static_cast<std::size_t>(a.shape(0));
+    const int d = a.ndim() == 1 ? 1 : static_cast<int>(a.shape(1));
+    if (n == 0 || d < 1 || d > 3) {
+      throw InputError(fmt::format(
+          "Correlator.add: x has shape ({}, {}): at least one particle, with d = 1, 2 or 3 "
+          "components",
+          n, d));
+    }
+    if (!correlator_) {
+      if (group_.empty()) {
+        group_.assign(n, 0u);
+        groups_ = 1;
+      } else if (n != group_.size()) {
+        throw InputError(
+            fmt::format("Correlator.add: x has {} particles, groups gives {}", n, group_.size()));
+      }
+      dimension_ = d;
+      start();
+    } else if (n != group_.size() || d != dimension_) {
+      throw InputError(
+          fmt::format("Correlator.add: x has shape ({}, {}), the earlier samples ({}, {})", n, d,
+                      group_.size(), dimension_));
+    }
+    const double* data = a.data();
+    for (std::size_t k = 0; k < n * static_cast<std::size_t>(d); ++k) {
+      if (!std::isfinite(data[k]))
+        throw InputError("Correlator.add: x holds NaN or infinite values");
+    }
+    std::visit(
+        [&](auto& c) {
+          constexpr int kD = CorrelatorDimension<std::decay_t<decltype(c)>>::value;
+          std::vector<Vec<kD>> sample(n);
+          for (std::size_t i = 0; i < n; ++i)
+            for (int k = 0; k < kD; ++k) sample[i][k] = data[i * kD + k];
+          c.add(sample);
+        },
+        *correlator_);
+  }
+
+  py::dict lags() const {
+    return with([&](const auto& c) { return lags_dict(c, statistic_ == 0, "mean"); });
+  }
+
+  py::dict diffusion(const py::object& from_arg, const py::object& to_arg,
+                     const py::object& drift_arg, const py::object& span_arg) const {
+    if (statistic_ != 0) {
+      throw InputError(fmt::format(
+          "Correlator.diffusion: the slope of a statistic='displacement' correlator; this one's "
+          "statistic is '{}' (its integral: green_kubo())",
+          kStatistics[statistic_]));
+    }
+    auto [from, to] = fit_window_from(from_arg, to_arg, "Correlator.diffusion");
+    std::tie(from, to) = correlation_fit_window(sampled(), from, to, std::nan(""));
+    const double span =
+        span_arg.is_none() ? 0.0 : non_negative_from(span_arg, "Correlator.diffusion: span");
+    return with([&](const auto& c) {
+      constexpr int kD = CorrelatorDimension<std::decay_t<decltype(c)>>::value;
+      const auto drift = per_group<kD>(drift_arg, "Correlator.diffusion: drift");
+      py::dict out =
+          fits_dict(drift.empty() ? c.diffusion(from, to) : c.diffusion(from, to, drift, span));
+      out["fit_from"] = from;
+      out["fit_to"] = to;
+      return out;
+    });
+  }
+
+  py::dict green_kubo(const py::object& to_arg, const py::object& mean_arg) const {
+    if (statistic_ == 0) {
+      throw InputError(
+          "Correlator.green_kubo: the integral of a statistic='product' or 'flux' correlator; "
+          "this one's statistic is 'displacement' (its slope: diffusion())");
+    }
+    double to = positive_from(to_arg, "Correlator.green_kubo: to", "automatic");
+    to = correlation_fit_window(sampled(), 0.0, to, std::nan("")).second;
+    return with([&](const auto& c) {
+      constexpr int kD = CorrelatorDimension<std::decay_t<decltype(c)>>::value;
+      const auto mean = per_group<kD>(mean_arg, "Correlator.green_kubo: mean");
+      py::dict out = fits_dict(mean.empty() ? c.green_kubo(to) : c.green_kubo(to, mean));
+      out["to"] = to;
+      return out;
+    });
+  }
+
+  std::uint64_t samples() const {
+    return with([](const auto& c) { return c.samples(); });
+  }
+  double interval() const { return interval_; }
+  std::string statistic() const { return kStatistics[statistic_]; }
+  py::object dimension() const {
+    return correlator_ ? py::object(py::int_(dimension_)) : py::object(py::none());
+  }
+  py::object particles() const {
+    return group_.empty() ? py::object(py::none()) : py::object(py::int_(group_.size()));
+  }
+  std::uint32_t groups() const { return groups_; }
+  std::size_t bytes() const {
+    return with([](const auto& c) { return c.bytes(); });
+  }
+  std::string repr() const {
+    return fmt::format("<kairos.Correlator: statistic '{}', interval {:.6g}, {} samples>",
+                       statistic(), interval_, samples());
+  }
+
+ private:
+  // groups: one non-negative integer per particle, every group 0 .. G - 1 with a particle.
+  void set_groups(const py::object& groups) {
+    const py::array_t<double> a = float_array(groups, "Correlator: groups");
+    if (a.ndim() != 1 || a.shape(0) == 0) {
+      throw InputError(
+          "Correlator: groups must be a 1-D sequence of group indices (0, 1, ...), "
+          "one per particle");
+    }
+    std::uint32_t count = 0;
+    for (py::ssize_t i = 0; i < a.shape(0); ++i) {
+      const double g = a.at(i);
+      if (!(g >= 0.0) || g != std::floor(g) || g > 1e6) {
+        throw InputError(fmt::format(
+            "Correlator: groups[{}] = {}: group indices are integers 0, 1, ... (below 10^6)", i,
+            g));
+      }
+      group_.push_back(static_cast<std::uint32_t>(g));
+      count = std::max(count, group_.back() + 1);
+    }
+    std::vector<bool> used(count, false);
+    for (const std::uint32_t g : group_) used[g] = true;
+    for (std::uint32_t g = 0; g < count; ++g) {
+      if (!used[g]) {
+        throw InputError(fmt::format(
+            "Correlator: groups has no particle in group {} (number the groups 0 .. {})", g,
+            count - 1));
+      }
+    }
+    groups_ = count;
+  }
+
+  // None (nothing), or a (groups, d) array: one vector per group (a drift, a mean).
+  template <int D>
+  std::vector<Vec<D>> per_group(const py::object& value, const std::string& name) const {
+    if (value.is_none()) return {};
+    const py::array_t<double> a = float_array(value, name);
+    const bool shaped = (a.ndim() == 2 && a.shape(0) == groups_ && a.shape(1) == D) ||
+                        (a.ndim() == 1 && D == 1 && a.shape(0) == groups_);
+    if (!shaped) {
+      throw InputError(
+          fmt::format("{} must have shape ({}, {}): one vector per group", name, groups_, D));
+    }
+    std::vector<Vec<D>> out(groups_);
+    for (std::uint32_t g = 0; g < groups_; ++g)
+      for (int k = 0; k < D; ++k) out[g][k] = a.data()[g * D + k];
+    for (const Vec<D>& v : out)
+      for (int k = 0; k < D; ++k)
+        if (!std::isfinite(v[k])) throw InputError(name + " holds NaN or infinite values");
+    return out;
+  }
+
+  // Any array-like of numbers as a C-contiguous float64 array; TypeError naming it otherwise.
+  static py::array_t<double> float_array(const py::object& value, const std::string& name) {
+    if (py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value)) {
+      throw py::type_error(
+          fmt::format("{} must be an array of numbers, not {}", name, type_name(value)));
+    }
+    try {
+      return py::module_::import("numpy").attr("ascontiguousarray")(value, "float64");
+    } catch (const py::error_already_set&) {
+      throw py::type_error(
+          fmt::format("{} must be an array of numbers, not {}", name, type_name(value)));
+    }
+  }
+
+  double interval_ = 0.0;
+  int statistic_ = 0;  // index in kStatistics (MsdCorrelator's Statistic)
+  int max_levels_ = 40;
+  std::vector<std::uint32_t> group_;
+  std::uint32_t groups_ = 1;
+  int dimension_ = 0;
+  std::optional<std::variant<MsdCorrelator<1>, MsdCorrelator<2>, MsdCorrelator<3>>> correlator_;
+};
+
 }  // namespace
 }  // namespace kairos
 
 PYBIND11_MODULE(kairos, m) {
+  using kairos::PyCorrelator;
   using kairos::PySimulation;
   m.doc() =
       "Kairos, event-driven particle dynamics: kairos.run (the `kairos run` command) and "
@@ -314,10 +970,14 @@ PYBIND11_MODULE(kairos, m) {
                            "An event-driven simulation in memory: the engine of `kairos run` "
                            "started from the same configuration (bit-identical trajectory), "
                            "advanced on request, without output files.")
-      .def(py::init<const py::object&, const py::object&, const py::object&>(), py::arg("config"),
-           py::arg("set") = py::none(), py::arg("restart") = py::none(),
+      .def(py::init<const py::object&, const py::object&, const py::object&, const py::object&,
+                    const py::object&>(),
+           py::arg("config"), py::arg("set") = py::none(), py::arg("restart") = py::none(),
+           py::arg("images") = true, py::arg("helfand") = false,
            "config: a TOML file's path, or TOML text; set: 'key=value' overrides; restart: a "
-           "restart file to continue from.")
+           "restart file to continue from; images: keep image counters (4 D bytes per particle) "
+           "for unwrapped_positions(), images() and msd(); helfand: keep the Helfand moments "
+           "for helfand_moments() and transport() (a conservative periodic system).")
       .def("advance", &PySimulation::advance, py::arg("time") = py::none(),
            py::arg("events") = py::none(), py::arg("collisions") = py::none(),
            "Advances to simulated time `time` (exactly; no event needs to happen then), or by "
@@ -344,5 +1004,75 @@ PYBIND11_MODULE(kairos, m) {
            "Of the stepped potentials, or the elastic energy of soft contacts in progress.")
       .def("__repr__", &PySimulation::repr)
       .def("save", &PySimulation::save, py::arg("path"),
-           "Writes a restart file (atomically) that `kairos run --restart` continues.");
+           "Writes a restart file (atomically) that `kairos run --restart` continues.")
+      .def_property_readonly("tracks_images", &PySimulation::tracks_images,
+                             "Image counters are kept (images=True, output.trajectory, "
+                             "analysis.msd, or a restart state that carried them).")
+      .def_property_readonly("tracks_helfand", &PySimulation::tracks_helfand,
+                             "The Helfand moments are kept (helfand=True or analysis.transport).")
+      .def("unwrapped_positions", &PySimulation::unwrapped_positions,
+           "Positions at the present time unwrapped through the periodic faces, (N, D).")
+      .def("images", &PySimulation::images,
+           "Periodic images of positions(), (N, D) int32: positions() + images() * box is the "
+           "unwrapped position.")
+      .def("rdf", &PySimulation::rdf, py::arg("bins") = 200, py::arg("r_max") = py::none(),
+           "g(r) of the present state per species pair, as rdf.tsv after one sample: a dict of "
+           "r, g (per pair), g_all, contact and sigma (per pair), ...")
+      .def("structure_factor", &PySimulation::structure_factor, py::arg("k_max") = py::none(),
+           "S(k) of the present state on the box's wave vectors, as sk.tsv after one sample: a "
+           "dict of k, S, vectors, available, s_zero, ...")
+      .def("bond_order", &PySimulation::bond_order, py::arg("cutoff") = 1.4,
+           "Bond orientational order of the present state: local q4, q6 (3D) or psi6 (2D) per "
+           "particle (NaN without neighbours) and the global values (q4_global, ...).")
+      .def("velocity_distribution", &PySimulation::velocity_distribution,
+           "The distribution of one velocity component in units of sqrt(kT/m) now, with the "
+           "kurtosis, Sonine a2 and tail ratio.")
+      .def("msd", &PySimulation::msd, py::arg("interval"), py::arg("duration"),
+           py::arg("fit_from") = py::none(), py::arg("fit_to") = py::none(),
+           py::arg("vacf") = false,
+           "ADVANCES the simulation by `duration`, sampling the unwrapped positions at the "
+           "multiples of `interval` (None: automatic) as analysis.msd does; returns the MSD "
+           "per species on log-spaced lags and D fitted over [fit_from, fit_to] (None: "
+           "automatic), with the VACF and Green-Kubo D if vacf=True.")
+      .def("helfand_moments", &PySimulation::helfand_moments,
+           "The Helfand moments now (needs helfand=True): kinetic_stress, virial, stress (D, D), "
+           "energy_kinetic, energy_collisional, energy (D,).")
+      .def("transport", &PySimulation::transport, py::arg("interval"), py::arg("duration"),
+           py::arg("fit_from") = py::none(), py::arg("fit_to") = py::none(),
+           "ADVANCES the simulation by `duration`, sampling the Helfand moments at the "
+           "multiples of `interval` (None: automatic) as analysis.transport does; returns the "
+           "shear and bulk viscosities and the thermal conductivity (Einstein-Helfand, "
+           "Green-Kubo beside) with their errors, and the per-lag tables.");
+
+  py::class_<PyCorrelator>(m, "Correlator",
+                           "The multiple-tau correlator of analysis.msd (log-spaced lags, many "
+                           "time origins, bounded memory) fed with your own samples.")
+      .def(py::init<const py::object&, const py::object&, const py::object&, const py::object&>(),
+           py::arg("interval"), py::arg("groups") = py::none(),
+           py::arg("statistic") = "displacement", py::arg("max_levels") = 40,
+           "interval: the time between samples; groups: one group index per particle (None: "
+           "one group); statistic: 'displacement' (<|x(t+lag) - x(t)|^2>), 'product' "
+           "(<x(t+lag).x(t)>) or 'flux' (<J(t+lag).J(t)> of the fluxes J of the samples).")
+      .def("add", &PyCorrelator::add, py::arg("x"),
+           "The next sample, `interval` after the previous one: an (n, d) array (d = 1, 2, 3; "
+           "(n,) for d = 1).")
+      .def("lags", &PyCorrelator::lags,
+           "The lags with at least one origin: lag, origins, mean (lags, groups) and for "
+           "displacements non_gaussian.")
+      .def("diffusion", &PyCorrelator::diffusion, py::arg("fit_from") = py::none(),
+           py::arg("fit_to") = py::none(), py::arg("drift") = py::none(),
+           py::arg("span") = py::none(),
+           "D per group from the slope of the mean-square displacement = 2 d D lag over the "
+           "lags in [fit_from, fit_to], with standard errors (NaN: fewer than 3 lags).")
+      .def("green_kubo", &PyCorrelator::green_kubo, py::arg("to") = py::none(),
+           py::arg("mean") = py::none(),
+           "(1/d) integral_0^to of the correlation per group, with standard errors.")
+      .def_property_readonly("samples", &PyCorrelator::samples)
+      .def_property_readonly("interval", &PyCorrelator::interval)
+      .def_property_readonly("statistic", &PyCorrelator::statistic)
+      .def_property_readonly("dimension", &PyCorrelator::dimension)
+      .def_property_readonly("particles", &PyCorrelator::particles)
+      .def_property_readonly("groups", &PyCorrelator::groups)
+      .def_property_readonly("bytes", &PyCorrelator::bytes)
+      .def("__repr__", &PyCorrelator::repr);
 }

@@ -72,12 +72,12 @@ void check_no_overlap_after_new_physics(const Engine& engine) {
   }
 }
 
-EngineOptions engine_options(const Config& config) {
+EngineOptions engine_options(const Config& config, const EngineTracking& tracking) {
   EngineOptions options;
   options.defer_soft_releases = config.soft.defer_releases;
   // Trajectory frames carry particles/image (and so does the restart file, for the next run).
-  options.track_images = config.output.trajectory || config.analysis.msd;
-  options.track_helfand = config.analysis.transport;
+  options.track_images = config.output.trajectory || config.analysis.msd || tracking.images;
+  options.track_helfand = config.analysis.transport || tracking.helfand;
   return options;
 }
 
@@ -86,7 +86,8 @@ EngineOptions engine_options(const Config& config) {
 template <int D, class Queue>
 EventEngineAdapter<D, Queue>::EventEngineAdapter(RunStart<D>&& start,
                                                  const Environment<D>& environment,
-                                                 std::vector<SoftTableUse> tables)
+                                                 std::vector<SoftTableUse> tables,
+                                                 const EngineTracking& tracking)
     : EventIntegrator<D>(start.state),
       driving_(start.config.driving),
       driving_kind_(driving_kinds().at(driving_.kind)),
@@ -94,7 +95,7 @@ EventEngineAdapter<D, Queue>::EventEngineAdapter(RunStart<D>&& start,
       rng_(start.rng),
       tables_(std::move(tables)),
       engine_(std::move(start.state), start.resumes() ? StartMode::kResume : StartMode::kPredict,
-              engine_options(start.config), environment),
+              engine_options(start.config, tracking), environment),
       watch_(engine_) {
   if (start.restarted() && !start.resumes()) check_no_overlap_after_new_physics(engine_);
   auto& kind = this->kind_;

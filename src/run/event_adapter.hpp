@@ -79,8 +79,9 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   // Takes the start state over (resumed exactly when start.resumes(), else every event
   // predicted afresh), with its environment and the soft tables attached to it (setup chain).
   // InputError for a state the engine refuses, or one that overlaps under new physics.
+  // `tracking`: what the engine keeps beyond what the configuration asks for.
   EventEngineAdapter(RunStart<D>&& start, const Environment<D>& environment,
-                     std::vector<SoftTableUse> tables);
+                     std::vector<SoftTableUse> tables, const EngineTracking& tracking = {});
 
   double time() const override { return engine_.time(); }
   std::uint64_t collisions() const override { return engine_.counters().collisions; }

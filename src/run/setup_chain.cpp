@@ -142,12 +142,13 @@ std::vector<SoftTableUse> start_tables(Environment<D>& environment, const RunSta
 
 template <int D, class Queue>
 std::unique_ptr<EventEngineAdapter<D, Queue>> start_event_engine(RunStart<D>&& start,
-                                                                 const TableProgress& progress) {
+                                                                 const TableProgress& progress,
+                                                                 const EngineTracking& tracking) {
   return named_restart_errors(start, [&] {
     Environment<D> environment = make_environment<D>(start.config, start.state);
     std::vector<SoftTableUse> tables = start_tables(environment, start, progress);
     return std::make_unique<EventEngineAdapter<D, Queue>>(std::move(start), environment,
-                                                          std::move(tables));
+                                                          std::move(tables), tracking);
   });
 }
 
@@ -195,7 +196,8 @@ void print_restart_note(const RestartPlan& plan, const std::string& restart_file
   template std::unique_ptr<Integrator<D>> start_integrator<D>(RunStart<D>&&,              \
                                                               const TableProgress&);      \
   template std::unique_ptr<EventEngineAdapter<D, CalendarQueue>>                          \
-  start_event_engine<D, CalendarQueue>(RunStart<D>&&, const TableProgress&);
+  start_event_engine<D, CalendarQueue>(RunStart<D>&&, const TableProgress&,               \
+                                       const EngineTracking&);
 KAIROS_SETUP_CHAIN(2)
 KAIROS_SETUP_CHAIN(3)
 #undef KAIROS_SETUP_CHAIN

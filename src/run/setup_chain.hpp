@@ -72,12 +72,20 @@ template <int D>
 std::unique_ptr<Integrator<D>> start_integrator(RunStart<D>&& start,
                                                 const TableProgress& progress = {});
 
+// What the event engine keeps beyond what the configuration asks for (the Python module's
+// Simulation): image counters (EngineOptions::track_images), the Helfand moments
+// (track_helfand; for a system transport_obstacle() lets through only).
+struct EngineTracking {
+  bool images = false;
+  bool helfand = false;
+};
+
 // Steps 2 to 4 for the event engine with a given queue (the Python module's Simulation).
 template <int D, class Queue>
 class EventEngineAdapter;
 template <int D, class Queue>
 std::unique_ptr<EventEngineAdapter<D, Queue>> start_event_engine(
-    RunStart<D>&& start, const TableProgress& progress = {});
+    RunStart<D>&& start, const TableProgress& progress = {}, const EngineTracking& tracking = {});
 
 // An InputError from setting up a restored state (its environment, the engine, the overlap
 // check) as reported: naming the restart file and, under new physics, the keys that changed.

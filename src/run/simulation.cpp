@@ -2,22 +2,27 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
+#include "core/periodic.hpp"
+#include "core/state_blocks.hpp"
 #include "io/config_choices.hpp"
 #include "run/event_adapter.hpp"
 #include "run/output_directory.hpp"
 #include "run/setup_chain.hpp"
+#include "run/trigger.hpp"
 #include "scheduler/calendar_queue.hpp"
 
 namespace kairos {
 
 template <int D>
 Simulation<D>::Simulation(const Config& config,
-                          const std::optional<std::filesystem::path>& restart_file)
+                          const std::optional<std::filesystem::path>& restart_file,
+                          const EngineTracking& tracking)
     : config_(config) {
   if (integrators().at(config.run.integrator) != IntegratorKind::kEvent) {
     throw InputError(fmt::format(
@@ -32,6 +37,13 @@ Simulation<D>::Simulation(const Config& config,
   }
   RunStart<D> start = start_run<D>(config, restart_file, "event");
   config_ = start.config;
+  if (tracking.helfand) {
+    if (const std::optional<TransportObstacle> obstacle = transport_obstacle(config_)) {
+      throw InputError(
+          fmt::format("the Helfand moments: {} ({}): they need a conservative periodic system",
+                      obstacle->why, obstacle->key));
+    }
+  }
   progress_ = start.resumed;
   const std::optional<RestartPlan> plan = start.plan;
   n_ = start.state.size();
@@ -41,7 +53,7 @@ Simulation<D>::Simulation(const Config& config,
   species_ = start.state.species;
   species_names_ = start.state.species_names;
   // The tables `kairos run` would use (the same speeds covered: the same maps, bit for bit).
-  engine_ = start_event_engine<D, CalendarQueue>(std::move(start));
+  engine_ = start_event_engine<D, CalendarQueue>(std::move(start), {}, tracking);
   const std::vector<SoftTableUse>& tables = engine_->tables();
   if (!tables.empty()) progress_.soft_table_max_speed = tables.front().spec.max_normal_speed;
   progress_.config = to_toml(config_);
@@ -102,6 +114,28 @@ bool Simulation<D>::advance_collisions(std::uint64_t count, const KeepGoing& kee
 }
 
 template <int D>
+bool Simulation<D>::sample_every(double interval, double duration,
+                                 const std::function<void()>& sample, const KeepGoing& keep_going) {
+  const double end = time() + duration;
+  if (!(interval > 0.0) || !std::isfinite(interval) || !(duration >= 0.0) || !std::isfinite(end))
+    throw InputError(
+        fmt::format("sampling every {} for {}: both must be finite, the interval "
+                    "positive and the duration not negative",
+                    interval, duration));
+  // As the run driver's loop (run_driver.cpp run_phase) with one trigger in time.
+  TimeTrigger trigger;
+  trigger.step = interval;
+  trigger.next = trigger.after(time());
+  while (time() < end) {
+    double stop = std::min(trigger.next, end);
+    if (stop >= end - TimeTrigger::slack(end)) stop = end;
+    if (!advance_to_time(stop, keep_going)) return false;
+    if (trigger.due(time())) sample();
+  }
+  return true;
+}
+
+template <int D>
 double Simulation<D>::time() const {
   return engine_->engine().time();
 }
@@ -142,6 +176,79 @@ template <int D>
 ParticleSystem<D> Simulation<D>::state() const {
   return engine_->engine().export_state();
 }
+template <int D>
+bool Simulation<D>::tracks_images() const {
+  return engine_->engine().tracks_images();
+}
+template <int D>
+bool Simulation<D>::tracks_helfand() const {
+  return engine_->engine().tracks_helfand();
+}
+
+template <int D>
+std::vector<Vec<D>> Simulation<D>::unwrapped_positions() const {
+  if (!tracks_images()) {
+    throw InputError(
+        "unwrapped positions need image counters: this Simulation keeps none (created with "
+        "images=False)");
+  }
+  if (engine_->kind().sheared) {
+    throw InputError(
+        "unwrapped positions under Lees-Edwards shear are not provided (the images across the "
+        "y faces move along x: docs/outputs.md); images() gives the counters");
+  }
+  std::vector<std::uint32_t> slot(n_);
+  for (std::size_t i = 0; i < n_; ++i) slot[i] = static_cast<std::uint32_t>(i);
+  std::vector<Vec<D>> out(n_);
+  engine_->unwrapped_positions(slot, out);
+  return out;
+}
+
+template <int D>
+std::vector<std::array<std::int32_t, D>> Simulation<D>::images() const {
+  if (!tracks_images()) {
+    throw InputError("images: this Simulation keeps no image counters (created with images=False)");
+  }
+  std::vector<std::array<std::int32_t, D>> out(n_);
+  const StateBlocks<D> state = engine_->state_blocks();
+  const ParticleSystem<D>& globals = state.globals();
+  state.for_each(
+      [&](const ParticleSystem<D>& part, std::size_t first) {
+        for (std::size_t j = 0; j < part.size(); ++j) {
+          // The counters count the wraps of the engine's position; positions() may wrap it
+          // once more (a particle at a face, not yet wrapped by its crossing).
+          const Vec<D> x = part.position(j, part.time);
+          std::array<std::int32_t, D> image = part.image[j];
+          for (int a = 0; a < D; ++a) {
+            if (!globals.periodic[a]) continue;
+            const double inside = wrap_into_box(x[a], globals.box[a]);
+            image[a] += static_cast<std::int32_t>(std::lround((x[a] - inside) / globals.box[a]));
+          }
+          out[first + j] = image;
+        }
+      },
+      StateBlocks<D>::kKinematics);
+  return out;
+}
+
+template <int D>
+typename HelfandMoments<D>::Moments Simulation<D>::helfand_moments() const {
+  if (!tracks_helfand()) {
+    throw InputError(
+        "the Helfand moments are not kept: create the Simulation with helfand=True (a "
+        "conservative periodic system)");
+  }
+  return engine_->engine().helfand_moments();
+}
+template <int D>
+const std::array<double, 9>& Simulation<D>::virial_tensor() const {
+  return engine_->engine().counters().virial_tensor;
+}
+template <int D>
+const EventIntegrator<D>& Simulation<D>::integrator() const {
+  return *engine_;
+}
+
 template <int D>
 void Simulation<D>::save(const std::filesystem::path& path) const {
   engine_->write_restart(path, progress_);

@@ -5,6 +5,7 @@
 // for bit, and save() writes a restart file that `kairos run --restart` continues.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -15,13 +16,17 @@
 
 #include "core/particle_system.hpp"
 #include "core/vec.hpp"
+#include "engine/helfand_moments.hpp"
 #include "io/config.hpp"
 #include "run/run_progress.hpp"
+#include "run/setup_chain.hpp"
 
 namespace kairos {
 
 template <int D, class Queue>
 class EventEngineAdapter;
+template <int D>
+class EventIntegrator;
 class CalendarQueue;
 
 template <int D>
@@ -29,8 +34,11 @@ class Simulation {
  public:
   // From a configuration (run.integrator "event"; [driving] is refused: its kicks belong to
   // `kairos run`), or from a restart file with it. InputError for anything the user must fix.
+  // `tracking`: image counters and Helfand moments kept beyond what the configuration asks for
+  // (the moments: InputError for a system transport_obstacle() names, as analysis.transport).
   explicit Simulation(const Config& config,
-                      const std::optional<std::filesystem::path>& restart_file = {});
+                      const std::optional<std::filesystem::path>& restart_file = {},
+                      const EngineTracking& tracking = {});
   ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
@@ -44,6 +52,12 @@ class Simulation {
   // Until `count` more events / collisions have happened (or no event is left: then false).
   bool advance_events(std::uint64_t count, const KeepGoing& keep_going = {});
   bool advance_collisions(std::uint64_t count, const KeepGoing& keep_going = {});
+  // Calls sample() at each multiple of `interval` in simulated time after time() up to
+  // time() + duration (the clock stopped there), as `kairos run` samples analysis.msd and
+  // analysis.transport (run/trigger.hpp TimeTrigger: a multiple within round-off of the end is
+  // taken at the end), and ends at time() + duration. False if stopped early by keep_going.
+  bool sample_every(double interval, double duration, const std::function<void()>& sample,
+                    const KeepGoing& keep_going = {});
 
   double time() const;
   std::uint64_t events() const;
@@ -66,6 +80,27 @@ class Simulation {
   double potential_energy() const;
   // The complete state (what a restart file holds).
   ParticleSystem<D> state() const;
+
+  // Image counters are kept (EngineTracking::images, output.trajectory or analysis.msd, or a
+  // start state that carried them): 4 D bytes per particle.
+  bool tracks_images() const;
+  // Per particle, at time(): the positions unwrapped (position + image * box along periodic
+  // axes), and the images of positions(), so that positions() + images() * box is the unwrapped
+  // position up to round-off. InputError without image counters; unwrapped_positions() also
+  // under Lees-Edwards shear (as analysis.msd).
+  std::vector<Vec<D>> unwrapped_positions() const;
+  std::vector<std::array<std::int32_t, D>> images() const;
+  // The Helfand moments are kept (EngineTracking::helfand or analysis.transport).
+  bool tracks_helfand() const;
+  // The Helfand moments at time(), from the start of this Simulation (InputError unless kept),
+  // and their collisional momentum part: the virial tensor sum r_ij,a dp_i,b (row-major D x D,
+  // since the state's start: a restart's included).
+  typename HelfandMoments<D>::Moments helfand_moments() const;
+  const std::array<double, 9>& virial_tensor() const;
+  // The engine under the run driver's interface, for the analyses (run/simulation_analyses.hpp).
+  const EventIntegrator<D>& integrator() const;
+  // The effective configuration (after a restart: as continued).
+  const Config& config() const { return config_; }
   // A restart file (atomically) that `kairos run --restart` continues bit-identically.
   void save(const std::filesystem::path& path) const;
 

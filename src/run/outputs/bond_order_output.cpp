@@ -11,19 +11,25 @@
 namespace kairos {
 
 template <int D>
-void BondOrderOutput<D>::begin(const RunContext<D>& run) {
-  const Configuration<D>& c = snapshot_->at(run.integrator());
-  const double cutoff = run.config().analysis.bond_cutoff;
-  const double reach = cutoff * 2.0 * snapshot_->largest_radius();
+void check_bond_cutoff(double cutoff, const StructureSnapshot<D>& snapshot,
+                       const Configuration<D>& c, const std::string& key) {
+  const double reach = cutoff * 2.0 * snapshot.largest_radius();
   for (int a = 0; a < D; ++a) {
     if (c.periodic[a] && !(reach <= 0.5 * c.box[a])) {
       throw InputError(fmt::format(
-          "analysis.bond_cutoff = {}: neighbours up to {:.6g} (the cut-off times the largest "
+          "{} = {}: neighbours up to {:.6g} (the cut-off times the largest "
           "contact distance) reach beyond half the periodic box edge {:.6g}; lower it or use a "
           "larger box",
-          cutoff, reach, c.box[a]));
+          key, cutoff, reach, c.box[a]));
     }
   }
+}
+
+template <int D>
+void BondOrderOutput<D>::begin(const RunContext<D>& run) {
+  const Configuration<D>& c = snapshot_->at(run.integrator());
+  const double cutoff = run.config().analysis.bond_cutoff;
+  check_bond_cutoff(cutoff, *snapshot_, c, "analysis.bond_cutoff");
   order_.emplace(cutoff);
 }
 
@@ -80,6 +86,10 @@ void BondOrderOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&
   }
 }
 
+template void check_bond_cutoff<2>(double, const StructureSnapshot<2>&, const Configuration<2>&,
+                                   const std::string&);
+template void check_bond_cutoff<3>(double, const StructureSnapshot<3>&, const Configuration<3>&,
+                                   const std::string&);
 template class BondOrderOutput<2>;
 template class BondOrderOutput<3>;
 

@@ -14,6 +14,12 @@
 
 namespace kairos {
 
+// InputError (naming `key`) unless neighbours up to `cutoff` contact distances of the largest
+// particles stay within half of every periodic edge.
+template <int D>
+void check_bond_cutoff(double cutoff, const StructureSnapshot<D>& snapshot,
+                       const Configuration<D>& c, const std::string& key);
+
 template <int D>
 class BondOrderOutput final : public AnalysisOutput<D> {
  public:

@@ -233,15 +233,9 @@ double MsdOutput<D>::mean_free_time() const {
 
 template <int D>
 std::pair<double, double> MsdOutput<D>::fit_window() const {
-  const double sampled = last_sample_ - first_sample_;
-  double to = config_.msd_fit_to > 0.0 ? config_.msd_fit_to : 0.25 * sampled;
-  double from = config_.msd_fit_from;
-  if (from == 0.0) {
-    // Ten collisions per particle are about ten mean free times.
-    const double mft = in_collisions_ ? 1.0 : mean_free_time();
-    from = std::max(0.1 * to, std::isfinite(mft) ? 10.0 * mft : 0.0);
-  }
-  return {from, to};
+  // Ten collisions per particle are about ten mean free times (the collision clock).
+  return correlation_fit_window(last_sample_ - first_sample_, config_.msd_fit_from,
+                                config_.msd_fit_to, in_collisions_ ? 1.0 : mean_free_time());
 }
 
 template <int D>

@@ -14,33 +14,51 @@
 namespace kairos {
 
 template <int D>
-void RdfOutput<D>::begin(const RunContext<D>& run) {
-  const Integrator<D>& integrator = run.integrator();
-  const Configuration<D>& c = snapshot_->at(integrator);
-  const std::vector<std::string>& names = snapshot_->species_names();
+RdfPairs rdf_pairs(const Integrator<D>& integrator, const StructureSnapshot<D>& snapshot) {
+  const std::vector<std::string>& names = snapshot.species_names();
   const std::size_t species = names.size();
+  RdfPairs out;
   // Contact values need hard cores (no soft spheres, no steps at or near them) and one radius
-  // per species; the contact theorem an elastic, smooth, unforced gas in a periodic box.
+  // per species.
   const EventIntegrator<D>* engine = integrator.as_event();
   if (engine == nullptr || engine->soft())
-    no_contact_ = "soft spheres: no contact value";
+    out.no_contact = "soft spheres: no contact value";
   else if (engine->stepped())
-    no_contact_ = "stepped potentials: steps near the hard core";
-  std::vector<double> contact(species_pairs(species), std::numeric_limits<double>::quiet_NaN());
-  pair_names_.assign(species_pairs(species), "");
+    out.no_contact = "stepped potentials: steps near the hard core";
+  out.contact.assign(species_pairs(species), std::numeric_limits<double>::quiet_NaN());
+  out.names.assign(species_pairs(species), "");
   for (std::size_t a = 0; a < species; ++a) {
     for (std::size_t b = a; b < species; ++b) {
       const std::size_t p = species_pair_index(a, b, species);
-      pair_names_[p] = names[a] + "-" + names[b];
-      const double sigma = snapshot_->species_radius()[a] + snapshot_->species_radius()[b];
-      const bool present = snapshot_->counts()[a] > 0 && snapshot_->counts()[b] > 0;
-      if (no_contact_.empty() && present) {
-        if (std::isnan(sigma)) no_contact_ = "the radii of a species differ";
-        contact[p] = sigma;
+      out.names[p] = names[a] + "-" + names[b];
+      const double sigma = snapshot.species_radius()[a] + snapshot.species_radius()[b];
+      const bool present = snapshot.counts()[a] > 0 && snapshot.counts()[b] > 0;
+      if (out.no_contact.empty() && present) {
+        if (std::isnan(sigma)) out.no_contact = "the radii of a species differ";
+        out.contact[p] = sigma;
       }
     }
   }
-  if (!no_contact_.empty()) std::fill(contact.begin(), contact.end(), std::nan(""));
+  if (!out.no_contact.empty()) std::fill(out.contact.begin(), out.contact.end(), std::nan(""));
+  return out;
+}
+
+template <int D>
+double automatic_rdf_distance(const StructureSnapshot<D>& snapshot, const Configuration<D>& c) {
+  const double shortest = *std::min_element(c.box.begin(), c.box.end());
+  return std::min(10.0 * snapshot.largest_radius(), 0.5 * shortest);
+}
+
+template <int D>
+void RdfOutput<D>::begin(const RunContext<D>& run) {
+  const Integrator<D>& integrator = run.integrator();
+  const Configuration<D>& c = snapshot_->at(integrator);
+  const EventIntegrator<D>* engine = integrator.as_event();
+  RdfPairs pairs = rdf_pairs(integrator, *snapshot_);
+  pair_names_ = std::move(pairs.names);
+  no_contact_ = std::move(pairs.no_contact);
+  const std::vector<double>& contact = pairs.contact;
+  // The contact theorem: an elastic, smooth, unforced gas in a periodic box.
   if (!no_contact_.empty()) {
     no_theorem_ = no_contact_;
   } else if (!integrator.bulk()) {
@@ -52,8 +70,7 @@ void RdfOutput<D>::begin(const RunContext<D>& run) {
   }
   double max_distance = run.config().analysis.rdf_max_distance;
   const double shortest = *std::min_element(c.box.begin(), c.box.end());
-  if (max_distance == 0.0)
-    max_distance = std::min(10.0 * snapshot_->largest_radius(), 0.5 * shortest);
+  if (max_distance == 0.0) max_distance = automatic_rdf_distance(*snapshot_, c);
   try {
     rdf_.emplace(c.box, c.periodic, snapshot_->counts(), max_distance,
                  static_cast<int>(run.config().analysis.rdf_bins), contact);
@@ -164,6 +181,10 @@ void RdfOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>& run) 
                  "analysis.rdf.compressibility_difference_in_stderr");
 }
 
+template RdfPairs rdf_pairs<2>(const Integrator<2>&, const StructureSnapshot<2>&);
+template RdfPairs rdf_pairs<3>(const Integrator<3>&, const StructureSnapshot<3>&);
+template double automatic_rdf_distance<2>(const StructureSnapshot<2>&, const Configuration<2>&);
+template double automatic_rdf_distance<3>(const StructureSnapshot<3>&, const Configuration<3>&);
 template class RdfOutput<2>;
 template class RdfOutput<3>;
 

@@ -17,6 +17,20 @@
 
 namespace kairos {
 
+// g(r)'s species pairs in the snapshot's last read: their names ("A-B", by species_pair_index),
+// contact distances (NaN: none), and why there are no contact values ("": there are; soft
+// spheres, stepped potentials, or a species whose radii differ).
+struct RdfPairs {
+  std::vector<std::string> names;
+  std::vector<double> contact;
+  std::string no_contact;
+};
+template <int D>
+RdfPairs rdf_pairs(const Integrator<D>& integrator, const StructureSnapshot<D>& snapshot);
+// analysis.rdf_max_distance = 0: five of the largest diameters, at most half the shortest edge.
+template <int D>
+double automatic_rdf_distance(const StructureSnapshot<D>& snapshot, const Configuration<D>& c);
+
 template <int D>
 class RdfOutput final : public AnalysisOutput<D> {
  public:

@@ -9,17 +9,25 @@
 namespace kairos {
 
 template <int D>
+std::string structure_factor_unavailable(const Integrator<D>& integrator,
+                                         const Configuration<D>& c) {
+  for (int a = 0; a < D; ++a) {
+    if (!c.periodic[a]) return "walls or open faces: S(k) needs a periodic box";
+  }
+  if (const EventIntegrator<D>* engine = integrator.as_event(); engine && engine->kind().sheared)
+    return "Lees-Edwards shear: the sheared box has no fixed wave vectors";
+  return "";
+}
+
+template <int D>
 void StructureFactorOutput<D>::begin(const RunContext<D>& run) {
   const Integrator<D>& integrator = run.integrator();
   const Configuration<D>& c = snapshot_->at(integrator);
-  for (int a = 0; a < D; ++a) {
-    if (!c.periodic[a]) return this->unavailable("walls or open faces: S(k) needs a periodic box");
-  }
-  if (const EventIntegrator<D>* engine = integrator.as_event(); engine && engine->kind().sheared)
-    return this->unavailable("Lees-Edwards shear: the sheared box has no fixed wave vectors");
-  const double d = 2.0 * snapshot_->largest_radius();
-  k_max_ = run.config().analysis.sk_max > 0.0 ? run.config().analysis.sk_max : 15.0 / d;
-  sk_.emplace(c.box, k_max_, 2.0 / d);
+  if (std::string why = structure_factor_unavailable(integrator, c); !why.empty())
+    return this->unavailable(std::move(why));
+  k_max_ = run.config().analysis.sk_max > 0.0 ? run.config().analysis.sk_max
+                                              : automatic_sk_max(*snapshot_);
+  sk_.emplace(c.box, k_max_, sk_fit_max(*snapshot_));
 }
 
 template <int D>
@@ -70,6 +78,8 @@ void StructureFactorOutput<D>::summarize(nlohmann::json& summary, const RunConte
   if (no_fit.empty()) set_error_quality(j, "s_zero_stderr", s.s_zero());
 }
 
+template std::string structure_factor_unavailable<2>(const Integrator<2>&, const Configuration<2>&);
+template std::string structure_factor_unavailable<3>(const Integrator<3>&, const Configuration<3>&);
 template class StructureFactorOutput<2>;
 template class StructureFactorOutput<3>;
 

@@ -15,6 +15,20 @@
 
 namespace kairos {
 
+// Why S(k) cannot be measured on this system ("": it can): walls or open faces, or shear.
+template <int D>
+std::string structure_factor_unavailable(const Integrator<D>& integrator,
+                                         const Configuration<D>& c);
+// analysis.sk_max = 0: 15 / d, d the largest diameter; S(0) is fitted to k <= 2 / d.
+template <int D>
+double automatic_sk_max(const StructureSnapshot<D>& snapshot) {
+  return 15.0 / (2.0 * snapshot.largest_radius());
+}
+template <int D>
+double sk_fit_max(const StructureSnapshot<D>& snapshot) {
+  return 2.0 / (2.0 * snapshot.largest_radius());
+}
+
 template <int D>
 class StructureFactorOutput final : public AnalysisOutput<D> {
  public:

@@ -15,8 +15,8 @@ namespace kairos {
 // The velocities relative to their mean (under Lees-Edwards shear: to the flow, from the event
 // engine's peculiar velocities), kT = Σ m c² / (D N) of this sample.
 template <int D>
-void VelocityDistributionOutput<D>::take(const RunContext<D>& run) {
-  const Integrator<D>& integrator = run.integrator();
+bool sample_velocity_distribution(const Integrator<D>& integrator,
+                                  VelocityDistribution<D>& distribution) {
   const auto n = static_cast<double>(integrator.size());
   if (const EventIntegrator<D>* engine = integrator.as_event(); engine && engine->kind().sheared) {
     std::vector<Vec<D>> c;
@@ -24,11 +24,11 @@ void VelocityDistributionOutput<D>::take(const RunContext<D>& run) {
     engine->peculiar_velocities(c, m);
     double sum = 0.0;
     for (std::size_t i = 0; i < c.size(); ++i) sum += m[i] * norm2(c[i]);
-    if (!(sum > 0.0)) return;
-    distribution_.begin(sum / (D * n));
-    for (std::size_t i = 0; i < c.size(); ++i) distribution_.add(c[i], m[i]);
-    distribution_.end();
-    return;
+    if (!(sum > 0.0)) return false;
+    distribution.begin(sum / (D * n));
+    for (std::size_t i = 0; i < c.size(); ++i) distribution.add(c[i], m[i]);
+    distribution.end();
+    return true;
   }
   // Two passes over the blocks: the mean velocity and kT, then the histogram.
   const StateBlocks<D> state = integrator.state_blocks();
@@ -47,15 +47,21 @@ void VelocityDistributionOutput<D>::take(const RunContext<D>& run) {
       kFields);
   const Vec<D> mean = (1.0 / mass) * momentum;
   const double kT = (energy - mass * norm2(mean)) / (D * n);
-  if (!(kT > 0.0)) return;  // at rest
-  distribution_.begin(kT);
+  if (!(kT > 0.0)) return false;  // at rest
+  distribution.begin(kT);
   state.for_each(
       [&](const ParticleSystem<D>& part, std::size_t) {
         for (std::size_t j = 0; j < part.size(); ++j)
-          distribution_.add(part.velocity(j, part.time) - mean, part.mass[j]);
+          distribution.add(part.velocity(j, part.time) - mean, part.mass[j]);
       },
       kFields);
-  distribution_.end();
+  distribution.end();
+  return true;
+}
+
+template <int D>
+void VelocityDistributionOutput<D>::take(const RunContext<D>& run) {
+  sample_velocity_distribution(run.integrator(), distribution_);
 }
 
 template <int D>
@@ -101,6 +107,8 @@ void VelocityDistributionOutput<D>::summarize(nlohmann::json& summary,
   j["outside_range"] = v.outside();
 }
 
+template bool sample_velocity_distribution<2>(const Integrator<2>&, VelocityDistribution<2>&);
+template bool sample_velocity_distribution<3>(const Integrator<3>&, VelocityDistribution<3>&);
 template class VelocityDistributionOutput<2>;
 template class VelocityDistributionOutput<3>;
 

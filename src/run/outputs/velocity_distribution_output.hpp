@@ -9,9 +9,17 @@
 #include <string>
 
 #include "analysis/structure.hpp"
+#include "run/integrator.hpp"
 #include "run/outputs/analysis_output.hpp"
 
 namespace kairos {
+
+// One sample of the integrator's velocities now into `distribution`: relative to their mean
+// (under Lees-Edwards shear: to the flow), kT = sum m c^2 / (D N) of this sample. False (no
+// sample) when the particles are at rest.
+template <int D>
+bool sample_velocity_distribution(const Integrator<D>& integrator,
+                                  VelocityDistribution<D>& distribution);
 
 template <int D>
 class VelocityDistributionOutput final : public AnalysisOutput<D> {

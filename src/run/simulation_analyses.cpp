@@ -1,0 +1,223 @@
+#include "run/simulation_analyses.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "analysis/thermodynamics.hpp"
+#include "core/error.hpp"
+#include "run/event_adapter.hpp"
+#include "run/outputs/bond_order_output.hpp"
+#include "run/outputs/rdf_output.hpp"
+#include "run/outputs/sampling_interval.hpp"
+#include "run/outputs/structure_factor_output.hpp"
+#include "run/outputs/structure_snapshot.hpp"
+#include "run/outputs/transport_output.hpp"
+#include "run/outputs/velocity_distribution_output.hpp"
+
+namespace kairos {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The sampling interval asked for, or the automatic one (analysis.msd_interval = 0).
+template <int D>
+SampledSpan begin_span(const Simulation<D>& sim, const CorrelationRequest& request) {
+  SampledSpan span;
+  span.interval = request.interval;
+  if (span.interval == 0.0) {
+    span.interval_automatic = true;
+    span.interval = half_enskog_mean_free_time(sim.integrator(), request.interval_name);
+  }
+  span.start_time = sim.time();
+  span.collisions = sim.collisions();
+  return span;
+}
+
+// The span's end: its mean free time as thermo.tsv defines it, and the fit window over the
+// sampled times.
+template <int D>
+void end_span(const Simulation<D>& sim, const CorrelationRequest& request, double sampled,
+              SampledSpan& span) {
+  span.end_time = sim.time();
+  span.collisions = sim.collisions() - span.collisions;
+  const Thermodynamics stats(D, sim.size(), sim.integrator().volume());
+  span.mean_free_time = stats.mean_free_time(span.end_time - span.start_time, span.collisions);
+  const auto [from, to] =
+      correlation_fit_window(sampled, request.fit_from, request.fit_to, span.mean_free_time);
+  span.fit_from = from;
+  span.fit_to = to;
+}
+
+}  // namespace
+
+template <int D>
+RdfNow<D> rdf_now(const Simulation<D>& sim, int bins, double max_distance) {
+  StructureSnapshot<D> snapshot;
+  const Configuration<D>& c = snapshot.at(sim.integrator());
+  RdfPairs pairs = rdf_pairs(sim.integrator(), snapshot);
+  if (max_distance == 0.0) max_distance = automatic_rdf_distance(snapshot, c);
+  std::optional<PairCorrelation<D>> rdf;
+  try {
+    rdf.emplace(c.box, c.periodic, snapshot.counts(), max_distance, bins, pairs.contact);
+  } catch (const std::invalid_argument&) {
+    const double shortest = *std::min_element(c.box.begin(), c.box.end());
+    throw InputError(fmt::format(
+        "rdf: the box (shortest edge {:.6g}) is too small for g(r) up to r_max = {:.6g} and the "
+        "contact windows (1.1 contact distances): both must stay within half of every edge",
+        shortest, max_distance));
+  }
+  rdf->sample(c);
+  RdfNow<D> out;
+  out.max_distance = rdf->max_distance();
+  out.bins = rdf->bins();
+  out.pairs = std::move(pairs.names);
+  out.no_contact = std::move(pairs.no_contact);
+  const std::size_t n_pairs = out.pairs.size();
+  out.g.assign(n_pairs, std::vector<double>(static_cast<std::size_t>(bins), kNaN));
+  for (int k = 0; k < bins; ++k) {
+    out.r.push_back((k + 0.5) * rdf->bin_width());
+    for (std::size_t p = 0; p < n_pairs; ++p) {
+      const BlockAverage v = rdf->g(p, k);
+      if (v.samples > 0) out.g[p][static_cast<std::size_t>(k)] = v.mean;
+    }
+    out.g_all.push_back(rdf->g_all(k).mean);
+  }
+  for (std::size_t p = 0; p < n_pairs; ++p) {
+    const BlockAverage v = rdf->contact(p);
+    out.sigma.push_back(rdf->contact_distance(p));
+    out.contact.push_back(v.samples > 0 ? v.mean : kNaN);
+  }
+  out.overlapping = rdf->overlapping();
+  out.at_contact = rdf->at_contact();
+  return out;
+}
+
+template <int D>
+StructureFactorNow structure_factor_now(const Simulation<D>& sim, double k_max) {
+  StructureSnapshot<D> snapshot;
+  const Configuration<D>& c = snapshot.at(sim.integrator());
+  if (const std::string why = structure_factor_unavailable(sim.integrator(), c); !why.empty())
+    throw InputError("structure_factor: " + why);
+  StructureFactorNow out;
+  out.k_max = k_max > 0.0 ? k_max : automatic_sk_max(snapshot);
+  StructureFactor<D> sk(c.box, out.k_max, sk_fit_max(snapshot));
+  sk.sample(c);
+  for (const auto& shell : sk.shells()) {
+    out.k.push_back(shell.k);
+    out.s.push_back(shell.s.mean);
+    out.vectors.push_back(shell.vectors);
+    out.available.push_back(shell.available);
+  }
+  out.fit_max = sk.fit_max();
+  out.fit_shells = sk.fit_shells();
+  out.s_zero = out.fit_shells > 0 ? sk.s_zero().mean : kNaN;
+  return out;
+}
+
+template <int D>
+BondOrderValues<D> bond_order_now(const Simulation<D>& sim, double cutoff, const std::string& key) {
+  StructureSnapshot<D> snapshot;
+  const Configuration<D>& c = snapshot.at(sim.integrator());
+  check_bond_cutoff(cutoff, snapshot, c, key);
+  return bond_order(c, cutoff);
+}
+
+template <int D>
+VelocityDistribution<D> velocity_distribution_now(const Simulation<D>& sim) {
+  VelocityDistribution<D> distribution;
+  sample_velocity_distribution(sim.integrator(), distribution);
+  return distribution;
+}
+
+template <int D>
+MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& request, bool vacf,
+                              const typename Simulation<D>::KeepGoing& keep_going) {
+  if (!sim.tracks_images()) {
+    throw InputError(
+        "msd: the mean-square displacement needs image counters: this Simulation keeps none "
+        "(created with images=False)");
+  }
+  if (sim.integrator().kind().sheared) {
+    throw InputError(
+        "msd: the mean-square displacement under Lees-Edwards shear is not measured yet (the "
+        "streaming displacement would need subtracting), as analysis.msd");
+  }
+  MsdMeasurement<D> m;
+  m.span = begin_span(sim, request);
+  // Every particle, grouped by species (analysis.msd with at most msd_particles particles).
+  m.species = sim.species_names();
+  if (m.species.empty()) m.species = {"A"};
+  const std::size_t n = sim.size();
+  std::vector<std::uint32_t> group(n, 0u), slot(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    slot[i] = static_cast<std::uint32_t>(i);
+    if (i < sim.species().size()) group[i] = sim.species()[i];
+    while (group[i] >= m.species.size()) m.species.push_back(std::to_string(m.species.size()));
+  }
+  const auto groups = static_cast<std::uint32_t>(m.species.size());
+  m.msd.emplace(group, groups, m.span.interval);
+  if (vacf) m.vacf.emplace(group, groups, m.span.interval, MsdCorrelator<D>::Statistic::kProduct);
+  std::vector<Vec<D>> sample(n);
+  const EventIntegrator<D>& engine = sim.integrator();
+  m.span.completed = sim.sample_every(
+      m.span.interval, request.duration,
+      [&] {
+        engine.unwrapped_positions(slot, sample);
+        if (m.msd->samples() == 0) m.sampled_from = sim.time();
+        m.sampled_to = sim.time();
+        m.msd->add(sample);
+        if (m.vacf) {
+          engine.velocities(slot, sample);
+          m.vacf->add(sample);
+        }
+      },
+      keep_going);
+  end_span(sim, request, m.sampled_to - m.sampled_from, m.span);
+  m.diffusion = m.msd->diffusion(m.span.fit_from, m.span.fit_to);
+  m.green_kubo = m.vacf ? m.vacf->green_kubo(m.span.fit_to)
+                        : std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>>(groups);
+  return m;
+}
+
+template <int D>
+TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationRequest& request,
+                                          const typename Simulation<D>::KeepGoing& keep_going) {
+  if (!sim.tracks_helfand()) {
+    throw InputError(
+        "transport: the Helfand moments are not kept: create the Simulation with helfand=True "
+        "(a conservative periodic system)");
+  }
+  TransportMeasurement<D> m;
+  m.span = begin_span(sim, request);
+  const EventIntegrator<D>& engine = sim.integrator();
+  m.transport.emplace(m.span.interval, sim.size(), engine.volume());
+  m.span.completed = sim.sample_every(
+      m.span.interval, request.duration,
+      [&] { m.transport->add(sim.time(), helfand_sample(engine)); }, keep_going);
+  end_span(sim, request, m.transport->last_time() - m.transport->first_time(), m.span);
+  m.einstein_helfand = m.transport->einstein_helfand(m.span.fit_from, m.span.fit_to);
+  m.green_kubo = m.transport->green_kubo(m.span.fit_to);
+  m.no_conductivity = HelfandTransport<D>::why_no_conductivity(
+      std::max<std::size_t>(1, sim.species_names().size()));
+  return m;
+}
+
+#define KAIROS_SIMULATION_ANALYSES(D)                                                              \
+  template RdfNow<D> rdf_now<D>(const Simulation<D>&, int, double);                                \
+  template StructureFactorNow structure_factor_now<D>(const Simulation<D>&, double);               \
+  template BondOrderValues<D> bond_order_now<D>(const Simulation<D>&, double, const std::string&); \
+  template VelocityDistribution<D> velocity_distribution_now<D>(const Simulation<D>&);             \
+  template MsdMeasurement<D> measure_msd<D>(Simulation<D>&, const CorrelationRequest&, bool,       \
+                                            const typename Simulation<D>::KeepGoing&);             \
+  template TransportMeasurement<D> measure_transport<D>(Simulation<D>&, const CorrelationRequest&, \
+                                                        const typename Simulation<D>::KeepGoing&);
+KAIROS_SIMULATION_ANALYSES(2)
+KAIROS_SIMULATION_ANALYSES(3)
+#undef KAIROS_SIMULATION_ANALYSES
+
+}  // namespace kairos
