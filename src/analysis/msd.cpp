@@ -345,13 +345,34 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
       ++used_lags;
     }
     if (used_lags < 2 || all.empty() || all[0].lag != 0.0) continue;
+    // The same integral from the origins of each time epoch that reaches every lag of it (the
+    // scatter the particles' subsets miss: a collective flux has few components).
+    std::vector<double> by_epoch;
+    for (int e = 0; e < kEpochs; ++e) {
+      const auto epoch_at = [&](const Lag& lag) {
+        return c(lag.epoch_mean[g][e], about_mean ? lag.epoch_mean_linear[g][e] : Vec<D>{});
+      };
+      double integral = 0.0;
+      bool complete = true;
+      for (std::size_t k = 1; complete && k < all.size() && all[k].lag <= to; ++k) {
+        const double a = epoch_at(all[k]), b = epoch_at(all[k - 1]);
+        complete = std::isfinite(a) && std::isfinite(b);
+        integral += 0.5 * (all[k].lag - all[k - 1].lag) * (a + b);
+      }
+      if (complete) by_epoch.push_back(integral / D);
+    }
     Diffusion d;
     d.lags = used_lags + 1;
     d.coefficient = total / D;
     std::vector<double> by_subset;
     for (int s = 0; s < kSubsets; ++s)
       if (group_size_[slot(g, s)] > 0) by_subset.push_back(part[s] / D);
-    d.stderr_ = d.particle_stderr = standard_error(by_subset);
+    d.particle_stderr = standard_error(by_subset);
+    d.epoch_stderr = standard_error(by_epoch);
+    d.epochs = static_cast<int>(by_epoch.size());
+    d.stderr_ = std::isnan(d.epoch_stderr)      ? d.particle_stderr
+                : std::isnan(d.particle_stderr) ? d.epoch_stderr
+                                                : std::max(d.particle_stderr, d.epoch_stderr);
     out[g] = d;
   }
   return out;
@@ -371,8 +392,13 @@ std::size_t MsdCorrelator<D>::bytes() const {
 }
 
 std::pair<double, double> correlation_fit_window(double sampled, double from, double to,
-                                                 double mean_free_time) {
-  if (!(to > 0.0)) to = 0.25 * sampled;
+                                                 double mean_free_time,
+                                                 double to_mean_free_times) {
+  if (!(to > 0.0)) {
+    to = to_mean_free_times > 0.0 && std::isfinite(mean_free_time) && mean_free_time > 0.0
+             ? to_mean_free_times * mean_free_time
+             : 0.25 * sampled;
+  }
   if (!(from > 0.0)) {
     from = std::max(0.1 * to, std::isfinite(mean_free_time) ? 10.0 * mean_free_time : 0.0);
   }

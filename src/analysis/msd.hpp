@@ -141,9 +141,15 @@ class MsdCorrelator {
 };
 
 // The fit window [from, to] of a correlator's slope (analysis.msd, analysis.transport and the
-// Python module's): `to` as given (> 0) or a quarter of the sampled span, `from` as given (> 0)
-// or the larger of a tenth of `to` and ten mean free times (NaN: not known).
+// Python module's): `to` as given (> 0), else `to_mean_free_times` mean free times when that is
+// > 0 and the mean free time is known, else a quarter of the sampled span; `from` as given
+// (> 0) or the larger of a tenth of `to` and ten mean free times (NaN: not known).
 std::pair<double, double> correlation_fit_window(double sampled, double from, double to,
-                                                 double mean_free_time);
+                                                 double mean_free_time,
+                                                 double to_mean_free_times = 0.0);
+// The transport coefficients' default longest lag: their Helfand moments reach their slope
+// within ~10-40 mean free times up to eta = 0.4 (docs/validation.md, "Transport
+// coefficients"); a window reaching further only adds noise.
+inline constexpr double kTransportFitMeanFreeTimes = 40.0;
 
 }  // namespace kairos

@@ -566,6 +566,7 @@ class PySimulation {
                      const py::object& fit_from_arg, const py::object& fit_to_arg) {
     CorrelationRequest request =
         correlation_request(interval_arg, duration_arg, fit_from_arg, fit_to_arg, "transport");
+    request.fit_to_mean_free_times = kTransportFitMeanFreeTimes;  // as analysis.transport's
     return visit([&](auto& s) {
       const auto m = advancing([&] { return measure_transport(s, request, python_keeps_going); });
       using T = typename std::decay_t<decltype(*m.transport)>;

@@ -48,7 +48,8 @@ void end_span(const Simulation<D>& sim, const CorrelationRequest& request, doubl
   const Thermodynamics stats(D, sim.size(), sim.integrator().volume());
   span.mean_free_time = stats.mean_free_time(span.end_time - span.start_time, span.collisions);
   const auto [from, to] =
-      correlation_fit_window(sampled, request.fit_from, request.fit_to, span.mean_free_time);
+      correlation_fit_window(sampled, request.fit_from, request.fit_to, span.mean_free_time,
+                             request.fit_to_mean_free_times);
   span.fit_from = from;
   span.fit_to = to;
 }

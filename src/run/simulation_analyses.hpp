@@ -78,6 +78,8 @@ struct CorrelationRequest {
   double interval = 0.0;
   double duration = 0.0;
   double fit_from = 0.0, fit_to = 0.0;
+  // The default longest lag in mean free times (0: a quarter of the span, as the MSD's).
+  double fit_to_mean_free_times = 0.0;
   // The key naming the interval in the message when none follows from a system at rest.
   std::string interval_name = "interval";
 };

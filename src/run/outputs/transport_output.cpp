@@ -65,7 +65,8 @@ std::pair<double, double> TransportOutput<D>::fit_window() const {
   const double sampled = transport_ ? transport_->last_time() - transport_->first_time() : 0.0;
   const double mft =
       stats_.mean_free_time(engine_.time() - start_time_, engine_.collisions() - start_collisions_);
-  return correlation_fit_window(sampled, config_.transport_fit_from, config_.transport_fit_to, mft);
+  return correlation_fit_window(sampled, config_.transport_fit_from, config_.transport_fit_to, mft,
+                                kTransportFitMeanFreeTimes);
 }
 
 template <int D>
