@@ -113,23 +113,8 @@ KAIROS_NEMD_8000 = {0.1: (1.007, 0.023), 0.2: (0.960, 0.040), 0.3: (1.031, 0.034
 # ------------------------------------------------------------------------------------------------
 # Runs
 
-def config_text(dimension, particles, eta, collisions, seed=1, equilibration=200.0,
-                analysis=None, shear_rate=None, thermo_interval=None):
-    lines = ["[system]", "dimension = %d" % dimension, "particles = %d" % particles,
-             "packing_fraction = %r" % eta, 'lattice = "%s"' % ("fcc" if dimension == 3 else "hex"),
-             "seed = %d" % seed, "", "[run]",
-             "equilibration_collisions_per_particle = %r" % float(equilibration),
-             "collisions_per_particle = %r" % float(collisions), ""]
-    if shear_rate is not None:
-        lines += ["[boundary]", "shear_rate = %r" % shear_rate, ""]
-    lines += ["[output]", "trajectory = false", 'progress = "never"']
-    if thermo_interval is not None:
-        lines.append("thermo_interval = %r" % thermo_interval)
-    lines.append("")
-    if analysis is not None:
-        lines += ["[analysis]"] + ["%s = %s" % (k, json.dumps(v)) for k, v in analysis.items()]
-        lines.append("")
-    return "\n".join(lines)
+def config_text(*args, equilibration=200.0, **kwargs):
+    return cached_runs.config_text(*args, equilibration=equilibration, **kwargs)
 
 
 def transport_analysis(eta, window, dimension=3):

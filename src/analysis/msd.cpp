@@ -247,6 +247,19 @@ double standard_error(const std::vector<double>& x) {
   return std::sqrt(squares / (n - 1.0) / n);
 }
 
+// The error bars of a coefficient from its estimates per particle subset and per time epoch:
+// each one's standard error, and the larger of the two (NaN: fewer than 2 estimates).
+template <class Diffusion>
+void set_errors(Diffusion& d, const std::vector<double>& by_subset,
+                const std::vector<double>& by_epoch) {
+  d.particle_stderr = standard_error(by_subset);
+  d.epoch_stderr = standard_error(by_epoch);
+  d.epochs = static_cast<int>(by_epoch.size());
+  d.stderr_ = std::isnan(d.epoch_stderr)      ? d.particle_stderr
+              : std::isnan(d.particle_stderr) ? d.epoch_stderr
+                                              : std::max(d.particle_stderr, d.epoch_stderr);
+}
+
 }  // namespace
 
 template <int D>
@@ -299,12 +312,7 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
       }
       if (te.size() >= 3) by_epoch.push_back(slope(te, ye) / (2.0 * D));
     }
-    d.particle_stderr = standard_error(by_subset);
-    d.epoch_stderr = standard_error(by_epoch);
-    d.epochs = static_cast<int>(by_epoch.size());
-    d.stderr_ = std::isnan(d.epoch_stderr)      ? d.particle_stderr
-                : std::isnan(d.particle_stderr) ? d.epoch_stderr
-                                                : std::max(d.particle_stderr, d.epoch_stderr);
+    set_errors(d, by_subset, by_epoch);
     out[g] = d;
   }
   return out;
@@ -367,12 +375,7 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
     std::vector<double> by_subset;
     for (int s = 0; s < kSubsets; ++s)
       if (group_size_[slot(g, s)] > 0) by_subset.push_back(part[s] / D);
-    d.particle_stderr = standard_error(by_subset);
-    d.epoch_stderr = standard_error(by_epoch);
-    d.epochs = static_cast<int>(by_epoch.size());
-    d.stderr_ = std::isnan(d.epoch_stderr)      ? d.particle_stderr
-                : std::isnan(d.particle_stderr) ? d.epoch_stderr
-                                                : std::max(d.particle_stderr, d.epoch_stderr);
+    set_errors(d, by_subset, by_epoch);
     out[g] = d;
   }
   return out;
@@ -392,8 +395,7 @@ std::size_t MsdCorrelator<D>::bytes() const {
 }
 
 std::pair<double, double> correlation_fit_window(double sampled, double from, double to,
-                                                 double mean_free_time,
-                                                 double to_mean_free_times) {
+                                                 double mean_free_time, double to_mean_free_times) {
   if (!(to > 0.0)) {
     to = to_mean_free_times > 0.0 && std::isfinite(mean_free_time) && mean_free_time > 0.0
              ? to_mean_free_times * mean_free_time
