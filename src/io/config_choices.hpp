@@ -55,7 +55,7 @@ const Choices<TrajectoryPhases>& trajectory_phases();
 const Choices<TrajectoryPrecision>& trajectory_precisions();
 const Choices<TrajectorySpacing>& trajectory_spacings();
 const Choices<TrajectoryField>& trajectory_fields();
-const Choices<MsdTime>& msd_time_scales();              // analysis.msd_time
+const Choices<MsdTime>& msd_time_scales();  // analysis.msd_time
 // boundary.wall[].face and boundary.open: the faces of a box of `dimension` (2 or 3), or all
 // six (dimension 0).
 const Choices<BoxFace>& box_faces(int dimension = 0);

@@ -8,9 +8,9 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
-#include "run/outputs/sampling_interval.hpp"
 #include "io/config_choices.hpp"
 #include "run/collision_estimate.hpp"
+#include "run/outputs/sampling_interval.hpp"
 
 namespace kairos {
 
