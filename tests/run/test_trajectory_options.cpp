@@ -346,7 +346,6 @@ TEST_P(TrajectoryOptions, LogSpacedFramesInTimeFallOnTheirExactTimes) {
 }
 
 TEST_P(TrajectoryOptions, LogSpacedCyclesStartAgainEveryPeriod) {
-  if (dem()) GTEST_SKIP() << "the exact times: the event integrator";
   run_whole(config("equilibration_time = 0.0\ntime = 3.0",
                    "interval_unit = \"time\"\nthermo_interval = 1.0\ntrajectory_interval = 0.1\n"
                    "trajectory_spacing = \"log\"\ntrajectory_frames_per_decade = 2\n"
@@ -357,7 +356,17 @@ TEST_P(TrajectoryOptions, LogSpacedCyclesStartAgainEveryPeriod) {
     for (int k = 0; k < 2; ++k) due.push_back(m * 1.0 + 0.1 * std::pow(10.0, k / 2.0));
   }
   due.push_back(3.0);
-  EXPECT_EQ(times_of(frames_of(file("out"))), due);
+  const std::vector<double> t = times_of(frames_of(file("out")));
+  if (!dem()) {
+    EXPECT_EQ(t, due);
+    return;
+  }
+  // The DEM writes at the first step at or after each time.
+  ASSERT_EQ(t.size(), due.size());
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    EXPECT_GE(t[k], due[k] - 1e-12) << k;
+    EXPECT_LT(t[k], due[k] + 0.01) << k;
+  }
 }
 
 TEST_P(TrajectoryOptions, LogSpacedFramesInCollisionsStartAtEachPhase) {
