@@ -8,6 +8,8 @@
 // with status 2; SIGINT/SIGTERM finish the current event, write every output and exit 130/143.
 // Before the run has begun (loading the config, building tables) a signal ends the process at
 // once with one line "kairos: interrupted ..." and the same status; nothing is written.
+#include <malloc.h>
+
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -245,6 +247,11 @@ int report_interrupted_setup(const kairos::Interrupted& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Allocations of 2 MiB and more are mappings of their own, given back when freed. glibc's
+  // default threshold slides up to 32 MiB after the first large free, and every later
+  // temporary of an output (whole-state copies, the block order) then stayed in the heap: ~40
+  // bytes per particle of the whole process's peak at N = 10^6 (docs/performance.md).
+  mallopt(M_MMAP_THRESHOLD, 2 << 20);
   CLI::App app{
       "Kairos: event-driven molecular dynamics of hard, granular, stepped-potential and soft "
       "spheres "

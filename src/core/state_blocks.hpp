@@ -14,7 +14,10 @@ namespace kairos {
 
 template <int D>
 struct StateBlocks {
-  static constexpr std::size_t kBlock = std::size_t{1} << 16;  // particles per block
+  // Particles per block: a block's buffers (up to 64 bytes per particle an array) stay below
+  // the 2 MiB from which allocations are mappings of their own (cli/main.cpp), so that the heap
+  // reuses them from one output to the next instead of faulting fresh pages in.
+  static constexpr std::size_t kBlock = std::size_t{1} << 13;
   // Which per-particle arrays a reader needs (fill may leave the others unset): a chunk of
   // positions need not read the scheduler's arrays.
   enum Fields : unsigned {

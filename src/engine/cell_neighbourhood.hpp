@@ -67,13 +67,13 @@ class CellNeighbourhood {
 
   // The members of the 3^D cells around `cell` as candidates. Cells away from the box faces
   // (most) need no periodic shifts and take a loop over fixed index offsets.
-  void gather(CellCode cell, CandidateList<D>& list, const HotRecord<D>* hot) {
+  void gather(CellCode cell, CandidateList<D>& list, const HotRecord<D>* hot) const {
     gather_cells(cell, kAllNeighbours.data(), CellGrid<D>::kNeighbourCells, list, hot);
   }
   // gather() for the cells numbered which[0 .. count) among the 3^D around `cell` (see
   // CellGrid::neighbour's numbering), in that order.
   void gather_cells(CellCode cell, const std::uint8_t* which, int count, CandidateList<D>& list,
-                    const HotRecord<D>* hot);
+                    const HotRecord<D>* hot) const;
   // Doubles a candidate list's storage (rare: a crowded neighbourhood); returns the new storage.
   static std::uint32_t* grow(CandidateList<D>& list) {
     list.ids.resize(2 * list.ids.size());
@@ -105,12 +105,12 @@ class CellNeighbourhood {
     const HotRecord<D>* hot;
   };
   void gather_vector(CellCode cell, const std::uint8_t* which, int count, CandidateList<D>& list,
-                     const HotRecord<D>* hot);
+                     const HotRecord<D>* hot) const;
   template <bool kTagged>
   void walk_lists(const std::uint32_t* cells, const std::uint32_t* tags, int count,
-                  CandidateList<D>& list, const HotRecord<D>* hot);
+                  CandidateList<D>& list, const HotRecord<D>* hot) const;
   void append_members(std::uint32_t p, const Links& links, CandidateList<D>& list, std::uint32_t& n,
-                      std::uint32_t*& cand, std::uint32_t& cap);
+                      std::uint32_t*& cand, std::uint32_t& cap) const;
 
   CellGrid<D> grid_;
   bool vector_gather_ = false;
@@ -124,7 +124,7 @@ class CellNeighbourhood {
 template <int D>
 [[gnu::always_inline]] inline void CellNeighbourhood<D>::append_members(
     std::uint32_t p, const Links& links, CandidateList<D>& list, std::uint32_t& n,
-    std::uint32_t*& cand, std::uint32_t& cap) {
+    std::uint32_t*& cand, std::uint32_t& cap) const {
   const std::uint32_t* next = links.next;
   const std::uint32_t end = links.end;
   const HotRecord<D>* hot = links.hot;
@@ -148,7 +148,8 @@ template <int D>
 // CellGrid::neighbour's numbering), in that order.
 template <int D>
 inline void CellNeighbourhood<D>::gather_cells(CellCode cell, const std::uint8_t* which, int count,
-                                               CandidateList<D>& list, const HotRecord<D>* hot) {
+                                               CandidateList<D>& list,
+                                               const HotRecord<D>* hot) const {
   if (vector_gather_) {
     gather_vector(cell, which, count, list, hot);
     return;
@@ -181,7 +182,8 @@ inline void CellNeighbourhood<D>::gather_cells(CellCode cell, const std::uint8_t
 template <int D>
 template <bool kTagged>
 void CellNeighbourhood<D>::walk_lists(const std::uint32_t* cells, const std::uint32_t* tags,
-                                      int count, CandidateList<D>& list, const HotRecord<D>* hot) {
+                                      int count, CandidateList<D>& list,
+                                      const HotRecord<D>* hot) const {
   const std::uint32_t* heads = grid_.heads();
   // Read once: the stores into the candidate list could alias them for the compiler.
   const Links links{grid_.links(), grid_.end(), hot};
@@ -229,7 +231,8 @@ void CellNeighbourhood<D>::walk_lists(const std::uint32_t* cells, const std::uin
 // compressed sixteen lists at a time; the rare third and later members follow by links.
 template <int D>
 inline void CellNeighbourhood<D>::gather_vector(CellCode cell, const std::uint8_t* which, int count,
-                                                CandidateList<D>& list, const HotRecord<D>* hot) {
+                                                CandidateList<D>& list,
+                                                const HotRecord<D>* hot) const {
   constexpr auto kCells = static_cast<std::uint32_t>(CellGrid<D>::kNeighbourCells);
   while (list.ids.size() < 2 * kCells + kCandidateSlack) grow(list);
   std::uint32_t cells[kCells], tags[kCells];

@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/periodic.hpp"
 #include "core/permutation.hpp"
+#include "core/release_pages.hpp"
 #include "dynamics/collision_time.hpp"
 #include "dynamics/trajectory_events.hpp"
 #include "engine/candidate_scan.hpp"
@@ -83,10 +84,14 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   }
   for (const ParticleKind& sh : kinds_) kind_radius_.push_back(sh.radius);
   const bool has_counts = s.collision_count.size() == n;
-  hot_.resize(n);
+  // Each record written once (reserve: no page touched before); read in the caller's order (a
+  // fresh start), the state's pages are released as they are read.
+  const bool in_order = mode != StartMode::kResume || s.order.empty();
+  hot_.reserve(n);
   for (std::uint32_t k = 0; k < n; ++k) {
     const Kinematics<D>& kin = s.kinematics[id_[k]];
-    hot_[k] = {kin.pos, kin.vel, kin.time, has_counts ? s.collision_count[id_[k]] : 0u, 0u};
+    hot_.push_back({kin.pos, kin.vel, kin.time, has_counts ? s.collision_count[id_[k]] : 0u, 0u});
+    if (in_order) release_read_front(s.kinematics.data(), k + 1);
   }
   // Read (kinds_ hold the radii): released before the queue and the renumbering take their
   // memory (docs/performance.md, "Memory").
@@ -875,6 +880,24 @@ Vec<D> EventEngine<D, Queue>::momentum() const {
   Vec<D> p{};
   for (std::uint32_t i = 0; i < size(); ++i) p = p + mass_of(i) * velocity(i, time_);
   return p;
+}
+
+template <int D, class Queue>
+std::array<double, 9> EventEngine<D, Queue>::peculiar_kinetic_tensor() const {
+  Vec<D> p{};
+  double mass = 0.0;
+  for (std::uint32_t i = 0; i < size(); ++i) {
+    p = p + mass_of(i) * velocity(i, time_);
+    mass += mass_of(i);
+  }
+  const Vec<D> mean = (1.0 / mass) * p;
+  std::array<double, 9> tensor{};
+  for (std::uint32_t i = 0; i < size(); ++i) {
+    const Vec<D> c = velocity(i, time_) - mean;
+    for (int a = 0; a < D; ++a)
+      for (int b = 0; b < D; ++b) tensor[a * D + b] += mass_of(i) * c[a] * c[b];
+  }
+  return tensor;
 }
 
 template <int D, class Queue>

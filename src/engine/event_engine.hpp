@@ -180,6 +180,12 @@ class EventEngine {
   std::size_t size() const { return hot_.size(); }
 
   double kinetic_energy() const;  // translational
+  // The largest overlap of any pair now (0 when none), from the engine's own cells: each pair
+  // tested as init/initial_state's max_overlap tests it (positions wrapped into the box as
+  // current_positions() gives them, the nearest image along periodic axes, none along bounded
+  // ones), without a copy of the state or a grid of its own. Not under shear (the images
+  // slide: the caller uses max_overlap_sheared).
+  double max_overlap_now() const;
   // Translational, of the velocities relative to the mean shear flow (Lees-Edwards); equal to
   // kinetic_energy() without shear.
   double peculiar_kinetic_energy() const;
@@ -208,6 +214,11 @@ class EventEngine {
   // Whether the AVX-512 loops read candidates' records by rows (EngineOptions::record_loads).
   bool candidate_row_loads() const { return row_loads_; }
   Vec<D> momentum() const;
+  // Sum over particles of m c_a c_b (row-major, D x D used), c the velocity now relative to the
+  // centre-of-mass velocity: the kinetic part of the pressure tensor times V. Two passes over
+  // the records in memory order, as kinetic_energy() sums (not under shear: the adapter takes
+  // the velocities relative to the flow).
+  std::array<double, 9> peculiar_kinetic_tensor() const;
   const Environment<D>& environment() const { return env_; }
   // Positions at the current time, wrapped into the box, in the caller's numbering.
   std::vector<Vec<D>> current_positions() const;
@@ -223,6 +234,10 @@ class EventEngine {
                                           std::span<const Vec<D>> v, std::span<const double> m)>;
   // Without positions (x empty), a third cheaper.
   void for_each_block(const BlockVisitor& f, bool with_positions = true) const;
+  // Drops the order in which blocks read the records (4 bytes per particle; blocks being
+  // written keep their own reference): the run calls it when events resume after outputs, so
+  // that the order is held only while outputs are written.
+  void release_block_order() const { block_order_.reset(); }
   // Each particle's collision counter (particle and wall collisions; it wraps at 2^32), in the
   // caller's numbering: which particles took part in the events between two calls.
   std::vector<std::uint32_t> collision_counts() const {
@@ -431,7 +446,8 @@ class EventEngine {
     std::vector<std::uint32_t> members;  // internal indices, block by block
     std::vector<std::uint32_t> start;    // block b's members: [start[b], start[b + 1])
   };
-  // Built at the first output after a renumbering (4 bytes per particle), kept until the next.
+  // Built at the first output of a moment (4 bytes per particle), kept until the next
+  // renumbering or release_block_order().
   const BlockOrder& block_order() const;
   mutable std::shared_ptr<const BlockOrder> block_order_;
   void size_particle_arrays(ParticleSystem<D>& out, std::size_t n) const;

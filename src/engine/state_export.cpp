@@ -197,7 +197,7 @@ void EventEngine<D, Queue>::for_each_block(const BlockVisitor& f, bool with_posi
   const std::size_t n = size();
   const BlockOrder& order = block_order();
   const std::size_t block = std::min(n, StateBlocks<D>::kBlock);
-  std::vector<Vec<D>> x(block), v(block);
+  std::vector<Vec<D>> x(with_positions ? block : 0), v(block);
   std::vector<double> m(block);
   for (std::size_t b = 0, first = 0; first < n; ++b, first += block) {
     const std::size_t count = std::min(block, n - first);
@@ -214,6 +214,41 @@ void EventEngine<D, Queue>::for_each_block(const BlockVisitor& f, bool with_posi
     }
     f(first, {x.data(), with_positions ? count : 0}, {v.data(), count}, {m.data(), count});
   }
+}
+
+template <int D, class Queue>
+double EventEngine<D, Queue>::max_overlap_now() const {
+  if (sheared_) throw std::logic_error("max_overlap_now: the images of a sheared box slide");
+  const CellGrid<D>& grid = cells_.grid();
+  const auto wrapped = [&](std::uint32_t k) {
+    Vec<D> x = position(k, time_);
+    for (int a = 0; a < D; ++a)
+      if (grid.periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
+    return x;
+  };
+  CandidateList list;
+  list.ids.resize(256);
+  list.shift.resize(256);
+  list.delayed.resize(256 + 8);
+  double worst = 0.0;
+  for (std::uint32_t i = 0; i < size(); ++i) {
+    cells_.gather(hot_[i].cell, list, hot_.data());
+    const Vec<D> xi = wrapped(i);
+    for (std::uint32_t c = 0; c < list.count; ++c) {
+      const std::uint32_t j = list.ids[c];
+      if (j <= i) continue;  // each pair once (a small grid may list a cell twice: no matter)
+      const Vec<D> xj = wrapped(j);
+      double r2 = 0.0;
+      for (int a = 0; a < D; ++a) {
+        double dx = xi[a] - xj[a];
+        if (grid.periodic(a)) dx = minimum_image(dx, box_[a]);
+        r2 += dx * dx;
+      }
+      const double sigma = radius_of(i) + radius_of(j);
+      if (r2 < sigma * sigma) worst = std::max(worst, sigma - std::sqrt(r2));
+    }
+  }
+  return worst;
 }
 
 template <int D, class Queue>

@@ -13,6 +13,7 @@
 
 #include "core/memory_budget.hpp"
 #include "core/particle_system.hpp"
+#include "core/release_pages.hpp"
 #include "core/stop_flag.hpp"
 #include "io/config.hpp"
 
@@ -104,10 +105,14 @@ template <int D>
 ParticleSystem<D> to_particle_system(InitialState<D>&& init) {
   ParticleSystem<D> s;
   s.box = init.box;
-  s.kinematics.resize(init.position.size());
+  // Written once each (reserve: no pages touched before), the pages read released as it goes.
+  s.kinematics.reserve(init.position.size());
   for (std::size_t i = 0; i < init.position.size(); ++i) {
     if ((i & 0xffffu) == 0xffffu) throw_if_stop_requested();  // a setup loop (core/stop_flag)
-    s.kinematics[i] = {init.position[i], init.velocity[i], 0.0, 0.5 * init.diameter[i]};
+    s.kinematics.push_back({init.position[i], init.velocity[i], 0.0, 0.5 * init.diameter[i]});
+    release_read_front(init.position.data(), i + 1);
+    release_read_front(init.velocity.data(), i + 1);
+    release_read_front(init.diameter.data(), i + 1);
   }
   std::vector<std::array<double, D>>().swap(init.position);
   std::vector<std::array<double, D>>().swap(init.velocity);

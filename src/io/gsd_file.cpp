@@ -23,7 +23,7 @@ constexpr std::uint64_t kMagic = 0x65DF65DF65DF65DFull;
 constexpr std::uint32_t kGsdVersion = 2u << 16;  // we write file layer 2.0
 constexpr std::uint64_t kInitialIndex = 128;     // entries
 constexpr std::uint64_t kInitialNamelist = 16;   // 64-byte segments
-constexpr std::size_t kBufferBytes = 1u << 22;   // chunk data is written in pieces of ~4 MiB
+constexpr std::size_t kBufferBytes = 1u << 18;   // chunk data is written in pieces of 256 KiB
 
 struct Header {
   std::uint64_t magic;
@@ -458,6 +458,10 @@ void Writer::append_to_chunk(const void* data, std::size_t bytes) {
   if (s.checksums) s.crcs.back().crc = data_crc(s.crcs.back().crc, data, bytes);
   c.given += bytes;
   if (s.buffer.size() + bytes > kBufferBytes) s.flush();
+  // Never more than kBufferBytes held (a vector left to grow by doubling kept 6 MB per writer).
+  if (bytes < kBufferBytes && s.buffer.size() + bytes > s.buffer.capacity())
+    s.buffer.reserve(
+        std::min(kBufferBytes, std::max(2 * s.buffer.capacity(), s.buffer.size() + bytes)));
   if (bytes >= kBufferBytes) {
     write_at(s.fd.get(), data, bytes, s.end + s.flushed, s.path);
     s.flushed += bytes;

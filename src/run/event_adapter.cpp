@@ -171,6 +171,7 @@ Advance EventEngineAdapter<D, Queue>::advance(const AdvanceLimits& limits) {
   // An output within round-off of the phase's end comes at the end (one row, not two).
   if (limits.phase_in_time && stop >= end_time - TimeTrigger::slack(end_time)) stop = end_time;
   Advance result;
+  engine_.release_block_order();  // the outputs of the moment before are written
   for (;;) {
     if (clock_stops) {
       if (driven) apply_due_kicks(stop);
@@ -267,6 +268,8 @@ double EventEngineAdapter<D, Queue>::momentum_scale() const {
 
 template <int D, class Queue>
 double EventEngineAdapter<D, Queue>::max_overlap() const {
+  // From the engine's cells: no copy of the positions beside it (the whole process's peak).
+  if (!this->kind_.sheared) return engine_.max_overlap_now();
   const StateBlocks<D> state = engine_.state_blocks(false);
   std::vector<double> diameters(this->size());
   state.for_each(
@@ -309,9 +312,8 @@ void EventEngineAdapter<D, Queue>::peculiar_velocities(std::vector<Vec<D>>& c,
     m = s.mass;
     return;
   }
-  // Whole copies of the velocities and masses (32 bytes per particle for the moment of a
-  // thermo row, below the set-up's peak): read in the engine's memory order, twice as fast at
-  // N = 10^6 as two passes over the blocks.
+  // Whole copies of the velocities and masses (32 bytes per particle while they are used): for
+  // the analyses that need every velocity at once; thermo rows use peculiar_kinetic_tensor().
   c = engine_.current_velocities();
   m = engine_.masses();
   Vec<D> mean{};
@@ -322,6 +324,21 @@ void EventEngineAdapter<D, Queue>::peculiar_velocities(std::vector<Vec<D>>& c,
   }
   mean = (1.0 / mass) * mean;
   for (std::size_t i = 0; i < n; ++i) c[i] = c[i] - mean;
+}
+
+// Under shear relative to the flow at each position, from whole copies; otherwise the engine's
+// two passes over its records (no copy: 32 bytes per particle at every thermo row before).
+template <int D, class Queue>
+std::array<double, 9> EventEngineAdapter<D, Queue>::peculiar_kinetic_tensor() const {
+  if (!this->kind_.sheared) return engine_.peculiar_kinetic_tensor();
+  std::vector<Vec<D>> c;
+  std::vector<double> m;
+  peculiar_velocities(c, m);
+  std::array<double, 9> tensor{};
+  for (std::size_t i = 0; i < c.size(); ++i)
+    for (int a = 0; a < D; ++a)
+      for (int b = 0; b < D; ++b) tensor[a * D + b] += m[i] * c[i][a] * c[i][b];
+  return tensor;
 }
 
 template <int D, class Queue>

@@ -6,6 +6,7 @@
 // its neighbours), whatever the queue; EventEngineAdapter<D, Queue> is the adapter itself.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -54,6 +55,9 @@ class EventIntegrator : public Integrator<D> {
   // Every particle's velocity relative to the mean (the centre-of-mass velocity, or under shear
   // the flow at its position) into `c`, and its mass into `m`, in the caller's numbering.
   virtual void peculiar_velocities(std::vector<Vec<D>>& c, std::vector<double>& m) const = 0;
+  // The sum over particles of m c_a c_b (row-major, D x D used) with c as above (the kinetic
+  // part of the pressure tensor times V), without a copy of the whole state where it can.
+  virtual std::array<double, 9> peculiar_kinetic_tensor() const = 0;
   // The unwrapped positions now of the particles with slot[id] != ~0u, into out[slot[id]]
   // (engine/image_counters.hpp; the run keeps image counters when an analysis needs them).
   virtual void unwrapped_positions(const std::vector<std::uint32_t>& slot,
@@ -130,6 +134,7 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   std::uint32_t sleeping() const override { return engine_.sleeping(); }
   const std::vector<SoftTableUse>& tables() const override { return tables_; }
   void peculiar_velocities(std::vector<Vec<D>>& c, std::vector<double>& m) const override;
+  std::array<double, 9> peculiar_kinetic_tensor() const override;
   void unwrapped_positions(const std::vector<std::uint32_t>& slot,
                            std::vector<Vec<D>>& out) const override {
     engine_.unwrapped_positions(slot, out);

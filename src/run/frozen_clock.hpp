@@ -25,9 +25,10 @@
 
 namespace kairos {
 
-// Checks, every window of events, that the window moved the clock by more than round-off, and
-// keeps each particle's collision counter at the start of the window, so that a frozen window
-// can be told apart by who collided in it (describe()).
+// Checks, every window of events, that the window moved the clock by more than round-off. A
+// frozen window is confirmed by a second one that keeps each particle's collision counter at
+// its start, so that the error can name who collided in it (describe()); the counters (4 bytes
+// per particle) are held only for that window.
 class FrozenClockWatch {
  public:
   // A window of 20 events per particle (at least 5 * 10^4): more than any burst of events at
@@ -38,7 +39,7 @@ class FrozenClockWatch {
       : window_(std::max<std::uint64_t>(50000, 20 * static_cast<std::uint64_t>(engine.size()))),
         first_time_(engine.time()),
         first_collisions_(engine.counters().collisions) {
-    start(engine);
+    start(engine, /*keep_counts=*/false);
   }
 
   // After an event: true when the window that ends now advanced the clock by no more than
@@ -57,10 +58,13 @@ class FrozenClockWatch {
     const double advance = time - start_time_;
     const double ulps_per_event =
         advance / (static_cast<double>(window_) * std::abs(time) * 0x1p-52);
-    if (!(advance > 1e-13 * std::abs(time)) || (ulps_per_event < 1e5 && advance < 1e-6 * most_))
-      return true;
+    if (!(advance > 1e-13 * std::abs(time)) || (ulps_per_event < 1e5 && advance < 1e-6 * most_)) {
+      if (!counts_.empty()) return true;  // the second frozen window in a row
+      start(engine, /*keep_counts=*/true);
+      return false;
+    }
     most_ = std::max(most_, advance);
-    start(engine);
+    start(engine, /*keep_counts=*/false);
     return false;
   }
 
@@ -81,12 +85,17 @@ class FrozenClockWatch {
 
  private:
   template <class Engine>
-  void start(const Engine& engine) {
+  void start(const Engine& engine, bool keep_counts) {
     next_ = engine.counters().events + window_;
     start_time_ = engine.time();
     start_wall_collisions_ = engine.counters().wall_collisions;
     start_collisions_ = engine.counters().collisions;
-    counts_ = engine.collision_counts();
+    if (keep_counts) {
+      counts_ = engine.collision_counts();
+    } else {
+      counts_.clear();
+      counts_.shrink_to_fit();
+    }
   }
 
   std::uint64_t window_, next_ = 0;
@@ -95,7 +104,9 @@ class FrozenClockWatch {
   double start_time_ = 0.0;
   double most_ = 0.0;  // the largest advance of a window so far
   std::uint64_t start_wall_collisions_ = 0, start_collisions_ = 0;
-  std::vector<std::uint32_t> counts_;  // per particle (caller's numbering), at the window start
+  // Per particle (caller's numbering), at the start of a window that confirms a frozen one;
+  // empty otherwise.
+  std::vector<std::uint32_t> counts_;
 };
 
 namespace frozen_clock_detail {
@@ -180,8 +191,12 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
   const std::vector<std::uint32_t> now = engine.collision_counts();
   const std::uint64_t wall_hits = engine.counters().wall_collisions - start_wall_collisions_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> busy;  // (collisions, particle)
-  for (std::uint32_t i = 0; i < n; ++i)
-    if (now[i] != counts_[i]) busy.push_back({now[i] - counts_[i], i});
+  // Without counters kept (a run too short for a window that never moved the clock), the
+  // counts since the counters began: since the start of a fresh run.
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const std::uint32_t before = counts_.empty() ? 0u : counts_[i];
+    if (now[i] != before) busy.push_back({now[i] - before, i});
+  }
   std::sort(busy.begin(), busy.end(), [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first > b.first : a.second < b.second;
   });

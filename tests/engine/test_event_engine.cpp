@@ -194,6 +194,51 @@ void expect_current_velocities_exported(const ParticleSystem<D>& start, const En
   }
 }
 
+// max_overlap_now() from the engine's cells against every pair (init's brute force, the
+// nearest image along periodic axes only): the same number, bit for bit, with overlaps placed
+// by hand (the particles moved onto neighbours, across a periodic face too) and after events
+// between walls under gravity (round-off contacts).
+template <int D>
+void expect_max_overlap_now_is_brute_force(ParticleSystem<D> start, const Environment<D>& env,
+                                           int events,
+                                           const std::vector<std::array<int, 3>>& moves) {
+  const double spacing = start.box[0] / std::round(std::pow(start.size(), 1.0 / D));
+  for (const auto& [i, j, percent] : moves) {  // i onto j, `percent` of a spacing along x
+    start.kinematics[i].pos = start.kinematics[j].pos;
+    start.kinematics[i].pos[0] += 0.01 * percent * spacing;
+  }
+  EventEngine<D, CalendarQueue> engine(start, StartMode::kPredict, {}, env);
+  for (int e = 0; e < events; ++e) ASSERT_NE(engine.step(), EventKind::kNone);
+  std::vector<double> diam;
+  for (const auto& k : start.kinematics) diam.push_back(2.0 * k.radius);
+  std::array<bool, D> periodic{};
+  for (int a = 0; a < D; ++a) periodic[a] = env.periodic(a);
+  const double brute =
+      max_overlap_bruteforce<D>(engine.box(), periodic, engine.current_positions(), diam);
+  EXPECT_EQ(engine.max_overlap_now(), brute);
+  if (!moves.empty()) {
+    EXPECT_GT(brute, 0.1 * spacing);
+  }
+}
+
+TEST(EventEngine, MaxOverlapNowIsTheBruteForceOne) {
+  // Overlaps placed by hand, the largest across the periodic face at x = 0 (the last particle
+  // of the first row moved to just below particle 0, the first: wrapped to the high face).
+  expect_max_overlap_now_is_brute_force(testing::lattice_system<3>(6, 0.3, 50), Environment<3>{}, 0,
+                                        {{7, 8, 45}, {5, 0, -40}, {20, 21, 50}});
+  expect_max_overlap_now_is_brute_force(testing::lattice_system<2>(12, 0.3, 51, 0.8, 1.2),
+                                        Environment<2>{}, 0, {{3, 4, 45}, {11, 0, -40}});
+  // Round-off contacts of grains between walls under gravity, the walls' axis bounded.
+  ParticleSystem<3> between = testing::lattice_system<3>(5, 0.15, 52, 1.5, 1.2);
+  for (auto& k : between.kinematics) k.pos[2] += 0.3;
+  Environment<3> walls;
+  walls.faces[4].kind = walls.faces[5].kind = FaceKind::kWall;
+  walls.gravity = {0.0, 0.0, -0.5};
+  expect_max_overlap_now_is_brute_force(between, walls, 20000, {});
+  expect_max_overlap_now_is_brute_force(testing::lattice_system<3>(8, 0.45, 53), Environment<3>{},
+                                        50000, {});
+}
+
 TEST(EventEngine, CurrentVelocitiesAreTheExportedOnes) {
   ParticleSystem<3> between = testing::lattice_system<3>(5, 0.15, 47, 1.5, 1.2);
   for (auto& k : between.kinematics) k.pos[2] += 0.3;  // clear of the walls at z = 0 and z = L

@@ -15,13 +15,7 @@ void PressureTensor<D>::production_starts(const RunContext<D>&) {
 
 template <int D>
 void PressureTensor<D>::sample(const RunContext<D>&) {
-  std::vector<Vec<D>> c;
-  std::vector<double> m;
-  engine_.peculiar_velocities(c, m);
-  std::array<double, 9> sample{};
-  for (std::size_t i = 0; i < c.size(); ++i)
-    for (int a = 0; a < D; ++a)
-      for (int b = 0; b < D; ++b) sample[a * D + b] += m[i] * c[i][a] * c[i][b];
+  const std::array<double, 9> sample = engine_.peculiar_kinetic_tensor();
   for (int k = 0; k < D * D; ++k) kinetic_sum_[k] += sample[k];
   ++samples_;
   const double time = engine_.time();
