@@ -19,6 +19,7 @@
 #include <new>
 #include <optional>
 #include <string>
+#include <system_error>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -50,6 +51,15 @@ void install_signal_handlers() {
   sa.sa_flags = SA_RESETHAND;  // a second signal kills at once
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  // A file size limit (ulimit -f) or a closed pipe on the console would kill the process in
+  // the middle of a write (a torn row, no summary, no restart file). Ignored, the write fails
+  // with EFBIG or EPIPE instead: an output's failure stops the run with every other output
+  // written (docs/guarantees.md); the console's is ignored.
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGXFSZ, &ignore, nullptr);
+  sigaction(SIGPIPE, &ignore, nullptr);
 }
 
 void print_summary(const kairos::RunOutcome& outcome) {
@@ -372,7 +382,11 @@ int main(int argc, char** argv) {
     // run.max_wall_seconds from now on, so that a long table build stops too.
     const kairos::ScopedStopDeadline setup_limit(config.run.max_wall_seconds);
     const kairos::RunOutcome outcome = kairos::run_simulation(config, restart_file, options);
-    print_summary(outcome);
+    try {
+      print_summary(outcome);
+    } catch (const std::system_error&) {
+      // The console is gone (a closed pipe): the outputs are written, the run's status stands.
+    }
     if (!outcome.error.empty()) {
       std::fprintf(stderr, "kairos: error: %s\n", outcome.error.c_str());
       return 2;

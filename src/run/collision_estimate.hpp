@@ -41,11 +41,15 @@ double mean_volume_diameter(double particle_volume, double n) {
 }
 
 // InputError when a phase of `collisions` (its target collision count) would take more than
-// 1e15 units of work, given the work one collision takes (events per collision, or DEM steps
-// per collision).
+// 1e13 units of work, or one collision more than 1e8, given the work one collision takes
+// (events per collision, or DEM steps per collision).
 inline void check_collisions_can_happen(double work_per_collision, double collisions,
                                         const FlightEstimate& flight, const char* unit) {
-  if (!(work_per_collision * collisions > 1e15)) return;
+  // A month and more of events at ~10^7 per second, or a collision that takes 10^8 events
+  // (minutes) however short the run: the largest sensible runs (10^7 particles, 10^4
+  // collisions per particle) take some 10^11 events, a gas at packing fraction 10^-6 some 10^4
+  // events per collision.
+  if (!(work_per_collision * collisions > 1e13) && !(work_per_collision > 1e8)) return;
   throw InputError(fmt::format(
       "the run is measured in collisions, but this system hardly ever collides: the mean free "
       "path is about {:.3g} (mean free time {:.3g}), so each collision takes some {:.3g} {} and "

@@ -223,7 +223,7 @@ Advance EventEngineAdapter<D, Queue>::advance(const AdvanceLimits& limits) {
 
 template <int D, class Queue>
 std::string EventEngineAdapter<D, Queue>::frozen_at_end() const {
-  return watch_.never_moved(engine_) ? watch_.describe(engine_) : std::string();
+  return watch_.frozen_at_end(engine_) ? watch_.describe(engine_) : std::string();
 }
 
 // Without a field (with gravity grains gather far denser than the mean), by the events a

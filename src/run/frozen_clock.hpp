@@ -25,10 +25,15 @@
 
 namespace kairos {
 
-// Checks, every window of events, that the window moved the clock by more than round-off. A
-// frozen window is confirmed by a second one that keeps each particle's collision counter at
-// its start, so that the error can name who collided in it (describe()); the counters (4 bytes
-// per particle) are held only for that window.
+// Two checks on the clock. Every window of events, that the window moved it by more than
+// round-off (or, a collapse creeping, by more than a sliver of what windows moved it before); a
+// frozen window is confirmed by a second. And every sixteenth of a window, how long the clock
+// has stood still beyond round-off: a stall of a quarter window's events (5 per particle, at
+// least 12 500) with a collision per particle is frozen however the windows fall on it (2D
+// collapses at e = 0.1 that round-off resolved again after 23 to 50 events per particle at one
+// instant fell between two windows). Each particle's collision counter is kept (4 bytes per
+// particle) only while a frozen window is being confirmed or a stall has lasted an eighth of a
+// window, so that the error can name who collides (describe()).
 class FrozenClockWatch {
  public:
   // A window of 20 events per particle (at least 5 * 10^4): more than any burst of events at
@@ -39,33 +44,55 @@ class FrozenClockWatch {
       : window_(std::max<std::uint64_t>(50000, 20 * static_cast<std::uint64_t>(engine.size()))),
         first_time_(engine.time()),
         first_collisions_(engine.counters().collisions) {
-    start(engine, /*keep_counts=*/false);
+    start(engine);
+    still_since_ = mark(engine);
+    part_time_ = engine.time();
+    next_part_ = engine.counters().events + part();
   }
 
-  // After an event: true when the window that ends now advanced the clock by no more than
-  // round-off (1e-13 of the time: some 500 ulps, where a valid window moves it by ~20 mean
-  // free times), or, a collapse in progress, when the window moved the clock by less than 1e-6
-  // of the most a window of this run did and its events came less than 10^5 ulps of the clock
-  // apart on average (a 2D gas of 5000 disks at e = 0.1 crawled 6e-8 in 10^5 events at
-  // t = 10.9, 10 ulps per event, after windows of up to 2.3 time units; 100 spheres jammed by a
-  // piston, 1800 ulps per event). Valid runs change their time per event by a few orders of
-  // magnitude at most (a gas compressed or cooling); the ulps guard the rest. One compare per
-  // event.
+  // After an event: true when the clock is frozen. A window (above) is frozen when it advanced
+  // the clock by no more than round-off (1e-13 of the time: some 500 ulps, where a valid window
+  // moves it by ~20 mean free times), or, a collapse in progress, when it moved the clock by
+  // less than 1e-6 of the most a window of this run did and its events came less than 10^5
+  // ulps of the clock apart on average (a 2D gas of 5000 disks at e = 0.1 crawled 6e-8 in 10^5
+  // events at t = 10.9, 10 ulps per event, after windows of up to 2.3 time units; 100 spheres
+  // jammed by a piston, 1800 ulps per event). Valid runs change their time per event by a few
+  // orders of magnitude at most (a gas compressed or cooling); the ulps guard the rest. One
+  // compare per event.
   template <class Engine>
   bool frozen(const Engine& engine) {
+    if (engine.counters().events < next_part_) return false;
+    if (stalled(engine)) return true;
     if (engine.counters().events < next_) return false;
-    const double time = engine.time();
-    const double advance = time - start_time_;
-    const double ulps_per_event =
-        advance / (static_cast<double>(window_) * std::abs(time) * 0x1p-52);
-    if (!(advance > 1e-13 * std::abs(time)) || (ulps_per_event < 1e5 && advance < 1e-6 * most_)) {
-      if (!counts_.empty()) return true;  // the second frozen window in a row
-      start(engine, /*keep_counts=*/true);
+    if (window_frozen(engine.time(), window_)) {
+      if (counting_ == Counting::kWindow) {  // the second frozen window in a row
+        report_ = window_start();
+        return true;
+      }
+      start(engine);
+      keep_counts(engine, Counting::kWindow);
       return false;
     }
-    most_ = std::max(most_, advance);
-    start(engine, /*keep_counts=*/false);
+    most_ = std::max(most_, engine.time() - start_time_);
+    start(engine);
+    if (counting_ == Counting::kWindow) drop_counts();
     return false;
+  }
+
+  // At the end of a run: the clock never moved since the watch began (never_moved); or a
+  // window was found frozen and the one confirming it, cut short by the end, is frozen too so
+  // far (a collapse the run's length ended would otherwise be "completed" at a frozen time).
+  template <class Engine>
+  bool frozen_at_end(const Engine& engine) const {
+    const std::uint64_t events = engine.counters().events - (next_ - window_);
+    if (never_moved(engine) ||
+        (counting_ == Counting::kWindow && events > 0 && window_frozen(engine.time(), events))) {
+      report_ = window_start();
+      return true;
+    }
+    if (!stands_still(engine.time(), part_time_) || !stall_long(engine)) return false;
+    report_ = still_since_;
+    return true;
   }
 
   // At the end of a run too short for a whole window: true when it made collisions (at least
@@ -78,24 +105,80 @@ class FrozenClockWatch {
            engine.time() == first_time_;
   }
 
-  // The error message for a frozen window: where the clock stopped, who collided in the window
-  // and against which walls, and the remedies.
+  // The error message for what frozen() or frozen_at_end() found: where the clock stopped, who
+  // collided since it stopped (or in the frozen window) and against which walls, the remedies.
   template <class Engine>
   std::string describe(const Engine& engine) const;
 
  private:
+  // Where a span of events began.
+  struct Mark {
+    std::uint64_t events = 0, collisions = 0, wall_collisions = 0;
+    double time = 0.0;
+  };
   template <class Engine>
-  void start(const Engine& engine, bool keep_counts) {
+  static Mark mark(const Engine& engine) {
+    const auto& c = engine.counters();
+    return {c.events, c.collisions, c.wall_collisions, engine.time()};
+  }
+  Mark window_start() const {
+    return {next_ - window_, start_collisions_, start_wall_collisions_, start_time_};
+  }
+  static bool stands_still(double time, double since) {
+    return !(time - since > 1e-13 * std::abs(time));
+  }
+  std::uint64_t part() const { return std::max<std::uint64_t>(1, window_ / 16); }
+  // A stall long enough to be frozen: a quarter window of events, a collision per particle.
+  template <class Engine>
+  bool stall_long(const Engine& engine) const {
+    return engine.counters().events - still_since_.events >= window_ / 4 &&
+           engine.counters().collisions - still_since_.collisions >=
+               std::max<std::uint64_t>(2, engine.size());
+  }
+
+  // Every sixteenth of a window: the stall check.
+  template <class Engine>
+  bool stalled(const Engine& engine) {
+    const double time = engine.time();
+    if (!stands_still(time, part_time_)) {
+      still_since_ = mark(engine);
+      if (counting_ == Counting::kStall) drop_counts();
+    }
+    part_time_ = time;
+    next_part_ = engine.counters().events + part();
+    if (counting_ == Counting::kNone &&
+        engine.counters().events - still_since_.events >= window_ / 8)
+      keep_counts(engine, Counting::kStall);
+    if (!stall_long(engine)) return false;
+    report_ = still_since_;
+    return true;
+  }
+
+  // Whether a window of `events` events that ends at `time` left the clock frozen (frozen()).
+  bool window_frozen(double time, std::uint64_t events) const {
+    const double advance = time - start_time_;
+    const double ulps_per_event =
+        advance / (static_cast<double>(events) * std::abs(time) * 0x1p-52);
+    return !(advance > 1e-13 * std::abs(time)) || (ulps_per_event < 1e5 && advance < 1e-6 * most_);
+  }
+
+  template <class Engine>
+  void start(const Engine& engine) {
     next_ = engine.counters().events + window_;
     start_time_ = engine.time();
     start_wall_collisions_ = engine.counters().wall_collisions;
     start_collisions_ = engine.counters().collisions;
-    if (keep_counts) {
-      counts_ = engine.collision_counts();
-    } else {
-      counts_.clear();
-      counts_.shrink_to_fit();
-    }
+  }
+  enum class Counting { kNone, kWindow, kStall };
+  template <class Engine>
+  void keep_counts(const Engine& engine, Counting why) {
+    counts_ = engine.collision_counts();
+    counting_ = why;
+  }
+  void drop_counts() {
+    counts_.clear();
+    counts_.shrink_to_fit();
+    counting_ = Counting::kNone;
   }
 
   std::uint64_t window_, next_ = 0;
@@ -104,9 +187,16 @@ class FrozenClockWatch {
   double start_time_ = 0.0;
   double most_ = 0.0;  // the largest advance of a window so far
   std::uint64_t start_wall_collisions_ = 0, start_collisions_ = 0;
-  // Per particle (caller's numbering), at the start of a window that confirms a frozen one;
-  // empty otherwise.
+  // Per particle (caller's numbering), since a frozen window's confirmation began or a stall
+  // reached an eighth of a window; empty otherwise.
   std::vector<std::uint32_t> counts_;
+  Counting counting_ = Counting::kNone;
+  // Sixteenths of a window: the next one's end, the time at the last one's, and where the
+  // clock last moved beyond round-off.
+  std::uint64_t next_part_ = 0;
+  double part_time_ = 0.0;
+  Mark still_since_;
+  mutable Mark report_;  // the span describe() reports
 };
 
 namespace frozen_clock_detail {
@@ -189,7 +279,7 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
   constexpr int D = std::tuple_size_v<std::remove_cvref_t<decltype(engine.box())>>;
   const std::size_t n = engine.size();
   const std::vector<std::uint32_t> now = engine.collision_counts();
-  const std::uint64_t wall_hits = engine.counters().wall_collisions - start_wall_collisions_;
+  const std::uint64_t wall_hits = engine.counters().wall_collisions - report_.wall_collisions;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> busy;  // (collisions, particle)
   // Without counters kept (a run too short for a window that never moved the clock), the
   // counts since the counters began: since the start of a fresh run.
@@ -230,15 +320,15 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
     const double inward = (f % 2 == 0 ? 1.0 : -1.0) * env.faces[f].wall.velocity[f / 2];
     if (inward > 0.0) pistons += (pistons.empty() ? "" : ", ") + face_name(f);
   }
-  const std::uint64_t events = engine.counters().events - (next_ - window_);
-  const double advance = engine.time() - start_time_;
+  const std::uint64_t events = engine.counters().events - report_.events;
+  const double advance = engine.time() - report_.time;
   std::string message = fmt::format(
       "the simulated clock is frozen at t = {:.17g}: the last {} events ({:.3g} per particle) "
       "moved it by {:.3g}",
       engine.time(), events, static_cast<double>(events) / static_cast<double>(n), advance);
   if (most_ > 0.0) message += fmt::format(" (earlier windows as long: up to {:.3g})", most_);
   if (busy.empty()) return message + "; no particle collided";
-  const std::uint64_t pair_hits = engine.counters().collisions - start_collisions_;
+  const std::uint64_t pair_hits = engine.counters().collisions - report_.collisions;
   const std::string cause = frozen_clock_detail::cause(env, walls, pair_hits, wall_hits, pistons);
   message += fmt::format(
       "; particle{} {} collide{} again and again{}{}: {}", busy.size() == 1 ? "" : "s", who,

@@ -1,6 +1,7 @@
 #include "run/run_driver.hpp"
 
 #include <sys/resource.h>
+#include <cstdio>
 
 #include <algorithm>
 #include <cmath>
@@ -48,7 +49,8 @@ RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& res
   integrator_ = start_integrator<D>(std::move(start), [&](const std::string& contact, double) {
     if (tell && contact != building) {
       building = contact;
-      fmt::print(stderr, "building the soft-contact map table of {} ...\n", contact);
+      std::fputs(fmt::format("building the soft-contact map table of {} ...\n", contact).c_str(),
+                 stderr);
     }
   });
   timed_ =
@@ -147,7 +149,13 @@ RunOutcome RunDriver<D>::run() {
     write_text_atomically(directory_->path() / "summary.json", outcome.summary.dump(2) + "\n");
   });
   // failures_.error now ends with the summary's failure (error_ holds the earlier ones).
-  if (failures_.failed_file("summary.json")) outcome.error = with_outputs();
+  if (failures_.failed_file("summary.json")) {
+    outcome.error = with_outputs();
+    // What the console lists is what the directory holds: the summary is not among it.
+    nlohmann::json& listed = outcome.summary["outputs"];
+    listed.erase(std::remove(listed.begin(), listed.end(), nlohmann::json("summary.json")),
+                 listed.end());
+  }
   return outcome;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 
 #include <fmt/format.h>
 
@@ -185,7 +186,8 @@ InputError restart_setup_error(const InputError& e, const fs::path& restart_file
 void print_restart_note(const RestartPlan& plan, const std::string& restart_file) {
   const std::string note = describe_restart(plan, restart_file);
   if (!note.empty())
-    fmt::print(stderr, "kairos: note: restart from '{}': {}\n", restart_file, note);
+    std::fputs(fmt::format("kairos: note: restart from '{}': {}\n", restart_file, note).c_str(),
+               stderr);
 }
 
 #define KAIROS_SETUP_CHAIN(D)                                                             \

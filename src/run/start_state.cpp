@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -94,7 +95,8 @@ void check_soft_overlaps(const InitialState<D>& init, const std::array<bool, D>&
 // them: every distance grows by that factor, the packing fraction shrinks by ~1e-7 relative, less
 // than the file's precision. Larger overlaps are left for check_no_overlap to report.
 template <int D>
-void expand_away_rounding_overlaps(InitialState<D>& init, const std::array<bool, D>& periodic) {
+double expand_away_rounding_overlaps(InitialState<D>& init, const std::array<bool, D>& periodic) {
+  double total = 1.0;  // the factor applied, returned
   double edge = 0.0;
   for (int a = 0; a < D; ++a) edge = std::max(edge, init.box[a]);
   double smallest = std::numeric_limits<double>::infinity();
@@ -104,10 +106,11 @@ void expand_away_rounding_overlaps(InitialState<D>& init, const std::array<bool,
   for (int attempt = 0; attempt < 8; ++attempt) {
     const double worst = max_overlap<D>(init.box, periodic, init.position, init.diameter, nullptr,
                                         nullptr, /*interruptible=*/true);
-    if (worst == 0.0 || worst > tolerance) return;
+    if (worst == 0.0 || worst > tolerance) return total;
     // Every overlapping pair has r >= sigma - worst with sigma >= smallest.
     const double factor =
         (1.0 + 8.0 * std::numeric_limits<double>::epsilon()) / (1.0 - worst / smallest);
+    total *= factor;
     for (int a = 0; a < D; ++a) init.box[a] *= factor;
     for (auto& x : init.position) {
       for (int a = 0; a < D; ++a) {
@@ -117,21 +120,32 @@ void expand_away_rounding_overlaps(InitialState<D>& init, const std::array<bool,
       }
     }
   }
+  return total;
 }
 
-// True when the last frame of a GSD file holds Kairos' float64 positions (a restart file).
+// True when the last frame of a GSD file holds float64 positions: Kairos' own (a restart file)
+// or HOOMD's particles/position written in float64 (the schema's float32 is not enforced by
+// every writer). Contacts are then exact to round-off of doubles (1e-12 relative), not floats.
 bool holds_exact_positions(const fs::path& path) {
   const gsd::Reader r(path);
-  return r.frame_count() > 0 && r.find(r.frame_count() - 1, "kairos/position").has_value();
+  if (r.frame_count() == 0) return false;
+  const std::uint64_t last = r.frame_count() - 1;
+  if (r.find(last, "kairos/position").has_value()) return true;
+  const auto position = r.find(last, "particles/position");
+  const auto first = r.find(0, "particles/position");  // a frame may inherit frame 0's
+  const auto& info = position ? position : first;
+  return info.has_value() && info->type == gsd::Type::float64;
 }
 
 // When the state comes from a file, the generating keys do not apply; say so if they disagree.
 void note_ignored_system_keys(const Config& config, std::size_t n, const std::string& source) {
   if (config.system.particles != 0 && config.system.particles != n) {
-    fmt::print(stderr,
-               "kairos: note: {} holds {} particles; system.particles = {} and the other "
-               "generating keys (packing_fraction, lattice, species) are not used\n",
-               source, n, config.system.particles);
+    std::fputs(
+        fmt::format("kairos: note: {} holds {} particles; system.particles = {} and the other "
+                    "generating keys (packing_fraction, lattice, species) are not used\n",
+                    source, n, config.system.particles)
+            .c_str(),
+        stderr);
   }
 }
 
@@ -187,8 +201,17 @@ ParticleSystem<D> build_start_state(const Config& config,
     InitialState<D> init = read_initial_state<D>(path, has_velocities, kind);
     const std::array<bool, D> periodic = periodic_axes<D>(config);
     const bool exact = holds_exact_positions(path);
-    if (!exact) expand_away_rounding_overlaps<D>(init, periodic);
     const std::string source = "system.initial_state '" + path.string() + "'";
+    if (!exact) {
+      const double factor = expand_away_rounding_overlaps<D>(init, periodic);
+      if (factor != 1.0) {
+        std::fputs(fmt::format("kairos: note: {}: the box and the positions were scaled by 1 + "
+                               "{:.3g} to clear overlaps within its float32 round-off\n",
+                               source, factor - 1.0)
+                       .c_str(),
+                   stderr);
+      }
+    }
     if (config.soft.enabled() && kind == RunKind::kDem) {
       check_soft_overlaps<D>(init, periodic, source);
     } else if (config.soft.enabled()) {

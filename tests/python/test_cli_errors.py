@@ -426,6 +426,34 @@ class InitialStateErrors(kt.KairosTestCase):
         self.assert_user_error(result, "claim.gsd", "particles/N = 50000000",
                                "'particles/position' holds 2 x 3 values")
 
+    def write_pair(self, name, dtype, gap):
+        """Two unit spheres along x at centre distance 1 + gap, positions stored as dtype."""
+        p = self.path(name)
+        with gsd.fl.open(name=p, mode="wb", application="test", schema="hoomd",
+                         schema_version=[1, 4]) as f:
+            f.write_chunk("configuration/box", np.array([10, 10, 10, 0, 0, 0], np.float32))
+            f.write_chunk("particles/N", np.array([2], np.uint32))
+            f.write_chunk("particles/position",
+                          np.array([[-0.5, 0.1, 0.1], [0.5 + gap, 0.1, 0.1]], dtype))
+            f.end_frame()
+        return p
+
+    def test_float64_positions_hold_contacts_to_double_round_off(self):
+        # A HOOMD file in float64 with a real overlap of 3e-6 used to be scaled away silently
+        # as float32 round-off; float64 contacts are exact to 1e-12 of the diameter.
+        self.run_from(self.write_pair("f64.gsd", np.float64, -3e-6), 3, "f64.gsd",
+                      "particles 0 and 1 overlap by 3e-06")
+        # An overlap within float32 round-off of a float32 file is cleared, and said so.
+        p = self.write_pair("f32.gsd", np.float32, -3e-7)
+        config = kt.base_config(production=1.0)
+        config["system"] = {"dimension": 3, "initial_state": p}
+        result = self.run_ok("run", self.write_config(config, "f32.toml"), "-o", self.path("o32"))
+        self.assertIn("scaled by 1 +", result.stderr)
+        self.assertIn("float32 round-off", result.stderr)
+        # float64 contacts within 1e-12 are contacts.
+        config["system"]["initial_state"] = self.write_pair("touch.gsd", np.float64, -1e-14)
+        self.run_ok("run", self.write_config(config, "touch.toml"), "-o", self.path("touch"))
+
     def test_tilted_box(self):
         # A triclinic box used to run as the rectangular box of its edges, without a word.
         p = kt.write_hoomd_file(self.path("tilted.gsd"), [[0, 0, 0], [2, 2, 2]], [10, 10, 10],

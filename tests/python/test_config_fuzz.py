@@ -13,7 +13,7 @@ unit; keys a mutation set are left alone) and runs `kairos run`. Every case must
 
 within a per-case time limit: never a signal, a hang, a timeout or an internal error (exit 3).
 
-    KAIROS_FUZZ_CASES=N   number of cases (default 150; 40 under the sanitizers, whose binary
+    KAIROS_FUZZ_CASES=N   number of cases (default 300; 80 under the sanitizers, whose binary
                           is 3-5x slower: ctest sets KAIROS_SANITIZED=1 there)
     KAIROS_FUZZ_SEED=S    the first case's seed (default 2026); case k uses S + k
 
@@ -31,7 +31,7 @@ import tomllib
 
 import kairos_testlib as kt
 
-CASES = int(os.environ.get("KAIROS_FUZZ_CASES", "40" if kt.SANITIZED else "150"))
+CASES = int(os.environ.get("KAIROS_FUZZ_CASES", "80" if kt.SANITIZED else "300"))
 SEED = int(os.environ.get("KAIROS_FUZZ_SEED", "2026"))
 CASE_TIMEOUT = 20.0 * kt.SLOWDOWN
 

@@ -92,6 +92,17 @@ class FrozenClock(kt.KairosTestCase):
         self.run_ok("run", self.write_config(config, "tc.toml"), "-o", self.path("tc"),
                     timeout=600)
 
+    def test_collapses_that_round_off_resolves_between_two_windows(self):
+        # 1000 disks at e = 0.1: clusters collapse, 23 to 50 events per particle at one
+        # instant, and round-off separates them again before a whole window of the watch has
+        # stood still (seeds 2 and 3 "completed" with such stalls; 8 seeds of 8 are caught now).
+        for seed in (2, 3):
+            config = kt.base_config(dimension=2, particles=1000, packing_fraction=0.25,
+                                    lattice="random", seed=seed, production=3000.0)
+            config["contact"] = {"restitution": 0.1}
+            line, s = self.frozen_run(config, "inelastic collapse", "at one instant")
+            self.assertIn("moved it by 0", line)
+
     def test_elastic_spheres_jammed_on_a_touching_lattice(self):
         # A simple cubic lattice at its close packing: every sphere touches its six neighbours
         # and none can move; elastic, so no TC model or slow-impact rule applies.
@@ -196,6 +207,16 @@ class NeverCollides(kt.KairosTestCase):
         config["run"] = {"equilibration_time": 0.0, "time": 10.0}
         self.run_ok("run", self.write_config(config, "timed.toml"), "-o", out, timeout=30)
         self.assertEqual(self.summary(out)["collisions"], 0)
+
+    def test_one_collision_of_a_short_run_would_take_for_ever(self):
+        # Two particles in a box of 10^6: one collision per particle is ~10^14 events (it used
+        # to run until killed: refused only beyond 10^15 events in all).
+        config = kt.base_config(particles=2, packing_fraction=1e-3, lattice="random",
+                                production=1.0)
+        config["system"]["box_scale"] = [1e6, 1e6, 1e6]
+        result = self.kairos("run", self.write_config(config), "-o", self.path("out"),
+                             timeout=30)
+        self.assert_user_error(result, "hardly ever collides", "events")
 
 
 if __name__ == "__main__":

@@ -129,7 +129,8 @@ class FailedWrites(kt.KairosTestCase):
         limit = 400000
 
         def limit_file_size():
-            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # write() then fails with EFBIG
+            # SIGXFSZ left at its default (subprocess restores it): kairos ignores it itself,
+            # so that write() fails with EFBIG instead of the signal killing the process.
             resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 
         out = self.path("out")
@@ -242,6 +243,27 @@ class FailedWrites(kt.KairosTestCase):
         self.assertEqual(line.count("thermo.tsv"), 1, line)
         self.assertEqual(line.count("summary.json"), 1, line)
         self.assertLess(line.index("thermo.tsv"), line.index("summary.json"), line)
+        # The console lists what the directory holds: not the summary that failed.
+        listed = [l for l in result.stdout.splitlines() if l.strip().startswith("outputs")]
+        self.assertEqual(len(listed), 1, result.stdout)
+        self.assertNotIn("summary.json", listed[0])
+        self.assertIn("restart.gsd", listed[0])
+
+
+class ClosedConsole(kt.KairosTestCase):
+    def test_a_closed_console_does_not_stop_the_run(self):
+        # `kairos run ... | head`: the console's pipe closes; the run used to die of SIGPIPE at
+        # its next line (no summary.json when that was a progress line). Kairos ignores
+        # SIGPIPE (subprocess restores its default in the child, so this tests kairos's own).
+        config = kt.base_config(particles=500, packing_fraction=0.3, production=50.0)
+        config["output"]["progress"] = "always"
+        out = self.path("out")
+        proc = subprocess.Popen([kt.KAIROS, "run", self.write_config(config), "-o", out],
+                                cwd=self.tmp, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        proc.stdout.close()
+        proc.stderr.close()
+        self.assertEqual(proc.wait(timeout=300), 0)
+        self.assertEqual(self.summary(out)["stop_reason"], "completed")
 
 
 class OutputDirectories(kt.KairosTestCase):
