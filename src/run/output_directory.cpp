@@ -18,6 +18,7 @@
 
 #include "core/error.hpp"
 #include "io/gsd_file.hpp"
+#include "run/outputs/registry.hpp"
 
 namespace kairos {
 
@@ -26,8 +27,6 @@ namespace fs = std::filesystem;
 namespace {
 
 // What a run writes into its directory (config.toml is only a description: not guarded).
-constexpr std::array<const char*, 5> kOutputs = {"summary.json", "thermo.tsv", "trajectory.gsd",
-                                                 "restart.gsd", "profile.tsv"};
 
 std::string holder_of(int fd) {
   char text[32] = {};
@@ -111,11 +110,11 @@ OutputDirectory::OutputDirectory(const fs::path& dir,
     // The pid only makes the message of a refused second run nicer.
   }
   std::string found;
-  for (const char* name : kOutputs)
-    if (fs::exists(dir / name, ec)) found += (found.empty() ? "" : ", ") + std::string(name);
+  for (const std::string& name : output_file_names())
+    if (fs::exists(dir / name, ec)) found += (found.empty() ? "" : ", ") + name;
   if (found.empty()) return;
   const auto remove_outputs = [&] {
-    for (const char* name : kOutputs) {
+    for (const std::string& name : output_file_names()) {
       // The restart file being continued stays until the continued run replaces it.
       if (continuing && fs::equivalent(dir / name, continuing->restart_file, ec)) continue;
       fs::remove(dir / name, ec);

@@ -298,6 +298,26 @@ class OutputDirectories(kt.KairosTestCase):
         self.run_ok("run", cfg, "-o", out, "--overwrite")
         self.assertFalse(self.summary(out)["restarted"])
 
+    def test_an_earlier_runs_analysis_files_are_outputs_too(self):
+        # An analysis file alone (msd.tsv) is an earlier run's output: kept unless --overwrite,
+        # which removes it with the rest, so that no stale helfand.tsv or msd.tsv lies beside
+        # a new run's files (the guard used to know the five files of the first outputs only).
+        config = kt.base_config(production=20.0)
+        config["analysis"] = {"msd": True, "transport": True}
+        out = self.path("out")
+        self.run_ok("run", self.write_config(config), "-o", out)
+        for name in os.listdir(out):
+            if name not in ("msd.tsv", "helfand.tsv", ".kairos.lock"):
+                os.remove(os.path.join(out, name))
+        del config["analysis"]
+        plain = self.write_config(config, "plain.toml")
+        result = self.kairos("run", plain, "-o", out)
+        self.assert_user_error(result, "holds the outputs of an earlier run", "msd.tsv",
+                               "--overwrite")
+        self.run_ok("run", plain, "-o", out, "--overwrite")
+        self.assertFalse(os.path.exists(os.path.join(out, "msd.tsv")))
+        self.assertFalse(os.path.exists(os.path.join(out, "helfand.tsv")))
+
 
 if __name__ == "__main__":
     kt.main()

@@ -75,6 +75,23 @@ ObserverList<D> make_observers(const Config& config, const Integrator<D>& integr
   return list;
 }
 
+const std::vector<std::string>& output_file_names() {
+  static const std::vector<std::string> names = {"summary.json",
+                                                 "thermo.tsv",
+                                                 "trajectory.gsd",
+                                                 "restart.gsd",
+                                                 "profile.tsv",
+                                                 "helfand.tsv",
+                                                 "green_kubo.tsv",
+                                                 "msd.tsv",
+                                                 "vacf.tsv",
+                                                 "rdf.tsv",
+                                                 "sk.tsv",
+                                                 "bond_order.tsv",
+                                                 "velocity_distribution.tsv"};
+  return names;
+}
+
 template ObserverList<2> make_observers<2>(const Config&, const Integrator<2>&);
 template ObserverList<3> make_observers<3>(const Config&, const Integrator<3>&);
 

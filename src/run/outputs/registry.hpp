@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "io/config.hpp"
@@ -18,5 +19,11 @@ using ObserverList = std::vector<std::unique_ptr<Observer<D>>>;
 // The observers of a run of `config` by `integrator` (which they read; it outlives them).
 template <int D>
 ObserverList<D> make_observers(const Config& config, const Integrator<D>& integrator);
+
+// Every file an output or analysis of make_observers may write into the output directory,
+// whatever the configuration (an earlier run's may have had others): the files the
+// directory's guard refuses to clobber and --overwrite removes (run/output_directory.cpp). A
+// new output adds its file here (a test checks the list against a run with every output on).
+const std::vector<std::string>& output_file_names();
 
 }  // namespace kairos
