@@ -54,11 +54,13 @@ class CellNeighbourhood {
   // instead of walking them one by one; the same candidates, in another order.
   CellNeighbourhood(const CellGrid<D>& grid, bool vector_gather)
       : grid_(grid), vector_gather_(vector_gather) {
-    for (CandidateList<D>& list : lists_) {
-      list.ids.resize(256);
-      list.shift.resize(256);
-      list.delayed.resize(256 + 8);
-    }
+    for (CandidateList<D>& list : lists_) size_list(list);
+  }
+  // A list's first storage (grow() doubles it when a neighbourhood is crowded).
+  static void size_list(CandidateList<D>& list) {
+    list.ids.resize(256);
+    list.shift.resize(256);
+    list.delayed.resize(256 + 8);
   }
 
   CellGrid<D>& grid() { return grid_; }

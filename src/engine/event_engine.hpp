@@ -449,6 +449,7 @@ class EventEngine {
   // Built at the first output of a moment (4 bytes per particle), kept until the next
   // renumbering or release_block_order().
   const BlockOrder& block_order() const;
+  Vec<D> wrapped_position_now(std::uint32_t k) const;
   mutable std::shared_ptr<const BlockOrder> block_order_;
   void size_particle_arrays(ParticleSystem<D>& out, std::size_t n) const;
   void export_particle(std::uint32_t k, std::uint32_t c, ParticleSystem<D>& out,

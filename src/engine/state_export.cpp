@@ -19,6 +19,16 @@ namespace {
 constexpr std::uint32_t kNoPartner = EventSlot::kNoPartner;
 }  // namespace
 
+// Particle k's position now, wrapped into the box along the periodic axes: what outputs and
+// the overlap check read.
+template <int D, class Queue>
+Vec<D> EventEngine<D, Queue>::wrapped_position_now(std::uint32_t k) const {
+  Vec<D> x = position(k, time_);
+  for (int a = 0; a < D; ++a)
+    if (cells_.grid().periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
+  return x;
+}
+
 template <int D, class Queue>
 ParticleSystem<D> EventEngine<D, Queue>::export_state(bool with_zones) const {
   const std::size_t n = size();
@@ -183,12 +193,7 @@ void EventEngine<D, Queue>::velocities(const std::vector<std::uint32_t>& slot,
 template <int D, class Queue>
 std::vector<Vec<D>> EventEngine<D, Queue>::current_positions() const {
   std::vector<Vec<D>> out(size());
-  for (std::uint32_t i = 0; i < size(); ++i) {
-    Vec<D> x = position(i, time_);
-    for (int a = 0; a < D; ++a)
-      if (cells_.grid().periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
-    out[id_[i]] = x;
-  }
+  for (std::uint32_t i = 0; i < size(); ++i) out[id_[i]] = wrapped_position_now(i);
   return out;
 }
 
@@ -204,11 +209,7 @@ void EventEngine<D, Queue>::for_each_block(const BlockVisitor& f, bool with_posi
     for (std::uint32_t e = order.start[b]; e < order.start[b + 1]; ++e) {
       const std::uint32_t k = order.members[e];
       const std::size_t j = id_[k] - first;
-      if (with_positions) {
-        x[j] = position(k, time_);  // as current_positions()
-        for (int a = 0; a < D; ++a)
-          if (cells_.grid().periodic(a)) x[j][a] = wrap_into_box(x[j][a], box_[a]);
-      }
+      if (with_positions) x[j] = wrapped_position_now(k);
       v[j] = velocity(k, time_);
       m[j] = mass_of(k);
     }
@@ -219,33 +220,19 @@ void EventEngine<D, Queue>::for_each_block(const BlockVisitor& f, bool with_posi
 template <int D, class Queue>
 double EventEngine<D, Queue>::max_overlap_now() const {
   if (sheared_) throw std::logic_error("max_overlap_now: the images of a sheared box slide");
-  const CellGrid<D>& grid = cells_.grid();
-  const auto wrapped = [&](std::uint32_t k) {
-    Vec<D> x = position(k, time_);
-    for (int a = 0; a < D; ++a)
-      if (grid.periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
-    return x;
-  };
+  std::array<bool, D> periodic{};
+  for (int a = 0; a < D; ++a) periodic[a] = cells_.grid().periodic(a);
   CandidateList list;
-  list.ids.resize(256);
-  list.shift.resize(256);
-  list.delayed.resize(256 + 8);
+  Cells::size_list(list);
   double worst = 0.0;
   for (std::uint32_t i = 0; i < size(); ++i) {
     cells_.gather(hot_[i].cell, list, hot_.data());
-    const Vec<D> xi = wrapped(i);
+    const Vec<D> xi = wrapped_position_now(i);
     for (std::uint32_t c = 0; c < list.count; ++c) {
       const std::uint32_t j = list.ids[c];
       if (j <= i) continue;  // each pair once (a small grid may list a cell twice: no matter)
-      const Vec<D> xj = wrapped(j);
-      double r2 = 0.0;
-      for (int a = 0; a < D; ++a) {
-        double dx = xi[a] - xj[a];
-        if (grid.periodic(a)) dx = minimum_image(dx, box_[a]);
-        r2 += dx * dx;
-      }
-      const double sigma = radius_of(i) + radius_of(j);
-      if (r2 < sigma * sigma) worst = std::max(worst, sigma - std::sqrt(r2));
+      worst = std::max(worst, pair_overlap<D>(box_, xi, wrapped_position_now(j), 2.0 * radius_of(i),
+                                              2.0 * radius_of(j), &periodic));
     }
   }
   return worst;

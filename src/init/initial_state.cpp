@@ -111,23 +111,6 @@ double box_volume(const std::array<double, D>& box) {
   return v;
 }
 
-// sigma_ij - r_ij under the minimum image convention when positive, else 0. Shared by the cell
-// and the brute-force search so that both give bit-identical values.
-template <int D>
-double pair_overlap(const std::array<double, D>& box, const std::array<double, D>& a,
-                    const std::array<double, D>& b, double da, double db,
-                    const std::array<bool, D>* periodic = nullptr) {
-  double r2 = 0.0;
-  for (int k = 0; k < D; ++k) {
-    double dx = a[k] - b[k];
-    if (periodic == nullptr || (*periodic)[k]) dx = minimum_image(dx, box[k]);
-    r2 += dx * dx;
-  }
-  const double sigma = 0.5 * (da + db);
-  if (!(r2 < sigma * sigma)) return 0.0;
-  return std::max(0.0, sigma - std::sqrt(r2));
-}
-
 // A periodic grid of cells at least `min_width` wide along every axis (at least one cell per
 // axis), with the total number of cells capped near `max_cells` by widening the cells.
 // Particles are kept in per-cell linked lists.

@@ -42,10 +42,9 @@ class FrozenClockWatch {
   template <class Engine>
   explicit FrozenClockWatch(const Engine& engine)
       : window_(std::max<std::uint64_t>(50000, 20 * static_cast<std::uint64_t>(engine.size()))),
-        first_time_(engine.time()),
-        first_collisions_(engine.counters().collisions) {
-    start(engine);
-    still_since_ = mark(engine);
+        window_start_(mark(engine)),
+        first_(window_start_) {
+    still_since_ = window_start_;
     part_time_ = engine.time();
     next_part_ = engine.counters().events + part();
   }
@@ -63,18 +62,18 @@ class FrozenClockWatch {
   bool frozen(const Engine& engine) {
     if (engine.counters().events < next_part_) return false;
     if (stalled(engine)) return true;
-    if (engine.counters().events < next_) return false;
+    if (engine.counters().events < window_start_.events + window_) return false;
     if (window_frozen(engine.time(), window_)) {
       if (counting_ == Counting::kWindow) {  // the second frozen window in a row
-        report_ = window_start();
+        report_ = window_start_;
         return true;
       }
-      start(engine);
+      window_start_ = mark(engine);
       keep_counts(engine, Counting::kWindow);
       return false;
     }
-    most_ = std::max(most_, engine.time() - start_time_);
-    start(engine);
+    most_ = std::max(most_, engine.time() - window_start_.time);
+    window_start_ = mark(engine);
     if (counting_ == Counting::kWindow) drop_counts();
     return false;
   }
@@ -84,10 +83,10 @@ class FrozenClockWatch {
   // far (a collapse the run's length ended would otherwise be "completed" at a frozen time).
   template <class Engine>
   bool frozen_at_end(const Engine& engine) const {
-    const std::uint64_t events = engine.counters().events - (next_ - window_);
+    const std::uint64_t events = engine.counters().events - window_start_.events;
     if (never_moved(engine) ||
         (counting_ == Counting::kWindow && events > 0 && window_frozen(engine.time(), events))) {
-      report_ = window_start();
+      report_ = window_start_;
       return true;
     }
     if (!stands_still(engine.time(), part_time_) || !stall_long(engine)) return false;
@@ -100,9 +99,9 @@ class FrozenClockWatch {
   // its collisions at one instant, its pressure undefined).
   template <class Engine>
   bool never_moved(const Engine& engine) const {
-    const std::uint64_t collisions = engine.counters().collisions - first_collisions_;
+    const std::uint64_t collisions = engine.counters().collisions - first_.collisions;
     return collisions >= std::max<std::uint64_t>(2, engine.size() / 100) &&
-           engine.time() == first_time_;
+           engine.time() == first_.time;
   }
 
   // The error message for what frozen() or frozen_at_end() found: where the clock stopped, who
@@ -120,9 +119,6 @@ class FrozenClockWatch {
   static Mark mark(const Engine& engine) {
     const auto& c = engine.counters();
     return {c.events, c.collisions, c.wall_collisions, engine.time()};
-  }
-  Mark window_start() const {
-    return {next_ - window_, start_collisions_, start_wall_collisions_, start_time_};
   }
   static bool stands_still(double time, double since) {
     return !(time - since > 1e-13 * std::abs(time));
@@ -156,19 +152,12 @@ class FrozenClockWatch {
 
   // Whether a window of `events` events that ends at `time` left the clock frozen (frozen()).
   bool window_frozen(double time, std::uint64_t events) const {
-    const double advance = time - start_time_;
+    const double advance = time - window_start_.time;
     const double ulps_per_event =
         advance / (static_cast<double>(events) * std::abs(time) * 0x1p-52);
     return !(advance > 1e-13 * std::abs(time)) || (ulps_per_event < 1e5 && advance < 1e-6 * most_);
   }
 
-  template <class Engine>
-  void start(const Engine& engine) {
-    next_ = engine.counters().events + window_;
-    start_time_ = engine.time();
-    start_wall_collisions_ = engine.counters().wall_collisions;
-    start_collisions_ = engine.counters().collisions;
-  }
   enum class Counting { kNone, kWindow, kStall };
   template <class Engine>
   void keep_counts(const Engine& engine, Counting why) {
@@ -181,12 +170,10 @@ class FrozenClockWatch {
     counting_ = Counting::kNone;
   }
 
-  std::uint64_t window_, next_ = 0;
-  double first_time_;  // when the watch began, and its collision count then
-  std::uint64_t first_collisions_;
-  double start_time_ = 0.0;
+  std::uint64_t window_;
+  Mark window_start_;  // where the window now being watched began
+  Mark first_;         // when the watch began
   double most_ = 0.0;  // the largest advance of a window so far
-  std::uint64_t start_wall_collisions_ = 0, start_collisions_ = 0;
   // Per particle (caller's numbering), since a frozen window's confirmation began or a stall
   // reached an eighth of a window; empty otherwise.
   std::vector<std::uint32_t> counts_;
