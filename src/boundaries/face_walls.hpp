@@ -56,6 +56,12 @@ class FaceWalls {
   }
   bool surface_moves(int f) const { return faces_[f].wall.plane_moves(f); }
   bool accelerates(int f) const { return faces_[f].wall.vibrates(); }
+  std::string name(int f) const { return std::string{"xyz"[f / 2], f % 2 == 0 ? '-' : '+'}; }
+  const ContactModel& contact(int f) const { return faces_[f].wall.contact; }
+  // The speed at which wall f's plane moves into the box (its vibration aside).
+  double approach_speed(int f) const {
+    return (f % 2 == 0 ? 1.0 : -1.0) * faces_[f].wall.velocity[f / 2];
+  }
 
   // Where the plane of wall f lies along its axis at time t.
   double position(int f, double t) const { return faces_[f].wall.plane_position(f, box_, t); }

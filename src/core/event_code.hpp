@@ -7,13 +7,17 @@
 //   [kKeptBase, kNoneKept)               a cell crossing that keeps the contact with particle
 //                                        bits - kKeptBase, found beyond the crossing by the
 //                                        prediction that scheduled it (incremental crossings)
+//   [kFirstSurface, kNoneKept)          a contact with boundary surface 2D + bits - kFirstSurface
+//                                        (the surfaces after the box faces: planes, ...)
 //   kNoneKept                            a cell crossing whose prediction found no contact at all
 //   kRelease                             the release of the soft contact the particle is in
 //   [kFirstWall, kFirstWall + 2D)        a contact with the wall on box face bits - kFirstWall
 //   kNoPartner (all bits set)            a cell crossing that kept nothing: it scans every
 //                                        neighbour cell
 //
-// Particle indices therefore stay below kKeptBase (2^31), and the kept range holds any index.
+// Particle indices therefore stay below kFirstSurface - kKeptBase (kMaxParticles), so the kept
+// range holds any index. The surfaces after the box faces took their codes from the top of the
+// kept range, which no particle index reached, so the codes of format-7 files kept their meaning.
 #pragma once
 
 #include <cstdint>
@@ -27,12 +31,15 @@ class EventCode {
  public:
   static constexpr std::uint32_t kNoPartner = EventSlot::kNoPartner;
   static constexpr std::uint32_t kKeptBase = EventSlot::kKeptBase;
-  // Room for this many wall surfaces (the box faces); a boundary registry with more surfaces
-  // needs a wider range first (a restart-format change; docs/extending.md).
-  static constexpr int kWallCodes = 2 * D;
-  static constexpr std::uint32_t kFirstWall = kNoPartner - kWallCodes;
+  // Room for this many boundary surfaces: the 2D box faces (the first component of the
+  // registry, model/boundaries.hpp) and kWallCodes - 2D more.
+  static constexpr int kWallCodes = 4096;
+  static constexpr std::uint32_t kFirstWall = kNoPartner - 2 * D;
   static constexpr std::uint32_t kRelease = kFirstWall - 1;
   static constexpr std::uint32_t kNoneKept = kRelease - 1;
+  static constexpr std::uint32_t kFirstSurface = kNoneKept - (kWallCodes - 2 * D);
+  // The most particles a code can name as a kept partner.
+  static constexpr std::uint32_t kMaxParticles = kFirstSurface - kKeptBase;
   // Codes from here on are not particles.
   static constexpr std::uint32_t kFirstCode = kKeptBase;
 
@@ -44,8 +51,10 @@ class EventCode {
   static constexpr EventCode crossing_keeping(std::uint32_t p) { return EventCode(kKeptBase + p); }
   // A crossing whose prediction found no contact at all.
   static constexpr EventCode crossing_keeping_none() { return EventCode(kNoneKept); }
-  static constexpr EventCode wall(int face) {
-    return EventCode(kFirstWall + static_cast<std::uint32_t>(face));
+  // A contact with boundary surface s (0 <= s < kWallCodes; the box faces are 0 .. 2D - 1).
+  static constexpr EventCode wall(int s) {
+    return EventCode(s < 2 * D ? kFirstWall + static_cast<std::uint32_t>(s)
+                               : kFirstSurface + static_cast<std::uint32_t>(s - 2 * D));
   }
   static constexpr EventCode release() { return EventCode(kRelease); }
   // The stored form (restart files, EventSlot::partner).
@@ -55,16 +64,24 @@ class EventCode {
   constexpr bool is_collision() const { return bits_ < kFirstCode; }
   constexpr std::uint32_t partner() const { return bits_; }  // is_collision() only
   constexpr bool is_crossing() const {
-    return bits_ == kNoPartner || (bits_ >= kKeptBase && bits_ <= kNoneKept);
+    return bits_ == kNoPartner || bits_ == kNoneKept ||
+           (bits_ >= kKeptBase && bits_ < kFirstSurface);
   }
   // A crossing that kept the contact with a particle (kept_partner()).
-  constexpr bool keeps_contact() const { return bits_ >= kKeptBase && bits_ < kNoneKept; }
+  constexpr bool keeps_contact() const { return bits_ >= kKeptBase && bits_ < kFirstSurface; }
   constexpr std::uint32_t kept_partner() const { return bits_ - kKeptBase; }
   constexpr bool keeps_nothing() const { return bits_ == kNoneKept; }
   // A crossing that scans every neighbour cell next.
   constexpr bool is_full_scan_crossing() const { return bits_ == kNoPartner; }
-  constexpr bool is_wall() const { return bits_ >= kFirstWall && bits_ < kNoPartner; }
-  constexpr int wall_face() const { return static_cast<int>(bits_ - kFirstWall); }
+  constexpr bool is_wall() const {
+    return (bits_ >= kFirstWall && bits_ < kNoPartner) ||
+           (bits_ >= kFirstSurface && bits_ < kNoneKept);
+  }
+  // The surface of a wall code (is_wall()): its number in the boundary registry.
+  constexpr int wall_face() const {
+    return bits_ >= kFirstWall ? static_cast<int>(bits_ - kFirstWall)
+                               : 2 * D + static_cast<int>(bits_ - kFirstSurface);
+  }
   constexpr bool is_release() const { return bits_ == kRelease; }
 
   // Whether stored bits make sense for n particles (a collision or kept partner in range).

@@ -168,6 +168,11 @@ void DemIntegrator<D>::set_friction(const Environment<D>& env) {
 
 template <int D>
 void DemIntegrator<D>::set_walls(const Environment<D>& env) {
+  if (!env.planes.empty()) {
+    throw InputError(
+        "boundary.plane: the DEM integrator (run.integrator = \"dem\") has walls on the box's "
+        "faces only ([[boundary.wall]]); plane walls anywhere need the event integrator");
+  }
   for (int k = 0; k < D; ++k) {
     periodic_[k] = env.periodic(k);
     if (base_.periodic[k] != periodic_[k])

@@ -43,7 +43,8 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
       env_(environment) {
   const std::size_t n = s.size();
   if (n < 2) throw InputError("a simulation needs at least 2 particles");
-  if (n > kFirstCode - 16) throw InputError("too many particles (at most 2^31 - 16)");
+  if (n > Code::kMaxParticles)
+    throw InputError("too many particles (at most " + std::to_string(Code::kMaxParticles) + ")");
   if (s.mass.size() != n || s.species.size() != n) {
     throw InputError("the state needs a mass and a species for every particle");
   }

@@ -111,6 +111,7 @@ class RestingParticles {
   template <class Ids>
   void restore(const std::vector<std::uint8_t>& stored, const Ids& id) {
     if (stored.size() != asleep_.size()) return;
+    count_ = 0;  // the flags are replaced, not added to
     for (std::uint32_t k = 0; k < asleep_.size(); ++k) {
       asleep_[k] = stored[id[k]] != 0 ? 1 : 0;
       count_ += asleep_[k];

@@ -53,6 +53,11 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
   }
   if (!env_.soft_tables.empty() && env_.soft_tables.size() != pairs)
     throw InputError("soft spheres: one lookup table (or none) per species pair is needed");
+  if (!env_.planes.empty()) {
+    throw InputError(
+        "boundary.plane: soft spheres ([soft]) meet walls on the box's faces only (the map's "
+        "wall contact is written for a box face); use [[boundary.wall]], or hard contacts");
+  }
   if (walls_ && env_.soft_wall.size() < species)
     throw InputError("soft spheres: walls need a soft contact law for every species");
   if (!env_.soft_wall_tables.empty() && env_.soft_wall_tables.size() != env_.soft_wall.size())

@@ -323,6 +323,32 @@ class Reader : public KeyReader {
     return face_number(valid.at(face));
   }
 
+  // [[boundary.plane]] number i: its normal (not zero; kept as written, normalised by
+  // make_environment) and point, then the contact law and the motion keys of a face wall. Whether
+  // it cuts a periodic axis is checked with the box (Environment::check).
+  PlaneConfig read_plane(const toml::table& pt, std::size_t i, int dimension,
+                         const ContactConfig& contact) const {
+    const std::string prefix = fmt::format("boundary.plane[{}]", i);
+    PlaneConfig plane;
+    plane.wall.contact = contact;
+    read_group(pt, prefix, plane_keys(), &plane, &dimension);
+    for (const char* key : {"normal", "point"}) {
+      if (pt.get(key) == nullptr) {
+        fail(&pt, prefix + "." + key,
+             fmt::format("missing required key '{}.{}' ({} numbers)", prefix, key, dimension));
+      }
+    }
+    double n2 = 0.0;
+    for (const double c : plane.normal) n2 += c * c;
+    if (!(n2 > 0.0) || !std::isfinite(n2)) {
+      fail(pt.get("normal"), prefix + ".normal",
+           fmt::format("{}.normal: must be a nonzero vector (it points into the domain)", prefix));
+    }
+    read_contact(pt, prefix, plane.wall.contact);
+    read_group(pt, prefix, wall_keys(), &plane.wall, &dimension);
+    return plane;
+  }
+
   void read_boundary(const toml::table& t, int dimension, const ContactConfig& contact,
                      BoundaryConfig& b) const {
     constexpr std::string_view p = "boundary";
@@ -362,6 +388,10 @@ class Reader : public KeyReader {
       read_group(wt, prefix, wall_keys(), &w, &dimension);
       b.walls.push_back(std::move(w));
     }
+
+    const std::vector<const toml::table*> plane_tables = table_array(t, p, "plane");
+    for (std::size_t i = 0; i < plane_tables.size(); ++i)
+      b.planes.push_back(read_plane(*plane_tables[i], i, dimension, contact));
 
     read_group(t, std::string(p), boundary_keys(), &b, &dimension);
     const toml::node* n_open = t.get("open");

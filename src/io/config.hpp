@@ -43,6 +43,10 @@ struct SystemConfig {
   // particles are placed, leaving empty space at the high end of each axis (e.g. a bed of
   // grains at the bottom of a tall box). Empty = all 1.
   std::vector<double> box_scale;
+  // Generated states only: where the particles sit in the stretched box along each axis, as the
+  // fraction of the added space below them: 0 at the low end (the default), 1 at the high end
+  // (grains poured into a funnel from above), 0.5 centred. Empty = all 0.
+  std::vector<double> box_place;
   // Molecules: with chain_length L > 0, the particles form N / L linear chains of L beads each
   // (consecutive particles bonded), generated on a simple cubic (3D) or square (2D) lattice of
   // spacing chain_spacing (0: the largest diameter) along a snake path. Bonds use [bond].
@@ -95,10 +99,21 @@ struct WallConfig {
   bool operator==(const WallConfig&) const = default;
 };
 
+// A plane wall anywhere ([[boundary.plane]], boundaries/plane_walls.hpp).
+struct PlaneConfig {
+  std::vector<double> normal;  // D components, into the domain (not normalised)
+  std::vector<double> point;   // D components: a point of the plane at t = 0
+  WallConfig wall;             // its contact law and motion: the keys of [[boundary.wall]]
+                               // but face
+
+  bool operator==(const PlaneConfig&) const = default;
+};
+
 struct BoundaryConfig {
-  std::vector<WallConfig> walls;  // [[boundary.wall]]
-  std::vector<std::string> open;  // boundary.open: faces with no wall (e.g. "z+")
-  double shear_rate = 0.0;        // Lees-Edwards: flow along x, gradient along y; 0: none
+  std::vector<WallConfig> walls;    // [[boundary.wall]]
+  std::vector<PlaneConfig> planes;  // [[boundary.plane]]
+  std::vector<std::string> open;    // boundary.open: faces with no wall (e.g. "z+")
+  double shear_rate = 0.0;          // Lees-Edwards: flow along x, gradient along y; 0: none
 
   bool operator==(const BoundaryConfig&) const = default;
 };

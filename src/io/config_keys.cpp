@@ -102,6 +102,14 @@ constexpr KeyDecl kSystem[] = {
      .default_text = "all `1.0`",
      .doc = "generated states: factors of the box edges, empty space at the high ends",
      .fill = 1.0},
+    {.name = "box_place",
+     .type = KeyType::kVector,
+     .member = field<&SystemConfig::box_place>,
+     .range = {.lo = 0.0, .hi = 1.0},
+     .default_text = "all `0.0`",
+     .doc = "generated states: where the particles sit in the box box_scale stretched, as the "
+            "fraction of the added space below them (0: at the low end, 1: at the high end)",
+     .fill = 0.0},
     {.name = "chain_length",
      .type = KeyType::kUnsigned,
      .member = field<&SystemConfig::chain_length>,
@@ -263,6 +271,23 @@ constexpr KeyDecl kWall[] = {
      .range = {.lo = -1e9, .hi = 1e9, .why = "(radians)"},
      .unit = "radians",
      .doc = "vibration phase"},
+};
+
+const PlaneConfig kPlaneDefaults{};
+constexpr KeyDecl kPlane[] = {
+    {.name = "normal",
+     .type = KeyType::kVector,
+     .member = field<&PlaneConfig::normal>,
+     .range = {.by_rule = true},  // not zero, no component along a periodic axis
+     .default_text = "**required**",
+     .doc = "the plane's normal, pointing into the domain (normalised)"},
+    {.name = "point",
+     .type = KeyType::kVector,
+     .member = field<&PlaneConfig::point>,
+     .range = {.by_rule = true},  // finite
+     .default_text = "**required**",
+     .unit = "length",
+     .doc = "a point of the plane at t = 0"},
 };
 
 const FieldConfig kFieldDefaults{};
@@ -911,6 +936,7 @@ constexpr KeyGroup kContactLawGroup{"contact law", kContactLaw, &kContactDefault
 constexpr KeyGroup kContactGroup{"contact", kContact, &kInteractionDefaults};
 constexpr KeyGroup kBoundaryGroup{"boundary", kBoundary, &kBoundaryDefaults};
 constexpr KeyGroup kWallGroup{"wall", kWall, &kWallDefaults};
+constexpr KeyGroup kPlaneGroup{"plane", kPlane, &kPlaneDefaults};
 constexpr KeyGroup kFieldGroup{"field", kField, &kFieldDefaults};
 constexpr KeyGroup kDrivingGroup{"driving", kDriving, &kDrivingDefaults};
 constexpr KeyGroup kRunGroup{"run", kRun, &kRunDefaults};
@@ -954,6 +980,9 @@ std::vector<DeclaredKey> build() {
       {"boundary.wall",
        KeyType::kTableArray,
        {{&kWallFaceGroup}, {&kContactLawGroup, "contact"}, {&kWallGroup}}},
+      {"boundary.plane",
+       KeyType::kTableArray,
+       {{&kPlaneGroup}, {&kContactLawGroup, "contact"}, {&kWallGroup, "boundary.wall"}}},
       {"driving", KeyType::kTable, {{&kDrivingGroup}}},
       {"field", KeyType::kTable, {{&kFieldGroup}}},
       {"run", KeyType::kTable, {{&kRunGroup}}},
@@ -1085,6 +1114,9 @@ const KeyGroup& boundary_keys() {
 }
 const KeyGroup& wall_keys() {
   return kWallGroup;
+}
+const KeyGroup& plane_keys() {
+  return kPlaneGroup;
 }
 const KeyGroup& field_keys() {
   return kFieldGroup;

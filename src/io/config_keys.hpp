@@ -184,6 +184,8 @@ const KeyGroup& contact_law_keys();     // [contact], [[contact.pair]], [[bounda
 const KeyGroup& contact_keys();         // [contact] alone: tc, sleep_speed
 const KeyGroup& boundary_keys();        // [boundary]
 const KeyGroup& wall_keys();            // [[boundary.wall]] (after face and the contact law)
+                                        // and [[boundary.plane]] (after its own keys)
+const KeyGroup& plane_keys();           // [[boundary.plane]]: normal, point
 const KeyGroup& field_keys();           // [field]
 const KeyGroup& driving_keys();         // [driving]
 const KeyGroup& run_keys();             // [run]

@@ -139,6 +139,12 @@ std::string to_toml(const Config& config) {
     out += group_toml(contact_law_keys(), &w.contact, "boundary.wall", dimension);
     out += group_toml(wall_keys(), &w, "boundary.wall", dimension);
   }
+  for (const PlaneConfig& p : config.boundary.planes) {
+    out += "\n[[boundary.plane]]\n";
+    out += group_toml(plane_keys(), &p, "boundary.plane", dimension);
+    out += group_toml(contact_law_keys(), &p.wall.contact, "boundary.plane", dimension);
+    out += group_toml(wall_keys(), &p.wall, "boundary.plane", dimension);
+  }
   out += table("driving", driving_keys(), &config.driving);
   out += table("field", field_keys(), &config.field);
   const SoftConfig& soft = config.soft;

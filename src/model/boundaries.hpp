@@ -22,6 +22,10 @@
 //   bool surface_moves(int s) const;            the surface itself moves through space (a piston,
 //                                               a vibration; not a plane sliding in itself)
 //   bool accelerates(int s) const;              its velocity changes (a vibration)
+//   std::string name(int s) const;              how messages name it ("z-", "boundary.plane[0]")
+//   const ContactModel& contact(int s) const;   its contact law
+//   double approach_speed(int s) const;         the speed it moves into the domain at (a
+//                                               piston; its vibration aside)
 //   ContactResult<D> resolve(int s, t, mass, radius, inertia_factor, force_elastic, v, w) const;
 //                                               the contact's response and its energy split
 //   bool overlaps(x, radius, t) const;          a particle overlaps one of its surfaces
@@ -34,18 +38,20 @@
 //                                               (which cells each surface reaches, the squeeze)
 //
 // is made from the run's model (Environment) in the constructor below, and has no per-particle
-// state (FaceWalls needs
-// none: its planes are functions of the time); a component with state (a wall with mass) adds its
-// restart data to ParticleSystem and its part of EventEngine::validate(). Dispatch is static (the
-// tuple below): no virtual call.
+// state (FaceWalls and PlaneWalls need none: their planes are functions of the time); a
+// component with state (a wall with mass) adds its restart data to ParticleSystem and its part
+// of EventEngine::validate(). Dispatch is static (the tuple below): no virtual call. Surface
+// codes: EventCode::wall has room for EventCode<D>::kWallCodes surfaces, the box faces first.
 #pragma once
 
 #include <cstdint>
 #include <stdexcept>
+#include <string>
 #include <tuple>
 #include <utility>
 
 #include "boundaries/face_walls.hpp"
+#include "boundaries/plane_walls.hpp"
 #include "model/environment.hpp"
 #include "scheduler/cell_grid.hpp"
 
@@ -118,6 +124,15 @@ class BoundarySet {
   bool accelerates(int s) const {
     return at(s, [](const auto& c, int k) { return c.accelerates(k); });
   }
+  std::string name(int s) const {
+    return at(s, [](const auto& c, int k) { return c.name(k); });
+  }
+  const ContactModel& contact(int s) const {
+    return at(s, [](const auto& c, int k) -> const ContactModel& { return c.contact(k); });
+  }
+  double approach_speed(int s) const {
+    return at(s, [](const auto& c, int k) { return c.approach_speed(k); });
+  }
   ContactResult<D> resolve(int s, double t, double mass, double radius, double inertia_factor,
                            bool force_elastic, Vec<D>& v, Spin<D>& w) const {
     return at(s, [&](const auto& c, int k) {
@@ -130,6 +145,12 @@ class BoundarySet {
     bool moves = false;
     for (int s = 0; s < surfaces_; ++s) moves = moves || (is_surface(s) && surface_moves(s));
     return moves;
+  }
+  // Whether some surface is not still (it slides, moves or vibrates: it can do work).
+  bool any_surface_drives() const {
+    bool drives = false;
+    for (int s = 0; s < surfaces_; ++s) drives = drives || (is_surface(s) && !holds_still(s));
+    return drives;
   }
   // The soonest contact of a particle in `cell` with any surface from time t before
   // t + horizon: (relative time, surface), surface -1 if none.
@@ -191,11 +212,13 @@ class BoundarySet {
 // in the constructor, which makes each from the run's model (its specification lives in the
 // Environment).
 template <int D>
-class Boundaries : public BoundarySet<D, FaceWalls<D>> {
+class Boundaries : public BoundarySet<D, FaceWalls<D>, PlaneWalls<D>> {
  public:
   Boundaries() = default;
   Boundaries(const Environment<D>& environment, const Vec<D>& box)
-      : BoundarySet<D, FaceWalls<D>>(FaceWalls<D>(environment.faces, box, environment.gravity)) {}
+      : BoundarySet<D, FaceWalls<D>, PlaneWalls<D>>(
+            FaceWalls<D>(environment.faces, box, environment.gravity),
+            PlaneWalls<D>(environment.planes, box, environment.faces, environment.gravity)) {}
 
   const FaceWalls<D>& faces() const { return this->template get<FaceWalls<D>>(); }
   FaceWalls<D>& faces() { return this->template get<FaceWalls<D>>(); }

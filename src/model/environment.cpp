@@ -12,6 +12,20 @@ const char* face_name(int face) {
   static const char* names[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
   return names[face];
 }
+
+template <int D>
+void check_wall_motion(const Wall<D>& w, const std::string& name) {
+  for (int a = 0; a < D; ++a) {
+    if (!std::isfinite(w.velocity[a])) throw InputError(name + ": velocity must be finite");
+  }
+  if (!(w.amplitude >= 0.0) || !std::isfinite(w.amplitude)) {
+    throw InputError(name + ": amplitude must be finite and >= 0");
+  }
+  if (!(w.angular_frequency >= 0.0) || !std::isfinite(w.angular_frequency) ||
+      !std::isfinite(w.phase)) {
+    throw InputError(name + ": frequency must be finite and >= 0 and the phase finite");
+  }
+}
 }  // namespace
 
 template <int D>
@@ -20,6 +34,8 @@ bool Environment<D>::rotates() const {
     if (!c.tangential.is_smooth()) return true;
   for (const Face<D>& f : faces)
     if (f.kind == FaceKind::kWall && !f.wall.contact.tangential.is_smooth()) return true;
+  for (const PlaneWall<D>& p : planes)
+    if (!p.wall.contact.tangential.is_smooth()) return true;
   return false;
 }
 
@@ -39,19 +55,29 @@ void Environment<D>::check() const {
                        " is periodic; an axis is periodic on both faces or on neither");
     }
   }
-  for (int f = 0; f < 2 * D; ++f) {
-    if (faces[f].kind != FaceKind::kWall) continue;
-    const Wall<D>& w = faces[f].wall;
-    const std::string name = std::string("wall ") + face_name(f);
+  for (int f = 0; f < 2 * D; ++f)
+    if (faces[f].kind == FaceKind::kWall)
+      check_wall_motion(faces[f].wall, std::string("wall ") + face_name(f));
+  for (std::size_t s = 0; s < planes.size(); ++s) {
+    const PlaneWall<D>& p = planes[s];
+    const std::string name = "boundary.plane[" + std::to_string(s) + "]";
+    check_wall_motion(p.wall, name);
+    double n2 = 0.0;
     for (int a = 0; a < D; ++a) {
-      if (!std::isfinite(w.velocity[a])) throw InputError(name + ": velocity must be finite");
+      if (!std::isfinite(p.normal[a])) throw InputError(name + ": normal must be finite");
+      n2 += p.normal[a] * p.normal[a];
     }
-    if (!(w.amplitude >= 0.0) || !std::isfinite(w.amplitude)) {
-      throw InputError(name + ": amplitude must be finite and >= 0");
-    }
-    if (!(w.angular_frequency >= 0.0) || !std::isfinite(w.angular_frequency) ||
-        !std::isfinite(w.phase)) {
-      throw InputError(name + ": frequency must be finite and >= 0 and the phase finite");
+    if (!(std::abs(n2 - 1.0) <= 1e-12))
+      throw InputError(name + ": the normal must be a unit vector");
+    if (!std::isfinite(p.offset)) throw InputError(name + ": point must be finite");
+    for (int a = 0; a < D; ++a) {
+      if (p.normal[a] != 0.0 && periodic(a)) {
+        throw InputError(name + ": the normal has a component along the periodic axis " +
+                         std::string(1, "xyz"[a]) +
+                         ": a plane must not cut a periodic axis (it would not meet its own "
+                         "periodic image); make that axis bounded (walls or open faces) or "
+                         "the normal perpendicular to it");
+      }
     }
   }
   for (int a = 0; a < D; ++a) {

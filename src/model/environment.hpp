@@ -19,6 +19,7 @@
 #include "core/vec.hpp"
 
 #include "boundaries/face_wall.hpp"
+#include "boundaries/plane_walls.hpp"
 #include "interactions/granular_contact.hpp"
 #include "interactions/soft_contact.hpp"
 #include "interactions/soft_map_table.hpp"
@@ -39,6 +40,8 @@ struct Environment {
   // Face 2k is the low face of axis k, 2k + 1 the high face. An axis is periodic iff both of
   // its faces are.
   std::array<Face<D>, 2 * D> faces{};
+  // Plane walls at any position and orientation (boundaries/plane_walls.hpp), after the faces.
+  std::vector<PlaneWall<D>> planes;
   // Contact law of species pair (a, b) at contact[a * species + b] (symmetric); empty: every
   // pair collides elastically and smoothly.
   std::vector<ContactModel> contact;
@@ -117,10 +120,11 @@ struct Environment {
   double wall_position(int f, const Vec<D>& box, double t) const {
     return faces[f].wall.plane_position(f, box, t);
   }
+  // Some face is a wall, or some plane wall is given.
   bool has_walls() const {
     for (const Face<D>& f : faces)
       if (f.kind == FaceKind::kWall) return true;
-    return false;
+    return !planes.empty();
   }
   const ContactModel* contact_of(std::uint32_t a, std::uint32_t b) const {
     return contact.empty() ? nullptr : &contact[a * species + b];

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -123,8 +124,9 @@ void check_box(const RangeScales& s) {
   }
 }
 
-void check_wall(const WallConfig& w, std::size_t index, const RangeScales& s) {
-  const std::string prefix = fmt::format("boundary.wall[{}]", index);
+// A wall's contact law and motion ([[boundary.wall]] at a face, or a [[boundary.plane]]): its
+// amplitude is measured in box edges along its axis (`edge`: for a plane, the longest edge).
+void check_wall(const WallConfig& w, const std::string& prefix, double edge, const RangeScales& s) {
   check_contact(w.contact, prefix, s);
   const double v = s.speed();
   const double fastest = declared(prefix + ".velocity").hi;
@@ -132,15 +134,12 @@ void check_wall(const WallConfig& w, std::size_t index, const RangeScales& s) {
     magnitude_within(fmt::format("{}.velocity[{}]", prefix, a), w.velocity[a], fastest * v,
                      short_number(fastest) + " times " + speed_unit(s));
   }
-  const ChoiceEntry<BoxFace>* face = box_faces().find(w.face);
-  const auto axis = face != nullptr ? static_cast<std::size_t>(face_axis(face->value)) : 3;
-  if (axis < s.box.size()) {
+  if (std::isfinite(edge)) {
     // Not half the edge: both walls of a shaken container (a damper) vibrate in phase and may
     // sweep further; walls that meet are an error when it happens. 1e300 broke the positions.
     const double edges = declared(prefix + ".amplitude").hi;
-    within(
-        prefix + ".amplitude", w.amplitude, 0.0, edges * s.box[axis],
-        fmt::format("up to {} box edges along its axis, {:.6g}", short_number(edges), s.box[axis]));
+    within(prefix + ".amplitude", w.amplitude, 0.0, edges * edge,
+           fmt::format("up to {} box edges along its axis, {:.6g}", short_number(edges), edge));
   }
   const double fastest_vibration = declared(prefix + ".frequency").hi;
   within(prefix + ".frequency", w.frequency, 0.0, fastest_vibration / s.time(),
@@ -186,9 +185,30 @@ void check_gravity(const Config& c, const RangeScales& s) {
   }
 }
 
+// A plane's point lies within 1e6 box edges of the box (further, n.x loses the particles'
+// digits), and its wall keys are a face wall's.
+void check_plane(const PlaneConfig& p, std::size_t index, const RangeScales& s) {
+  const std::string prefix = fmt::format("boundary.plane[{}]", index);
+  double longest = 0.0;
+  for (const double edge : s.box) longest = std::max(longest, edge);
+  for (std::size_t a = 0; a < p.point.size(); ++a) {
+    magnitude_within(fmt::format("{}.point[{}]", prefix, a), p.point[a], 1e6 * longest,
+                     fmt::format("1e6 times the longest box edge, {:.6g}", longest));
+  }
+  check_wall(p.wall, prefix, longest, s);
+}
+
 void check_boundary(const Config& c, const RangeScales& s) {
   check_box(s);
-  for (std::size_t w = 0; w < c.boundary.walls.size(); ++w) check_wall(c.boundary.walls[w], w, s);
+  for (std::size_t w = 0; w < c.boundary.walls.size(); ++w) {
+    const WallConfig& wall = c.boundary.walls[w];
+    const ChoiceEntry<BoxFace>* face = box_faces().find(wall.face);
+    const auto axis = face != nullptr ? static_cast<std::size_t>(face_axis(face->value)) : 3;
+    check_wall(wall, fmt::format("boundary.wall[{}]", w),
+               axis < s.box.size() ? s.box[axis] : std::numeric_limits<double>::quiet_NaN(), s);
+  }
+  for (std::size_t p = 0; p < c.boundary.planes.size(); ++p)
+    check_plane(c.boundary.planes[p], p, s);
   // The images slide at gamma L_y; faster than 1e6 / tau the image shifts and the flow's heating
   // swamp every collision (and 1e300 overflows the positions).
   const double fastest = declared("boundary.shear_rate").hi;

@@ -302,6 +302,21 @@ ContactModel make_contact_model(const ContactConfig& c, const std::string& where
   return m;
 }
 
+namespace {
+// A wall's contact law and motion from its keys (a face wall's or a plane's).
+template <int D>
+Wall<D> make_wall(const WallConfig& wc, const std::string& where) {
+  Wall<D> wall;
+  wall.contact = make_contact_model(wc.contact, where);
+  for (int a = 0; a < D && a < static_cast<int>(wc.velocity.size()); ++a)
+    wall.velocity[a] = wc.velocity[a];
+  wall.amplitude = wc.amplitude;
+  wall.angular_frequency = 2.0 * std::numbers::pi * wc.frequency;
+  wall.phase = wc.phase;
+  return wall;
+}
+}  // namespace
+
 template <int D>
 Environment<D> make_environment(const Config& config, const ParticleSystem<D>& state) {
   // Before anything is built from them (a cut-off of 1e300 would spin in the step tables).
@@ -335,12 +350,19 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
     const int f = face_index(wc.face, D);
     Face<D>& face = env.faces[f];
     face.kind = FaceKind::kWall;
-    face.wall.contact = make_contact_model(wc.contact, fmt::format("boundary.wall[{}]", w));
-    for (int a = 0; a < D && a < static_cast<int>(wc.velocity.size()); ++a)
-      face.wall.velocity[a] = wc.velocity[a];
-    face.wall.amplitude = wc.amplitude;
-    face.wall.angular_frequency = 2.0 * std::numbers::pi * wc.frequency;
-    face.wall.phase = wc.phase;
+    face.wall = make_wall<D>(wc, fmt::format("boundary.wall[{}]", w));
+  }
+  for (std::size_t k = 0; k < config.boundary.planes.size(); ++k) {
+    const PlaneConfig& pc = config.boundary.planes[k];
+    PlaneWall<D> plane;
+    for (int a = 0; a < D && a < static_cast<int>(pc.normal.size()); ++a)
+      plane.normal[a] = pc.normal[a];
+    plane.normal = (1.0 / std::sqrt(norm2(plane.normal))) * plane.normal;  // not 0: the reader
+    Vec<D> point{};
+    for (int a = 0; a < D && a < static_cast<int>(pc.point.size()); ++a) point[a] = pc.point[a];
+    plane.offset = dot(plane.normal, point);
+    plane.wall = make_wall<D>(pc.wall, fmt::format("boundary.plane[{}]", k));
+    env.planes.push_back(plane);
   }
   for (const std::string& open : config.boundary.open)
     env.faces[face_index(open, D)].kind = FaceKind::kOpen;

@@ -10,6 +10,7 @@
 #include "core/periodic.hpp"
 #include "core/stop_flag.hpp"
 #include "init/initial_state.hpp"
+#include "model/boundaries.hpp"
 #include "run/collision_estimate.hpp"
 #include "run/trigger.hpp"
 #include "scheduler/binary_heap_queue.hpp"
@@ -110,11 +111,7 @@ EventEngineAdapter<D, Queue>::EventEngineAdapter(RunStart<D>&& start,
   kind.rotating = environment.rotates() || engine_.rotational_energy() > 0.0;
   kind.dissipative = environment.tc > 0.0 || environment.dissipative_steps() ||
                      environment.soft_spheres() || !environment.plain();
-  for (int f = 0; f < 2 * D; ++f)
-    kind.moving_walls =
-        kind.moving_walls ||
-        (environment.faces[f].kind == FaceKind::kWall &&
-         (environment.wall_moves(f) || norm2(environment.faces[f].wall.velocity) > 0.0));
+  kind.moving_walls = Boundaries<D>(environment, engine_.box()).any_surface_drives();
   if (kind.driven) {
     next_kick_ = start.restarted() && start.resumed.next_kick_time >= engine_.time()
                      ? start.resumed.next_kick_time

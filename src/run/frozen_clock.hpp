@@ -21,6 +21,7 @@
 #include <fmt/format.h>
 
 #include "core/vec.hpp"
+#include "model/boundaries.hpp"
 #include "model/environment.hpp"
 
 namespace kairos {
@@ -188,21 +189,18 @@ class FrozenClockWatch {
 
 namespace frozen_clock_detail {
 
-// The faces whose wall the particle at x (radius r) touches at time t, by name ("the wall z-").
+// The boundary surfaces the particle at x (radius r) touches at time t.
 template <int D>
-std::vector<int> touched_walls(const Environment<D>& env, const Vec<D>& box, const Vec<D>& x,
+std::vector<int> touched_walls(const Boundaries<D>& boundaries, const Vec<D>& box, const Vec<D>& x,
                                double r, double t) {
-  std::vector<int> faces;
-  for (int f = 0; f < 2 * D; ++f) {
-    if (env.faces[f].kind != FaceKind::kWall) continue;
-    const double gap = std::abs(x[f / 2] - env.wall_position(f, box, t)) - r;
-    if (gap < 1e-6 * r + 1e-9 * box[f / 2]) faces.push_back(f);
+  double longest = 0.0;
+  for (int a = 0; a < D; ++a) longest = std::max(longest, box[a]);
+  std::vector<int> surfaces;
+  for (int s = 0; s < boundaries.surfaces(); ++s) {
+    if (!boundaries.is_surface(s)) continue;
+    if (std::abs(boundaries.gap(s, x, t)) - r < 1e-6 * r + 1e-9 * longest) surfaces.push_back(s);
   }
-  return faces;
-}
-
-inline std::string face_name(int f) {
-  return fmt::format("{}{}", "xyz"[f / 2], f % 2 == 0 ? '-' : '+');
+  return surfaces;
 }
 
 // Why the clock froze and what changes it, from what collided in the window: the particles
@@ -210,8 +208,9 @@ inline std::string face_name(int f) {
 // floor need to sleep), among themselves (an inelastic collapse, or elastic particles jammed
 // with no room to move), or squeezed by a wall moving inwards.
 template <int D>
-std::string cause(const Environment<D>& env, const std::vector<int>& walls, std::uint64_t pair_hits,
-                  std::uint64_t wall_hits, const std::string& pistons) {
+std::string cause(const Environment<D>& env, const Boundaries<D>& boundaries,
+                  const std::vector<int>& walls, std::uint64_t pair_hits, std::uint64_t wall_hits,
+                  const std::string& pistons) {
   if (!pistons.empty()) {
     return fmt::format(
         "squeezed by the wall {} moving into them, which leaves them no room (they jam); end "
@@ -220,12 +219,11 @@ std::string cause(const Environment<D>& env, const std::vector<int>& walls, std:
   }
   if (wall_hits > pair_hits && !walls.empty()) {
     std::string sticky, resting;
-    for (const int f : walls) {
-      const Wall<D>& w = env.faces[f].wall;
-      if (w.contact.normal(0.0) == 0.0)
-        sticky += (sticky.empty() ? "" : ", ") + face_name(f);
-      else if (!w.vibrates())
-        resting += (resting.empty() ? "" : ", ") + face_name(f);
+    for (const int s : walls) {
+      if (boundaries.contact(s).normal(0.0) == 0.0)
+        sticky += (sticky.empty() ? "" : ", ") + boundaries.name(s);
+      else if (!boundaries.accelerates(s))
+        resting += (resting.empty() ? "" : ", ") + boundaries.name(s);
     }
     if (!sticky.empty()) {
       return fmt::format(
@@ -262,7 +260,6 @@ std::string cause(const Environment<D>& env, const std::vector<int>& walls, std:
 
 template <class Engine>
 std::string FrozenClockWatch::describe(const Engine& engine) const {
-  using frozen_clock_detail::face_name;
   constexpr int D = std::tuple_size_v<std::remove_cvref_t<decltype(engine.box())>>;
   const std::size_t n = engine.size();
   const std::vector<std::uint32_t> now = engine.collision_counts();
@@ -284,28 +281,28 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
     who += fmt::format("{}{}", k == 0 ? "" : k + 1 == named ? " and " : ", ", busy[k].second);
   if (busy.size() > named) who += fmt::format(" (of {} particles)", busy.size());
 
+  const auto& env = engine.environment();
+  const Boundaries<D> boundaries(env, engine.box());
   std::vector<int> walls;
   if (wall_hits > 0) {
     const auto state = engine.export_state(/*with_zones=*/false);
     for (std::size_t k = 0; k < named; ++k) {
       const std::uint32_t i = busy[k].second;
-      for (const int f : frozen_clock_detail::touched_walls<D>(
-               engine.environment(), state.box, state.position(i, state.time),
-               state.kinematics[i].radius, state.time))
-        if (std::find(walls.begin(), walls.end(), f) == walls.end()) walls.push_back(f);
+      for (const int s : frozen_clock_detail::touched_walls<D>(
+               boundaries, state.box, state.position(i, state.time), state.kinematics[i].radius,
+               state.time))
+        if (std::find(walls.begin(), walls.end(), s) == walls.end()) walls.push_back(s);
     }
   }
   std::string where;
   for (std::size_t k = 0; k < walls.size(); ++k)
-    where += fmt::format("{}{}", k == 0 ? "" : ", ", face_name(walls[k]));
+    where += fmt::format("{}{}", k == 0 ? "" : ", ", boundaries.name(walls[k]));
 
-  const auto& env = engine.environment();
   // A wall moving inwards (a piston) squeezes the particles whether it touches the busiest.
   std::string pistons;
-  for (int f = 0; f < 2 * D; ++f) {
-    if (env.faces[f].kind != FaceKind::kWall) continue;
-    const double inward = (f % 2 == 0 ? 1.0 : -1.0) * env.faces[f].wall.velocity[f / 2];
-    if (inward > 0.0) pistons += (pistons.empty() ? "" : ", ") + face_name(f);
+  for (int s = 0; s < boundaries.surfaces(); ++s) {
+    if (boundaries.is_surface(s) && boundaries.approach_speed(s) > 0.0)
+      pistons += (pistons.empty() ? "" : ", ") + boundaries.name(s);
   }
   const std::uint64_t events = engine.counters().events - report_.events;
   const double advance = engine.time() - report_.time;
@@ -316,7 +313,8 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
   if (most_ > 0.0) message += fmt::format(" (earlier windows as long: up to {:.3g})", most_);
   if (busy.empty()) return message + "; no particle collided";
   const std::uint64_t pair_hits = engine.counters().collisions - report_.collisions;
-  const std::string cause = frozen_clock_detail::cause(env, walls, pair_hits, wall_hits, pistons);
+  const std::string cause =
+      frozen_clock_detail::cause(env, boundaries, walls, pair_hits, wall_hits, pistons);
   message += fmt::format(
       "; particle{} {} collide{} again and again{}{}: {}", busy.size() == 1 ? "" : "s", who,
       busy.size() == 1 ? "s" : "", advance > 0.0 ? ", ever faster" : " at one instant",

@@ -87,9 +87,11 @@ Effect effect_of(const std::string& key) {
     return Effect::kResume;
   if (k == "contact.sleep_speed") return Effect::kRepredict;  // sleepers predict nothing
   if (starts_with(k, "contact.")) return Effect::kResume;
-  if (starts_with(k, "boundary.wall.")) {
-    const std::string_view leaf =
-        std::string_view(k).substr(std::string_view("boundary.wall.").size());
+  // A wall's or a plane's contact law resumes; its place and motion re-predict (a plane moved
+  // into the particles is refused by the start checks, naming the particle).
+  for (const std::string_view table : {"boundary.wall.", "boundary.plane."}) {
+    if (!starts_with(k, table)) continue;
+    const std::string_view leaf = std::string_view(k).substr(table.size());
     if (std::find(kWallLaw.begin(), kWallLaw.end(), leaf) != kWallLaw.end()) return Effect::kResume;
     return Effect::kRepredict;
   }

@@ -151,7 +151,8 @@ void note_ignored_system_keys(const Config& config, std::size_t n, const std::st
 
 // A generated state fills a periodic box. Along an axis with walls (or open faces) the box
 // grows by the largest diameter, half on each side, so that no particle touches a wall; then
-// system.box_scale stretches the box, leaving empty space at the high end of each axis.
+// system.box_scale stretches the box, leaving empty space at the high end of each axis (or,
+// with system.box_place, below the particles too).
 template <int D>
 void make_room_for_walls(const Config& config, InitialState<D>& init) {
   double dmax = 0.0;
@@ -162,8 +163,16 @@ void make_room_for_walls(const Config& config, InitialState<D>& init) {
     init.box[a] += dmax;
     for (auto& x : init.position) x[a] += 0.5 * dmax;
   }
-  for (int a = 0; a < D && a < static_cast<int>(config.system.box_scale.size()); ++a)
+  for (int a = 0; a < D && a < static_cast<int>(config.system.box_scale.size()); ++a) {
+    const double before = init.box[a];
     init.box[a] *= config.system.box_scale[a];
+    // system.box_place: the share of the added space that lies below the particles.
+    const double below = a < static_cast<int>(config.system.box_place.size())
+                             ? config.system.box_place[a] * (init.box[a] - before)
+                             : 0.0;
+    if (below > 0.0)
+      for (auto& x : init.position) x[a] += below;
+  }
 }
 
 // Velocities drawn from the temperature are peculiar: under Lees-Edwards shear the mean flow

@@ -1,13 +1,12 @@
-// The boundary registry with two geometries: the face walls and the worked example of
-// docs/extending.md (fixed planes anywhere, plane_walls_example.hpp). Surfaces are numbered
-// across components, each call reaches the component that owns the surface, and the soonest
-// contact is found among all of them.
+// The boundary registry with two geometries: the face walls and the planes anywhere
+// (boundaries/plane_walls, the example of docs/extending.md). Surfaces are numbered across
+// components, each call reaches the component that owns the surface, and the soonest contact is
+// found among all of them.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "model/boundaries.hpp"
-#include "plane_walls_example.hpp"
 
 namespace kairos {
 namespace {
@@ -21,9 +20,12 @@ Set floor_and_a_slope() {
   const Vec<3> gravity{0.0, 0.0, -1.0};
   // A slope x + z = 6 (normal into the domain: towards -x and -z), and its restitution 0.5.
   const double s = 1.0 / std::sqrt(2.0);
-  PlaneWalls<3>::Plane slope{{-s, 0.0, -s}, -6.0 * s, {}};
-  slope.contact.normal = NormalRestitution::constant(0.5);
-  return Set(FaceWalls<3>(faces, {10.0, 10.0, 10.0}, gravity), PlaneWalls<3>({slope}, gravity));
+  PlaneWall<3> slope;
+  slope.normal = {-s, 0.0, -s};
+  slope.offset = -6.0 * s;
+  slope.wall.contact.normal = NormalRestitution::constant(0.5);
+  const Vec<3> box{10.0, 10.0, 10.0};
+  return Set(FaceWalls<3>(faces, box, gravity), PlaneWalls<3>({slope}, box, faces, gravity));
 }
 
 TEST(BoundarySet, SurfacesAreNumberedAcrossComponents) {
@@ -44,7 +46,7 @@ TEST(BoundarySet, TheSoonestContactIsFoundAmongAllComponents) {
   const Set set = floor_and_a_slope();
   const CellGrid<3> grid({10.0, 10.0, 10.0}, Vec<3>{1.0, 1.0, 1.0}, {true, true, false}, 1000);
   Set with_reach = set;
-  with_reach.template get<FaceWalls<3>>().set_reach(grid, 0.5);
+  with_reach.prepare(grid, 0.5, 0.0, true);
   // Moving along +x at 4, at height 3 (the floor 2.5 of free fall away, sqrt(5) = 2.24): the
   // slope comes first, where x + z = 6 - R sqrt 2 (its gap closes at 4 / sqrt 2, gravity
   // adding 1 / sqrt 2 per unit time).

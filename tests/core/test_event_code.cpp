@@ -69,7 +69,17 @@ Kind kind_by_the_table(std::uint32_t bits) {
   if (bits >= all - 2 * D) return Kind::kWall;
   if (bits == all - 2 * D - 1) return Kind::kRelease;
   if (bits == all - 2 * D - 2) return Kind::kNoneKept;
+  // The surfaces after the box faces: the 4096 - 2D codes just below kNoneKept.
+  if (bits >= all - 2 * D - 2 - (4096 - 2 * D)) return Kind::kWall;
   return Kind::kKept;
+}
+
+// The surface a wall code names: a face (from the top), or a surface after the faces.
+template <int D>
+int surface_by_the_table(std::uint32_t bits) {
+  const std::uint32_t all = 0xffffffffu;
+  if (bits >= all - 2 * D) return static_cast<int>(bits - (all - 2 * D));
+  return 2 * D + static_cast<int>(bits - (all - 2 * D - 2 - (4096 - 2 * D)));
 }
 
 template <int D>
@@ -79,6 +89,10 @@ void every_bit_pattern_names_one_kind() {
   // Both sides of every edge of the table, and random patterns.
   std::vector<std::uint32_t> bits = {0u, 1u, base - 2, base - 1, base, base + 1};
   for (std::uint32_t k = 0; k <= 2 * D + 4; ++k) bits.push_back(all - k);
+  const std::uint32_t first_surface = all - 2 * D - 2 - (4096 - 2 * D);
+  for (const std::uint32_t b :
+       {first_surface - 2, first_surface - 1, first_surface, first_surface + 1})
+    bits.push_back(b);
   std::mt19937 rng(11);
   for (int k = 0; k < 20000; ++k) bits.push_back(static_cast<std::uint32_t>(rng()));
   for (const std::uint32_t b : bits) {
@@ -104,7 +118,7 @@ void every_bit_pattern_names_one_kind() {
       EXPECT_EQ(c, Code::crossing_keeping(b - base));
     }
     if (want == Kind::kWall) {
-      EXPECT_EQ(c.wall_face(), static_cast<int>(b - (all - 2 * D)));
+      EXPECT_EQ(c.wall_face(), surface_by_the_table<D>(b));
       EXPECT_EQ(c, Code::wall(c.wall_face()));
     }
   }
@@ -139,7 +153,8 @@ void valid_bits_at_the_edges() {
   EXPECT_TRUE(Code::valid_bits(Code::crossing_keeping(0).bits(), n));
   EXPECT_TRUE(Code::valid_bits(Code::crossing_keeping(n - 1).bits(), n));
   EXPECT_FALSE(Code::valid_bits(Code::crossing_keeping(n).bits(), n));
-  EXPECT_FALSE(Code::valid_bits(Code::kNoneKept - 1, n));  // the last kept code
+  EXPECT_FALSE(Code::valid_bits(Code::kFirstSurface - 1, n));  // the last kept code
+  EXPECT_TRUE(Code::valid_bits(Code::kFirstSurface, n));       // the first surface after the faces
   EXPECT_FALSE(Code::valid_bits(Code::crossing_keeping(0).bits(), 0));
   // Codes that name no particle make sense for any n, none included.
   for (const std::uint32_t m : {0u, 1u, n}) {
@@ -155,15 +170,17 @@ TEST(EventCode, ValidBitsAtTheEdgesOfEachRange) {
   valid_bits_at_the_edges<3>();
 }
 
-// The engine takes at most 2^31 - 16 particles (EventEngine's constructor): every index it can
-// hand out fits the kept range, below the codes that name no particle.
+// The engine takes at most kMaxParticles particles (EventEngine's constructor): every index it
+// can hand out fits the kept range, below the codes that name no particle.
 template <int D>
 void kept_range_holds_every_engine_index() {
   using Code = EventCode<D>;
-  const std::uint32_t most = Code::kFirstCode - 16;  // the engine's largest particle count
+  const std::uint32_t most = Code::kMaxParticles;  // the engine's largest particle count
   const std::uint32_t last = most - 1;
-  EXPECT_LE(last, Code::kNoneKept - Code::kKeptBase - 1);
+  EXPECT_LE(last, Code::kFirstSurface - Code::kKeptBase - 1);
+  EXPECT_EQ(most, (1u << 31) - 4099u);  // below kNoPartner, release, none-kept, 4096 surfaces
   const Code kept = Code::crossing_keeping(last);
+  EXPECT_FALSE(kept.is_wall());
   EXPECT_TRUE(kept.keeps_contact());
   EXPECT_FALSE(kept.keeps_nothing());
   EXPECT_EQ(kept.kept_partner(), last);

@@ -59,6 +59,10 @@ face = "z-"
 [[boundary.wall]]
 face = "z+"
 
+[[boundary.plane]]
+normal = [0.0, 1.0, 1.0]
+point = [0.0, 0.0, 0.5]
+
 [driving]
 kind = "andersen"
 )";

@@ -1,0 +1,157 @@
+#include "boundaries/plane_walls.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "dynamics/collision_time.hpp"
+#include "dynamics/trajectory_events.hpp"
+
+namespace kairos {
+
+template <int D>
+PlaneWalls<D>::PlaneWalls(std::vector<PlaneWall<D>> planes, const Vec<D>& box,
+                          const std::array<Face<D>, 2 * D>& faces, const Vec<D>& gravity)
+    : planes_(std::move(planes)), box_(box), faces_(faces), gravity_(gravity) {}
+
+// Along the normal the particle's height above the plane is n.x - R, moving at n.v with
+// acceleration n.g; the plane's offset moves at u = n.velocity (plus its vibration): the
+// solvers of the face walls (dynamics/trajectory_events), on the projected motion
+// (docs/physics.md#walls-at-any-orientation).
+template <int D>
+double PlaneWalls<D>::event_time(int s, const Vec<D>& x, const Vec<D>& v, double radius, double t,
+                                 double horizon) const {
+  const PlaneWall<D>& p = plane(s);
+  const NormalMotion m{dot(p.normal, x) - radius, dot(p.normal, v), dot(p.normal, gravity_)};
+  const double u = p.normal_speed();
+  const double d = p.offset + (u != 0.0 ? u * t : 0.0);
+  if (p.wall.vibrates()) {
+    const NormalMotion rel{m.height, m.velocity - u, m.accel};
+    const VibratedPlane vibrated{
+        d, p.wall.amplitude, p.wall.angular_frequency,
+        std::remainder(p.wall.angular_frequency * t + p.wall.phase, 2.0 * M_PI)};
+    return vibrated_plane_event_time(rel, vibrated, horizon);
+  }
+  return moving_plane_event_time(m, d, u, horizon);
+}
+
+// The lowest n.x over the cell (its outer layers along a bounded axis reach to infinity).
+template <int D>
+bool PlaneWalls<D>::reaches(int s, CellCode cell, const CellGrid<D>& grid) const {
+  const PlaneWall<D>& p = plane(s);
+  if (p.normal_speed() != 0.0) return true;
+  double lowest = 0.0;
+  for (int a = 0; a < D; ++a) {
+    const double n = p.normal[a];
+    if (n == 0.0) continue;
+    const double edge = n > 0.0 ? grid.lower_bound(cell, a) : grid.upper_bound(cell, a);
+    if (!std::isfinite(edge)) return true;
+    lowest += n * edge;
+  }
+  return lowest - (p.offset + p.wall.amplitude) < rmax_;
+}
+
+template <int D>
+std::pair<double, int> PlaneWalls<D>::next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
+                                                   CellCode cell, const CellGrid<D>& grid, double t,
+                                                   double horizon) const {
+  std::pair<double, int> best{horizon, -1};
+  for (int s = 0; s < surfaces(); ++s) {
+    if (!reaches(s, cell, grid)) continue;
+    const double when = event_time(s, x, v, radius, t, best.first);
+    if (when < best.first) best = {when, s};
+  }
+  return best;
+}
+
+template <int D>
+ContactResult<D> PlaneWalls<D>::resolve(int s, double t, double mass, double radius,
+                                        double inertia_factor, bool force_elastic, Vec<D>& v,
+                                        Spin<D>& w) const {
+  const PlaneWall<D>& p = plane(s);
+  WallContactInput<D> in;
+  in.normal = p.normal;
+  in.wall_velocity = p.surface_velocity(t);
+  in.mass = mass;
+  in.radius = radius;
+  in.inertia_factor = inertia_factor;
+  in.force_elastic = force_elastic;
+  return resolve_wall_contact(p.wall.contact, in, v, w);
+}
+
+template <int D>
+bool PlaneWalls<D>::overlaps(const Vec<D>& x, double radius, double t) const {
+  for (int s = 0; s < surfaces(); ++s)
+    if (gap(s, x, t) < radius) return true;
+  return false;
+}
+
+template <int D>
+void PlaneWalls<D>::check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const {
+  for (int s = 0; s < surfaces(); ++s) {
+    const double g = gap(s, x, t);
+    if (g < radius * (1.0 - 1e-12)) {
+      throw InputError(fmt::format(
+          "particle {} overlaps the wall {} (centre {:.6g} from its plane{}, radius {:.6g})", id,
+          name(s), g, g < 0.0 ? ", on the side away from its normal" : "", radius));
+    }
+  }
+}
+
+// As the face walls' (boundaries/face_walls.cpp): the relative margin keeps the run from
+// spending 1e4 ever faster bounces on the last sliver of room.
+constexpr double kPlaneSqueezeMargin = 1e-3;
+
+// A plane moving into the domain (u = n.velocity > 0) sweeps it: the farthest a centre can be
+// along n is the box's far side less a radius (max n.x over the box, the corner the normal points
+// to), unless a face there is open (the particles leave through it: no squeeze). The first time
+// the plane's innermost position (its vibration counted) leaves less than a diameter (times
+// 1 + margin) before that side, no particle fits. Other planes are not counted: they can only
+// squeeze the particles sooner, which the run drivers' frozen-clock watch reports.
+template <int D>
+void PlaneWalls<D>::prepare(const CellGrid<D>& /*grid*/, double rmax, double /*particle_volume*/,
+                            bool /*uniform*/) {
+  rmax_ = rmax;
+  squeeze_time_ = kNever;
+  squeeze_plane_ = -1;
+  for (int s = 0; s < surfaces(); ++s) {
+    const PlaneWall<D>& p = plane(s);
+    const double u = p.normal_speed();
+    if (!(u > 0.0)) continue;
+    double far = 0.0;
+    bool escapes = false;
+    for (int a = 0; a < D; ++a) {
+      const double n = p.normal[a];
+      if (n == 0.0) continue;
+      const Face<D>& side = faces_[2 * a + (n > 0.0 ? 1 : 0)];
+      escapes = escapes || side.kind == FaceKind::kOpen;
+      if (n > 0.0) far += n * box_[a];
+    }
+    if (escapes) continue;
+    const double room =
+        far - p.offset - p.wall.amplitude - 2.0 * rmax * (1.0 + kPlaneSqueezeMargin);
+    const double when = room / u;
+    if (when < squeeze_time_) {
+      squeeze_time_ = when;
+      squeeze_plane_ = s;
+    }
+  }
+}
+
+template <int D>
+void PlaneWalls<D>::throw_squeezed(double t, double dmax, bool /*uniform*/) const {
+  const PlaneWall<D>& p = plane(squeeze_plane_);
+  throw InputError(fmt::format(
+      "boundary: at t = {:.10g} the wall {}, moving into the particles at {:.6g} along its "
+      "normal, leaves less than the largest particle diameter {:.6g} between it and the far side "
+      "of the box: there is no room left; end the run before t = {:.10g}, or move the plane more "
+      "slowly or less far",
+      t, name(squeeze_plane_), p.normal_speed(), dmax, squeeze_time_));
+}
+
+template class PlaneWalls<2>;
+template class PlaneWalls<3>;
+
+}  // namespace kairos

@@ -1,0 +1,125 @@
+// Plane walls at any position and orientation ([[boundary.plane]]): the second boundary
+// component (docs/extending.md, "Adding a boundary geometry"), beside the walls on the box's
+// faces.
+//
+// A plane is the set n . x = c(t) with n the unit normal into the domain (the side the particles
+// are on) and c(t) = c0 + u t + A sin(w t + phi), u = n . velocity: a plane has everything a face
+// wall has: its own contact law, a velocity whose components in the plane slide its surface and
+// whose normal component moves it (a piston), and a vibration along its normal. Like a face
+// wall it is a function of the absolute time, so it adds nothing to restart files.
+//
+// The domain is the box less the half-spaces behind the planes. A plane must not cut a periodic
+// axis (the normal's component along it is 0, checked by Environment::check): across a periodic
+// face the plane would not meet its own image.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "boundaries/face_wall.hpp"
+#include "core/vec.hpp"
+#include "dynamics/collision_time.hpp"
+#include "interactions/granular_contact.hpp"
+#include "scheduler/cell_grid.hpp"
+
+namespace kairos {
+
+// One plane wall: where it is, how it moves (velocity, vibration: the fields of Wall<D>, whose
+// normal is n here instead of a box axis) and its contact law.
+template <int D>
+struct PlaneWall {
+  Vec<D> normal{};      // unit, into the domain
+  double offset = 0.0;  // c0: the plane is n . x = c0 at t = 0
+  Wall<D> wall;         // contact law, velocity (sliding and along n), vibration along n
+
+  double normal_speed() const { return dot(normal, wall.velocity); }
+  // c(t): where the plane lies along its normal at time t.
+  double position(double t) const {
+    const double u = normal_speed();
+    double c = offset;
+    if (u != 0.0) c += u * t;
+    return wall.vibrates() ? c + wall.amplitude * std::sin(wall.angular_frequency * t + wall.phase)
+                           : c;
+  }
+  // The surface's whole velocity at time t: sliding and normal, plus the vibration's along n.
+  Vec<D> surface_velocity(double t) const {
+    if (!wall.vibrates()) return wall.velocity;
+    return wall.velocity + (wall.amplitude * wall.angular_frequency *
+                            std::cos(wall.angular_frequency * t + wall.phase)) *
+                               normal;
+  }
+  bool plane_moves() const { return normal_speed() != 0.0 || wall.vibrates(); }
+};
+
+template <int D>
+class PlaneWalls {
+ public:
+  PlaneWalls() = default;
+  // The planes, the box (its faces bound the domain too) and which of its faces are open
+  // (particles may leave through them), the uniform acceleration particles feel.
+  PlaneWalls(std::vector<PlaneWall<D>> planes, const Vec<D>& box,
+             const std::array<Face<D>, 2 * D>& faces, const Vec<D>& gravity);
+
+  // The boundary interface (model/boundaries.hpp): surface s is plane s.
+  bool any() const { return !planes_.empty(); }
+  int surfaces() const { return static_cast<int>(planes_.size()); }
+  bool is_surface(int /*s*/) const { return true; }
+  const PlaneWall<D>& plane(int s) const { return planes_[static_cast<std::size_t>(s)]; }
+  std::string name(int s) const { return "boundary.plane[" + std::to_string(s) + "]"; }
+  const ContactModel& contact(int s) const { return plane(s).wall.contact; }
+  double approach_speed(int s) const { return plane(s).normal_speed(); }
+
+  double gap(int s, const Vec<D>& x, double t) const {
+    return dot(plane(s).normal, x) - plane(s).position(t);
+  }
+  Vec<D> normal(int s, const Vec<D>& /*x*/, double /*t*/) const { return plane(s).normal; }
+  Vec<D> velocity(int s, const Vec<D>& /*x*/, double t) const {
+    return plane(s).surface_velocity(t);
+  }
+  bool holds_still(int s) const {
+    return !plane(s).wall.vibrates() && norm2(plane(s).wall.velocity) == 0.0;
+  }
+  bool surface_moves(int s) const { return plane(s).plane_moves(); }
+  bool accelerates(int s) const { return plane(s).wall.vibrates(); }
+
+  // Relative time from t of the contact of a particle of this radius (at x with velocity v at
+  // t) with plane s; kNever if after t + horizon.
+  double event_time(int s, const Vec<D>& x, const Vec<D>& v, double radius, double t,
+                    double horizon) const;
+  // Whether a particle in `cell` can touch plane s before it leaves the cell: the cell's nearest
+  // point along the normal is within rmax (and the vibration's amplitude) of the plane; a plane
+  // moving along its normal reaches every cell.
+  bool reaches(int s, CellCode cell, const CellGrid<D>& grid) const;
+  std::pair<double, int> next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
+                                      CellCode cell, const CellGrid<D>& grid, double t,
+                                      double horizon) const;
+  // A particle (velocity v, spin w, updated in place) meets plane s at time t: a partner of
+  // infinite mass moving with its whole velocity.
+  ContactResult<D> resolve(int s, double t, double mass, double radius, double inertia_factor,
+                           bool force_elastic, Vec<D>& v, Spin<D>& w) const;
+  bool overlaps(const Vec<D>& x, double radius, double t) const;
+  // Throws InputError naming the particle and the plane it overlaps (round-off contacts, 1e-12
+  // of the radius, are contacts).
+  void check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const;
+
+  // Set-up: the particles' largest radius (the cells' reach) and when a plane moving into the
+  // domain leaves no room for one particle between it and the far side of the box.
+  void prepare(const CellGrid<D>& grid, double rmax, double particle_volume, bool uniform);
+  double squeeze_time() const { return squeeze_time_; }
+  [[noreturn]] void throw_squeezed(double t, double dmax, bool uniform) const;
+
+ private:
+  std::vector<PlaneWall<D>> planes_;
+  Vec<D> box_{};
+  std::array<Face<D>, 2 * D> faces_{};
+  Vec<D> gravity_{};
+  double rmax_ = 0.0;
+  double squeeze_time_ = kNever;
+  int squeeze_plane_ = -1;
+};
+
+}  // namespace kairos
