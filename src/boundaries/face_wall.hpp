@@ -59,6 +59,24 @@ struct Face {
   Wall<D> wall;  // used when kind == kWall
 };
 
+// A particle (velocity v, spin w, updated in place) meets a surface of infinite mass with unit
+// normal n (towards the particle) moving at wall_velocity at the contact: every geometry's
+// response (resolve_wall_contact with the surface's law).
+template <int D>
+ContactResult<D> resolve_surface_contact(const ContactModel& law, const Vec<D>& normal,
+                                         const Vec<D>& wall_velocity, double mass, double radius,
+                                         double inertia_factor, bool force_elastic, Vec<D>& v,
+                                         Spin<D>& w) {
+  WallContactInput<D> in;
+  in.normal = normal;
+  in.wall_velocity = wall_velocity;
+  in.mass = mass;
+  in.radius = radius;
+  in.inertia_factor = inertia_factor;
+  in.force_elastic = force_elastic;
+  return resolve_wall_contact(law, in, v, w);
+}
+
 // The unit normal of a face's wall, into the box.
 template <int D>
 Vec<D> face_normal(int face) {

@@ -76,14 +76,8 @@ ContactResult<D> FaceWalls<D>::resolve(int f, double t, double mass, double radi
                                        double inertia_factor, bool force_elastic, Vec<D>& v,
                                        Spin<D>& w) const {
   const Wall<D>& wall = faces_[f].wall;
-  WallContactInput<D> in;
-  in.normal = face_normal<D>(f);
-  in.wall_velocity = wall.surface_velocity(f, t);
-  in.mass = mass;
-  in.radius = radius;
-  in.inertia_factor = inertia_factor;
-  in.force_elastic = force_elastic;
-  return resolve_wall_contact(wall.contact, in, v, w);
+  return resolve_surface_contact<D>(wall.contact, face_normal<D>(f), wall.surface_velocity(f, t),
+                                    mass, radius, inertia_factor, force_elastic, v, w);
 }
 
 template <int D>

@@ -71,14 +71,8 @@ ContactResult<D> PlaneWalls<D>::resolve(int s, double t, double mass, double rad
                                         double inertia_factor, bool force_elastic, Vec<D>& v,
                                         Spin<D>& w) const {
   const PlaneWall<D>& p = plane(s);
-  WallContactInput<D> in;
-  in.normal = p.normal;
-  in.wall_velocity = p.surface_velocity(t);
-  in.mass = mass;
-  in.radius = radius;
-  in.inertia_factor = inertia_factor;
-  in.force_elastic = force_elastic;
-  return resolve_wall_contact(p.wall.contact, in, v, w);
+  return resolve_surface_contact<D>(p.wall.contact, p.normal, p.surface_velocity(t), mass, radius,
+                                    inertia_factor, force_elastic, v, w);
 }
 
 template <int D>
