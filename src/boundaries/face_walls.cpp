@@ -47,28 +47,16 @@ void FaceWalls<D>::set_reach(const CellGrid<D>& grid, double rmax) {
   }
 }
 
-// Whether a cell lies within layers_[f] layers of face f (a non-periodic axis).
+// Whether a particle in cell c can touch face f: f has a wall, and the cell lies within
+// layers_[f] layers of it (a non-periodic axis) unless the wall moves along its normal (a piston
+// may reach any layer).
 template <int D>
 bool FaceWalls<D>::reaches(int f, CellCode c, const CellGrid<D>& grid) const {
-  const int a = f / 2, k = grid.coordinate(c, a);
+  const int a = f / 2;
+  if (faces_[f].kind != FaceKind::kWall) return false;
+  if (faces_[f].wall.velocity[a] != 0.0) return true;
+  const int k = grid.coordinate(c, a);
   return f % 2 == 0 ? k < layers_[f] : grid.cells_along(a) - 1 - k < layers_[f];
-}
-
-// Only the layers next to a face that its wall's vibration can reach can touch a fixed or
-// vibrating wall; a wall with a normal velocity (a piston) may reach any layer.
-template <int D>
-std::pair<double, int> FaceWalls<D>::next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
-                                                  CellCode cell, const CellGrid<D>& grid, double t,
-                                                  double horizon) const {
-  std::pair<double, int> best{horizon, -1};
-  for (int f = 0; f < 2 * D; ++f) {
-    const int a = f / 2;
-    if (faces_[f].kind != FaceKind::kWall) continue;
-    if (faces_[f].wall.velocity[a] == 0.0 && !reaches(f, cell, grid)) continue;
-    const double when = event_time(f, x, v, radius, t, best.first);
-    if (when < best.first) best = {when, f};
-  }
-  return best;
 }
 
 template <int D>

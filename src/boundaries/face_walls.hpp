@@ -78,14 +78,9 @@ class FaceWalls {
   // particle's centre within its radius of the plane, which moves up to the amplitude into the
   // box), for cells of the grid's widths and particles up to rmax.
   void set_reach(const CellGrid<D>& grid, double rmax);
-  // Whether a particle in cell c can touch wall f (a piston, moving along its normal, reaches
-  // every layer).
+  // Whether a particle in cell c can touch face f before it leaves the cell: f has a wall, and
+  // the cell is within reach of it (a piston, moving along its normal, reaches every layer).
   bool reaches(int f, CellCode c, const CellGrid<D>& grid) const;
-  // The particle's soonest wall contact from time t before t + horizon: (relative time, face),
-  // face -1 if none.
-  std::pair<double, int> next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
-                                      CellCode cell, const CellGrid<D>& grid, double t,
-                                      double horizon) const;
 
   // A particle (velocity v, spin w, updated in place) meets wall f at time t: the wall is a
   // partner of infinite mass moving with its whole velocity (sliding, normal, vibrating), so

@@ -54,19 +54,6 @@ bool PlaneWalls<D>::reaches(int s, CellCode cell, const CellGrid<D>& grid) const
 }
 
 template <int D>
-std::pair<double, int> PlaneWalls<D>::next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
-                                                   CellCode cell, const CellGrid<D>& grid, double t,
-                                                   double horizon) const {
-  std::pair<double, int> best{horizon, -1};
-  for (int s = 0; s < surfaces(); ++s) {
-    if (!reaches(s, cell, grid)) continue;
-    const double when = event_time(s, x, v, radius, t, best.first);
-    if (when < best.first) best = {when, s};
-  }
-  return best;
-}
-
-template <int D>
 ContactResult<D> PlaneWalls<D>::resolve(int s, double t, double mass, double radius,
                                         double inertia_factor, bool force_elastic, Vec<D>& v,
                                         Spin<D>& w) const {

@@ -94,9 +94,6 @@ class PlaneWalls {
   // point along the normal is within rmax (and the vibration's amplitude) of the plane; a plane
   // moving along its normal reaches every cell.
   bool reaches(int s, CellCode cell, const CellGrid<D>& grid) const;
-  std::pair<double, int> next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
-                                      CellCode cell, const CellGrid<D>& grid, double t,
-                                      double horizon) const;
   // A particle (velocity v, spin w, updated in place) meets plane s at time t: a partner of
   // infinite mass moving with its whole velocity.
   ContactResult<D> resolve(int s, double t, double mass, double radius, double inertia_factor,

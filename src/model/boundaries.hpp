@@ -12,9 +12,9 @@
 //   double event_time(int s, x, v, radius, t, horizon) const;
 //                                               when a particle (at x, velocity v at time t,
 //                                               under the uniform field) first touches it
-//   std::pair<double, int> next_contact(x, v, radius, cell, grid, t, horizon) const;
-//                                               the soonest of its surfaces a particle in `cell`
-//                                               can reach (its own filter by cells)
+//   bool reaches(int s, cell, grid) const;      a particle in `cell` can touch surface s before
+//                                               it leaves the cell (the component's own filter
+//                                               by cells; false for an absent surface)
 //   double gap(int s, x, t) const;              centre to surface, positive inside
 //   Vec<D> normal(int s, x, t) const;           unit normal into the domain at x's contact point
 //   Vec<D> velocity(int s, x, t) const;         the surface's velocity there
@@ -160,8 +160,11 @@ class BoundarySet {
     std::pair<double, int> best{horizon, -1};
     int first = 0;
     for_each([&](const auto& c) {
-      const auto [dt, k] = c.next_contact(x, v, radius, cell, grid, t, best.first);
-      if (k >= 0 && dt < best.first) best = {dt, first + k};
+      for (int k = 0; k < c.surfaces(); ++k) {
+        if (!c.reaches(k, cell, grid)) continue;
+        const double when = c.event_time(k, x, v, radius, t, best.first);
+        if (when < best.first) best = {when, first + k};
+      }
       first += c.surfaces();
     });
     return best;

@@ -91,12 +91,22 @@ TEST(FaceWalls, OnlyTheLayersAWallReachesTestIt) {
   EXPECT_FALSE(walls.reaches(4, grid.code_at({3, 3, 2}), grid));
   EXPECT_TRUE(walls.reaches(5, grid.code_at({3, 3, 9}), grid));
   EXPECT_FALSE(walls.reaches(5, grid.code_at({3, 3, 8}), grid));
+  // A face without a wall reaches nothing; a piston (moving along its normal) reaches every
+  // layer.
+  EXPECT_FALSE(walls.reaches(0, grid.code_at({0, 3, 3}), grid));
+  Environment<3> with_piston = env;
+  with_piston.faces[5].wall.velocity[2] = -0.1;
+  FaceWalls<3> piston = walls_of(with_piston);
+  piston.set_reach(grid, 0.5);
+  EXPECT_TRUE(piston.reaches(5, grid.code_at({3, 3, 0}), grid));
+  EXPECT_FALSE(piston.reaches(4, grid.code_at({3, 3, 5}), grid));
   // A particle in a layer the floor cannot reach finds no contact, whatever its motion.
-  const auto far = walls.next_contact({5.0, 5.0, 5.5}, {0.0, 0.0, -1.0}, 0.5,
-                                      grid.code_at({5, 5, 5}), grid, 0.0, kNever);
+  const BoundarySet<3, FaceWalls<3>> set(walls);
+  const auto far = set.next_contact({5.0, 5.0, 5.5}, {0.0, 0.0, -1.0}, 0.5, grid.code_at({5, 5, 5}),
+                                    grid, 0.0, kNever);
   EXPECT_EQ(far.second, -1);
-  const auto near = walls.next_contact({5.0, 5.0, 1.5}, {0.0, 0.0, -1.0}, 0.5,
-                                       grid.code_at({5, 5, 1}), grid, 0.0, kNever);
+  const auto near = set.next_contact({5.0, 5.0, 1.5}, {0.0, 0.0, -1.0}, 0.5,
+                                     grid.code_at({5, 5, 1}), grid, 0.0, kNever);
   EXPECT_EQ(near.second, 4);
 }
 
