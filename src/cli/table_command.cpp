@@ -220,17 +220,22 @@ void write_plot_files(const SoftMapTable& t, const std::filesystem::path& dir, i
 }
 
 // The tables `kairos run CONFIG` would use (same state, same speed range, same cache), built now or
-// read from the cache; one report each. The setup chain's first steps (run/setup_chain.hpp).
+// read from the cache; one report each. The setup chain's steps 1 to 3 (run/setup_chain.hpp), as
+// `kairos run` takes them.
 template <int D>
 void build_config_tables(const Config& config) {
   if (!config.soft.enabled()) throw InputError("the config has no [soft] table");
+  if (!config.soft.tables)
+    throw InputError("soft.tables = false: the run integrates each contact and uses no table");
+  if (integrators().at(config.run.integrator) != IntegratorKind::kEvent)
+    throw InputError(fmt::format("run.integrator = \"{}\": only the event integrator uses tables",
+                                 config.run.integrator));
   const RunStart<D> start = start_run<D>(config, std::nullopt, config.run.integrator);
   Environment<D> env = make_environment<D>(start.config, start.state);
   // A progress line on terminals only (as for a table from flags): a log gets no \r lines.
   const bool tell = ::isatty(STDERR_FILENO) != 0;
-  const std::vector<SoftTableUse> used = attach_soft_tables(
-      env, start.state, soft_table_settings(start.config, start.resumed),
-      [tell](const std::string& contact, double f) {
+  const std::vector<SoftTableUse> used =
+      start_tables(env, start, [tell](const std::string& contact, double f) {
         if (!tell) return;
         std::fprintf(stderr, "\rbuilding the table of %s: %5.1f %%", contact.c_str(), 100.0 * f);
         std::fflush(stderr);

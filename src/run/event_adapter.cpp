@@ -162,6 +162,10 @@ Advance EventEngineAdapter<D, Queue>::advance(const AdvanceLimits& limits) {
   const bool driven = this->kind_.driven;
   // The limits, in locals for the loop (the engine's calls cannot change them).
   const std::uint64_t threshold = limits.collisions;
+  // The next event count to return at: the limit, or the next poll (every 16 384 events) of
+  // the stop flag, the wall time and the progress line.
+  const std::uint64_t next_poll = (engine_.counters().events | std::uint64_t{0x3fff}) + 1;
+  const std::uint64_t check_at = std::min(limits.events, next_poll);
   const double end_time = limits.phase_end_time;
   const bool clock_stops = limits.clock_stops;
   double stop = std::min(limits.next_output_time, end_time);
@@ -208,8 +212,9 @@ Advance EventEngineAdapter<D, Queue>::advance(const AdvanceLimits& limits) {
       return result;
     }
     const EventCounters& c = engine_.counters();
-    const bool poll = (c.events & 0x3fffu) == 0;
-    if (c.collisions >= threshold || engine_.time() >= end_time || poll || stop_requested()) {
+    if (c.collisions >= threshold || engine_.time() >= end_time || c.events >= check_at ||
+        stop_requested()) {
+      const bool poll = c.events >= next_poll;
       result.collision_triggers = true;
       result.update_progress = poll;
       result.check_wall_time = poll;

@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/periodic.hpp"
 #include "core/state_blocks.hpp"
+#include "core/stop_flag.hpp"
 #include "io/config_choices.hpp"
 #include "run/event_adapter.hpp"
 #include "run/output_directory.hpp"
@@ -67,31 +68,46 @@ Simulation<D>::Simulation(const Config& config,
 template <int D>
 Simulation<D>::~Simulation() = default;
 
+// The run driver's loop (EventEngineAdapter::advance, as `kairos run` advances), with the
+// Simulation's stop rules: an event, a state or a frozen clock that cannot go on is the
+// caller's InputError; keep_going is asked at the adapter's polls (every 16 384 events).
 template <int D>
-bool Simulation<D>::run_while(const std::function<bool()>& more, const KeepGoing& keep_going) {
-  EventEngine<D, CalendarQueue>& engine = engine_->engine();
-  FrozenClockWatch& watch = engine_->clock_watch();
-  while (more()) {
-    if (engine.step() == EventKind::kNone) return false;
-    if (watch.frozen(engine)) throw InputError(watch.describe(engine));
-    if ((engine.counters().events & 0x3fffu) == 0 && keep_going && !keep_going()) return false;
+bool Simulation<D>::advance_within(const AdvanceLimits& limits, const std::function<bool()>& done,
+                                   const KeepGoing& keep_going) {
+  while (!done()) {
+    const Advance a = engine_->advance(limits);
+    switch (a.stop) {
+      case AdvanceStop::kNone:
+        break;
+      case AdvanceStop::kFrozenClock:
+      case AdvanceStop::kError:
+        throw InputError(a.error);
+      default:
+        return false;  // no event left
+    }
+    if (done()) return true;
+    if ((a.update_progress || stop_requested()) && keep_going && !keep_going()) return false;
   }
   return true;
 }
 
 template <int D>
 bool Simulation<D>::advance_to_time(double t, const KeepGoing& keep_going) {
-  if (!(t >= engine_->engine().time()) || !std::isfinite(t)) {
+  EventEngine<D, CalendarQueue>& engine = engine_->engine();
+  if (!(t >= engine.time()) || !std::isfinite(t)) {
     throw InputError(
         fmt::format("advance to time {}: the simulation is at time {} already (or "
                     "the time is not finite)",
-                    t, engine_->engine().time()));
+                    t, engine.time()));
   }
-  if (!run_while([&] { return engine_->engine().next_event_time() <= t; }, keep_going)) {
-    if (engine_->engine().next_event_time() <= t) return false;  // stopped by keep_going
-  }
-  engine_->engine().advance_clock(t);
-  return true;
+  // The clock stops at t, as at the end of a phase measured in time.
+  AdvanceLimits limits;
+  limits.next_output_time = t;
+  limits.phase_end_time = t;
+  limits.phase_in_time = true;
+  limits.clock_stops = true;
+  return advance_within(
+      limits, [&] { return engine.time() == t && !(engine.next_event_time() <= t); }, keep_going);
 }
 
 namespace {
@@ -103,14 +119,18 @@ std::uint64_t target_after(std::uint64_t now, std::uint64_t count) {
 
 template <int D>
 bool Simulation<D>::advance_events(std::uint64_t count, const KeepGoing& keep_going) {
-  const std::uint64_t target = target_after(engine_->engine().counters().events, count);
-  return run_while([&] { return engine_->engine().counters().events < target; }, keep_going);
+  AdvanceLimits limits;
+  limits.events = target_after(events(), count);
+  return advance_within(
+      limits, [&] { return events() >= limits.events; }, keep_going);
 }
 
 template <int D>
 bool Simulation<D>::advance_collisions(std::uint64_t count, const KeepGoing& keep_going) {
-  const std::uint64_t target = target_after(engine_->engine().counters().collisions, count);
-  return run_while([&] { return engine_->engine().counters().collisions < target; }, keep_going);
+  AdvanceLimits limits;
+  limits.collisions = target_after(collisions(), count);
+  return advance_within(
+      limits, [&] { return collisions() >= limits.collisions; }, keep_going);
 }
 
 template <int D>

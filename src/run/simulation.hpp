@@ -18,6 +18,7 @@
 #include "core/vec.hpp"
 #include "engine/helfand_moments.hpp"
 #include "io/config.hpp"
+#include "run/integrator.hpp"
 #include "run/run_progress.hpp"
 #include "run/setup_chain.hpp"
 
@@ -105,8 +106,10 @@ class Simulation {
   void save(const std::filesystem::path& path) const;
 
  private:
-  // Events while `more` holds; false if none was left or keep_going said stop.
-  bool run_while(const std::function<bool()>& more, const KeepGoing& keep_going);
+  // Advances within `limits` until done() holds: true then; false if no event was left or
+  // keep_going said stop.
+  bool advance_within(const AdvanceLimits& limits, const std::function<bool()>& done,
+                      const KeepGoing& keep_going);
 
   Config config_;
   std::unique_ptr<EventEngineAdapter<D, CalendarQueue>> engine_;

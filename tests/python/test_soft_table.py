@@ -5,6 +5,7 @@ installed), a head-on (wall) table, and the user errors.
 """
 
 import glob
+import json
 import os
 import subprocess
 import sys
@@ -120,6 +121,16 @@ class SoftTableCli(kt.KairosTestCase):
         self.assertEqual(report_value(built, "file"), table["cache_file"])
         self.assert_user_error(self.kairos("table", "build", "--config", path, "--model", "hertz"),
                                "--config")
+        # A run that uses no table has none to build: said, not built.
+        untabled = json.loads(json.dumps(config))
+        untabled["soft"]["tables"] = False
+        self.assert_user_error(self.kairos("table", "build", "--config",
+                                           self.write_config(untabled, "direct.toml")),
+                               "soft.tables")
+        dem = json.loads(json.dumps(config))
+        dem["run"]["integrator"] = "dem"
+        self.assert_user_error(self.kairos("table", "build", "--config",
+                                           self.write_config(dem, "dem.toml")), "run.integrator")
         del config["soft"]
         self.assert_user_error(self.kairos("table", "build", "--config",
                                            self.write_config(config, "hard.toml")), "[soft]")
