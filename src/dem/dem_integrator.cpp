@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -168,11 +169,6 @@ void DemIntegrator<D>::set_friction(const Environment<D>& env) {
 
 template <int D>
 void DemIntegrator<D>::set_walls(const Environment<D>& env) {
-  if (!env.planes.empty()) {
-    throw InputError(
-        "boundary.plane: the DEM integrator (run.integrator = \"dem\") has walls on the box's "
-        "faces only ([[boundary.wall]]); plane walls anywhere need the event integrator");
-  }
   for (int k = 0; k < D; ++k) {
     periodic_[k] = env.periodic(k);
     if (base_.periodic[k] != periodic_[k])
@@ -188,6 +184,11 @@ void DemIntegrator<D>::set_walls(const Environment<D>& env) {
     walls_[static_cast<std::size_t>(f)] = env.faces[static_cast<std::size_t>(f)].wall;
     any_wall_ = any_wall_ || kind == FaceKind::kWall;
   }
+  boundaries_ = Boundaries<D>(env, box_);
+  wall_shear_.assign(static_cast<std::size_t>(boundaries_.surfaces()), {});
+  for (int s = 2 * D; s < boundaries_.surfaces(); ++s)
+    any_surface_ = any_surface_ || boundaries_.is_surface(s);
+  any_wall_ = any_wall_ || any_surface_;
   if (any_wall_) {
     if (env.soft_wall.size() != species_)
       throw InputError(fmt::format("DEM: {} particle-wall laws for {} species (one per species)",
@@ -351,8 +352,8 @@ void DemIntegrator<D>::init(const DemOptions& options) {
         }
       }
     }
-    for (int f = 0; f < 2 * D; ++f)
-      if (wall_on_[static_cast<std::size_t>(f)])
+    for (int f = 0; f < boundaries_.surfaces(); ++f)
+      if (f < 2 * D ? wall_on_[static_cast<std::size_t>(f)] : boundaries_.is_surface(f))
         wall_shear_[static_cast<std::size_t>(f)].assign(n, Vec<D>{});
   }
   skin_ = options.skin * max_diameter_;
@@ -966,12 +967,93 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
       }
     }
   }
+  if (any_surface_) {
+    WallSums sums{potential, loss, work, spring, slip, entered};
+    add_surface_forces(count_collisions, t, sums);
+    potential = sums.potential;
+    loss = sums.loss;
+    work = sums.work;
+    spring = sums.spring;
+    slip = sums.slip;
+    entered = sums.entered;
+  }
   potential_ += potential + spring;
   wall_spring_energy_ = spring;
   wall_slip_power_ = slip;
   wall_loss_power_ = loss;
   wall_work_power_ = work;
   wall_collisions_ += count_collisions ? entered : 0;
+}
+
+template <int D>
+void DemIntegrator<D>::add_surface_forces(bool count_collisions, double t, WallSums& sums) {
+  int first = 0;
+  boundaries_.for_each([&](const auto& c) {
+    // The faces have their own loop (compute_wall_forces).
+    if constexpr (!std::is_same_v<std::decay_t<decltype(c)>, FaceWalls<D>>)
+      add_component_forces(c, first, count_collisions, t, sums);
+    first += c.surfaces();
+  });
+}
+
+// As the faces' loop with the surface's own gap, normal (into the domain) and velocity at the
+// particle's contact point.
+template <int D>
+template <class Component>
+void DemIntegrator<D>::add_component_forces(const Component& c, int first, bool count_collisions,
+                                            double t, WallSums& sums) {
+  const std::size_t n = size();
+  for (int k = 0; k < c.surfaces(); ++k) {
+    if (!c.is_surface(k)) continue;
+    std::vector<Vec<D>>& springs = wall_shear_[static_cast<std::size_t>(first + k)];
+    for (std::size_t i = 0; i < n; ++i) {
+      Vec<D> x;
+      for (int a = 0; a < D; ++a) x[a] = x_[a][i];
+      const double gap = c.gap(k, x, t);  // the centre's distance from the surface
+      const double R = radius_[i];
+      if (gap >= R) {
+        if (friction_ && springs[i] != Vec<D>{}) springs[i] = Vec<D>{};
+        continue;
+      }
+      const double overlap = R - gap;
+      if (overlap > max_overlap_fraction_ * R)
+        throw InputError(fmt::format(
+            "DEM: particle {} overlaps {} by {} (more than {} of its radius) at t = {}: time "
+            "step dt = {} too large, the wall too fast or the initial state outside",
+            id_[i], c.name(k), overlap, max_overlap_fraction_, t, dt_));
+      const Vec<D> normal = c.normal(k, x, t);
+      const Vec<D> wall_velocity = c.velocity(k, x, t);
+      if (count_collisions) {  // apart one step earlier (u_ holds the drift velocity)?
+        Vec<D> before;
+        for (int a = 0; a < D; ++a) before[a] = x[a] - dt_ * u_[a][i];
+        if (c.gap(k, before, t - dt_) >= R) ++sums.entered;
+      }
+      Vec<D> v;
+      for (int a = 0; a < D; ++a) v[a] = vp_[a][i];
+      const double rdot = dot(v - wall_velocity, normal);  // the gap's rate of change
+      const std::size_t s = sp_[i];
+      const double kk = wall_stiffness_[s], damping = wall_damping_[s];
+      const bool hertz = wall_hertz_[s] != 0;
+      const NormalForce nf = normal_force(hertz, kk, damping, overlap, rdot);
+      const double F = nf.force;
+      sums.potential += nf.energy;
+      sums.loss += (nf.elastic - F) * rdot;
+      sums.work += F * dot(normal, wall_velocity);
+      for (int a = 0; a < D; ++a) f_[a][i] += F * normal[a];
+      if (friction_ && friction_wall_[s].coefficient > 0.0) {
+        const SoftFriction& fr = friction_wall_[s];
+        // The contact point (at x - gap n) relative to the surface.
+        const Vec<D> vc = v - gap * cross(spin(wp_, i), normal) - wall_velocity;
+        const Vec<D> vt = vc - dot(vc, normal) * normal;
+        const auto [kt, gt] = tangential_law(fr, hertz, kk, damping, nf.root);
+        const Vec<D> ft = tangential_force<D>(springs[i], normal, vt, kt, gt, fr.coefficient * F,
+                                              count_collisions ? dt_ : 0.0, sums.spring, sums.slip);
+        for (int a = 0; a < D; ++a) f_[a][i] += ft[a];
+        add_spin(tq_, i, -gap * cross(normal, ft));
+        sums.work += dot(ft, wall_velocity);
+      }
+    }
+  }
 }
 
 template <int D>

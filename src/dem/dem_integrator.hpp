@@ -35,8 +35,9 @@
 // which a new integrator continues bit for bit (restart files carry it).
 //
 // Walls and gravity (the Environment constructor): a face of the box may be a wall, a plane
-// that is fixed, slides in its plane (no effect: the contacts are frictionless) or moves along
-// its normal (a piston's constant speed, a vibration A sin(w t + phi): Environment's Wall). A
+// that is fixed, slides in its plane (felt through friction only) or moves along its normal (a
+// piston's constant speed, a vibration A sin(w t + phi): Environment's Wall); plane walls
+// anywhere ([[boundary.plane]], boundaries/plane_walls.hpp) move the same ways. A
 // particle of species s closer to a wall than its radius feels the normal force of the law
 // soft_wall[s] with the reduced mass of the particle alone (the wall's mass is infinite), the
 // overlap R - d and the gap's rate of change, clipped at zero like a pair's. The wall's work on
@@ -64,10 +65,11 @@
 #include <cstdint>
 #include <vector>
 
-#include "model/environment.hpp"
 #include "core/particle_system.hpp"
 #include "interactions/granular_contact.hpp"
 #include "interactions/soft_contact.hpp"
+#include "model/boundaries.hpp"
+#include "model/environment.hpp"
 
 namespace kairos {
 
@@ -106,7 +108,8 @@ class DemIntegrator {
   DemIntegrator(const ParticleSystem<D>& system, const std::vector<SoftContactLaw>& laws,
                 std::uint32_t species, const DemOptions& options = {});
   // Laws, walls and gravity from an environment: env.soft and env.species as above, a wall at
-  // every face of kind kWall with the law env.soft_wall[s] for particles of species s, and
+  // every face of kind kWall and every plane of env.planes with the law env.soft_wall[s] for
+  // particles of species s, and
   // env.gravity. The system's periodic axes and gravity must be the environment's. InputError
   // for what the DEM does not integrate: open faces, shear, stepped potentials, no soft laws.
   // The default time step also covers the wall contacts (reduced mass m_min) and, under
@@ -173,6 +176,18 @@ class DemIntegrator {
   void set_friction(const Environment<D>& env);
   // Wall forces (added to f_) at positions x and predicted velocities vp at time t.
   void compute_wall_forces(bool count_collisions, double t);
+  // What the wall contacts add up to in one force evaluation.
+  struct WallSums {
+    double potential = 0.0, loss = 0.0, work = 0.0, spring = 0.0, slip = 0.0;
+    std::uint64_t entered = 0;
+  };
+  // The contacts with the surfaces of the boundary components other than the box faces (plane
+  // walls): the faces' force law through the boundary interface (gap, normal and velocity at
+  // the contact), component by component (static dispatch).
+  void add_surface_forces(bool count_collisions, double t, WallSums& sums);
+  template <class Component>
+  void add_component_forces(const Component& c, int first, bool count_collisions, double t,
+                            WallSums& sums);
   template <bool Gravity, bool Walls>
   void kick_drift(double& vmax2, double& vsum2);
   void synchronise(bool from_half_step);
@@ -230,7 +245,11 @@ class DemIntegrator {
   std::array<bool, D> periodic_{};
   std::array<bool, 2 * D> wall_on_{};
   std::array<Wall<D>, 2 * D> walls_{};
-  bool any_wall_ = false;
+  // Every surface of the run (model/boundaries.hpp): the faces above run their own loop over the
+  // coordinate arrays; the other components' surfaces (any_surface_) go through add_surface_forces.
+  Boundaries<D> boundaries_;
+  bool any_surface_ = false;
+  bool any_wall_ = false;  // a face wall or another surface
   std::vector<SoftContactLaw> wall_laws_;
   std::vector<double> wall_stiffness_, wall_damping_;
   std::vector<std::uint8_t> wall_hertz_;
@@ -246,7 +265,7 @@ class DemIntegrator {
   bool friction_ = false;
   std::vector<SoftFriction> friction_pair_, friction_wall_;
   std::vector<Vec<D>> shear_;
-  std::array<std::vector<Vec<D>>, 2 * D> wall_shear_;
+  std::vector<std::vector<Vec<D>>> wall_shear_;  // per surface (faces first), per slot
   std::vector<double> w_[kSpin], uw_[kSpin], wp_[kSpin], tq_[kSpin];
   std::vector<double> inertia_, inv_inertia_;
   std::vector<double> inertia_factor_;  // q per species: I = q m R^2
