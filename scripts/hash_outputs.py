@@ -72,6 +72,9 @@ EXTRA = [
     ("continued_shear", "examples/shear_flow_2d.toml", None, [], []),
     ("continued_vibrated", "examples/vibrated_bed_2d.toml", None, [], []),
     ("continued_dem", "examples/dem_pile_3d.toml", None, [], []),
+    # Friction against a sliding floor (the wall springs travel in the restart file).
+    ("continued_dem_rough_sliding", "examples/dem_pile_3d.toml", None,
+     ["soft.friction=0.5", "boundary.wall[0].velocity=[0.3, 0.0, 0.0]"], []),
     # The structure analyses of a continued run (its averages start afresh), with their own
     # interval in the continuation.
     ("continued_structure", "examples/hard_spheres_structure.toml", None,

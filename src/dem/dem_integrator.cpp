@@ -907,11 +907,63 @@ Vec<D> DemIntegrator<D>::half_box() const {
   return half;
 }
 
+// Whether slot i (of radius R) touches surface s at `gap`: if not, its spring there is reset;
+// InputError if it overlaps by more than the integrator allows.
+template <int D>
+bool DemIntegrator<D>::touches(std::size_t i, int s, double gap, double t,
+                               std::vector<Vec<D>>& springs) {
+  const double R = radius_[i];
+  if (gap >= R) {
+    if (friction_ && springs[i] != Vec<D>{}) springs[i] = Vec<D>{};
+    return false;
+  }
+  const double overlap = R - gap;
+  if (overlap > max_overlap_fraction_ * R)
+    throw InputError(fmt::format(
+        "DEM: particle {} overlaps the wall {} by {} (more than {} of its radius) at t = {}: "
+        "time step dt = {} too large, the wall too fast or the initial state outside",
+        id_[i], boundaries_.name(s), overlap, max_overlap_fraction_, t, dt_));
+  return true;
+}
+
+// One wall contact of slot i (both loops): the normal force of its species' wall law, its
+// energy split and the surface's work, and with friction the tangential spring.
+template <int D>
+void DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, Vec<D>& spring,
+                                        bool count_collisions, WallSums& sums) {
+  const std::size_t s = sp_[i];
+  const double kk = wall_stiffness_[s], damping = wall_damping_[s];
+  const bool hertz = wall_hertz_[s] != 0;
+  const NormalForce nf = normal_force(hertz, kk, damping, radius_[i] - c.gap, c.rdot);
+  const double F = nf.force;
+  sums.potential += nf.energy;
+  sums.loss += (nf.elastic - F) * c.rdot;
+  // d(KE + U)/dt = -(F_el - F) rdot + F w_n, w_n the surface's velocity along the normal.
+  sums.work += F * c.normal_speed;
+  if (c.axis >= 0) {
+    f_[c.axis][i] += c.normal[c.axis] * F;  // a face: the other components stay untouched
+  } else {
+    for (int a = 0; a < D; ++a) f_[a][i] += F * c.normal[a];
+  }
+  if (!friction_ || !(friction_wall_[s].coefficient > 0.0)) return;
+  const SoftFriction& fr = friction_wall_[s];
+  Vec<D> v;
+  for (int a = 0; a < D; ++a) v[a] = vp_[a][i];
+  // The contact point (on the surface, at x - gap n) relative to the surface.
+  const Vec<D> vc = v - c.gap * cross(spin(wp_, i), c.normal) - c.velocity;
+  const Vec<D> vt = vc - dot(vc, c.normal) * c.normal;
+  const auto [kt, gt] = tangential_law(fr, hertz, kk, damping, nf.root);
+  const Vec<D> ft = tangential_force<D>(spring, c.normal, vt, kt, gt, fr.coefficient * F,
+                                        count_collisions ? dt_ : 0.0, sums.spring, sums.slip);
+  for (int a = 0; a < D; ++a) f_[a][i] += ft[a];
+  add_spin(tq_, i, -c.gap * cross(c.normal, ft));
+  sums.work += dot(ft, c.velocity);  // a sliding wall drags (and heats) by friction
+}
+
 template <int D>
 void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
   const std::size_t n = size();
-  double potential = 0.0, loss = 0.0, work = 0.0, spring = 0.0, slip = 0.0;
-  std::uint64_t entered = 0;
+  WallSums sums;
   for (int f = 0; f < 2 * D; ++f) {
     if (!wall_on_[static_cast<std::size_t>(f)]) continue;
     const int k = f / 2;
@@ -920,69 +972,30 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
     const double p = wall.plane_position(f, box_, t), w = wall.plane_speed(f, t);
     const double p_before = wall.plane_position(f, box_, t - dt_);
     const double* const x = x_[k].data();
-    // Friction: the wall's velocity (sliding in its plane, moving along its normal) and normal.
-    Vec<D> wall_velocity = wall.velocity, normal{};
-    wall_velocity[k] = w;
-    normal[k] = sign;
+    // The wall's velocity (sliding in its plane, moving along its normal) and normal.
+    WallContact c{.axis = k};
+    c.velocity = wall.velocity;
+    c.velocity[k] = w;
+    c.normal[k] = sign;
+    c.normal_speed = sign * w;
     std::vector<Vec<D>>& springs = wall_shear_[static_cast<std::size_t>(f)];
     for (std::size_t i = 0; i < n; ++i) {
-      const double gap = sign * (x[i] - p);  // the centre's distance from the plane
-      const double R = radius_[i];
-      if (gap >= R) {
-        if (friction_ && springs[i] != Vec<D>{}) springs[i] = Vec<D>{};
-        continue;
-      }
-      const double overlap = R - gap;
-      if (overlap > max_overlap_fraction_ * R)
-        throw InputError(fmt::format(
-            "DEM: particle {} overlaps the wall at face {} by {} (more than {} of its radius) at "
-            "t = {}: time step dt = {} too large, the wall too fast or the initial state outside",
-            id_[i], f, overlap, max_overlap_fraction_, t, dt_));
+      c.gap = sign * (x[i] - p);  // the centre's distance from the plane
+      if (!touches(i, f, c.gap, t, springs)) continue;
       // Apart one step earlier (u_ holds the drift velocity)?
-      if (count_collisions && sign * (x[i] - dt_ * u_[k][i] - p_before) >= R) ++entered;
-      const double rdot = sign * (vp_[k][i] - w);  // the gap's rate of change
-      const std::size_t s = sp_[i];
-      const double kk = wall_stiffness_[s], c = wall_damping_[s];
-      const bool hertz = wall_hertz_[s] != 0;
-      const NormalForce nf = normal_force(hertz, kk, c, overlap, rdot);
-      const double F = nf.force;
-      potential += nf.energy;
-      loss += (nf.elastic - F) * rdot;
-      // d(KE + U)/dt = -(F_el - F) rdot + F w_n, w_n the plane's velocity along the normal.
-      work += F * sign * w;
-      f_[k][i] += sign * F;
-      if (friction_ && friction_wall_[s].coefficient > 0.0) {
-        const SoftFriction& fr = friction_wall_[s];
-        Vec<D> v;
-        for (int a = 0; a < D; ++a) v[a] = vp_[a][i];
-        // The contact point (on the wall's plane, at x - gap n) relative to the wall.
-        const Vec<D> vc = v - gap * cross(spin(wp_, i), normal) - wall_velocity;
-        const Vec<D> vt = vc - dot(vc, normal) * normal;
-        const auto [kt, gt] = tangential_law(fr, hertz, kk, c, nf.root);
-        const Vec<D> ft = tangential_force<D>(springs[i], normal, vt, kt, gt, fr.coefficient * F,
-                                              count_collisions ? dt_ : 0.0, spring, slip);
-        for (int a = 0; a < D; ++a) f_[a][i] += ft[a];
-        add_spin(tq_, i, -gap * cross(normal, ft));
-        work += dot(ft, wall_velocity);  // a sliding wall drags (and heats) by friction
-      }
+      if (count_collisions && sign * (x[i] - dt_ * u_[k][i] - p_before) >= radius_[i])
+        ++sums.entered;
+      c.rdot = sign * (vp_[k][i] - w);  // the gap's rate of change
+      add_wall_contact(i, c, springs[i], count_collisions, sums);
     }
   }
-  if (any_surface_) {
-    WallSums sums{potential, loss, work, spring, slip, entered};
-    add_surface_forces(count_collisions, t, sums);
-    potential = sums.potential;
-    loss = sums.loss;
-    work = sums.work;
-    spring = sums.spring;
-    slip = sums.slip;
-    entered = sums.entered;
-  }
-  potential_ += potential + spring;
-  wall_spring_energy_ = spring;
-  wall_slip_power_ = slip;
-  wall_loss_power_ = loss;
-  wall_work_power_ = work;
-  wall_collisions_ += count_collisions ? entered : 0;
+  if (any_surface_) add_surface_forces(count_collisions, t, sums);
+  potential_ += sums.potential + sums.spring;
+  wall_spring_energy_ = sums.spring;
+  wall_slip_power_ = sums.slip;
+  wall_loss_power_ = sums.loss;
+  wall_work_power_ = sums.work;
+  wall_collisions_ += count_collisions ? sums.entered : 0;
 }
 
 template <int D>
@@ -1000,58 +1013,29 @@ void DemIntegrator<D>::add_surface_forces(bool count_collisions, double t, WallS
 // particle's contact point.
 template <int D>
 template <class Component>
-void DemIntegrator<D>::add_component_forces(const Component& c, int first, bool count_collisions,
-                                            double t, WallSums& sums) {
+void DemIntegrator<D>::add_component_forces(const Component& component, int first,
+                                            bool count_collisions, double t, WallSums& sums) {
   const std::size_t n = size();
-  for (int k = 0; k < c.surfaces(); ++k) {
-    if (!c.is_surface(k)) continue;
+  for (int k = 0; k < component.surfaces(); ++k) {
+    if (!component.is_surface(k)) continue;
     std::vector<Vec<D>>& springs = wall_shear_[static_cast<std::size_t>(first + k)];
     for (std::size_t i = 0; i < n; ++i) {
       Vec<D> x;
       for (int a = 0; a < D; ++a) x[a] = x_[a][i];
-      const double gap = c.gap(k, x, t);  // the centre's distance from the surface
-      const double R = radius_[i];
-      if (gap >= R) {
-        if (friction_ && springs[i] != Vec<D>{}) springs[i] = Vec<D>{};
-        continue;
-      }
-      const double overlap = R - gap;
-      if (overlap > max_overlap_fraction_ * R)
-        throw InputError(fmt::format(
-            "DEM: particle {} overlaps {} by {} (more than {} of its radius) at t = {}: time "
-            "step dt = {} too large, the wall too fast or the initial state outside",
-            id_[i], c.name(k), overlap, max_overlap_fraction_, t, dt_));
-      const Vec<D> normal = c.normal(k, x, t);
-      const Vec<D> wall_velocity = c.velocity(k, x, t);
+      WallContact c{.gap = component.gap(k, x, t)};
+      if (!touches(i, first + k, c.gap, t, springs)) continue;
+      c.normal = component.normal(k, x, t);
+      c.velocity = component.velocity(k, x, t);
+      c.normal_speed = dot(c.normal, c.velocity);
       if (count_collisions) {  // apart one step earlier (u_ holds the drift velocity)?
         Vec<D> before;
         for (int a = 0; a < D; ++a) before[a] = x[a] - dt_ * u_[a][i];
-        if (c.gap(k, before, t - dt_) >= R) ++sums.entered;
+        if (component.gap(k, before, t - dt_) >= radius_[i]) ++sums.entered;
       }
       Vec<D> v;
       for (int a = 0; a < D; ++a) v[a] = vp_[a][i];
-      const double rdot = dot(v - wall_velocity, normal);  // the gap's rate of change
-      const std::size_t s = sp_[i];
-      const double kk = wall_stiffness_[s], damping = wall_damping_[s];
-      const bool hertz = wall_hertz_[s] != 0;
-      const NormalForce nf = normal_force(hertz, kk, damping, overlap, rdot);
-      const double F = nf.force;
-      sums.potential += nf.energy;
-      sums.loss += (nf.elastic - F) * rdot;
-      sums.work += F * dot(normal, wall_velocity);
-      for (int a = 0; a < D; ++a) f_[a][i] += F * normal[a];
-      if (friction_ && friction_wall_[s].coefficient > 0.0) {
-        const SoftFriction& fr = friction_wall_[s];
-        // The contact point (at x - gap n) relative to the surface.
-        const Vec<D> vc = v - gap * cross(spin(wp_, i), normal) - wall_velocity;
-        const Vec<D> vt = vc - dot(vc, normal) * normal;
-        const auto [kt, gt] = tangential_law(fr, hertz, kk, damping, nf.root);
-        const Vec<D> ft = tangential_force<D>(springs[i], normal, vt, kt, gt, fr.coefficient * F,
-                                              count_collisions ? dt_ : 0.0, sums.spring, sums.slip);
-        for (int a = 0; a < D; ++a) f_[a][i] += ft[a];
-        add_spin(tq_, i, -gap * cross(normal, ft));
-        sums.work += dot(ft, wall_velocity);
-      }
+      c.rdot = dot(v - c.velocity, c.normal);  // the gap's rate of change
+      add_wall_contact(i, c, springs[i], count_collisions, sums);
     }
   }
 }

@@ -181,6 +181,17 @@ class DemIntegrator {
     double potential = 0.0, loss = 0.0, work = 0.0, spring = 0.0, slip = 0.0;
     std::uint64_t entered = 0;
   };
+  // A particle's contact with a surface: the centre's distance from it, the gap's rate of
+  // change, the surface's normal (into the domain), its velocity there and that velocity along
+  // the normal; axis >= 0 when the normal is that axis (a box face).
+  struct WallContact {
+    double gap = 0.0, rdot = 0.0, normal_speed = 0.0;
+    Vec<D> normal{}, velocity{};
+    int axis = -1;
+  };
+  bool touches(std::size_t i, int surface, double gap, double t, std::vector<Vec<D>>& springs);
+  void add_wall_contact(std::size_t i, const WallContact& c, Vec<D>& spring, bool count_collisions,
+                        WallSums& sums);
   // The contacts with the surfaces of the boundary components other than the box faces (plane
   // walls): the faces' force law through the boundary interface (gap, normal and velocity at
   // the contact), component by component (static dispatch).

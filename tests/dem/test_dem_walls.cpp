@@ -186,7 +186,7 @@ TEST(DemWalls, RefusesWhatItCannotIntegrate) {
   EXPECT_NE(message(no_wall_law, s).find("particle-wall laws"), std::string::npos);
   ParticleSystem<3> outside = s;
   outside.kinematics[0].pos[2] = -1.0;
-  EXPECT_NE(message(walls_z(law), outside).find("overlaps the wall at face 4"), std::string::npos);
+  EXPECT_NE(message(walls_z(law), outside).find("overlaps the wall z-"), std::string::npos);
   // The law-only constructor knows no walls and no gravity (the environment's constructor
   // takes both from the environment, whatever flags the state carries).
   const auto law_only = [&](const ParticleSystem<3>& state) {
