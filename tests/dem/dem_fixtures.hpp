@@ -32,4 +32,14 @@ inline void add_bed(ParticleSystem<3>& s, const JitteredBed& bed) {
       }
 }
 
+// One sphere (R = 0.5, m = 1) at x with velocity v in a 20^3 box periodic along x and y.
+inline ParticleSystem<3> one_sphere(const Vec<3>& x, const Vec<3>& v) {
+  ParticleSystem<3> s;
+  s.box = {20.0, 20.0, 20.0};
+  s.periodic = {true, true, false};
+  s.kinematics.push_back({x, v, 0.0, 0.5});
+  s.mass = {1.0};
+  return s;
+}
+
 }  // namespace kairos::testing

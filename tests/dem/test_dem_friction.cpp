@@ -16,6 +16,8 @@
 namespace kairos {
 namespace {
 
+using testing::one_sphere;
+
 Environment<3> rough_floor(const SoftContactLaw& law, const SoftFriction& friction, double g) {
   Environment<3> env;
   env.species = 1;
@@ -27,15 +29,6 @@ Environment<3> rough_floor(const SoftContactLaw& law, const SoftFriction& fricti
   env.faces[4].kind = FaceKind::kWall;
   env.faces[5].kind = FaceKind::kWall;
   return env;
-}
-
-ParticleSystem<3> one_sphere(const Vec<3>& x, const Vec<3>& v) {
-  ParticleSystem<3> s;
-  s.box = {20.0, 20.0, 20.0};
-  s.periodic = {true, true, false};
-  s.kinematics.push_back({x, v, 0.0, 0.5});
-  s.mass = {1.0};
-  return s;
 }
 
 TEST(DemFriction, SlidingSphereEndsRollingAtFiveSevenths) {

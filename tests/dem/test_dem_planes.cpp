@@ -13,10 +13,13 @@
 
 #include "core/error.hpp"
 #include "dem/dem_integrator.hpp"
+#include "dem_fixtures.hpp"
 #include "interactions/soft_contact.hpp"
 
 namespace kairos {
 namespace {
+
+using testing::one_sphere;
 
 const SoftContactLaw kLaw = SoftContactLaw::linear_dashpot(1e5, 20.0);
 
@@ -37,15 +40,6 @@ PlaneWall<3> plane_through(const Vec<3>& normal, const Vec<3>& point) {
   p.normal = normal;
   p.offset = dot(normal, point);
   return p;
-}
-
-ParticleSystem<3> one_sphere(const Vec<3>& x, const Vec<3>& v) {
-  ParticleSystem<3> s;
-  s.box = {20.0, 20.0, 20.0};
-  s.periodic = {true, true, false};
-  s.kinematics.push_back({x, v, 0.0, 0.5});
-  s.mass = {1.0};
-  return s;
 }
 
 // A sphere dropped onto a floor bounces the same on the face wall at z = 0 as on a plane at
