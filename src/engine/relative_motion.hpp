@@ -53,6 +53,8 @@ inline RelativeMotion relative_motion_at(const Vec<D>& xi, const Vec<D>& vi, con
 // gap / (-rg + sqrt(...)) is at least gap / (-2 rg)). Receding pairs (r.g >= 0, a particle
 // with itself included) and near misses give kNever-like `false`; an overlapping, approaching
 // pair meets now (0). docs/physics.md#hard-sphere-contact-time.
+// `true` means only that the cheap bound did not rule the pair out: dt may still exceed `best`
+// (the bound is a lower bound), so every caller compares dt with its best before keeping it.
 inline bool contact_before(const RelativeMotion& p, double sigma2, double best, double& dt) {
   const double gap = p.r2 - sigma2;
   if (!(p.rg < 0.0) || gap > -2.0 * p.rg * best) return false;
