@@ -83,6 +83,9 @@ EXTRA = [
      ["field.gravity=[0.0, 0.0, -2.0]"]),
     ("profile_vibrated", "examples/vibrated_bed_3d.toml", None, ['output.profile_axis="z"'],
      None),
+    # Stepped potentials under Lees-Edwards shear (the sheared stepped loop), continued.
+    ("sheared_steps", "examples/square_well_fluid_3d.toml", None,
+     ["boundary.shear_rate=0.5", 'driving.kind="none"', "system.particles=1000"], []),
     ("driven_andersen", None, HARD.format(eta=0.3),
      ['driving.kind="andersen"', "driving.rate=0.5"], None),
     # Lengths and outputs in simulated time (the clock stops at every output).

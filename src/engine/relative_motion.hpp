@@ -1,5 +1,6 @@
 // The state of a pair at time t, written once: every scalar candidate loop (hard spheres,
-// stepped potentials, the soft-contact probe) and the kept-contact test include it, and a new
+// stepped potentials, the soft-contact probe, the sheared lists) and the kept-contact test
+// include it, and a new
 // interaction supplies only the math that turns r.r, r.g and g.g into an event time (as HOOMD's
 // pair evaluators do for forces). The AVX-512 loops (candidate_scan.cpp) evaluate the same
 // expressions in the same order, lane by lane, so every loop gives the same bits.
@@ -13,6 +14,7 @@
 #include <cmath>
 
 #include "core/vec.hpp"
+#include "dynamics/collision_time.hpp"
 
 namespace kairos {
 
@@ -25,12 +27,14 @@ struct RelativeMotion {
 
 // The pair (i, j) at time t: i at xi with velocity vi, j from its record `rec` (position at
 // rec[0 .. D), velocity at rec[D .. 2D)) dtj after the record's time, seen through `shift`.
-// half_accel and accel: g / 2 and g (kAccelerated only).
-template <int D, bool kAccelerated = false>
+// half_accel and accel: g / 2 and g (kAccelerated only). kMovingImage: under Lees-Edwards
+// shear the image moves with j's velocity plus image_velocity (boundaries/lees_edwards.hpp).
+template <int D, bool kAccelerated = false, bool kMovingImage = false>
 inline RelativeMotion relative_motion_at(const Vec<D>& xi, const Vec<D>& vi, const double* rec,
                                          double dtj, const Vec<D>& shift,
                                          const double* half_accel = nullptr,
-                                         const double* accel = nullptr) {
+                                         const double* accel = nullptr,
+                                         const double* image_velocity = nullptr) {
   RelativeMotion p;
   for (int a = 0; a < D; ++a) {
     double xj = rec[a] + rec[D + a] * dtj;
@@ -39,6 +43,7 @@ inline RelativeMotion relative_motion_at(const Vec<D>& xi, const Vec<D>& vi, con
       xj = xj + (half_accel[a] * dtj) * dtj;
       vj = vj + accel[a] * dtj;
     }
+    if constexpr (kMovingImage) vj = vj + image_velocity[a];
     const double r = xi[a] - (xj + shift[a]);
     const double g = vi[a] - vj;
     p.r2 = p.r2 + r * r;
@@ -63,6 +68,13 @@ inline bool contact_before(const RelativeMotion& p, double sigma2, double best, 
   dt = gap / (-p.rg + std::sqrt(disc));
   if (!(dt > 0.0)) dt = 0.0;  // overlapping and approaching: now
   return true;
+}
+
+// The contact time of a pair in state p at distance sigma by the quadratic's rule
+// (dynamics/collision_time.hpp quadratic_contact_time, as pair_contact_time takes it): the
+// loops that test pairs one by one against an unknown best (sheared lists).
+inline double quadratic_contact_time(const RelativeMotion& p, double sigma) {
+  return quadratic_contact_time(p.r2 - sigma * sigma, 2.0 * p.rg, p.g2);
 }
 
 }  // namespace kairos

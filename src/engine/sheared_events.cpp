@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "core/periodic.hpp"
 #include "engine/event_engine.hpp"
+#include "engine/relative_motion.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
 #include "scheduler/tournament_tree_queue.hpp"
@@ -74,9 +75,11 @@ std::uint32_t EventEngine<D, Queue>::scan_sheared(const CandidateList& list, std
   for (std::uint32_t k = 0; k < list.count; ++k) {
     const std::uint32_t j = list.ids[k];
     const std::uint32_t tag = list.shift[k];
-    const Vec<D> r = xi - (flight_position(hot_[j], t) + list.shifts[tag]);
-    const Vec<D> g = vi - (hot_[j].vel + list.velocity_shifts[tag]);
-    const double dt = pair_contact_time<D>(r.data(), g.data(), radius_of(i) + radius_of(j));
+    const HotRecord<D>& hj = hot_[j];
+    const RelativeMotion p = relative_motion_at<D, false, true>(
+        xi, vi, reinterpret_cast<const double*>(&hj), t - hj.time, list.shifts[tag], nullptr,
+        nullptr, list.velocity_shifts[tag].data());
+    const double dt = quadratic_contact_time(p, radius_of(i) + radius_of(j));
     if (dt < best) {
       best = dt;
       found = j;

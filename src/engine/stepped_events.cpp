@@ -11,6 +11,7 @@
 #include "core/periodic.hpp"
 #include "engine/candidate_scan.hpp"
 #include "engine/event_engine.hpp"
+#include "engine/relative_motion.hpp"
 #include "interactions/step_potential.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -234,17 +235,18 @@ std::uint32_t EventEngine<D, Queue>::scan_stepped_sheared(const CandidateList& l
     const std::uint32_t j = list.ids[k];
     if (j == i) continue;
     const std::uint32_t tag = list.shift[k];
-    const Vec<D> r = xi - (flight_position(hot_[j], t) + list.shifts[tag]);
-    const Vec<D> g = vi - (hot_[j].vel + list.velocity_shifts[tag]);
+    const HotRecord<D>& hj = hot_[j];
+    const RelativeMotion p = relative_motion_at<D, false, true>(
+        xi, vi, reinterpret_cast<const double*>(&hj), t - hj.time, list.shifts[tag], nullptr,
+        nullptr, list.velocity_shifts[tag].data());
     const PairSteps::Zone z = steps_.lookup(j, steps_.pair_table(si, species_of(j)));
     double dt;
     if (z.table == PairSteps::kHard) {
-      dt = pair_contact_time<D>(r.data(), g.data(), radius_of(i) + radius_of(j));
+      dt = quadratic_contact_time(p, radius_of(i) + radius_of(j));
     } else {
       const ZoneTable& table = steps_.table(z.table);
-      const double r2 = norm2(r);
-      if (z.zone > 0 && r2 > 4.0 * table.r2[0]) continue;  // another image of a listed pair
-      dt = table.event_time(z.zone, r2, dot(r, g), norm2(g));
+      if (z.zone > 0 && p.r2 > 4.0 * table.r2[0]) continue;  // another image of a listed pair
+      dt = table.event_time(z.zone, p.r2, p.rg, p.g2);
     }
     if (dt < best) {
       best = dt;

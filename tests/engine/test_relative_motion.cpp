@@ -122,6 +122,30 @@ RelativeMotion pair(const Vec<3>& r, const Vec<3>& g) {
   return relative_motion_at<3>(r, g, origin, 0.0, {});
 }
 
+// Under Lees-Edwards shear the image above moves at +U along x: the pair's relative velocity
+// takes it out, and the sheared loops' quadratic rule gives pair_contact_time's bits.
+TEST(RelativeMotion, AMovingImageAddsItsVelocity) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int n = 0; n < 1000; ++n) {
+    const Vec<2> xi{u(rng), u(rng)}, vi{u(rng), u(rng)}, shift{u(rng), 10.0};
+    const Vec<2> image_velocity{3.0 * u(rng), 0.0};
+    const double rec[4] = {u(rng), u(rng) - 10.0, u(rng), u(rng)};
+    const double dtj = 0.5 * (u(rng) + 2.0);
+    const RelativeMotion m = relative_motion_at<2, false, true>(xi, vi, rec, dtj, shift, nullptr,
+                                                                nullptr, image_velocity.data());
+    Vec<2> r, g;
+    for (int a = 0; a < 2; ++a) {
+      r[a] = xi[a] - ((rec[a] + rec[2 + a] * dtj) + shift[a]);
+      g[a] = vi[a] - (rec[2 + a] + image_velocity[a]);
+    }
+    ASSERT_EQ(m.r2, norm2(r));
+    ASSERT_EQ(m.rg, dot(r, g));
+    ASSERT_EQ(m.g2, norm2(g));
+    ASSERT_EQ(quadratic_contact_time(m, 1.3), pair_contact_time<2>(r.data(), g.data(), 1.3));
+  }
+}
+
 TEST(RelativeMotion, ContactTestAtTheEdges) {
   double dt = -1.0;
   // Overlapping (distance 0.75 < 1) and approaching: they meet now.
