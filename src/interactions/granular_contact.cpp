@@ -8,22 +8,17 @@
 #include <stdexcept>
 
 #include "core/error.hpp"
+#include "interactions/parameter_domain.hpp"
 
 namespace kairos {
 namespace {
 
-bool finite_within(double x, double lo, double hi) {
-  return std::isfinite(x) && x >= lo && x <= hi;
-}
-
 void require_restitution(double e, const char* what) {
-  if (!finite_within(e, 0.0, 1.0))
-    throw InputError(fmt::format("{} must be in [0, 1], got {}", what, e));
+  require_in(kRestitutionDomain, e, what);
 }
 
 void require_tangential(double beta, const char* what) {
-  if (!finite_within(beta, -1.0, 1.0))
-    throw InputError(fmt::format("{} must be in [-1, 1], got {}", what, beta));
+  require_in(kTangentialRestitutionDomain, beta, what);
 }
 
 void require_positive(double x, const char* what) {
@@ -32,8 +27,7 @@ void require_positive(double x, const char* what) {
 }
 
 void require_non_negative(double x, const char* what) {
-  if (!(std::isfinite(x) && x >= 0.0))
-    throw InputError(fmt::format("{} must be finite and >= 0, got {}", what, x));
+  require_in(kNonNegativeDomain, x, what);
 }
 
 // Inverse of the Padé form on x >= 0 by bisection (it is monotone); e in (0, 1].
@@ -87,9 +81,7 @@ NormalRestitution NormalRestitution::viscoelastic_from_material(double dissipati
 }
 
 NormalRestitution NormalRestitution::viscoelastic_at(double e_reference, double reference_speed) {
-  if (!finite_within(e_reference, 0.0, 1.0) || e_reference == 0.0)
-    throw InputError(fmt::format("the viscoelastic reference restitution must be in (0, 1], got {}",
-                                 e_reference));
+  require_in(kSoftRestitutionDomain, e_reference, "the viscoelastic reference restitution");
   require_positive(reference_speed, "the viscoelastic reference speed");
   const double x = e_reference == 1.0 ? 0.0 : viscoelastic_variable_for(e_reference);
   return viscoelastic(x / std::pow(reference_speed, 0.1));
@@ -108,9 +100,9 @@ NormalRestitution NormalRestitution::table(std::vector<double> speeds, std::vect
       throw InputError(fmt::format(
           "restitution table: speeds must be strictly increasing, but speed #{} ({}) follows {}",
           k + 1, speeds[k], speeds[k - 1]));
-    if (!finite_within(values[k], 0.0, 1.0))
-      throw InputError(fmt::format("restitution table: e = {} at speed {} is outside [0, 1]",
-                                   values[k], speeds[k]));
+    if (!kRestitutionDomain.contains(values[k]))
+      throw InputError(fmt::format("restitution table: e = {} at speed {} is not {}", values[k],
+                                   speeds[k], kRestitutionDomain.text()));
   }
   NormalRestitution r;
   r.model_.emplace<Table>(Table{std::move(speeds), std::move(values)});

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "interactions/parameter_domain.hpp"
 #include "interactions/soft_contact.hpp"
 
 namespace kairos {
@@ -248,13 +249,14 @@ StepTable spring_dashpot_table(const PotentialSpec& spec, const ContinuousPotent
                            spec.length, core));
   }
   if (spec.steps < 1) fail(spec, fmt::format("steps must be at least 1, not {}", spec.steps));
-  if (!(spec.damping >= 0.0) || !std::isfinite(spec.damping))
-    fail(spec, fmt::format("damping must be finite and at least 0, not {}", spec.damping));
+  if (!kNonNegativeDomain.contains(spec.damping))
+    fail(spec, fmt::format("damping must be {}, not {}", kNonNegativeDomain.text(), spec.damping));
   double gamma = spec.damping;
   if (spec.restitution != 0.0) {
     if (spec.damping != 0.0) fail(spec, "give damping or restitution, not both");
-    if (!(spec.restitution > 0.0 && spec.restitution <= 1.0)) {
-      fail(spec, fmt::format("restitution must be in (0, 1], not {}", spec.restitution));
+    if (!kSoftRestitutionDomain.contains(spec.restitution)) {
+      fail(spec, fmt::format("restitution must be {}, not {}", kSoftRestitutionDomain.text(),
+                             spec.restitution));
     }
     if (!(reduced_mass > 0.0) || !std::isfinite(reduced_mass)) {
       fail(spec, "restitution needs the pair's masses (one mass per species); give damping");

@@ -12,6 +12,7 @@
 
 #include "core/error.hpp"
 #include "core/stop_flag.hpp"
+#include "interactions/parameter_domain.hpp"
 
 namespace kairos {
 namespace {
@@ -25,13 +26,11 @@ void require_positive(double x, const char* what) {
 }
 
 void require_non_negative(double x, const char* what) {
-  if (!(std::isfinite(x) && x >= 0.0))
-    throw InputError(fmt::format("soft contact: {} must be finite and >= 0, got {}", what, x));
+  require_in(kNonNegativeDomain, x, what, "soft contact: ");
 }
 
 void require_poisson(double nu, const char* what) {
-  if (!(std::isfinite(nu) && nu > -1.0 && nu <= 0.5))
-    throw InputError(fmt::format("soft contact: {} must be in (-1, 0.5], got {}", what, nu));
+  require_in(kPoissonRatioDomain, nu, what, "soft contact: ");
 }
 
 void require_finite(const Vec<3>& a, const char* what) {
@@ -631,9 +630,7 @@ double solve_decreasing(F&& e_of, double e, double x_max, const char* what) {
 }
 
 void require_restitution(double e) {
-  if (!(e > 0.0 && e <= 1.0))
-    throw InputError(
-        fmt::format("soft contact: the coefficient of restitution must be in (0, 1], got {}", e));
+  require_in(kSoftRestitutionDomain, e, "the coefficient of restitution", "soft contact: ");
 }
 
 }  // namespace

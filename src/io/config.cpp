@@ -8,6 +8,8 @@
 // "file" or "override 'key=value'".
 #include "io/config.hpp"
 
+#include "interactions/parameter_domain.hpp"
+
 #include <fmt/format.h>
 
 #include <toml++/toml.h>
@@ -220,11 +222,11 @@ class Reader : public KeyReader {
     const toml::node* n_model = t.get("restitution_model");
     const toml::node* n_table = t.get("restitution_table");
     if (restitution_models().is(c.restitution_model, RestitutionModel::kViscoelastic) &&
-        !(c.restitution > 0.0)) {
+        !kSoftRestitutionDomain.contains(c.restitution)) {
       fail(n_restitution != nullptr ? n_restitution : n_model, path("restitution"),
-           fmt::format("{}: must be in (0, 1] with restitution_model = \"viscoelastic\" (it is "
+           fmt::format("{}: must be {} with restitution_model = \"viscoelastic\" (it is "
                        "e at restitution_speed), got {}",
-                       path("restitution"), c.restitution));
+                       path("restitution"), kSoftRestitutionDomain.text(), c.restitution));
     }
     if (restitution_models().is(c.restitution_model, RestitutionModel::kTable)) {
       if (n_table == nullptr && c.restitution_table.empty()) {
@@ -605,12 +607,12 @@ class Reader : public KeyReader {
       check_rule_range(n_a, path("dissipation"), law.dissipation);
       check_rule_range(n_speed, path("restitution_speed"), law.restitution_speed);
     }
-    if (!(law.restitution == 0.0 || (law.restitution > 0.0 && law.restitution <= 1.0)) ||
+    if (!(law.restitution == 0.0 || kSoftRestitutionDomain.contains(law.restitution)) ||
         (n_e != nullptr && law.restitution == 0.0)) {
       fail(n_e, path("restitution"),
-           fmt::format("{}: must be in (0, 1] (the head-on coefficient of restitution{}), got {}",
-                       path("restitution"), dashpot ? "" : " at restitution_speed",
-                       law.restitution));
+           fmt::format("{}: must be {} (the head-on coefficient of restitution{}), got {}",
+                       path("restitution"), kSoftRestitutionDomain.text(),
+                       dashpot ? "" : " at restitution_speed", law.restitution));
     }
   }
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "interactions/parameter_domain.hpp"
 #include "io/config_keys.hpp"
 #include "io/config_override.hpp"
 #include "io/config_text.hpp"
@@ -412,9 +413,10 @@ class KeyReader {
              fmt::format("{}: impact speeds must be strictly increasing, got {} after {}", row_path,
                          speed, out.back()[0]));
       }
-      if (!(e >= 0.0 && e <= 1.0)) {
+      if (!kRestitutionDomain.contains(e)) {
         fail(row->get(1), row_path,
-             fmt::format("{}: restitution must be in [0, 1], got {}", row_path, e));
+             fmt::format("{}: restitution must be {}, got {}", row_path, kRestitutionDomain.text(),
+                         e));
       }
       out.push_back({speed, e});
     }

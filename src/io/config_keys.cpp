@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "interactions/parameter_domain.hpp"
 #include "interactions/potential_spec.hpp"
 #include "io/config.hpp"
 #include "io/config_choices.hpp"
@@ -46,6 +47,10 @@ constexpr Range between(double lo, double hi, Scale scale) {
 }
 // A range that depends on another key (a potential's kind, a soft law's model): checked by the
 // reader's rule for it, and by run/config_ranges.cpp for the kinds that use it.
+// A physical domain of interactions/parameter_domain.hpp as a key's range.
+constexpr Range domain(const ParameterDomain& d) {
+  return {.lo = d.lo, .hi = d.hi, .lo_open = d.lo_open, .hi_open = d.hi_open};
+}
 constexpr Range by_rule(Range r) {
   r.by_rule = true;
   return r;
@@ -167,7 +172,7 @@ constexpr KeyDecl kContactLaw[] = {
     {.name = "restitution",
      .type = KeyType::kFloat,
      .member = field<&ContactConfig::restitution>,
-     .range = fraction,
+     .range = domain(kRestitutionDomain),
      .doc = "normal coefficient of restitution e"},
     {.name = "restitution_model",
      .type = KeyType::kString,
@@ -189,12 +194,12 @@ constexpr KeyDecl kContactLaw[] = {
     {.name = "tangential_restitution",
      .type = KeyType::kFloat,
      .member = field<&ContactConfig::tangential_restitution>,
-     .range = {.lo = -1.0, .hi = 1.0},
+     .range = domain(kTangentialRestitutionDomain),
      .doc = "tangential coefficient of restitution beta (-1: smooth)"},
     {.name = "friction",
      .type = KeyType::kFloat,
      .member = field<&ContactConfig::friction>,
-     .range = {.lo = 0.0, .allow_infinity = true},
+     .range = {.lo = kNonNegativeDomain.lo, .allow_infinity = true},
      .doc = "Coulomb friction coefficient (Walton); inf: no limit"},
     {.name = "elastic_below_speed",
      .type = KeyType::kFloat,
@@ -753,14 +758,14 @@ constexpr KeyDecl kSpringDashpot[] = {
     {.name = "restitution",
      .type = KeyType::kFloat,
      .member = field<&PotentialSpec::restitution>,
-     .range = {.lo = 0.0, .hi = 1.0, .lo_open = true},
+     .range = domain(kSoftRestitutionDomain),
      .default_text = "none",
      .doc = "spring_dashpot: head-on restitution (instead of damping)",
      .written = &spring_dashpot_restitution},
     {.name = "damping",
      .type = KeyType::kFloat,
      .member = field<&PotentialSpec::damping>,
-     .range = non_negative,
+     .range = domain(kNonNegativeDomain),
      .default_text = "`0`",
      .unit = "force / speed",
      .doc = "spring_dashpot: dashpot coefficient gamma",
@@ -809,7 +814,7 @@ constexpr KeyDecl kSoftLaw[] = {
     {.name = "damping",
      .type = KeyType::kFloat,
      .member = field<&SoftLawConfig::damping>,
-     .range = by_rule(non_negative),
+     .range = by_rule(domain(kNonNegativeDomain)),
      .unit = "force / speed",
      .doc = "dashpot: gamma",
      .written = &dashpot_damping},
@@ -824,13 +829,13 @@ constexpr KeyDecl kSoftLaw[] = {
     {.name = "poisson",
      .type = KeyType::kFloat,
      .member = field<&SoftLawConfig::poisson>,
-     .range = by_rule({.lo = -1.0, .hi = 0.5, .lo_open = true}),
+     .range = by_rule(domain(kPoissonRatioDomain)),
      .doc = "hertz: Poisson's ratio",
      .written = &hertz},
     {.name = "restitution",
      .type = KeyType::kFloat,
      .member = field<&SoftLawConfig::restitution>,
-     .range = by_rule({.lo = 0.0, .hi = 1.0, .lo_open = true}),
+     .range = by_rule(domain(kSoftRestitutionDomain)),
      .default_text = "none",
      .doc = "head-on coefficient of restitution (instead of damping / dissipation)",
      .written = &restitution_given},
