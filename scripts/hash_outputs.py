@@ -57,6 +57,21 @@ VOLATILE = {"wall_seconds", "collisions_per_second", "events_per_second", "steps
 # inline TOML, inline TOML, overrides, a continuation's overrides or None).
 HARD = "[system]\nparticles = 4000\npacking_fraction = {eta}\n"
 DISKS = "[system]\ndimension = 2\nparticles = 4000\npacking_fraction = {eta}\n"
+SOFT_WALLS = """[system]
+particles = 1000
+packing_fraction = 0.1
+lattice = "random"
+seed = 5
+[soft]
+model = "dashpot"
+stiffness = 1e4
+restitution = 0.8
+[[boundary.wall]]
+face = "z-"
+[[boundary.wall]]
+face = "z+"
+velocity = [0.0, 0.0, -0.05]
+"""
 EXTRA = [
     ("bench_hs_eta005", None, HARD.format(eta=0.05), [], None),
     ("bench_hs_eta020", None, HARD.format(eta=0.2), [], None),
@@ -83,6 +98,9 @@ EXTRA = [
      ["field.gravity=[0.0, 0.0, -2.0]"]),
     ("profile_vibrated", "examples/vibrated_bed_3d.toml", None, ['output.profile_axis="z"'],
      None),
+    # Soft spheres against walls (a fixed floor, a slow piston; the map's wall contact),
+    # continued.
+    ("continued_soft_walls", None, SOFT_WALLS, [], []),
     # Stepped potentials under Lees-Edwards shear (the sheared stepped loop), continued.
     ("sheared_steps", "examples/square_well_fluid_3d.toml", None,
      ["boundary.shear_rate=0.5", 'driving.kind="none"', "system.particles=1000"], []),

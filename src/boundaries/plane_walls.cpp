@@ -63,9 +63,9 @@ ContactResult<D> PlaneWalls<D>::resolve(int s, double t, double mass, double rad
 }
 
 template <int D>
-bool PlaneWalls<D>::overlaps(const Vec<D>& x, double radius, double t) const {
+bool PlaneWalls<D>::overlaps(const Vec<D>& x, double radius, double t, int skip) const {
   for (int s = 0; s < surfaces(); ++s)
-    if (gap(s, x, t) < radius) return true;
+    if (s != skip && gap(s, x, t) < radius) return true;
   return false;
 }
 

@@ -375,7 +375,17 @@ class EventEngine {
   void setup_soft(const ParticleSystem<D>& s);
   void restore_frozen(const ParticleSystem<D>& s, StartMode mode);
   void collide_soft(std::uint32_t i, std::uint32_t j, double t);
-  void hit_wall_soft(std::uint32_t i, int face, double t);
+  void hit_wall_soft(std::uint32_t i, int surface, double t);
+  // A soft contact with a wall (hit_wall_soft): the wall's normal n into the domain, the
+  // particle's speed towards it vn, the gap, the velocity while frozen against it; a box face
+  // (axis >= 0) keeps its one-axis arithmetic and wall_speed, another surface its velocity.
+  struct SoftWallContact {
+    Vec<D> normal{}, wall_velocity{}, frozen{};
+    double vn = 0.0, gap = 0.0, wall_speed = 0.0;
+    int axis = -1;
+  };
+  SoftWallContact soft_wall_contact(std::uint32_t i, int surface, double t) const;
+  Vec<D> soft_wall_rebound(std::uint32_t i, const SoftWallContact& c, double e, double& work) const;
   // Gives the contact particle i is frozen in its post-contact velocities at time t (early:
   // before its release time, exception B). Returns the partner (a particle, whose prediction
   // is now the caller's business, or a wall code), kNoPartner if i is not frozen.
@@ -427,13 +437,13 @@ class EventEngine {
   // The map from the table, or integrated directly outside it (counted).
   CollisionMap soft_map(const SoftMapTable* table, const CollisionUnits& units);
   // Places i at xi (and j at xj, unless j is kNoPartner) at time t unless that overlaps a third
-  // particle or a wall (other than face skip_face; exception A): then nothing changes and the
+  // particle or a wall (other than surface skip_surface; exception A): then nothing changes and the
   // result is false. Placed, the neighbourhoods of i and j are left gathered in cells_.list(0) and
   // (unless `shared`, one cell) cells_.list(1).
   // With a window, also sets window->met if a third particle meets the pair, frozen at
   // window->velocity, before window->until (and predicts, see FrozenWindow).
   bool try_place(std::uint32_t i, const Vec<D>& xi, std::uint32_t j, const Vec<D>& xj, double t,
-                 int skip_face, bool& shared, FrozenWindow* window = nullptr);
+                 int skip_surface, bool& shared, FrozenWindow* window = nullptr);
   // Moves particle i into the cell of its (changed) position.
   void relocate(std::uint32_t i);
   bool frozen_pair(std::uint32_t i, std::uint32_t j) const {

@@ -148,8 +148,15 @@ template <int D, class Queue>
 std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i, double t,
                                                                 double horizon) const {
   const HotRecord<D>& h = hot_[i];
+  // A particle frozen against a wall moves with it; round-off in a tilted normal must not make
+  // it meet that wall again.
+  int frozen_against = -1;
+  if (soft_) [[unlikely]] {
+    const Code partner = Code::from_bits(soft_state_.partner(i));
+    if (partner.is_wall()) frozen_against = partner.wall_face();
+  }
   return boundaries_.next_contact(flight_position(h, t), flight_velocity(h, t), radius_of(i),
-                                  h.cell, cells_.grid(), t, horizon);
+                                  h.cell, cells_.grid(), t, horizon, frozen_against);
 }
 
 // A particle meets a wall: the wall is a partner of infinite mass moving with its velocity

@@ -53,11 +53,6 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
   }
   if (!env_.soft_tables.empty() && env_.soft_tables.size() != pairs)
     throw InputError("soft spheres: one lookup table (or none) per species pair is needed");
-  if (!env_.planes.empty()) {
-    throw InputError(
-        "boundary.plane: soft spheres ([soft]) meet walls on the box's faces only (the map's "
-        "wall contact is written for a box face); use [[boundary.wall]], or hard contacts");
-  }
   if (walls_ && env_.soft_wall.size() < species)
     throw InputError("soft spheres: walls need a soft contact law for every species");
   if (!env_.soft_wall_tables.empty() && env_.soft_wall_tables.size() != env_.soft_wall.size())
@@ -77,11 +72,10 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
   }
   // A piston (a wall at constant velocity) is an inertial frame: the map holds in it, and the
   // frozen particle moves with the wall. A vibrated wall accelerates during the contact.
-  for (int f = 0; f < 2 * D; ++f) {
-    if (boundaries_.faces().is_wall(f) && boundaries_.faces().wall(f).vibrates())
-      throw InputError(
-          "soft spheres cannot meet vibrating walls (the wall accelerates during a contact; "
-          "use run.integrator = \"dem\")");
+  for (int w = 0; w < boundaries_.surfaces(); ++w) {
+    if (boundaries_.is_surface(w) && boundaries_.accelerates(w))
+      throw InputError("soft spheres cannot meet the vibrating wall " + boundaries_.name(w) +
+                       " (the wall accelerates during a contact; use run.integrator = \"dem\")");
   }
   const std::size_t n = s.size();
   soft_state_ = SoftContactState<D>(n, options_.defer_soft_releases);
@@ -98,7 +92,8 @@ void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s, StartMode
   for (std::uint32_t k = 0; k < n; ++k) internal[id_[k]] = k;
   for (const FrozenContact<D>& c : s.frozen) {
     const bool wall = c.j == FrozenContact<D>::kWall;
-    if (c.i >= n || (!wall && (c.j >= n || c.j == c.i)) || (wall && c.face >= 2 * D) ||
+    if (c.i >= n || (!wall && (c.j >= n || c.j == c.i)) ||
+        (wall && c.face >= static_cast<std::uint32_t>(boundaries_.surfaces())) ||
         !(c.release_time >= s.time) || !std::isfinite(c.release_time)) {
       throw InputError("the state's soft contact of particle " + std::to_string(c.i) +
                        " is inconsistent (partner, face or release time)");
@@ -107,10 +102,10 @@ void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s, StartMode
     if (soft_state_.partner(i) != kNone)
       throw InputError("particle " + std::to_string(c.i) + " is in two soft contacts");
     if (wall) {
-      if (!boundaries_.faces().is_wall(static_cast<int>(c.face)))
+      if (!boundaries_.is_surface(static_cast<int>(c.face)))
         throw InputError("particle " + std::to_string(c.i) +
-                         " is in contact with a face that is "
-                         "not a wall");
+                         " is in contact with a wall that this run does not have (surface " +
+                         std::to_string(c.face) + ")");
       soft_state_.restore(i, wall_partner(static_cast<int>(c.face)), c.release_time, c.velocity_i);
     } else {
       const std::uint32_t j = internal[c.j];
@@ -182,7 +177,7 @@ void EventEngine<D, Queue>::relocate(std::uint32_t i) {
 // meets the frozen pair before the release (cheap rejection first, as in the candidate loops).
 template <int D, class Queue>
 bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::uint32_t j,
-                                      const Vec<D>& xj, double t, int skip_face, bool& shared,
+                                      const Vec<D>& xj, double t, int skip_surface, bool& shared,
                                       FrozenWindow* window) {
   const std::uint32_t both[2] = {i, j};
   const Vec<D> to[2] = {xi, xj};
@@ -204,7 +199,7 @@ bool EventEngine<D, Queue>::try_place(std::uint32_t i, const Vec<D>& xi, std::ui
   auto overlaps = [&](std::uint32_t p, const CandidateList& list, int slot) {
     const Vec<D>& x = hot_[p].pos;
     const double radius = radius_of(p);
-    if (walls_ && boundaries_.faces().overlaps(x, radius, t, skip_face)) return true;
+    if (walls_ && boundaries_.overlaps(x, radius, t, skip_surface)) return true;
     std::uint32_t delayed = 0;
     const CandidateScan<D> scan = scan_of(list, p, &delayed);
     ContactProbe<D> probe{x, velocity, span, i, j, false};
@@ -519,18 +514,63 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
   predict_released();
 }
 
+// The map's wall contact in the wall's frame along its normal n (into the domain): the
+// particle's normal speed vn towards the wall, its velocity after (the relative normal velocity
+// reversed and scaled by e), while frozen (moving with the wall along n) and the work the wall's
+// impulse does. A box face keeps its one-axis arithmetic (the bits of every earlier run).
 template <int D, class Queue>
-void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
+typename EventEngine<D, Queue>::SoftWallContact EventEngine<D, Queue>::soft_wall_contact(
+    std::uint32_t i, int surface, double t) const {
+  const HotRecord<D>& h = hot_[i];
+  SoftWallContact c;
+  if (surface < 2 * D) {
+    const int a = surface / 2;
+    const double sgn = surface % 2 == 0 ? 1.0 : -1.0;
+    const double wall_speed = boundaries_.faces().wall(surface).velocity[a];
+    c.normal[a] = sgn;
+    c.vn = -sgn * (h.vel[a] - wall_speed);
+    c.gap = sgn * (h.pos[a] - boundaries_.faces().position(surface, t));
+    c.frozen = h.vel;
+    c.frozen[a] = wall_speed;
+    c.axis = a;
+    c.wall_speed = wall_speed;
+    return c;
+  }
+  c.normal = boundaries_.normal(surface, h.pos, t);
+  c.wall_velocity = boundaries_.velocity(surface, h.pos, t);
+  c.vn = -dot(h.vel - c.wall_velocity, c.normal);
+  c.gap = boundaries_.gap(surface, h.pos, t);
+  c.frozen = h.vel + c.vn * c.normal;
+  return c;
+}
+
+// After the contact (restitution e): the velocity and the work the wall did on the particle.
+template <int D, class Queue>
+Vec<D> EventEngine<D, Queue>::soft_wall_rebound(std::uint32_t i, const SoftWallContact& c, double e,
+                                                double& work) const {
+  const HotRecord<D>& h = hot_[i];
+  const double m = mass_of(i);
+  Vec<D> after = h.vel;
+  if (c.axis >= 0) {
+    after[c.axis] = c.wall_speed + c.normal[c.axis] * e * c.vn;
+    work = m * c.wall_speed * (after[c.axis] - h.vel[c.axis]);  // impulse . wall velocity
+    return after;
+  }
+  after = h.vel + ((1.0 + e) * c.vn) * c.normal;
+  work = m * dot(c.wall_velocity, after - h.vel);
+  return after;
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int surface, double t) {
   const std::uint32_t partner = release(i, t, true);
   if (is_particle(partner)) queue_.update(partner, predict(partner, t));
   advance_to(i, t);
   HotRecord<D>& h = hot_[i];
-  const int a = face / 2;
-  const double sgn = face % 2 == 0 ? 1.0 : -1.0;
-  // The wall's normal velocity: constant (setup refuses vibrations), so the map holds in its
-  // frame; the frozen particle moves with the wall.
-  const double wall_speed = boundaries_.faces().wall(face).velocity[a];
-  const double vn = -sgn * (h.vel[a] - wall_speed);
+  // The wall's velocity is constant (setup refuses vibrations), so the map holds in its frame;
+  // the frozen particle moves with the wall.
+  const SoftWallContact contact = soft_wall_contact(i, surface, t);
+  const double vn = contact.vn;
   if (!(vn > 0.0)) {  // released early, it now leaves the wall
     ++h.collisions;
     queue_.update(i, predict(i, t));
@@ -543,26 +583,28 @@ void EventEngine<D, Queue>::hit_wall_soft(std::uint32_t i, int face, double t) {
   const CollisionUnits units = reduce_collision_unchecked(env_.soft_wall[s], m, radius, vn, 0.0);
   const CollisionMap map = soft_map(table, units);
   const double e = -map.eps_rdot;
-  Vec<D> after = h.vel;
-  after[a] = wall_speed + sgn * e * vn;
+  double work = 0.0;
+  const Vec<D> after = soft_wall_rebound(i, contact, e, work);
   counters_.dissipated_at_walls += 0.5 * m * vn * vn * (1.0 - e * e);
-  counters_.work_by_walls += m * wall_speed * (after[a] - h.vel[a]);  // impulse . wall velocity
+  counters_.work_by_walls += work;
   // Already overlapping the wall (released from it, then turned back by a third body): no
   // first contact to start the map from, so the contact is instantaneous.
-  const double gap = sgn * (h.pos[a] - boundaries_.faces().position(face, t));
-  const bool overlapping = gap < radius * (1.0 - 1e-9);
+  const bool overlapping = contact.gap < radius * (1.0 - 1e-9);
   if (overlapping) ++counters_.soft_overlap_fallbacks;
   bool placed = false;
   if (env_.soft_collisions == SoftCollisions::kMapped && !overlapping) {
+    // Into the wall by the end overlap.
     Vec<D> x = h.pos;
-    x[a] -= sgn * map.end_overlap * units.length_unit;  // into the wall by the end overlap
+    if (contact.axis >= 0) {
+      x[contact.axis] -= contact.normal[contact.axis] * map.end_overlap * units.length_unit;
+    } else {
+      x = x - (map.end_overlap * units.length_unit) * contact.normal;
+    }
     bool shared = true;
-    if (try_place(i, x, kNone, x, t, face, shared)) {
-      Vec<D> frozen_velocity = h.vel;
-      frozen_velocity[a] = wall_speed;
-      counters_.soft_contact_energy += 0.5 * m * (norm2(after) - norm2(frozen_velocity));
-      h.vel = frozen_velocity;
-      soft_state_.begin(i, wall_partner(face));
+    if (try_place(i, x, kNone, x, t, surface, shared)) {
+      counters_.soft_contact_energy += 0.5 * m * (norm2(after) - norm2(contact.frozen));
+      h.vel = contact.frozen;
+      soft_state_.begin(i, wall_partner(surface));
       soft_state_.schedule_release(i, t + map.eps_t * units.time_unit, after);
       ++counters_.soft_contacts;
       ++counters_.wall_collisions;

@@ -28,7 +28,8 @@
 //                                               piston; its vibration aside)
 //   ContactResult<D> resolve(int s, t, mass, radius, inertia_factor, force_elastic, v, w) const;
 //                                               the contact's response and its energy split
-//   bool overlaps(x, radius, t) const;          a particle overlaps one of its surfaces
+//   bool overlaps(x, radius, t, skip) const;    a particle overlaps one of its surfaces (other
+//                                               than surface skip; -1: none skipped)
 //   void check_start(x, radius, t, id) const;   throws InputError naming particle and surface
 //   double squeeze_time() const;                when moving surfaces leave no room (kNever)
 //   [[noreturn]] void throw_squeezed(t, dmax, uniform) const;
@@ -152,16 +153,17 @@ class BoundarySet {
     for (int s = 0; s < surfaces_; ++s) drives = drives || (is_surface(s) && !holds_still(s));
     return drives;
   }
-  // The soonest contact of a particle in `cell` with any surface from time t before
-  // t + horizon: (relative time, surface), surface -1 if none.
+  // The soonest contact of a particle in `cell` with any surface but `skip` (a soft contact's
+  // wall while the particle is frozen against it; -1: none) from time t before t + horizon:
+  // (relative time, surface), surface -1 if none.
   std::pair<double, int> next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
                                       CellCode cell, const CellGrid<D>& grid, double t,
-                                      double horizon) const {
+                                      double horizon, int skip = -1) const {
     std::pair<double, int> best{horizon, -1};
     int first = 0;
     for_each([&](const auto& c) {
       for (int k = 0; k < c.surfaces(); ++k) {
-        if (!c.reaches(k, cell, grid)) continue;
+        if (first + k == skip || !c.reaches(k, cell, grid)) continue;
         const double when = c.event_time(k, x, v, radius, t, best.first);
         if (when < best.first) best = {when, first + k};
       }
@@ -169,9 +171,15 @@ class BoundarySet {
     });
     return best;
   }
-  bool overlaps(const Vec<D>& x, double radius, double t) const {
+  // Whether a particle overlaps some surface other than `skip` (-1: none skipped).
+  bool overlaps(const Vec<D>& x, double radius, double t, int skip = -1) const {
     bool any = false;
-    for_each([&](const auto& c) { any = any || c.overlaps(x, radius, t); });
+    int first = 0;
+    for_each([&](const auto& c) {
+      const int local = skip >= first && skip < first + c.surfaces() ? skip - first : -1;
+      any = any || c.overlaps(x, radius, t, local);
+      first += c.surfaces();
+    });
     return any;
   }
   void check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const {

@@ -642,7 +642,7 @@ TEST(SoftErrors, UnsupportedCombinationsAreRefusedByName) {
   env.faces[4].kind = env.faces[5].kind = FaceKind::kWall;
   env.faces[4].wall.amplitude = 0.01;
   env.faces[4].wall.angular_frequency = 3.0;
-  refused(env, "vibrating walls");
+  refused(env, "vibrating wall");
   // Collisions reduce their units unchecked: a bad law is refused when the engine starts.
   env = soft_environment<3>(law);
   env.soft[1].stiffness = 0.0;
