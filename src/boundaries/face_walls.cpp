@@ -60,9 +60,9 @@ bool FaceWalls<D>::reaches(int f, CellCode c, const CellGrid<D>& grid) const {
 }
 
 template <int D>
-ContactResult<D> FaceWalls<D>::resolve(int f, double t, double mass, double radius,
-                                       double inertia_factor, bool force_elastic, Vec<D>& v,
-                                       Spin<D>& w) const {
+ContactResult<D> FaceWalls<D>::resolve(int f, const Vec<D>& /*x*/, double t, double mass,
+                                       double radius, double inertia_factor, bool force_elastic,
+                                       Vec<D>& v, Spin<D>& w) const {
   const Wall<D>& wall = faces_[f].wall;
   return resolve_surface_contact<D>(wall.contact, face_normal<D>(f), wall.surface_velocity(f, t),
                                     mass, radius, inertia_factor, force_elastic, v, w);

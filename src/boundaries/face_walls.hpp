@@ -56,6 +56,7 @@ class FaceWalls {
   }
   bool surface_moves(int f) const { return faces_[f].wall.plane_moves(f); }
   bool accelerates(int f) const { return faces_[f].wall.vibrates(); }
+  bool flat(int /*f*/) const { return true; }
   std::string name(int f) const { return std::string{"xyz"[f / 2], f % 2 == 0 ? '-' : '+'}; }
   const ContactModel& contact(int f) const { return faces_[f].wall.contact; }
   // The speed at which wall f's plane moves into the box (its vibration aside).
@@ -85,8 +86,8 @@ class FaceWalls {
   // A particle (velocity v, spin w, updated in place) meets wall f at time t: the wall is a
   // partner of infinite mass moving with its whole velocity (sliding, normal, vibrating), so
   // restitution acts on the normal velocity relative to the wall.
-  ContactResult<D> resolve(int f, double t, double mass, double radius, double inertia_factor,
-                           bool force_elastic, Vec<D>& v, Spin<D>& w) const;
+  ContactResult<D> resolve(int f, const Vec<D>& x, double t, double mass, double radius,
+                           double inertia_factor, bool force_elastic, Vec<D>& v, Spin<D>& w) const;
 
   // Whether a particle of this radius centred at x overlaps a wall (other than skip_face) at
   // time t.

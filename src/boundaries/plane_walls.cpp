@@ -54,9 +54,9 @@ bool PlaneWalls<D>::reaches(int s, CellCode cell, const CellGrid<D>& grid) const
 }
 
 template <int D>
-ContactResult<D> PlaneWalls<D>::resolve(int s, double t, double mass, double radius,
-                                        double inertia_factor, bool force_elastic, Vec<D>& v,
-                                        Spin<D>& w) const {
+ContactResult<D> PlaneWalls<D>::resolve(int s, const Vec<D>& /*x*/, double t, double mass,
+                                        double radius, double inertia_factor, bool force_elastic,
+                                        Vec<D>& v, Spin<D>& w) const {
   const PlaneWall<D>& p = plane(s);
   return resolve_surface_contact<D>(p.wall.contact, p.normal, p.surface_velocity(t), mass, radius,
                                     inertia_factor, force_elastic, v, w);

@@ -85,6 +85,7 @@ class PlaneWalls {
   }
   bool surface_moves(int s) const { return plane(s).plane_moves(); }
   bool accelerates(int s) const { return plane(s).wall.vibrates(); }
+  bool flat(int /*s*/) const { return true; }
 
   // Relative time from t of the contact of a particle of this radius (at x with velocity v at
   // t) with plane s; kNever if after t + horizon.
@@ -96,8 +97,8 @@ class PlaneWalls {
   bool reaches(int s, CellCode cell, const CellGrid<D>& grid) const;
   // A particle (velocity v, spin w, updated in place) meets plane s at time t: a partner of
   // infinite mass moving with its whole velocity.
-  ContactResult<D> resolve(int s, double t, double mass, double radius, double inertia_factor,
-                           bool force_elastic, Vec<D>& v, Spin<D>& w) const;
+  ContactResult<D> resolve(int s, const Vec<D>& x, double t, double mass, double radius,
+                           double inertia_factor, bool force_elastic, Vec<D>& v, Spin<D>& w) const;
   // Whether a particle of this radius centred at x overlaps a plane (other than skip) at t.
   bool overlaps(const Vec<D>& x, double radius, double t, int skip = -1) const;
   // Throws InputError naming the particle and the plane it overlaps (round-off contacts, 1e-12

@@ -180,7 +180,7 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t) {
   Spin<D> wi{};
   if (!spin_.empty()) wi = to_spin<D>(spin_[i]);
   const ContactResult<D> res =
-      boundaries_.resolve(surface, t, mass_of(i), radius_of(i),
+      boundaries_.resolve(surface, h.pos, t, mass_of(i), radius_of(i),
                           env_.inertia_factor_of(species_of(i)), elastic, h.vel, wi);
   if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
   counters_.dissipated_at_walls += res.dissipated;

@@ -73,6 +73,11 @@ void EventEngine<D, Queue>::setup_soft(const ParticleSystem<D>& s) {
   // A piston (a wall at constant velocity) is an inertial frame: the map holds in it, and the
   // frozen particle moves with the wall. A vibrated wall accelerates during the contact.
   for (int w = 0; w < boundaries_.surfaces(); ++w) {
+    // The map's wall contact keeps one normal for the whole contact.
+    if (boundaries_.is_surface(w) && !boundaries_.flat(w))
+      throw InputError("soft spheres under the event integrator meet flat walls only, not " +
+                       boundaries_.name(w) +
+                       " (the map's wall contact keeps one normal); use run.integrator = \"dem\"");
     if (boundaries_.is_surface(w) && boundaries_.accelerates(w))
       throw InputError("soft spheres cannot meet the vibrating wall " + boundaries_.name(w) +
                        " (the wall accelerates during a contact; use run.integrator = \"dem\")");

@@ -351,6 +351,40 @@ class Reader : public KeyReader {
     return plane;
   }
 
+  // [[boundary.cylinder]] number i: its axis (2D: z), center and radius (required), the side
+  // the particles are on and its rotation, then its contact law. Whether it crosses a periodic
+  // face is checked with the box (Environment::check).
+  CylinderConfig read_cylinder(const toml::table& ct, std::size_t i, int dimension,
+                               const ContactConfig& contact) const {
+    const std::string prefix = fmt::format("boundary.cylinder[{}]", i);
+    CylinderConfig cylinder;
+    cylinder.contact = contact;
+    read_group(ct, prefix, cylinder_keys(), &cylinder, &dimension);
+    for (const char* key : {"center", "radius"}) {
+      if (ct.get(key) == nullptr) {
+        fail(&ct, prefix + "." + key,
+             fmt::format("missing required key '{}.{}'{}", prefix, key,
+                         std::string_view(key) == "center" ? fmt::format(" ({} numbers)", dimension)
+                                                           : std::string(" (> 0)")));
+      }
+    }
+    if (!axes(3).contains(cylinder.axis)) {
+      fail(ct.get("axis"), prefix + ".axis",
+           fmt::format("{}.axis: '{}' is not an axis (x, y or z)", prefix, cylinder.axis));
+    }
+    if (dimension == 2 && cylinder.axis != "z") {
+      fail(ct.get("axis"), prefix + ".axis",
+           fmt::format("{}.axis: '{}': in 2D a cylinder is a circle in the plane, its axis is z",
+                       prefix, cylinder.axis));
+    }
+    for (const double c : cylinder.center) {
+      if (!std::isfinite(c))
+        fail(ct.get("center"), prefix + ".center", prefix + ".center: must be finite");
+    }
+    read_contact(ct, prefix, cylinder.contact);
+    return cylinder;
+  }
+
   void read_boundary(const toml::table& t, int dimension, const ContactConfig& contact,
                      BoundaryConfig& b) const {
     constexpr std::string_view p = "boundary";
@@ -394,6 +428,9 @@ class Reader : public KeyReader {
     const std::vector<const toml::table*> plane_tables = table_array(t, p, "plane");
     for (std::size_t i = 0; i < plane_tables.size(); ++i)
       b.planes.push_back(read_plane(*plane_tables[i], i, dimension, contact));
+    const std::vector<const toml::table*> cylinder_tables = table_array(t, p, "cylinder");
+    for (std::size_t i = 0; i < cylinder_tables.size(); ++i)
+      b.cylinders.push_back(read_cylinder(*cylinder_tables[i], i, dimension, contact));
 
     read_group(t, std::string(p), boundary_keys(), &b, &dimension);
     const toml::node* n_open = t.get("open");

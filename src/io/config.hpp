@@ -109,11 +109,24 @@ struct PlaneConfig {
   bool operator==(const PlaneConfig&) const = default;
 };
 
+// A cylinder wall ([[boundary.cylinder]], boundaries/cylinder_walls.hpp).
+struct CylinderConfig {
+  std::string axis = "z";      // its axis's direction (2D: "z", the circle in the plane)
+  std::vector<double> center;  // D components: a point of the axis
+  double radius = 0.0;         // required
+  bool inside = true;          // the particles are inside it (a drum), else outside (an obstacle)
+  double angular_velocity = 0.0;  // about the axis, right-handed
+  ContactConfig contact;          // its contact law: the keys of [contact]
+
+  bool operator==(const CylinderConfig&) const = default;
+};
+
 struct BoundaryConfig {
-  std::vector<WallConfig> walls;    // [[boundary.wall]]
-  std::vector<PlaneConfig> planes;  // [[boundary.plane]]
-  std::vector<std::string> open;    // boundary.open: faces with no wall (e.g. "z+")
-  double shear_rate = 0.0;          // Lees-Edwards: flow along x, gradient along y; 0: none
+  std::vector<WallConfig> walls;          // [[boundary.wall]]
+  std::vector<PlaneConfig> planes;        // [[boundary.plane]]
+  std::vector<CylinderConfig> cylinders;  // [[boundary.cylinder]]
+  std::vector<std::string> open;          // boundary.open: faces with no wall (e.g. "z+")
+  double shear_rate = 0.0;                // Lees-Edwards: flow along x, gradient along y; 0: none
 
   bool operator==(const BoundaryConfig&) const = default;
 };

@@ -295,6 +295,40 @@ constexpr KeyDecl kPlane[] = {
      .doc = "a point of the plane at t = 0"},
 };
 
+const CylinderConfig kCylinderDefaults{};
+constexpr KeyDecl kCylinder[] = {
+    {.name = "axis",
+     .type = KeyType::kString,
+     .member = field<&CylinderConfig::axis>,
+     .range = {.by_rule = true},  // x, y or z; 2D: z only
+     .default_text = "`\"z\"`",
+     .doc = "the direction of its axis: x, y or z (2D: z, the circle in the plane)"},
+    {.name = "center",
+     .type = KeyType::kVector,
+     .member = field<&CylinderConfig::center>,
+     .range = {.by_rule = true},  // finite
+     .default_text = "**required**",
+     .unit = "length",
+     .doc = "a point of its axis"},
+    {.name = "radius",
+     .type = KeyType::kFloat,
+     .member = field<&CylinderConfig::radius>,
+     .range = {.lo = 0.0, .lo_open = true, .by_rule = true},
+     .default_text = "**required**",
+     .unit = "length",
+     .doc = "its radius"},
+    {.name = "inside",
+     .type = KeyType::kBoolean,
+     .member = field<&CylinderConfig::inside>,
+     .doc = "the particles are inside it (a drum, a silo); false: outside (an obstacle)"},
+    {.name = "angular_velocity",
+     .type = KeyType::kFloat,
+     .member = field<&CylinderConfig::angular_velocity>,
+     .range = {.lo = -1e6, .hi = 1e6, .scale = Scale::kRate},
+     .unit = "radians / time",
+     .doc = "its rotation about the axis, right-handed (a rotating drum)"},
+};
+
 const FieldConfig kFieldDefaults{};
 constexpr KeyDecl kField[] = {
     {.name = "gravity",
@@ -942,6 +976,7 @@ constexpr KeyGroup kContactGroup{"contact", kContact, &kInteractionDefaults};
 constexpr KeyGroup kBoundaryGroup{"boundary", kBoundary, &kBoundaryDefaults};
 constexpr KeyGroup kWallGroup{"wall", kWall, &kWallDefaults};
 constexpr KeyGroup kPlaneGroup{"plane", kPlane, &kPlaneDefaults};
+constexpr KeyGroup kCylinderGroup{"cylinder", kCylinder, &kCylinderDefaults};
 constexpr KeyGroup kFieldGroup{"field", kField, &kFieldDefaults};
 constexpr KeyGroup kDrivingGroup{"driving", kDriving, &kDrivingDefaults};
 constexpr KeyGroup kRunGroup{"run", kRun, &kRunDefaults};
@@ -988,6 +1023,9 @@ std::vector<DeclaredKey> build() {
       {"boundary.plane",
        KeyType::kTableArray,
        {{&kPlaneGroup}, {&kContactLawGroup, "contact"}, {&kWallGroup, "boundary.wall"}}},
+      {"boundary.cylinder",
+       KeyType::kTableArray,
+       {{&kCylinderGroup}, {&kContactLawGroup, "contact"}}},
       {"driving", KeyType::kTable, {{&kDrivingGroup}}},
       {"field", KeyType::kTable, {{&kFieldGroup}}},
       {"run", KeyType::kTable, {{&kRunGroup}}},
@@ -1122,6 +1160,9 @@ const KeyGroup& wall_keys() {
 }
 const KeyGroup& plane_keys() {
   return kPlaneGroup;
+}
+const KeyGroup& cylinder_keys() {
+  return kCylinderGroup;
 }
 const KeyGroup& field_keys() {
   return kFieldGroup;

@@ -22,11 +22,12 @@
 //   bool surface_moves(int s) const;            the surface itself moves through space (a piston,
 //                                               a vibration; not a plane sliding in itself)
 //   bool accelerates(int s) const;              its velocity changes (a vibration)
+//   bool flat(int s) const;                     one normal over its whole surface (a plane)
 //   std::string name(int s) const;              how messages name it ("z-", "boundary.plane[0]")
 //   const ContactModel& contact(int s) const;   its contact law
 //   double approach_speed(int s) const;         the speed it moves into the domain at (a
 //                                               piston; its vibration aside)
-//   ContactResult<D> resolve(int s, t, mass, radius, inertia_factor, force_elastic, v, w) const;
+//   ContactResult<D> resolve(int s, x, t, mass, radius, inertia_factor, force_elastic, v, w) const;
 //                                               the contact's response and its energy split
 //   bool overlaps(x, radius, t, skip) const;    a particle overlaps one of its surfaces (other
 //                                               than surface skip; -1: none skipped)
@@ -51,6 +52,7 @@
 #include <tuple>
 #include <utility>
 
+#include "boundaries/cylinder_walls.hpp"
 #include "boundaries/face_walls.hpp"
 #include "boundaries/plane_walls.hpp"
 #include "model/environment.hpp"
@@ -125,6 +127,9 @@ class BoundarySet {
   bool accelerates(int s) const {
     return at(s, [](const auto& c, int k) { return c.accelerates(k); });
   }
+  bool flat(int s) const {
+    return at(s, [](const auto& c, int k) { return c.flat(k); });
+  }
   std::string name(int s) const {
     return at(s, [](const auto& c, int k) { return c.name(k); });
   }
@@ -134,10 +139,10 @@ class BoundarySet {
   double approach_speed(int s) const {
     return at(s, [](const auto& c, int k) { return c.approach_speed(k); });
   }
-  ContactResult<D> resolve(int s, double t, double mass, double radius, double inertia_factor,
-                           bool force_elastic, Vec<D>& v, Spin<D>& w) const {
+  ContactResult<D> resolve(int s, const Vec<D>& x, double t, double mass, double radius,
+                           double inertia_factor, bool force_elastic, Vec<D>& v, Spin<D>& w) const {
     return at(s, [&](const auto& c, int k) {
-      return c.resolve(k, t, mass, radius, inertia_factor, force_elastic, v, w);
+      return c.resolve(k, x, t, mass, radius, inertia_factor, force_elastic, v, w);
     });
   }
   // Whether some surface moves (a sleeper predicts no events of its own and would not see it
@@ -223,13 +228,14 @@ class BoundarySet {
 // in the constructor, which makes each from the run's model (its specification lives in the
 // Environment).
 template <int D>
-class Boundaries : public BoundarySet<D, FaceWalls<D>, PlaneWalls<D>> {
+class Boundaries : public BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>> {
  public:
   Boundaries() = default;
   Boundaries(const Environment<D>& environment, const Vec<D>& box)
-      : BoundarySet<D, FaceWalls<D>, PlaneWalls<D>>(
+      : BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>>(
             FaceWalls<D>(environment.faces, box, environment.gravity),
-            PlaneWalls<D>(environment.planes, box, environment.faces, environment.gravity)) {}
+            PlaneWalls<D>(environment.planes, box, environment.faces, environment.gravity),
+            CylinderWalls<D>(environment.cylinders, environment.gravity)) {}
 
   const FaceWalls<D>& faces() const { return this->template get<FaceWalls<D>>(); }
   FaceWalls<D>& faces() { return this->template get<FaceWalls<D>>(); }

@@ -18,6 +18,7 @@
 #include "core/periodic.hpp"
 #include "core/vec.hpp"
 
+#include "boundaries/cylinder_walls.hpp"
 #include "boundaries/face_wall.hpp"
 #include "boundaries/plane_walls.hpp"
 #include "interactions/granular_contact.hpp"
@@ -42,6 +43,7 @@ struct Environment {
   std::array<Face<D>, 2 * D> faces{};
   // Plane walls at any position and orientation (boundaries/plane_walls.hpp), after the faces.
   std::vector<PlaneWall<D>> planes;
+  std::vector<CylinderWall<D>> cylinders;  // boundaries/cylinder_walls.hpp
   // Contact law of species pair (a, b) at contact[a * species + b] (symmetric); empty: every
   // pair collides elastically and smoothly.
   std::vector<ContactModel> contact;
@@ -124,7 +126,7 @@ struct Environment {
   bool has_walls() const {
     for (const Face<D>& f : faces)
       if (f.kind == FaceKind::kWall) return true;
-    return !planes.empty();
+    return !planes.empty() || !cylinders.empty();
   }
   const ContactModel* contact_of(std::uint32_t a, std::uint32_t b) const {
     return contact.empty() ? nullptr : &contact[a * species + b];

@@ -198,6 +198,22 @@ void check_plane(const PlaneConfig& p, std::size_t index, const RangeScales& s) 
   check_wall(p.wall, prefix, longest, s);
 }
 
+// A cylinder's center and radius lie within 1e6 box edges (further, |x - c| loses the
+// particles' digits).
+void check_cylinder(const CylinderConfig& c, std::size_t index, const RangeScales& s) {
+  const std::string prefix = fmt::format("boundary.cylinder[{}]", index);
+  double longest = 0.0;
+  for (const double edge : s.box) longest = std::max(longest, edge);
+  const std::string why = fmt::format("1e6 times the longest box edge, {:.6g}", longest);
+  for (std::size_t a = 0; a < c.center.size(); ++a)
+    magnitude_within(fmt::format("{}.center[{}]", prefix, a), c.center[a], 1e6 * longest, why);
+  magnitude_within(prefix + ".radius", c.radius, 1e6 * longest, why);
+  // As the shear rate: faster, the surface's sweep swamps every collision.
+  const double fastest = declared("boundary.cylinder[].angular_velocity").hi;
+  magnitude_within(prefix + ".angular_velocity", c.angular_velocity, fastest / s.time(),
+                   short_number(fastest) + " / tau, " + time_unit(s));
+}
+
 void check_boundary(const Config& c, const RangeScales& s) {
   check_box(s);
   for (std::size_t w = 0; w < c.boundary.walls.size(); ++w) {
@@ -209,6 +225,8 @@ void check_boundary(const Config& c, const RangeScales& s) {
   }
   for (std::size_t p = 0; p < c.boundary.planes.size(); ++p)
     check_plane(c.boundary.planes[p], p, s);
+  for (std::size_t k = 0; k < c.boundary.cylinders.size(); ++k)
+    check_cylinder(c.boundary.cylinders[k], k, s);
   // The images slide at gamma L_y; faster than 1e6 / tau the image shifts and the flow's heating
   // swamp every collision (and 1e300 overflows the positions).
   const double fastest = declared("boundary.shear_rate").hi;

@@ -87,9 +87,9 @@ Effect effect_of(const std::string& key) {
     return Effect::kResume;
   if (k == "contact.sleep_speed") return Effect::kRepredict;  // sleepers predict nothing
   if (starts_with(k, "contact.")) return Effect::kResume;
-  // A wall's or a plane's contact law resumes; its place and motion re-predict (a plane moved
-  // into the particles is refused by the start checks, naming the particle).
-  for (const std::string_view table : {"boundary.wall.", "boundary.plane."}) {
+  // A wall's, a plane's or a cylinder's contact law resumes; its place and motion re-predict (a
+  // plane moved into the particles is refused by the start checks, naming the particle).
+  for (const std::string_view table : {"boundary.wall.", "boundary.plane.", "boundary.cylinder."}) {
     if (!starts_with(k, table)) continue;
     const std::string_view leaf = std::string_view(k).substr(table.size());
     if (std::find(kWallLaw.begin(), kWallLaw.end(), leaf) != kWallLaw.end()) return Effect::kResume;

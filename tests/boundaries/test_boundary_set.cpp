@@ -74,7 +74,7 @@ TEST(BoundarySet, TheResponseComesFromTheSurfacesOwnLaw) {
   const double s = 1.0 / std::sqrt(2.0);
   Vec<3> v{2.0, 1.0, 0.0};  // into the slope at 2 s along its normal
   Spin<3> w{};
-  const ContactResult<3> r = set.resolve(6, 0.0, 1.0, 0.5, 0.4, false, v, w);
+  const ContactResult<3> r = set.resolve(6, Vec<3>{}, 0.0, 1.0, 0.5, 0.4, false, v, w);
   // Normal velocity -2s becomes +s (e = 0.5); the tangential part (1, 1, -1) s... unchanged.
   EXPECT_NEAR(dot(v, set.normal(6, {}, 0.0)), 0.5 * 2.0 * s, 1e-14);
   EXPECT_NEAR(v[1], 1.0, 1e-15);

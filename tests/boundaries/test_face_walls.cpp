@@ -56,7 +56,7 @@ TEST(FaceWalls, ElasticContactReflectsTheRelativeNormalVelocityAndCountsTheWork)
   const FaceWalls<3> walls = walls_of(box_with_floor_and_lid(-0.5));
   Vec<3> v{0.3, -0.2, 1.0};
   Spin<3> w{};
-  const ContactResult<3> r = walls.resolve(5, 1.0, 2.0, 0.5, 0.4, false, v, w);
+  const ContactResult<3> r = walls.resolve(5, Vec<3>{}, 1.0, 2.0, 0.5, 0.4, false, v, w);
   // Relative normal velocity 1.5 towards the lid becomes 1.5 away from it.
   EXPECT_NEAR(v[2], -0.5 - 1.5, 1e-14);
   EXPECT_DOUBLE_EQ(v[0], 0.3);
@@ -72,7 +72,7 @@ TEST(FaceWalls, InelasticFloorDissipatesWhatTheParticleLoses) {
   const FaceWalls<3> walls = walls_of(env);
   Vec<3> v{0.0, 0.0, -2.0};
   Spin<3> w{};
-  const ContactResult<3> r = walls.resolve(4, 0.0, 1.0, 0.5, 0.4, false, v, w);
+  const ContactResult<3> r = walls.resolve(4, Vec<3>{}, 0.0, 1.0, 0.5, 0.4, false, v, w);
   EXPECT_NEAR(v[2], 1.0, 1e-14);
   EXPECT_NEAR(r.dissipated, 0.5 * (4.0 - 1.0), 1e-14);
   EXPECT_NEAR(work_on_particle(r), 0.0, 1e-14);  // a fixed wall does no work

@@ -88,8 +88,8 @@ TEST(PlaneWalls, AnAxisAlignedPlaneIsTheFaceWallBitForBit) {
     ASSERT_EQ(planes.gap(0, x, t), face_walls.gap(4, x, t));
     Vec<3> v1 = v, v2 = v;
     Spin<3> w1{}, w2{};
-    planes.resolve(0, t, 1.0, 0.5, 0.4, false, v1, w1);
-    face_walls.resolve(4, t, 1.0, 0.5, 0.4, false, v2, w2);
+    planes.resolve(0, Vec<3>{}, t, 1.0, 0.5, 0.4, false, v1, w1);
+    face_walls.resolve(4, Vec<3>{}, t, 1.0, 0.5, 0.4, false, v2, w2);
     ASSERT_EQ(v1, v2);
     ASSERT_EQ(w1, w2);
   }

@@ -63,6 +63,11 @@ face = "z+"
 normal = [0.0, 1.0, 1.0]
 point = [0.0, 0.0, 0.5]
 
+[[boundary.cylinder]]
+axis = "x"
+center = [0.0, 2.0, 2.0]
+radius = 1.0
+
 [driving]
 kind = "andersen"
 )";
