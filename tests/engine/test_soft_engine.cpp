@@ -26,6 +26,7 @@
 #include "io/gsd_snapshot.hpp"
 #include "scheduler/binary_heap_queue.hpp"
 #include "scheduler/calendar_queue.hpp"
+#include "soft_wall_checks.hpp"
 
 namespace kairos {
 namespace {
@@ -540,18 +541,7 @@ TEST(SoftWalls, PistonContactIsTheMapInTheWallsFrame) {
   env.faces[4].kind = env.faces[5].kind = FaceKind::kWall;
   env.faces[5].wall.velocity[2] = u;
   Engine3 engine(s, StartMode::kPredict, {}, env);
-  const auto budget = [&] {
-    const EventCounters& c = engine.counters();
-    return engine.kinetic_energy() + engine.potential_energy() + c.dissipated_at_walls -
-           c.work_by_walls;
-  };
-  const double e0 = budget();
-  EventKind kind;
-  while ((kind = engine.step()) != EventKind::kSoftRelease) {
-    ASSERT_NE(kind, EventKind::kNone);
-    EXPECT_NEAR(budget(), e0, 1e-12);
-  }
-  EXPECT_NEAR(budget(), e0, 1e-12);
+  testing::step_to_release_keeping_the_wall_budget(engine);
   const double vn = v[2] - u;  // the approach speed in the wall's frame
   const CollisionUnits units = reduce_collision(law, m, 0.5, vn, 0.0);
   const CollisionMap map = collision_map(units.reduced);
@@ -560,17 +550,7 @@ TEST(SoftWalls, PistonContactIsTheMapInTheWallsFrame) {
   EXPECT_EQ(after.kinematics[0].vel[0], v[0]);
   EXPECT_NEAR(after.counters.work_by_walls, m * u * (after.kinematics[0].vel[2] - v[2]), 1e-12);
   EXPECT_GT(after.counters.work_by_walls, 0.0);  // the lid coming down hits the sphere back
-
-  DemOptions options;
-  options.dt = map.eps_t * units.time_unit / 20000.0;
-  DemIntegrator<3> dem(s, env, options);
-  dem.step(static_cast<long>((engine.time() + 0.05) / options.dt));
-  const Vec<3> x = after.position(0, dem.time());
-  for (int a = 0; a < 3; ++a) {
-    EXPECT_NEAR(dem.position(0)[a], x[a], 1e-6) << a;
-    EXPECT_NEAR(dem.velocity(0)[a], after.kinematics[0].vel[a], 1e-6) << a;
-  }
-  EXPECT_NEAR(dem.work_by_walls(), after.counters.work_by_walls, 1e-6);
+  testing::expect_the_dem_agrees(s, env, units, map, engine.time(), after);
 }
 
 TEST(SoftResume, ResumingFromARestartFileWithContactsInProgressIsBitIdentical) {

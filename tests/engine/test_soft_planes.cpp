@@ -21,6 +21,7 @@
 #include "interactions/soft_contact.hpp"
 #include "io/gsd_snapshot.hpp"
 #include "scheduler/calendar_queue.hpp"
+#include "soft_wall_checks.hpp"
 
 namespace kairos {
 namespace {
@@ -103,18 +104,7 @@ TEST(SoftPlanes, ATiltedPistonIsTheMapInTheWallsFrameAndAgreesWithTheDem) {
   // The plane moves: at t0 = 0.3 it is u t0 further along the normal.
   s.kinematics[0].pos = s.kinematics[0].pos + (u * 0.3) * kNormal;
   Engine3 engine(s, StartMode::kPredict, {}, env);
-  const auto budget = [&] {
-    const EventCounters& c = engine.counters();
-    return engine.kinetic_energy() + engine.potential_energy() + c.dissipated_at_walls -
-           c.work_by_walls;
-  };
-  const double e0 = budget();
-  EventKind kind;
-  while ((kind = engine.step()) != EventKind::kSoftRelease) {
-    ASSERT_NE(kind, EventKind::kNone);
-    EXPECT_NEAR(budget(), e0, 1e-12);
-  }
-  EXPECT_NEAR(budget(), e0, 1e-12);
+  testing::step_to_release_keeping_the_wall_budget(engine);
   EXPECT_NEAR(engine.time(), 0.3, 0.3);  // met near t0, released after the contact time
   const CollisionUnits units = reduce_collision(law, m, 0.5, vn, 0.0);
   const CollisionMap map = collision_map(units.reduced);
@@ -122,17 +112,7 @@ TEST(SoftPlanes, ATiltedPistonIsTheMapInTheWallsFrameAndAgreesWithTheDem) {
   const Vec<3> w = after.kinematics[0].vel;
   EXPECT_NEAR(dot(w, kNormal), u - map.eps_rdot * vn, 1e-12);
   EXPECT_GT(after.counters.work_by_walls, 0.0);  // the piston pushes the sphere back
-
-  DemOptions options;
-  options.dt = map.eps_t * units.time_unit / 20000.0;
-  DemIntegrator<3> dem(s, env, options);
-  dem.step(static_cast<long>((engine.time() + 0.05) / options.dt));
-  const Vec<3> x = after.position(0, dem.time());
-  for (int a = 0; a < 3; ++a) {
-    EXPECT_NEAR(dem.position(0)[a], x[a], 1e-6) << a;
-    EXPECT_NEAR(dem.velocity(0)[a], w[a], 1e-6) << a;
-  }
-  EXPECT_NEAR(dem.work_by_walls(), after.counters.work_by_walls, 1e-6);
+  testing::expect_the_dem_agrees(s, env, units, map, engine.time(), after);
 }
 
 // A soft gas above a slope, inside walls: the engine's state checked against brute force
