@@ -13,19 +13,19 @@
 
 namespace kairos {
 
-template <int D>
-double CylinderWalls<D>::gap(int s, const Vec<D>& x, double /*t*/) const {
+template <int D, RoundShape S>
+double RoundWalls<D, S>::gap(int s, const Vec<D>& x, double /*t*/) const {
   const CylinderWall<D>& c = cylinder(s);
-  const double d = std::sqrt(norm2(c.across(x)));
+  const double d = std::sqrt(norm2(c.across(x - c.center)));
   return c.inside ? c.radius - d : d - c.radius;
 }
 
 // Across the axis, towards it (inside) or away from it (outside). On the axis itself (only an
 // outside cylinder of radius 0 would put a particle there) any direction across it will do.
-template <int D>
-Vec<D> CylinderWalls<D>::normal(int s, const Vec<D>& x, double /*t*/) const {
+template <int D, RoundShape S>
+Vec<D> RoundWalls<D, S>::normal(int s, const Vec<D>& x, double /*t*/) const {
   const CylinderWall<D>& c = cylinder(s);
-  Vec<D> r = c.across(x);
+  Vec<D> r = c.across(x - c.center);
   const double d = std::sqrt(norm2(r));
   if (!(d > 0.0)) {
     r = Vec<D>{};
@@ -37,8 +37,8 @@ Vec<D> CylinderWalls<D>::normal(int s, const Vec<D>& x, double /*t*/) const {
 }
 
 // omega e_axis x (p - c) at the surface point p nearest to x; in 2D omega (-y, x).
-template <int D>
-Vec<D> CylinderWalls<D>::velocity(int s, const Vec<D>& x, double t) const {
+template <int D, RoundShape S>
+Vec<D> RoundWalls<D, S>::velocity(int s, const Vec<D>& x, double t) const {
   const CylinderWall<D>& c = cylinder(s);
   if (c.angular_velocity == 0.0) return Vec<D>{};
   const Vec<D> n = normal(s, x, t);
@@ -58,16 +58,12 @@ Vec<D> CylinderWalls<D>::velocity(int s, const Vec<D>& x, double t) const {
 // f(t) = |r(t)|^2 - L^2 is a quartic (a quadratic without a field across the axis). Inside the
 // valid side is |r| <= R_c - R, outside |r| >= R_c + R; f is signed so that f < 0 is the
 // overlapping side, as the solvers want (docs/physics.md#cylinder-walls).
-template <int D>
-double CylinderWalls<D>::event_time(int s, const Vec<D>& x, const Vec<D>& v, double radius,
+template <int D, RoundShape S>
+double RoundWalls<D, S>::event_time(int s, const Vec<D>& x, const Vec<D>& v, double radius,
                                     double /*t*/, double horizon) const {
   const CylinderWall<D>& c = cylinder(s);
-  const Vec<D> r = c.across(x);
-  Vec<D> u = v, a = gravity_;
-  if constexpr (D == 3) {
-    u[c.axis] = 0.0;
-    a[c.axis] = 0.0;
-  }
+  const Vec<D> r = c.across(x - c.center);
+  const Vec<D> u = c.across(v), a = c.across(gravity_);
   const double reach = c.inside ? c.radius - radius : c.radius + radius;
   const double sign = c.inside ? -1.0 : 1.0;
   const double rr = norm2(r), ru = dot(r, u), uu = norm2(u), ra = dot(r, a), ua = dot(u, a),
@@ -80,12 +76,12 @@ double CylinderWalls<D>::event_time(int s, const Vec<D>& x, const Vec<D>& v, dou
 
 // The cell's nearest and farthest points across the axis (its outer layers along a bounded
 // axis reach to infinity: reached).
-template <int D>
-bool CylinderWalls<D>::reaches(int s, CellCode cell, const CellGrid<D>& grid) const {
+template <int D, RoundShape S>
+bool RoundWalls<D, S>::reaches(int s, CellCode cell, const CellGrid<D>& grid) const {
   const CylinderWall<D>& c = cylinder(s);
   double near2 = 0.0, far2 = 0.0;
   for (int b = 0; b < D; ++b) {
-    if (D == 3 && b == c.axis) continue;
+    if (D == 3 && S == RoundShape::kCylinder && b == c.axis) continue;
     const double lo = grid.lower_bound(cell, b) - c.center[b];
     const double hi = grid.upper_bound(cell, b) - c.center[b];
     if (!std::isfinite(lo) || !std::isfinite(hi)) return true;
@@ -102,23 +98,23 @@ bool CylinderWalls<D>::reaches(int s, CellCode cell, const CellGrid<D>& grid) co
   return near2 <= to * to;
 }
 
-template <int D>
-ContactResult<D> CylinderWalls<D>::resolve(int s, const Vec<D>& x, double t, double mass,
+template <int D, RoundShape S>
+ContactResult<D> RoundWalls<D, S>::resolve(int s, const Vec<D>& x, double t, double mass,
                                            double radius, double inertia_factor, bool force_elastic,
                                            Vec<D>& v, Spin<D>& w) const {
   return resolve_surface_contact<D>(cylinder(s).contact, normal(s, x, t), velocity(s, x, t), mass,
                                     radius, inertia_factor, force_elastic, v, w);
 }
 
-template <int D>
-bool CylinderWalls<D>::overlaps(const Vec<D>& x, double radius, double t, int skip) const {
+template <int D, RoundShape S>
+bool RoundWalls<D, S>::overlaps(const Vec<D>& x, double radius, double t, int skip) const {
   for (int s = 0; s < surfaces(); ++s)
     if (s != skip && gap(s, x, t) < radius) return true;
   return false;
 }
 
-template <int D>
-void CylinderWalls<D>::check_start(const Vec<D>& x, double radius, double t,
+template <int D, RoundShape S>
+void RoundWalls<D, S>::check_start(const Vec<D>& x, double radius, double t,
                                    std::uint64_t id) const {
   for (int s = 0; s < surfaces(); ++s) {
     const double g = gap(s, x, t);
@@ -131,12 +127,14 @@ void CylinderWalls<D>::check_start(const Vec<D>& x, double radius, double t,
   }
 }
 
-template <int D>
-void CylinderWalls<D>::throw_squeezed(double /*t*/, double /*dmax*/, bool /*uniform*/) const {
-  throw std::logic_error("CylinderWalls::throw_squeezed: a cylinder never squeezes");
+template <int D, RoundShape S>
+void RoundWalls<D, S>::throw_squeezed(double /*t*/, double /*dmax*/, bool /*uniform*/) const {
+  throw std::logic_error("RoundWalls::throw_squeezed: a round wall never squeezes");
 }
 
-template class CylinderWalls<2>;
-template class CylinderWalls<3>;
+template class RoundWalls<2, RoundShape::kCylinder>;
+template class RoundWalls<3, RoundShape::kCylinder>;
+template class RoundWalls<2, RoundShape::kSphere>;
+template class RoundWalls<3, RoundShape::kSphere>;
 
 }  // namespace kairos

@@ -1,16 +1,18 @@
-// Cylinder walls ([[boundary.cylinder]]): the third boundary component (docs/extending.md,
-// "Adding a boundary geometry"). A cylinder of radius R_c about an axis along a box axis (in 2D a
-// circle in the plane), holding the particles inside it (a drum, a silo) or outside it (an
-// obstacle), fixed or rotating about its axis at angular velocity omega (a rotating drum: its
-// surface moves at omega x (p - c), which a rough or frictional contact feels). It runs along
-// its whole axis: through a periodic axis, or between the walls or planes that close it.
+// Cylinder and sphere walls ([[boundary.cylinder]], [[boundary.sphere]]): the third and fourth
+// boundary components (docs/extending.md, "Adding a boundary geometry"), one implementation
+// (RoundWalls) for both. A cylinder of radius R_c about an axis along a box axis (in 2D a circle
+// in the plane), or a sphere of radius R_c, holds the particles inside it (a drum, a silo, a
+// spherical container) or outside it (an obstacle), fixed or rotating about an axis at angular
+// velocity omega (a rotating drum: its surface moves at omega e x (p - c), which a rough or
+// frictional contact feels). A cylinder runs along its whole axis: through a periodic axis, or
+// between the walls or planes that close it.
 //
-// Distances are measured in the plane across the axis: r_perp(x) = x - c less its component along
-// the axis. Inside, the gap is R_c - |r_perp| and the normal into the domain points to the axis;
-// outside, the gap is |r_perp| - R_c and the normal points away from it. Under a field across
-// the axis a particle's |r_perp(t)|^2 is a quartic in t, solved by the certified search of
-// dynamics/trajectory_events (quartic_event_time); along the axis the field does not matter.
-// Like the planes it is a function of the time alone: nothing in restart files.
+// Distances are measured from the centre c: for a sphere r(x) = x - c, for a cylinder the same
+// less its component along the axis. Inside, the gap is R_c - |r| and the normal into the domain
+// points to the centre (axis); outside, the gap is |r| - R_c and the normal points away. Under a
+// field a particle's |r(t)|^2 is a quartic in t, solved by the certified search of
+// dynamics/trajectory_events (quartic_event_time); along a cylinder's axis the field does not
+// matter. Like the planes they are functions of the time alone: nothing in restart files.
 #pragma once
 
 #include <cstdint>
@@ -26,37 +28,49 @@
 
 namespace kairos {
 
+enum class RoundShape { kCylinder, kSphere };
+
 template <int D>
 struct CylinderWall {
-  int axis = D - 1;  // the axis's direction (3D: 0, 1 or 2; 2D: the circle's, out of the plane)
-  Vec<D> center{};   // a point of the axis (its component along the axis does not matter)
+  // The axis's direction (3D: 0, 1 or 2; 2D: the circle's, out of the plane); a sphere's
+  // rotation axis.
+  int axis = D - 1;
+  Vec<D> center{};  // a point of the axis (its component along the axis does not matter), or a
+                    // sphere's centre
+  RoundShape shape = RoundShape::kCylinder;
   double radius = 1.0;
   bool inside = true;             // the particles are inside it
   double angular_velocity = 0.0;  // about the axis, right-handed (2D: counter-clockwise)
   ContactModel contact;           // its contact law
 
-  // The centre's offset from the axis, across it.
-  Vec<D> across(const Vec<D>& x) const {
-    Vec<D> r = x - center;
-    if constexpr (D == 3) r[axis] = 0.0;
+  // A vector measured from the centre (the axis): for a cylinder its component along the axis
+  // dropped.
+  Vec<D> across(Vec<D> r) const {
+    if constexpr (D == 3)
+      if (shape == RoundShape::kCylinder) r[axis] = 0.0;
     return r;
   }
 };
 
-template <int D>
-class CylinderWalls {
+template <int D, RoundShape Shape>
+class RoundWalls {
  public:
-  CylinderWalls() = default;
-  // The cylinders and the uniform acceleration the particles feel.
-  CylinderWalls(std::vector<CylinderWall<D>> cylinders, const Vec<D>& gravity)
-      : cylinders_(std::move(cylinders)), gravity_(gravity) {}
+  RoundWalls() = default;
+  // The cylinders (spheres) and the uniform acceleration the particles feel.
+  RoundWalls(std::vector<CylinderWall<D>> walls, const Vec<D>& gravity)
+      : cylinders_(std::move(walls)), gravity_(gravity) {
+    for (CylinderWall<D>& c : cylinders_) c.shape = Shape;
+  }
 
-  // The boundary interface (model/boundaries.hpp): surface s is cylinder s.
+  // The boundary interface (model/boundaries.hpp): surface s is cylinder (sphere) s.
   bool any() const { return !cylinders_.empty(); }
   int surfaces() const { return static_cast<int>(cylinders_.size()); }
   bool is_surface(int /*s*/) const { return true; }
   const CylinderWall<D>& cylinder(int s) const { return cylinders_[static_cast<std::size_t>(s)]; }
-  std::string name(int s) const { return "boundary.cylinder[" + std::to_string(s) + "]"; }
+  std::string name(int s) const {
+    return (Shape == RoundShape::kSphere ? "boundary.sphere[" : "boundary.cylinder[") +
+           std::to_string(s) + "]";
+  }
   const ContactModel& contact(int s) const { return cylinder(s).contact; }
   double approach_speed(int /*s*/) const { return 0.0; }
   bool flat(int /*s*/) const { return false; }
@@ -71,21 +85,21 @@ class CylinderWalls {
 
   double event_time(int s, const Vec<D>& x, const Vec<D>& v, double radius, double t,
                     double horizon) const;
-  // Whether a particle in `cell` can touch cylinder s before it leaves the cell: across the
-  // axis, the cell's farthest point (inside) or nearest point (outside) is within the largest
-  // radius of the surface.
+  // Whether a particle in `cell` can touch surface s before it leaves the cell: the cell's
+  // farthest point (inside) or nearest point (outside) from the centre (across the axis) is
+  // within the largest radius of the surface.
   bool reaches(int s, CellCode cell, const CellGrid<D>& grid) const;
   ContactResult<D> resolve(int s, const Vec<D>& x, double t, double mass, double radius,
                            double inertia_factor, bool force_elastic, Vec<D>& v, Spin<D>& w) const;
   bool overlaps(const Vec<D>& x, double radius, double t, int skip = -1) const;
-  // Throws InputError naming the particle and the cylinder it overlaps.
+  // Throws InputError naming the particle and the surface it overlaps.
   void check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const;
 
   void prepare(const CellGrid<D>& /*grid*/, double rmax, double /*particle_volume*/,
                bool /*uniform*/) {
     rmax_ = rmax;
   }
-  // A cylinder does not move: it never leaves the particles no room.
+  // It does not move: it never leaves the particles no room.
   double squeeze_time() const { return kNever; }
   [[noreturn]] void throw_squeezed(double t, double dmax, bool uniform) const;
 
@@ -94,5 +108,10 @@ class CylinderWalls {
   Vec<D> gravity_{};
   double rmax_ = 0.0;
 };
+
+template <int D>
+using CylinderWalls = RoundWalls<D, RoundShape::kCylinder>;
+template <int D>
+using SphereWalls = RoundWalls<D, RoundShape::kSphere>;
 
 }  // namespace kairos

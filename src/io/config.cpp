@@ -354,9 +354,9 @@ class Reader : public KeyReader {
   // [[boundary.cylinder]] number i: its axis (2D: z), center and radius (required), the side
   // the particles are on and its rotation, then its contact law. Whether it crosses a periodic
   // face is checked with the box (Environment::check).
-  CylinderConfig read_cylinder(const toml::table& ct, std::size_t i, int dimension,
-                               const ContactConfig& contact) const {
-    const std::string prefix = fmt::format("boundary.cylinder[{}]", i);
+  CylinderConfig read_cylinder(const toml::table& ct, std::string_view table, std::size_t i,
+                               int dimension, const ContactConfig& contact) const {
+    const std::string prefix = fmt::format("boundary.{}[{}]", table, i);
     CylinderConfig cylinder;
     cylinder.contact = contact;
     read_group(ct, prefix, cylinder_keys(), &cylinder, &dimension);
@@ -374,8 +374,8 @@ class Reader : public KeyReader {
     }
     if (dimension == 2 && cylinder.axis != "z") {
       fail(ct.get("axis"), prefix + ".axis",
-           fmt::format("{}.axis: '{}': in 2D a cylinder is a circle in the plane, its axis is z",
-                       prefix, cylinder.axis));
+           fmt::format("{}.axis: '{}': in 2D a {} is a circle in the plane, its axis is z", prefix,
+                       cylinder.axis, table));
     }
     for (const double c : cylinder.center) {
       if (!std::isfinite(c))
@@ -430,7 +430,10 @@ class Reader : public KeyReader {
       b.planes.push_back(read_plane(*plane_tables[i], i, dimension, contact));
     const std::vector<const toml::table*> cylinder_tables = table_array(t, p, "cylinder");
     for (std::size_t i = 0; i < cylinder_tables.size(); ++i)
-      b.cylinders.push_back(read_cylinder(*cylinder_tables[i], i, dimension, contact));
+      b.cylinders.push_back(read_cylinder(*cylinder_tables[i], "cylinder", i, dimension, contact));
+    const std::vector<const toml::table*> sphere_tables = table_array(t, p, "sphere");
+    for (std::size_t i = 0; i < sphere_tables.size(); ++i)
+      b.spheres.push_back(read_cylinder(*sphere_tables[i], "sphere", i, dimension, contact));
 
     read_group(t, std::string(p), boundary_keys(), &b, &dimension);
     const toml::node* n_open = t.get("open");

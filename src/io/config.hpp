@@ -125,6 +125,7 @@ struct BoundaryConfig {
   std::vector<WallConfig> walls;          // [[boundary.wall]]
   std::vector<PlaneConfig> planes;        // [[boundary.plane]]
   std::vector<CylinderConfig> cylinders;  // [[boundary.cylinder]]
+  std::vector<CylinderConfig> spheres;    // [[boundary.sphere]]: axis is the rotation's
   std::vector<std::string> open;          // boundary.open: faces with no wall (e.g. "z+")
   double shear_rate = 0.0;                // Lees-Edwards: flow along x, gradient along y; 0: none
 

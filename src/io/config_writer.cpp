@@ -145,10 +145,13 @@ std::string to_toml(const Config& config) {
     out += group_toml(contact_law_keys(), &p.wall.contact, "boundary.plane", dimension);
     out += group_toml(wall_keys(), &p.wall, "boundary.plane", dimension);
   }
-  for (const CylinderConfig& c : config.boundary.cylinders) {
-    out += "\n[[boundary.cylinder]]\n";
-    out += group_toml(cylinder_keys(), &c, "boundary.cylinder", dimension);
-    out += group_toml(contact_law_keys(), &c.contact, "boundary.cylinder", dimension);
+  for (const bool sphere : {false, true}) {
+    const std::string name = sphere ? "boundary.sphere" : "boundary.cylinder";
+    for (const CylinderConfig& c : sphere ? config.boundary.spheres : config.boundary.cylinders) {
+      out += "\n[[" + name + "]]\n";
+      out += group_toml(cylinder_keys(), &c, name, dimension);
+      out += group_toml(contact_law_keys(), &c.contact, name, dimension);
+    }
   }
   out += table("driving", driving_keys(), &config.driving);
   out += table("field", field_keys(), &config.field);

@@ -228,14 +228,16 @@ class BoundarySet {
 // in the constructor, which makes each from the run's model (its specification lives in the
 // Environment).
 template <int D>
-class Boundaries : public BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>> {
+class Boundaries
+    : public BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>, SphereWalls<D>> {
  public:
   Boundaries() = default;
   Boundaries(const Environment<D>& environment, const Vec<D>& box)
-      : BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>>(
+      : BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>, SphereWalls<D>>(
             FaceWalls<D>(environment.faces, box, environment.gravity),
             PlaneWalls<D>(environment.planes, box, environment.faces, environment.gravity),
-            CylinderWalls<D>(environment.cylinders, environment.gravity)) {}
+            CylinderWalls<D>(environment.cylinders, environment.gravity),
+            SphereWalls<D>(environment.spheres, environment.gravity)) {}
 
   const FaceWalls<D>& faces() const { return this->template get<FaceWalls<D>>(); }
   FaceWalls<D>& faces() { return this->template get<FaceWalls<D>>(); }

@@ -36,8 +36,9 @@ bool Environment<D>::rotates() const {
     if (f.kind == FaceKind::kWall && !f.wall.contact.tangential.is_smooth()) return true;
   for (const PlaneWall<D>& p : planes)
     if (!p.wall.contact.tangential.is_smooth()) return true;
-  for (const CylinderWall<D>& c : cylinders)
-    if (!c.contact.tangential.is_smooth()) return true;
+  for (const auto* round : {&cylinders, &spheres})
+    for (const CylinderWall<D>& c : *round)
+      if (!c.contact.tangential.is_smooth()) return true;
   return false;
 }
 
@@ -82,21 +83,26 @@ void Environment<D>::check() const {
       }
     }
   }
-  for (std::size_t s = 0; s < cylinders.size(); ++s) {
-    const CylinderWall<D>& c = cylinders[s];
-    const std::string name = "boundary.cylinder[" + std::to_string(s) + "]";
-    if (c.axis < 0 || c.axis >= D) throw InputError(name + ": axis must be a box axis");
-    if (!(c.radius > 0.0) || !std::isfinite(c.radius))
-      throw InputError(name + ": radius must be finite and > 0");
-    if (!std::isfinite(c.angular_velocity))
-      throw InputError(name + ": angular_velocity must be finite");
-    for (int a = 0; a < D; ++a) {
-      if (!std::isfinite(c.center[a])) throw InputError(name + ": center must be finite");
-      if ((D == 2 || a != c.axis) && periodic(a)) {
-        throw InputError(name + ": the axis " + std::string(1, "xyz"[a]) +
-                         " across the cylinder is periodic: a cylinder must not cross a "
-                         "periodic face (it would not meet its own periodic image); make that "
-                         "axis bounded (walls or open faces)");
+  for (const bool sphere : {false, true}) {
+    const std::vector<CylinderWall<D>>& round = sphere ? spheres : cylinders;
+    for (std::size_t s = 0; s < round.size(); ++s) {
+      const CylinderWall<D>& c = round[s];
+      const std::string name =
+          std::string(sphere ? "boundary.sphere[" : "boundary.cylinder[") + std::to_string(s) + "]";
+      if (c.axis < 0 || c.axis >= D) throw InputError(name + ": axis must be a box axis");
+      if (!(c.radius > 0.0) || !std::isfinite(c.radius))
+        throw InputError(name + ": radius must be finite and > 0");
+      if (!std::isfinite(c.angular_velocity))
+        throw InputError(name + ": angular_velocity must be finite");
+      for (int a = 0; a < D; ++a) {
+        if (!std::isfinite(c.center[a])) throw InputError(name + ": center must be finite");
+        if ((sphere || D == 2 || a != c.axis) && periodic(a)) {
+          throw InputError(
+              name + ": the axis " + std::string(1, "xyz"[a]) +
+              (sphere ? " is periodic: a sphere" : " across the cylinder is periodic: a cylinder") +
+              " must not cross a periodic face (it would not meet its own periodic "
+              "image); make that axis bounded (walls or open faces)");
+        }
       }
     }
   }

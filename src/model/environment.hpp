@@ -44,6 +44,7 @@ struct Environment {
   // Plane walls at any position and orientation (boundaries/plane_walls.hpp), after the faces.
   std::vector<PlaneWall<D>> planes;
   std::vector<CylinderWall<D>> cylinders;  // boundaries/cylinder_walls.hpp
+  std::vector<CylinderWall<D>> spheres;    // the same, round in every direction
   // Contact law of species pair (a, b) at contact[a * species + b] (symmetric); empty: every
   // pair collides elastically and smoothly.
   std::vector<ContactModel> contact;
@@ -126,7 +127,7 @@ struct Environment {
   bool has_walls() const {
     for (const Face<D>& f : faces)
       if (f.kind == FaceKind::kWall) return true;
-    return !planes.empty() || !cylinders.empty();
+    return !planes.empty() || !cylinders.empty() || !spheres.empty();
   }
   const ContactModel* contact_of(std::uint32_t a, std::uint32_t b) const {
     return contact.empty() ? nullptr : &contact[a * species + b];

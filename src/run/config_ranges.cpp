@@ -200,8 +200,9 @@ void check_plane(const PlaneConfig& p, std::size_t index, const RangeScales& s) 
 
 // A cylinder's center and radius lie within 1e6 box edges (further, |x - c| loses the
 // particles' digits).
-void check_cylinder(const CylinderConfig& c, std::size_t index, const RangeScales& s) {
-  const std::string prefix = fmt::format("boundary.cylinder[{}]", index);
+void check_cylinder(const CylinderConfig& c, std::string_view table, std::size_t index,
+                    const RangeScales& s) {
+  const std::string prefix = fmt::format("boundary.{}[{}]", table, index);
   double longest = 0.0;
   for (const double edge : s.box) longest = std::max(longest, edge);
   const std::string why = fmt::format("1e6 times the longest box edge, {:.6g}", longest);
@@ -226,7 +227,9 @@ void check_boundary(const Config& c, const RangeScales& s) {
   for (std::size_t p = 0; p < c.boundary.planes.size(); ++p)
     check_plane(c.boundary.planes[p], p, s);
   for (std::size_t k = 0; k < c.boundary.cylinders.size(); ++k)
-    check_cylinder(c.boundary.cylinders[k], k, s);
+    check_cylinder(c.boundary.cylinders[k], "cylinder", k, s);
+  for (std::size_t k = 0; k < c.boundary.spheres.size(); ++k)
+    check_cylinder(c.boundary.spheres[k], "sphere", k, s);
   // The images slide at gamma L_y; faster than 1e6 / tau the image shifts and the flow's heating
   // swamp every collision (and 1e300 overflows the positions).
   const double fastest = declared("boundary.shear_rate").hi;

@@ -364,17 +364,22 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
     plane.wall = make_wall<D>(pc.wall, fmt::format("boundary.plane[{}]", k));
     env.planes.push_back(plane);
   }
-  for (std::size_t k = 0; k < config.boundary.cylinders.size(); ++k) {
-    const CylinderConfig& cc = config.boundary.cylinders[k];
-    CylinderWall<D> cylinder;
-    cylinder.axis = D == 2 ? D - 1 : static_cast<int>(axes(3).at(cc.axis));
-    for (int a = 0; a < D && a < static_cast<int>(cc.center.size()); ++a)
-      cylinder.center[a] = cc.center[a];
-    cylinder.radius = cc.radius;
-    cylinder.inside = cc.inside;
-    cylinder.angular_velocity = cc.angular_velocity;
-    cylinder.contact = make_contact_model(cc.contact, fmt::format("boundary.cylinder[{}]", k));
-    env.cylinders.push_back(cylinder);
+  for (const bool sphere : {false, true}) {
+    const std::vector<CylinderConfig>& given =
+        sphere ? config.boundary.spheres : config.boundary.cylinders;
+    for (std::size_t k = 0; k < given.size(); ++k) {
+      const CylinderConfig& cc = given[k];
+      CylinderWall<D> round;
+      round.axis = D == 2 ? D - 1 : static_cast<int>(axes(3).at(cc.axis));
+      for (int a = 0; a < D && a < static_cast<int>(cc.center.size()); ++a)
+        round.center[a] = cc.center[a];
+      round.radius = cc.radius;
+      round.inside = cc.inside;
+      round.angular_velocity = cc.angular_velocity;
+      round.contact = make_contact_model(
+          cc.contact, fmt::format("boundary.{}[{}]", sphere ? "sphere" : "cylinder", k));
+      (sphere ? env.spheres : env.cylinders).push_back(round);
+    }
   }
   for (const std::string& open : config.boundary.open)
     env.faces[face_index(open, D)].kind = FaceKind::kOpen;

@@ -89,7 +89,8 @@ Effect effect_of(const std::string& key) {
   if (starts_with(k, "contact.")) return Effect::kResume;
   // A wall's, a plane's or a cylinder's contact law resumes; its place and motion re-predict (a
   // plane moved into the particles is refused by the start checks, naming the particle).
-  for (const std::string_view table : {"boundary.wall.", "boundary.plane.", "boundary.cylinder."}) {
+  for (const std::string_view table :
+       {"boundary.wall.", "boundary.plane.", "boundary.cylinder.", "boundary.sphere."}) {
     if (!starts_with(k, table)) continue;
     const std::string_view leaf = std::string_view(k).substr(table.size());
     if (std::find(kWallLaw.begin(), kWallLaw.end(), leaf) != kWallLaw.end()) return Effect::kResume;

@@ -1,4 +1,5 @@
-// Cylinder walls (boundaries/cylinder_walls): the third boundary component. Its gap, normal and
+// Cylinder and sphere walls (boundaries/cylinder_walls): the third and fourth boundary
+// components, one implementation. Its gap, normal and
 // surface velocity in closed form (inside and outside, 2D and 3D, the rotation's sense); event
 // times against dense sampling under a field across the axis (a quartic), never after the
 // sampled contact; every cell a particle can touch the cylinder from is reached; the engine in a
@@ -69,10 +70,34 @@ TEST(CylinderWalls, GapNormalAndSurfaceVelocityInClosedForm) {
   EXPECT_NEAR(circle.velocity(0, right, 0.0)[0], 0.0, 1e-15);
 }
 
+TEST(SphereWalls, GapNormalAndSurfaceVelocityInClosedForm) {
+  // A spherical container of radius 4 about (5, 5, 5) turning at 0.5 about +z.
+  const SphereWalls<3> in({drum<3>({5.0, 5.0, 5.0}, 4.0, 0.5, 2)}, {});
+  const Vec<3> x{7.0, 5.0, 7.0};  // sqrt 8 from the centre, along (1, 0, 1)
+  EXPECT_NEAR(in.gap(0, x, 0.0), 4.0 - std::sqrt(8.0), 1e-15);
+  const Vec<3> n = in.normal(0, x, 0.0);
+  EXPECT_NEAR(n[0], -std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(n[2], -std::sqrt(0.5), 1e-15);
+  // The surface point c + 4 (1, 0, 1) / sqrt 2: omega e_z x (p - c) = (0, 0.5 * 4 / sqrt 2, 0).
+  const Vec<3> u = in.velocity(0, x, 0.0);
+  EXPECT_NEAR(u[1], std::sqrt(2.0), 1e-14);
+  EXPECT_NEAR(u[0], 0.0, 1e-15);
+  EXPECT_EQ(in.name(0), "boundary.sphere[0]");
+  // The same point against a cylinder about z: only (x, y) counts.
+  const CylinderWalls<3> cylinder({drum<3>({5.0, 5.0, 5.0}, 4.0, 0.0, 2)}, {});
+  EXPECT_NEAR(cylinder.gap(0, x, 0.0), 2.0, 1e-15);
+  CylinderWall<3> ball = drum<3>({5.0, 5.0, 5.0}, 1.0);
+  ball.inside = false;
+  const SphereWalls<3> out({ball}, {});
+  EXPECT_NEAR(out.gap(0, x, 0.0), std::sqrt(8.0) - 1.0, 1e-15);
+  EXPECT_NEAR(out.normal(0, x, 0.0)[2], std::sqrt(0.5), 1e-15);
+}
+
 // The first time the sampled gap falls below the radius (steps of h), kNever if none before
 // t_max: the particle at x + v t + g t^2 / 2.
-template <int D>
-double sampled_contact(const CylinderWalls<D>& c, const Vec<D>& x, const Vec<D>& v, const Vec<D>& g,
+template <class Walls, std::size_t D>
+double sampled_contact(const Walls& c, const std::array<double, D>& x,
+                       const std::array<double, D>& v, const std::array<double, D>& g,
                        double radius, double h, double t_max) {
   for (double t = 0.0; t <= t_max; t += h) {
     const Vec<D> at = x + t * v + (0.5 * t * t) * g;
@@ -107,6 +132,34 @@ TEST(CylinderWalls, EventTimesUnderAFieldAcrossTheAxisAgreeWithDenseSampling) {
     EXPECT_GT(predicted, sampled - h - 1e-12) << k;  // nor before the step it falls in
   }
   EXPECT_GT(met, 35);  // the obstacles are often missed
+}
+
+TEST(SphereWalls, EventTimesUnderAFieldAgreeWithDenseSampling) {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Vec<3> g{0.3, 0.2, -1.0};
+  int met = 0;
+  for (int k = 0; k < 80; ++k) {
+    CylinderWall<3> c = drum<3>({5.0, 5.0, 5.0}, k % 2 == 0 ? 4.0 : 1.0);
+    c.inside = k % 2 == 0;
+    const SphereWalls<3> walls({c}, g);
+    const double r = c.inside ? 2.5 * std::abs(u(rng)) : 2.0 + std::abs(u(rng));
+    Vec<3> dir{u(rng), u(rng), u(rng)};
+    dir = (1.0 / std::sqrt(norm2(dir))) * dir;
+    const Vec<3> x = Vec<3>{5.0, 5.0, 5.0} + r * dir;
+    const Vec<3> v{2.0 * u(rng), 2.0 * u(rng), 2.0 * u(rng)};
+    const double h = 1e-5;
+    const double sampled = sampled_contact(walls, x, v, g, 0.5, h, 4.0);
+    const double predicted = walls.event_time(0, x, v, 0.5, 1.0, 4.0);
+    if (sampled == kNever) {
+      EXPECT_EQ(predicted, kNever) << k;
+      continue;
+    }
+    ++met;
+    EXPECT_LE(predicted, sampled + 1e-12) << k;
+    EXPECT_GT(predicted, sampled - h - 1e-12) << k;
+  }
+  EXPECT_GT(met, 35);
 }
 
 // Every particle that can touch the cylinder before leaving its cell sits in a reached cell;
@@ -193,6 +246,47 @@ TEST(CylinderWallsInTheEngine, ARotatingDrumKeepsEveryPredictionAndClosesTheBudg
   // Turning counter-clockwise, the drum carries the bed up on its right: the centre of mass
   // sits right of the axis (without rotation, symmetric grains would average at x = 10).
   EXPECT_GT(mean_x / samples, 10.5);
+}
+
+// 3D: elastic spheres in a spherical container under gravity: every prediction checked by brute
+// force, the energy (kinetic + gravitational) conserved, nobody outside.
+TEST(SphereWallsInTheEngine, AnElasticGasInASphericalContainerConservesEnergy) {
+  ParticleSystem<3> s;
+  s.box = {12.0, 12.0, 12.0};
+  s.periodic = {false, false, false};
+  std::mt19937_64 rng(6);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int k = 0; k < 4; ++k) {
+        const Vec<3> x{4.2 + 1.2 * i, 4.2 + 1.2 * j, 4.2 + 1.2 * k};
+        s.kinematics.push_back({x, {u(rng), u(rng), u(rng)}, 0.0, 0.5});
+        s.mass.push_back(1.0);
+        s.species.push_back(0);
+      }
+  s.species_names = {"A"};
+  Environment<3> env;
+  for (int f = 0; f < 6; ++f) env.faces[static_cast<std::size_t>(f)].kind = FaceKind::kWall;
+  env.gravity = {0.0, 0.0, -1.0};
+  env.sleep_speed = 0.0;
+  env.spheres = {drum<3>({6.0, 6.0, 6.0}, 5.5)};
+  EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, {}, env);
+  const auto energy = [&] {
+    double e = engine.kinetic_energy();
+    for (const Vec<3>& p : engine.current_positions()) e += p[2];
+    return e;
+  };
+  const double e0 = energy();
+  for (int k = 0; k < 8000; ++k) {
+    ASSERT_NE(engine.step(), EventKind::kNone);
+    if (k % 5 == 0) {
+      ASSERT_NO_THROW(engine.validate()) << "after event " << k;
+    }
+  }
+  EXPECT_NEAR(energy(), e0, 1e-10 * e0);
+  EXPECT_GT(engine.counters().wall_collisions, 300u);
+  for (const Vec<3>& p : engine.current_positions())
+    ASSERT_GT(5.5 - std::sqrt(norm2(p - Vec<3>{6.0, 6.0, 6.0})), 0.5 - 1e-9);
 }
 
 // The DEM meets the drum through the same component: a disk dropped at the bottom of a fixed

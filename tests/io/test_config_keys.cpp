@@ -68,6 +68,10 @@ axis = "x"
 center = [0.0, 2.0, 2.0]
 radius = 1.0
 
+[[boundary.sphere]]
+center = [3.0, 2.0, 2.0]
+radius = 1.0
+
 [driving]
 kind = "andersen"
 )";

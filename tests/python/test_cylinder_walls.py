@@ -1,7 +1,8 @@
-"""Cylinder walls ([[boundary.cylinder]]) through the CLI: the rotating-drum example turns its bed
+"""Cylinder and sphere walls ([[boundary.cylinder]], [[boundary.sphere]]) through the CLI: the rotating-drum example turns its bed
 (the centre of mass carried up on the side the drum rises, every disk inside the drum in every
 frame, the energy budget closed with the drum's work), its config.toml reads back to the same
-run, a restart continues it bit for bit, and bad cylinders are refused naming the key.
+run, a restart continues it bit for bit, and bad cylinders are refused naming the key; an
+elastic gas in a spherical container keeps its energy with every sphere inside.
 """
 
 import os
@@ -81,6 +82,29 @@ class CylinderWalls(kt.KairosTestCase):
         del config["field"]
         config["soft"] = {"model": "dashpot", "stiffness": 1e4, "restitution": 0.9}
         self.refused(config, "boundary.cylinder[0]", "flat walls only")
+
+
+    def test_an_elastic_gas_in_a_spherical_container(self):
+        config = kt.base_config(particles=200, packing_fraction=0.1, lattice="random", seed=5,
+                                production=20.0)
+        config["system"]["box_scale"] = [1.8, 1.8, 1.8]
+        config["system"]["box_place"] = [0.5, 0.5, 0.5]
+        config["boundary"] = {"wall": [{"face": f} for f in ("x-", "x+", "y-", "y+", "z-", "z+")]}
+        out = self.path("ball")
+        # The box: 200 spheres at 0.1 fill a cube of edge 10.2, stretched 1.8 times; the
+        # container about the box's centre reaches just past that cube's corners.
+        edge = (200 * np.pi / 6 / 0.1) ** (1.0 / 3.0) * 1.8
+        config["boundary"]["sphere"] = [{"center": [edge / 2] * 3, "radius": edge / 2 - 0.01}]
+        self.run_ok("run", self.write_config(config, "ball.toml"), "-o", out)
+        s = self.summary(out)
+        self.assertLess(abs(s["granular"]["energy_balance_relative"]), 1e-12)
+        self.assertGreater(s["granular"]["wall_collisions"], 50)
+        x = kt.read_exact_state(os.path.join(out, "restart.gsd"))["kairos/state/position"]
+        r = np.linalg.norm(x - edge / 2, axis=1)
+        self.assertLess(r.max(), edge / 2 - 0.01 - 0.5 + 1e-9)
+        # A sphere must not cross a periodic face.
+        del config["boundary"]["wall"]
+        self.refused(config, "boundary.sphere[0]", "periodic")
 
 
 if __name__ == "__main__":
