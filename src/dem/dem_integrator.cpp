@@ -929,7 +929,7 @@ bool DemIntegrator<D>::touches(std::size_t i, int s, double gap, double t,
 // One wall contact of slot i (both loops): the normal force of its species' wall law, its
 // energy split and the surface's work, and with friction the tangential spring.
 template <int D>
-void DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, Vec<D>& spring,
+void DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, Vec<D>* spring,
                                         bool count_collisions, WallSums& sums) {
   const std::size_t s = sp_[i];
   const double kk = wall_stiffness_[s], damping = wall_damping_[s];
@@ -953,7 +953,7 @@ void DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, Vec
   const Vec<D> vc = v - c.gap * cross(spin(wp_, i), c.normal) - c.velocity;
   const Vec<D> vt = vc - dot(vc, c.normal) * c.normal;
   const auto [kt, gt] = tangential_law(fr, hertz, kk, damping, nf.root);
-  const Vec<D> ft = tangential_force<D>(spring, c.normal, vt, kt, gt, fr.coefficient * F,
+  const Vec<D> ft = tangential_force<D>(*spring, c.normal, vt, kt, gt, fr.coefficient * F,
                                         count_collisions ? dt_ : 0.0, sums.spring, sums.slip);
   for (int a = 0; a < D; ++a) f_[a][i] += ft[a];
   add_spin(tq_, i, -c.gap * cross(c.normal, ft));
@@ -986,7 +986,7 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
       if (count_collisions && sign * (x[i] - dt_ * u_[k][i] - p_before) >= radius_[i])
         ++sums.entered;
       c.rdot = sign * (vp_[k][i] - w);  // the gap's rate of change
-      add_wall_contact(i, c, springs[i], count_collisions, sums);
+      add_wall_contact(i, c, friction_ ? &springs[i] : nullptr, count_collisions, sums);
     }
   }
   if (any_surface_) add_surface_forces(count_collisions, t, sums);
@@ -1035,7 +1035,7 @@ void DemIntegrator<D>::add_component_forces(const Component& component, int firs
       Vec<D> v;
       for (int a = 0; a < D; ++a) v[a] = vp_[a][i];
       c.rdot = dot(v - c.velocity, c.normal);  // the gap's rate of change
-      add_wall_contact(i, c, springs[i], count_collisions, sums);
+      add_wall_contact(i, c, friction_ ? &springs[i] : nullptr, count_collisions, sums);
     }
   }
 }

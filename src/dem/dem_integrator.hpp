@@ -189,11 +189,12 @@ class DemIntegrator {
     Vec<D> normal{}, velocity{};
     int axis = -1;
   };
-  // Inlined into both loops (a call per contact cost the faces' loop 2 %).
+  // Inlined into both loops (a call per contact cost the faces' loop 2 %). `spring`: the
+  // contact's tangential spring (friction only; null without).
   [[gnu::always_inline]] inline bool touches(std::size_t i, int surface, double gap, double t,
                                              std::vector<Vec<D>>& springs);
   [[gnu::always_inline]] inline void add_wall_contact(std::size_t i, const WallContact& c,
-                                                      Vec<D>& spring, bool count_collisions,
+                                                      Vec<D>* spring, bool count_collisions,
                                                       WallSums& sums);
   // The contacts with the surfaces of the boundary components other than the box faces (plane
   // walls): the faces' force law through the boundary interface (gap, normal and velocity at

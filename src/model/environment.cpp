@@ -1,5 +1,7 @@
 #include "model/environment.hpp"
 
+#include "core/event_code.hpp"
+
 #include <cmath>
 #include <string>
 
@@ -82,6 +84,13 @@ void Environment<D>::check() const {
                          "the normal perpendicular to it");
       }
     }
+  }
+  const std::size_t surfaces = 2 * D + planes.size() + cylinders.size() + spheres.size();
+  if (surfaces > static_cast<std::size_t>(EventCode<D>::kWallCodes)) {
+    throw InputError("boundary: " + std::to_string(surfaces - 2 * D) +
+                     " plane, cylinder and sphere walls; at most " +
+                     std::to_string(EventCode<D>::kWallCodes - 2 * D) +
+                     " fit the event codes (build a rough floor of grains instead)");
   }
   for (const bool sphere : {false, true}) {
     const std::vector<CylinderWall<D>>& round = sphere ? spheres : cylinders;

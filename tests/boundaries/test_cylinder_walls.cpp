@@ -13,6 +13,7 @@
 
 #include "boundaries/cylinder_walls.hpp"
 #include "core/error.hpp"
+#include "core/event_code.hpp"
 #include "dem/dem_integrator.hpp"
 #include "engine/event_engine.hpp"
 #include "interactions/soft_contact.hpp"
@@ -313,6 +314,21 @@ TEST(CylinderWallsInTheDem, ADiskRestsAtTheBottomOfTheDrum) {
   EXPECT_NEAR(x[0], 10.0, 1e-12);  // straight down
   EXPECT_NEAR(9.0 - std::hypot(x[0] - 10.0, x[1] - 10.0), 0.5 - 1.0 / 1e4, 1e-6);
   EXPECT_GE(dem.wall_collisions(), 1u);
+}
+
+// More surfaces than the event codes hold is the user's error, named as such.
+TEST(CylinderWalls, MoreSurfacesThanEventCodesAreAnInputError) {
+  Environment<2> env;
+  for (int f = 0; f < 4; ++f) env.faces[static_cast<std::size_t>(f)].kind = FaceKind::kWall;
+  env.cylinders.assign(EventCode<2>::kWallCodes - 4, drum<2>({10.0, 10.0}, 9.0));
+  EXPECT_NO_THROW(env.check());
+  env.spheres = {drum<2>({10.0, 10.0}, 9.0)};
+  try {
+    env.check();
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("at most 4092"), std::string::npos) << e.what();
+  }
 }
 
 TEST(CylinderWallsInTheEngine, SoftSpheresUnderTheEventIntegratorAreRefusedNamingIt) {

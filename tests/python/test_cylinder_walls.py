@@ -69,6 +69,9 @@ class CylinderWalls(kt.KairosTestCase):
         del config["boundary"]["cylinder"][0]["radius"]
         self.refused(config, "boundary.cylinder[0].radius", "missing required key")
         config = drum_config(1.0)
+        config["boundary"]["cylinder"][0]["radius"] = 0.0
+        self.refused(config, "boundary.cylinder[0].radius", "must be > 0")
+        config = drum_config(1.0)
         config["boundary"]["cylinder"][0]["axis"] = "x"
         self.refused(config, "boundary.cylinder[0].axis", "in 2D")
         config = drum_config(1.0)
