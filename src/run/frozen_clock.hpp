@@ -218,10 +218,12 @@ std::string cause(const Environment<D>& env, const Boundaries<D>& boundaries,
         pistons);
   }
   if (wall_hits > pair_hits && !walls.empty()) {
-    std::string sticky, resting;
+    std::string sticky, resting, dragging;
     for (const int s : walls) {
       if (boundaries.contact(s).normal(0.0) == 0.0)
         sticky += (sticky.empty() ? "" : ", ") + boundaries.name(s);
+      else if (!boundaries.accelerates(s) && !boundaries.holds_still(s))
+        dragging += (dragging.empty() ? "" : ", ") + boundaries.name(s);
       else if (!boundaries.accelerates(s))
         resting += (resting.empty() ? "" : ", ") + boundaries.name(s);
     }
@@ -231,6 +233,13 @@ std::string cause(const Environment<D>& env, const Boundaries<D>& boundaries,
           "is met again at once (no contact law, TC model or sleeping undoes that); give it a "
           "restitution above 0 (boundary.wall restitution)",
           sticky);
+    }
+    if (!dragging.empty() && env.has_gravity()) {
+      return fmt::format(
+          "grains pressed against the moving (sliding or turning) wall {} under gravity are met "
+          "again and again, and sleeping needs a still wall; make their slow impacts elastic "
+          "(contact.tc, the TC model, or the wall's elastic_below_speed)",
+          dragging);
     }
     if (!resting.empty() && env.has_gravity()) {
       return env.sleep_speed == 0.0

@@ -87,6 +87,19 @@ class CylinderWalls(kt.KairosTestCase):
         self.refused(config, "boundary.cylinder[0]", "flat walls only")
 
 
+    def test_a_frozen_clock_against_the_turning_drum_names_it_and_the_remedy(self):
+        # Without the TC model, a fast drum (Fr = 5.9) presses grains against its moving wall,
+        # where they cannot sleep: the run stops naming the wall and the TC model.
+        config = drum_config(100.0)
+        del config["contact"]["tc"]
+        config["boundary"]["cylinder"][0]["angular_velocity"] = 0.5
+        result = self.kairos("run", self.write_config(config, "fast.toml"), "-o",
+                             self.path("fast"))
+        self.assertNotEqual(result.returncode, 0)
+        for needle in ("frozen", "moving (sliding or turning) wall boundary.cylinder[0]",
+                       "contact.tc"):
+            self.assertIn(needle, result.stderr)
+
     def test_an_elastic_gas_in_a_spherical_container(self):
         config = kt.base_config(particles=200, packing_fraction=0.1, lattice="random", seed=5,
                                 production=20.0)
