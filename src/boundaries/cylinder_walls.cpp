@@ -39,9 +39,15 @@ Vec<D> RoundWalls<D, S>::normal(int s, const Vec<D>& x, double /*t*/) const {
 // omega e_axis x (p - c) at the surface point p nearest to x; in 2D omega (-y, x).
 template <int D, RoundShape S>
 Vec<D> RoundWalls<D, S>::velocity(int s, const Vec<D>& x, double t) const {
+  if (cylinder(s).angular_velocity == 0.0) return Vec<D>{};
+  return velocity_at(s, normal(s, x, t));
+}
+
+// The surface's velocity where its normal is n (the normal found once serves both).
+template <int D, RoundShape S>
+Vec<D> RoundWalls<D, S>::velocity_at(int s, const Vec<D>& n) const {
   const CylinderWall<D>& c = cylinder(s);
   if (c.angular_velocity == 0.0) return Vec<D>{};
-  const Vec<D> n = normal(s, x, t);
   const Vec<D> p = (c.inside ? -c.radius : c.radius) * n;  // the surface point, from the axis
   Vec<D> u{};
   if constexpr (D == 2) {
@@ -102,8 +108,9 @@ template <int D, RoundShape S>
 ContactResult<D> RoundWalls<D, S>::resolve(int s, const Vec<D>& x, double t, double mass,
                                            double radius, double inertia_factor, bool force_elastic,
                                            Vec<D>& v, Spin<D>& w) const {
-  return resolve_surface_contact<D>(cylinder(s).contact, normal(s, x, t), velocity(s, x, t), mass,
-                                    radius, inertia_factor, force_elastic, v, w);
+  const Vec<D> n = normal(s, x, t);
+  return resolve_surface_contact<D>(cylinder(s).contact, n, velocity_at(s, n), mass, radius,
+                                    inertia_factor, force_elastic, v, w);
 }
 
 template <int D, RoundShape S>

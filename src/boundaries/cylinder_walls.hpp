@@ -104,6 +104,8 @@ class RoundWalls {
   [[noreturn]] void throw_squeezed(double t, double dmax, bool uniform) const;
 
  private:
+  Vec<D> velocity_at(int s, const Vec<D>& n) const;
+
   std::vector<CylinderWall<D>> cylinders_;
   Vec<D> gravity_{};
   double rmax_ = 0.0;
