@@ -130,6 +130,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
         if (resting_.asleep(k)) hot_[k].vel = Vec<D>{};
     }
   }
+  if (env_.has_fixed_grains()) fix_grains(moving);
   if (env_.tc > 0.0) {
     last_collision_.assign(n, -kNever);
     if (s.last_collision_time.size() == n)
@@ -193,6 +194,39 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
           : 0;
   next_renumber_ = next_renumber_after(counters_.collisions);
   if (options_.track_helfand) start_helfand();
+}
+
+// Fixed grains (docs/physics.md#fixed-grains): the particles of a fixed species become sleepers
+// that never wake. They must start at rest, and the features whose rules would move them or
+// that a resting particle would miss are refused.
+template <int D, class Queue>
+void EventEngine<D, Queue>::fix_grains(bool moving_surfaces) {
+  const auto refuse = [](const std::string& what) {
+    throw InputError("fixed grains (a species with fixed = true) cannot be combined with " + what);
+  };
+  if (soft_) refuse("soft spheres (soft.model)");
+  if (stepped_) refuse("stepped potentials or bonds (a fixed grain would miss its steps)");
+  if (sheared_) refuse("Lees-Edwards shear (boundary.shear_rate)");
+  if (moving_surfaces) {
+    refuse(
+        "a wall that moves along its normal (a piston or a vibration): a fixed grain "
+        "predicts no events of its own and would not see it coming");
+  }
+  const auto n = static_cast<std::uint32_t>(size());
+  if (resting_.count() == 0 && !resting_.on()) resting_ = Resting(n, 0.0, env_.gravity);
+  for (std::uint32_t k = 0; k < n; ++k) {
+    if (!env_.fixed_species(species_of(k))) continue;
+    const bool spins = !spin_.empty() && norm2(spin_[k]) != 0.0;
+    if (norm2(hot_[k].vel) != 0.0 || spins) {
+      throw InputError("particle " + std::to_string(id_[k]) +
+                       " belongs to a fixed species (species " + std::to_string(species_of(k)) +
+                       ") but " + (spins ? "rotates" : "has a velocity") +
+                       ": a fixed grain starts at rest");
+    }
+    resting_.fix(k);
+  }
+  if (resting_.fixed_count() == n)
+    throw InputError("every particle belongs to a fixed species: nothing would move");
 }
 
 // The Helfand moments from now (engine/helfand_moments.hpp): the centre of mass's velocity,

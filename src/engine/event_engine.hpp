@@ -206,7 +206,9 @@ class EventEngine {
   // Pairs that crossed the outermost step of their potential inwards since this engine was
   // built (not part of the state): the contacts of a stepped soft potential (spring_dashpot).
   std::uint64_t step_captures() const { return step_captures_; }
-  std::uint32_t sleeping() const { return resting_.count(); }
+  // Particles asleep now (the fixed grains aside), and the fixed grains.
+  std::uint32_t sleeping() const { return resting_.sleepers(); }
+  std::uint32_t fixed_grains() const { return resting_.fixed_count(); }
   // Cell crossings since this engine was built (not part of the state) that scanned only the
   // cells new to the particle's neighbourhood (EngineOptions::incremental_crossings).
   std::uint64_t incremental_crossing_scans() const { return incremental_scans_; }
@@ -295,6 +297,7 @@ class EventEngine {
   double helfand_energy(std::uint32_t k) const;
   void helfand_before(std::uint32_t i, std::uint32_t j, double t);
   void helfand_after(std::uint32_t i, std::uint32_t j, const Vec<D>& r);
+  void fix_grains(bool moving_surfaces);
   void fall_asleep(std::uint32_t i, double t);
   void wake(std::uint32_t i, double t);
   // Leaves a resting contact (normal n, gravity into it) asleep or with at least the sleep

@@ -2,6 +2,7 @@
 // under contact laws, wall contacts, and resting particles (engine/resting_particles.hpp decides,
 // this file applies). The plain elastic path never comes here.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -250,44 +251,56 @@ double EventEngine<D, Queue>::spin_energy(std::uint32_t i) const {
   return 0.5 * env_.inertia_factor_of(species_of(i)) * mass_of(i) * r * r * norm2(spin_[i]);
 }
 
-// Whether particle i touches (within a few sleep-speed bounce heights) a fixed wall or a
-// sleeper that gravity presses it onto.
+// Whether particle i touches (within a few sleep-speed bounce heights) fixed walls or sleepers
+// that hold it up against gravity, one alone or together (RestingParticles::hold_up: a grain
+// in a V of two steep supports rests there).
 template <int D, class Queue>
 bool EventEngine<D, Queue>::resting_on_support(std::uint32_t i, double t) {
   const double eps = resting_.support_distance(radius_of(i));
   const Vec<D> x = position(i, t);
-  for (int s = 0; s < boundaries_.surfaces(); ++s) {
+  constexpr int kMaxSupports = 16;  // more touch no sphere; the first ones decide
+  std::array<Vec<D>, kMaxSupports> normals;
+  int count = 0;
+  for (int s = 0; s < boundaries_.surfaces() && count < kMaxSupports; ++s) {
     if (!boundaries_.is_surface(s) || !boundaries_.holds_still(s)) continue;
-    if (resting_.holds_up(boundaries_.normal(s, x, t)) &&
-        boundaries_.gap(s, x, t) - radius_of(i) < eps)
-      return true;
+    if (boundaries_.gap(s, x, t) - radius_of(i) < eps) {
+      normals[count++] = boundaries_.normal(s, x, t);
+      if (resting_.holds_up(normals[count - 1])) return true;
+    }
   }
   CandidateList& list = cells_.list(1);
   gather(hot_[i].cell, list);
-  for (std::uint32_t k = 0; k < list.count; ++k) {
+  for (std::uint32_t k = 0; k < list.count && count < kMaxSupports; ++k) {
     const std::uint32_t j = list.ids[k];
     if (j == i || !is_asleep(j)) continue;
     Vec<D> r = x - hot_[j].pos;
     if (list.n_shifts > 1) r = r - list.shifts[list.shift[k]];
     const double dist = std::sqrt(norm2(r));
-    if (resting_.holds_up((1.0 / dist) * r) && dist - (radius_of(i) + radius_of(j)) < eps)
-      return true;
+    if (dist - (radius_of(i) + radius_of(j)) < eps) {
+      normals[count++] = (1.0 / dist) * r;
+      if (resting_.holds_up(normals[count - 1])) return true;
+    }
   }
-  return false;
+  return resting_.hold_up(normals.data(), count);
 }
 
 // An awake particle i meets a sleeping j. A gentle contact leaves j asleep (an immovable
-// support, as a wall of infinite mass); a harder one wakes j for an ordinary collision.
+// support, as a wall of infinite mass); a harder one wakes j for an ordinary collision. A fixed
+// grain is never woken: every contact with it is the support's. Nor is a sleeper woken by a
+// wedged particle (`again`: it has not moved since its previous event): between resting things
+// with no clearance a falling particle would wake its neighbours again and again at one instant
+// (the normal of a nearly level contact takes a little of its fall each time); it stops there.
 template <int D, class Queue>
 void EventEngine<D, Queue>::collide_with_sleeper(std::uint32_t i, std::uint32_t j, double t,
                                                  const Vec<D>& r, double r2, bool again) {
   HotRecord<D>& hi = hot_[i];
   const Vec<D> n = (1.0 / std::sqrt(r2)) * r;
   const double gn = dot(hi.vel, n);
-  if (resting_.hit_wakes(gn)) {
+  if (!resting_.fixed(j) && !again && resting_.hit_wakes(gn)) {
     wake(j, t);
     resolve_pair(i, j, t, r, r2);
     ++hot_[j].collisions;
+    ++counters_.collisions;
   } else {
     const ContactModel plain;
     WallContactInput<D> in;
@@ -295,18 +308,27 @@ void EventEngine<D, Queue>::collide_with_sleeper(std::uint32_t i, std::uint32_t 
     in.mass = mass_of(i);
     in.radius = radius_of(i);
     in.inertia_factor = env_.inertia_factor_of(species_of(i));
+    // The TC model acts on a fixed grain's contacts as on a wall's (hit_wall).
+    if (resting_.fixed(j) && !last_collision_.empty()) {
+      in.force_elastic = t - last_collision_[i] < env_.tc;
+      last_collision_[i] = t;
+    }
     const ContactModel& law =
         env_.contact.empty() ? plain : *env_.contact_of(species_of(i), species_of(j));
     Spin<D> wi{};
     if (!spin_.empty()) wi = to_spin<D>(spin_[i]);
     const ContactResult<D> res = resolve_wall_contact(law, in, hi.vel, wi);
     if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
-    counters_.dissipated_in_collisions += res.dissipated;
+    // A fixed grain is an immovable body, as a wall: its contacts count and dissipate as a
+    // wall's (a collision moves two particles, this contact one).
+    const bool fixed = resting_.fixed(j);
+    double& dissipated = fixed ? counters_.dissipated_at_walls : counters_.dissipated_in_collisions;
+    dissipated += res.dissipated;
     counters_.virial += dot(r, res.impulse);
     add_virial_tensor(r, res.impulse);
-    counters_.dissipated_in_collisions -= settle_after_contact(i, n, Vec<D>{}, t, again);
+    dissipated -= settle_after_contact(i, n, Vec<D>{}, t, again);
+    ++(fixed ? counters_.wall_collisions : counters_.collisions);
   }
-  ++counters_.collisions;
   ++hi.collisions;
   queue_.update(i, predict(i, t));
   queue_.update(j, predict(j, t));

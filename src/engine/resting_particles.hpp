@@ -5,10 +5,17 @@
 // the rules decide. docs/architecture.md, "Resting particles", says why they are needed: a
 // bouncing ball with e < 1 bounces infinitely often in finite time, and a pile is full of such
 // cascades; docs/physics.md#sleeping gives the rules.
+//
+// Fixed grains (docs/physics.md#fixed-grains) are sleepers that never wake: flag 2 instead of 1.
+// The engine meets them as it meets any sleeper (they do not move and feel no gravity), but a
+// hit never wakes them, so a collision with one is always the contact with an immovable
+// support. They need the flags without the sleeping rules: on() is false when only they rest.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,7 +37,8 @@ class RestingParticles {
   };
 
   RestingParticles() = default;
-  // Sleeping on, below `speed`, for n particles under gravity g (speed > 0).
+  // Sleeping on, below `speed`, for n particles under gravity g (speed > 0; 0: the flags only,
+  // for fixed grains, and no particle falls asleep).
   RestingParticles(std::size_t n, double speed, const Vec<D>& gravity)
       : asleep_(n, 0), speed_(speed), gravity_(gravity) {}
 
@@ -48,6 +56,18 @@ class RestingParticles {
   // How many sleep now; while none does, the engine's paths test nothing else.
   std::uint32_t count() const { return count_; }
   bool asleep(std::uint32_t i) const { return !asleep_.empty() && asleep_[i] != 0; }
+  // A fixed grain: asleep for good (a hit never wakes it).
+  bool fixed(std::uint32_t i) const { return !asleep_.empty() && asleep_[i] == kFixed; }
+  std::uint32_t fixed_count() const { return fixed_; }
+  // Particles asleep now that may wake (the fixed grains aside).
+  std::uint32_t sleepers() const { return count_ - fixed_; }
+  // Makes particle i a fixed grain (once, at the start; it must be at rest).
+  void fix(std::uint32_t i) {
+    if (asleep_[i] == kFixed) return;
+    if (asleep_[i] == 0) ++count_;
+    asleep_[i] = kFixed;
+    ++fixed_;
+  }
   // Whether some of the listed particles sleeps (one OR per candidate, no branch).
   bool any_of(const std::uint32_t* ids, std::uint32_t n) const {
     const std::uint8_t* asleep = asleep_.data();
@@ -60,6 +80,7 @@ class RestingParticles {
     ++count_;
   }
   void wake(std::uint32_t i) {
+    if (asleep_[i] == kFixed) throw std::logic_error("RestingParticles::wake: a fixed grain");
     asleep_[i] = 0;
     --count_;
   }
@@ -68,6 +89,27 @@ class RestingParticles {
   // up against gravity: n within 60 degrees of straight up. Steeper contacts are side contacts.
   bool holds_up(const Vec<D>& n) const {
     return dot(gravity_, n) < -0.5 * std::sqrt(norm2(gravity_));
+  }
+  // Whether supports of these unit normals (each from a support to the particle) hold the
+  // particle up together: one of them holds it up alone, or straight up lies in the cone they
+  // span (up = sum of a_k n_k with every a_k >= 0: two normals on either side of the vertical
+  // in 2D, three around it in 3D), as two steep supports of a V hold a grain that neither holds
+  // alone.
+  bool hold_up(const Vec<D>* normals, int count) const {
+    for (int k = 0; k < count; ++k)
+      if (holds_up(normals[k])) return true;
+    const Vec<D> up = (-1.0 / std::sqrt(norm2(gravity_))) * gravity_;
+    if constexpr (D == 2) {
+      for (int a = 0; a < count; ++a)
+        for (int b = a + 1; b < count; ++b)
+          if (in_cone(up, normals[a], normals[b])) return true;
+    } else {
+      for (int a = 0; a < count; ++a)
+        for (int b = a + 1; b < count; ++b)
+          for (int c = b + 1; c < count; ++c)
+            if (in_cone(up, normals[a], normals[b], normals[c])) return true;
+    }
+    return false;
   }
   // How close to a support a particle of this radius must be to rest on it: a few sleep-speed
   // bounce heights.
@@ -107,18 +149,21 @@ class RestingParticles {
   }
 
   // Restart data: the flags of the state's particles (`stored`, in the caller's numbering,
-  // empty: none asleep), for the engine's particles k whose caller's number is id[k].
+  // empty: none asleep), for the engine's particles k whose caller's number is id[k]. Fixed
+  // grains stay fixed (they are the model's, marked by fix(), not the state's).
   template <class Ids>
   void restore(const std::vector<std::uint8_t>& stored, const Ids& id) {
     if (stored.size() != asleep_.size()) return;
-    count_ = 0;  // the flags are replaced, not added to
+    count_ = fixed_;  // the flags are replaced, not added to
     for (std::uint32_t k = 0; k < asleep_.size(); ++k) {
+      if (asleep_[k] == kFixed) continue;
       asleep_[k] = stored[id[k]] != 0 ? 1 : 0;
       count_ += asleep_[k];
     }
   }
-  // The flag to export for particle k (the state's `asleep` is written only while some sleep).
-  std::uint8_t flag(std::uint32_t k) const { return asleep_[k]; }
+  // The flag to export for particle k, 1 asleep or fixed (the state's `asleep` is written only
+  // while some particle rests).
+  std::uint8_t flag(std::uint32_t k) const { return asleep_[k] != 0 ? 1 : 0; }
   void permute(const std::vector<std::uint32_t>& order, std::vector<bool>& done) {
     if (!asleep_.empty()) permute_in_place(asleep_, order, done);
   }
@@ -127,18 +172,45 @@ class RestingParticles {
   // record holds; fail(message) otherwise.
   template <class Velocity, class Fail, class Name>
   void validate(Velocity&& velocity, Fail&& fail, Name&& name) const {
-    std::uint32_t n = 0;
+    std::uint32_t n = 0, fixed = 0;
     for (std::uint32_t k = 0; k < asleep_.size(); ++k) {
       if (asleep_[k] == 0) continue;
       ++n;
-      if (norm2(velocity(k)) != 0.0) fail("sleeping particle " + name(k) + " moves");
+      if (asleep_[k] == kFixed) ++fixed;
+      if (norm2(velocity(k)) != 0.0)
+        fail((asleep_[k] == kFixed ? "fixed particle " : "sleeping particle ") + name(k) +
+             " moves");
     }
     if (n != count_) fail("the count of sleepers is not the number of sleeping particles");
+    if (fixed != fixed_) fail("the count of fixed grains is not the number of fixed particles");
   }
 
  private:
-  HugeVector<std::uint8_t> asleep_;  // per particle, 1 asleep; empty unless on()
-  std::uint32_t count_ = 0;
+  // Whether u = a n1 + b n2 with a, b >= 0 (2D; n1, n2 not parallel).
+  static bool in_cone(const Vec<2>& u, const Vec<2>& n1, const Vec<2>& n2) {
+    const double det = n1[0] * n2[1] - n1[1] * n2[0];
+    if (std::abs(det) < 1e-12) return false;
+    const double a = (u[0] * n2[1] - u[1] * n2[0]) / det;
+    const double b = (n1[0] * u[1] - n1[1] * u[0]) / det;
+    return a >= 0.0 && b >= 0.0;
+  }
+  // Whether u = a n1 + b n2 + c n3 with a, b, c >= 0 (3D; the normals not coplanar), by
+  // Cramer's rule with triple products.
+  static bool in_cone(const Vec<3>& u, const Vec<3>& n1, const Vec<3>& n2, const Vec<3>& n3) {
+    const auto triple = [](const Vec<3>& x, const Vec<3>& y, const Vec<3>& z) {
+      return x[0] * (y[1] * z[2] - y[2] * z[1]) - x[1] * (y[0] * z[2] - y[2] * z[0]) +
+             x[2] * (y[0] * z[1] - y[1] * z[0]);
+    };
+    const double det = triple(n1, n2, n3);
+    if (std::abs(det) < 1e-12) return false;
+    return triple(u, n2, n3) / det >= 0.0 && triple(n1, u, n3) / det >= 0.0 &&
+           triple(n1, n2, u) / det >= 0.0;
+  }
+
+  static constexpr std::uint8_t kFixed = 2;
+  HugeVector<std::uint8_t> asleep_;  // per particle, 1 asleep, kFixed fixed; empty unless needed
+  std::uint32_t count_ = 0;          // asleep or fixed
+  std::uint32_t fixed_ = 0;
   double speed_ = 0.0;
   Vec<D> gravity_{};
 };

@@ -1006,6 +1006,9 @@ InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& 
     sort_spatially(state);  // neighbours close in memory: fewer cache misses in the engine
   }
   assign_maxwell_boltzmann_velocities(state, system.temperature, rng);
+  std::vector<bool> fixed;
+  for (const SpeciesConfig& sp : species) fixed.push_back(sp.fixed);
+  rest_fixed_grains(state, fixed, system.temperature);
   return state;
 }
 
@@ -1103,6 +1106,50 @@ void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std:
   for (auto& v : state.velocity) {
     for (int k = 0; k < D; ++k) v[k] *= scale;
   }
+}
+
+// Fixed grains start at rest; the particles that move keep no net momentum and share the
+// temperature kT over their D (N_mobile - 1) degrees of freedom, as without fixed grains.
+template <int D>
+void rest_fixed_grains(InitialState<D>& state, const std::vector<bool>& fixed_species, double kT) {
+  const auto fixed = [&](std::size_t i) {
+    return state.species[i] < fixed_species.size() && fixed_species[state.species[i]];
+  };
+  const std::size_t N = state.velocity.size();
+  std::size_t mobile = 0;
+  for (std::size_t i = 0; i < N; ++i) {
+    if (fixed(i)) {
+      state.velocity[i] = std::array<double, D>{};
+    } else {
+      ++mobile;
+    }
+  }
+  if (mobile == N) return;
+  CompensatedSum total_mass;
+  for (std::size_t i = 0; i < N; ++i)
+    if (!fixed(i)) total_mass.add(state.mass[i]);
+  for (int pass = 0; pass < 2; ++pass) {
+    std::array<CompensatedSum, D> momentum{};
+    for (std::size_t i = 0; i < N; ++i)
+      if (!fixed(i))
+        for (int k = 0; k < D; ++k) momentum[k].add(state.mass[i] * state.velocity[i][k]);
+    for (int k = 0; k < D; ++k) {
+      const double v_cm = mobile > 0 ? momentum[k].value() / total_mass.value() : 0.0;
+      for (std::size_t i = 0; i < N; ++i)
+        if (!fixed(i)) state.velocity[i][k] -= v_cm;
+    }
+  }
+  CompensatedSum ke;
+  for (std::size_t i = 0; i < N; ++i)
+    for (int k = 0; k < D; ++k) ke.add(state.mass[i] * state.velocity[i][k] * state.velocity[i][k]);
+  if (mobile < 2 || kT == 0.0 || !(ke.value() > 0.0)) {
+    for (std::size_t i = 0; i < N; ++i)
+      if (!fixed(i)) state.velocity[i] = std::array<double, D>{};
+    return;
+  }
+  const double scale = std::sqrt(kT * D * static_cast<double>(mobile - 1) / ke.value());
+  for (auto& v : state.velocity)
+    for (int k = 0; k < D; ++k) v[k] *= scale;
 }
 
 namespace {
@@ -1251,6 +1298,7 @@ double max_overlap_bruteforce(const std::array<double, D>& box,
 #define KAIROS_INSTANTIATE(D)                                                                     \
   template double packing_fraction<D>(const InitialState<D>&);                                    \
   template InitialState<D> make_initial_state<D>(const SystemConfig&, std::mt19937_64&, RunKind); \
+  template void rest_fixed_grains<D>(InitialState<D>&, const std::vector<bool>&, double);         \
   template void assign_maxwell_boltzmann_velocities<D>(InitialState<D>&, double,                  \
                                                        std::mt19937_64&);                         \
   template double max_overlap<D>(                                                                 \

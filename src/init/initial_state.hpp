@@ -145,6 +145,12 @@ void sort_spatially(InitialState<D>& state);
 template <int D>
 void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std::mt19937_64& rng);
 
+// Fixed grains (fixed_species[s] for species s) start at rest; the particles that move get
+// zero total momentum and 2 KE / (D (N_mobile - 1)) = kT again. Nothing changes without a
+// fixed species.
+template <int D>
+void rest_fixed_grains(InitialState<D>& state, const std::vector<bool>& fixed_species, double kT);
+
 // Largest overlap (sigma_ij - r_ij, > 0 means overlapping) over all pairs under the minimum
 // image convention, found with a cell grid (exact: every pair that can overlap is checked).
 // Returns 0 when no pair overlaps. `worst_i` < `worst_j` (optional) receive the worst pair, or

@@ -85,6 +85,7 @@ class Reader : public KeyReader {
       read_soft(section(root, "soft", empty), config.system.species, config.soft);
     }
     check_soft_and_dem(root, config);
+    check_fixed_species(root, config);
     check_trajectory_keys(root, config);
     if (config.system.chain_length > 0 && config.bonds.empty()) {
       fail(nullptr, "system.chain_length",
@@ -697,6 +698,64 @@ class Reader : public KeyReader {
     return root.at_path(path).node();
   }
 
+  // Fixed grains (system.species[].fixed): the event engine meets them as sleepers that never
+  // wake (docs/physics.md#fixed-grains); what that cannot be combined with (yet) is refused.
+  void check_fixed_species(const toml::table& root, const Config& c) const {
+    std::size_t fixed = 0, last = 0;
+    for (std::size_t s = 0; s < c.system.species.size(); ++s)
+      if (c.system.species[s].fixed) ++fixed, last = s;
+    if (fixed == 0) return;
+    const std::string key = fmt::format("system.species[{}].fixed", last);
+    const toml::node* n_fixed = node_at(root, fmt::format("system.species[{}].fixed", last));
+    const auto conflict = [&](std::string_view other, std::string_view why) {
+      const toml::node* n = node_at(root, other);
+      fail(n != nullptr ? n : n_fixed, key,
+           fmt::format("{}: fixed grains cannot be combined with {} ({})", key, other, why));
+    };
+    if (fixed == c.system.species.size()) {
+      fail(n_fixed, key,
+           fmt::format("{}: every species is fixed: nothing would move (leave at least one "
+                       "species free)",
+                       key));
+    }
+    if (c.soft.enabled())
+      conflict("soft.model", "soft contacts and the DEM meet no fixed grain yet");
+    if (!c.potentials.empty())
+      conflict("potential", "a fixed grain would miss its steps, as a sleeper would");
+    if (!c.bonds.empty()) conflict("bond", "a fixed grain would miss its steps");
+    if (c.boundary.shear_rate != 0.0)
+      conflict("boundary.shear_rate", "the sheared images of a fixed grain would move");
+    if (!driving_kinds().is(c.driving.kind, DrivingKind::kNone))
+      conflict("driving.kind", "a kick would set a fixed grain moving");
+    if (c.analysis.mutual_diffusion) {
+      conflict("analysis.mutual_diffusion", "interdiffusion is defined for species that all move");
+    }
+    // A fixed grain predicts no events of its own: a wall moving along its normal would reach
+    // it unseen (as it would a sleeper).
+    const auto moves = [&](const WallConfig& w, std::string_view prefix, bool face) {
+      const char* why = "a fixed grain would not see the moving wall coming";
+      if (w.amplitude > 0.0 && w.frequency > 0.0)
+        conflict(fmt::format("{}.amplitude", prefix), why);
+      if (face && !w.velocity.empty()) {
+        const int axis = face_number(box_faces(c.system.dimension).at(w.face)) / 2;
+        if (axis < static_cast<int>(w.velocity.size()) && w.velocity[axis] != 0.0)
+          conflict(fmt::format("{}.velocity", prefix), why);
+      }
+    };
+    for (std::size_t w = 0; w < c.boundary.walls.size(); ++w)
+      moves(c.boundary.walls[w], fmt::format("boundary.wall[{}]", w), true);
+    for (std::size_t p = 0; p < c.boundary.planes.size(); ++p) {
+      const PlaneConfig& plane = c.boundary.planes[p];
+      const std::string prefix = fmt::format("boundary.plane[{}]", p);
+      moves(plane.wall, prefix, false);
+      double along = 0.0;
+      for (std::size_t a = 0; a < plane.normal.size() && a < plane.wall.velocity.size(); ++a)
+        along += plane.normal[a] * plane.wall.velocity[a];
+      if (along != 0.0)
+        conflict(prefix + ".velocity", "a fixed grain would not see the moving wall coming");
+    }
+  }
+
   // What soft spheres and the DEM integrator cannot be combined with (yet).
   void check_soft_and_dem(const toml::table& root, const Config& c) const {
     const toml::node* n_model = node_at(root, "soft.model");
@@ -1019,6 +1078,10 @@ std::optional<TransportObstacle> transport_obstacle(const Config& c) {
     return refuse("driving.kind", "driving does not conserve energy");
   if (c.soft.enabled())
     return refuse("soft.model", "soft contacts move particles while they last (not supported yet)");
+  for (std::size_t s = 0; s < c.system.species.size(); ++s)
+    if (c.system.species[s].fixed)
+      return refuse(fmt::format("system.species[{}].fixed", s),
+                    "fixed grains do not conserve momentum");
   const auto conservative = [](const ContactConfig& k) {
     const bool elastic = k.restitution_model == "constant" && k.restitution == 1.0;
     const bool tangential = k.tangential_restitution == -1.0 || k.friction == 0.0 ||

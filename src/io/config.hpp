@@ -26,6 +26,9 @@ struct SpeciesConfig {
   double fraction = 1.0;  // number fraction; fractions are normalised to sum 1
   // Moment of inertia I = q m R^2 (rough particles); 0 = default: 2/5 (spheres), 1/2 (disks).
   double inertia_factor = 0.0;
+  // Fixed grains: particles of this species never move (infinite mass, at rest): rough floors,
+  // obstacles, a porous matrix. docs/physics.md#fixed-grains.
+  bool fixed = false;
 
   bool operator==(const SpeciesConfig&) const = default;
 };

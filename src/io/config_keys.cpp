@@ -159,6 +159,10 @@ constexpr KeyDecl kSpecies[] = {
                .why = "(I = q m R^2 with the mass within R; or 0 for the default: 2/5 for "
                       "spheres, 1/2 for disks)"},
      .doc = "q of the moment of inertia I = q m R^2 (0: 2/5 spheres, 1/2 disks)"},
+    {.name = "fixed",
+     .type = KeyType::kBoolean,
+     .member = field<&SpeciesConfig::fixed>,
+     .doc = "its particles never move (infinite mass, at rest): floors, obstacles"},
 };
 
 // ----- contact laws

@@ -4,7 +4,8 @@
 // A component owns some contact surfaces (FaceWalls: the walls on the box's faces). Surfaces
 // are numbered across the components in the order of the registry below, and a wall event's
 // code names its surface (EventCode::wall). Each component provides, for its own surfaces s
-// (0 .. surfaces() - 1):
+// (0 .. surfaces() - 1), what the concept BoundaryComponent below states (and the registry
+// checks at compile time):
 //
 //   bool any() const;                           it has a surface in this run
 //   int surfaces() const;                       how many it owns (some may be absent: is_surface)
@@ -46,6 +47,7 @@
 // codes: EventCode::wall has room for EventCode<D>::kWallCodes surfaces, the box faces first.
 #pragma once
 
+#include <concepts>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -60,10 +62,39 @@
 
 namespace kairos {
 
+// The boundary interface of the header comment, stated once: a type the registry (or a test's
+// BoundarySet) accepts.
+template <class C, int D>
+concept BoundaryComponent = requires(const C& c, C& setup, int s, const Vec<D>& x, double value,
+                                     bool flag, CellCode cell, const CellGrid<D>& grid, Vec<D>& v,
+                                     Spin<D>& w, std::uint64_t id) {
+  { c.any() } -> std::convertible_to<bool>;
+  { c.surfaces() } -> std::convertible_to<int>;
+  { c.is_surface(s) } -> std::convertible_to<bool>;
+  { c.event_time(s, x, x, value, value, value) } -> std::convertible_to<double>;
+  { c.reaches(s, cell, grid) } -> std::convertible_to<bool>;
+  { c.gap(s, x, value) } -> std::convertible_to<double>;
+  { c.normal(s, x, value) } -> std::convertible_to<Vec<D>>;
+  { c.velocity(s, x, value) } -> std::convertible_to<Vec<D>>;
+  { c.holds_still(s) } -> std::convertible_to<bool>;
+  { c.surface_moves(s) } -> std::convertible_to<bool>;
+  { c.accelerates(s) } -> std::convertible_to<bool>;
+  { c.flat(s) } -> std::convertible_to<bool>;
+  { c.name(s) } -> std::convertible_to<std::string>;
+  { c.contact(s) } -> std::same_as<const ContactModel&>;
+  { c.approach_speed(s) } -> std::convertible_to<double>;
+  { c.resolve(s, x, value, value, value, value, flag, v, w) } -> std::same_as<ContactResult<D>>;
+  { c.overlaps(x, value, value, s) } -> std::convertible_to<bool>;
+  c.check_start(x, value, value, id);
+  { c.squeeze_time() } -> std::convertible_to<double>;
+  c.throw_squeezed(value, value, flag);
+  setup.prepare(grid, value, value, flag);
+};
+
 // Surfaces over a set of components, numbered in the order the components are given. The run's
 // registry is Boundaries below; a test can put other sets together.
 template <int D, class... C>
-class BoundarySet {
+requires(BoundaryComponent<C, D>&&...) class BoundarySet {
  public:
   using Components = std::tuple<C...>;
 

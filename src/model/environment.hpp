@@ -51,6 +51,15 @@ struct Environment {
   std::uint32_t species = 0;
   // Moment of inertia I = q m R^2 per species; empty: 2/5 (spheres) or 1/2 (disks).
   std::vector<double> inertia_factor;
+  // Fixed grains (docs/physics.md#fixed-grains): fixed[s] != 0 when particles of species s never
+  // move (infinite mass, at rest); empty: every particle moves.
+  std::vector<std::uint8_t> fixed;
+  bool fixed_species(std::uint32_t s) const { return s < fixed.size() && fixed[s] != 0; }
+  bool has_fixed_grains() const {
+    for (const std::uint8_t f : fixed)
+      if (f != 0) return true;
+    return false;
+  }
   // TC model (Luding & McNamara): a collision within tc of either partner's previous one is
   // elastic. 0: off.
   double tc = 0.0;

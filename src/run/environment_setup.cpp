@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/error.hpp"
 #include "io/config_choices.hpp"
@@ -344,6 +345,19 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
     for (const SpeciesConfig& sc : config.system.species)
       if (sc.name == species_names[s] && sc.inertia_factor > 0.0)
         env.inertia_factor[s] = sc.inertia_factor;
+  }
+  for (std::size_t c = 0; c < config.system.species.size(); ++c) {
+    const SpeciesConfig& sc = config.system.species[c];
+    if (!sc.fixed) continue;
+    const auto s = std::find(species_names.begin(), species_names.end(), sc.name);
+    if (s == species_names.end()) {
+      throw InputError(
+          fmt::format("system.species[{}].fixed: the state has no species '{}' (its "
+                      "species: {})",
+                      c, sc.name, fmt::join(species_names, ", ")));
+    }
+    env.fixed.resize(n, 0);
+    env.fixed[static_cast<std::size_t>(s - species_names.begin())] = 1;
   }
   for (std::size_t w = 0; w < config.boundary.walls.size(); ++w) {
     const WallConfig& wc = config.boundary.walls[w];

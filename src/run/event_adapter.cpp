@@ -106,7 +106,10 @@ EventEngineAdapter<D, Queue>::EventEngineAdapter(RunStart<D>&& start,
                   environment.sheared() || environment.soft_spheres() ||
                   environment.dissipative_steps();
   for (int a = 0; a < D; ++a) kind.granular = kind.granular || !environment.periodic(a);
-  bulk_ = !environment.has_gravity();
+  // Fixed grains: a matrix or a floor, not a bulk fluid; the temperature counts the others.
+  this->set_fixed(engine_.fixed_grains());
+  kind.granular = kind.granular || environment.has_fixed_grains();
+  bulk_ = !environment.has_gravity() && !environment.has_fixed_grains();
   for (int a = 0; a < D; ++a) bulk_ = bulk_ && environment.periodic(a);
   kind.rotating = environment.rotates() || engine_.rotational_energy() > 0.0;
   kind.dissipative = environment.tc > 0.0 || environment.dissipative_steps() ||
@@ -239,9 +242,27 @@ void EventEngineAdapter<D, Queue>::check_collisions_can_happen(double collisions
         for (const double mj : m) mass += mj;
       },
       /*with_positions=*/false);
-  const auto n = static_cast<double>(this->size());
+  auto n = static_cast<double>(this->size());
+  double particle_volume = this->particle_volume();
+  if (this->mobile() < this->size()) {
+    // With fixed grains, collisions are those between the particles that move (a contact with
+    // a fixed grain is a wall collision): their density, size and mass.
+    n = static_cast<double>(this->mobile());
+    particle_volume = mass = 0.0;
+    const Environment<D>& env = engine_.environment();
+    engine_.state_blocks(false).for_each(
+        [&](const ParticleSystem<D>& part, std::size_t) {
+          for (std::size_t j = 0; j < part.size(); ++j) {
+            if (env.fixed_species(part.species.empty() ? 0u : part.species[j])) continue;
+            const double r = part.kinematics[j].radius;
+            particle_volume += D == 3 ? 4.0 / 3.0 * M_PI * r * r * r : M_PI * r * r;
+            mass += part.mass[j];
+          }
+        },
+        StateBlocks<D>::kKinematics | StateBlocks<D>::kIdentity);
+  }
   const FlightEstimate flight =
-      estimate_flight<D>(n, this->volume(), mean_volume_diameter<D>(this->particle_volume(), n),
+      estimate_flight<D>(n, this->volume(), mean_volume_diameter<D>(particle_volume, n),
                          std::sqrt(2.0 * engine_.kinetic_energy() / mass));
   double width = 0.0;
   for (int a = 0; a < D; ++a) width += engine_.grid().width(a) / D;

@@ -98,6 +98,9 @@ class Integrator {
 
   // The system, as it started (the box does not change).
   std::size_t size() const { return n_; }
+  // The particles that move: all but the fixed grains (docs/physics.md#fixed-grains). The
+  // temperature's degrees of freedom and the lengths per particle count these.
+  std::size_t mobile() const { return n_ - fixed_; }
   const Vec<D>& box() const { return box_; }
   double volume() const { return volume_; }
   double particle_volume() const { return particle_volume_; }  // sum over particles
@@ -166,6 +169,8 @@ class Integrator {
 
  protected:
   // The sizes of the start state (read before an engine takes the state over).
+  // How many of the particles are fixed grains (set once by the integrator that knows).
+  void set_fixed(std::size_t fixed) { fixed_ = fixed; }
   explicit Integrator(const ParticleSystem<D>& start) : n_(start.size()), box_(start.box) {
     for (int a = 0; a < D; ++a) volume_ *= start.box[a];
     for (const auto& k : start.kinematics) {
@@ -176,6 +181,7 @@ class Integrator {
 
  private:
   std::size_t n_ = 0;
+  std::size_t fixed_ = 0;
   Vec<D> box_{};
   double volume_ = 1.0, particle_volume_ = 0.0;
 };

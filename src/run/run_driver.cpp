@@ -88,7 +88,7 @@ void RunDriver<D>::add_observer(std::unique_ptr<Observer<D>> observer) {
 template <int D>
 std::uint64_t RunDriver<D>::collisions_for(double per_particle) const {
   return static_cast<std::uint64_t>(
-      std::llround(per_particle * static_cast<double>(integrator_->size()) / 2.0));
+      std::llround(per_particle * static_cast<double>(integrator_->mobile()) / 2.0));
 }
 
 template <int D>
@@ -280,7 +280,7 @@ void RunDriver<D>::start_triggers(std::uint64_t begin, double begin_time, bool c
     if (spacing.per_decade > 0.0) {
       // In collisions: the lags at their exact collision counts (the first count at or after
       // each), the period a whole number of collisions as a step is.
-      const double per_collision = static_cast<double>(integrator_->size()) / 2.0;
+      const double per_collision = static_cast<double>(integrator_->mobile()) / 2.0;
       LogSpacing log{.first = timed ? interval : interval * per_collision,
                      .per_decade = spacing.per_decade,
                      .period = spacing.period > 0.0 && !timed

@@ -142,7 +142,8 @@ void note_ignored_system_keys(const Config& config, std::size_t n, const std::st
   if (config.system.particles != 0 && config.system.particles != n) {
     std::fputs(
         fmt::format("kairos: note: {} holds {} particles; system.particles = {} and the other "
-                    "generating keys (packing_fraction, lattice, species) are not used\n",
+                    "generating keys (packing_fraction, lattice, the species' diameter, mass and "
+                    "fraction) are not used\n",
                     source, n, config.system.particles)
             .c_str(),
         stderr);
@@ -237,6 +238,14 @@ ParticleSystem<D> build_start_state(const Config& config,
     note_ignored_system_keys(config, init.position.size(), "system.initial_state");
     if (!has_velocities) {
       assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
+      std::vector<bool> fixed;
+      for (const std::string& name : init.species_names) {
+        bool f = false;
+        for (const SpeciesConfig& sc : config.system.species)
+          f = f || (sc.name == name && sc.fixed);
+        fixed.push_back(f);
+      }
+      rest_fixed_grains(init, fixed, config.system.temperature);
       add_shear_flow(config, init);
     }
     return to_particle_system<D>(std::move(init));

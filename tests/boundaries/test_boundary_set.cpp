@@ -13,6 +13,17 @@ namespace {
 
 using Set = BoundarySet<3, FaceWalls<3>, PlaneWalls<3>>;
 
+// The interface is the concept BoundaryComponent: every registered geometry meets it in both
+// dimensions, and a type without the members does not (the registry would not compile with it).
+static_assert(BoundaryComponent<FaceWalls<2>, 2> && BoundaryComponent<FaceWalls<3>, 3>);
+static_assert(BoundaryComponent<PlaneWalls<2>, 2> && BoundaryComponent<PlaneWalls<3>, 3>);
+static_assert(BoundaryComponent<CylinderWalls<2>, 2> && BoundaryComponent<CylinderWalls<3>, 3>);
+static_assert(BoundaryComponent<SphereWalls<2>, 2> && BoundaryComponent<SphereWalls<3>, 3>);
+struct OnlyAnAnyMember {
+  bool any() const { return false; }
+};
+static_assert(!BoundaryComponent<OnlyAnAnyMember, 3>);
+
 Set floor_and_a_slope() {
   std::array<Face<3>, 6> faces{};
   faces[4].kind = FaceKind::kWall;  // z-: the floor

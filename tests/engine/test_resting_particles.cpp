@@ -3,9 +3,11 @@
 // flags, the renumbering and the component's own check.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -272,6 +274,89 @@ TEST(RestingParticles, AStateWithoutFlagsRestoresNobodyAsleep) {
   rest.restore({}, id);
   EXPECT_EQ(rest.count(), 0u);
   for (std::uint32_t k = 0; k < 3; ++k) EXPECT_FALSE(rest.asleep(k));
+}
+
+}  // namespace
+}  // namespace kairos
+
+namespace kairos {
+namespace {
+
+// Supports hold a particle together when straight up lies in the cone of their normals: two
+// steep ones on either side of the vertical in 2D (a V), three around it in 3D; steep ones all
+// on one side, or two in 3D, do not.
+TEST(RestingParticles, SteepSupportsHoldTogetherWhenTheyEncloseTheVertical) {
+  const double a = 75.0 * std::numbers::pi / 180.0;  // from the vertical: too steep alone
+  const RestingParticles<2> disk(1, 0.01, {0.0, -3.0});
+  const std::array<Vec<2>, 2> v{Vec<2>{std::sin(a), std::cos(a)},
+                                Vec<2>{-std::sin(a), std::cos(a)}};
+  ASSERT_FALSE(disk.holds_up(v[0]));
+  ASSERT_FALSE(disk.holds_up(v[1]));
+  EXPECT_TRUE(disk.hold_up(v.data(), 2));
+  EXPECT_FALSE(disk.hold_up(v.data(), 1));
+  const std::array<Vec<2>, 2> one_side{Vec<2>{std::sin(a), std::cos(a)},
+                                       Vec<2>{std::sin(1.2 * a), std::cos(1.2 * a)}};
+  EXPECT_FALSE(disk.hold_up(one_side.data(), 2));
+  // A V that opens downwards (an overhang on either side) holds nothing.
+  const std::array<Vec<2>, 2> under{Vec<2>{std::sin(a), -std::cos(a)},
+                                    Vec<2>{-std::sin(a), -std::cos(a)}};
+  EXPECT_FALSE(disk.hold_up(under.data(), 2));
+
+  const RestingParticles<3> sphere(1, 0.01, {0.0, 0.0, -1.0});
+  std::array<Vec<3>, 3> around{};
+  for (int k = 0; k < 3; ++k) {
+    const double phi = 2.0 * std::numbers::pi * k / 3.0;
+    around[k] = {std::sin(a) * std::cos(phi), std::sin(a) * std::sin(phi), std::cos(a)};
+  }
+  EXPECT_TRUE(sphere.hold_up(around.data(), 3));
+  EXPECT_FALSE(sphere.hold_up(around.data(), 2));  // two supports: a ridge it rolls off
+  std::array<Vec<3>, 3> crowded{};
+  for (int k = 0; k < 3; ++k) {
+    const double phi = 0.5 * k;  // all within 60 degrees of azimuth of each other
+    crowded[k] = {std::sin(a) * std::cos(phi), std::sin(a) * std::sin(phi), std::cos(a)};
+  }
+  EXPECT_FALSE(sphere.hold_up(crowded.data(), 3));
+  // One support within 60 degrees is enough, among any others.
+  std::array<Vec<3>, 2> mixed{crowded[0], Vec<3>{0.0, 0.0, 1.0}};
+  EXPECT_TRUE(sphere.hold_up(mixed.data(), 2));
+}
+
+// Fixed grains: flag 2, counted apart from the sleepers, kept by a restore, never woken.
+TEST(RestingParticles, FixedGrainsStayFixed) {
+  RestingParticles<2> rest(4, 0.0, {0.0, -1.0});
+  EXPECT_FALSE(rest.on());
+  rest.fix(1);
+  rest.fix(3);
+  rest.fix(3);  // once is enough
+  EXPECT_EQ(rest.count(), 2u);
+  EXPECT_EQ(rest.fixed_count(), 2u);
+  EXPECT_EQ(rest.sleepers(), 0u);
+  EXPECT_TRUE(rest.fixed(1));
+  EXPECT_TRUE(rest.asleep(1));
+  EXPECT_FALSE(rest.fixed(0));
+  EXPECT_THROW(rest.wake(1), std::logic_error);
+  // A restart's flags replace the sleepers' but not the fixed grains'.
+  const std::vector<std::uint8_t> stored{1, 0, 0, 0};
+  const std::vector<std::uint32_t> id{0, 1, 2, 3};
+  rest.restore(stored, id);
+  EXPECT_TRUE(rest.asleep(0));
+  EXPECT_TRUE(rest.fixed(1));
+  EXPECT_TRUE(rest.fixed(3));
+  EXPECT_EQ(rest.count(), 3u);
+  EXPECT_EQ(rest.sleepers(), 1u);
+  EXPECT_EQ(rest.flag(1), 1);  // exported as resting
+  int failures = 0;
+  std::string message;
+  const auto fail = [&](const std::string& m) {
+    ++failures;
+    message = m;
+  };
+  const auto name = [](std::uint32_t k) { return std::to_string(k); };
+  rest.validate([](std::uint32_t) { return Vec<2>{}; }, fail, name);
+  EXPECT_EQ(failures, 0);
+  rest.validate([](std::uint32_t k) { return k == 3 ? Vec<2>{0.1, 0.0} : Vec<2>{}; }, fail, name);
+  EXPECT_EQ(failures, 1);
+  EXPECT_NE(message.find("fixed particle 3 moves"), std::string::npos) << message;
 }
 
 }  // namespace

@@ -133,6 +133,40 @@ TEST(SettlingPile, DiskWedgedInAGapOfItsOwnSizeStops) {
   EXPECT_EQ(engine.sleeping(), 3u);
 }
 
+// A disk falls into a slot between two chains of resting disks that reach the side walls; the
+// slot is narrower than the disk, so it meets both sides 0.004 above the floor, through nearly
+// level normals, at 0.18: fast enough for a normal speed above the sleep speed. It wakes the
+// chains, which have nowhere to go, and everything must come to rest with the disk held in the
+// slot. (The rule that a wedged particle does not wake a sleeper is guarded by the run of
+// examples/fixed_obstacles_2d.toml in tests/python/test_examples.py: without it that run ends
+// in a frozen clock at t = 53.6, a falling grain waking its blocked neighbours again and again
+// at one instant; this smaller case comes to rest either way.)
+TEST(SettlingPile, DiskFallingIntoANarrowSlotBetweenBlockedChainsStops) {
+  constexpr int D = 2;
+  ParticleSystem<D> s;
+  const double lift = 0.004;
+  const double half = std::sqrt(1.0 - lift * lift);  // the slot's half width at contact
+  const double w = 3.0 + 2.0 * half;
+  s.box = {w, 8.0};
+  s.kinematics = {{{0.5, 0.5}, {0.0, 0.0}, 0.0, 0.5},
+                  {{1.5, 0.5}, {0.0, 0.0}, 0.0, 0.5},
+                  {{w - 1.5, 0.5}, {0.0, 0.0}, 0.0, 0.5},
+                  {{w - 0.5, 0.5}, {0.0, 0.0}, 0.0, 0.5},
+                  {{0.5 * w + 1e-7, 0.5 + lift + 0.016}, {0.0, 0.0}, 0.0, 0.5}};
+  s.mass.assign(5, 1.0);
+  s.species.assign(5, 0);
+  s.species_names = {"A"};
+  Engine<D> engine(s, StartMode::kPredict, EngineOptions{}, container<D>(0.8, 0.0));
+  int events = 0;
+  while (engine.step() != EventKind::kNone) {
+    ASSERT_LT(++events, 10000) << "stalled at t = " << engine.time();
+    engine.validate();
+  }
+  EXPECT_EQ(engine.sleeping(), 5u);
+  EXPECT_LE(engine.max_overlap_now(), 1e-12);
+  EXPECT_GT(engine.current_positions()[4][1], 0.5);  // held in the slot, above the floor
+}
+
 // A sphere resting on a single sleeper 70 degrees off its top is pressed into a slope too
 // steep to hold it: it slides off (hops of the sleep speed, not an endless cascade of ever
 // smaller bounces) and comes to rest on the floor.

@@ -31,6 +31,8 @@ EXAMPLES = {
     # the run by itself (the config's budget is only a cap).
     "granular_pile_3d.toml": ("plot_pile_3d.py", [
         "system.particles=300", "output.thermo_interval=1", "output.trajectory_interval=2"]),
+    # Whole (750 disks, a fraction of a second): it ends by itself when every grain sleeps.
+    "fixed_obstacles_2d.toml": ("plot_fixed_grains.py", []),
     "shear_flow_2d.toml": ("plot_shear_flow_2d.py", [
         "system.particles=2000", "run.equilibration_collisions_per_particle=2",
         "run.collisions_per_particle=5", "output.trajectory_interval=2",
@@ -115,6 +117,23 @@ class GranularExamples(kt.KairosTestCase):
         self.assertEqual(s["granular"]["sleeping_now"], s["particles"])
         self.assertEqual(s["kinetic_energy"], 0.0)
         self.draw_picture("granular_pile_3d.toml", out)
+
+    def test_fixed_obstacles_2d(self):
+        out, s = self.check_run("fixed_obstacles_2d.toml")
+        # Every grain ends asleep, on the floor or on the fixed obstacles, which never moved.
+        self.assertEqual(s["stop_reason"], "no_more_events")
+        g = s["granular"]
+        self.assertEqual(g["fixed_grains"], 150)
+        self.assertEqual(g["sleeping_now"], s["particles"] - 150)
+        self.assertEqual(s["kinetic_energy"], 0.0)
+        frames = kt.open_trajectory(os.path.join(out, "trajectory.gsd"))
+        first, last = frames[0].particles, frames[-1].particles
+        fixed = first.typeid == first.types.index("obstacle")
+        np.testing.assert_array_equal(first.position[fixed], last.position[fixed])
+        on_obstacles = np.sum(last.position[~fixed, 1] + 0.5 * frames[-1].configuration.box[1]
+                              > 40.0)
+        self.assertGreater(on_obstacles, 50)  # some grains rest on the obstacles
+        self.draw_picture("fixed_obstacles_2d.toml", out)
 
     def test_shear_flow_2d(self):
         out, s = self.check_run("shear_flow_2d.toml")

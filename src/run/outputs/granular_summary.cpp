@@ -39,12 +39,14 @@ void GranularSummary<D>::summarize(nlohmann::json& j, const RunContext<D>&) cons
     c2 += s;
     c4 += s * s;
   }
-  set_sonine_a2(j, g, sonine_a2<D>(c2, c4, static_cast<double>(engine_.size())), engine_.bulk());
+  set_sonine_a2(j, g, sonine_a2<D>(c2, c4, static_cast<double>(engine_.size())), engine_.bulk(),
+                engine_.mobile() < engine_.size());
   g["wall_collisions"] = c.wall_collisions - start_.wall_collisions;
   g["elastic_by_rule"] = c.elastic_by_rule - start_.elastic_by_rule;
   g["sliding_collisions"] = c.sliding_collisions - start_.sliding_collisions;
   g["fell_asleep"] = c.fell_asleep - start_.fell_asleep;
   g["sleeping_now"] = engine_.sleeping();
+  if (engine_.mobile() < engine_.size()) g["fixed_grains"] = engine_.size() - engine_.mobile();
   g["dissipated_in_collisions"] = c.dissipated_in_collisions - start_.dissipated_in_collisions;
   g["dissipated_at_walls"] = c.dissipated_at_walls - start_.dissipated_at_walls;
   g["work_by_walls"] = c.work_by_walls - start_.work_by_walls;

@@ -36,16 +36,24 @@ CollisionInterval collision_interval(double wanted, std::size_t particles) {
 
 template <int D>
 MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
-    : engine_(engine), config_(config.analysis), stats_(D, engine.size(), engine.volume()) {
+    : engine_(engine), config_(config.analysis), stats_(D, engine.mobile(), engine.volume()) {
   const std::size_t n = engine.size();
   const auto wanted = static_cast<std::size_t>(config_.msd_particles);
-  const std::size_t step = n <= wanted ? 1 : (n + wanted - 1) / wanted;
+  // Every step-th particle that moves (fixed grains are not followed).
+  const std::size_t mobile = engine.mobile();
+  const std::size_t step = mobile <= wanted ? 1 : (mobile + wanted - 1) / wanted;
   slot_.assign(n, ~0u);  // not followed
   species_of_.assign(n, 0u);
   double radius = -1.0, mass = -1.0;
   bool equal_particles = true;
   const StateBlocks<D> state = engine.state_blocks();
   species_names_ = state.globals().species_names;
+  std::vector<bool>& fixed = fixed_species_;
+  fixed.assign(species_names_.size(), false);
+  for (std::size_t s = 0; s < species_names_.size(); ++s)
+    for (const SpeciesConfig& sc : config.system.species)
+      if (sc.name == species_names_[s] && sc.fixed) fixed[s] = true;
+  std::size_t moving = 0;  // particles that move, counted in order
   state.for_each(
       [&](const ParticleSystem<D>& part, std::size_t first) {
         for (std::size_t j = 0; j < part.size(); ++j) {
@@ -58,7 +66,8 @@ MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
             mass = m;
           }
           equal_particles = equal_particles && r == radius && m == mass;
-          if (id % step != 0) continue;
+          if (species < fixed.size() && fixed[species]) continue;
+          if (moving++ % step != 0) continue;
           slot_[id] = static_cast<std::uint32_t>(group_.size());
           group_.push_back(species);
         }
@@ -190,6 +199,7 @@ void MsdOutput<D>::production_starts(const RunContext<D>&) {
   }
   start_time_ = engine_.time();
   start_collisions_ = engine_.collisions();
+  start_wall_collisions_ = engine_.counters().wall_collisions;
 }
 
 template <int D>
@@ -227,6 +237,16 @@ void MsdOutput<D>::write(const RunContext<D>& run) {
 
 template <int D>
 double MsdOutput<D>::mean_free_time() const {
+  if (engine_.mobile() < engine_.size()) {
+    // With fixed grains: between a moving particle's contacts of any kind (2 per collision, 1
+    // per contact with a fixed grain or a wall).
+    const double contacts =
+        2.0 * static_cast<double>(engine_.collisions() - start_collisions_) +
+        static_cast<double>(engine_.counters().wall_collisions - start_wall_collisions_);
+    return contacts > 0.0
+               ? static_cast<double>(engine_.mobile()) * (engine_.time() - start_time_) / contacts
+               : std::nan("");
+  }
   return stats_.mean_free_time(engine_.time() - start_time_,
                                engine_.collisions() - start_collisions_);
 }
@@ -343,6 +363,12 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
   }
   for (std::size_t g = 0; g < species_names_.size(); ++g) {
     nlohmann::json s;
+    if (g < fixed_species_.size() && fixed_species_[g]) {
+      s["coefficient"] = nullptr;
+      s["why"] = "a fixed species: its particles never move (not followed)";
+      species[species_names_[g]] = s;
+      continue;
+    }
     if (g < fits.size() && fits[g]) {
       s["coefficient"] = fits[g]->coefficient;
       s["coefficient_stderr"] = finite_or_null(fits[g]->stderr_);

@@ -87,6 +87,11 @@ class MsdOutput final : public Observer<D> {
   double first_sample_ = 0.0, last_sample_ = 0.0;
   double start_time_ = 0.0;
   std::uint64_t start_collisions_ = 0;
+  // Fixed grains (docs/physics.md#fixed-grains): which species are fixed, and the contacts with
+  // immovable bodies at the start (a particle's contact with a fixed grain or a wall changes
+  // its velocity as a collision does: the mean free time counts them).
+  std::vector<bool> fixed_species_;
+  std::uint64_t start_wall_collisions_ = 0;
 };
 
 }  // namespace kairos

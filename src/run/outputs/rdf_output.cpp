@@ -62,7 +62,7 @@ void RdfOutput<D>::begin(const RunContext<D>& run) {
   if (!no_contact_.empty()) {
     no_theorem_ = no_contact_;
   } else if (!integrator.bulk()) {
-    no_theorem_ = "walls, open faces or a field: the pressure is not uniform in the box";
+    no_theorem_ = not_bulk_reason(integrator.mobile() < integrator.size(), true);
   } else if (engine->kind().dissipative || engine->kind().rotating) {
     no_theorem_ = "inelastic or rough collisions: the contact theorem holds for elastic spheres";
   } else if (engine->kind().sheared || engine->kind().driven) {

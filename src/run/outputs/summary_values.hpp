@@ -33,9 +33,21 @@ inline void set_error_quality(nlohmann::json& where, const std::string& key,
   where[key + "_reliable"] = b.reliable;
 }
 
-inline void set_sonine_a2(nlohmann::json& summary, nlohmann::json& where, double a2, bool bulk) {
+// Why a bulk value is undefined: walls, open faces or a field make the system inhomogeneous;
+// fixed grains (docs/physics.md#fixed-grains) too.
+inline const char* not_bulk_reason(bool fixed_grains, bool pressure) {
+  if (fixed_grains) {
+    return pressure ? "fixed grains: their contacts push on the particles as walls do"
+                    : "fixed grains: the gas is not homogeneous";
+  }
+  return pressure ? "walls, open faces or a field: the pressure is not uniform in the box"
+                  : "walls, open faces or a field: the gas is not homogeneous";
+}
+
+inline void set_sonine_a2(nlohmann::json& summary, nlohmann::json& where, double a2, bool bulk,
+                          bool fixed_grains = false) {
   set_or_explain(summary, where, "sonine_a2", a2,
-                 !bulk                ? "walls, open faces or a field: the gas is not homogeneous"
+                 !bulk                ? not_bulk_reason(fixed_grains, false)
                  : !std::isfinite(a2) ? "every particle at rest"
                                       : "",
                  "granular.sonine_a2");

@@ -16,7 +16,7 @@ void ThermoOutput<D>::open(const RunContext<D>& run) {
   file_.emplace(run.restarted() ? LineFile(path, kHeader, run.continuation().thermo_rows)
                                 : LineFile::create(path, kHeader));
   rows_kept_ = file_->rows();
-  stats_.emplace(D, integrator.size(), integrator.volume());
+  stats_.emplace(D, integrator.mobile(), integrator.volume());
   events_start_ = integrator.events();
   collisions_start_ = integrator.collisions();
   // Continued in its own directory: the next row covers the interval from the last kept one.
@@ -142,7 +142,7 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
   j["kinetic_energy"] = ke;
   std::string why;
   if (!integrator.bulk())
-    why = "walls, open faces or a field: the pressure is not uniform in the box";
+    why = not_bulk_reason(integrator.mobile() < integrator.size(), true);
   else if (!(production_time > 0.0))
     why = "no production time elapsed";
   else if (!(kT_production > 0.0))
