@@ -4,11 +4,14 @@
 
 namespace kairos {
 
-Thermodynamics::Thermodynamics(int dimension, std::size_t particles, double volume)
-    : dimension_(dimension), n_(static_cast<double>(particles)), volume_(volume) {}
+Thermodynamics::Thermodynamics(int dimension, std::size_t particles, double volume, bool held_frame)
+    : dimension_(dimension),
+      n_(static_cast<double>(particles)),
+      free_particles_(held_frame ? n_ : n_ - 1.0),
+      volume_(volume) {}
 
 double Thermodynamics::temperature(double kinetic_energy) const {
-  return 2.0 * kinetic_energy / (dimension_ * (n_ - 1.0));
+  return 2.0 * kinetic_energy / (dimension_ * free_particles_);
 }
 
 double Thermodynamics::compressibility(double virial, double kT, double duration) const {

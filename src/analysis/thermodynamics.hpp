@@ -1,5 +1,6 @@
 // Thermodynamics of a hard-particle run from its event counters (docs/outputs.md):
-//   kT = 2 K / (D (N - 1))                 (total momentum fixed: D (N - 1) degrees of freedom)
+//   kT = 2 K / (D (N - 1))                 (total momentum fixed: D (N - 1) degrees of freedom;
+//                                           D N with fixed grains, which take up momentum)
 //   Z  = 1 + W / (D N kT t)                W = sum over collisions of r_ij . J_i
 //   P  = Z N kT / V,  mean free time = N t / (2 N_coll),  c = 2 N_coll / N.
 // Rows cover the interval since the previous row; production rows feed the block averages.
@@ -33,7 +34,9 @@ struct ThermoRow {
 
 class Thermodynamics {
  public:
-  Thermodynamics(int dimension, std::size_t particles, double volume);
+  // held_frame: something immovable (fixed grains) takes up momentum, so all D N degrees of
+  // freedom are free: kT = 2 K / (D N) (N: the particles that move).
+  Thermodynamics(int dimension, std::size_t particles, double volume, bool held_frame = false);
 
   double temperature(double kinetic_energy) const;
   double compressibility(double virial, double kT, double duration) const;
@@ -53,6 +56,7 @@ class Thermodynamics {
  private:
   double dimension_;
   double n_;
+  double free_particles_;  // N - 1, or N in a held frame
   double volume_;
   ThermoPoint last_;
   std::vector<double> z_samples_, mft_samples_;

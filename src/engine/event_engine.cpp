@@ -119,7 +119,8 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
         "contact.sleep_speed: resting particles cannot sleep under stepped potentials (a "
         "sleeper would miss its steps); set it to 0");
   }
-  if (accelerated_ && walls_ && !moving && !stepped_) {
+  // Fixed grains are supports too: a floor of them sleeps grains without a wall.
+  if (accelerated_ && (walls_ || env_.has_fixed_grains()) && !moving && !stepped_) {
     double dmin = kNever;
     for (const ParticleKind& sh : kinds_) dmin = std::min(dmin, 2.0 * sh.radius);
     const double speed = Resting::speed_for(env_.sleep_speed, env_.gravity, dmin);

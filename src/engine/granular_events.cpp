@@ -286,17 +286,22 @@ bool EventEngine<D, Queue>::resting_on_support(std::uint32_t i, double t) {
 
 // An awake particle i meets a sleeping j. A gentle contact leaves j asleep (an immovable
 // support, as a wall of infinite mass); a harder one wakes j for an ordinary collision. A fixed
-// grain is never woken: every contact with it is the support's. Nor is a sleeper woken by a
-// wedged particle (`again`: it has not moved since its previous event): between resting things
-// with no clearance a falling particle would wake its neighbours again and again at one instant
-// (the normal of a nearly level contact takes a little of its fall each time); it stops there.
+// grain is never woken: every contact with it is the support's. Nor is a sleeper that fell
+// asleep at this instant, met again by a wedged particle (`again`: it has not moved since its
+// previous event): between resting things that cannot give way a falling particle would wake
+// its neighbours, which fall asleep again at once, again and again at one instant (the normal
+// of a nearly level contact takes a little of its fall each time); it stops there. A blow
+// still spreads through a pile: each sleeper it reaches has slept since before.
 template <int D, class Queue>
 void EventEngine<D, Queue>::collide_with_sleeper(std::uint32_t i, std::uint32_t j, double t,
                                                  const Vec<D>& r, double r2, bool again) {
   HotRecord<D>& hi = hot_[i];
   const Vec<D> n = (1.0 / std::sqrt(r2)) * r;
   const double gn = dot(hi.vel, n);
-  if (!resting_.fixed(j) && !again && resting_.hit_wakes(gn)) {
+  // A sleeper that fell asleep at this very instant, met again by a particle that has not
+  // moved since: a cascade at one instant, not a blow to pass on.
+  const bool rewoken = again && hot_[j].time == t;
+  if (!resting_.fixed(j) && !rewoken && resting_.hit_wakes(gn)) {
     wake(j, t);
     resolve_pair(i, j, t, r, r2);
     ++hot_[j].collisions;

@@ -94,7 +94,7 @@ class RestingParticles {
   // particle up together: one of them holds it up alone, or straight up lies in the cone they
   // span (up = sum of a_k n_k with every a_k >= 0: two normals on either side of the vertical
   // in 2D, three around it in 3D), as two steep supports of a V hold a grain that neither holds
-  // alone.
+  // alone (in 3D also two, when the vertical lies in their plane: a level trough).
   bool hold_up(const Vec<D>* normals, int count) const {
     for (int k = 0; k < count; ++k)
       if (holds_up(normals[k])) return true;
@@ -104,6 +104,9 @@ class RestingParticles {
         for (int b = a + 1; b < count; ++b)
           if (in_cone(up, normals[a], normals[b])) return true;
     } else {
+      for (int a = 0; a < count; ++a)
+        for (int b = a + 1; b < count; ++b)
+          if (in_level_trough(up, normals[a], normals[b])) return true;
       for (int a = 0; a < count; ++a)
         for (int b = a + 1; b < count; ++b)
           for (int c = b + 1; c < count; ++c)
@@ -205,6 +208,22 @@ class RestingParticles {
     if (std::abs(det) < 1e-12) return false;
     return triple(u, n2, n3) / det >= 0.0 && triple(n1, u, n3) / det >= 0.0 &&
            triple(n1, n2, u) / det >= 0.0;
+  }
+
+  // Two supports hold a sphere (3D) when up lies in the plane of their normals, to round-off
+  // (a level trough: along it the sphere has no slope to roll down), and between them.
+  static bool in_level_trough(const Vec<3>& u, const Vec<3>& n1, const Vec<3>& n2) {
+    const Vec<3> axis{n1[1] * n2[2] - n1[2] * n2[1], n1[2] * n2[0] - n1[0] * n2[2],
+                      n1[0] * n2[1] - n1[1] * n2[0]};
+    const double length2 = norm2(axis);
+    if (length2 < 1e-24) return false;
+    const double off = dot(u, axis);
+    if (off * off > 1e-18 * length2) return false;  // a slope along the trough
+    const double g12 = dot(n1, n2);
+    const double det = 1.0 - g12 * g12;  // unit normals
+    const double a = (dot(u, n1) - g12 * dot(u, n2)) / det;
+    const double b = (dot(u, n2) - g12 * dot(u, n1)) / det;
+    return a >= 0.0 && b >= 0.0;
   }
 
   static constexpr std::uint8_t kFixed = 2;

@@ -1108,8 +1108,8 @@ void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std:
   }
 }
 
-// Fixed grains start at rest; the particles that move keep no net momentum and share the
-// temperature kT over their D (N_mobile - 1) degrees of freedom, as without fixed grains.
+// Fixed grains start at rest; they take up momentum, so the particles that move keep what they
+// drew and share the temperature kT over all their D N_mobile degrees of freedom.
 template <int D>
 void rest_fixed_grains(InitialState<D>& state, const std::vector<bool>& fixed_species, double kT) {
   const auto fixed = [&](std::size_t i) {
@@ -1125,29 +1125,14 @@ void rest_fixed_grains(InitialState<D>& state, const std::vector<bool>& fixed_sp
     }
   }
   if (mobile == N) return;
-  CompensatedSum total_mass;
-  for (std::size_t i = 0; i < N; ++i)
-    if (!fixed(i)) total_mass.add(state.mass[i]);
-  for (int pass = 0; pass < 2; ++pass) {
-    std::array<CompensatedSum, D> momentum{};
-    for (std::size_t i = 0; i < N; ++i)
-      if (!fixed(i))
-        for (int k = 0; k < D; ++k) momentum[k].add(state.mass[i] * state.velocity[i][k]);
-    for (int k = 0; k < D; ++k) {
-      const double v_cm = mobile > 0 ? momentum[k].value() / total_mass.value() : 0.0;
-      for (std::size_t i = 0; i < N; ++i)
-        if (!fixed(i)) state.velocity[i][k] -= v_cm;
-    }
-  }
   CompensatedSum ke;
   for (std::size_t i = 0; i < N; ++i)
     for (int k = 0; k < D; ++k) ke.add(state.mass[i] * state.velocity[i][k] * state.velocity[i][k]);
-  if (mobile < 2 || kT == 0.0 || !(ke.value() > 0.0)) {
-    for (std::size_t i = 0; i < N; ++i)
-      if (!fixed(i)) state.velocity[i] = std::array<double, D>{};
+  if (mobile == 0 || kT == 0.0 || !(ke.value() > 0.0)) {
+    for (auto& v : state.velocity) v = std::array<double, D>{};
     return;
   }
-  const double scale = std::sqrt(kT * D * static_cast<double>(mobile - 1) / ke.value());
+  const double scale = std::sqrt(kT * D * static_cast<double>(mobile) / ke.value());
   for (auto& v : state.velocity)
     for (int k = 0; k < D; ++k) v[k] *= scale;
 }

@@ -145,9 +145,9 @@ void sort_spatially(InitialState<D>& state);
 template <int D>
 void assign_maxwell_boltzmann_velocities(InitialState<D>& state, double kT, std::mt19937_64& rng);
 
-// Fixed grains (fixed_species[s] for species s) start at rest; the particles that move get
-// zero total momentum and 2 KE / (D (N_mobile - 1)) = kT again. Nothing changes without a
-// fixed species.
+// Fixed grains (fixed_species[s] for species s) start at rest; the particles that move keep
+// their velocities' directions and get 2 KE / (D N_mobile) = kT (the fixed grains take up
+// momentum: every degree of freedom is free). Nothing changes without a fixed species.
 template <int D>
 void rest_fixed_grains(InitialState<D>& state, const std::vector<bool>& fixed_species, double kT);
 

@@ -730,8 +730,18 @@ class Reader : public KeyReader {
     if (c.analysis.mutual_diffusion) {
       conflict("analysis.mutual_diffusion", "interdiffusion is defined for species that all move");
     }
-    // A fixed grain predicts no events of its own: a wall moving along its normal would reach
-    // it unseen (as it would a sleeper).
+    // Not yet measured over the moving particles alone (they would count the fixed grains as
+    // particles at rest).
+    if (c.analysis.velocity_distribution)
+      conflict("analysis.velocity_distribution", "not yet measured without the fixed grains");
+    if (!c.output.profile_axis.empty())
+      conflict("output.profile_axis", "not yet measured without the fixed grains");
+    if (c.analysis.msd_viscosity > 0.0) {
+      conflict("analysis.msd_viscosity",
+               "the Yeh-Hummer correction assumes a fluid whose momentum is conserved");
+    }
+    // A fixed grain predicts no wall contacts (as a sleeper): a wall moving along its normal
+    // would reach it unseen.
     const auto moves = [&](const WallConfig& w, std::string_view prefix, bool face) {
       const char* why = "a fixed grain would not see the moving wall coming";
       if (w.amplitude > 0.0 && w.frequency > 0.0)

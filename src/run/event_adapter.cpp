@@ -108,6 +108,16 @@ EventEngineAdapter<D, Queue>::EventEngineAdapter(RunStart<D>&& start,
   for (int a = 0; a < D; ++a) kind.granular = kind.granular || !environment.periodic(a);
   // Fixed grains: a matrix or a floor, not a bulk fluid; the temperature counts the others.
   this->set_fixed(engine_.fixed_grains());
+  if (engine_.fixed_grains() > 0) {
+    fixed_.assign(this->size(), 0);
+    engine_.state_blocks(false).for_each(
+        [&](const ParticleSystem<D>& part, std::size_t first) {
+          for (std::size_t j = 0; j < part.size(); ++j)
+            fixed_[first + j] =
+                environment.fixed_species(part.species.empty() ? 0u : part.species[j]) ? 1 : 0;
+        },
+        StateBlocks<D>::kIdentity);
+  }
   kind.granular = kind.granular || environment.has_fixed_grains();
   bulk_ = !environment.has_gravity() && !environment.has_fixed_grains();
   for (int a = 0; a < D; ++a) bulk_ = bulk_ && environment.periodic(a);
@@ -371,6 +381,15 @@ double EventEngineAdapter<D, Queue>::total_energy() const {
   if (!env.has_gravity()) return e;
   for (int a = 0; a < D; ++a)
     if (env.periodic(a) && env.gravity[a] != 0.0) return std::nan("");
+  if (!fixed_.empty()) {
+    // The fixed grains' potential energy never changes: left out, so that it does not swell
+    // the scale of the energy balance.
+    engine_.for_each_block([&](std::size_t first, auto x, auto, auto m) {
+      for (std::size_t j = 0; j < x.size(); ++j)
+        if (fixed_[first + j] == 0) e -= m[j] * dot(env.gravity, x[j]);
+    });
+    return e;
+  }
   engine_.for_each_block([&](std::size_t, auto x, auto, auto m) {
     for (std::size_t j = 0; j < x.size(); ++j) e -= m[j] * dot(env.gravity, x[j]);
   });

@@ -153,6 +153,7 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   FrozenClockWatch& clock_watch() { return watch_; }
 
  private:
+  std::vector<std::uint8_t> fixed_;  // per particle (the caller's numbering): a fixed grain
   // Stochastic driving ([driving]): Poisson events at rate N * rate, each on one random
   // particle, applied between the engine's events. The RNG and the next event's time are in
   // the restart file, so a continued run draws the same kicks.

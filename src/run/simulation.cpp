@@ -186,7 +186,9 @@ double Simulation<D>::kinetic_energy() const {
 template <int D>
 double Simulation<D>::temperature() const {
   // kT as thermo.tsv gives it (under shear: of the velocities relative to the flow).
-  return Thermodynamics(D, n_, engine_->volume()).temperature(engine_->thermal_energy());
+  const std::size_t moving = engine_->mobile();
+  return Thermodynamics(D, moving, engine_->volume(), moving < n_)
+      .temperature(engine_->thermal_energy());
 }
 template <int D>
 double Simulation<D>::potential_energy() const {

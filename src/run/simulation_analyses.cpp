@@ -45,7 +45,8 @@ void end_span(const Simulation<D>& sim, const CorrelationRequest& request, doubl
               SampledSpan& span) {
   span.end_time = sim.time();
   span.collisions = sim.collisions() - span.collisions;
-  const Thermodynamics stats(D, sim.size(), sim.integrator().volume());
+  const std::size_t moving = sim.integrator().mobile();
+  const Thermodynamics stats(D, moving, sim.integrator().volume(), moving < sim.size());
   span.mean_free_time = stats.mean_free_time(span.end_time - span.start_time, span.collisions);
   const auto [from, to] =
       correlation_fit_window(sampled, request.fit_from, request.fit_to, span.mean_free_time,

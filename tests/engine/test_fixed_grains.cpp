@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "engine_fixtures.hpp"
+#include "interactions/input_error_matchers.hpp"
 #include "scheduler/calendar_queue.hpp"
 
 namespace kairos {
@@ -30,6 +31,23 @@ Environment<D> with_fixed_species(const ContactModel& law) {
   env.species = 2;
   env.contact.assign(4, law);
   env.fixed = {0, 1};
+  return env;
+}
+
+// The same under gravity -1 along the last axis, in a box with side walls, a floor and an open
+// top, restitution e (and the TC model's tc).
+template <int D>
+Environment<D> box_with_floor(double e, double tc = 0.0) {
+  ContactModel law;
+  law.normal = NormalRestitution::constant(e);
+  Environment<D> env = with_fixed_species<D>(law);
+  env.gravity[D - 1] = -1.0;
+  env.tc = tc;
+  for (int f = 0; f < 2 * D - 1; ++f) {
+    env.faces[f].kind = FaceKind::kWall;
+    env.faces[f].wall.contact = law;
+  }
+  env.faces[2 * D - 1].kind = FaceKind::kOpen;
   return env;
 }
 
@@ -163,15 +181,7 @@ TEST(FixedGrains, PileSettlesOnAFloorOfFixedGrains) {
   }
   s.mass.assign(s.kinematics.size(), 1.0);
   s.species_names = {"grain", "floor"};
-  ContactModel law;
-  law.normal = NormalRestitution::constant(0.8);
-  Environment<D> env = with_fixed_species<D>(law);
-  env.gravity[1] = -1.0;
-  for (int f : {0, 1, 2}) {
-    env.faces[f].kind = FaceKind::kWall;
-    env.faces[f].wall.contact = law;
-  }
-  env.faces[3].kind = FaceKind::kOpen;
+  const Environment<D> env = box_with_floor<D>(0.8);
   Engine<D> engine(s, StartMode::kPredict, EngineOptions{}, env);
   double e0 = engine.kinetic_energy();
   for (std::size_t i = kFloor; i < s.size(); ++i) e0 += s.kinematics[i].pos[1];
@@ -211,12 +221,7 @@ TEST(FixedGrains, DiskComesToRestInAVOfTwoSteepFixedGrains) {
   s.mass.assign(3, 1.0);
   s.species = {1, 1, 0};
   s.species_names = {"grain", "fixed"};
-  ContactModel law;
-  law.normal = NormalRestitution::constant(0.8);
-  Environment<D> env = with_fixed_species<D>(law);
-  env.gravity[1] = -1.0;
-  for (int f = 0; f < 3; ++f) env.faces[f].kind = FaceKind::kWall;
-  env.faces[3].kind = FaceKind::kOpen;
+  const Environment<D> env = box_with_floor<D>(0.8);
   Engine<D> engine(s, StartMode::kPredict, EngineOptions{}, env);
   int events = 0;
   while (engine.step() != EventKind::kNone) {
@@ -230,16 +235,44 @@ TEST(FixedGrains, DiskComesToRestInAVOfTwoSteepFixedGrains) {
   EXPECT_NEAR(x[0], 4.0, 1e-3);
 }
 
-// What the engine refuses, with errors that name the problem.
-template <class F>
-std::string error_of(F&& make) {
-  try {
-    make();
-  } catch (const InputError& e) {
-    return e.what();
+// Under gravity with sleeping on, a state exported half-way (sleepers and fixed grains both
+// flagged in it) resumes bit for bit: the fixed grains are marked again from their species and
+// the sleepers' flags restored.
+TEST(FixedGrains, SettlingOnFixedGrainsResumesBitForBit) {
+  constexpr int D = 2;
+  ParticleSystem<D> s;
+  s.box = {12.0, 10.0};
+  for (int k = 0; k < 12; ++k) {
+    s.kinematics.push_back({{0.5 + k, 0.5}, {0.0, 0.0}, 0.0, 0.5});
+    s.species.push_back(1);
   }
-  return "";
+  for (int k = 0; k < 20; ++k) {
+    s.kinematics.push_back({{0.9 + 1.1 * (k % 10), 2.5 + 1.5 * (k / 10)},
+                            {0.3 * std::sin(k), 0.2 * std::cos(k)},
+                            0.0,
+                            0.5});
+    s.species.push_back(0);
+  }
+  s.mass.assign(s.kinematics.size(), 1.0);
+  s.species_names = {"grain", "fixed"};
+  const Environment<D> env = box_with_floor<D>(0.7, 1e-4);
+  Engine<D> first(s, StartMode::kPredict, EngineOptions{}, env);
+  while (first.sleeping() < 5) ASSERT_NE(first.step(), EventKind::kNone);
+  Engine<D> resumed(first.export_state(), StartMode::kResume, EngineOptions{}, env);
+  EXPECT_EQ(resumed.sleeping(), first.sleeping());
+  EXPECT_EQ(resumed.fixed_grains(), 12u);
+  for (;;) {
+    const EventKind a = first.step(), b = resumed.step();
+    ASSERT_EQ(a, b);
+    if (a == EventKind::kNone) break;
+  }
+  EXPECT_EQ(resumed.time(), first.time());
+  EXPECT_EQ(resumed.sleeping(), 20u);
+  EXPECT_EQ(resumed.current_positions(), first.current_positions());
 }
+
+// What the engine refuses, with errors that name the problem.
+using test_util::error_of;
 
 TEST(FixedGrains, RefusesAMovingFixedGrainAndAllFixed) {
   constexpr int D = 2;

@@ -310,6 +310,18 @@ TEST(RestingParticles, SteepSupportsHoldTogetherWhenTheyEncloseTheVertical) {
   }
   EXPECT_TRUE(sphere.hold_up(around.data(), 3));
   EXPECT_FALSE(sphere.hold_up(around.data(), 2));  // two supports: a ridge it rolls off
+  // ... unless the vertical lies in their plane: a level trough of two steep sides holds it,
+  // a trough tilted by 1e-6 does not (it rolls along), nor one that opens downwards.
+  const std::array<Vec<3>, 2> trough{Vec<3>{std::sin(a), 0.0, std::cos(a)},
+                                     Vec<3>{-std::sin(a), 0.0, std::cos(a)}};
+  EXPECT_TRUE(sphere.hold_up(trough.data(), 2));
+  const double tilt = 1e-6;
+  std::array<Vec<3>, 2> tilted = trough;
+  for (Vec<3>& n : tilted) n = Vec<3>{n[0], std::cos(a) * std::sin(tilt), n[2] * std::cos(tilt)};
+  EXPECT_FALSE(sphere.hold_up(tilted.data(), 2));
+  const std::array<Vec<3>, 2> roof{Vec<3>{std::sin(a), 0.0, -std::cos(a)},
+                                   Vec<3>{-std::sin(a), 0.0, -std::cos(a)}};
+  EXPECT_FALSE(sphere.hold_up(roof.data(), 2));
   std::array<Vec<3>, 3> crowded{};
   for (int k = 0; k < 3; ++k) {
     const double phi = 0.5 * k;  // all within 60 degrees of azimuth of each other

@@ -28,7 +28,7 @@ void GranularSummary<D>::summarize(nlohmann::json& j, const RunContext<D>&) cons
   g["moving_walls"] = kind.moving_walls;
   g["driven"] = kind.driven;
   g["rotational_temperature"] = 2.0 * engine_.rotational_energy() /
-                                ((D == 3 ? 3.0 : 1.0) * static_cast<double>(engine_.size()));
+                                ((D == 3 ? 3.0 : 1.0) * static_cast<double>(engine_.mobile()));
   // The Sonine coefficient of the velocities relative to the mean.
   std::vector<Vec<D>> u;
   std::vector<double> m;

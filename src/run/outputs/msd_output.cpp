@@ -36,7 +36,9 @@ CollisionInterval collision_interval(double wanted, std::size_t particles) {
 
 template <int D>
 MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
-    : engine_(engine), config_(config.analysis), stats_(D, engine.mobile(), engine.volume()) {
+    : engine_(engine),
+      config_(config.analysis),
+      stats_(D, engine.mobile(), engine.volume(), engine.mobile() < engine.size()) {
   const std::size_t n = engine.size();
   const auto wanted = static_cast<std::size_t>(config_.msd_particles);
   // Every step-th particle that moves (fixed grains are not followed).
@@ -97,18 +99,19 @@ MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
   automatic_interval_ = interval_ == 0.0;
   if (in_collisions_) {
     // Half a collision per particle, as half a mean free time in time.
-    interval_ = collision_interval(automatic_interval_ ? 0.5 : interval_, n).per_particle;
+    interval_ = collision_interval(automatic_interval_ ? 0.5 : interval_, mobile).per_particle;
   } else if (automatic_interval_) {
     interval_ = half_enskog_mean_free_time(engine, "analysis.msd_interval");
   }
 
   restitution_ = config.interactions.contact.restitution;
-  number_density_ = static_cast<double>(n) / engine.volume();
+  number_density_ = static_cast<double>(mobile) / engine.volume();
   sigma_ = 2.0 * radius;
   if (in_collisions_) {
-    theory_why_ = equal_particles ? theory_does_not_apply(config)
-                                  : "the particles differ in diameter or mass (the theory is for "
-                                    "equal particles)";
+    theory_why_ = mobile < n        ? "fixed grains: the gas is not homogeneous"
+                  : equal_particles ? theory_does_not_apply(config)
+                                    : "the particles differ in diameter or mass (the theory is "
+                                      "for equal particles)";
     if (theory_why_.empty()) theory_ = hcs_self_diffusion(D, restitution_, number_density_, sigma_);
   }
 
@@ -180,9 +183,9 @@ std::vector<std::string> MsdOutput<D>::more_files() const {
 
 template <int D>
 double MsdOutput<D>::clock() const {
-  return in_collisions_
-             ? 2.0 * static_cast<double>(engine_.collisions()) / static_cast<double>(engine_.size())
-             : engine_.time();
+  return in_collisions_ ? 2.0 * static_cast<double>(engine_.collisions()) /
+                              static_cast<double>(engine_.mobile())
+                        : engine_.time();
 }
 
 template <int D>

@@ -16,7 +16,8 @@ void ThermoOutput<D>::open(const RunContext<D>& run) {
   file_.emplace(run.restarted() ? LineFile(path, kHeader, run.continuation().thermo_rows)
                                 : LineFile::create(path, kHeader));
   rows_kept_ = file_->rows();
-  stats_.emplace(D, integrator.mobile(), integrator.volume());
+  stats_.emplace(D, integrator.mobile(), integrator.volume(),
+                 integrator.mobile() < integrator.size());
   events_start_ = integrator.events();
   collisions_start_ = integrator.collisions();
   // Continued in its own directory: the next row covers the interval from the last kept one.
@@ -52,7 +53,7 @@ void ThermoOutput<D>::write_row(const RunContext<D>& run, const std::string& pha
   }
   const double rotational_temperature =
       2.0 * integrator.rotational_energy() /
-      ((D == 3 ? 3.0 : 1.0) * static_cast<double>(integrator.size()));
+      ((D == 3 ? 3.0 : 1.0) * static_cast<double>(integrator.mobile()));
   file_->append(fmt::format(
       "{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t"
       "{:.17g}\t{:.17g}\t{:.17g}\n",
