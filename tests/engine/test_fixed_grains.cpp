@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "../interactions/input_error_matchers.hpp"
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "engine_fixtures.hpp"
-#include "interactions/input_error_matchers.hpp"
 #include "scheduler/calendar_queue.hpp"
 
 namespace kairos {
