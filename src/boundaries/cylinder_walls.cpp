@@ -114,13 +114,6 @@ ContactResult<D> RoundWalls<D, S>::resolve(int s, const Vec<D>& x, double t, dou
 }
 
 template <int D, RoundShape S>
-bool RoundWalls<D, S>::overlaps(const Vec<D>& x, double radius, double t, int skip) const {
-  for (int s = 0; s < surfaces(); ++s)
-    if (s != skip && gap(s, x, t) < radius) return true;
-  return false;
-}
-
-template <int D, RoundShape S>
 void RoundWalls<D, S>::check_start(const Vec<D>& x, double radius, double t,
                                    std::uint64_t id) const {
   for (int s = 0; s < surfaces(); ++s) {

@@ -91,7 +91,6 @@ class RoundWalls {
   bool reaches(int s, CellCode cell, const CellGrid<D>& grid) const;
   ContactResult<D> resolve(int s, const Vec<D>& x, double t, double mass, double radius,
                            double inertia_factor, bool force_elastic, Vec<D>& v, Spin<D>& w) const;
-  bool overlaps(const Vec<D>& x, double radius, double t, int skip = -1) const;
   // Throws InputError naming the particle and the surface it overlaps.
   void check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const;
 

@@ -69,15 +69,6 @@ ContactResult<D> FaceWalls<D>::resolve(int f, const Vec<D>& /*x*/, double t, dou
 }
 
 template <int D>
-bool FaceWalls<D>::overlaps(const Vec<D>& x, double radius, double t, int skip_face) const {
-  for (int f = 0; f < 2 * D; ++f) {
-    if (f == skip_face || faces_[f].kind != FaceKind::kWall) continue;
-    if (gap(f, x, t) < radius) return true;
-  }
-  return false;
-}
-
-template <int D>
 void FaceWalls<D>::check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const {
   for (int f = 0; f < 2 * D; ++f) {
     if (faces_[f].kind != FaceKind::kWall) continue;

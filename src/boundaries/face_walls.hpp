@@ -89,9 +89,6 @@ class FaceWalls {
   ContactResult<D> resolve(int f, const Vec<D>& x, double t, double mass, double radius,
                            double inertia_factor, bool force_elastic, Vec<D>& v, Spin<D>& w) const;
 
-  // Whether a particle of this radius centred at x overlaps a wall (other than skip_face) at
-  // time t.
-  bool overlaps(const Vec<D>& x, double radius, double t, int skip_face = -1) const;
   // A start state's particle `id` at x: throws InputError naming the particle and the wall it
   // overlaps (round-off contacts, 1e-12 of the radius, are contacts).
   void check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const;

@@ -63,13 +63,6 @@ ContactResult<D> PlaneWalls<D>::resolve(int s, const Vec<D>& /*x*/, double t, do
 }
 
 template <int D>
-bool PlaneWalls<D>::overlaps(const Vec<D>& x, double radius, double t, int skip) const {
-  for (int s = 0; s < surfaces(); ++s)
-    if (s != skip && gap(s, x, t) < radius) return true;
-  return false;
-}
-
-template <int D>
 void PlaneWalls<D>::check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const {
   for (int s = 0; s < surfaces(); ++s) {
     const double g = gap(s, x, t);

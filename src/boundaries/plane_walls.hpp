@@ -99,8 +99,6 @@ class PlaneWalls {
   // infinite mass moving with its whole velocity.
   ContactResult<D> resolve(int s, const Vec<D>& x, double t, double mass, double radius,
                            double inertia_factor, bool force_elastic, Vec<D>& v, Spin<D>& w) const;
-  // Whether a particle of this radius centred at x overlaps a plane (other than skip) at t.
-  bool overlaps(const Vec<D>& x, double radius, double t, int skip = -1) const;
   // Throws InputError naming the particle and the plane it overlaps (round-off contacts, 1e-12
   // of the radius, are contacts).
   void check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const;

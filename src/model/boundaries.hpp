@@ -30,8 +30,6 @@
 //                                               piston; its vibration aside)
 //   ContactResult<D> resolve(int s, x, t, mass, radius, inertia_factor, force_elastic, v, w) const;
 //                                               the contact's response and its energy split
-//   bool overlaps(x, radius, t, skip) const;    a particle overlaps one of its surfaces (other
-//                                               than surface skip; -1: none skipped)
 //   void check_start(x, radius, t, id) const;   throws InputError naming particle and surface
 //   double squeeze_time() const;                when moving surfaces leave no room (kNever)
 //   [[noreturn]] void throw_squeezed(t, dmax, uniform) const;
@@ -84,7 +82,6 @@ concept BoundaryComponent = requires(const C& c, C& setup, int s, const Vec<D>& 
   { c.contact(s) } -> std::same_as<const ContactModel&>;
   { c.approach_speed(s) } -> std::convertible_to<double>;
   { c.resolve(s, x, value, value, value, value, flag, v, w) } -> std::same_as<ContactResult<D>>;
-  { c.overlaps(x, value, value, s) } -> std::convertible_to<bool>;
   c.check_start(x, value, value, id);
   { c.squeeze_time() } -> std::convertible_to<double>;
   c.throw_squeezed(value, value, flag);
@@ -207,13 +204,14 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
     });
     return best;
   }
-  // Whether a particle overlaps some surface other than `skip` (-1: none skipped).
+  // Whether a particle overlaps some surface other than `skip` (-1: none skipped): its centre
+  // nearer than its radius, from the components' gaps (one rule for every geometry).
   bool overlaps(const Vec<D>& x, double radius, double t, int skip = -1) const {
     bool any = false;
     int first = 0;
     for_each([&](const auto& c) {
-      const int local = skip >= first && skip < first + c.surfaces() ? skip - first : -1;
-      any = any || c.overlaps(x, radius, t, local);
+      for (int k = 0; k < c.surfaces() && !any; ++k)
+        any = first + k != skip && c.is_surface(k) && c.gap(k, x, t) < radius;
       first += c.surfaces();
     });
     return any;

@@ -121,8 +121,9 @@ TEST(FaceWalls, StartChecksNameTheParticleAndAcceptRoundOffContacts) {
     EXPECT_NE(what.find("particle 42"), std::string::npos) << what;
     EXPECT_NE(what.find("high face of axis z"), std::string::npos) << what;
   }
-  EXPECT_TRUE(walls.overlaps({5.0, 5.0, 0.4}, 0.5, 0.0));
-  EXPECT_FALSE(walls.overlaps({5.0, 5.0, 0.4}, 0.5, 0.0, 4));  // the floor skipped
+  const BoundarySet<3, FaceWalls<3>> set(walls);
+  EXPECT_TRUE(set.overlaps({5.0, 5.0, 0.4}, 0.5, 0.0));
+  EXPECT_FALSE(set.overlaps({5.0, 5.0, 0.4}, 0.5, 0.0, 4));  // the floor skipped
 }
 
 TEST(FaceWalls, ApproachingWallsLeaveNoRoomAtTheSqueezeTime) {

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "core/particle_system.hpp"
+#include "model/environment.hpp"
 
 namespace kairos::testing {
 
@@ -53,6 +54,25 @@ ParticleSystem<D> lattice_system(int n, double eta, std::uint64_t seed, double m
   for (auto& k : s.kinematics) k.vel = scale * k.vel;
   s.species_names = {"A", "B"};
   return s;
+}
+
+// A container under gravity -1 along the last axis: walls on the sides and a floor, an open
+// top, every contact (pairs of `species` species and walls) of restitution e, the TC model's tc.
+template <int D>
+Environment<D> gravity_container(double e, double tc = 0.0, std::uint32_t species = 1) {
+  Environment<D> env;
+  env.gravity[D - 1] = -1.0;
+  env.species = species;
+  ContactModel law;
+  law.normal = NormalRestitution::constant(e);
+  env.contact.assign(static_cast<std::size_t>(species) * species, law);
+  env.tc = tc;
+  for (int f = 0; f < 2 * D - 1; ++f) {
+    env.faces[f].kind = FaceKind::kWall;
+    env.faces[f].wall.contact = law;
+  }
+  env.faces[2 * D - 1].kind = FaceKind::kOpen;
+  return env;
 }
 
 }  // namespace kairos::testing

@@ -38,16 +38,8 @@ Environment<D> with_fixed_species(const ContactModel& law) {
 // top, restitution e (and the TC model's tc).
 template <int D>
 Environment<D> box_with_floor(double e, double tc = 0.0) {
-  ContactModel law;
-  law.normal = NormalRestitution::constant(e);
-  Environment<D> env = with_fixed_species<D>(law);
-  env.gravity[D - 1] = -1.0;
-  env.tc = tc;
-  for (int f = 0; f < 2 * D - 1; ++f) {
-    env.faces[f].kind = FaceKind::kWall;
-    env.faces[f].wall.contact = law;
-  }
-  env.faces[2 * D - 1].kind = FaceKind::kOpen;
+  Environment<D> env = testing::gravity_container<D>(e, tc, 2);
+  env.fixed = {0, 1};
   return env;
 }
 

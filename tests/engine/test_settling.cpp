@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "engine/event_engine.hpp"
+#include "engine_fixtures.hpp"
 #include "scheduler/calendar_queue.hpp"
 
 namespace kairos {
@@ -49,29 +50,12 @@ ParticleSystem<D> loose_grains(int per_row, int layers, std::uint64_t seed) {
   return s;
 }
 
-template <int D>
-Environment<D> container(double e, double tc) {
-  Environment<D> env;
-  env.gravity[D - 1] = -1.0;
-  env.species = 1;
-  ContactModel law;
-  law.normal = NormalRestitution::constant(e);
-  env.contact = {law};
-  env.tc = tc;
-  for (int f = 0; f < 2 * D - 1; ++f) {
-    env.faces[f].kind = FaceKind::kWall;
-    env.faces[f].wall.contact = law;
-  }
-  env.faces[2 * D - 1].kind = FaceKind::kOpen;
-  return env;
-}
-
 // Runs until nothing can happen; checks the invariants every `check_every` events.
 template <int D>
 void check_pile_settles(int per_row, int layers, double e, double tc, std::uint64_t seed,
                         int check_every, std::uint64_t max_events) {
   const ParticleSystem<D> s = loose_grains<D>(per_row, layers, seed);
-  Engine<D> engine(s, StartMode::kPredict, EngineOptions{}, container<D>(e, tc));
+  Engine<D> engine(s, StartMode::kPredict, EngineOptions{}, testing::gravity_container<D>(e, tc));
   double e0 = engine.kinetic_energy();
   for (const Kinematics<D>& k : s.kinematics) e0 += k.pos[D - 1];
   std::uint64_t events = 0;
@@ -124,7 +108,8 @@ TEST(SettlingPile, DiskWedgedInAGapOfItsOwnSizeStops) {
   s.mass = {1.0, 1.0, 1.0};
   s.species = {0, 0, 0};
   s.species_names = {"A"};
-  Engine<D> engine(s, StartMode::kPredict, EngineOptions{}, container<D>(0.8, 0.0));
+  Engine<D> engine(s, StartMode::kPredict, EngineOptions{},
+                   testing::gravity_container<D>(0.8, 0.0));
   int events = 0;
   while (engine.step() != EventKind::kNone) {
     ASSERT_LT(++events, 1000) << "stalled at t = " << engine.time();
@@ -156,7 +141,8 @@ TEST(SettlingPile, DiskFallingIntoANarrowSlotBetweenBlockedChainsStops) {
   s.mass.assign(5, 1.0);
   s.species.assign(5, 0);
   s.species_names = {"A"};
-  Engine<D> engine(s, StartMode::kPredict, EngineOptions{}, container<D>(0.8, 0.0));
+  Engine<D> engine(s, StartMode::kPredict, EngineOptions{},
+                   testing::gravity_container<D>(0.8, 0.0));
   int events = 0;
   while (engine.step() != EventKind::kNone) {
     ASSERT_LT(++events, 10000) << "stalled at t = " << engine.time();
@@ -181,7 +167,8 @@ TEST(SettlingPile, SphereSlidesOffASteepSlope) {
   s.mass = {1.0, 1.0};
   s.species = {0, 0};
   s.species_names = {"A"};
-  Engine<D> engine(s, StartMode::kPredict, EngineOptions{}, container<D>(0.8, 0.0));
+  Engine<D> engine(s, StartMode::kPredict, EngineOptions{},
+                   testing::gravity_container<D>(0.8, 0.0));
   int events = 0;
   while (engine.step() != EventKind::kNone) {
     ASSERT_LT(++events, 100000) << "stalled at t = " << engine.time();

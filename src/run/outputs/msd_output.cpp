@@ -50,11 +50,10 @@ MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
   bool equal_particles = true;
   const StateBlocks<D> state = engine.state_blocks();
   species_names_ = state.globals().species_names;
-  std::vector<bool>& fixed = fixed_species_;
+  std::vector<bool>& fixed = fixed_species_;  // as the model has them (matched by name)
   fixed.assign(species_names_.size(), false);
   for (std::size_t s = 0; s < species_names_.size(); ++s)
-    for (const SpeciesConfig& sc : config.system.species)
-      if (sc.name == species_names_[s] && sc.fixed) fixed[s] = true;
+    fixed[s] = engine.environment().fixed_species(static_cast<std::uint32_t>(s));
   std::size_t moving = 0;  // particles that move, counted in order
   state.for_each(
       [&](const ParticleSystem<D>& part, std::size_t first) {
