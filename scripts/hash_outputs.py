@@ -44,7 +44,9 @@ SMALLER = {"granular_clustering_2d.toml": ["system.particles=20000"],
            # Its tracers hardly collide with each other (their contacts with the fixed grains
            # are wall collisions): measured in time.
            "lorentz_gas_3d.toml": ["system.particles=8300", "run.equilibration_time=0",
-                                   "run.time=100"]}
+                                   "run.time=100"],
+           # Measured in time (the lid's motion).
+           "free_piston_3d.toml": ["run.equilibration_time=1", "run.time=4"]}
 # Restart chunks that are the run's bookkeeping rather than its state: the run's id, the stored
 # configuration (it names the output directory), the checksum over both.
 RESTART_SKIPPED = ["kairos/run/id", "kairos/run/config", "kairos/checksum"]
@@ -102,6 +104,9 @@ EXTRA = [
      ["field.gravity=[0.0, 0.0, -2.0]"]),
     ("profile_vibrated", "examples/vibrated_bed_3d.toml", None, ['output.profile_axis="z"'],
      None),
+    # A wall with mass (its motion travels in the restart file), continued.
+    ("continued_free_piston", "examples/free_piston_3d.toml", None,
+     ["run.equilibration_time=1", "run.time=3"], ["run.time=2"]),
     # Soft spheres against walls (a fixed floor, a slow piston; the map's wall contact),
     # continued.
     ("continued_soft_walls", None, SOFT_WALLS, [], []),

@@ -290,3 +290,16 @@ def read_soft_table(plotdir):
     if os.path.exists(errors):
         result["errors"] = grids(read_tsv(errors))
     return result
+
+
+# The hard-sphere equation of state: the Kolafa-Labik-Malijevsky series in x = eta / (1 - eta)
+# with the coefficients fitted to event-driven data by Pieprzyk, Bannerman, Branka, Chudak and
+# Heyes (Phys. Chem. Chem. Phys. 21, 6886 (2019); docs/physics.md#equations-of-state).
+KLM_TERMS = [(3, 2.3647684), (4, -0.8698551), (5, 1.1062803), (6, -1.1014221), (7, 0.66605866),
+             (8, -0.03633431), (10, -0.20965164), (14, 0.10555569), (22, -0.00872380)]
+
+
+def hard_sphere_z(eta):
+    """Z = P / (rho kT) of the hard-sphere fluid at packing fraction eta."""
+    x = eta / (1.0 - eta)
+    return 1.0 + 4.0 * x + 6.0 * x * x + sum(c * x ** k for k, c in KLM_TERMS)

@@ -27,9 +27,17 @@ struct Wall {
   double amplitude = 0.0;          // vibration along the normal: offset A sin(w t + phi)
   double angular_frequency = 0.0;  // w
   double phase = 0.0;              // phi
+  // A wall with mass (a free piston, boundaries/wall_body.hpp; face walls only): its plane
+  // moves along its axis under the impulses of the particles it meets, the constant `force`
+  // along its normal (into the box) and the field. 0: a wall of infinite mass that moves as
+  // prescribed above. Its plane is then state, not a function of the time: plane_position
+  // below does not describe it (FaceWalls::position does).
+  double mass = 0.0;
+  double force = 0.0;
   bool vibrates() const { return amplitude > 0.0 && angular_frequency > 0.0; }
-  // Whether the plane moves (a normal velocity or a vibration) as the wall of `face`.
-  bool plane_moves(int face) const { return velocity[face / 2] != 0.0 || vibrates(); }
+  bool massive() const { return mass > 0.0; }
+  // Whether the plane moves (a normal velocity, a vibration, or a mass) as the wall of `face`.
+  bool plane_moves(int face) const { return velocity[face / 2] != 0.0 || vibrates() || massive(); }
 
   // Where the plane of the wall at `face` lies along its axis at time t, in a box of edges
   // `box` (the header's formula).

@@ -14,7 +14,23 @@ template <int D>
 FaceWalls<D>::FaceWalls(const std::array<Face<D>, 2 * D>& faces, const Vec<D>& box,
                         const Vec<D>& gravity)
     : faces_(faces), box_(box), gravity_(gravity) {
-  for (const Face<D>& f : faces_) any_ = any_ || f.kind == FaceKind::kWall;
+  for (int f = 0; f < 2 * D; ++f) {
+    if (faces_[f].kind != FaceKind::kWall) continue;
+    any_ = true;
+    const Wall<D>& w = faces_[f].wall;
+    if (!w.massive()) continue;
+    any_massive_ = true;
+    // The force acts along the normal (into the box), the field on the wall's mass.
+    const double sgn = f % 2 == 0 ? 1.0 : -1.0;
+    bodies_[f].mass = w.mass;
+    bodies_[f].accel = sgn * w.force / w.mass + gravity_[f / 2];
+    bodies_[f].position = rest_position(f);
+    if (!std::isfinite(bodies_[f].accel)) {
+      throw InputError("boundary.wall (" + name(f) + "): the force over the mass, " +
+                       std::to_string(w.force) + " / " + std::to_string(w.mass) +
+                       ", is not a finite acceleration");
+    }
+  }
 }
 
 // Along the wall's normal n (into the box: +e_a at the low face, -e_a at the high one) the
@@ -28,6 +44,15 @@ double FaceWalls<D>::event_time(int face, const Vec<D>& x, const Vec<D>& v, doub
   const int a = face / 2;
   const double sgn = face % 2 == 0 ? 1.0 : -1.0;
   const NormalMotion m{sgn * x[a] - radius, sgn * v[a], sgn * gravity_[a]};
+  if (w.massive()) [[unlikely]] {
+    // The gap between the particle's lowest point and the plane, both on parabolas: a
+    // quadratic in the time from t.
+    const WallBody& b = bodies_[face];
+    return within_horizon(
+        quadratic_event_time(m.height - sgn * b.position_at(t), m.velocity - sgn * b.speed_at(t),
+                             0.5 * (m.accel - sgn * b.accel)),
+        horizon);
+  }
   const double u = sgn * w.velocity[a];
   const double d = (face % 2 == 0 ? 0.0 : -box_[a]) + (u != 0.0 ? u * t : 0.0);
   if (w.vibrates()) {
@@ -45,6 +70,12 @@ void FaceWalls<D>::set_reach(const CellGrid<D>& grid, double rmax) {
     const double reach = faces_[f].wall.amplitude + rmax;
     layers_[f] = 1 + static_cast<int>(std::floor(reach / grid.width(f / 2)));
   }
+  for (int a = 0; a < D; ++a) {
+    widths_[a] = grid.width(a);
+    cells_along_[a] = grid.cells_along(a);
+  }
+  for (int f = 0; f < 2 * D; ++f)
+    if (massive(f)) layer_[f] = layer_of(f, bodies_[f].position);
 }
 
 // Whether a particle in cell c can touch face f: f has a wall, and the cell lies within
@@ -56,6 +87,10 @@ bool FaceWalls<D>::reaches(int f, CellCode c, const CellGrid<D>& grid) const {
   if (faces_[f].kind != FaceKind::kWall) return false;
   if (faces_[f].wall.velocity[a] != 0.0) return true;
   const int k = grid.coordinate(c, a);
+  if (massive(f)) [[unlikely]] {
+    const auto [first, last] = band(f);
+    return k >= first && k <= last;
+  }
   return f % 2 == 0 ? k < layers_[f] : grid.cells_along(a) - 1 - k < layers_[f];
 }
 
@@ -64,8 +99,130 @@ ContactResult<D> FaceWalls<D>::resolve(int f, const Vec<D>& /*x*/, double t, dou
                                        double radius, double inertia_factor, bool force_elastic,
                                        Vec<D>& v, Spin<D>& w) const {
   const Wall<D>& wall = faces_[f].wall;
+  if (wall.massive()) [[unlikely]] {
+    WallContactInput<D> in;
+    in.normal = face_normal<D>(f);
+    in.wall_velocity = velocity(f, Vec<D>{}, t);
+    in.mass = mass;
+    in.wall_mass = wall.mass;
+    in.radius = radius;
+    in.inertia_factor = inertia_factor;
+    in.force_elastic = force_elastic;
+    return resolve_wall_contact(wall.contact, in, v, w);
+  }
   return resolve_surface_contact<D>(wall.contact, face_normal<D>(f), wall.surface_velocity(f, t),
                                     mass, radius, inertia_factor, force_elastic, v, w);
+}
+
+template <int D>
+int FaceWalls<D>::layer_of(int f, double x) const {
+  const int a = f / 2;
+  const int k = static_cast<int>(std::floor(x / widths_[a]));
+  return std::clamp(k, 0, cells_along_[a] - 1);
+}
+
+// A particle touching the plane has its centre within its radius of it, on the box's side:
+// within layers_[f] layers of the plane's layer (set_reach), one more on the far side for
+// positions a round-off across a cell's face.
+template <int D>
+std::pair<int, int> FaceWalls<D>::band(int f) const {
+  const int last = cells_along_[f / 2] - 1;
+  if (f % 2 == 0) return {std::max(0, layer_[f] - 1), std::min(last, layer_[f] + layers_[f])};
+  return {std::max(0, layer_[f] - layers_[f]), std::min(last, layer_[f] + 1)};
+}
+
+template <int D>
+void FaceWalls<D>::restore(const std::vector<WallMotion>& motion, double t) {
+  for (int f = 0; f < 2 * D; ++f) {
+    if (!massive(f)) continue;
+    bodies_[f].time = t;
+    bodies_[f].position = rest_position(f);
+    bodies_[f].speed = 0.0;
+    bodies_[f].version = 0;
+    layer_[f] = layer_of(f, bodies_[f].position);
+  }
+  for (const WallMotion& m : motion) {
+    const int f = static_cast<int>(m.face);
+    if (f >= 2 * D || !massive(f)) {
+      throw InputError("the state holds the motion of a wall with mass at face " +
+                       (f < 2 * D ? name(f) : std::to_string(f)) +
+                       " but this run gives that face no mass (boundary.wall.mass)");
+    }
+    WallBody& b = bodies_[f];
+    b.time = m.time;
+    b.position = m.position;
+    b.speed = m.speed;
+    b.version = m.version;
+    if (m.accel != b.accel) {
+      // Another force, mass or field from now on: the wall moved with the state's own up to
+      // its time t, and moves on from there (wall events predicted before are stale).
+      const WallBody before{b.mass, m.accel, m.time, m.position, m.speed, m.version};
+      b.position = before.position_at(t);
+      b.speed = before.speed_at(t);
+      b.time = t;
+      ++b.version;
+    }
+    if (!std::isfinite(b.position_at(t)) || !std::isfinite(b.speed)) {
+      throw InputError("the state's motion of the wall with mass at face " + name(f) +
+                       " is not finite");
+    }
+    // The layer the run had it in (a plane within round-off of a cell face could be put in
+    // either), unless the state does not say or the grid differs.
+    const bool kept = m.layer >= 0 && m.layer < cells_along_[f / 2] &&
+                      std::abs(layer_of(f, b.position_at(t)) - m.layer) <= 1;
+    layer_[f] = kept ? m.layer : layer_of(f, b.position_at(t));
+  }
+  find_next_change(t);
+}
+
+template <int D>
+std::vector<WallMotion> FaceWalls<D>::motion() const {
+  std::vector<WallMotion> out;
+  for (int f = 0; f < 2 * D; ++f)
+    if (massive(f)) out.push_back(bodies_[f].state(f, layer_[f]));
+  return out;
+}
+
+template <int D>
+void FaceWalls<D>::push(int f, double t, const Vec<D>& impulse_on_particle) {
+  bodies_[f].kick(t, -impulse_on_particle[f / 2]);
+  find_next_change(t);
+}
+
+// The plane leaves [lower, upper] of its layer: the cell's faces, as the particles' crossings
+// find them; the outer layers extend to infinity (a lid pushed out of the box moves on in the
+// outermost layer, and the particles follow it there).
+template <int D>
+void FaceWalls<D>::find_next_change(double t) {
+  next_change_ = kNever;
+  next_change_face_ = -1;
+  for (int f = 0; f < 2 * D; ++f) {
+    if (!massive(f)) continue;
+    const int a = f / 2;
+    const WallBody& b = bodies_[f];
+    const double lo = layer_[f] == 0 ? -kNever : layer_[f] * widths_[a];
+    const double hi = layer_[f] == cells_along_[a] - 1 ? kNever : (layer_[f] + 1) * widths_[a];
+    const double when =
+        t + interval_exit_time_accelerated(b.position_at(t), b.speed_at(t), b.accel, lo, hi);
+    if (when < next_change_) {
+      next_change_ = when;
+      next_change_face_ = f;
+    }
+  }
+}
+
+template <int D>
+int FaceWalls<D>::change_layer(double t) {
+  const int f = next_change_face_;
+  const int a = f / 2;
+  const double x = bodies_[f].position_at(t);
+  const double lo = layer_[f] * widths_[a];
+  const double hi = (layer_[f] + 1) * widths_[a];
+  // Through the nearer face of the layer (an inner face: the outer layers have none outside).
+  layer_[f] = std::clamp(layer_[f] + (std::abs(x - hi) < std::abs(x - lo) ? 1 : -1), 0,
+                         cells_along_[a] - 1);
+  find_next_change(t);
+  return f;
 }
 
 template <int D>

@@ -5,8 +5,11 @@
 // velocity v at time t, under the uniform field) first touches a wall's plane, which layers of
 // cells a wall can reach, the contact's response with its energy split, whether a start state
 // overlaps a wall, and when approaching walls leave no room for the particles. It keeps no
-// per-particle state: a wall's plane is a function of the time (boundaries/face_wall.hpp), so
-// it adds nothing to restart files. The engine calls it and it never calls back.
+// per-particle state. A wall of infinite mass has its plane as a function of the time
+// (boundaries/face_wall.hpp) and adds nothing to restart files; a wall with mass (a free
+// piston, boundaries/wall_body.hpp) keeps its motion here, which the engine sets at each of
+// its contacts (push) and exports for restarts (motion). The engine calls it and it never
+// calls back.
 //
 // Conventions: face 2k is the low face of axis k, 2k + 1 the high one; normals point into the
 // box; the particle's relative time to an event is returned (kNever: none before the horizon).
@@ -15,8 +18,10 @@
 #include <array>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "boundaries/face_wall.hpp"
+#include "boundaries/wall_body.hpp"
 #include "core/vec.hpp"
 #include "dynamics/collision_time.hpp"
 #include "interactions/granular_contact.hpp"
@@ -48,14 +53,20 @@ class FaceWalls {
   bool is_surface(int f) const { return is_wall(f); }
   Vec<D> normal(int f, const Vec<D>& /*x*/, double /*t*/) const { return face_normal<D>(f); }
   Vec<D> velocity(int f, const Vec<D>& /*x*/, double t) const {
+    if (massive(f)) [[unlikely]] {
+      Vec<D> v{};
+      v[f / 2] = bodies_[f].speed_at(t);
+      return v;
+    }
     return faces_[f].wall.surface_velocity(f, t);
   }
   bool holds_still(int f) const {
     const Wall<D>& w = faces_[f].wall;
-    return !w.vibrates() && norm2(w.velocity) == 0.0;
+    return !w.vibrates() && norm2(w.velocity) == 0.0 && !w.massive();
   }
   bool surface_moves(int f) const { return faces_[f].wall.plane_moves(f); }
-  bool accelerates(int f) const { return faces_[f].wall.vibrates(); }
+  // Its velocity changes (a vibration; a wall with mass, pushed by the particles).
+  bool accelerates(int f) const { return faces_[f].wall.vibrates() || massive(f); }
   bool flat(int /*f*/) const { return true; }
   std::string name(int f) const { return std::string{"xyz"[f / 2], f % 2 == 0 ? '-' : '+'}; }
   const ContactModel& contact(int f) const { return faces_[f].wall.contact; }
@@ -65,7 +76,11 @@ class FaceWalls {
   }
 
   // Where the plane of wall f lies along its axis at time t.
-  double position(int f, double t) const { return faces_[f].wall.plane_position(f, box_, t); }
+  double position(int f, double t) const {
+    if (massive(f)) [[unlikely]]
+      return bodies_[f].position_at(t);
+    return faces_[f].wall.plane_position(f, box_, t);
+  }
   // The centre's distance from the plane of wall f at time t, positive inside the box.
   double gap(int f, const Vec<D>& x, double t) const {
     return face_gap(f, x[f / 2], position(f, t));
@@ -80,7 +95,8 @@ class FaceWalls {
   // box), for cells of the grid's widths and particles up to rmax.
   void set_reach(const CellGrid<D>& grid, double rmax);
   // Whether a particle in cell c can touch face f before it leaves the cell: f has a wall, and
-  // the cell is within reach of it (a piston, moving along its normal, reaches every layer).
+  // the cell is within reach of it (a piston, moving along its normal, reaches every layer; a
+  // wall with mass the layers of its band, while its plane stays in its layer of cells).
   bool reaches(int f, CellCode c, const CellGrid<D>& grid) const;
 
   // A particle (velocity v, spin w, updated in place) meets wall f at time t: the wall is a
@@ -88,6 +104,32 @@ class FaceWalls {
   // restitution acts on the normal velocity relative to the wall.
   ContactResult<D> resolve(int f, const Vec<D>& x, double t, double mass, double radius,
                            double inertia_factor, bool force_elastic, Vec<D>& v, Spin<D>& w) const;
+
+  // Walls with mass (boundaries/wall_body.hpp).
+  bool any_massive() const { return any_massive_; }
+  bool massive(int f) const { return faces_[f].wall.massive(); }
+  const WallBody& body(int f) const { return bodies_[f]; }
+  // The version a wall event predicted now carries (0 for a wall of infinite mass): the event
+  // is stale once the wall's motion has changed.
+  std::uint32_t event_version(int f) const { return massive(f) ? bodies_[f].version : 0u; }
+  // Sets the walls' motion from a state at time t (`motion` empty: each wall with mass at rest
+  // on its face). Throws InputError for a motion of a face without mass, or one that is not
+  // finite. Call after prepare().
+  void restore(const std::vector<WallMotion>& motion, double t);
+  std::vector<WallMotion> motion() const;
+  // The impulse a contact gave the particle (ContactResult::impulse) at time t moves wall f.
+  void push(int f, double t, const Vec<D>& impulse_on_particle);
+  // When the plane of a wall with mass next leaves its layer of cells (kNever if none has
+  // mass), and that change made (at that time t): returns the face. The outer layers extend
+  // to infinity: a lid the particles push out of the box moves on in the outermost layer.
+  double next_layer_change() const { return next_change_; }
+  int change_layer(double t);
+  // The layers of cells along wall f's axis (first, last) holding every particle that can
+  // touch it while its plane stays in its layer (the cells reaches() accepts).
+  std::pair<int, int> band(int f) const;
+  // The mechanical energy of wall f with mass: M v^2 / 2 less the work of its constant force
+  // and the field since it rested on its face.
+  double energy(int f, double t) const { return bodies_[f].energy_at(t, rest_position(f)); }
 
   // A start state's particle `id` at x: throws InputError naming the particle and the wall it
   // overlaps (round-off contacts, 1e-12 of the radius, are contacts).
@@ -115,6 +157,19 @@ class FaceWalls {
   double squeeze_time_ = kNever;
   int squeeze_axis_ = -1;
   double squeeze_needed_ = 0.0;  // the room the particles need along squeeze_axis_
+  // Walls with mass: their motion, the layer of cells their plane is in, the grid's widths and
+  // cells along each axis (set_reach), the next layer change.
+  bool any_massive_ = false;
+  std::array<WallBody, 2 * D> bodies_{};
+  std::array<int, 2 * D> layer_{};
+  Vec<D> widths_{};
+  std::array<int, D> cells_along_{};
+  double next_change_ = kNever;
+  int next_change_face_ = -1;
+  double rest_position(int f) const { return f % 2 == 0 ? 0.0 : box_[f / 2]; }
+  int layer_of(int f, double x) const;
+  // Sets next_change_ from time t (the bodies' motion and layers).
+  void find_next_change(double t);
 };
 
 }  // namespace kairos

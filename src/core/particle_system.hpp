@@ -127,6 +127,23 @@ struct FrozenContact {
   bool operator==(const FrozenContact&) const = default;
 };
 
+// A wall with mass (boundaries/wall_body.hpp): where the plane of the wall at `face` was along
+// its axis at `time` (its last contact), its speed then and its constant acceleration since
+// (a run continued with another force, mass or field moves it on with this one to the state's
+// time first); `version` counts the changes of its motion (wall events predicted before a
+// change are stale), `layer` is the layer of cells its plane is in (-1: work it out from the
+// position). Scheduler state: part of an exact restart.
+struct WallMotion {
+  std::uint32_t face = 0;
+  double time = 0.0;
+  double position = 0.0;
+  double speed = 0.0;
+  std::uint32_t version = 0;
+  double accel = 0.0;
+  std::int32_t layer = -1;
+  bool operator==(const WallMotion&) const = default;
+};
+
 // Angular velocity: a vector in 3D, the z component alone in 2D.
 template <int D>
 using AngularVelocity = Vec<D == 3 ? 3 : 1>;
@@ -183,6 +200,8 @@ struct ParticleSystem {
   std::optional<std::vector<PairZone>> zones;
   // Soft spheres: the contacts in progress (mapped contacts waiting for their release).
   std::vector<FrozenContact<D>> frozen;
+  // Walls with mass: their motion (empty: none, or each at rest on its face at `time`).
+  std::vector<WallMotion> wall_motion;
   // DEM runs: what a resumed DemIntegrator needs to continue bit for bit (empty: start afresh).
   DemResume dem;
 

@@ -180,6 +180,11 @@ void DemIntegrator<D>::set_walls(const Environment<D>& env) {
     if (kind == FaceKind::kOpen)
       throw InputError(fmt::format(
           "DEM: face {} of the box is open (particles leaving the box are not supported)", f));
+    if (kind == FaceKind::kWall && env.faces[static_cast<std::size_t>(f)].wall.massive())
+      throw InputError(fmt::format(
+          "DEM: the wall on face {}{} has mass (boundary.wall.mass): the DEM integrator moves "
+          "no wall with mass yet",
+          "xyz"[f / 2], f % 2 == 0 ? '-' : '+'));
     wall_on_[static_cast<std::size_t>(f)] = kind == FaceKind::kWall;
     walls_[static_cast<std::size_t>(f)] = env.faces[static_cast<std::size_t>(f)].wall;
     any_wall_ = any_wall_ || kind == FaceKind::kWall;

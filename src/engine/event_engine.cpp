@@ -64,6 +64,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
                        (options_.record_loads == RecordLoads::kAuto && !cpu_gathers_fast()));
   setup_environment(s);
   setup_soft(s);
+  if (massive_walls_) check_massive_walls(s, mode);
 
   // Internal numbering: the stored one when resuming, else the caller's (renumbered below).
   id_.resize(n);
@@ -347,6 +348,8 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
     particle_volume +=
         D == 3 ? 4.0 / 3.0 * M_PI * k.radius * k.radius * k.radius : M_PI * k.radius * k.radius;
   boundaries_.prepare(cells_.grid(), rmax, particle_volume, uniform_radius_);
+  massive_walls_ = boundaries_.faces().any_massive();
+  boundaries_.faces().restore(s.wall_motion, time_);
   if (time_ >= boundaries_.squeeze_time()) throw_squeezed(time_);
   // Shear (sliding images) and steps (zones) keep full scans.
   incremental_crossings_ = options_.incremental_crossings && !stepped_ && !sheared_;
@@ -622,7 +625,8 @@ double EventEngine<D, Queue>::conclude_prediction(std::uint32_t i, double t,
   if (walls_) {
     const auto [dt, face] = next_wall_contact(i, t, when - t);
     if (face >= 0) {
-      pending_[i] = {Code::wall(face), 0};
+      pending_[i] = {Code::wall(face),
+                     massive_walls_ ? boundaries_.faces().event_version(face) : 0u};
       when = t + dt;
     }
   }
@@ -842,6 +846,12 @@ EventKind EventEngine<D, Queue>::step() {
     shift_images();
     return EventKind::kImageShift;
   }
+  // (A lid that never changes layer again has kNever: no event, whatever the queue holds.)
+  if (massive_walls_ && boundaries_.faces().next_layer_change() < kNever &&
+      boundaries_.faces().next_layer_change() <= queue_.top_time()) [[unlikely]] {
+    change_wall_layer();
+    return EventKind::kWallLayer;
+  }
   const std::uint32_t i = queue_.top();
   const double t = queue_.top_time();
   if (!std::isfinite(t)) return EventKind::kNone;
@@ -862,6 +872,11 @@ EventKind EventEngine<D, Queue>::step() {
     if (e.code.is_release()) {
       release_event(i, t);
       return EventKind::kSoftRelease;
+    }
+    if (massive_walls_ && stale_wall_event(e)) [[unlikely]] {
+      ++counters_.stale_events;
+      queue_.update(i, predict(i, t));
+      return EventKind::kStale;
     }
     hit_wall(i, e.code.wall_face(), t);
     return EventKind::kWallCollision;

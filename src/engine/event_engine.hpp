@@ -58,6 +58,8 @@ namespace kairos {
 // kImageShift: under Lees-Edwards shear, the images across the y faces moved on by a cell width
 // and the particles next to those faces were predicted again.
 // kSoftRelease: a soft contact ended, its frozen pair got its post-contact velocities.
+// kWallLayer: the plane of a wall with mass entered another layer of cells, and the particles
+// it can now reach were looked at again.
 enum class EventKind {
   kNone,
   kCollision,
@@ -65,7 +67,8 @@ enum class EventKind {
   kStale,
   kWallCollision,
   kImageShift,
-  kSoftRelease
+  kSoftRelease,
+  kWallLayer
 };
 
 // How an engine starts: predict every event from the state, or resume the scheduler state the
@@ -126,7 +129,10 @@ class EventEngine {
 
   double time() const { return time_; }
   // When the next event happens (kNever if nothing ever will).
-  double next_event_time() { return std::min(queue_.top_time(), shear_.next_shift_time()); }
+  double next_event_time() {
+    const double next = std::min(queue_.top_time(), shear_.next_shift_time());
+    return massive_walls_ ? std::min(next, boundaries_.faces().next_layer_change()) : next;
+  }
 
   // Where particle i (the engine's numbering) is and how it moves at time t (not before its local
   // time, unless it sits in a deferred soft contact: then the frozen motion until the release).
@@ -222,6 +228,8 @@ class EventEngine {
   // the velocities relative to the flow).
   std::array<double, 9> peculiar_kinetic_tensor() const;
   const Environment<D>& environment() const { return env_; }
+  // Every wall as the engine meets it now (walls with mass where their motion put them).
+  const Boundaries<D>& boundaries() const { return boundaries_; }
   // Positions at the current time, wrapped into the box, in the caller's numbering.
   std::vector<Vec<D>> current_positions() const;
   // Velocities at the current time, in the caller's numbering: export_state()'s
@@ -287,6 +295,18 @@ class EventEngine {
   // The particle's soonest wall contact from time t before t + horizon: (relative time, face).
   std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
   void hit_wall(std::uint32_t i, int surface, double t);
+  // Walls with mass (boundaries/wall_body.hpp): a wall event predicted before the wall's
+  // motion last changed is stale; after a change (a contact, or the plane in a new layer of
+  // cells) every particle the wall can reach gets the contact as its event if it now comes
+  // first.
+  bool stale_wall_event(const PendingEvent& e) const {
+    const int f = e.code.wall_face();
+    return f < 2 * D && boundaries_.faces().massive(f) &&
+           e.partner_count != boundaries_.faces().body(f).version;
+  }
+  void wall_moved(int face, double t);
+  void check_massive_walls(const ParticleSystem<D>& s, StartMode mode) const;
+  void change_wall_layer();
   // Walls moving towards each other left no room for the particles (FaceWalls::squeeze_time).
   [[noreturn]] void throw_squeezed(double t) const;
   // Sleeping particles (gravity with walls): see Environment::sleep_speed.
@@ -492,6 +512,7 @@ class EventEngine {
   bool accelerated_ = false;      // uniform gravity
   Vec<D> half_gravity_{};
   bool walls_ = false;                   // boundaries_.any()
+  bool massive_walls_ = false;           // some face wall has mass
   bool bounded_ = false;                 // some axis has walls or open faces
   bool granular_contacts_ = false;       // some contact law is not elastic and smooth
   HugeVector<AngularVelocity<D>> spin_;  // rough particles only

@@ -195,7 +195,81 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t) {
   counters_.sliding_collisions += res.slid ? 1u : 0u;
   ++counters_.wall_collisions;
   ++h.collisions;  // its velocity changed: partners' predictions with it are stale
+  // A wall with mass recoils. The impulse on it points out of the box (J_n >= 0), so from
+  // now on its plane lies, at every time, no nearer the particles than the old motion had it:
+  // every other particle's contact with it comes later, if at all, and its pending event (at
+  // most that old contact) still comes first; a wall event of the old motion is found stale
+  // when it is due (stale_wall_event). So no other particle needs looking at here.
+  if (massive_walls_ && surface < 2 * D && boundaries_.faces().massive(surface)) [[unlikely]]
+    boundaries_.faces().push(surface, t, res.impulse);
   queue_.update(i, predict(i, t));
+}
+
+// The plane of wall `face` (with mass) entered another layer of cells at time t, or its
+// motion changed so that it may come nearer the particles. A particle that cannot reach it
+// (outside its band of cells) meets it only after a crossing into the band, or after the
+// plane's next change of layer, and is predicted again then. Each particle in the band gets
+// the contact as its event if the contact comes before its pending event; a pending wall event
+// of an old motion that comes first is left in place and found stale when it is due
+// (stale_wall_event): it is no later than the contact, since that did not replace it.
+template <int D, class Queue>
+void EventEngine<D, Queue>::wall_moved(int face, double t) {
+  const FaceWalls<D>& walls = boundaries_.faces();
+  const CellGrid<D>& grid = cells_.grid();
+  const int axis = face / 2;
+  const auto [first, last] = walls.band(face);
+  const PendingEvent contact{Code::wall(face), walls.body(face).version};
+  std::array<int, D> c{};
+  std::array<int, D> lo{}, hi{};
+  for (int a = 0; a < D; ++a) {
+    lo[a] = a == axis ? first : 0;
+    hi[a] = a == axis ? last : grid.cells_along(a) - 1;
+  }
+  c = lo;
+  while (true) {
+    const std::uint32_t cell = grid.index(grid.code_at(c));
+    for (std::uint32_t p = grid.first(cell); p != grid.end(); p = grid.next(p)) {
+      const double due = queue_.time_of(p);
+      const HotRecord<D>& h = hot_[p];
+      const double dt = walls.event_time(face, flight_position(h, t), flight_velocity(h, t),
+                                         radius_of(p), t, due - t);
+      if (t + dt < due) {
+        pending_[p] = contact;
+        queue_.update(p, std::max(t, t + dt));
+      }
+    }
+    int a = 0;
+    while (a < D && ++c[a] > hi[a]) c[a] = lo[a], ++a;
+    if (a == D) break;
+  }
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::change_wall_layer() {
+  const double t = boundaries_.faces().next_layer_change();
+  time_ = t;
+  wall_moved(boundaries_.faces().change_layer(t), t);
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::check_massive_walls(const ParticleSystem<D>& s, StartMode mode) const {
+  const auto refuse = [](const std::string& why) {
+    throw InputError("boundary.wall.mass: a wall with mass cannot be combined with " + why);
+  };
+  if (soft_) refuse("soft spheres yet (soft.model)");
+  if (sheared_) refuse("Lees-Edwards shear yet (boundary.shear_rate)");
+  if (mode != StartMode::kResume) return;
+  for (int f = 0; f < 2 * D; ++f) {
+    if (!boundaries_.faces().massive(f)) continue;
+    const bool held =
+        std::any_of(s.wall_motion.begin(), s.wall_motion.end(),
+                    [&](const WallMotion& m) { return m.face == static_cast<std::uint32_t>(f); });
+    if (!held) {
+      throw InputError("cannot resume: the state holds no motion of the wall with mass at face " +
+                       boundaries_.name(f) +
+                       " (it was written by a run without it; start from it afresh instead)");
+    }
+  }
 }
 
 template <int D, class Queue>

@@ -116,7 +116,22 @@ void EventEngine<D, Queue>::validate() {
       const double speed_at_contact =
           std::abs(dot(v + (due - t) * env_.gravity - boundaries_.velocity(f, x_due, due),
                        boundaries_.normal(f, x_due, due)));
-      if (std::isfinite(due) && late(queue_.time_of(i), due, speed_at_contact)) {
+      // A wall with mass is looked for only by the particles in its band of cells until its
+      // plane changes layer (EventEngine::wall_moved); a particle outside the band meets it
+      // after that at the earliest.
+      const bool massive = massive_walls_ && f < 2 * D && boundaries_.faces().massive(f);
+      const double pending =
+          massive && !boundaries_.faces().reaches(f, hot_[i].cell, cells_.grid())
+              ? std::min(queue_.time_of(i), boundaries_.faces().next_layer_change())
+              : queue_.time_of(i);
+      // A wall event of the wall's present motion is the contact itself, not an earlier time.
+      if (massive && pending_[i].code.is_wall() && pending_[i].code.wall_face() == f &&
+          !stale_wall_event(pending_[i]) && std::isfinite(due) &&
+          late(due, queue_.time_of(i), speed_at_contact)) {
+        fail("particle " + name(i) + " has an event with wall " + std::to_string(f) + " at " +
+             std::to_string(queue_.time_of(i)) + " before its contact at " + std::to_string(due));
+      }
+      if (std::isfinite(due) && late(pending, due, speed_at_contact)) {
         fail("particle " + name(i) + " meets wall " + std::to_string(f) + " at " +
              std::to_string(due) + " before its pending event (at " +
              std::to_string(queue_.time_of(i)) + ", partner code " +

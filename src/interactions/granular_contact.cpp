@@ -276,13 +276,20 @@ ContactResult<D> resolve_contact(const ContactModel& model, const ContactInput<D
   return r;
 }
 
+// The normal mass of a wall contact: the particle's, or m M / (m + M) for a wall with mass.
+template <int D>
+double wall_normal_mass(const WallContactInput<D>& in) {
+  if (std::isinf(in.wall_mass)) return in.mass;
+  return in.mass * in.wall_mass / (in.mass + in.wall_mass);
+}
+
 template <int D>
 ContactResult<D> resolve_wall_contact(const ContactModel& model, const WallContactInput<D>& in,
                                       Vec<D>& v) {
   require_smooth(model.tangential);
   const double gn = dot(v - in.wall_velocity, in.normal);
   if (!(gn < 0.0)) return {};
-  const Impulse<D> imp = normal_impulse<D>(model, in.force_elastic, -gn, in.mass);
+  const Impulse<D> imp = normal_impulse<D>(model, in.force_elastic, -gn, wall_normal_mass(in));
   ContactResult<D> r = result_of<D>(imp, in.normal, -gn);
   r.translational_energy_change = kick<D>(r.impulse, in.mass, v);
   return r;
@@ -296,7 +303,7 @@ ContactResult<D> resolve_wall_contact(const ContactModel& model, const WallConta
   const Vec<D> relative = v - in.wall_velocity;
   const double gn = dot(relative, n);
   if (!(gn < 0.0)) return {};
-  Impulse<D> imp = normal_impulse<D>(model, in.force_elastic, -gn, in.mass);
+  Impulse<D> imp = normal_impulse<D>(model, in.force_elastic, -gn, wall_normal_mass(in));
   if (!imp.elastic) {
     // The wall neither recoils nor turns: 1/m_t = 1/m + R^2/I = (1 + q)/(q m).
     const double q = in.inertia_factor;

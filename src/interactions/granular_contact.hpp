@@ -149,6 +149,10 @@ struct WallContactInput {
   Vec<D> normal{};  // unit normal from the wall towards the particle
   Vec<D> wall_velocity{};
   double mass = 1.0;
+  // A wall with mass (boundaries/wall_body.hpp) recoils along the normal: the normal impulse
+  // takes the reduced mass m M / (m + M). It neither turns nor moves in its plane, so the
+  // tangential impulse is the fixed wall's. Infinite: the wall does not recoil.
+  double wall_mass = std::numeric_limits<double>::infinity();
   double radius = 0.5;  // unused by smooth contacts
   double inertia_factor = D == 3 ? kSolidSphereInertia : kDiskInertia;
   bool force_elastic = false;

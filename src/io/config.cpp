@@ -86,6 +86,7 @@ class Reader : public KeyReader {
     }
     check_soft_and_dem(root, config);
     check_fixed_species(root, config);
+    check_wall_masses(root, config);
     check_trajectory_keys(root, config);
     if (config.system.chain_length > 0 && config.bonds.empty()) {
       fail(nullptr, "system.chain_length",
@@ -746,6 +747,7 @@ class Reader : public KeyReader {
       const char* why = "a fixed grain would not see the moving wall coming";
       if (w.amplitude > 0.0 && w.frequency > 0.0)
         conflict(fmt::format("{}.amplitude", prefix), why);
+      if (w.mass > 0.0) conflict(fmt::format("{}.mass", prefix), why);
       if (face && !w.velocity.empty()) {
         const int axis = face_number(box_faces(c.system.dimension).at(w.face)) / 2;
         if (axis < static_cast<int>(w.velocity.size()) && w.velocity[axis] != 0.0)
@@ -763,6 +765,55 @@ class Reader : public KeyReader {
         along += plane.normal[a] * plane.wall.velocity[a];
       if (along != 0.0)
         conflict(prefix + ".velocity", "a fixed grain would not see the moving wall coming");
+    }
+  }
+
+  // Walls with mass (boundaries/wall_body.hpp): face walls of the event engine whose motion
+  // is their own; what that cannot be combined with (yet) is refused.
+  void check_wall_masses(const toml::table& root, const Config& c) const {
+    for (std::size_t p = 0; p < c.boundary.planes.size(); ++p) {
+      const WallConfig& w = c.boundary.planes[p].wall;
+      for (const char* key : {"mass", "force"}) {
+        if ((key[0] == 'm' ? w.mass : w.force) == 0.0) continue;
+        const std::string name = fmt::format("boundary.plane[{}].{}", p, key);
+        fail(node_at(root, name), name,
+             fmt::format("{}: only the walls on the box's faces ([[boundary.wall]]) can have "
+                         "mass yet",
+                         name));
+      }
+    }
+    for (std::size_t k = 0; k < c.boundary.walls.size(); ++k) {
+      const WallConfig& w = c.boundary.walls[k];
+      const std::string prefix = fmt::format("boundary.wall[{}]", k);
+      const auto key_node = [&](std::string_view key) {
+        return node_at(root, fmt::format("{}.{}", prefix, key));
+      };
+      if (w.mass == 0.0) {
+        if (w.force != 0.0) {
+          fail(key_node("force"), prefix + ".force",
+               fmt::format("{}.force: a force moves only a wall with mass (set {}.mass)", prefix,
+                           prefix));
+        }
+        continue;
+      }
+      const auto conflict = [&](std::string_view key, std::string_view why) {
+        const std::string name = std::string(key).find('.') == std::string::npos
+                                     ? fmt::format("{}.{}", prefix, key)
+                                     : std::string(key);
+        const toml::node* n = node_at(root, name);
+        fail(n != nullptr ? n : key_node("mass"), name,
+             fmt::format("{}: a wall with mass ({}.mass) cannot be combined with {} ({})", name,
+                         prefix, name, why));
+      };
+      if (!w.velocity.empty())
+        for (double u : w.velocity)
+          if (u != 0.0) conflict("velocity", "its motion follows from the impulses it takes");
+      if (w.amplitude > 0.0 && w.frequency > 0.0)
+        conflict("amplitude", "its motion follows from the impulses it takes");
+      if (c.soft.enabled())
+        conflict("soft.model", "soft contacts and the DEM meet no wall with mass yet");
+      if (c.boundary.shear_rate != 0.0) conflict("boundary.shear_rate", "not combined yet");
+      if (c.analysis.transport) conflict("analysis.transport", "momentum is not conserved");
     }
   }
 

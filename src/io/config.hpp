@@ -98,6 +98,8 @@ struct WallConfig {
   double amplitude = 0.0;        // vibration along the normal: A sin(2 pi f t + phase)
   double frequency = 0.0;        // f, cycles per unit time
   double phase = 0.0;            // radians
+  double mass = 0.0;             // > 0: a wall with mass (a free piston; 0: infinite mass)
+  double force = 0.0;            // on a wall with mass, along its normal (into the box)
 
   bool operator==(const WallConfig&) const = default;
 };

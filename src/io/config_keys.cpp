@@ -280,6 +280,18 @@ constexpr KeyDecl kWall[] = {
      .range = {.lo = -1e9, .hi = 1e9, .why = "(radians)"},
      .unit = "radians",
      .doc = "vibration phase"},
+    {.name = "mass",
+     .type = KeyType::kFloat,
+     .member = field<&WallConfig::mass>,
+     .range = {.lo = 0.0, .hi = 1e9},
+     .unit = "mass",
+     .doc = "a wall with mass M moves along its axis, pushed by the particles (0: infinite mass)"},
+    {.name = "force",
+     .type = KeyType::kFloat,
+     .member = field<&WallConfig::force>,
+     .range = {.lo = -1e9, .hi = 1e9},
+     .unit = "force",
+     .doc = "constant force on a wall with mass, along its normal into the box"},
 };
 
 const PlaneConfig kPlaneDefaults{};

@@ -476,6 +476,24 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& bloc
         w.write_chunk("kairos/state/frozen_deferred", nf, 1 + 2 * D, deferred.data());
       }
     }
+    if (!s.wall_motion.empty()) {
+      // Walls with mass: face, time, position, speed, version, acceleration, layer.
+      constexpr std::uint32_t kColumns = 7;
+      const std::uint64_t nw = s.wall_motion.size();
+      std::vector<double> rows(kColumns * nw);
+      for (std::size_t k = 0; k < nw; ++k) {
+        const WallMotion& m = s.wall_motion[k];
+        double* row = &rows[kColumns * k];
+        row[0] = m.face;
+        row[1] = m.time;
+        row[2] = m.position;
+        row[3] = m.speed;
+        row[4] = m.version;
+        row[5] = m.accel;
+        row[6] = m.layer;
+      }
+      w.write_chunk("kairos/state/wall_motion", nw, kColumns, rows.data());
+    }
     if (!has.angular_velocity.empty()) {
       constexpr std::uint32_t kSpin = D == 3 ? 3 : 1;
       write_particle_chunk<double>(w, "kairos/state/angular_velocity", kSpin, blocks,
@@ -646,6 +664,28 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
           c.release_position_j[a] = row[1 + D + a];
         }
       }
+    }
+  }
+  if (const auto chunk = r.find(f, "kairos/state/wall_motion")) {
+    constexpr std::size_t kColumns = 7;  // as written above
+    const std::size_t nw = chunk->N;
+    const auto rows = require<double>(r, f, "kairos/state/wall_motion", path, kColumns * nw);
+    for (std::size_t k = 0; k < nw; ++k) {
+      const double* row = &rows[kColumns * k];
+      const bool whole = [&] {
+        for (std::size_t c : {0u, 4u, 6u})
+          if (row[c] != std::floor(row[c])) return false;
+        return true;
+      }();
+      if (!whole || !(row[0] >= 0.0 && row[0] < 2 * D) ||
+          !(row[4] >= 0.0 && row[4] <= 4294967295.0) || !(row[6] >= -1.0 && row[6] < 65536.0)) {
+        throw InputError("'" + path.string() +
+                         "' is not a valid restart file: " + "kairos/state/wall_motion row " +
+                         std::to_string(k) + " names no face, version or layer");
+      }
+      s.wall_motion.push_back({static_cast<std::uint32_t>(row[0]), row[1], row[2], row[3],
+                               static_cast<std::uint32_t>(row[4]), row[5],
+                               static_cast<std::int32_t>(row[6])});
     }
   }
   if (r.find(f, "kairos/state/zone_count")) {

@@ -23,6 +23,9 @@
 //   kairos/state/frozen_deferred      float64 F x (1 + 2D): deferred (1 or 0), the release
 //                                     positions i and j (only when some release is deferred;
 //                                     absent: none is)
+//   kairos/state/wall_motion          float64 W x 7: face, time, position, speed, version,
+//                                     acceleration, layer of each wall with mass
+//                                     (ParticleSystem::wall_motion; only when there is one)
 // Format 4 files are read with no soft contacts. Format 6 adds frozen_deferred; format 7 adds
 //   kairos/checksum  uint32 x 1: CRC-32 (zlib) of every other chunk of the frame, over their
 //                    canonical serialisation (gsd_file.hpp, "Frame checksums"), written last

@@ -27,6 +27,14 @@ void check_wall_motion(const Wall<D>& w, const std::string& name) {
       !std::isfinite(w.phase)) {
     throw InputError(name + ": frequency must be finite and >= 0 and the phase finite");
   }
+  if (!(w.mass >= 0.0) || !std::isfinite(w.mass) || !std::isfinite(w.force))
+    throw InputError(name + ": mass must be finite and >= 0 and the force finite");
+  if (w.mass == 0.0 && w.force != 0.0)
+    throw InputError(name + ": a force moves only a wall with mass");
+  if (w.mass > 0.0 && (w.vibrates() || norm2(w.velocity) != 0.0))
+    throw InputError(name +
+                     ": a wall with mass moves as the impulses it takes say (no velocity "
+                     "or vibration of its own)");
 }
 }  // namespace
 

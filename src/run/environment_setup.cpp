@@ -314,6 +314,8 @@ Wall<D> make_wall(const WallConfig& wc, const std::string& where) {
   wall.amplitude = wc.amplitude;
   wall.angular_frequency = 2.0 * std::numbers::pi * wc.frequency;
   wall.phase = wc.phase;
+  wall.mass = wc.mass;
+  wall.force = wc.force;
   return wall;
 }
 }  // namespace

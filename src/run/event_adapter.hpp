@@ -106,6 +106,16 @@ class EventEngineAdapter final : public EventIntegrator<D> {
     return engine_.counters().dissipated_in_collisions + engine_.counters().dissipated_at_walls;
   }
   double work_by_walls() const override { return engine_.counters().work_by_walls; }
+  std::vector<WallReading> walls_with_mass() const override {
+    std::vector<WallReading> out;
+    const FaceWalls<D>& faces = engine_.boundaries().faces();
+    const double t = engine_.time();
+    for (int f = 0; f < 2 * D; ++f)
+      if (faces.is_wall(f) && faces.massive(f))
+        out.push_back(
+            {faces.name(f), faces.position(f, t), faces.body(f).speed_at(t), faces.energy(f, t)});
+    return out;
+  }
   Vec<D> momentum() const override { return engine_.momentum(); }
   double momentum_scale() const override;
   double max_overlap() const override;

@@ -291,7 +291,7 @@ std::string FrozenClockWatch::describe(const Engine& engine) const {
   if (busy.size() > named) who += fmt::format(" (of {} particles)", busy.size());
 
   const auto& env = engine.environment();
-  const Boundaries<D> boundaries(env, engine.box());
+  const Boundaries<D>& boundaries = engine.boundaries();  // walls with mass where they are now
   std::vector<int> walls;
   if (wall_hits > 0) {
     const auto state = engine.export_state(/*with_zones=*/false);

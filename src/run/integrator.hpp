@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "analysis/thermodynamics.hpp"
+#include "boundaries/wall_body.hpp"
 #include "core/particle_system.hpp"
 #include "core/state_blocks.hpp"
 #include "core/vec.hpp"
@@ -142,6 +143,8 @@ class Integrator {
   virtual double potential_energy() const = 0;
   virtual double dissipated_energy() const = 0;
   virtual double work_by_walls() const = 0;
+  // The walls with mass now (boundaries/wall_body.hpp), box faces in order: none by default.
+  virtual std::vector<WallReading> walls_with_mass() const { return {}; }
   virtual Vec<D> momentum() const = 0;
   // Sum of m |v| over the particles: the scale of the momentum drift.
   virtual double momentum_scale() const = 0;

@@ -156,6 +156,28 @@ void check_walls_stay(const Config& before, const Config& now, double t,
   }
 }
 
+// A face wall that gains or loses its mass on a restart would change what the state holds (the
+// wall's motion) and thermo.tsv's columns: refused. Another mass or force is fine (the wall
+// moves on from where the state has it).
+void check_wall_masses_stay(const Config& before, const Config& now,
+                            const std::string& restart_file) {
+  const auto massive = [](const Config& c, const std::string& face) {
+    for (const WallConfig& w : c.boundary.walls)
+      if (w.face == face) return w.mass > 0.0;
+    return false;
+  };
+  for (const char* face : {"x-", "x+", "y-", "y+", "z-", "z+"}) {
+    const bool was = massive(before, face), is = massive(now, face);
+    if (was == is) continue;
+    throw InputError(fmt::format(
+        "restart file '{}': the wall on face {} {} mass (boundary.wall.mass) in the run that "
+        "wrote it and {} now: a wall cannot gain or lose its mass during a run (its motion is "
+        "part of the state, and thermo.tsv's columns would change); start a new run from the "
+        "state with system.initial_state = \"{}\"",
+        restart_file, face, was ? "had" : "had no", is ? "has" : "has none", restart_file));
+  }
+}
+
 }  // namespace
 
 RestartPlan plan_restart(const Config& now, const std::string& stored, bool contacts_in_progress,
@@ -187,6 +209,7 @@ RestartPlan plan_restart(const Config& now, const std::string& stored, bool cont
     if (!a.contains(key)) keys.push_back(key);
   std::sort(keys.begin(), keys.end());
   check_walls_stay(before, now, before_time, restart_file);
+  check_wall_masses_stay(before, now, restart_file);
   for (const std::string& key : keys) {
     const auto was = a.find(key), is = b.find(key);
     const std::string from = was == a.end() ? "absent" : was->second;

@@ -1373,3 +1373,61 @@ TEST(ConfigExamples, GranularExamples) {
 
 }  // namespace
 }  // namespace kairos
+
+// ----- walls with mass (boundary.wall.mass, .force)
+
+namespace kairos {
+namespace {
+
+constexpr std::string_view kLid = R"(
+[[boundary.wall]]
+face = "z-"
+[[boundary.wall]]
+face = "z+"
+mass = 20.0
+force = 100.0
+)";
+
+TEST(ConfigWallMass, MassAndForceAreRead) {
+  const Config c = parse_config(minimal_plus(kLid), "t.toml");
+  ASSERT_EQ(c.boundary.walls.size(), 2u);
+  EXPECT_EQ(c.boundary.walls[1].mass, 20.0);
+  EXPECT_EQ(c.boundary.walls[1].force, 100.0);
+  EXPECT_EQ(c.boundary.walls[0].mass, 0.0);
+}
+
+TEST(ConfigWallMass, ForceWithoutMassIsAnError) {
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"z-\"\n[[boundary.wall]]\nface = "
+                            "\"z+\"\nforce = 3.0"),
+               {"boundary.wall[1].force", "a force moves only a wall with mass"});
+}
+
+TEST(ConfigWallMass, MassWithAVelocityOrVibrationIsAnError) {
+  expect_error(minimal_plus(std::string(kLid) + "velocity = [0.0, 0.0, -0.1]"),
+               {"boundary.wall[1].velocity", "a wall with mass"});
+  expect_error(minimal_plus(std::string(kLid) + "amplitude = 0.1\nfrequency = 2.0"),
+               {"boundary.wall[1].amplitude", "a wall with mass"});
+}
+
+TEST(ConfigWallMass, NegativeMassIsAnError) {
+  expect_error(minimal_plus("[[boundary.wall]]\nface = \"z-\"\n[[boundary.wall]]\nface = "
+                            "\"z+\"\nmass = -1.0"),
+               {"boundary.wall[1].mass", "must be in [0, 1e+09]"});
+}
+
+TEST(ConfigWallMass, APlaneWithMassIsAnError) {
+  expect_error(minimal_plus("[[boundary.plane]]\nnormal = [0.0, 0.0, 1.0]\npoint = [0.0, 0.0, "
+                            "1.0]\nmass = 5.0"),
+               {"boundary.plane[0].mass", "only the walls on the box's faces"});
+}
+
+TEST(ConfigWallMass, SoftSpheresShearAndFixedGrainsAreRefused) {
+  expect_error(minimal_plus(std::string(kLid) + "[soft]\nmodel = \"dashpot\"\nstiffness = 1e4"),
+               {"soft.model", "a wall with mass"});
+  expect_error(minimal_plus("species = [{name = \"g\"}, {name = \"f\", fixed = true}]\n" +
+                            std::string(kLid)),
+               {"boundary.wall[1].mass", "fixed grains"});
+}
+
+}  // namespace
+}  // namespace kairos

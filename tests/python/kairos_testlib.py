@@ -129,6 +129,13 @@ def base_config(dimension=3, particles=500, packing_fraction=0.3, lattice=None, 
     return config
 
 
+def with_sections(config, **sections):
+    """`config` with each keyword's dict merged into that section (created if absent)."""
+    for name, keys in sections.items():
+        config.setdefault(name, {}).update(keys)
+    return config
+
+
 # ------------------------------------------------------------------------------------------------
 # Running kairos
 

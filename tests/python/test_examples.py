@@ -33,6 +33,9 @@ EXAMPLES = {
         "system.particles=300", "output.thermo_interval=1", "output.trajectory_interval=2"]),
     # Whole (750 disks, a fraction of a second): it ends by itself when every grain sleeps.
     "fixed_obstacles_2d.toml": ("plot_fixed_grains.py", []),
+    # Measured in time: the lid comes down in the first few time units.
+    "free_piston_3d.toml": ("plot_free_piston.py", [
+        "run.equilibration_time=5", "run.time=10", "output.thermo_interval=1"]),
     "shear_flow_2d.toml": ("plot_shear_flow_2d.py", [
         "system.particles=2000", "run.equilibration_collisions_per_particle=2",
         "run.collisions_per_particle=5", "output.trajectory_interval=2",
@@ -134,6 +137,14 @@ class GranularExamples(kt.KairosTestCase):
                               > 40.0)
         self.assertGreater(on_obstacles, 50)  # some grains rest on the obstacles
         self.draw_picture("fixed_obstacles_2d.toml", out)
+
+    def test_free_piston_3d(self):
+        out, s = self.check_run("free_piston_3d.toml")
+        thermo = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        header, rows = thermo[0], thermo[1]
+        lid = [r[header.index("wall_z+_position")] for r in rows]
+        self.assertLess(lid[-1], lid[0])  # the lid came down onto the gas
+        self.draw_picture("free_piston_3d.toml", out)
 
     def test_shear_flow_2d(self):
         out, s = self.check_run("shear_flow_2d.toml")

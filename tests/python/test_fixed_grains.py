@@ -96,9 +96,7 @@ def matrix_config(**extra):
         {"name": "fluid", "fraction": 3.0},
         {"name": "matrix", "fraction": 1.0, "fixed": True},
     ]
-    for section, keys in extra.items():
-        config.setdefault(section, {}).update(keys)
-    return config
+    return kt.with_sections(config, **extra)
 
 
 class FixedGrains(kt.KairosTestCase):

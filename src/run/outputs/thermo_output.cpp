@@ -11,10 +11,18 @@ template <int D>
 void ThermoOutput<D>::open(const RunContext<D>& run) {
   const Integrator<D>& integrator = run.integrator();
   const std::filesystem::path path = run.directory() / name();
+  std::string header(kHeader);
+  const std::vector<WallReading> walls = integrator.walls_with_mass();
+  if (!walls.empty()) {
+    header.pop_back();  // its newline
+    for (const WallReading& w : walls)
+      header += fmt::format("\twall_{0}_position\twall_{0}_speed\twall_{0}_energy", w.face);
+    header += '\n';
+  }
   // A new file, or (a continued run) the existing one cut to the rows the continued state had
   // written (all complete rows when not recorded).
-  file_.emplace(run.restarted() ? LineFile(path, kHeader, run.continuation().thermo_rows)
-                                : LineFile::create(path, kHeader));
+  file_.emplace(run.restarted() ? LineFile(path, header, run.continuation().thermo_rows)
+                                : LineFile::create(path, header));
   rows_kept_ = file_->rows();
   stats_.emplace(D, integrator.mobile(), integrator.volume(),
                  integrator.mobile() < integrator.size());
@@ -34,6 +42,15 @@ bool ThermoOutput<D>::pending(const RunContext<D>& run) const {
   const Integrator<D>& integrator = run.integrator();
   return integrator.collisions() > stats_->last().collisions ||
          (run.timed() && integrator.time() > stats_->last().time);
+}
+
+// The columns of the walls with mass (empty without).
+template <int D>
+std::string wall_columns(const Integrator<D>& integrator) {
+  std::string out;
+  for (const WallReading& w : integrator.walls_with_mass())
+    out += fmt::format("\t{:.17g}\t{:.17g}\t{:.17g}", w.position, w.speed, w.energy);
+  return out;
 }
 
 // One row per line. Granular columns: rotational temperature per rotational degree of freedom
@@ -56,10 +73,11 @@ void ThermoOutput<D>::write_row(const RunContext<D>& run, const std::string& pha
       ((D == 3 ? 3.0 : 1.0) * static_cast<double>(integrator.mobile()));
   file_->append(fmt::format(
       "{}\t{:.17g}\t{}\t{}\t{:.10g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t"
-      "{:.17g}\t{:.17g}\t{:.17g}\n",
+      "{:.17g}\t{:.17g}\t{:.17g}{}\n",
       phase, r.at.time, r.at.events, r.at.collisions, r.collisions_per_particle, r.temperature,
       r.pressure, r.compressibility, r.kinetic_energy, r.mean_free_time, rotational_temperature,
-      integrator.dissipated_energy(), integrator.work_by_walls(), integrator.potential_energy()));
+      integrator.dissipated_energy(), integrator.work_by_walls(), integrator.potential_energy(),
+      wall_columns(integrator)));
   if (kept) {
     rows_kept_ = file_->rows();
     kept_mark_ = r.at;

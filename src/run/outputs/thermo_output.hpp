@@ -4,7 +4,8 @@
 //
 // Rows are written whole or not at all (io/line_file.hpp). A continued run cuts the file back
 // to the rows its restart state had written and measures the next row from the last kept one
-// (the thermo mark), so that the file is one uninterrupted run's. Production rows are the
+// (the thermo mark), so that the file is one uninterrupted run's. A run with walls with mass
+// adds three columns per such wall (wall_<face>_position, _speed, _energy). Production rows are the
 // moments analyses sample at (RunContext::sample_production_row).
 #pragma once
 
