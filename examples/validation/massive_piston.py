@@ -184,7 +184,11 @@ def oscillation(kairos, tmp, dimension, seed):
     height = x.mean()
     eta = rho * unit
     k_s = adiabatic_modulus(dimension, rho, kt, eta)
-    predicted = math.sqrt(k_s * area / ((mass + particles / 3.0) * height))
+    # The column's height as the bulk density sees it (Gibbs's dividing surfaces): the height
+    # that would hold all the particles at the bulk density, N / (A rho) - the lid's mean
+    # height less the layers the walls hold (and the centres' exclusion from them).
+    effective = particles / (area * rho)
+    predicted = math.sqrt(k_s * area / ((mass + particles / 3.0) * effective))
     # Autocorrelation of the height; successive zero crossings are half a period apart.
     d = x - x.mean()
     n = len(d)
@@ -196,7 +200,7 @@ def oscillation(kairos, tmp, dimension, seed):
     half_periods = np.diff(crossings[:12]) * dt
     measured = math.pi / half_periods.mean()
     spread = math.pi * half_periods.std() / half_periods.mean() ** 2 / math.sqrt(len(half_periods))
-    return predicted, measured, spread, eta, kt, height, x.std()
+    return predicted, measured, spread, eta, kt, height, x.std(), effective
 
 
 def main():
@@ -211,14 +215,16 @@ def main():
                     print(f"  {dimension}D seed {seed}: eta_bulk = {eta:.4f}, Z = P/(rho kT) = "
                           f"{z:.4f} +- {z_err:.4f}, reference {ref:.4f}, "
                           f"ratio {z / ref:.4f}")
-        print("Oscillation of a heavy lid (M = 20000, no thermostat)")
+        print("Oscillation of a heavy lid (M = 20000; settled under the thermostat, then "
+              "without it)")
         for dimension in (3, 2):
             for seed in range(1, seeds + 1):
-                predicted, measured, spread, eta, kt, height, amplitude = oscillation(
-                    kairos, tmp, dimension, seed)
+                predicted, measured, spread, eta, kt, height, amplitude, effective = \
+                    oscillation(kairos, tmp, dimension, seed)
                 print(f"  {dimension}D seed {seed}: eta = {eta:.4f}, kT = {kt:.4f}, H = "
-                      f"{height:.3f} (rms {amplitude:.3f}): omega measured {measured:.5f} +- "
-                      f"{spread:.5f}, predicted {predicted:.5f}, ratio {measured / predicted:.4f}")
+                      f"{height:.3f} (rms {amplitude:.3f}), N/(A rho) = {effective:.3f}: omega "
+                      f"measured {measured:.5f} +- {spread:.5f}, predicted {predicted:.5f}, "
+                      f"ratio {measured / predicted:.4f}")
 
 
 if __name__ == "__main__":

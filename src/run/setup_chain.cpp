@@ -141,12 +141,32 @@ std::vector<SoftTableUse> start_tables(Environment<D>& environment, const RunSta
                             soft_table_settings(start.config, start.resumed), progress);
 }
 
+// A wall with mass that nothing pushes into the box (no inward force, no field towards the
+// particles) is carried off by them for as long as the run lasts, the gas expanding after it:
+// physics, but rarely what was meant, and ever slower (docs/config.md).
+template <int D>
+void note_walls_carried_off(const Environment<D>& environment) {
+  for (int f = 0; f < 2 * D; ++f) {
+    const Wall<D>& w = environment.faces[f].wall;
+    if (environment.faces[f].kind != FaceKind::kWall || !w.massive()) continue;
+    const double inward = f % 2 == 0 ? 1.0 : -1.0;
+    if (w.force + inward * w.mass * environment.gravity[f / 2] > 0.0) continue;
+    std::fputs(fmt::format("kairos: note: boundary.wall ({}{}) has mass but nothing pushes it "
+                           "into the box (its force and the field): the particles will carry "
+                           "it off for as long as the run lasts\n",
+                           "xyz"[f / 2], f % 2 == 0 ? '-' : '+')
+                   .c_str(),
+               stderr);
+  }
+}
+
 template <int D, class Queue>
 std::unique_ptr<EventEngineAdapter<D, Queue>> start_event_engine(RunStart<D>&& start,
                                                                  const TableProgress& progress,
                                                                  const EngineTracking& tracking) {
   return named_restart_errors(start, [&] {
     Environment<D> environment = make_environment<D>(start.config, start.state);
+    note_walls_carried_off(environment);
     std::vector<SoftTableUse> tables = start_tables(environment, start, progress);
     return std::make_unique<EventEngineAdapter<D, Queue>>(std::move(start), environment,
                                                           std::move(tables), tracking);

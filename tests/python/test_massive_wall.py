@@ -137,6 +137,15 @@ class MassiveWall(kt.KairosTestCase):
         work = np.array([r[header.index("wall_work")] for r in rows])
         np.testing.assert_allclose(energy + work, 0.0, atol=1e-8)
 
+    def test_a_lid_that_nothing_pushes_in_gets_a_note(self):
+        cfg = lid_config(run={"time": 2.0})
+        cfg["boundary"]["wall"][1]["force"] = 0.0
+        result = self.run_ok("run", self.write_config(cfg), "-o", self.path("out"))
+        self.assertIn("nothing pushes it into the box", result.stderr)
+        quiet = self.run_ok("run", self.write_config(lid_config(run={"time": 2.0}), "q.toml"),
+                            "-o", self.path("quiet"))
+        self.assertNotIn("nothing pushes it", quiet.stderr)
+
     def test_refusals_name_their_keys(self):
         lid = {"wall": [{"face": "z-"}, {"face": "z+", "mass": 20.0, "force": 150.0}]}
         cases = [
