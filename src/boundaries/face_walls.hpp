@@ -125,8 +125,34 @@ class FaceWalls {
   double next_layer_change() const { return next_change_; }
   int change_layer(double t);
   // The layers of cells along wall f's axis (first, last) holding every particle that can
-  // touch it while its plane stays in its layer (the cells reaches() accepts).
+  // touch it while its plane stays in its layer (the cells reaches() accepts), and visit(cell
+  // index) for each of their cells.
   std::pair<int, int> band(int f) const;
+  template <class F>
+  void for_each_band_cell(int f, const CellGrid<D>& grid, F&& visit) const {
+    const int axis = f / 2;
+    const auto [first, last] = band(f);
+    std::array<int, D> lo{}, hi{};
+    for (int a = 0; a < D; ++a) {
+      lo[a] = a == axis ? first : 0;
+      hi[a] = a == axis ? last : grid.cells_along(a) - 1;
+    }
+    std::array<int, D> c = lo;
+    while (true) {
+      visit(grid.index(grid.code_at(c)));
+      int a = 0;
+      while (a < D && ++c[a] > hi[a]) c[a] = lo[a], ++a;
+      if (a == D) return;
+    }
+  }
+  // What the outputs show of each wall with mass at time t (WallReading), faces in order.
+  std::vector<WallReading> readings(double t) const {
+    std::vector<WallReading> out;
+    for (int f = 0; f < 2 * D; ++f)
+      if (is_wall(f) && massive(f))
+        out.push_back({name(f), position(f, t), bodies_[f].speed_at(t), energy(f, t)});
+    return out;
+  }
   // The mechanical energy of wall f with mass: M v^2 / 2 less the work of its constant force
   // and the field since it rested on its face.
   double energy(int f, double t) const { return bodies_[f].energy_at(t, rest_position(f)); }

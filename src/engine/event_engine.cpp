@@ -348,8 +348,8 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
     particle_volume +=
         D == 3 ? 4.0 / 3.0 * M_PI * k.radius * k.radius * k.radius : M_PI * k.radius * k.radius;
   boundaries_.prepare(cells_.grid(), rmax, particle_volume, uniform_radius_);
-  massive_walls_ = boundaries_.faces().any_massive();
-  boundaries_.faces().restore(s.wall_motion, time_);
+  massive_walls_ = boundaries_.any_massive();
+  boundaries_.restore(s.wall_motion, time_);
   if (time_ >= boundaries_.squeeze_time()) throw_squeezed(time_);
   // Shear (sliding images) and steps (zones) keep full scans.
   incremental_crossings_ = options_.incremental_crossings && !stepped_ && !sheared_;
@@ -625,8 +625,7 @@ double EventEngine<D, Queue>::conclude_prediction(std::uint32_t i, double t,
   if (walls_) {
     const auto [dt, face] = next_wall_contact(i, t, when - t);
     if (face >= 0) {
-      pending_[i] = {Code::wall(face),
-                     massive_walls_ ? boundaries_.faces().event_version(face) : 0u};
+      pending_[i] = {Code::wall(face), massive_walls_ ? boundaries_.event_version(face) : 0u};
       when = t + dt;
     }
   }
@@ -847,8 +846,8 @@ EventKind EventEngine<D, Queue>::step() {
     return EventKind::kImageShift;
   }
   // (A lid that never changes layer again has kNever: no event, whatever the queue holds.)
-  if (massive_walls_ && boundaries_.faces().next_layer_change() < kNever &&
-      boundaries_.faces().next_layer_change() <= queue_.top_time()) [[unlikely]] {
+  if (massive_walls_ && boundaries_.next_layer_change() < kNever &&
+      boundaries_.next_layer_change() <= queue_.top_time()) [[unlikely]] {
     change_wall_layer();
     return EventKind::kWallLayer;
   }

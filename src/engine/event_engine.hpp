@@ -131,7 +131,7 @@ class EventEngine {
   // When the next event happens (kNever if nothing ever will).
   double next_event_time() {
     const double next = std::min(queue_.top_time(), shear_.next_shift_time());
-    return massive_walls_ ? std::min(next, boundaries_.faces().next_layer_change()) : next;
+    return massive_walls_ ? std::min(next, boundaries_.next_layer_change()) : next;
   }
 
   // Where particle i (the engine's numbering) is and how it moves at time t (not before its local
@@ -301,10 +301,9 @@ class EventEngine {
   // first.
   bool stale_wall_event(const PendingEvent& e) const {
     const int f = e.code.wall_face();
-    return f < 2 * D && boundaries_.faces().massive(f) &&
-           e.partner_count != boundaries_.faces().body(f).version;
+    return boundaries_.massive(f) && e.partner_count != boundaries_.event_version(f);
   }
-  void wall_moved(int face, double t);
+  void wall_moved(int surface, double t);
   void check_massive_walls(const ParticleSystem<D>& s, StartMode mode) const;
   void change_wall_layer();
   // Walls moving towards each other left no room for the particles (FaceWalls::squeeze_time).

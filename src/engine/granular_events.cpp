@@ -200,8 +200,8 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t) {
   // every other particle's contact with it comes later, if at all, and its pending event (at
   // most that old contact) still comes first; a wall event of the old motion is found stale
   // when it is due (stale_wall_event). So no other particle needs looking at here.
-  if (massive_walls_ && surface < 2 * D && boundaries_.faces().massive(surface)) [[unlikely]]
-    boundaries_.faces().push(surface, t, res.impulse);
+  if (massive_walls_ && boundaries_.massive(surface)) [[unlikely]]
+    boundaries_.push(surface, t, res.impulse);
   queue_.update(i, predict(i, t));
 }
 
@@ -213,42 +213,28 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t) {
 // of an old motion that comes first is left in place and found stale when it is due
 // (stale_wall_event): it is no later than the contact, since that did not replace it.
 template <int D, class Queue>
-void EventEngine<D, Queue>::wall_moved(int face, double t) {
-  const FaceWalls<D>& walls = boundaries_.faces();
+void EventEngine<D, Queue>::wall_moved(int surface, double t) {
   const CellGrid<D>& grid = cells_.grid();
-  const int axis = face / 2;
-  const auto [first, last] = walls.band(face);
-  const PendingEvent contact{Code::wall(face), walls.body(face).version};
-  std::array<int, D> c{};
-  std::array<int, D> lo{}, hi{};
-  for (int a = 0; a < D; ++a) {
-    lo[a] = a == axis ? first : 0;
-    hi[a] = a == axis ? last : grid.cells_along(a) - 1;
-  }
-  c = lo;
-  while (true) {
-    const std::uint32_t cell = grid.index(grid.code_at(c));
+  const PendingEvent contact{Code::wall(surface), boundaries_.event_version(surface)};
+  boundaries_.for_each_band_cell(surface, grid, [&](std::uint32_t cell) {
     for (std::uint32_t p = grid.first(cell); p != grid.end(); p = grid.next(p)) {
       const double due = queue_.time_of(p);
       const HotRecord<D>& h = hot_[p];
-      const double dt = walls.event_time(face, flight_position(h, t), flight_velocity(h, t),
-                                         radius_of(p), t, due - t);
+      const double dt = boundaries_.event_time(surface, flight_position(h, t),
+                                               flight_velocity(h, t), radius_of(p), t, due - t);
       if (t + dt < due) {
         pending_[p] = contact;
         queue_.update(p, std::max(t, t + dt));
       }
     }
-    int a = 0;
-    while (a < D && ++c[a] > hi[a]) c[a] = lo[a], ++a;
-    if (a == D) break;
-  }
+  });
 }
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::change_wall_layer() {
-  const double t = boundaries_.faces().next_layer_change();
+  const double t = boundaries_.next_layer_change();
   time_ = t;
-  wall_moved(boundaries_.faces().change_layer(t), t);
+  wall_moved(boundaries_.change_layer(t), t);
 }
 
 template <int D, class Queue>
@@ -259,8 +245,8 @@ void EventEngine<D, Queue>::check_massive_walls(const ParticleSystem<D>& s, Star
   if (soft_) refuse("soft spheres yet (soft.model)");
   if (sheared_) refuse("Lees-Edwards shear yet (boundary.shear_rate)");
   if (mode != StartMode::kResume) return;
-  for (int f = 0; f < 2 * D; ++f) {
-    if (!boundaries_.faces().massive(f)) continue;
+  for (int f = 0; f < boundaries_.surfaces(); ++f) {
+    if (!boundaries_.is_surface(f) || !boundaries_.massive(f)) continue;
     const bool held =
         std::any_of(s.wall_motion.begin(), s.wall_motion.end(),
                     [&](const WallMotion& m) { return m.face == static_cast<std::uint32_t>(f); });

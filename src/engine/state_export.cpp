@@ -98,7 +98,7 @@ ParticleSystem<D> EventEngine<D, Queue>::export_globals(bool with_zones) const {
   for (int a = 0; a < D; ++a) out.periodic[a] = cells_.grid().periodic(a);
   out.bonds = bonds_;
   out.bond_types = bond_types_;
-  out.wall_motion = boundaries_.faces().motion();
+  out.wall_motion = boundaries_.motion();
   if (stepped_ && with_zones) out.zones = steps_.export_zones(id_.data());
   for (std::uint32_t k = 0; soft_ && k < size(); ++k) {
     const std::uint32_t p = soft_state_.partner(k);

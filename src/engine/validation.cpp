@@ -119,11 +119,10 @@ void EventEngine<D, Queue>::validate() {
       // A wall with mass is looked for only by the particles in its band of cells until its
       // plane changes layer (EventEngine::wall_moved); a particle outside the band meets it
       // after that at the earliest.
-      const bool massive = massive_walls_ && f < 2 * D && boundaries_.faces().massive(f);
-      const double pending =
-          massive && !boundaries_.faces().reaches(f, hot_[i].cell, cells_.grid())
-              ? std::min(queue_.time_of(i), boundaries_.faces().next_layer_change())
-              : queue_.time_of(i);
+      const bool massive = massive_walls_ && boundaries_.massive(f);
+      const double pending = massive && !boundaries_.reaches(f, hot_[i].cell, cells_.grid())
+                                 ? std::min(queue_.time_of(i), boundaries_.next_layer_change())
+                                 : queue_.time_of(i);
       // A wall event of the wall's present motion is the contact itself, not an earlier time.
       if (massive && pending_[i].code.is_wall() && pending_[i].code.wall_face() == f &&
           !stale_wall_event(pending_[i]) && std::isfinite(due) &&

@@ -39,22 +39,30 @@
 //                                               (which cells each surface reaches, the squeeze)
 //
 // is made from the run's model (Environment) in the constructor below, and has no per-particle
-// state (FaceWalls and PlaneWalls need none: their planes are functions of the time); a
-// component with state (a wall with mass) adds its restart data to ParticleSystem and its part
-// of EventEngine::validate(). Dispatch is static (the tuple below): no virtual call. Surface
-// codes: EventCode::wall has room for EventCode<D>::kWallCodes surfaces, the box faces first.
+// state. A surface with a motion of its own (a wall with mass, boundaries/wall_body.hpp, which
+// FaceWalls provides) is a component that also has the members of MovingBoundary below; the
+// set dispatches them, and the engine meets such a surface only through them (its contacts
+// push it, its events carry the version of its motion, its plane's change of cell layer is an
+// event, its motion travels in ParticleSystem::wall_motion). Dispatch is static (the tuple
+// below): no virtual call. Surface codes: EventCode::wall has room for
+// EventCode<D>::kWallCodes surfaces, the box faces first.
 #pragma once
 
+#include <algorithm>
 #include <concepts>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "boundaries/cylinder_walls.hpp"
 #include "boundaries/face_walls.hpp"
 #include "boundaries/plane_walls.hpp"
+#include "boundaries/wall_body.hpp"
+#include "core/error.hpp"
 #include "model/environment.hpp"
 #include "scheduler/cell_grid.hpp"
 
@@ -86,6 +94,41 @@ concept BoundaryComponent = requires(const C& c, C& setup, int s, const Vec<D>& 
   { c.squeeze_time() } -> std::convertible_to<double>;
   c.throw_squeezed(value, value, flag);
   setup.prepare(grid, value, value, flag);
+};
+
+// The members of a component whose surfaces may move by themselves (walls with mass), for its
+// own surfaces s:
+//
+//   bool any_massive() const;                   some surface has a motion of its own
+//   bool massive(int s) const;                  surface s has one
+//   std::uint32_t event_version(int s) const;   the version a wall event predicted now carries
+//                                               (0 for a surface without mass); stale when the
+//                                               motion has changed since
+//   void push(int s, t, impulse_on_particle);   a contact's impulse moves surface s
+//   double next_layer_change() const;           when a surface next enters another layer of
+//                                               cells (kNever: never)
+//   int change_layer(double t);                 that change made; returns the surface
+//   void for_each_band_cell(s, grid, f) const;  f(cell index) for every cell holding particles
+//                                               that can touch s while it stays in its layer
+//   double energy(int s, double t) const;       its mechanical energy
+//   std::vector<WallMotion> motion() const;     the motions for a restart (face = surface)
+//   void restore(motion, t);                    set from a state at time t
+//   std::vector<WallReading> readings(t) const; what outputs show of each
+template <class C, int D>
+concept MovingBoundary = requires(const C& c, C& moved, int s, double t, const Vec<D>& impulse,
+                                  const CellGrid<D>& grid, const std::vector<WallMotion>& motion,
+                                  void (*visit)(std::uint32_t)) {
+  { c.any_massive() } -> std::convertible_to<bool>;
+  { c.massive(s) } -> std::convertible_to<bool>;
+  { c.event_version(s) } -> std::convertible_to<std::uint32_t>;
+  moved.push(s, t, impulse);
+  { c.next_layer_change() } -> std::convertible_to<double>;
+  { moved.change_layer(t) } -> std::convertible_to<int>;
+  c.for_each_band_cell(s, grid, visit);
+  { c.energy(s, t) } -> std::convertible_to<double>;
+  { c.motion() } -> std::same_as<std::vector<WallMotion>>;
+  moved.restore(motion, t);
+  { c.readings(t) } -> std::same_as<std::vector<WallReading>>;
 };
 
 // Surfaces over a set of components, numbered in the order the components are given. The run's
@@ -227,6 +270,120 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
   void prepare(const CellGrid<D>& grid, double rmax, double particle_volume, bool uniform) {
     for_each([&](auto& c) { c.prepare(grid, rmax, particle_volume, uniform); });
   }
+  bool reaches(int s, CellCode cell, const CellGrid<D>& grid) const {
+    return at(s, [&](const auto& c, int k) { return c.reaches(k, cell, grid); });
+  }
+
+  // Surfaces with a motion of their own (MovingBoundary; none in a component without them).
+  bool any_massive() const {
+    bool any = false;
+    for_each([&](const auto& c) {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>)
+        any = any || c.any_massive();
+    });
+    return any;
+  }
+  bool massive(int s) const {
+    return at(s, [](const auto& c, int k) {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) return c.massive(k);
+      return false;
+    });
+  }
+  std::uint32_t event_version(int s) const {
+    return at(s, [](const auto& c, int k) -> std::uint32_t {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) return c.event_version(k);
+      return 0u;
+    });
+  }
+  void push(int s, double t, const Vec<D>& impulse_on_particle) {
+    at_moving(s, [&](auto& c, int k) { c.push(k, t, impulse_on_particle); });
+  }
+  double next_layer_change() const {
+    double when = kNever;
+    for_each([&](const auto& c) {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>)
+        when = std::min(when, c.next_layer_change());
+    });
+    return when;
+  }
+  // The soonest change of layer made (at its time t); returns its surface.
+  int change_layer(double t) {
+    const double when = next_layer_change();
+    int first = 0, changed = -1;
+    for_each([&](auto& c) {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) {
+        if (changed < 0 && c.next_layer_change() == when) changed = first + c.change_layer(t);
+      }
+      first += c.surfaces();
+    });
+    if (changed < 0) throw std::logic_error("Boundaries::change_layer: no change due");
+    return changed;
+  }
+  template <class F>
+  void for_each_band_cell(int s, const CellGrid<D>& grid, F&& f) const {
+    at(s, [&](const auto& c, int k) {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>)
+        c.for_each_band_cell(k, grid, f);
+    });
+  }
+  double energy(int s, double t) const {
+    return at(s, [&](const auto& c, int k) {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) return c.energy(k, t);
+      return 0.0;
+    });
+  }
+  // The motions of every surface with mass, numbered as the set numbers surfaces.
+  std::vector<WallMotion> motion() const {
+    std::vector<WallMotion> out;
+    int first = 0;
+    for_each([&](const auto& c) {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) {
+        for (WallMotion m : c.motion()) {
+          m.face += static_cast<std::uint32_t>(first);
+          out.push_back(m);
+        }
+      }
+      first += c.surfaces();
+    });
+    return out;
+  }
+  // Each moving component gets the motions of its surfaces (renumbered as its own); a motion
+  // of a surface of no moving component is an InputError.
+  void restore(const std::vector<WallMotion>& motion, double t) {
+    int first = 0;
+    std::size_t taken = 0;
+    for_each([&](auto& c) {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) {
+        std::vector<WallMotion> own;
+        for (WallMotion m : motion) {
+          if (m.face < static_cast<std::uint32_t>(first) ||
+              m.face >= static_cast<std::uint32_t>(first + c.surfaces()))
+            continue;
+          m.face -= static_cast<std::uint32_t>(first);
+          own.push_back(m);
+        }
+        taken += own.size();
+        c.restore(own, t);
+      }
+      first += c.surfaces();
+    });
+    if (taken != motion.size()) {
+      throw InputError(
+          "the state holds the motion of a wall with mass at a surface that "
+          "cannot have one (surface numbers beyond the box's faces)");
+    }
+  }
+  std::vector<WallReading> readings(double t) const {
+    std::vector<WallReading> out;
+    for_each([&](const auto& c) {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) {
+        const std::vector<WallReading> own = c.readings(t);
+        out.insert(out.end(), own.begin(), own.end());
+      }
+    });
+    return out;
+  }
+
   // The error of the component whose surfaces leave no room first (squeeze_time() <= t).
   [[noreturn]] void throw_squeezed(double t, double dmax, bool uniform) const {
     const double when = squeeze_time();
@@ -237,6 +394,20 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
   }
 
  private:
+  // g(component, local surface) for surface s of a moving component (nothing for another).
+  template <class G>
+  void at_moving(int s, G&& g) {
+    int first = 0;
+    bool done = false;
+    for_each([&](auto& c) {
+      if (!done && s >= first && s < first + c.surfaces()) {
+        if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) g(c, s - first);
+        done = true;
+      }
+      first += c.surfaces();
+    });
+  }
+
   template <std::size_t I, class G>
   decltype(auto) dispatch(int s, G&& g) const {
     const auto& c = std::get<I>(components_);

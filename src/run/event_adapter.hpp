@@ -107,14 +107,7 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   }
   double work_by_walls() const override { return engine_.counters().work_by_walls; }
   std::vector<WallReading> walls_with_mass() const override {
-    std::vector<WallReading> out;
-    const FaceWalls<D>& faces = engine_.boundaries().faces();
-    const double t = engine_.time();
-    for (int f = 0; f < 2 * D; ++f)
-      if (faces.is_wall(f) && faces.massive(f))
-        out.push_back(
-            {faces.name(f), faces.position(f, t), faces.body(f).speed_at(t), faces.energy(f, t)});
-    return out;
+    return engine_.boundaries().readings(engine_.time());
   }
   Vec<D> momentum() const override { return engine_.momentum(); }
   double momentum_scale() const override;

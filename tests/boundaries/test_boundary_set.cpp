@@ -19,6 +19,9 @@ static_assert(BoundaryComponent<FaceWalls<2>, 2> && BoundaryComponent<FaceWalls<
 static_assert(BoundaryComponent<PlaneWalls<2>, 2> && BoundaryComponent<PlaneWalls<3>, 3>);
 static_assert(BoundaryComponent<CylinderWalls<2>, 2> && BoundaryComponent<CylinderWalls<3>, 3>);
 static_assert(BoundaryComponent<SphereWalls<2>, 2> && BoundaryComponent<SphereWalls<3>, 3>);
+// The face walls carry the walls with mass; the other geometries have no motion of their own.
+static_assert(MovingBoundary<FaceWalls<2>, 2> && MovingBoundary<FaceWalls<3>, 3>);
+static_assert(!MovingBoundary<PlaneWalls<3>, 3> && !MovingBoundary<CylinderWalls<3>, 3>);
 struct OnlyAnAnyMember {
   bool any() const { return false; }
 };
