@@ -70,6 +70,16 @@ class MassiveWall(kt.KairosTestCase):
         z_measured = pressure / (bulk * temperature)
         self.assertAlmostEqual(z_measured / z_spheres(eta), 1.0, delta=0.012,
                                msg="Z = %.4f at eta = %.4f" % (z_measured, eta))
+        # summary.json's lid: the pressure it imposes, its mean height, and its own degree of
+        # freedom at the gas's temperature (equipartition: M <v^2> = kT; 200 rows, nearly
+        # independent at this spacing, give <v^2> to about 10 %).
+        lid_summary = s["walls_with_mass"][0]
+        self.assertEqual(lid_summary["face"], "z+")
+        self.assertAlmostEqual(lid_summary["pressure"], pressure, delta=1e-12 * pressure)
+        self.assertAlmostEqual(lid_summary["position_mean"], lid.mean(), delta=1e-9)
+        self.assertEqual(lid_summary["samples"], len(production))
+        self.assertAlmostEqual(100.0 * lid_summary["speed_rms"] ** 2 / temperature, 1.0,
+                               delta=0.3)
 
     def test_the_lids_energy_is_minus_its_work(self):
         out = self.path("out")

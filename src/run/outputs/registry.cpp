@@ -22,6 +22,7 @@
 #include "run/outputs/trajectory_output.hpp"
 #include "run/outputs/transport_output.hpp"
 #include "run/outputs/velocity_distribution_output.hpp"
+#include "run/outputs/walls_with_mass_summary.hpp"
 
 namespace kairos {
 
@@ -72,6 +73,7 @@ ObserverList<D> make_observers(const Config& config, const Integrator<D>& integr
     if (engine->kind().granular) add<GranularSummary<D>>(list, *engine);
   }
   if (const DemAdapter<D>* dem = integrator.as_dem()) add<DemSummary<D>>(list, *dem);
+  if (!integrator.walls_with_mass().empty()) add<WallsWithMassSummary<D>>(list);
   return list;
 }
 

@@ -1,0 +1,78 @@
+#include "run/outputs/walls_with_mass_summary.hpp"
+
+#include <cmath>
+
+#include "analysis/block_average.hpp"
+#include "run/outputs/summary_values.hpp"
+
+namespace kairos {
+
+template <int D>
+void WallsWithMassSummary<D>::sample(const RunContext<D>& run) {
+  const std::vector<WallReading> walls = run.integrator().walls_with_mass();
+  if (faces_.empty()) {
+    for (const WallReading& w : walls) faces_.push_back(w.face);
+    positions_.resize(walls.size());
+    speeds_.resize(walls.size());
+  }
+  for (std::size_t k = 0; k < walls.size() && k < faces_.size(); ++k) {
+    positions_[k].push_back(walls[k].position);
+    speeds_[k].push_back(walls[k].speed);
+  }
+}
+
+// The pressure the force imposes: F over the wall's area, the product of the box's edges
+// across its axis (in 2D the one edge).
+template <int D>
+void WallsWithMassSummary<D>::summarize(nlohmann::json& summary, const RunContext<D>& run) const {
+  const std::vector<WallReading> now = run.integrator().walls_with_mass();
+  if (now.empty()) return;
+  const Vec<D>& box = run.integrator().box();
+  nlohmann::json walls = nlohmann::json::array();
+  for (std::size_t k = 0; k < now.size(); ++k) {
+    const std::string& face = now[k].face;
+    const int axis = face[0] - 'x';
+    double area = 1.0;
+    for (int a = 0; a < D; ++a)
+      if (a != axis) area *= box[a];
+    double mass = 0.0, force = 0.0;
+    for (const WallConfig& w : run.config().boundary.walls) {
+      if (w.face == face) {
+        mass = w.mass;
+        force = w.force;
+      }
+    }
+    nlohmann::json j;
+    j["face"] = face;
+    j["mass"] = mass;
+    j["force"] = force;
+    j["pressure"] = force / area;
+    j["position"] = now[k].position;  // at the end
+    j["energy"] = now[k].energy;
+    const std::string key = "walls_with_mass." + face + ".position_mean";
+    if (k < positions_.size() && positions_[k].size() >= 2) {
+      const BlockAverage b = block_average(positions_[k]);
+      j["position_mean"] = b.mean;
+      j["position_stderr"] = b.stderr_;
+      set_error_quality(j, "position_stderr", b);
+      double var = 0.0, v2 = 0.0;
+      for (const double x : positions_[k]) var += (x - b.mean) * (x - b.mean);
+      for (const double v : speeds_[k]) v2 += v * v;
+      j["position_rms"] = std::sqrt(var / static_cast<double>(positions_[k].size()));
+      j["speed_rms"] = std::sqrt(v2 / static_cast<double>(speeds_[k].size()));
+      j["samples"] = positions_[k].size();
+    } else {
+      set_or_explain(summary, j, "position_mean", NAN,
+                     "fewer than 2 production thermo rows to average the wall's position over",
+                     key);
+      j["samples"] = k < positions_.size() ? positions_[k].size() : 0;
+    }
+    walls.push_back(std::move(j));
+  }
+  summary["walls_with_mass"] = std::move(walls);
+}
+
+template class WallsWithMassSummary<2>;
+template class WallsWithMassSummary<3>;
+
+}  // namespace kairos
