@@ -148,6 +148,10 @@ void FaceWalls<D>::restore(const std::vector<WallMotion>& motion, double t) {
                        (f < 2 * D ? name(f) : std::to_string(f)) +
                        " but this run gives that face no mass (boundary.wall.mass)");
     }
+    const auto same_face = [&](const WallMotion& other) { return other.face == m.face; };
+    if (std::count_if(motion.begin(), motion.end(), same_face) > 1) {
+      throw InputError("the state holds two motions of the wall with mass at face " + name(f));
+    }
     WallBody& b = bodies_[f];
     b.time = m.time;
     b.position = m.position;

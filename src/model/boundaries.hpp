@@ -284,7 +284,7 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
     return any;
   }
   bool massive(int s) const {
-    return at(s, [](const auto& c, int k) {
+    return at(s, [](const auto& c, int k) -> bool {
       if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) return c.massive(k);
       return false;
     });
@@ -295,8 +295,11 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
       return 0u;
     });
   }
+  // (Only a surface with mass moves: a push on another is ignored.)
   void push(int s, double t, const Vec<D>& impulse_on_particle) {
-    at_moving(s, [&](auto& c, int k) { c.push(k, t, impulse_on_particle); });
+    at_moving(s, [&](auto& c, int k) {
+      if (c.massive(k)) c.push(k, t, impulse_on_particle);
+    });
   }
   double next_layer_change() const {
     double when = kNever;
@@ -309,6 +312,7 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
   // The soonest change of layer made (at its time t); returns its surface.
   int change_layer(double t) {
     const double when = next_layer_change();
+    if (!(when < kNever)) throw std::logic_error("Boundaries::change_layer: no change due");
     int first = 0, changed = -1;
     for_each([&](auto& c) {
       if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) {
@@ -327,7 +331,7 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
     });
   }
   double energy(int s, double t) const {
-    return at(s, [&](const auto& c, int k) {
+    return at(s, [&](const auto& c, int k) -> double {
       if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) return c.energy(k, t);
       return 0.0;
     });

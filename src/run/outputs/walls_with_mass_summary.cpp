@@ -1,6 +1,7 @@
 #include "run/outputs/walls_with_mass_summary.hpp"
 
 #include <cmath>
+#include <string>
 
 #include "analysis/block_average.hpp"
 #include "run/outputs/summary_values.hpp"
@@ -21,8 +22,9 @@ void WallsWithMassSummary<D>::sample(const RunContext<D>& run) {
   }
 }
 
-// The pressure the force imposes: F over the wall's area, the product of the box's edges
-// across its axis (in 2D the one edge).
+// The pressure the wall holds the particles at: its force plus its weight along its normal
+// (M g_k, + into the box at a low face), over its area, the product of the box's edges across
+// its axis (in 2D the one edge).
 template <int D>
 void WallsWithMassSummary<D>::summarize(nlohmann::json& summary, const RunContext<D>& run) const {
   const std::vector<WallReading> now = run.integrator().walls_with_mass();
@@ -46,10 +48,13 @@ void WallsWithMassSummary<D>::summarize(nlohmann::json& summary, const RunContex
     j["face"] = face;
     j["mass"] = mass;
     j["force"] = force;
-    j["pressure"] = force / area;
+    const double inward = face[1] == '-' ? 1.0 : -1.0;
+    const std::vector<double>& field = run.config().field.gravity;
+    const double gravity = axis < static_cast<int>(field.size()) ? field[axis] : 0.0;
+    j["pressure"] = (force + inward * mass * gravity) / area;
     j["position"] = now[k].position;  // at the end
     j["energy"] = now[k].energy;
-    const std::string key = "walls_with_mass." + face + ".position_mean";
+    const std::string key = "walls_with_mass[" + std::to_string(k) + "].position_mean";
     if (k < positions_.size() && positions_[k].size() >= 2) {
       const BlockAverage b = block_average(positions_[k]);
       j["position_mean"] = b.mean;
