@@ -1,6 +1,8 @@
 // Small hand-built systems for engine tests (independent of the initial-state module).
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <random>
 
@@ -73,6 +75,19 @@ Environment<D> gravity_container(double e, double tc = 0.0, std::uint32_t specie
   }
   env.faces[2 * D - 1].kind = FaceKind::kOpen;
   return env;
+}
+
+// Steps an engine and the one resumed from its exported state `events` times each, then
+// expects both at the same time with the same positions and velocities, to the bit.
+template <class Engine>
+void expect_same_continuation(Engine& first, Engine& resumed, int events) {
+  for (int k = 0; k < events; ++k) {
+    first.step();
+    resumed.step();
+  }
+  EXPECT_EQ(resumed.time(), first.time());
+  EXPECT_EQ(resumed.current_positions(), first.current_positions());
+  EXPECT_EQ(resumed.current_velocities(), first.current_velocities());
 }
 
 }  // namespace kairos::testing

@@ -140,13 +140,7 @@ TEST(FixedGrains, ResumeContinuesBitForBit) {
   for (int k = 0; k < 3000; ++k) first.step();
   Engine<D> resumed(first.export_state(), StartMode::kResume, EngineOptions{}, env);
   EXPECT_EQ(resumed.fixed_grains(), first.fixed_grains());
-  for (int k = 0; k < 3000; ++k) {
-    first.step();
-    resumed.step();
-  }
-  EXPECT_EQ(resumed.time(), first.time());
-  EXPECT_EQ(resumed.current_positions(), first.current_positions());
-  EXPECT_EQ(resumed.current_velocities(), first.current_velocities());
+  testing::expect_same_continuation(first, resumed, 3000);
 }
 
 // Grains (diameter 1) dropped from a loose lattice onto a floor of fixed grains spaced 1/15 of

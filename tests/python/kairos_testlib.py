@@ -246,6 +246,21 @@ class KairosTestCase(unittest.TestCase):
         self.run_ok("run", full, "-o", whole)
         return first, second, whole
 
+    def assert_split_ends_as_whole(self, half, full, chunks=()):
+        """run_split_and_whole, then the continued run's restart file must hold the uninterrupted
+        one's exact state (EXACT_CHUNKS and the further restart `chunks`) to the bit; returns
+        the two output directories (second, whole)."""
+        _, second, whole = self.run_split_and_whole(half, full)
+        a = read_exact_state(os.path.join(second, "restart.gsd"))
+        b = read_exact_state(os.path.join(whole, "restart.gsd"))
+        for name in a:
+            np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+        for name in chunks:
+            np.testing.assert_array_equal(restart_chunk(os.path.join(second, "restart.gsd"), name),
+                                          restart_chunk(os.path.join(whole, "restart.gsd"), name),
+                                          err_msg=name)
+        return second, whole
+
     def summary(self, outdir):
         with open(os.path.join(outdir, "summary.json")) as f:
             return json.load(f)

@@ -100,16 +100,10 @@ class MassiveWall(kt.KairosTestCase):
     def test_a_restart_continues_bit_for_bit(self):
         half = lid_config(run={"time": 20.0})
         full = lid_config()
-        _, second, whole = self.run_split_and_whole(half, full)
-        a, b = kt.read_exact_state(os.path.join(second, "restart.gsd")), \
-            kt.read_exact_state(os.path.join(whole, "restart.gsd"))
-        for key in a:
-            np.testing.assert_array_equal(a[key], b[key], err_msg=key)
-        motion = [kt.restart_chunk(os.path.join(d, "restart.gsd"), "kairos/state/wall_motion")
-                  for d in (second, whole)]
-        np.testing.assert_array_equal(motion[0], motion[1])
-        self.assertEqual(motion[0].shape, (1, 7))  # docs/outputs.md
-        self.assertEqual(motion[0][0][0], 5.0)  # the face z+
+        second, _ = self.assert_split_ends_as_whole(half, full, ["kairos/state/wall_motion"])
+        motion = kt.restart_chunk(os.path.join(second, "restart.gsd"), "kairos/state/wall_motion")
+        self.assertEqual(motion.shape, (1, 7))  # docs/outputs.md
+        self.assertEqual(motion[0][0], 5.0)  # the face z+
 
     def test_a_restart_may_change_the_force_but_not_add_a_mass(self):
         first = self.path("first")
