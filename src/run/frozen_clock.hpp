@@ -218,8 +218,9 @@ std::string cause(const Environment<D>& env, const Boundaries<D>& boundaries,
         pistons);
   }
   if (wall_hits > pair_hits && !walls.empty()) {
-    std::string sticky, resting, dragging;
+    std::string sticky, resting, dragging, massive;
     for (const int s : walls) {
+      if (boundaries.massive(s)) massive += (massive.empty() ? "" : ", ") + boundaries.name(s);
       if (boundaries.contact(s).normal(0.0) == 0.0)
         sticky += (sticky.empty() ? "" : ", ") + boundaries.name(s);
       else if (!boundaries.accelerates(s) && !boundaries.holds_still(s))
@@ -233,6 +234,15 @@ std::string cause(const Environment<D>& env, const Boundaries<D>& boundaries,
           "is met again at once (no contact law, TC model or sleeping undoes that); give it a "
           "restitution above 0 (boundary.wall restitution)",
           sticky);
+    }
+    if (!massive.empty()) {
+      return fmt::format(
+          "grains pressed against the wall with mass {} are met again and again (an inelastic "
+          "collapse against it, or grains coming to rest on it: sleeping is off with a moving "
+          "wall); the TC model (contact.tc) or elastic slow impacts (the wall's "
+          "elastic_below_speed) undo a collapse, but grains cannot rest on a wall with mass for "
+          "long: keep them moving (a gas, driving) or the wall's load light",
+          massive);
     }
     if (!dragging.empty() && env.has_gravity()) {
       return fmt::format(

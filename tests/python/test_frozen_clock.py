@@ -72,6 +72,20 @@ class FrozenClock(kt.KairosTestCase):
         self.run_ok("run", self.write_config(pile(-1.0), "sleep.toml"), "-o", out)
         self.assertIn(self.summary(out)["stop_reason"], ("completed", "no_more_events"))
 
+    def test_grains_pressed_by_a_falling_heavy_lid(self):
+        # A lid of mass 0.7 pushed down (force 2, falling faster than the grains) onto grains on
+        # a floor of mass 3 pushed up (force 5, more than its weight): the grains collapse
+        # inelastically against the lid, which sleeping (off with a moving wall) cannot stop.
+        config = kt.base_config(dimension=2, particles=60, packing_fraction=0.2,
+                                lattice="random", seed=11, production=10000.0)
+        config["contact"] = {"restitution": 0.95, "tangential_restitution": 0.3}
+        config["field"] = {"gravity": [0.0, -1.0]}
+        config["boundary"] = {"wall": [{"face": "x-"}, {"face": "x+"},
+                                       {"face": "y-", "mass": 3.0, "force": 5.0},
+                                       {"face": "y+", "mass": 0.7, "force": 2.0}]}
+        line, _ = self.frozen_run(config, "wall with mass y+", "contact.tc")
+        self.assertNotIn("fixed wall", line)
+
     def test_inelastic_collapse_in_a_2d_gas(self):
         # Restitution 0.1 without the TC model: clusters collapse, the clock crawls a few ulps
         # per event (it used to "complete" 6000 collisions per particle at a crawling clock).
