@@ -20,7 +20,7 @@ an elastic hard-sphere (hard-disk) gas. Two checks (docs/validation.md "Walls wi
 
     python3 examples/validation/massive_piston.py build/kairos [seeds]
 
-About 10 minutes on one core for 2 seeds.
+About 15 minutes on one core for 2 seeds.
 """
 
 import math
