@@ -386,6 +386,19 @@ class PySimulation {
   double potential_energy() const {
     return visit([](const auto& s) { return s.potential_energy(); });
   }
+  py::list walls_with_mass() const {
+    const std::vector<WallReading> walls = visit([](const auto& s) { return s.walls_with_mass(); });
+    py::list out;
+    for (const WallReading& w : walls) {
+      py::dict d;
+      d["face"] = w.face;
+      d["position"] = w.position;
+      d["speed"] = w.speed;
+      d["energy"] = w.energy;
+      out.append(d);
+    }
+    return out;
+  }
   bool tracks_images() const {
     return visit([](const auto& s) { return s.tracks_images(); });
   }
@@ -1003,6 +1016,9 @@ PYBIND11_MODULE(kairos, m) {
            "velocities relative to the flow.")
       .def("potential_energy", &PySimulation::potential_energy,
            "Of the stepped potentials, or the elastic energy of soft contacts in progress.")
+      .def("walls_with_mass", &PySimulation::walls_with_mass,
+           "The walls with mass now (boundary.wall.mass): one dict each, face, position (of its "
+           "plane along its axis), speed and energy, as thermo.tsv's columns.")
       .def("__repr__", &PySimulation::repr)
       .def("save", &PySimulation::save, py::arg("path"),
            "Writes a restart file (atomically) that `kairos run --restart` continues.")

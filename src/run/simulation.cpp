@@ -180,6 +180,11 @@ std::vector<Vec<D>> Simulation<D>::velocities() const {
   return engine_->engine().current_velocities();
 }
 template <int D>
+std::vector<WallReading> Simulation<D>::walls_with_mass() const {
+  return engine_->walls_with_mass();
+}
+
+template <int D>
 double Simulation<D>::kinetic_energy() const {
   return engine_->engine().kinetic_energy();
 }

@@ -79,6 +79,8 @@ class Simulation {
   double temperature() const;
   // Of the stepped potentials, or the elastic energy of soft contacts in progress.
   double potential_energy() const;
+  // The walls with mass now (boundaries/wall_body.hpp): face, position, speed, energy.
+  std::vector<WallReading> walls_with_mass() const;
   // The complete state (what a restart file holds).
   ParticleSystem<D> state() const;
 

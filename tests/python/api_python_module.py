@@ -123,6 +123,25 @@ class Module(kt.KairosTestCase):
         self.assertEqual(again.time, 1.0)
         self.assertTrue(np.array_equal(again.positions(), sim.positions()))
 
+    def test_a_lid_with_mass_as_the_cli_has_it(self):
+        # A free piston (docs/config.md): the module's walls_with_mass() at the end is the
+        # CLI's last thermo.tsv row, and the lid came down onto the gas.
+        config = hard_config(time=4.0)
+        config["system"]["packing_fraction"] = 0.2
+        config["boundary"] = {"wall": [{"face": "z-"},
+                                       {"face": "z+", "mass": 10.0, "force": 200.0}]}
+        config["output"].update({"interval_unit": "time", "thermo_interval": 4.0})
+        sim, _ = self.cli_and_module_agree(config, 4.0)
+        out = self.path("cli-%d" % self.runs)
+        walls = sim.walls_with_mass()
+        self.assertEqual([w["face"] for w in walls], ["z+"])
+        header, rows, _ = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        for key in ("position", "speed", "energy"):
+            self.assertEqual(walls[0][key], rows[-1][header.index("wall_z+_" + key)], key)
+        self.assertLess(walls[0]["position"], sim.box[2] - 0.5)
+        self.assertEqual(kairos.Simulation(self.write_config(hard_config(), "plain.toml"))
+                         .walls_with_mass(), [])
+
     def test_arrays_obey_the_physics(self):
         sim = kairos.Simulation(self.write_config(hard_config()))
         box = sim.box
