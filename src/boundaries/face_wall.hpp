@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 #include "core/vec.hpp"
 #include "interactions/granular_contact.hpp"
@@ -36,6 +37,11 @@ struct Wall {
   double force = 0.0;
   bool vibrates() const { return amplitude > 0.0 && angular_frequency > 0.0; }
   bool massive() const { return mass > 0.0; }
+  // What pushes a wall with mass at `face` into the box: its force plus its weight along its
+  // normal (the field g on M). At rest on average it holds the particles at this over its area.
+  double inward_push(int face, const Vec<D>& gravity) const {
+    return force + (face % 2 == 0 ? 1.0 : -1.0) * mass * gravity[face / 2];
+  }
   // Whether the plane moves (a normal velocity, a vibration, or a mass) as the wall of `face`.
   bool plane_moves(int face) const { return velocity[face / 2] != 0.0 || vibrates() || massive(); }
 
@@ -67,18 +73,20 @@ struct Face {
   Wall<D> wall;  // used when kind == kWall
 };
 
-// A particle (velocity v, spin w, updated in place) meets a surface of infinite mass with unit
-// normal n (towards the particle) moving at wall_velocity at the contact: every geometry's
-// response (resolve_wall_contact with the surface's law).
+// A particle (velocity v, spin w, updated in place) meets a surface with unit normal n
+// (towards the particle) moving at wall_velocity at the contact: every geometry's response
+// (resolve_wall_contact with the surface's law). The surface has infinite mass unless given
+// `wall_mass` (a wall with mass recoils along n).
 template <int D>
-ContactResult<D> resolve_surface_contact(const ContactModel& law, const Vec<D>& normal,
-                                         const Vec<D>& wall_velocity, double mass, double radius,
-                                         double inertia_factor, bool force_elastic, Vec<D>& v,
-                                         Spin<D>& w) {
+ContactResult<D> resolve_surface_contact(
+    const ContactModel& law, const Vec<D>& normal, const Vec<D>& wall_velocity, double mass,
+    double radius, double inertia_factor, bool force_elastic, Vec<D>& v, Spin<D>& w,
+    double wall_mass = std::numeric_limits<double>::infinity()) {
   WallContactInput<D> in;
   in.normal = normal;
   in.wall_velocity = wall_velocity;
   in.mass = mass;
+  in.wall_mass = wall_mass;
   in.radius = radius;
   in.inertia_factor = inertia_factor;
   in.force_elastic = force_elastic;

@@ -95,23 +95,13 @@ bool FaceWalls<D>::reaches(int f, CellCode c, const CellGrid<D>& grid) const {
 }
 
 template <int D>
-ContactResult<D> FaceWalls<D>::resolve(int f, const Vec<D>& /*x*/, double t, double mass,
-                                       double radius, double inertia_factor, bool force_elastic,
-                                       Vec<D>& v, Spin<D>& w) const {
+ContactResult<D> FaceWalls<D>::resolve(int f, const Vec<D>& x, double t, double mass, double radius,
+                                       double inertia_factor, bool force_elastic, Vec<D>& v,
+                                       Spin<D>& w) const {
   const Wall<D>& wall = faces_[f].wall;
-  if (wall.massive()) [[unlikely]] {
-    WallContactInput<D> in;
-    in.normal = face_normal<D>(f);
-    in.wall_velocity = velocity(f, Vec<D>{}, t);
-    in.mass = mass;
-    in.wall_mass = wall.mass;
-    in.radius = radius;
-    in.inertia_factor = inertia_factor;
-    in.force_elastic = force_elastic;
-    return resolve_wall_contact(wall.contact, in, v, w);
-  }
-  return resolve_surface_contact<D>(wall.contact, face_normal<D>(f), wall.surface_velocity(f, t),
-                                    mass, radius, inertia_factor, force_elastic, v, w);
+  return resolve_surface_contact<D>(wall.contact, face_normal<D>(f), velocity(f, x, t), mass,
+                                    radius, inertia_factor, force_elastic, v, w,
+                                    wall.massive() ? wall.mass : kNever);
 }
 
 template <int D>

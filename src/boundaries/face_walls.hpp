@@ -148,9 +148,15 @@ class FaceWalls {
   // What the outputs show of each wall with mass at time t (WallReading), faces in order.
   std::vector<WallReading> readings(double t) const {
     std::vector<WallReading> out;
-    for (int f = 0; f < 2 * D; ++f)
-      if (is_wall(f) && massive(f))
-        out.push_back({name(f), position(f, t), bodies_[f].speed_at(t), energy(f, t)});
+    for (int f = 0; f < 2 * D; ++f) {
+      if (!is_wall(f) || !massive(f)) continue;
+      const Wall<D>& w = faces_[f].wall;
+      double area = 1.0;
+      for (int a = 0; a < D; ++a)
+        if (a != f / 2) area *= box_[a];
+      out.push_back({name(f), position(f, t), bodies_[f].speed_at(t), energy(f, t), w.mass, w.force,
+                     w.inward_push(f, gravity_) / area});
+    }
     return out;
   }
   // The mechanical energy of wall f with mass: M v^2 / 2 less the work of its constant force

@@ -6,9 +6,9 @@
 // the axis (n_a = +1 at a low face, -1 at a high one), so a particle's contact with it solves a
 // quadratic, as with a fixed plane. At a contact the particle's impulse J changes the wall's
 // velocity by -J_a / M, and the wall's motion is set afresh from that instant: every wall event
-// predicted before is stale (`version`), and the engine looks again at the particles the wall
-// can reach (EventEngine::wall_moved). The motion is part of the state (WallMotion in restart
-// files): a continued run is bit-identical.
+// predicted before is stale (`version`); as the impulse pushes the wall away from the
+// particles, no other contact comes earlier (docs/physics.md#walls-with-mass). The motion is
+// part of the state (WallMotion in restart files): a continued run is bit-identical.
 #pragma once
 
 #include <cstdint>
@@ -51,12 +51,17 @@ struct WallBody {
 };
 
 // What outputs read of a wall with mass at some time: its face's name ("z+"), where its plane
-// is along its axis, its speed along the axis, and its mechanical energy (FaceWalls::energy).
+// is along its axis, its speed along the axis, its mechanical energy (FaceWalls::energy), its
+// mass and force, and the pressure it holds the particles at on average (Wall::inward_push over
+// its area).
 struct WallReading {
   std::string face;
   double position = 0.0;
   double speed = 0.0;
   double energy = 0.0;
+  double mass = 0.0;
+  double force = 0.0;
+  double pressure = 0.0;
 };
 
 }  // namespace kairos

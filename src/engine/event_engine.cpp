@@ -845,11 +845,13 @@ EventKind EventEngine<D, Queue>::step() {
     shift_images();
     return EventKind::kImageShift;
   }
-  // (A lid that never changes layer again has kNever: no event, whatever the queue holds.)
-  if (massive_walls_ && boundaries_.next_layer_change() < kNever &&
-      boundaries_.next_layer_change() <= queue_.top_time()) [[unlikely]] {
-    change_wall_layer();
-    return EventKind::kWallLayer;
+  if (massive_walls_) [[unlikely]] {
+    // (A lid that never changes layer again has kNever: no event, whatever the queue holds.)
+    const double change = boundaries_.next_layer_change();
+    if (change < kNever && change <= queue_.top_time()) {
+      change_wall_layer(change);
+      return EventKind::kWallLayer;
+    }
   }
   const std::uint32_t i = queue_.top();
   const double t = queue_.top_time();

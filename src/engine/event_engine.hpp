@@ -296,16 +296,15 @@ class EventEngine {
   std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
   void hit_wall(std::uint32_t i, int surface, double t);
   // Walls with mass (boundaries/wall_body.hpp): a wall event predicted before the wall's
-  // motion last changed is stale; after a change (a contact, or the plane in a new layer of
-  // cells) every particle the wall can reach gets the contact as its event if it now comes
-  // first.
+  // motion last changed is stale; when the plane enters a new layer of cells, every particle
+  // it can now reach gets the contact as its event if that comes first (wall_moved).
   bool stale_wall_event(const PendingEvent& e) const {
     const int f = e.code.wall_face();
     return boundaries_.massive(f) && e.partner_count != boundaries_.event_version(f);
   }
   void wall_moved(int surface, double t);
   void check_massive_walls(const ParticleSystem<D>& s, StartMode mode) const;
-  void change_wall_layer();
+  void change_wall_layer(double t);  // the next change, due at t
   // Walls moving towards each other left no room for the particles (FaceWalls::squeeze_time).
   [[noreturn]] void throw_squeezed(double t) const;
   // Sleeping particles (gravity with walls): see Environment::sleep_speed.

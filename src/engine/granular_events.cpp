@@ -231,8 +231,7 @@ void EventEngine<D, Queue>::wall_moved(int surface, double t) {
 }
 
 template <int D, class Queue>
-void EventEngine<D, Queue>::change_wall_layer() {
-  const double t = boundaries_.next_layer_change();
+void EventEngine<D, Queue>::change_wall_layer(double t) {
   time_ = t;
   wall_moved(boundaries_.change_layer(t), t);
 }

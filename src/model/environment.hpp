@@ -126,12 +126,6 @@ struct Environment {
   bool wall_moves(int f) const {
     return faces[f].kind == FaceKind::kWall && faces[f].wall.plane_moves(f);
   }
-  // Where the plane of wall face f lies along its axis at time t (box: the box's edges): the
-  // plane of boundaries/face_wall.hpp (the frozen-clock watch reads walls through this; the
-  // event engine through its boundary components).
-  double wall_position(int f, const Vec<D>& box, double t) const {
-    return faces[f].wall.plane_position(f, box, t);
-  }
   // Some face is a wall, or some plane wall is given.
   bool has_walls() const {
     for (const Face<D>& f : faces)

@@ -11,47 +11,27 @@ namespace kairos {
 template <int D>
 void WallsWithMassSummary<D>::sample(const RunContext<D>& run) {
   const std::vector<WallReading> walls = run.integrator().walls_with_mass();
-  if (faces_.empty()) {
-    for (const WallReading& w : walls) faces_.push_back(w.face);
+  if (positions_.empty()) {
     positions_.resize(walls.size());
     speeds_.resize(walls.size());
   }
-  for (std::size_t k = 0; k < walls.size() && k < faces_.size(); ++k) {
+  for (std::size_t k = 0; k < walls.size() && k < positions_.size(); ++k) {
     positions_[k].push_back(walls[k].position);
     speeds_[k].push_back(walls[k].speed);
   }
 }
 
-// The pressure the wall holds the particles at: its force plus its weight along its normal
-// (M g_k, + into the box at a low face), over its area, the product of the box's edges across
-// its axis (in 2D the one edge).
 template <int D>
 void WallsWithMassSummary<D>::summarize(nlohmann::json& summary, const RunContext<D>& run) const {
   const std::vector<WallReading> now = run.integrator().walls_with_mass();
   if (now.empty()) return;
-  const Vec<D>& box = run.integrator().box();
   nlohmann::json walls = nlohmann::json::array();
   for (std::size_t k = 0; k < now.size(); ++k) {
-    const std::string& face = now[k].face;
-    const int axis = face[0] - 'x';
-    double area = 1.0;
-    for (int a = 0; a < D; ++a)
-      if (a != axis) area *= box[a];
-    double mass = 0.0, force = 0.0;
-    for (const WallConfig& w : run.config().boundary.walls) {
-      if (w.face == face) {
-        mass = w.mass;
-        force = w.force;
-      }
-    }
     nlohmann::json j;
-    j["face"] = face;
-    j["mass"] = mass;
-    j["force"] = force;
-    const double inward = face[1] == '-' ? 1.0 : -1.0;
-    const std::vector<double>& field = run.config().field.gravity;
-    const double gravity = axis < static_cast<int>(field.size()) ? field[axis] : 0.0;
-    j["pressure"] = (force + inward * mass * gravity) / area;
+    j["face"] = now[k].face;
+    j["mass"] = now[k].mass;
+    j["force"] = now[k].force;
+    j["pressure"] = now[k].pressure;
     j["position"] = now[k].position;  // at the end
     j["energy"] = now[k].energy;
     const std::string key = "walls_with_mass[" + std::to_string(k) + "].position_mean";

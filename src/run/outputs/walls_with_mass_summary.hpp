@@ -21,7 +21,6 @@ class WallsWithMassSummary final : public Observer<D> {
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 
  private:
-  std::vector<std::string> faces_;
   std::vector<std::vector<double>> positions_, speeds_;  // per wall, per row
 };
 
