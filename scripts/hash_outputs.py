@@ -46,7 +46,9 @@ SMALLER = {"granular_clustering_2d.toml": ["system.particles=20000"],
            "lorentz_gas_3d.toml": ["system.particles=8300", "run.equilibration_time=0",
                                    "run.time=100"],
            # Measured in time (the lid's motion).
-           "free_piston_3d.toml": ["run.equilibration_time=1", "run.time=4"]}
+           "free_piston_3d.toml": ["run.equilibration_time=1", "run.time=4"],
+           # Measured in time (the container's swing).
+           "spring_damper_3d.toml": ["run.equilibration_time=1", "run.time=4"]}
 # Restart chunks that are the run's bookkeeping rather than its state: the run's id, the stored
 # configuration (it names the output directory), the checksum over both.
 RESTART_SKIPPED = ["kairos/run/id", "kairos/run/config", "kairos/checksum"]
@@ -107,6 +109,10 @@ EXTRA = [
     # A wall with mass (its motion travels in the restart file), continued.
     ("continued_free_piston", "examples/free_piston_3d.toml", None,
      ["run.equilibration_time=1", "run.time=3"], ["run.time=2"]),
+    # A container on a spring (its motion and its spring travel in the restart file),
+    # continued with another drive frequency.
+    ("continued_spring_damper", "examples/spring_damper_3d.toml", None,
+     ["run.equilibration_time=1", "run.time=3"], ["run.time=2", "boundary.container.drive_frequency=0.6"]),
     # Soft spheres against walls (a fixed floor, a slow piston; the map's wall contact),
     # continued.
     ("continued_soft_walls", None, SOFT_WALLS, [], []),

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 
+#include "boundaries/wall_spring.hpp"
 #include "core/vec.hpp"
 #include "interactions/granular_contact.hpp"
 
@@ -35,6 +36,11 @@ struct Wall {
   // below does not describe it (FaceWalls::position does).
   double mass = 0.0;
   double force = 0.0;
+  // A wall with mass tied to a moving anchor by a spring and a dashpot (boundaries/
+  // wall_spring.hpp), and whether it is joined to the wall on the other face of its axis as
+  // one body, a container (both then have the same mass and spring).
+  WallSpring spring{};
+  bool joined = false;
   bool vibrates() const { return amplitude > 0.0 && angular_frequency > 0.0; }
   bool massive() const { return mass > 0.0; }
   // What pushes a wall with mass at `face` into the box: its force plus its weight along its

@@ -10,6 +10,9 @@
 
 namespace kairos {
 
+// The horizon of a spring's layer search, in periods of its fastest motion.
+constexpr double kSpringSearchPeriods = 4.0;
+
 template <int D>
 FaceWalls<D>::FaceWalls(const std::array<Face<D>, 2 * D>& faces, const Vec<D>& box,
                         const Vec<D>& gravity)
@@ -24,11 +27,22 @@ FaceWalls<D>::FaceWalls(const std::array<Face<D>, 2 * D>& faces, const Vec<D>& b
     const double sgn = f % 2 == 0 ? 1.0 : -1.0;
     bodies_[f].mass = w.mass;
     bodies_[f].accel = sgn * w.force / w.mass + gravity_[f / 2];
+    bodies_[f].rest = rest_position(f);
     bodies_[f].position = rest_position(f);
     if (!std::isfinite(bodies_[f].accel)) {
       throw InputError("boundary.wall (" + name(f) + "): the force over the mass, " +
                        std::to_string(w.force) + " / " + std::to_string(w.mass) +
                        ", is not a finite acceleration");
+    }
+    if (w.spring.on()) {
+      bodies_[f].spring = SpringMotion(w.spring, w.mass, bodies_[f].accel);
+      bodies_[f].set(0.0, bodies_[f].rest, 0.0);
+    }
+    if (w.joined && !(faces_[f ^ 1].kind == FaceKind::kWall && faces_[f ^ 1].wall.joined &&
+                      faces_[f ^ 1].wall.mass == w.mass && faces_[f ^ 1].wall.spring == w.spring)) {
+      throw InputError("boundary.container: the walls " + name(f & ~1) + " and " + name(f | 1) +
+                       " are joined as one body but differ (both must be walls of the same "
+                       "mass and spring)");
     }
   }
 }
@@ -45,9 +59,11 @@ double FaceWalls<D>::event_time(int face, const Vec<D>& x, const Vec<D>& v, doub
   const double sgn = face % 2 == 0 ? 1.0 : -1.0;
   const NormalMotion m{sgn * x[a] - radius, sgn * v[a], sgn * gravity_[a]};
   if (w.massive()) [[unlikely]] {
+    const WallBody& b = bodies_[face];
+    // On a spring: the certified search against the driven oscillator's path.
+    if (b.sprung()) return oscillating_plane_event_time(m, b.plane(t, sgn), horizon);
     // The gap between the particle's lowest point and the plane, both on parabolas: a
     // quadratic in the time from t.
-    const WallBody& b = bodies_[face];
     return within_horizon(
         quadratic_event_time(m.height - sgn * b.position_at(t), m.velocity - sgn * b.speed_at(t),
                              0.5 * (m.accel - sgn * b.accel)),
@@ -125,9 +141,8 @@ template <int D>
 void FaceWalls<D>::restore(const std::vector<WallMotion>& motion, double t) {
   for (int f = 0; f < 2 * D; ++f) {
     if (!massive(f)) continue;
-    bodies_[f].time = t;
-    bodies_[f].position = rest_position(f);
-    bodies_[f].speed = 0.0;
+    bodies_[f].set(t, rest_position(f), 0.0);
+    bodies_[f].work = {};
     bodies_[f].version = 0;
     layer_[f] = layer_of(f, bodies_[f].position);
   }
@@ -143,17 +158,27 @@ void FaceWalls<D>::restore(const std::vector<WallMotion>& motion, double t) {
       throw InputError("the state holds two motions of the wall with mass at face " + name(f));
     }
     WallBody& b = bodies_[f];
-    b.time = m.time;
-    b.position = m.position;
-    b.speed = m.speed;
+    // The motion the state was made with (its acceleration, and spring if any).
+    WallBody before = b;
+    before.accel = m.accel;
+    before.spring =
+        m.sprung() ? SpringMotion({m.spring[1], m.spring[2], m.spring[3], m.spring[4], m.spring[5]},
+                                  m.spring[0], m.accel)
+                   : SpringMotion{};
+    before.set(m.time, m.position, m.speed);
+    before.work = {m.drive_work, m.dashpot};
     b.version = m.version;
-    if (m.accel != b.accel) {
-      // Another force, mass or field from now on: the wall moved with the state's own up to
-      // its time t, and moves on from there (wall events predicted before are stale).
-      const WallBody before{b.mass, m.accel, m.time, m.position, m.speed, m.version};
-      b.position = before.position_at(t);
-      b.speed = before.speed_at(t);
-      b.time = t;
+    b.work = before.work;
+    const bool same =
+        m.accel == b.accel && m.sprung() == b.sprung() &&
+        (!b.sprung() || (m.spring[0] == b.mass && before.spring.spring() == b.spring.spring()));
+    if (same) {
+      b.set(m.time, m.position, m.speed);
+    } else {
+      // Another force, mass, field or spring from now on: the wall moved with the state's own
+      // up to its time t, and moves on from there (wall events predicted before are stale).
+      b.work = before.work_at(t);
+      b.set(t, before.position_at(t), before.speed_at(t));
       ++b.version;
     }
     if (!std::isfinite(b.position_at(t)) || !std::isfinite(b.speed)) {
@@ -180,6 +205,7 @@ std::vector<WallMotion> FaceWalls<D>::motion() const {
 template <int D>
 void FaceWalls<D>::push(int f, double t, const Vec<D>& impulse_on_particle) {
   bodies_[f].kick(t, -impulse_on_particle[f / 2]);
+  if (faces_[f].wall.joined) bodies_[f ^ 1].kick(t, -impulse_on_particle[f / 2]);
   find_next_change(t);
 }
 
@@ -190,17 +216,36 @@ template <int D>
 void FaceWalls<D>::find_next_change(double t) {
   next_change_ = kNever;
   next_change_face_ = -1;
+  next_change_recheck_ = false;
   for (int f = 0; f < 2 * D; ++f) {
     if (!massive(f)) continue;
     const int a = f / 2;
     const WallBody& b = bodies_[f];
     const double lo = layer_[f] == 0 ? -kNever : layer_[f] * widths_[a];
     const double hi = layer_[f] == cells_along_[a] - 1 ? kNever : (layer_[f] + 1) * widths_[a];
-    const double when =
-        t + interval_exit_time_accelerated(b.position_at(t), b.speed_at(t), b.accel, lo, hi);
+    bool recheck = false;
+    double when = kNever;
+    if (b.sprung()) [[unlikely]] {
+      // The first time the oscillator's path reaches either face of the layer, searched up to a
+      // horizon of a few periods (the search's cost grows with the periods it covers); if
+      // none, the search is made again then.
+      const double horizon =
+          kSpringSearchPeriods * 2.0 * M_PI / std::max(b.spring.wd(), b.spring.spring().omega);
+      double dt = kNever;
+      if (hi < kNever) dt = oscillating_plane_event_time({hi, 0.0, 0.0}, b.plane(t, 1.0), horizon);
+      if (lo > -kNever) {
+        dt = std::min(dt, oscillating_plane_event_time({-lo, 0.0, 0.0}, b.plane(t, -1.0),
+                                                       std::min(dt, horizon)));
+      }
+      recheck = !(dt < kNever);
+      when = t + (recheck ? horizon : dt);
+    } else {
+      when = t + interval_exit_time_accelerated(b.position_at(t), b.speed_at(t), b.accel, lo, hi);
+    }
     if (when < next_change_) {
       next_change_ = when;
       next_change_face_ = f;
+      next_change_recheck_ = recheck;
     }
   }
 }
@@ -208,6 +253,10 @@ void FaceWalls<D>::find_next_change(double t) {
 template <int D>
 int FaceWalls<D>::change_layer(double t) {
   const int f = next_change_face_;
+  if (next_change_recheck_) {
+    find_next_change(t);
+    return -1;
+  }
   const int a = f / 2;
   const double x = bodies_[f].position_at(t);
   const double lo = layer_[f] * widths_[a];
@@ -217,6 +266,34 @@ int FaceWalls<D>::change_layer(double t) {
                          cells_along_[a] - 1);
   find_next_change(t);
   return f;
+}
+
+template <int D>
+std::vector<WallReading> FaceWalls<D>::readings(double t) const {
+  std::vector<WallReading> out;
+  for (int f = 0; f < 2 * D; ++f) {
+    if (!is_wall(f) || !massive(f)) continue;
+    const Wall<D>& w = faces_[f].wall;
+    if (w.joined && f % 2 == 1) continue;  // the container, read at its low wall
+    double area = 1.0;
+    for (int a = 0; a < D; ++a)
+      if (a != f / 2) area *= box_[a];
+    const WallBody& b = bodies_[f];
+    WallReading r{w.joined ? std::string(1, "xyz"[f / 2]) : name(f),
+                  position(f, t),
+                  b.speed_at(t),
+                  energy(f, t),
+                  w.mass,
+                  w.force,
+                  w.joined ? 0.0 : w.inward_push(f, gravity_) / area};
+    r.sprung = b.sprung();
+    r.container = w.joined;
+    const SpringWork work = b.work_at(t);
+    r.drive_work = work.drive;
+    r.dashpot = work.dashpot;
+    out.push_back(r);
+  }
+  return out;
 }
 
 template <int D>

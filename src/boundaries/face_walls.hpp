@@ -117,10 +117,21 @@ class FaceWalls {
   // finite. Call after prepare().
   void restore(const std::vector<WallMotion>& motion, double t);
   std::vector<WallMotion> motion() const;
-  // The impulse a contact gave the particle (ContactResult::impulse) at time t moves wall f.
+  // The impulse a contact gave the particle (ContactResult::impulse) at time t moves wall f
+  // (and the other wall of a container with it).
   void push(int f, double t, const Vec<D>& impulse_on_particle);
+  // visit(s) for each wall whose plane a push on wall f may have brought nearer the particles
+  // at some later time, so that particles near it must be looked at again: none for a free
+  // lid (the push moves it away at every later time), the wall itself on a spring (which
+  // brings it back), the other wall of a container.
+  template <class F>
+  void for_each_disturbed(int f, F&& visit) const {
+    if (bodies_[f].sprung()) visit(f);
+    if (faces_[f].wall.joined) visit(f ^ 1);
+  }
   // When the plane of a wall with mass next leaves its layer of cells (kNever if none has
-  // mass), and that change made (at that time t): returns the face. The outer layers extend
+  // mass), and that change made (at that time t): returns the face, or -1 if the time was only
+  // the horizon of a spring's search (searched again from there). The outer layers extend
   // to infinity: a lid the particles push out of the box moves on in the outermost layer.
   double next_layer_change() const { return next_change_; }
   int change_layer(double t);
@@ -145,23 +156,16 @@ class FaceWalls {
       if (a == D) return;
     }
   }
-  // What the outputs show of each wall with mass at time t (WallReading), faces in order.
-  std::vector<WallReading> readings(double t) const {
-    std::vector<WallReading> out;
-    for (int f = 0; f < 2 * D; ++f) {
-      if (!is_wall(f) || !massive(f)) continue;
-      const Wall<D>& w = faces_[f].wall;
-      double area = 1.0;
-      for (int a = 0; a < D; ++a)
-        if (a != f / 2) area *= box_[a];
-      out.push_back({name(f), position(f, t), bodies_[f].speed_at(t), energy(f, t), w.mass, w.force,
-                     w.inward_push(f, gravity_) / area});
-    }
-    return out;
-  }
+  // What the outputs show of each wall with mass at time t (WallReading), faces in order; a
+  // container once, named by its axis ("z"), at its low wall's place.
+  std::vector<WallReading> readings(double t) const;
   // The mechanical energy of wall f with mass: M v^2 / 2 less the work of its constant force
-  // and the field since it rested on its face.
-  double energy(int f, double t) const { return bodies_[f].energy_at(t, rest_position(f)); }
+  // and the field since it rested on its face (plus its spring's energy). A container's is
+  // counted at its low wall (0 at the high one), so that the surfaces' energies add up.
+  double energy(int f, double t) const {
+    if (faces_[f].wall.joined && f % 2 == 1) return 0.0;
+    return bodies_[f].energy_at(t);
+  }
 
   // A start state's particle `id` at x: throws InputError naming the particle and the wall it
   // overlaps (round-off contacts, 1e-12 of the radius, are contacts).
@@ -198,6 +202,7 @@ class FaceWalls {
   std::array<int, D> cells_along_{};
   double next_change_ = kNever;
   int next_change_face_ = -1;
+  bool next_change_recheck_ = false;  // the due "change" only renews a spring's search
   double rest_position(int f) const { return f % 2 == 0 ? 0.0 : box_[f / 2]; }
   int layer_of(int f, double x) const;
   // Sets next_change_ from time t (the bodies' motion and layers).

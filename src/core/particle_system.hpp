@@ -141,6 +141,13 @@ struct WallMotion {
   std::uint32_t version = 0;
   double accel = 0.0;
   std::int32_t layer = -1;
+  // A wall on a spring (boundaries/wall_spring.hpp; all 0 otherwise): its mass and the
+  // spring's stiffness, damping, anchor amplitude, angular frequency and phase the motion was
+  // made with, and the anchor's work and the dashpot's dissipation up to `time`.
+  std::array<double, 6> spring{};
+  double drive_work = 0.0;
+  double dashpot = 0.0;
+  bool sprung() const { return spring[1] > 0.0; }
   bool operator==(const WallMotion&) const = default;
 };
 

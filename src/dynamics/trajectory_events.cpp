@@ -72,6 +72,79 @@ double opening_span(const GapJet& j, double accel, double amp_w, double k3) {
   return std::fmax(local, accel < 0.0 ? ahead / -accel : kNever);
 }
 
+// What the certified stepping needs to know of a plane's motion from t = 0 on: |d - d0| <=
+// reach, |d'| <= speed, and bounds k2 >= |f''|, k3 >= |f'''| on the gap (with their round-off).
+struct PlaneBounds {
+  double reach, speed, k2, k3;
+};
+
+// The certified stepping of vibrated_plane_event_time (trajectory_events.hpp) for any plane
+// motion: jet(t) gives the gap's GapJet at relative time t.
+template <class Jet>
+double certified_plane_event_time(const NormalMotion& m, const PlaneBounds& b, Jet jet,
+                                  double t_max) {
+  double t = 0.0;
+  for (int step = 0; step < kMaxVibratedSteps; ++step) {
+    const GapJet j = jet(t);
+    const bool touching = j.f <= 2.0 * j.err0;       // in contact up to round-off, or overlapping
+    if (touching && j.f1 < -2.0 * j.err1) return t;  // ... and approaching
+    double h = touching ? 0.0 : open_gap_span(j, m.accel, b.reach, b.k2);
+    if (j.f1 > 2.0 * j.err1) {
+      h = std::fmax(h, opening_span(j, m.accel, b.speed, b.k3));
+    } else if (touching) {
+      // Touching at zero relative speed (up to round-off): f' is about to turn negative
+      // unless f'' > 0, which keeps f' from decreasing for (f'' - err) / k3.
+      if (j.f2 - j.err2 <= 0.0) return t;
+      h = (j.f2 - j.err2) / b.k3;
+    }
+    const double next = std::fmax(t + h, std::nextafter(t, kNever));  // always make progress
+    if (!(next <= t_max) || std::isinf(next)) return kNever;  // event-free up to the horizon
+    t = next;
+  }
+  return t;
+}
+
+// The oscillating plane's offset less d0, and its derivatives. The transient's coefficients
+// after a derivative: (u, b) -> (-gamma u + wd b, -gamma b - wd u).
+OffsetJet displacement_jet(const OscillatingPlane& p, double t) {
+  const double e = std::exp(-p.gamma * t);
+  const double c = std::cos(p.wd * t);
+  const double s = std::sin(p.wd * t);
+  const double u1 = -p.gamma * p.u + p.wd * p.b, b1 = -p.gamma * p.b - p.wd * p.u;
+  const double u2 = -p.gamma * u1 + p.wd * b1, b2 = -p.gamma * b1 - p.wd * u1;
+  const double arg = p.omega * t + p.phase;
+  const double sa = std::sin(arg);
+  const double ca = std::cos(arg);
+  const double aw = p.amplitude * p.omega;
+  return {e * (p.u * c + p.b * s) + p.amplitude * sa, e * (u1 * c + b1 * s) + aw * ca,
+          e * (u2 * c + b2 * s) - aw * p.omega * sa};
+}
+
+// tr and w0: p.transient() and p.w0(), computed once per search.
+GapJet oscillating_gap(const NormalMotion& m, const OscillatingPlane& p, double p0, double tr,
+                       double w0, double t) {
+  const OffsetJet o = displacement_jet(p, t);
+  GapJet j{};
+  j.poly = p0 + (m.velocity + 0.5 * m.accel * t) * t;
+  j.poly1 = m.velocity + m.accel * t;
+  j.f = j.poly - o.d;
+  j.f1 = j.poly1 - o.d1;
+  j.f2 = m.accel - o.d2;
+  // A few ulps per term; the arguments of the sines and the exponential are rounded by a few
+  // ulps of their size, and the transient is at most transient() w0^n in its n-th derivative.
+  const double u = 8.0 * kEps;
+  const double trig = 2.0 + std::fabs(p.omega * t + p.phase);
+  const double decay = 4.0 + (p.gamma + p.wd) * t;
+  const double amp = std::fabs(p.amplitude), w = std::fabs(p.omega);
+  const double g = std::fabs(m.accel);
+  j.poly1_err = u * (std::fabs(m.velocity) + g * t);
+  j.err0 =
+      u * (std::fabs(p0) + std::fabs(m.velocity) * t + g * t * t) + u * (amp * trig + tr * decay);
+  j.err1 = j.poly1_err + u * (amp * w * trig + tr * w0 * decay);
+  j.err2 = u * (g + amp * w * w * trig + tr * w0 * w0 * decay);
+  return j;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Quartic
 
@@ -173,28 +246,34 @@ double vibrated_plane_event_time(const NormalMotion& m, const VibratedPlane& p, 
   const double p0 = m.height - p.d0;
   const double amp = std::fabs(p.amplitude);
   const double w = std::fabs(p.omega);
-  const double slack = 1.0 + 16.0 * kEps;                        // the bounds' own round-off
-  const double k2 = (std::fabs(m.accel) + amp * w * w) * slack;  // >= |f''|
-  const double k3 = amp * w * w * w * slack;                     // >= |f'''|
-  double t = 0.0;
-  for (int step = 0; step < kMaxVibratedSteps; ++step) {
-    const GapJet j = vibrated_gap(m, p, p0, t);
-    const bool touching = j.f <= 2.0 * j.err0;       // in contact up to round-off, or overlapping
-    if (touching && j.f1 < -2.0 * j.err1) return t;  // ... and approaching
-    double h = touching ? 0.0 : open_gap_span(j, m.accel, amp, k2);
-    if (j.f1 > 2.0 * j.err1) {
-      h = std::fmax(h, opening_span(j, m.accel, amp * w, k3));
-    } else if (touching) {
-      // Touching at zero relative speed (up to round-off): f' is about to turn negative
-      // unless f'' > 0, which keeps f' from decreasing for (f'' - err) / k3.
-      if (j.f2 - j.err2 <= 0.0) return t;
-      h = (j.f2 - j.err2) / k3;
-    }
-    const double next = std::fmax(t + h, std::nextafter(t, kNever));  // always make progress
-    if (!(next <= t_max) || std::isinf(next)) return kNever;  // event-free up to the horizon
-    t = next;
-  }
-  return t;
+  const double slack = 1.0 + 16.0 * kEps;  // the bounds' own round-off
+  const PlaneBounds bounds{amp, amp * w, (std::fabs(m.accel) + amp * w * w) * slack,
+                           amp * w * w * w * slack};
+  return certified_plane_event_time(
+      m, bounds, [&](double t) { return vibrated_gap(m, p, p0, t); }, t_max);
+}
+
+OffsetJet oscillating_plane_offset(const OscillatingPlane& p, double t) {
+  OffsetJet o = displacement_jet(p, t);
+  o.d += p.d0;
+  return o;
+}
+
+double oscillating_plane_event_time(const NormalMotion& m, const OscillatingPlane& p,
+                                    double t_max) {
+  const double transient = p.transient();
+  const double amp = std::fabs(p.amplitude);
+  const double w = std::fabs(p.omega);
+  const double w0 = p.w0();
+  const double k3 = transient * w0 * w0 * w0 + amp * w * w * w;
+  if (k3 == 0.0) return fixed_plane_event_time(m, oscillating_plane_offset(p, 0.0).d, t_max);
+  const double slack = 1.0 + 16.0 * kEps;
+  const PlaneBounds bounds{transient + amp, transient * w0 + amp * w,
+                           (std::fabs(m.accel) + transient * w0 * w0 + amp * w * w) * slack,
+                           k3 * slack};
+  const double p0 = m.height - p.d0;
+  return certified_plane_event_time(
+      m, bounds, [&](double t) { return oscillating_gap(m, p, p0, transient, w0, t); }, t_max);
 }
 
 double quartic_event_time(const std::array<double, 5>& c, double t_max) {

@@ -142,6 +142,35 @@ inline VibratedPlane rephased(const VibratedPlane& p, double dt) {
 double vibrated_plane_event_time(const NormalMotion& m, const VibratedPlane& p,
                                  double t_max = kNever);
 
+// A plane moving along its normal as a driven, damped oscillator does between kicks (a wall of
+// mass M on a spring to a sinusoidally moving anchor, boundaries/wall_body.hpp): offset
+//   d(t) = d0 + e^(-gamma t) (u cos(wd t) + b sin(wd t)) + amplitude sin(omega t + phase),
+// t relative to the particle's current time: the transient of the free oscillation (decay rate
+// gamma = c / 2M, frequency wd = sqrt(w0^2 - gamma^2), w0^2 = k / M) and the steady response to
+// the drive.
+struct OscillatingPlane {
+  double d0 = 0.0;
+  double u = 0.0, b = 0.0;  // the transient's cosine and sine parts at t = 0
+  double gamma = 0.0, wd = 0.0;
+  double amplitude = 0.0, omega = 0.0, phase = 0.0;
+  // A bound on the transient's size from t = 0 on (it only decays): sqrt(u^2 + b^2).
+  double transient() const { return std::hypot(u, b); }
+  // sqrt(gamma^2 + wd^2): the n-th derivative of the transient is at most transient() w0^n.
+  double w0() const { return std::hypot(gamma, wd); }
+};
+
+// The offset d(t) and its first two derivatives.
+struct OffsetJet {
+  double d = 0.0, d1 = 0.0, d2 = 0.0;
+};
+OffsetJet oscillating_plane_offset(const OscillatingPlane& p, double t);
+
+// Stable event time of the gap f(t) = height(t) - d(t) against an oscillating plane, by the
+// vibrated plane's certified stepping (the same contract): the bounds |d''| <= T w0^2 + A w^2,
+// |d'''| <= T w0^3 + A w^3 and |d - d0| <= T + A hold from t = 0 on (T = transient()).
+double oscillating_plane_event_time(const NormalMotion& m, const OscillatingPlane& p,
+                                    double t_max = kNever);
+
 // Stable event time of the polynomial f(t) = c[0] + c[1] t + ... + c[4] t^4
 // (docs/physics.md#quartic-pair-contact): f' vanishes on monotone pieces of f found from the
 // roots of f'' (closed form) and a bracketed Newton search on f', so every piece is monotone,

@@ -200,8 +200,14 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t) {
   // every other particle's contact with it comes later, if at all, and its pending event (at
   // most that old contact) still comes first; a wall event of the old motion is found stale
   // when it is due (stale_wall_event). So no other particle needs looking at here.
-  if (massive_walls_ && boundaries_.massive(surface)) [[unlikely]]
+  // On a spring, or in a container, the push can bring a plane nearer the particles later on:
+  // the particles near those planes are looked at again (wall_moved).
+  if (massive_walls_ && boundaries_.massive(surface)) [[unlikely]] {
     boundaries_.push(surface, t, res.impulse);
+    queue_.update(i, predict(i, t));
+    boundaries_.for_each_disturbed(surface, [&](int s) { wall_moved(s, t); });
+    return;
+  }
   queue_.update(i, predict(i, t));
 }
 
@@ -233,7 +239,8 @@ void EventEngine<D, Queue>::wall_moved(int surface, double t) {
 template <int D, class Queue>
 void EventEngine<D, Queue>::change_wall_layer(double t) {
   time_ = t;
-  wall_moved(boundaries_.change_layer(t), t);
+  const int surface = boundaries_.change_layer(t);
+  if (surface >= 0) wall_moved(surface, t);
 }
 
 template <int D, class Queue>

@@ -26,6 +26,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -87,6 +88,7 @@ class Reader : public KeyReader {
     check_soft_and_dem(root, config);
     check_fixed_species(root, config);
     check_wall_masses(root, config);
+    check_container(root, config);
     check_trajectory_keys(root, config);
     if (config.system.chain_length > 0 && config.bonds.empty()) {
       fail(nullptr, "system.chain_length",
@@ -442,6 +444,18 @@ class Reader : public KeyReader {
       b.spheres.push_back(read_cylinder(*sphere_tables[i], "sphere", i, dimension, contact));
 
     read_group(t, std::string(p), boundary_keys(), &b, &dimension);
+    const toml::table none;
+    const toml::table* container = &none;
+    if (const toml::node* n = t.get("container"); n != nullptr) {
+      container = n->as_table();
+      if (container == nullptr) {
+        fail(n, "boundary.container",
+             fmt::format("boundary.container: expected a table ([boundary.container]), found {}",
+                         describe(*n)));
+      }
+      check_keys(*container, "boundary.container");
+    }
+    read_group(*container, "boundary.container", container_keys(), &b.container, &dimension);
     const toml::node* n_open = t.get("open");
     for (std::size_t i = 0; i < b.open.size(); ++i) {
       const std::string& face = b.open[i];
@@ -814,6 +828,83 @@ class Reader : public KeyReader {
         conflict("soft.model", "soft contacts and the DEM meet no wall with mass yet");
       if (c.boundary.shear_rate != 0.0) conflict("boundary.shear_rate", "not combined yet");
       if (c.analysis.transport) conflict("analysis.transport", "momentum is not conserved");
+    }
+  }
+
+  // [boundary.container]: the walls of one axis joined as one body of mass M on a spring to a
+  // moving anchor (boundaries/wall_spring.hpp); what it needs and cannot be combined with.
+  void check_container(const toml::table& root, const Config& c) const {
+    const ContainerConfig& box = c.boundary.container;
+    const auto key = [](std::string_view k) { return fmt::format("boundary.container.{}", k); };
+    const auto refuse = [&](std::string_view k, const std::string& why) {
+      const toml::node* n = node_at(root, key(k));
+      fail(n != nullptr ? n : node_at(root, "boundary.container"), key(k),
+           fmt::format("{}: {}", key(k), why));
+    };
+    if (box.axis.empty()) {
+      if (!(box == ContainerConfig{})) {
+        refuse("axis",
+               "the container's keys are given but no axis (set boundary.container.axis to the "
+               "axis whose two walls form the container)");
+      }
+      return;
+    }
+    const int axis = static_cast<int>(axes(c.system.dimension).at(box.axis));
+    const std::string lo = fmt::format("{}-", box.axis), hi = fmt::format("{}+", box.axis);
+    for (const std::string& face : {lo, hi}) {
+      const auto wall = std::find_if(c.boundary.walls.begin(), c.boundary.walls.end(),
+                                     [&](const WallConfig& w) { return w.face == face; });
+      if (wall == c.boundary.walls.end()) {
+        refuse("axis", fmt::format("the container is the walls {} and {}, but face {} has no "
+                                   "wall (add a [[boundary.wall]] with face = \"{}\")",
+                                   lo, hi, face, face));
+      }
+      const std::size_t k = static_cast<std::size_t>(wall - c.boundary.walls.begin());
+      const bool moves = wall->mass != 0.0 || wall->force != 0.0 ||
+                         (wall->amplitude > 0.0 && wall->frequency > 0.0) ||
+                         (axis < static_cast<int>(wall->velocity.size()) &&
+                          wall->velocity[static_cast<std::size_t>(axis)] != 0.0);
+      if (moves) {
+        refuse("axis", fmt::format("the container moves its walls; boundary.wall[{}] ({}) must "
+                                   "not have a mass, force, vibration or normal velocity of its "
+                                   "own",
+                                   k, face));
+      }
+    }
+    if (!(box.mass > 0.0)) refuse("mass", "a container needs its mass (> 0)");
+    const double k = box.spring_stiffness, damping = box.spring_damping;
+    if (k == 0.0 && (damping != 0.0 || box.drive_amplitude != 0.0)) {
+      refuse(damping != 0.0 ? "spring_damping" : "drive_amplitude",
+             "needs a spring (boundary.container.spring_stiffness > 0)");
+    }
+    if (k > 0.0 && !(damping < 2.0 * std::sqrt(k * box.mass))) {
+      refuse("spring_damping",
+             fmt::format("{} is at or above critical damping 2 sqrt(k M) = {:.6g}: only an "
+                         "underdamped spring is supported",
+                         damping, 2.0 * std::sqrt(k * box.mass)));
+    }
+    const double w = 2.0 * std::numbers::pi * box.drive_frequency;
+    if (k > 0.0 && damping == 0.0 && box.drive_amplitude > 0.0 &&
+        std::abs(k - box.mass * w * w) <= 1e-9 * k) {
+      refuse("drive_frequency",
+             "drives an undamped spring at its resonance sqrt(k / M) / 2 pi: its amplitude would "
+             "grow without bound (add spring_damping or move the frequency)");
+    }
+    const auto conflict = [&](std::string_view other, std::string_view why) {
+      const toml::node* n = node_at(root, other);
+      fail(n != nullptr ? n : node_at(root, key("axis")), std::string(other),
+           fmt::format("{}: a container (boundary.container) cannot be combined with {} ({})",
+                       other, other, why));
+    };
+    if (c.soft.enabled())
+      conflict("soft.model", "soft contacts and the DEM meet no wall with mass yet");
+    if (c.boundary.shear_rate != 0.0) conflict("boundary.shear_rate", "not combined yet");
+    if (c.analysis.transport) conflict("analysis.transport", "momentum is not conserved");
+    for (std::size_t s = 0; s < c.system.species.size(); ++s) {
+      if (c.system.species[s].fixed) {
+        conflict(fmt::format("system.species[{}].fixed", s),
+                 "a fixed grain would not see the moving wall coming");
+      }
     }
   }
 

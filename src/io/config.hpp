@@ -126,8 +126,23 @@ struct CylinderConfig {
   bool operator==(const CylinderConfig&) const = default;
 };
 
+// The walls of one axis joined as a container of finite mass on a spring to a moving anchor
+// ([boundary.container], boundaries/wall_spring.hpp): the spring-driven granular damper.
+struct ContainerConfig {
+  std::string axis;               // x, y or z; "": no container
+  double mass = 0.0;              // M, > 0
+  double spring_stiffness = 0.0;  // k (0: no spring, a free container)
+  double spring_damping = 0.0;    // c, below 2 sqrt(k M)
+  double drive_amplitude = 0.0;   // the anchor's A sin(2 pi f t + phase)
+  double drive_frequency = 0.0;   // f, cycles per unit time
+  double drive_phase = 0.0;       // radians
+
+  bool operator==(const ContainerConfig&) const = default;
+};
+
 struct BoundaryConfig {
   std::vector<WallConfig> walls;          // [[boundary.wall]]
+  ContainerConfig container;              // [boundary.container]
   std::vector<PlaneConfig> planes;        // [[boundary.plane]]
   std::vector<CylinderConfig> cylinders;  // [[boundary.cylinder]]
   std::vector<CylinderConfig> spheres;    // [[boundary.sphere]]: axis is the rotation's

@@ -294,6 +294,52 @@ constexpr KeyDecl kWall[] = {
      .doc = "constant force on a wall with mass, along its normal into the box"},
 };
 
+const ContainerConfig kContainerDefaults{};
+constexpr KeyDecl kContainer[] = {
+    {.name = "axis",
+     .type = KeyType::kString,
+     .member = field<&ContainerConfig::axis>,
+     .range = {.by_rule = true},  // "" is none; both faces of the axis must be walls
+     .choices = &choices_in<&axes>,
+     .doc = "the axis whose two walls are joined as the container (\"\": none)"},
+    {.name = "mass",
+     .type = KeyType::kFloat,
+     .member = field<&ContainerConfig::mass>,
+     .range = {.lo = 0.0, .hi = 1e9},
+     .unit = "mass",
+     .doc = "the container's mass M (required with an axis)"},
+    {.name = "spring_stiffness",
+     .type = KeyType::kFloat,
+     .member = field<&ContainerConfig::spring_stiffness>,
+     .range = {.lo = 0.0, .hi = 1e15},
+     .unit = "force / length",
+     .doc = "stiffness k of the spring to the anchor (0: no spring)"},
+    {.name = "spring_damping",
+     .type = KeyType::kFloat,
+     .member = field<&ContainerConfig::spring_damping>,
+     .range = {.lo = 0.0, .hi = 1e15, .by_rule = true},  // below 2 sqrt(k M)
+     .unit = "force / speed",
+     .doc = "damping c of the dashpot beside the spring (underdamped: c < 2 sqrt(k M))"},
+    {.name = "drive_amplitude",
+     .type = KeyType::kFloat,
+     .member = field<&ContainerConfig::drive_amplitude>,
+     .range = {.lo = 0.0, .hi = 1e9},
+     .unit = "length",
+     .doc = "the anchor's amplitude A: it moves as A sin(2 pi f t + phase)"},
+    {.name = "drive_frequency",
+     .type = KeyType::kFloat,
+     .member = field<&ContainerConfig::drive_frequency>,
+     .range = {.lo = 0.0, .hi = 1e9, .by_rule = true},  // not at an undamped resonance
+     .unit = "cycles per unit time",
+     .doc = "the anchor's frequency f"},
+    {.name = "drive_phase",
+     .type = KeyType::kFloat,
+     .member = field<&ContainerConfig::drive_phase>,
+     .range = {.lo = -1e9, .hi = 1e9, .why = "(radians)"},
+     .unit = "radians",
+     .doc = "the anchor's phase"},
+};
+
 const PlaneConfig kPlaneDefaults{};
 constexpr KeyDecl kPlane[] = {
     {.name = "normal",
@@ -992,6 +1038,7 @@ constexpr KeyGroup kContactGroup{"contact", kContact, &kInteractionDefaults};
 constexpr KeyGroup kBoundaryGroup{"boundary", kBoundary, &kBoundaryDefaults};
 constexpr KeyGroup kWallGroup{"wall", kWall, &kWallDefaults};
 constexpr KeyGroup kPlaneGroup{"plane", kPlane, &kPlaneDefaults};
+constexpr KeyGroup kContainerGroup{"container", kContainer, &kContainerDefaults};
 constexpr KeyGroup kCylinderGroup{"cylinder", kCylinder, &kCylinderDefaults};
 constexpr KeyGroup kFieldGroup{"field", kField, &kFieldDefaults};
 constexpr KeyGroup kDrivingGroup{"driving", kDriving, &kDrivingDefaults};
@@ -1036,6 +1083,7 @@ std::vector<DeclaredKey> build() {
       {"boundary.wall",
        KeyType::kTableArray,
        {{&kWallFaceGroup}, {&kContactLawGroup, "contact"}, {&kWallGroup}}},
+      {"boundary.container", KeyType::kTable, {{&kContainerGroup}}},
       {"boundary.plane",
        KeyType::kTableArray,
        {{&kPlaneGroup}, {&kContactLawGroup, "contact"}, {&kWallGroup, "boundary.wall"}}},
@@ -1179,6 +1227,9 @@ const KeyGroup& wall_keys() {
 }
 const KeyGroup& plane_keys() {
   return kPlaneGroup;
+}
+const KeyGroup& container_keys() {
+  return kContainerGroup;
 }
 const KeyGroup& cylinder_keys() {
   return kCylinderGroup;

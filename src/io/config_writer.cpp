@@ -145,6 +145,11 @@ std::string to_toml(const Config& config) {
     out += group_toml(contact_law_keys(), &p.wall.contact, "boundary.plane", dimension);
     out += group_toml(wall_keys(), &p.wall, "boundary.plane", dimension);
   }
+  if (!config.boundary.container.axis.empty()) {
+    out += "\n[boundary.container]\n";
+    out +=
+        group_toml(container_keys(), &config.boundary.container, "boundary.container", dimension);
+  }
   for (const bool sphere : {false, true}) {
     const std::string name = sphere ? "boundary.sphere" : "boundary.cylinder";
     for (const CylinderConfig& c : sphere ? config.boundary.spheres : config.boundary.cylinders) {

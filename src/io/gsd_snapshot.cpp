@@ -493,6 +493,21 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& bloc
         row[6] = m.layer;
       }
       w.write_chunk("kairos/state/wall_motion", nw, kColumns, rows.data());
+      // Walls on a spring: face, mass, stiffness, damping, anchor amplitude, angular frequency,
+      // phase, the anchor's work, the dashpot's dissipation.
+      std::vector<double> springs;
+      for (const WallMotion& m : s.wall_motion) {
+        if (!m.sprung()) continue;
+        springs.push_back(m.face);
+        springs.insert(springs.end(), m.spring.begin(), m.spring.end());
+        springs.push_back(m.drive_work);
+        springs.push_back(m.dashpot);
+      }
+      if (!springs.empty()) {
+        constexpr std::uint32_t kSpringColumns = 9;
+        w.write_chunk("kairos/state/wall_spring", springs.size() / kSpringColumns, kSpringColumns,
+                      springs.data());
+      }
     }
     if (!has.angular_velocity.empty()) {
       constexpr std::uint32_t kSpin = D == 3 ? 3 : 1;
@@ -686,6 +701,26 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
       s.wall_motion.push_back({static_cast<std::uint32_t>(row[0]), row[1], row[2], row[3],
                                static_cast<std::uint32_t>(row[4]), row[5],
                                static_cast<std::int32_t>(row[6])});
+    }
+    if (const auto springs = r.find(f, "kairos/state/wall_spring")) {
+      constexpr std::size_t kSpringColumns = 9;  // as written above
+      const std::size_t ns = springs->N;
+      const auto values =
+          require<double>(r, f, "kairos/state/wall_spring", path, kSpringColumns * ns);
+      for (std::size_t k = 0; k < ns; ++k) {
+        const double* row = &values[kSpringColumns * k];
+        const auto m = std::find_if(s.wall_motion.begin(), s.wall_motion.end(),
+                                    [&](const WallMotion& w) { return w.face == row[0]; });
+        const bool valid = m != s.wall_motion.end() && row[1] > 0.0 && row[2] > 0.0;
+        if (!valid) {
+          throw InputError("'" + path.string() + "' is not a valid restart file: " +
+                           "kairos/state/wall_spring row " + std::to_string(k) +
+                           " names no wall with mass, or no mass and stiffness");
+        }
+        std::copy(row + 1, row + 7, m->spring.begin());
+        m->drive_work = row[7];
+        m->dashpot = row[8];
+      }
     }
   }
   if (r.find(f, "kairos/state/zone_count")) {

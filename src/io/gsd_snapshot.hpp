@@ -26,6 +26,10 @@
 //   kairos/state/wall_motion          float64 W x 7: face, time, position, speed, version,
 //                                     acceleration, layer of each wall with mass
 //                                     (ParticleSystem::wall_motion; only when there is one)
+//   kairos/state/wall_spring          float64 S x 9: face, mass, spring stiffness, damping,
+//                                     anchor amplitude, angular frequency, phase, the anchor's
+//                                     work and the dashpot's dissipation of each wall with mass
+//                                     on a spring (only when there is one)
 // Format 4 files are read with no soft contacts. Format 6 adds frozen_deferred; format 7 adds
 //   kairos/checksum  uint32 x 1: CRC-32 (zlib) of every other chunk of the frame, over their
 //                    canonical serialisation (gsd_file.hpp, "Frame checksums"), written last

@@ -105,9 +105,12 @@ concept BoundaryComponent = requires(const C& c, C& setup, int s, const Vec<D>& 
 //                                               (0 for a surface without mass); stale when the
 //                                               motion has changed since
 //   void push(int s, t, impulse_on_particle);   a contact's impulse moves surface s
+//   void for_each_disturbed(s, f) const;        f(surface) for each surface a push on s may
+//                                               have brought nearer the particles later on
 //   double next_layer_change() const;           when a surface next enters another layer of
 //                                               cells (kNever: never)
-//   int change_layer(double t);                 that change made; returns the surface
+//   int change_layer(double t);                 that change made; returns the surface (-1:
+//                                               none changed, its search was renewed)
 //   void for_each_band_cell(s, grid, f) const;  f(cell index) for every cell holding particles
 //                                               that can touch s while it stays in its layer
 //   double energy(int s, double t) const;       its mechanical energy
@@ -122,6 +125,7 @@ concept MovingBoundary = requires(const C& c, C& moved, int s, double t, const V
   { c.massive(s) } -> std::convertible_to<bool>;
   { c.event_version(s) } -> std::convertible_to<std::uint32_t>;
   moved.push(s, t, impulse);
+  c.for_each_disturbed(s, visit);
   { c.next_layer_change() } -> std::convertible_to<double>;
   { moved.change_layer(t) } -> std::convertible_to<int>;
   c.for_each_band_cell(s, grid, visit);
@@ -301,6 +305,17 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
       if (c.massive(k)) c.push(k, t, impulse_on_particle);
     });
   }
+  template <class F>
+  void for_each_disturbed(int s, F&& f) const {
+    int first = 0;
+    for_each([&](const auto& c) {
+      if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) {
+        if (s >= first && s < first + c.surfaces())
+          c.for_each_disturbed(s - first, [&](int k) { f(first + k); });
+      }
+      first += c.surfaces();
+    });
+  }
   double next_layer_change() const {
     double when = kNever;
     for_each([&](const auto& c) {
@@ -309,18 +324,23 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
     });
     return when;
   }
-  // The soonest change of layer made (at its time t); returns its surface.
+  // The soonest change of layer made (at its time t); returns its surface (-1: none changed).
   int change_layer(double t) {
     const double when = next_layer_change();
     if (!(when < kNever)) throw std::logic_error("Boundaries::change_layer: no change due");
     int first = 0, changed = -1;
+    bool done = false;
     for_each([&](auto& c) {
       if constexpr (MovingBoundary<std::remove_cvref_t<decltype(c)>, D>) {
-        if (changed < 0 && c.next_layer_change() == when) changed = first + c.change_layer(t);
+        if (!done && c.next_layer_change() == when) {
+          done = true;
+          const int k = c.change_layer(t);
+          changed = k < 0 ? -1 : first + k;
+        }
       }
       first += c.surfaces();
     });
-    if (changed < 0) throw std::logic_error("Boundaries::change_layer: no change due");
+    if (!done) throw std::logic_error("Boundaries::change_layer: no change due");
     return changed;
   }
   template <class F>

@@ -399,6 +399,17 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
   }
   for (const std::string& open : config.boundary.open)
     env.faces[face_index(open, D)].kind = FaceKind::kOpen;
+  if (const ContainerConfig& box = config.boundary.container; !box.axis.empty()) {
+    // Both walls of the axis become one body (boundaries/wall_spring.hpp).
+    const int axis = static_cast<int>(axes(D).at(box.axis));
+    for (int f = 2 * axis; f < 2 * axis + 2; ++f) {
+      Wall<D>& w = env.faces[f].wall;
+      w.mass = box.mass;
+      w.joined = true;
+      w.spring = {box.spring_stiffness, box.spring_damping, box.drive_amplitude,
+                  2.0 * std::numbers::pi * box.drive_frequency, box.drive_phase};
+    }
+  }
   for (int a = 0; a < D && a < static_cast<int>(config.field.gravity.size()); ++a)
     env.gravity[a] = config.field.gravity[a];
   env.shear_rate = config.boundary.shear_rate;

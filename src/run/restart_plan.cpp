@@ -161,20 +161,44 @@ void check_walls_stay(const Config& before, const Config& now, double t,
 // moves on from where the state has it).
 void check_wall_masses_stay(const Config& before, const Config& now,
                             const std::string& restart_file) {
+  // Its own mass, or the container's (boundary.container: the walls of its axis).
   const auto massive = [](const Config& c, const std::string& face) {
+    if (!c.boundary.container.axis.empty() && face.starts_with(c.boundary.container.axis))
+      return true;
     for (const WallConfig& w : c.boundary.walls)
       if (w.face == face) return w.mass > 0.0;
     return false;
+  };
+  const auto sprung = [](const Config& c) {
+    return !c.boundary.container.axis.empty() && c.boundary.container.spring_stiffness > 0.0;
   };
   for (const char* face : {"x-", "x+", "y-", "y+", "z-", "z+"}) {
     const bool was = massive(before, face), is = massive(now, face);
     if (was == is) continue;
     throw InputError(fmt::format(
-        "restart file '{}': the wall on face {} {} mass (boundary.wall.mass) in the run that "
-        "wrote it and {} now: a wall cannot gain or lose its mass during a run (its motion is "
-        "part of the state, and thermo.tsv's columns would change); start a new run from the "
-        "state with system.initial_state = \"{}\"",
+        "restart file '{}': the wall on face {} {} mass (boundary.wall.mass or "
+        "boundary.container) in the run that wrote it and {} now: a wall cannot gain or lose "
+        "its mass during a run (its motion is part of the state, and thermo.tsv's columns "
+        "would change); start a new run from the state with system.initial_state = \"{}\"",
         restart_file, face, was ? "had" : "had no", is ? "has" : "has none", restart_file));
+  }
+  if (before.boundary.container.axis != now.boundary.container.axis ||
+      sprung(before) != sprung(now)) {
+    throw InputError(fmt::format(
+        "restart file '{}': boundary.container {} in the run that wrote it and {} now: a "
+        "container cannot change its axis, or gain or lose its spring, during a run "
+        "(thermo.tsv's columns would change); start a new run from the state with "
+        "system.initial_state = \"{}\"",
+        restart_file,
+        before.boundary.container.axis.empty()
+            ? "was none"
+            : fmt::format("was along {}{}", before.boundary.container.axis,
+                          sprung(before) ? " on a spring" : " without a spring"),
+        now.boundary.container.axis.empty()
+            ? "none"
+            : fmt::format("along {}{}", now.boundary.container.axis,
+                          sprung(now) ? " on a spring" : " without a spring"),
+        restart_file));
   }
 }
 

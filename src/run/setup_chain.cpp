@@ -149,6 +149,7 @@ void note_walls_carried_off(const Environment<D>& environment) {
   for (int f = 0; f < 2 * D; ++f) {
     const Wall<D>& w = environment.faces[f].wall;
     if (environment.faces[f].kind != FaceKind::kWall || !w.massive()) continue;
+    if (w.joined || w.spring.on()) continue;  // a container: the other wall holds the particles
     if (w.inward_push(f, environment.gravity) > 0.0) continue;
     std::fputs(fmt::format("kairos: note: boundary.wall ({}{}) has mass but nothing pushes it "
                            "into the box (its force and the field): the particles will carry "

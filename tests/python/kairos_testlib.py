@@ -83,21 +83,25 @@ def _toml_value(v):
 
 def toml_text(config):
     """{'system': {...}, 'run': {...}, 'output': {...}} -> TOML text. A value in a section may be
-    a list of dicts (an array of tables, e.g. system.species)."""
+    a list of dicts (an array of tables, e.g. system.species) or a dict (a table, e.g.
+    boundary.container)."""
     lines = []
     for section, table in config.items():
         lines.append("[%s]" % section)
-        arrays = []
+        arrays, tables = [], []
         for key, value in table.items():
             if isinstance(value, list) and value and isinstance(value[0], dict):
                 arrays.append((key, value))
+            elif isinstance(value, dict):
+                tables.append((key, [value]))
             else:
                 lines.append("%s = %s" % (key, _toml_value(value)))
-        for key, elements in arrays:
-            for element in elements:
-                lines.append("[[%s.%s]]" % (section, key))
-                for k, v in element.items():
-                    lines.append("%s = %s" % (k, _toml_value(v)))
+        for brackets, entries in (("[[%s.%s]]", arrays), ("[%s.%s]", tables)):
+            for key, elements in entries:
+                for element in elements:
+                    lines.append(brackets % (section, key))
+                    for k, v in element.items():
+                        lines.append("%s = %s" % (k, _toml_value(v)))
         lines.append("")
     return "\n".join(lines)
 

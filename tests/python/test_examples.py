@@ -36,6 +36,9 @@ EXAMPLES = {
     # Measured in time: the lid comes down in the first few time units.
     "free_piston_3d.toml": ("plot_free_piston.py", [
         "run.equilibration_time=5", "run.time=10", "output.thermo_interval=1"]),
+    # Measured in time: the container swings up within a few cycles.
+    "spring_damper_3d.toml": ("plot_spring_damper.py", [
+        "run.equilibration_time=4", "run.time=8"]),
     "shear_flow_2d.toml": ("plot_shear_flow_2d.py", [
         "system.particles=2000", "run.equilibration_collisions_per_particle=2",
         "run.collisions_per_particle=5", "output.trajectory_interval=2",
@@ -145,6 +148,14 @@ class GranularExamples(kt.KairosTestCase):
         lid = [r[header.index("wall_z+_position")] for r in rows]
         self.assertLess(lid[-1], lid[0])  # the lid came down onto the gas
         self.draw_picture("free_piston_3d.toml", out)
+
+    def test_spring_damper_3d(self):
+        out, s = self.check_run("spring_damper_3d.toml")
+        header, rows, _ = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        swing = max(abs(r[header.index("wall_z_position")]) for r in rows)
+        self.assertGreater(swing, 4.0)  # the anchor (A = 2) drives it at resonance
+        self.assertLess(swing, 20.1)  # ... and the grains hold it below its swing alone
+        self.draw_picture("spring_damper_3d.toml", out)
 
     def test_shear_flow_2d(self):
         out, s = self.check_run("shear_flow_2d.toml")

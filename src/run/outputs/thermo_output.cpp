@@ -15,8 +15,10 @@ void ThermoOutput<D>::open(const RunContext<D>& run) {
   const std::vector<WallReading> walls = integrator.walls_with_mass();
   if (!walls.empty()) {
     header.pop_back();  // its newline
-    for (const WallReading& w : walls)
+    for (const WallReading& w : walls) {
       header += fmt::format("\twall_{0}_position\twall_{0}_speed\twall_{0}_energy", w.face);
+      if (w.sprung) header += fmt::format("\twall_{0}_drive_work\twall_{0}_dashpot", w.face);
+    }
     header += '\n';
   }
   // A new file, or (a continued run) the existing one cut to the rows the continued state had
@@ -48,8 +50,10 @@ bool ThermoOutput<D>::pending(const RunContext<D>& run) const {
 template <int D>
 std::string wall_columns(const Integrator<D>& integrator) {
   std::string out;
-  for (const WallReading& w : integrator.walls_with_mass())
+  for (const WallReading& w : integrator.walls_with_mass()) {
     out += fmt::format("\t{:.17g}\t{:.17g}\t{:.17g}", w.position, w.speed, w.energy);
+    if (w.sprung) out += fmt::format("\t{:.17g}\t{:.17g}", w.drive_work, w.dashpot);
+  }
   return out;
 }
 

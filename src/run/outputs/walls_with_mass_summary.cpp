@@ -30,8 +30,16 @@ void WallsWithMassSummary<D>::summarize(nlohmann::json& summary, const RunContex
     nlohmann::json j;
     j["face"] = now[k].face;
     j["mass"] = now[k].mass;
-    j["force"] = now[k].force;
-    j["pressure"] = now[k].pressure;
+    if (now[k].container) {
+      j["container"] = true;
+    } else {
+      j["force"] = now[k].force;
+      j["pressure"] = now[k].pressure;
+    }
+    if (now[k].sprung) {
+      j["drive_work"] = now[k].drive_work;  // since the start of the simulation
+      j["dashpot_dissipated"] = now[k].dashpot;
+    }
     j["position"] = now[k].position;  // at the end
     j["energy"] = now[k].energy;
     const std::string key = "walls_with_mass[" + std::to_string(k) + "].position_mean";
