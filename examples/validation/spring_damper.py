@@ -26,7 +26,7 @@ anchor that moves as A sin(W t). Two checks (docs/validation.md "The spring-driv
 
     python3 examples/validation/spring_damper.py build/kairos
 
-About a minute on one core.
+About 10 s on one core.
 """
 
 import math

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -23,6 +24,7 @@ FaceWalls<D>::FaceWalls(const std::array<Face<D>, 2 * D>& faces, const Vec<D>& b
     const Wall<D>& w = faces_[f].wall;
     if (!w.massive()) continue;
     any_massive_ = true;
+    if (!own_body(f)) continue;  // the high wall of a container: its low wall's body
     // The force acts along the normal (into the box), the field on the wall's mass.
     const double sgn = f % 2 == 0 ? 1.0 : -1.0;
     bodies_[f].mass = w.mass;
@@ -59,13 +61,13 @@ double FaceWalls<D>::event_time(int face, const Vec<D>& x, const Vec<D>& v, doub
   const double sgn = face % 2 == 0 ? 1.0 : -1.0;
   const NormalMotion m{sgn * x[a] - radius, sgn * v[a], sgn * gravity_[a]};
   if (w.massive()) [[unlikely]] {
-    const WallBody& b = bodies_[face];
+    const WallBody& b = body(face);
     // On a spring: the certified search against the driven oscillator's path.
-    if (b.sprung()) return oscillating_plane_event_time(m, b.plane(t, sgn), horizon);
+    if (b.sprung()) return oscillating_plane_event_time(m, b.plane(t, sgn, shift(face)), horizon);
     // The gap between the particle's lowest point and the plane, both on parabolas: a
     // quadratic in the time from t.
     return within_horizon(
-        quadratic_event_time(m.height - sgn * b.position_at(t), m.velocity - sgn * b.speed_at(t),
+        quadratic_event_time(m.height - sgn * position(face, t), m.velocity - sgn * b.speed_at(t),
                              0.5 * (m.accel - sgn * b.accel)),
         horizon);
   }
@@ -91,7 +93,7 @@ void FaceWalls<D>::set_reach(const CellGrid<D>& grid, double rmax) {
     cells_along_[a] = grid.cells_along(a);
   }
   for (int f = 0; f < 2 * D; ++f)
-    if (massive(f)) layer_[f] = layer_of(f, bodies_[f].position);
+    if (massive(f)) layer_[f] = layer_of(f, body(f).position + shift(f));
 }
 
 // Whether a particle in cell c can touch face f: f has a wall, and the cell lies within
@@ -140,18 +142,20 @@ std::pair<int, int> FaceWalls<D>::band(int f) const {
 template <int D>
 void FaceWalls<D>::restore(const std::vector<WallMotion>& motion, double t) {
   for (int f = 0; f < 2 * D; ++f) {
-    if (!massive(f)) continue;
+    if (!massive(f) || !own_body(f)) continue;
     bodies_[f].set(t, rest_position(f), 0.0);
     bodies_[f].work = {};
     bodies_[f].version = 0;
-    layer_[f] = layer_of(f, bodies_[f].position);
   }
+  for (int f = 0; f < 2 * D; ++f)
+    if (massive(f)) layer_[f] = layer_of(f, position(f, t));
   for (const WallMotion& m : motion) {
     const int f = static_cast<int>(m.face);
-    if (f >= 2 * D || !massive(f)) {
+    if (f >= 2 * D || !massive(f) || !own_body(f)) {
       throw InputError("the state holds the motion of a wall with mass at face " +
                        (f < 2 * D ? name(f) : std::to_string(f)) +
-                       " but this run gives that face no mass (boundary.wall.mass)");
+                       " but this run gives that face no mass of its own (boundary.wall.mass, "
+                       "or the low wall of a boundary.container)");
     }
     const auto same_face = [&](const WallMotion& other) { return other.face == m.face; };
     if (std::count_if(motion.begin(), motion.end(), same_face) > 1) {
@@ -186,10 +190,15 @@ void FaceWalls<D>::restore(const std::vector<WallMotion>& motion, double t) {
                        " is not finite");
     }
     // The layer the run had it in (a plane within round-off of a cell face could be put in
-    // either), unless the state does not say or the grid differs.
-    const bool kept = m.layer >= 0 && m.layer < cells_along_[f / 2] &&
-                      std::abs(layer_of(f, b.position_at(t)) - m.layer) <= 1;
-    layer_[f] = kept ? m.layer : layer_of(f, b.position_at(t));
+    // either), unless the state does not say or the grid differs. A container's high wall:
+    // from its place (the state holds one row per body).
+    for (const int g : {f, f ^ 1}) {
+      if (g != f && !faces_[f].wall.joined) continue;
+      const int layer = g == f ? m.layer : -1;
+      const bool kept = layer >= 0 && layer < cells_along_[g / 2] &&
+                        std::abs(layer_of(g, position(g, t)) - layer) <= 1;
+      layer_[g] = kept ? layer : layer_of(g, position(g, t));
+    }
   }
   find_next_change(t);
 }
@@ -198,14 +207,13 @@ template <int D>
 std::vector<WallMotion> FaceWalls<D>::motion() const {
   std::vector<WallMotion> out;
   for (int f = 0; f < 2 * D; ++f)
-    if (massive(f)) out.push_back(bodies_[f].state(f, layer_[f]));
+    if (massive(f) && own_body(f)) out.push_back(bodies_[f].state(f, layer_[f]));
   return out;
 }
 
 template <int D>
 void FaceWalls<D>::push(int f, double t, const Vec<D>& impulse_on_particle) {
-  bodies_[f].kick(t, -impulse_on_particle[f / 2]);
-  if (faces_[f].wall.joined) bodies_[f ^ 1].kick(t, -impulse_on_particle[f / 2]);
+  bodies_[body_index(f)].kick(t, -impulse_on_particle[f / 2]);
   find_next_change(t);
 }
 
@@ -220,27 +228,30 @@ void FaceWalls<D>::find_next_change(double t) {
   for (int f = 0; f < 2 * D; ++f) {
     if (!massive(f)) continue;
     const int a = f / 2;
-    const WallBody& b = bodies_[f];
+    const WallBody& b = body(f);
     const double lo = layer_[f] == 0 ? -kNever : layer_[f] * widths_[a];
     const double hi = layer_[f] == cells_along_[a] - 1 ? kNever : (layer_[f] + 1) * widths_[a];
     bool recheck = false;
     double when = kNever;
     if (b.sprung()) [[unlikely]] {
+      const OscillatingPlane up = b.plane(t, 1.0, shift(f));
+      const double reach = up.transient() + std::abs(up.amplitude);
+      if (up.d0 - reach > lo && up.d0 + reach < hi) continue;  // it cannot leave before a kick
       // The first time the oscillator's path reaches either face of the layer, searched up to a
       // horizon of a few periods (the search's cost grows with the periods it covers); if
       // none, the search is made again then.
-      const double horizon =
-          kSpringSearchPeriods * 2.0 * M_PI / std::max(b.spring.wd(), b.spring.spring().omega);
+      const double horizon = kSpringSearchPeriods * 2.0 * std::numbers::pi /
+                             std::max(b.spring.wd(), b.spring.spring().omega);
       double dt = kNever;
-      if (hi < kNever) dt = oscillating_plane_event_time({hi, 0.0, 0.0}, b.plane(t, 1.0), horizon);
+      if (hi < kNever) dt = oscillating_plane_event_time({hi, 0.0, 0.0}, up, horizon);
       if (lo > -kNever) {
-        dt = std::min(dt, oscillating_plane_event_time({-lo, 0.0, 0.0}, b.plane(t, -1.0),
+        dt = std::min(dt, oscillating_plane_event_time({-lo, 0.0, 0.0}, b.plane(t, -1.0, shift(f)),
                                                        std::min(dt, horizon)));
       }
       recheck = !(dt < kNever);
       when = t + (recheck ? horizon : dt);
     } else {
-      when = t + interval_exit_time_accelerated(b.position_at(t), b.speed_at(t), b.accel, lo, hi);
+      when = t + interval_exit_time_accelerated(position(f, t), b.speed_at(t), b.accel, lo, hi);
     }
     if (when < next_change_) {
       next_change_ = when;
@@ -258,7 +269,7 @@ int FaceWalls<D>::change_layer(double t) {
     return -1;
   }
   const int a = f / 2;
-  const double x = bodies_[f].position_at(t);
+  const double x = position(f, t);
   const double lo = layer_[f] * widths_[a];
   const double hi = (layer_[f] + 1) * widths_[a];
   // Through the nearer face of the layer (an inner face: the outer layers have none outside).
@@ -278,7 +289,7 @@ std::vector<WallReading> FaceWalls<D>::readings(double t) const {
     double area = 1.0;
     for (int a = 0; a < D; ++a)
       if (a != f / 2) area *= box_[a];
-    const WallBody& b = bodies_[f];
+    const WallBody& b = body(f);
     WallReading r{w.joined ? std::string(1, "xyz"[f / 2]) : name(f),
                   position(f, t),
                   b.speed_at(t),

@@ -55,7 +55,7 @@ class FaceWalls {
   Vec<D> velocity(int f, const Vec<D>& /*x*/, double t) const {
     if (massive(f)) [[unlikely]] {
       Vec<D> v{};
-      v[f / 2] = bodies_[f].speed_at(t);
+      v[f / 2] = body(f).speed_at(t);
       return v;
     }
     return faces_[f].wall.surface_velocity(f, t);
@@ -78,7 +78,7 @@ class FaceWalls {
   // Where the plane of wall f lies along its axis at time t.
   double position(int f, double t) const {
     if (massive(f)) [[unlikely]]
-      return bodies_[f].position_at(t);
+      return body(f).position_at(t) + shift(f);
     return faces_[f].wall.plane_position(f, box_, t);
   }
   // The centre's distance from the plane of wall f at time t, positive inside the box.
@@ -108,10 +108,12 @@ class FaceWalls {
   // Walls with mass (boundaries/wall_body.hpp).
   bool any_massive() const { return any_massive_; }
   bool massive(int f) const { return faces_[f].wall.massive(); }
-  const WallBody& body(int f) const { return bodies_[f]; }
+  // The body that moves wall f: its own, or for the high wall of a container (Wall::joined)
+  // the low wall's, whose plane lies the box's edge below it (shift).
+  const WallBody& body(int f) const { return bodies_[body_index(f)]; }
   // The version a wall event predicted now carries (0 for a wall of infinite mass): the event
   // is stale once the wall's motion has changed.
-  std::uint32_t event_version(int f) const { return massive(f) ? bodies_[f].version : 0u; }
+  std::uint32_t event_version(int f) const { return massive(f) ? body(f).version : 0u; }
   // Sets the walls' motion from a state at time t (`motion` empty: each wall with mass at rest
   // on its face). Throws InputError for a motion of a face without mass, or one that is not
   // finite. Call after prepare().
@@ -126,7 +128,7 @@ class FaceWalls {
   // brings it back), the other wall of a container.
   template <class F>
   void for_each_disturbed(int f, F&& visit) const {
-    if (bodies_[f].sprung()) visit(f);
+    if (body(f).sprung()) visit(f);
     if (faces_[f].wall.joined) visit(f ^ 1);
   }
   // When the plane of a wall with mass next leaves its layer of cells (kNever if none has
@@ -164,7 +166,7 @@ class FaceWalls {
   // counted at its low wall (0 at the high one), so that the surfaces' energies add up.
   double energy(int f, double t) const {
     if (faces_[f].wall.joined && f % 2 == 1) return 0.0;
-    return bodies_[f].energy_at(t);
+    return body(f).energy_at(t);
   }
 
   // A start state's particle `id` at x: throws InputError naming the particle and the wall it
@@ -204,6 +206,9 @@ class FaceWalls {
   int next_change_face_ = -1;
   bool next_change_recheck_ = false;  // the due "change" only renews a spring's search
   double rest_position(int f) const { return f % 2 == 0 ? 0.0 : box_[f / 2]; }
+  bool own_body(int f) const { return !faces_[f].wall.joined || f % 2 == 0; }
+  int body_index(int f) const { return own_body(f) ? f : f - 1; }
+  double shift(int f) const { return own_body(f) ? 0.0 : box_[f / 2]; }
   int layer_of(int f, double x) const;
   // Sets next_change_ from time t (the bodies' motion and layers).
   void find_next_change(double t);

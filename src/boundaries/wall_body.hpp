@@ -78,15 +78,14 @@ struct WallBody {
     set(t, x, v + impulse / mass);
     ++version;
   }
-  // Its plane along a face's normal (sgn = +1 at a low face, -1 at a high one) from time t on,
-  // as the event solvers take it (times relative to t). On a spring only.
-  OscillatingPlane plane(double t, double sgn) const {
-    const double s = t - time;
-    const double e = std::exp(-spring.gamma() * s);
-    const double c = std::cos(spring.wd() * s), sn = std::sin(spring.wd() * s);
-    return {sgn * (rest + spring.sag()),
-            sgn * e * (h0 * c + b0 * sn),
-            sgn * e * (b0 * c - h0 * sn),
+  // Its plane, moved by `shift` along the axis (a container's high wall), along a face's normal
+  // (sgn = +1 at a low face, -1 at a high one) from time t on, as the event solvers take it
+  // (times relative to t). On a spring only.
+  OscillatingPlane plane(double t, double sgn, double shift = 0.0) const {
+    const auto [u, b] = spring.transient_coefficients(h0, b0, t - time);
+    return {sgn * (rest + shift + spring.sag()),
+            sgn * u,
+            sgn * b,
             spring.gamma(),
             spring.wd(),
             sgn * spring.response(),

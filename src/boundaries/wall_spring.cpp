@@ -48,28 +48,40 @@ double integral_of_product(const std::array<Mode, N>& x, const std::array<Mode, 
 
 }  // namespace
 
+SpringProblem spring_problem(const WallSpring& spring, double mass) {
+  if (!spring.on()) return SpringProblem::kNone;
+  const double k = spring.stiffness, c = spring.damping, W = spring.omega;
+  if (!(c < 2.0 * std::sqrt(k * mass))) return SpringProblem::kOverdamped;
+  if (c == 0.0 && spring.amplitude != 0.0 && std::abs(k - mass * W * W) <= 1e-9 * k)
+    return SpringProblem::kResonant;
+  return SpringProblem::kNone;
+}
+
 SpringMotion::SpringMotion(const WallSpring& spring, double mass, double accel)
     : spring_(spring), mass_(mass), accel_(accel) {
   if (!spring.on()) return;
   const double k = spring.stiffness, c = spring.damping;
+  switch (spring_problem(spring, mass)) {
+    case SpringProblem::kOverdamped:
+      throw InputError(
+          "boundary.container: the spring is critically damped or overdamped (damping " +
+          std::to_string(c) +
+          " >= 2 sqrt(stiffness mass) = " + std::to_string(2.0 * std::sqrt(k * mass)) +
+          "); only an underdamped spring is supported: lower spring_damping");
+    case SpringProblem::kResonant:
+      throw InputError(
+          "boundary.container: an undamped spring driven at its resonance (drive_frequency "
+          "equals sqrt(spring_stiffness / mass) / 2 pi) has no steady motion: its amplitude "
+          "grows without bound; give the spring some damping or drive it off resonance");
+    case SpringProblem::kNone:
+      break;
+  }
   w0_ = std::sqrt(k / mass);
   gamma_ = c / (2.0 * mass);
-  if (!(gamma_ < w0_)) {
-    throw InputError("boundary.container: the spring is critically damped or overdamped (damping " +
-                     std::to_string(c) +
-                     " >= 2 sqrt(stiffness mass) = " + std::to_string(2.0 * mass * w0_) +
-                     "); only an underdamped spring is supported: lower spring_damping");
-  }
   wd_ = std::sqrt((w0_ - gamma_) * (w0_ + gamma_));
   sag_ = accel / (w0_ * w0_);
   const double W = spring.omega;
   const Complex denominator{k - mass * W * W, c * W};
-  if (spring.amplitude != 0.0 && std::abs(denominator) == 0.0) {
-    throw InputError(
-        "boundary.container: an undamped spring driven at its resonance (drive_frequency equals "
-        "sqrt(spring_stiffness / mass) / 2 pi) has no steady motion: its amplitude grows without "
-        "bound; give the spring some damping or drive it off resonance");
-  }
   gain_ = spring.amplitude != 0.0 ? Complex{k, c * W} / denominator : Complex{1.0, 0.0};
   response_ = std::abs(gain_) * spring.amplitude;
   psi_ = std::arg(gain_);
@@ -96,6 +108,13 @@ std::pair<double, double> SpringMotion::transient_at(double x, double v, double 
   const double h0 = x - steady(t);
   const double h1 = v - steady_speed(t);
   return {h0, (h1 + gamma_ * h0) / wd_};
+}
+
+std::pair<double, double> SpringMotion::transient_coefficients(double h0, double b0,
+                                                               double s) const {
+  const double e = std::exp(-gamma_ * s);
+  const double c = std::cos(wd_ * s), sn = std::sin(wd_ * s);
+  return {e * (h0 * c + b0 * sn), e * (b0 * c - h0 * sn)};
 }
 
 double SpringMotion::transient(double h0, double b0, double s) const {

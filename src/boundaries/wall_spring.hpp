@@ -28,6 +28,12 @@ struct WallSpring {
   bool operator==(const WallSpring&) const = default;
 };
 
+// Springs that cannot be run: critically damped or overdamped (c >= 2 sqrt(k M): the event
+// search needs the underdamped transient), or undamped and driven at its resonance (within 1e-9
+// of k = M W^2: no steady motion). The reader names the keys; SpringMotion throws.
+enum class SpringProblem { kNone, kOverdamped, kResonant };
+SpringProblem spring_problem(const WallSpring& spring, double mass);
+
 // The anchor's work on the spring and dashpot, and what the dashpot dissipated, over a time.
 struct SpringWork {
   double drive = 0.0;
@@ -60,6 +66,9 @@ class SpringMotion {
   std::pair<double, double> transient_at(double x, double v, double t) const;
   // The transient's value and its derivative s after it had (h0, b0).
   double transient(double h0, double b0, double s) const;
+  // The transient's coefficients a time s after it had (h0, b0): e^(-gamma s) times (h0, b0)
+  // turned by wd s, so that from then on it is e^(-gamma r) (h cos(wd r) + b sin(wd r)).
+  std::pair<double, double> transient_coefficients(double h0, double b0, double s) const;
   double transient_speed(double h0, double b0, double s) const;
   // Its mechanical energy at displacement x, speed v, time t.
   double energy(double x, double v, double t) const;

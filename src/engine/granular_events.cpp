@@ -251,14 +251,13 @@ void EventEngine<D, Queue>::check_massive_walls(const ParticleSystem<D>& s, Star
   if (soft_) refuse("soft spheres yet (soft.model)");
   if (sheared_) refuse("Lees-Edwards shear yet (boundary.shear_rate)");
   if (mode != StartMode::kResume) return;
-  for (int f = 0; f < boundaries_.surfaces(); ++f) {
-    if (!boundaries_.is_surface(f) || !boundaries_.massive(f)) continue;
-    const bool held =
-        std::any_of(s.wall_motion.begin(), s.wall_motion.end(),
-                    [&](const WallMotion& m) { return m.face == static_cast<std::uint32_t>(f); });
+  // Every motion this run keeps (one per body: a container's is its low wall's).
+  for (const WallMotion& own : boundaries_.motion()) {
+    const bool held = std::any_of(s.wall_motion.begin(), s.wall_motion.end(),
+                                  [&](const WallMotion& m) { return m.face == own.face; });
     if (!held) {
       throw InputError("cannot resume: the state holds no motion of the wall with mass at face " +
-                       boundaries_.name(f) +
+                       boundaries_.name(static_cast<int>(own.face)) +
                        " (it was written by a run without it; start from it afresh instead)");
     }
   }

@@ -8,6 +8,8 @@
 // "file" or "override 'key=value'".
 #include "io/config.hpp"
 
+#include "boundaries/wall_spring.hpp"
+
 #include "interactions/parameter_domain.hpp"
 
 #include <fmt/format.h>
@@ -849,7 +851,10 @@ class Reader : public KeyReader {
       }
       return;
     }
-    const int axis = static_cast<int>(axes(c.system.dimension).at(box.axis));
+    if (!axes(c.system.dimension).contains(box.axis)) {
+      refuse("axis", fmt::format("'{}' is not an axis of the box ({})", box.axis,
+                                 axes(c.system.dimension).names(", ", " or ")));
+    }
     const std::string lo = fmt::format("{}-", box.axis), hi = fmt::format("{}+", box.axis);
     for (const std::string& face : {lo, hi}) {
       const auto wall = std::find_if(c.boundary.walls.begin(), c.boundary.walls.end(),
@@ -860,35 +865,42 @@ class Reader : public KeyReader {
                                    lo, hi, face, face));
       }
       const std::size_t k = static_cast<std::size_t>(wall - c.boundary.walls.begin());
+      const bool slides = std::any_of(wall->velocity.begin(), wall->velocity.end(),
+                                      [](double u) { return u != 0.0; });
       const bool moves = wall->mass != 0.0 || wall->force != 0.0 ||
-                         (wall->amplitude > 0.0 && wall->frequency > 0.0) ||
-                         (axis < static_cast<int>(wall->velocity.size()) &&
-                          wall->velocity[static_cast<std::size_t>(axis)] != 0.0);
+                         (wall->amplitude > 0.0 && wall->frequency > 0.0) || slides;
       if (moves) {
         refuse("axis", fmt::format("the container moves its walls; boundary.wall[{}] ({}) must "
-                                   "not have a mass, force, vibration or normal velocity of its "
-                                   "own",
+                                   "not have a mass, force, vibration or velocity of its own",
                                    k, face));
       }
     }
     if (!(box.mass > 0.0)) refuse("mass", "a container needs its mass (> 0)");
     const double k = box.spring_stiffness, damping = box.spring_damping;
-    if (k == 0.0 && (damping != 0.0 || box.drive_amplitude != 0.0)) {
-      refuse(damping != 0.0 ? "spring_damping" : "drive_amplitude",
-             "needs a spring (boundary.container.spring_stiffness > 0)");
+    if (k == 0.0) {
+      for (const auto& [name, value] :
+           {std::pair{"spring_damping", damping}, std::pair{"drive_amplitude", box.drive_amplitude},
+            std::pair{"drive_frequency", box.drive_frequency},
+            std::pair{"drive_phase", box.drive_phase}}) {
+        if (value != 0.0) refuse(name, "needs a spring (boundary.container.spring_stiffness > 0)");
+      }
     }
-    if (k > 0.0 && !(damping < 2.0 * std::sqrt(k * box.mass))) {
-      refuse("spring_damping",
-             fmt::format("{} is at or above critical damping 2 sqrt(k M) = {:.6g}: only an "
-                         "underdamped spring is supported",
-                         damping, 2.0 * std::sqrt(k * box.mass)));
-    }
-    const double w = 2.0 * std::numbers::pi * box.drive_frequency;
-    if (k > 0.0 && damping == 0.0 && box.drive_amplitude > 0.0 &&
-        std::abs(k - box.mass * w * w) <= 1e-9 * k) {
-      refuse("drive_frequency",
-             "drives an undamped spring at its resonance sqrt(k / M) / 2 pi: its amplitude would "
-             "grow without bound (add spring_damping or move the frequency)");
+    const WallSpring spring{k, damping, box.drive_amplitude,
+                            2.0 * std::numbers::pi * box.drive_frequency, box.drive_phase};
+    switch (spring_problem(spring, box.mass)) {
+      case SpringProblem::kOverdamped:
+        refuse("spring_damping",
+               fmt::format("{} is at or above critical damping 2 sqrt(k M) = {:.6g}: only an "
+                           "underdamped spring is supported",
+                           damping, 2.0 * std::sqrt(k * box.mass)));
+        return;
+      case SpringProblem::kResonant:
+        refuse("drive_frequency",
+               "drives an undamped spring at its resonance sqrt(k / M) / 2 pi: its amplitude "
+               "would grow without bound (add spring_damping or move the frequency)");
+        return;
+      case SpringProblem::kNone:
+        break;
     }
     const auto conflict = [&](std::string_view other, std::string_view why) {
       const toml::node* n = node_at(root, other);

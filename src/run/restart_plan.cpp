@@ -179,26 +179,26 @@ void check_wall_masses_stay(const Config& before, const Config& now,
         "restart file '{}': the wall on face {} {} mass (boundary.wall.mass or "
         "boundary.container) in the run that wrote it and {} now: a wall cannot gain or lose "
         "its mass during a run (its motion is part of the state, and thermo.tsv's columns "
-        "would change); start a new run from the state with system.initial_state = \"{}\"",
+        "would change); start a new run from the state with system.initial_state = \"{}\" "
+        "(its walls then start on their faces: grains that a moved wall holds beyond its face "
+        "make that start fail)",
         restart_file, face, was ? "had" : "had no", is ? "has" : "has none", restart_file));
   }
+  const auto described = [&](const Config& c) {
+    return c.boundary.container.axis.empty()
+               ? std::string("none")
+               : fmt::format("along {}{}", c.boundary.container.axis,
+                             sprung(c) ? " on a spring" : " without a spring");
+  };
   if (before.boundary.container.axis != now.boundary.container.axis ||
       sprung(before) != sprung(now)) {
     throw InputError(fmt::format(
-        "restart file '{}': boundary.container {} in the run that wrote it and {} now: a "
+        "restart file '{}': boundary.container was {} in the run that wrote it and is {} now: a "
         "container cannot change its axis, or gain or lose its spring, during a run "
         "(thermo.tsv's columns would change); start a new run from the state with "
-        "system.initial_state = \"{}\"",
-        restart_file,
-        before.boundary.container.axis.empty()
-            ? "was none"
-            : fmt::format("was along {}{}", before.boundary.container.axis,
-                          sprung(before) ? " on a spring" : " without a spring"),
-        now.boundary.container.axis.empty()
-            ? "none"
-            : fmt::format("along {}{}", now.boundary.container.axis,
-                          sprung(now) ? " on a spring" : " without a spring"),
-        restart_file));
+        "system.initial_state = \"{}\" (its walls then start on their faces: grains that a "
+        "moved container holds beyond them make that start fail)",
+        restart_file, described(before), described(now), restart_file));
   }
 }
 

@@ -100,7 +100,7 @@ class SpringContainer(kt.KairosTestCase):
         second, _ = self.assert_split_ends_as_whole(
             half, full, ["kairos/state/wall_motion", "kairos/state/wall_spring"])
         spring = kt.restart_chunk(os.path.join(second, "restart.gsd"), "kairos/state/wall_spring")
-        self.assertEqual(spring.shape, (2, 9))  # both walls; docs/outputs.md
+        self.assertEqual(spring.shape, (1, 9))  # one body, at its low wall; docs/outputs.md
         self.assertEqual(spring[0][1], 2000.0)
         faster = damper(run={"equilibration_time": 0.0, "time": 3.0})
         faster["boundary"]["container"]["drive_frequency"] = 0.8
@@ -157,6 +157,16 @@ class SpringContainer(kt.KairosTestCase):
                                             "drive_amplitude": 1.0}}),
              ["boundary.container.drive_amplitude", "needs a spring"]),
             (soft, ["soft.model", "container"]),
+            (damper(boundary={"wall": [{"face": "z-"}, {"face": "z+"}],
+                              "container": {"axis": "q", "mass": 2.0}}),
+             ["boundary.container.axis", "'q' is not an axis"]),
+            (damper(boundary={"wall": [{"face": "z-", "velocity": [0.5, 0.0, 0.0]},
+                                       {"face": "z+"}],
+                              "container": {"axis": "z", "mass": 2.0}}),
+             ["boundary.container.axis", "must not have a mass, force, vibration or velocity"]),
+            (damper(boundary={"wall": [{"face": "z-"}, {"face": "z+"}],
+                              "container": {"axis": "z", "mass": 2.0, "drive_frequency": 1.0}}),
+             ["boundary.container.drive_frequency", "needs a spring"]),
         ]
         for k, (cfg, needles) in enumerate(cases):
             with self.subTest(case=k):
