@@ -50,6 +50,9 @@ struct SystemConfig {
   // fraction of the added space below them: 0 at the low end (the default), 1 at the high end
   // (grains poured into a funnel from above), 0.5 centred. Empty = all 0.
   std::vector<double> box_place;
+  // Generated states only: particles that a plane, cylinder or sphere wall cuts through, or
+  // that lie beyond one, are moved to random free places inside every wall.
+  bool fill_inside = false;
   // Molecules: with chain_length L > 0, the particles form N / L linear chains of L beads each
   // (consecutive particles bonded), generated on a simple cubic (3D) or square (2D) lattice of
   // spacing chain_spacing (0: the largest diameter) along a snake path. Bonds use [bond].

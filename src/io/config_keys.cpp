@@ -115,6 +115,11 @@ constexpr KeyDecl kSystem[] = {
      .doc = "generated states: where the particles sit in the box box_scale stretched, as the "
             "fraction of the added space below them (0: at the low end, 1: at the high end)",
      .fill = 0.0},
+    {.name = "fill_inside",
+     .type = KeyType::kBoolean,
+     .member = field<&SystemConfig::fill_inside>,
+     .doc = "generated states: particles outside a plane, cylinder or sphere wall are moved to "
+            "random free places inside every wall"},
     {.name = "chain_length",
      .type = KeyType::kUnsigned,
      .member = field<&SystemConfig::chain_length>,

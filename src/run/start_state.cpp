@@ -12,10 +12,13 @@
 
 #include "core/error.hpp"
 #include "core/periodic.hpp"
+#include "core/stop_flag.hpp"
 #include "init/initial_state.hpp"
 #include "init/initial_state_file.hpp"
 #include "io/config_choices.hpp"
 #include "io/gsd_file.hpp"
+#include "model/boundaries.hpp"
+#include "run/environment_setup.hpp"
 
 namespace kairos {
 
@@ -186,6 +189,104 @@ void add_shear_flow(const Config& config, InitialState<D>& init) {
     init.velocity[i][0] += rate * (init.position[i][1] - 0.5 * init.box[1]);
 }
 
+// system.fill_inside: every particle that a wall other than the box's faces (a plane, a
+// cylinder, a sphere) cuts through, or that lies beyond one, is moved to a random free place
+// inside every wall: uniform over the box, accepted where it is at least its radius from every
+// surface and apart from every particle already in place (a cell grid as wide as the largest
+// diameter finds them). InputError naming the key when some particle finds no such place.
+template <int D>
+void move_inside_walls(const Config& config, ParticleSystem<D>& s, std::mt19937_64& rng) {
+  const Environment<D> env = make_environment<D>(config, s);
+  const Boundaries<D> walls(env, s.box);
+  const std::array<bool, D> periodic = periodic_axes<D>(config);
+  const auto inside = [&](const Vec<D>& x, double r) {
+    for (int k = 0; k < walls.surfaces(); ++k)
+      if (walls.is_surface(k) && !(walls.gap(k, x, 0.0) >= r)) return false;
+    return true;
+  };
+  double dmax = 0.0;
+  for (const Kinematics<D>& k : s.kinematics) dmax = std::max(dmax, 2.0 * k.radius);
+  std::array<int, D> cells{};
+  for (int a = 0; a < D; ++a) cells[a] = std::max(1, static_cast<int>(s.box[a] / dmax));
+  const auto cell_of = [&](const Vec<D>& x) {
+    std::array<int, D> c{};
+    for (int a = 0; a < D; ++a)
+      c[a] = std::clamp(static_cast<int>(std::floor(x[a] / s.box[a] * cells[a])), 0, cells[a] - 1);
+    return c;
+  };
+  const auto index = [&](const std::array<int, D>& c) {
+    std::size_t i = 0;
+    for (int a = D - 1; a >= 0; --a) i = i * static_cast<std::size_t>(cells[a]) + c[a];
+    return i;
+  };
+  std::size_t total = 1;
+  for (int a = 0; a < D; ++a) total *= static_cast<std::size_t>(cells[a]);
+  std::vector<std::vector<std::uint32_t>> grid(total);
+  std::vector<std::uint32_t> outside;
+  for (std::uint32_t i = 0; i < s.kinematics.size(); ++i) {
+    const Kinematics<D>& k = s.kinematics[i];
+    if (inside(k.pos, k.radius)) {
+      grid[index(cell_of(k.pos))].push_back(i);
+    } else {
+      outside.push_back(i);
+    }
+  }
+  // Apart from every particle in place: the 3^D cells around x (wrapped on periodic axes).
+  const auto free_at = [&](const Vec<D>& x, double r) {
+    const std::array<int, D> c = cell_of(x);
+    std::array<int, D> d{};
+    d.fill(-1);
+    while (true) {
+      std::array<int, D> n{};
+      bool valid = true;
+      for (int a = 0; a < D; ++a) {
+        n[a] = c[a] + d[a];
+        if (periodic[a]) n[a] = (n[a] + cells[a]) % cells[a];
+        valid = valid && n[a] >= 0 && n[a] < cells[a];
+      }
+      if (valid) {
+        for (const std::uint32_t j : grid[index(n)]) {
+          double d2 = 0.0;
+          for (int a = 0; a < D; ++a) {
+            double dx = x[a] - s.kinematics[j].pos[a];
+            if (periodic[a]) dx = minimum_image(dx, s.box[a]);
+            d2 += dx * dx;
+          }
+          const double contact = r + s.kinematics[j].radius;
+          if (d2 < contact * contact) return false;
+        }
+      }
+      int a = 0;
+      while (a < D && ++d[a] > 1) d[a] = -1, ++a;
+      if (a == D) return true;
+    }
+  };
+  constexpr long kTries = 1000000;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (std::size_t moved = 0; moved < outside.size(); ++moved) {
+    const std::uint32_t i = outside[moved];
+    Kinematics<D>& k = s.kinematics[i];
+    bool placed = false;
+    for (long t = 0; t < kTries && !placed; ++t) {
+      if ((t & 0xfff) == 0xfff) throw_if_stop_requested();
+      Vec<D> x;
+      for (int a = 0; a < D; ++a) x[a] = unit(rng) * s.box[a];
+      if (!inside(x, k.radius) || !free_at(x, k.radius)) continue;
+      k.pos = x;
+      grid[index(cell_of(x))].push_back(i);
+      placed = true;
+    }
+    if (!placed) {
+      throw InputError(fmt::format(
+          "system.fill_inside: no free place inside the walls for particle {} after {} random "
+          "tries ({} of the {} particles the walls cut off were moved inside): there is not "
+          "enough room inside them at system.packing_fraction = {}; lower it, or widen the box "
+          "with system.box_scale",
+          i, kTries, moved, outside.size(), config.system.packing_fraction));
+    }
+  }
+}
+
 }  // namespace
 
 template <int D>
@@ -257,7 +358,9 @@ ParticleSystem<D> build_start_state(const Config& config,
   check_no_overlap<D>(init, periodic, "generated initial state", /*exact=*/true);
   make_room_for_walls(config, init);
   add_shear_flow(config, init);
-  return to_particle_system<D>(std::move(init));
+  ParticleSystem<D> state = to_particle_system<D>(std::move(init));
+  if (config.system.fill_inside) move_inside_walls(config, state, rng);
+  return state;
 }
 
 template ParticleSystem<2> build_start_state<2>(const Config&, const std::optional<fs::path>&,
