@@ -38,13 +38,15 @@ import tempfile
 import gsd.hoomd
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "plot"))
+import kairos_output as ko  # noqa: E402  (the examples' own reader)
+
 
 def read_thermo(path):
-    with open(path) as f:
-        lines = [line for line in f.read().splitlines() if line]
-    header = lines[0].split("\t")
-    rows = [line.split("\t") for line in lines[1:] if line.startswith("production")]
-    return lambda name: np.array([float(r[header.index(name)]) for r in rows])
+    """The production rows of thermo.tsv, by column name."""
+    thermo = ko.read_tsv(path)
+    production = thermo["phase"] == "production"
+    return lambda name: thermo[name][production]
 
 
 def run(kairos, path, text):

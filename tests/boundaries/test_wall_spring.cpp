@@ -11,6 +11,7 @@
 #include "../interactions/input_error_matchers.hpp"
 #include "boundaries/wall_body.hpp"
 #include "core/error.hpp"
+#include "spring_reference.hpp"
 
 namespace kairos {
 namespace {
@@ -23,26 +24,10 @@ struct Case {
 // M = 2, k = 50 (w0 = 5), c = 3 (gamma = 0.75), anchor 0.4 sin(3 t + 0.2), field -1.
 const Case kCase{{50.0, 3.0, 0.4, 3.0, 0.2}, 2.0, -1.0};
 
-// Runge-Kutta 4 of the equation of motion from (x, v) at t0 to t1, in n steps.
+// The reference integration (spring_reference.hpp) for this case.
 std::pair<double, double> integrate(const Case& c, double t0, double x, double v, double t1,
                                     int n) {
-  const WallSpring& s = c.spring;
-  const auto accel = [&](double t, double x_, double v_) {
-    const double a = s.amplitude * std::sin(s.omega * t + s.phase);
-    const double da = s.amplitude * s.omega * std::cos(s.omega * t + s.phase);
-    return (-s.stiffness * (x_ - a) - s.damping * (v_ - da)) / c.mass + c.accel;
-  };
-  const double h = (t1 - t0) / n;
-  for (int i = 0; i < n; ++i) {
-    const double t = t0 + i * h;
-    const double k1x = v, k1v = accel(t, x, v);
-    const double k2x = v + 0.5 * h * k1v, k2v = accel(t + 0.5 * h, x + 0.5 * h * k1x, k2x);
-    const double k3x = v + 0.5 * h * k2v, k3v = accel(t + 0.5 * h, x + 0.5 * h * k2x, k3x);
-    const double k4x = v + h * k3v, k4v = accel(t + h, x + h * k3x, k4x);
-    x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
-    v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
-  }
-  return {x, v};
+  return testing::integrate_spring(c.spring, c.mass, c.accel, t0, x, v, t1, n);
 }
 
 WallBody body_of(const Case& c, double rest) {

@@ -58,6 +58,36 @@ ParticleSystem<D> lattice_system(int n, double eta, std::uint64_t seed, double m
   return s;
 }
 
+// Walls on the faces of the last axis (the others periodic), every contact (particles and
+// walls) of restitution e, under `gravity` along that axis: the set-up that walls with mass
+// and containers are given their mass in.
+template <int D>
+Environment<D> walls_on_last_axis(double e = 1.0, double gravity = 0.0) {
+  Environment<D> env;
+  ContactModel law;
+  law.normal = NormalRestitution::constant(e);
+  if (e != 1.0) {
+    env.species = 2;
+    env.contact.assign(4, law);
+  }
+  env.gravity[D - 1] = gravity;
+  for (int f = 2 * D - 2; f < 2 * D; ++f) {
+    env.faces[f].kind = FaceKind::kWall;
+    env.faces[f].wall.contact = law;
+  }
+  return env;
+}
+
+// The lattice gas moved half a spacing up each axis, so that no particle touches walls on the
+// faces of the last axis (walls with mass, containers).
+template <int D>
+ParticleSystem<D> gas_between_walls(int n, double eta, std::uint64_t seed) {
+  ParticleSystem<D> s = lattice_system<D>(n, eta, seed);
+  for (Kinematics<D>& k : s.kinematics)
+    for (int a = 0; a < D; ++a) k.pos[a] += 0.25 * s.box[a] / n;
+  return s;
+}
+
 // A container under gravity -1 along the last axis: walls on the sides and a floor, an open
 // top, every contact (pairs of `species` species and walls) of restitution e, the TC model's tc.
 template <int D>

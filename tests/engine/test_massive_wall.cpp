@@ -35,32 +35,13 @@ constexpr int kLid3 = 5;  // z+ in 3D
 // pushed into the box by `force`; every contact of restitution e.
 template <int D>
 Environment<D> piston(double mass, double force, double e = 1.0, double gravity = 0.0) {
-  Environment<D> env;
-  ContactModel law;
-  law.normal = NormalRestitution::constant(e);
-  if (e != 1.0) {
-    env.species = 2;
-    env.contact.assign(4, law);
-  }
-  env.gravity[D - 1] = gravity;
-  for (int f = 2 * D - 2; f < 2 * D; ++f) {
-    env.faces[f].kind = FaceKind::kWall;
-    env.faces[f].wall.contact = law;
-  }
+  Environment<D> env = testing::walls_on_last_axis<D>(e, gravity);
   env.faces[2 * D - 1].wall.mass = mass;
   env.faces[2 * D - 1].wall.force = force;
   return env;
 }
 
-// The fixture's lattice gas moved half a spacing up each axis, so that no particle touches the
-// walls of the last axis.
-template <int D>
-ParticleSystem<D> gas_between_walls(int n, double eta, std::uint64_t seed) {
-  ParticleSystem<D> s = testing::lattice_system<D>(n, eta, seed);
-  for (Kinematics<D>& k : s.kinematics)
-    for (int a = 0; a < D; ++a) k.pos[a] += 0.25 * s.box[a] / n;
-  return s;
-}
+using testing::gas_between_walls;
 
 // The wall's mechanical energy plus the particles' kinetic and field energy.
 template <class EngineType>

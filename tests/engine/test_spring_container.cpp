@@ -11,8 +11,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 #include <vector>
 
+#include "../boundaries/spring_reference.hpp"
 #include "engine/event_engine.hpp"
 #include "engine_fixtures.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -28,17 +30,8 @@ using Engine = EventEngine<D, CalendarQueue>;
 template <int D>
 Environment<D> container(double mass, const WallSpring& spring, double e = 1.0,
                          double gravity = 0.0) {
-  Environment<D> env;
-  ContactModel law;
-  law.normal = NormalRestitution::constant(e);
-  if (e != 1.0) {
-    env.species = 2;
-    env.contact.assign(4, law);
-  }
-  env.gravity[D - 1] = gravity;
+  Environment<D> env = testing::walls_on_last_axis<D>(e, gravity);
   for (int f = 2 * D - 2; f < 2 * D; ++f) {
-    env.faces[f].kind = FaceKind::kWall;
-    env.faces[f].wall.contact = law;
     env.faces[f].wall.mass = mass;
     env.faces[f].wall.joined = true;
     env.faces[f].wall.spring = spring;
@@ -46,13 +39,7 @@ Environment<D> container(double mass, const WallSpring& spring, double e = 1.0,
   return env;
 }
 
-template <int D>
-ParticleSystem<D> gas_between_walls(int n, double eta, std::uint64_t seed) {
-  ParticleSystem<D> s = testing::lattice_system<D>(n, eta, seed);
-  for (Kinematics<D>& k : s.kinematics)
-    for (int a = 0; a < D; ++a) k.pos[a] += 0.25 * s.box[a] / n;
-  return s;
-}
+using testing::gas_between_walls;
 
 // Grains (kinetic, rotational, field) + the container's energy (at its low wall) + what the
 // dashpot and the collisions dissipated - what the anchor put in: constant.
@@ -181,25 +168,12 @@ TEST(SpringContainer, AnUntouchedContainerSwingsAsTheSpringAlone) {
   Engine<2> engine(s, StartMode::kPredict, EngineOptions{}, container<2>(20.0, spring));
   const FaceWalls<2>& walls = engine.boundaries().faces();
   double x = 0.0, v = 0.0, t = 0.0;
-  const auto accel = [&](double tt, double xx, double vv) {
-    const double a = 1.5 * std::sin(1.7 * tt + 0.3), da = 1.5 * 1.7 * std::cos(1.7 * tt + 0.3);
-    return (-80.0 * (xx - a) - 2.0 * (vv - da)) / 20.0;
-  };
   std::uint64_t layers = 0;
   while (engine.time() < 30.0) {
     ASSERT_EQ(engine.step(), EventKind::kWallLayer);
     ++layers;
     const double t1 = engine.time();
-    const int n = 2000;
-    const double h = (t1 - t) / n;
-    for (int i = 0; i < n; ++i, t += h) {
-      const double k1x = v, k1v = accel(t, x, v);
-      const double k2x = v + 0.5 * h * k1v, k2v = accel(t + 0.5 * h, x + 0.5 * h * k1x, k2x);
-      const double k3x = v + 0.5 * h * k2v, k3v = accel(t + 0.5 * h, x + 0.5 * h * k2x, k3x);
-      const double k4x = v + h * k3v, k4v = accel(t + h, x + h * k3x, k4x);
-      x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
-      v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
-    }
+    std::tie(x, v) = testing::integrate_spring(spring, 20.0, 0.0, t, x, v, t1, 2000);
     t = t1;
     ASSERT_NEAR(walls.position(2, t1), x, 1e-8) << t1;
     ASSERT_NEAR(walls.body(2).speed_at(t1), v, 1e-8) << t1;

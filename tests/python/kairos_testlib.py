@@ -265,6 +265,15 @@ class KairosTestCase(unittest.TestCase):
                                           err_msg=name)
         return second, whole
 
+    def assert_refused_cases(self, cases):
+        """Each (config, needles) of `cases` is refused with one error line naming every
+        needle (assert_user_error), each as its own subtest."""
+        for k, (cfg, needles) in enumerate(cases):
+            with self.subTest(case=k):
+                result = self.kairos("run", self.write_config(cfg, "bad%d.toml" % k), "-o",
+                                     self.path("bad%d" % k))
+                self.assert_user_error(result, *needles)
+
     def summary(self, outdir):
         with open(os.path.join(outdir, "summary.json")) as f:
             return json.load(f)

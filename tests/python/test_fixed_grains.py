@@ -159,11 +159,7 @@ class FixedGrains(kt.KairosTestCase):
         every = matrix_config()
         every["system"]["species"][0]["fixed"] = True
         cases.append((every, ["system.species[1].fixed", "nothing would move"]))
-        for k, (cfg, needles) in enumerate(cases):
-            with self.subTest(case=k):
-                result = self.kairos("run", self.write_config(cfg, "bad%d.toml" % k), "-o",
-                                     self.path("bad%d" % k))
-                self.assert_user_error(result, *needles)
+        self.assert_refused_cases(cases)
 
     def test_a_lorentz_gas_measured_in_collisions_is_refused(self):
         # Its tracers (here of diameter 1e-5) hardly meet each other, and only those meetings
