@@ -1,19 +1,21 @@
 #!/usr/bin/env python3
 """The rotating drum (examples/rotating_drum_2d.toml) run by both integrators on the same drum and
-grains (docs/validation.md, "Cylinder walls and a rotating drum"): the event-driven engine with
+grains (docs/validation.md, "The rotating drum against the DEM"): the event-driven engine with
 hard rough disks (restitution e = 0.8, Coulomb friction mu = 0.5, Walton's sticking restitution
 beta0 = 0.4; the TC model at tc = 1e-5, and at the example's 1e-3 for contrast) and the DEM with soft disks (a linear spring-dashpot of the same e at stiffness
 k = 10^5 m g / d, Coulomb friction mu = 0.5 with a tangential spring, k_t / k_n = 2/7).
 300 disks in a drum of radius 23.5 turning at omega = 0.1 under g = 1 (Froude number
-omega^2 R / g = 0.23: the rolling regime).
+omega^2 R / g = 0.23, in the cascading range: the surface is curved, grains are carried high up
+the rising wall).
 
 Measured in the second half of each run (frames every 2 time units), for each integrator:
-- the bed's tilt: the direction of its centre of mass from the axis, against the downward
-  vertical. For a bed bounded by a flat free surface this is the surface's slope, the dynamic
-  angle of repose (the centre of mass of a circular segment lies on the perpendicular to its
-  chord through the centre);
-- the flowing layer: the disks' velocity along the free surface against their depth below it,
-  on the perpendicular to the surface through the axis (a strip 4 diameters wide);
+- the free surface's slope over the middle of the bed (free_surface: a line fitted to the
+  columns' 90th-percentile heights), the dynamic angle of repose;
+- the bed's tilt: the direction of its centre of mass from the axis against the downward
+  vertical (for a flat surface it would equal the slope; here the curved surface and the grains
+  carried up the wall make it larger);
+- the flowing layer: the disks' velocity along the fitted surface against their depth below it,
+  in a strip 4 diameters wide across the surface through its point nearest the axis;
 - the cost: the wall time of the run.
 
     python3 examples/validation/drum_event_vs_dem.py build/kairos [seeds] [-o drum.png]
@@ -63,9 +65,25 @@ def run(kairos, tmp, name, text):
     return out, time.monotonic() - start
 
 
+def free_surface(x):
+    """The free surface of one frame as a line y = a + b x (relative to the axis): in columns 2
+    wide across the middle of the drum (|x| < 0.6 R), the height below which 90 % of the
+    column's disks lie, fitted by least squares."""
+    xs, ys = [], []
+    for left in np.arange(-0.6 * RADIUS, 0.6 * RADIUS, 2.0):
+        column = x[(x[:, 0] >= left) & (x[:, 0] < left + 2.0)]
+        if len(column) >= 5:
+            xs.append(left + 1.0)
+            ys.append(np.percentile(column[:, 1], 90.0))
+    b, a = np.polyfit(xs, ys, 1)
+    return a, b
+
+
 def measure(out):
-    """Tilt (degrees) per frame of the second half, and (depth, speed along the surface) pairs."""
-    tilts, samples = [], []
+    """Per frame of the second half: the free surface's slope and the bed's tilt (degrees), and
+    (depth below the surface, speed along it downhill) of the disks in a strip 4 wide across the
+    surface through the point nearest the axis."""
+    slopes, tilts, samples = [], [], []
     with gsd.hoomd.open(os.path.join(out, "trajectory.gsd"), "rb") as f:
         frames = list(f)
     for frame in frames[len(frames) // 2:]:
@@ -73,31 +91,18 @@ def measure(out):
         x = frame.particles.position[:, :2].astype(np.float64) + 0.5 * box - CENTER
         v = frame.particles.velocity[:, :2].astype(np.float64)
         com = x.mean(axis=0)
-        tilt = math.atan2(com[0], -com[1])
-        tilts.append(math.degrees(tilt))
-        # The surface's unit normal (up, out of the bed) and its downhill direction.
-        normal = np.array([-math.sin(tilt), math.cos(tilt)])
-        downhill = np.array([-normal[1], normal[0]]) * (1.0 if tilt > 0 else -1.0)
-        # The surface's height along the normal: the chord of a segment holding the bed's area.
-        area = len(x) * math.pi / 4.0 / 0.82  # disks at a packing fraction of about 0.82
-        h = surface_offset(area)
-        along = x @ downhill
-        depth = h - x @ normal
+        tilts.append(math.degrees(math.atan2(com[0], -com[1])))
+        a, b = free_surface(x)
+        slopes.append(math.degrees(math.atan(b)))
+        norm = math.hypot(1.0, b)
+        normal = np.array([-b, 1.0]) / norm  # up, out of the bed
+        downhill = -math.copysign(1.0, b) * np.array([1.0, b]) / norm
+        foot = a * normal / norm  # the surface's point nearest the axis
+        depth = (x - foot) @ -normal
+        along = (x - foot) @ downhill
         strip = np.abs(along) < 2.0
-        for d, u in zip(depth[strip], (v @ downhill)[strip]):
-            samples.append((d, u))
-    return np.array(tilts), np.array(samples)
-
-
-def surface_offset(area):
-    """Height h of the chord (along the normal, from the axis) below which the drum holds this
-    area: R^2 acos(-h/R) + h sqrt(R^2 - h^2) = area, by bisection."""
-    lo, hi = -RADIUS, RADIUS
-    for _ in range(100):
-        mid = 0.5 * (lo + hi)
-        below = RADIUS ** 2 * math.acos(-mid / RADIUS) + mid * math.sqrt(RADIUS ** 2 - mid ** 2)
-        lo, hi = (mid, hi) if below < area else (lo, mid)
-    return 0.5 * (lo + hi)
+        samples.extend(zip(depth[strip], (v @ downhill)[strip]))
+    return np.array(slopes), np.array(tilts), np.array(samples)
 
 
 def profile(samples, edges):
@@ -125,20 +130,20 @@ def main():
         for seed in range(1, args.seeds + 1):
             for kind, text in configs(example, seed, args.time).items():
                 out, seconds = run(kairos, tmp, f"{kind}{seed}", text)
-                tilts, samples = measure(out)
-                results[kind].append((tilts, samples, seconds))
+                slopes, tilts, samples = measure(out)
+                results[kind].append((slopes, tilts, samples, seconds))
         edges = np.arange(-1.0, 14.0, 1.0)
-        print("integrator    tilt (deg)        surface speed   wall s per run")
+        print("integrator    surface slope (deg)   bed tilt (deg)   wall s per run")
         curves = {}
         for kind, runs in results.items():
-            per_run = np.array([t.mean() for t, _, _ in runs])
-            error = per_run.std(ddof=1) / math.sqrt(len(per_run)) if len(per_run) > 1 else 0.0
-            samples = np.concatenate([s for _, s, _ in runs])
-            centres, means = profile(samples, edges)
-            curves[kind] = (centres, means)
-            top = means[np.argmin(np.abs(centres - 0.5))] if len(means) else float("nan")
-            print(f"{kind:12s}  {per_run.mean():6.2f} +- {error:4.2f}    {top:8.3f}       "
-                  f"{np.mean([s for _, _, s in runs]):6.1f}")
+            slope = np.array([r[0].mean() for r in runs])
+            tilt = np.array([r[1].mean() for r in runs])
+            spread = (lambda a: a.std(ddof=1) / math.sqrt(len(a)) if len(a) > 1 else 0.0)
+            samples = np.concatenate([r[2] for r in runs])
+            curves[kind] = profile(samples, edges)
+            print(f"{kind:12s}  {slope.mean():6.2f} +- {spread(slope):4.2f}       "
+                  f"{tilt.mean():6.2f} +- {spread(tilt):4.2f}   {np.mean([r[3] for r in runs]):6.1f}")
+        print("(+- : the standard error over the seeds)")
         print("\ndepth   speed along the surface (event, event tc = 1e-3, dem)")
         for d in edges[:-1] + 0.5:
             row = [curves[k][1][np.argmin(np.abs(curves[k][0] - d))]

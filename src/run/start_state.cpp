@@ -196,6 +196,19 @@ void add_shear_flow(const Config& config, InitialState<D>& init) {
 // diameter finds them). InputError naming the key when some particle finds no such place.
 template <int D>
 void move_inside_walls(const Config& config, ParticleSystem<D>& s, std::mt19937_64& rng) {
+  // Moved one by one, a chain's beads would leave their bonds; moved across the shear's
+  // gradient, a particle would keep the flow velocity of its old height.
+  if (!s.bonds.empty()) {
+    throw InputError(
+        "system.fill_inside: cannot move the beads of chains (system.chain_length) inside the "
+        "walls one by one: their bonds would break; place the chains with system.box_scale and "
+        "system.box_place instead");
+  }
+  if (config.boundary.shear_rate != 0.0) {
+    throw InputError(
+        "system.fill_inside: cannot be combined with Lees-Edwards shear (boundary.shear_rate): "
+        "a moved particle would keep the flow velocity of its old height");
+  }
   const Environment<D> env = make_environment<D>(config, s);
   const Boundaries<D> walls(env, s.box);
   const std::array<bool, D> periodic = periodic_axes<D>(config);
@@ -206,8 +219,15 @@ void move_inside_walls(const Config& config, ParticleSystem<D>& s, std::mt19937_
   };
   double dmax = 0.0;
   for (const Kinematics<D>& k : s.kinematics) dmax = std::max(dmax, 2.0 * k.radius);
+  // Cells at least the largest diameter wide, and no more than about 4 N of them (a box
+  // stretched far by box_scale would otherwise need a cell per diameter of empty space).
+  double wanted = 1.0;
+  for (int a = 0; a < D; ++a) wanted *= std::max(1.0, s.box[a] / dmax);
+  const double shrink = std::max(
+      1.0, std::pow(wanted / (4.0 * static_cast<double>(s.kinematics.size()) + 64.0), 1.0 / D));
   std::array<int, D> cells{};
-  for (int a = 0; a < D; ++a) cells[a] = std::max(1, static_cast<int>(s.box[a] / dmax));
+  for (int a = 0; a < D; ++a)
+    cells[a] = std::max(1, static_cast<int>(std::min(s.box[a] / dmax / shrink, 1e6)));
   const auto cell_of = [&](const Vec<D>& x) {
     std::array<int, D> c{};
     for (int a = 0; a < D; ++a)
@@ -280,8 +300,8 @@ void move_inside_walls(const Config& config, ParticleSystem<D>& s, std::mt19937_
       throw InputError(fmt::format(
           "system.fill_inside: no free place inside the walls for particle {} after {} random "
           "tries ({} of the {} particles the walls cut off were moved inside): there is not "
-          "enough room inside them at system.packing_fraction = {}; lower it, or widen the box "
-          "with system.box_scale",
+          "enough room inside them at system.packing_fraction = {}; lower it (or give the "
+          "walls more room inside)",
           i, kTries, moved, outside.size(), config.system.packing_fraction));
     }
   }
@@ -337,6 +357,12 @@ ParticleSystem<D> build_start_state(const Config& config,
       check_no_overlap<D>(init, periodic, source, exact);
     }
     note_ignored_system_keys(config, init.position.size(), "system.initial_state");
+    if (config.system.fill_inside) {
+      std::fputs(
+          "kairos: note: system.fill_inside applies to generated states only; "
+          "system.initial_state's particles are used where the file has them\n",
+          stderr);
+    }
     if (!has_velocities) {
       assign_maxwell_boltzmann_velocities(init, config.system.temperature, rng);
       std::vector<bool> fixed;

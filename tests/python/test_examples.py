@@ -36,6 +36,8 @@ EXAMPLES = {
     # Measured in time: the lid comes down in the first few time units.
     "free_piston_3d.toml": ("plot_free_piston.py", [
         "run.equilibration_time=5", "run.time=10", "output.thermo_interval=1"]),
+    # Measured in time; the spheres fall into a bed within a few time units.
+    "rotating_drum_3d.toml": ("plot_drum.py", ["run.time=8", "output.trajectory_interval=4"]),
     # Measured in time: the container swings up within a few cycles.
     "spring_damper_3d.toml": ("plot_spring_damper.py", [
         "run.equilibration_time=4", "run.time=8"]),
@@ -148,6 +150,16 @@ class GranularExamples(kt.KairosTestCase):
         lid = [r[header.index("wall_z+_position")] for r in rows]
         self.assertLess(lid[-1], lid[0])  # the lid came down onto the gas
         self.draw_picture("free_piston_3d.toml", out)
+
+    def test_rotating_drum_3d(self):
+        out, s = self.check_run("rotating_drum_3d.toml")
+        self.assertLess(abs(s["granular"]["energy_balance_relative"]), 1e-10)
+        frames = kt.open_trajectory(os.path.join(out, "trajectory.gsd"))
+        for frame in frames:  # every sphere inside the drum (float32 positions)
+            box = np.array(frame.configuration.box[:2], dtype=np.float64)
+            x = frame.particles.position[:, :2].astype(np.float64) + 0.5 * box - 7.805
+            self.assertLess(np.hypot(x[:, 0], x[:, 1]).max(), 7.6 - 0.5 + 1e-4)
+        self.draw_picture("rotating_drum_3d.toml", out)
 
     def test_spring_damper_3d(self):
         out, s = self.check_run("spring_damper_3d.toml")
