@@ -165,17 +165,13 @@ void FaceWalls<D>::restore(const std::vector<WallMotion>& motion, double t) {
     // The motion the state was made with (its acceleration, and spring if any).
     WallBody before = b;
     before.accel = m.accel;
-    before.spring =
-        m.sprung() ? SpringMotion({m.spring[1], m.spring[2], m.spring[3], m.spring[4], m.spring[5]},
-                                  m.spring[0], m.accel)
-                   : SpringMotion{};
+    before.spring = m.sprung() ? SpringMotion(spring_of(m), m.spring[0], m.accel) : SpringMotion{};
     before.set(m.time, m.position, m.speed);
     before.work = {m.drive_work, m.dashpot};
     b.version = m.version;
     b.work = before.work;
-    const bool same =
-        m.accel == b.accel && m.sprung() == b.sprung() &&
-        (!b.sprung() || (m.spring[0] == b.mass && before.spring.spring() == b.spring.spring()));
+    const bool same = m.accel == b.accel && m.sprung() == b.sprung() &&
+                      (!b.sprung() || (m.spring[0] == b.mass && spring_of(m) == b.spring.spring()));
     if (same) {
       b.set(m.time, m.position, m.speed);
     } else {
@@ -245,8 +241,10 @@ void FaceWalls<D>::find_next_change(double t) {
       double dt = kNever;
       if (hi < kNever) dt = oscillating_plane_event_time({hi, 0.0, 0.0}, up, horizon);
       if (lo > -kNever) {
-        dt = std::min(dt, oscillating_plane_event_time({-lo, 0.0, 0.0}, b.plane(t, -1.0, shift(f)),
-                                                       std::min(dt, horizon)));
+        const OscillatingPlane down{-up.d0, -up.u,         -up.b,    up.gamma,
+                                    up.wd,  -up.amplitude, up.omega, up.phase};
+        dt = std::min(dt,
+                      oscillating_plane_event_time({-lo, 0.0, 0.0}, down, std::min(dt, horizon)));
       }
       recheck = !(dt < kNever);
       when = t + (recheck ? horizon : dt);

@@ -92,6 +92,7 @@ struct WallBody {
             spring.spring().omega,
             spring.response_phase_at(t)};
   }
+  // Its state for a restart file; spring_of below reads the spring back from it.
   WallMotion state(int face, int layer) const {
     WallMotion m{static_cast<std::uint32_t>(face), time, position, speed, version, accel, layer};
     if (sprung()) {
@@ -103,6 +104,11 @@ struct WallBody {
     return m;
   }
 };
+
+// The spring a WallMotion of WallBody::state was made with (its mass is spring[0]).
+inline WallSpring spring_of(const WallMotion& m) {
+  return {m.spring[1], m.spring[2], m.spring[3], m.spring[4], m.spring[5]};
+}
 
 // What outputs read of a wall with mass at some time: its face's name ("z+"), where its plane
 // is along its axis, its speed along the axis, its mechanical energy (FaceWalls::energy), its

@@ -118,7 +118,7 @@ std::pair<double, double> SpringMotion::transient_coefficients(double h0, double
 }
 
 double SpringMotion::transient(double h0, double b0, double s) const {
-  return std::exp(-gamma_ * s) * (h0 * std::cos(wd_ * s) + b0 * std::sin(wd_ * s));
+  return transient_coefficients(h0, b0, s).first;
 }
 double SpringMotion::transient_speed(double h0, double b0, double s) const {
   return std::exp(-gamma_ * s) * ((-gamma_ * h0 + wd_ * b0) * std::cos(wd_ * s) +

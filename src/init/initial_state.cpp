@@ -15,6 +15,7 @@
 #include "core/memory_budget.hpp"
 #include "core/periodic.hpp"
 #include "core/stop_flag.hpp"
+#include "init/insertion_grid.hpp"
 
 namespace kairos {
 namespace {
@@ -103,96 +104,6 @@ double round_down_6(double x) {
   const double r = std::floor(x / scale) * scale;
   return r > x ? std::nextafter(x, 0.0) : r;
 }
-
-template <int D>
-double box_volume(const std::array<double, D>& box) {
-  double v = 1.0;
-  for (int k = 0; k < D; ++k) v *= box[k];
-  return v;
-}
-
-// A periodic grid of cells at least `min_width` wide along every axis (at least one cell per
-// axis), with the total number of cells capped near `max_cells` by widening the cells.
-// Particles are kept in per-cell linked lists.
-template <int D>
-class CellGrid {
- public:
-  CellGrid(const std::array<double, D>& box, double min_width, std::size_t particles) : box_(box) {
-    const std::size_t max_cells = std::max<std::size_t>(64, 2 * particles);
-    double width = min_width;
-    double total = 1.0;
-    for (int k = 0; k < D; ++k) total *= std::max(1.0, std::floor(box[k] / width));
-    if (total > static_cast<double>(max_cells)) {
-      width = std::max(width, std::pow(box_volume<D>(box) / static_cast<double>(max_cells),
-                                       1.0 / static_cast<double>(D)));
-    }
-    std::size_t cells = 1;
-    for (int k = 0; k < D; ++k) {
-      const double nk =
-          std::min(std::max(1.0, std::floor(box[k] / width)), static_cast<double>(max_cells));
-      n_[k] = static_cast<std::size_t>(nk);
-      cells *= n_[k];
-    }
-    head_.assign(cells, kNoParticle);
-    next_.assign(particles, kNoParticle);
-  }
-
-  std::array<std::size_t, D> coords(const std::array<double, D>& x) const {
-    std::array<std::size_t, D> c{};
-    for (int k = 0; k < D; ++k) {
-      const double u = wrap_into_box(x[k], box_[k]) / box_[k] * static_cast<double>(n_[k]);
-      c[k] = std::min(static_cast<std::size_t>(u), n_[k] - 1);
-    }
-    return c;
-  }
-
-  std::size_t index(const std::array<std::size_t, D>& c) const {
-    std::size_t idx = 0;
-    for (int k = D - 1; k >= 0; --k) idx = idx * n_[k] + c[k];
-    return idx;
-  }
-
-  void insert(std::uint32_t particle, const std::array<double, D>& x) {
-    const std::size_t cell = index(coords(x));
-    next_[particle] = head_[cell];
-    head_[cell] = particle;
-  }
-
-  // Calls f(particle) for every particle in the cells adjacent to (and including) the cell at
-  // `c`, until f returns true. Along an axis with fewer than 3 cells every cell is visited
-  // exactly once. Returns whether f stopped the iteration.
-  template <class F>
-  bool for_each_neighbour(const std::array<std::size_t, D>& c, F&& f) const {
-    std::array<std::array<std::size_t, 3>, D> axis{};
-    std::array<std::size_t, D> count{};
-    for (int k = 0; k < D; ++k) {
-      if (n_[k] >= 3) {
-        axis[k] = {(c[k] + n_[k] - 1) % n_[k], c[k], (c[k] + 1) % n_[k]};
-        count[k] = 3;
-      } else {
-        for (std::size_t m = 0; m < n_[k]; ++m) axis[k][m] = m;
-        count[k] = n_[k];
-      }
-    }
-    std::array<std::size_t, D> pick{};
-    while (true) {
-      std::array<std::size_t, D> cell{};
-      for (int k = 0; k < D; ++k) cell[k] = axis[k][pick[k]];
-      for (std::uint32_t p = head_[index(cell)]; p != kNoParticle; p = next_[p]) {
-        if (f(p)) return true;
-      }
-      int k = 0;
-      while (k < D && ++pick[k] == count[k]) pick[k++] = 0;
-      if (k == D) return false;
-    }
-  }
-
- private:
-  std::array<double, D> box_;
-  std::array<std::size_t, D> n_{};
-  std::vector<std::uint32_t> head_;
-  std::vector<std::uint32_t> next_;
-};
 
 // ---------------------------------------------------------------------------------------------
 // Lattices.
@@ -579,7 +490,7 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
                      std::mt19937_64& rng) {
   const std::size_t N = state.position.size();
   const double dmax = *std::max_element(state.diameter.begin(), state.diameter.end());
-  CellGrid<D> grid(layout.box, dmax, N);
+  InsertionGrid<D> grid(layout.box, dmax, N);
   // Memory: at most 8 N voxel ids at the start of a diameter class, 16 N after refinements.
   const std::size_t max_voxels = std::max<std::size_t>(8 * N, 1024);
   std::optional<VoxelSampler<D>> voxels;
@@ -1169,7 +1080,7 @@ double worst_pair(const std::array<double, D>& box, const std::vector<std::array
   }
   if (N < 2 || !(dmax > 0.0)) return 0.0;
 
-  CellGrid<D> grid(box, dmax, N);
+  InsertionGrid<D> grid(box, dmax, N);
   for (std::size_t i = 0; i < N; ++i) grid.insert(static_cast<std::uint32_t>(i), pos[i]);
   double worst = 0.0;
   for (std::size_t i = 0; i < N; ++i) {

@@ -784,6 +784,16 @@ class Reader : public KeyReader {
     }
   }
 
+  // What a wall with mass (a lid, a container) cannot be combined with (yet), each passed to
+  // conflict(key, why), which names the wall's own key.
+  template <class Conflict>
+  static void refuse_with_moving_mass(const Config& c, Conflict&& conflict) {
+    if (c.soft.enabled())
+      conflict("soft.model", "soft contacts and the DEM meet no wall with mass yet");
+    if (c.boundary.shear_rate != 0.0) conflict("boundary.shear_rate", "not combined yet");
+    if (c.analysis.transport) conflict("analysis.transport", "momentum is not conserved");
+  }
+
   // Walls with mass (boundaries/wall_body.hpp): face walls of the event engine whose motion
   // is their own; what that cannot be combined with (yet) is refused.
   void check_wall_masses(const toml::table& root, const Config& c) const {
@@ -826,10 +836,7 @@ class Reader : public KeyReader {
           if (u != 0.0) conflict("velocity", "its motion follows from the impulses it takes");
       if (w.amplitude > 0.0 && w.frequency > 0.0)
         conflict("amplitude", "its motion follows from the impulses it takes");
-      if (c.soft.enabled())
-        conflict("soft.model", "soft contacts and the DEM meet no wall with mass yet");
-      if (c.boundary.shear_rate != 0.0) conflict("boundary.shear_rate", "not combined yet");
-      if (c.analysis.transport) conflict("analysis.transport", "momentum is not conserved");
+      refuse_with_moving_mass(c, conflict);
     }
   }
 
@@ -908,10 +915,7 @@ class Reader : public KeyReader {
            fmt::format("{}: a container (boundary.container) cannot be combined with {} ({})",
                        other, other, why));
     };
-    if (c.soft.enabled())
-      conflict("soft.model", "soft contacts and the DEM meet no wall with mass yet");
-    if (c.boundary.shear_rate != 0.0) conflict("boundary.shear_rate", "not combined yet");
-    if (c.analysis.transport) conflict("analysis.transport", "momentum is not conserved");
+    refuse_with_moving_mass(c, conflict);
     for (std::size_t s = 0; s < c.system.species.size(); ++s) {
       if (c.system.species[s].fixed) {
         conflict(fmt::format("system.species[{}].fixed", s),

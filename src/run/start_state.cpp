@@ -15,6 +15,7 @@
 #include "core/stop_flag.hpp"
 #include "init/initial_state.hpp"
 #include "init/initial_state_file.hpp"
+#include "init/insertion_grid.hpp"
 #include "io/config_choices.hpp"
 #include "io/gsd_file.hpp"
 #include "model/boundaries.hpp"
@@ -219,67 +220,31 @@ void move_inside_walls(const Config& config, ParticleSystem<D>& s, std::mt19937_
   };
   double dmax = 0.0;
   for (const Kinematics<D>& k : s.kinematics) dmax = std::max(dmax, 2.0 * k.radius);
-  // Cells at least the largest diameter wide, and no more than about 4 N of them (a box
-  // stretched far by box_scale would otherwise need a cell per diameter of empty space).
-  double wanted = 1.0;
-  for (int a = 0; a < D; ++a) wanted *= std::max(1.0, s.box[a] / dmax);
-  const double shrink = std::max(
-      1.0, std::pow(wanted / (4.0 * static_cast<double>(s.kinematics.size()) + 64.0), 1.0 / D));
-  std::array<int, D> cells{};
-  for (int a = 0; a < D; ++a)
-    cells[a] = std::max(1, static_cast<int>(std::min(s.box[a] / dmax / shrink, 1e6)));
-  const auto cell_of = [&](const Vec<D>& x) {
-    std::array<int, D> c{};
-    for (int a = 0; a < D; ++a)
-      c[a] = std::clamp(static_cast<int>(std::floor(x[a] / s.box[a] * cells[a])), 0, cells[a] - 1);
-    return c;
-  };
-  const auto index = [&](const std::array<int, D>& c) {
-    std::size_t i = 0;
-    for (int a = D - 1; a >= 0; --a) i = i * static_cast<std::size_t>(cells[a]) + c[a];
-    return i;
-  };
-  std::size_t total = 1;
-  for (int a = 0; a < D; ++a) total *= static_cast<std::size_t>(cells[a]);
-  std::vector<std::vector<std::uint32_t>> grid(total);
+  // The particles in place, in random insertion's grid (cells at least dmax wide, capped in
+  // number); those outside a wall are moved one by one.
+  InsertionGrid<D> grid(s.box, dmax, s.kinematics.size());
   std::vector<std::uint32_t> outside;
   for (std::uint32_t i = 0; i < s.kinematics.size(); ++i) {
     const Kinematics<D>& k = s.kinematics[i];
     if (inside(k.pos, k.radius)) {
-      grid[index(cell_of(k.pos))].push_back(i);
+      grid.insert(i, k.pos);
     } else {
       outside.push_back(i);
     }
   }
-  // Apart from every particle in place: the 3^D cells around x (wrapped on periodic axes).
+  // Apart from every particle in place (the grid's cells around x; the minimum image on
+  // periodic axes only).
   const auto free_at = [&](const Vec<D>& x, double r) {
-    const std::array<int, D> c = cell_of(x);
-    std::array<int, D> d{};
-    d.fill(-1);
-    while (true) {
-      std::array<int, D> n{};
-      bool valid = true;
+    return !grid.for_each_neighbour(grid.coords(x), [&](std::uint32_t j) {
+      double d2 = 0.0;
       for (int a = 0; a < D; ++a) {
-        n[a] = c[a] + d[a];
-        if (periodic[a]) n[a] = (n[a] + cells[a]) % cells[a];
-        valid = valid && n[a] >= 0 && n[a] < cells[a];
+        double dx = x[a] - s.kinematics[j].pos[a];
+        if (periodic[a]) dx = minimum_image(dx, s.box[a]);
+        d2 += dx * dx;
       }
-      if (valid) {
-        for (const std::uint32_t j : grid[index(n)]) {
-          double d2 = 0.0;
-          for (int a = 0; a < D; ++a) {
-            double dx = x[a] - s.kinematics[j].pos[a];
-            if (periodic[a]) dx = minimum_image(dx, s.box[a]);
-            d2 += dx * dx;
-          }
-          const double contact = r + s.kinematics[j].radius;
-          if (d2 < contact * contact) return false;
-        }
-      }
-      int a = 0;
-      while (a < D && ++d[a] > 1) d[a] = -1, ++a;
-      if (a == D) return true;
-    }
+      const double contact = r + s.kinematics[j].radius;
+      return d2 < contact * contact;
+    });
   };
   constexpr long kTries = 1000000;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -293,7 +258,7 @@ void move_inside_walls(const Config& config, ParticleSystem<D>& s, std::mt19937_
       for (int a = 0; a < D; ++a) x[a] = unit(rng) * s.box[a];
       if (!inside(x, k.radius) || !free_at(x, k.radius)) continue;
       k.pos = x;
-      grid[index(cell_of(x))].push_back(i);
+      grid.insert(i, x);
       placed = true;
     }
     if (!placed) {
