@@ -14,7 +14,58 @@ namespace kairos {
 template <int D>
 PlaneWalls<D>::PlaneWalls(std::vector<PlaneWall<D>> planes, const Vec<D>& box,
                           const std::array<Face<D>, 2 * D>& faces, const Vec<D>& gravity)
-    : planes_(std::move(planes)), box_(box), faces_(faces), gravity_(gravity) {}
+    : planes_(std::move(planes)), box_(box), faces_(faces), gravity_(gravity) {
+  std::vector<CylinderWall<D>> edges;
+  for (std::size_t k = 0; k < planes_.size(); ++k) {
+    const PlaneWall<D>& p = planes_[k];
+    if (!p.spanned()) continue;
+    const auto [along, across] = p.edge_axes();
+    if (along < 0 || across < 0) continue;  // refused by Environment::check
+    const double ends[2] = {p.span_min, p.span_max};
+    for (const double end : ends) {
+      if (!std::isfinite(end)) continue;
+      CylinderWall<D>& edge = edges.emplace_back();
+      edge.axis = along;
+      edge.center[p.span_axis] = end;
+      edge.center[across] = (p.offset - p.normal[p.span_axis] * end) / p.normal[across];
+      edge.radius = 0.0;
+      edge.inside = false;
+      edge.contact = p.wall.contact;
+      edge_names_.push_back(
+          fmt::format("boundary.plane[{}] edge at {} = {:.6g}", k, "xyz"[p.span_axis], end));
+    }
+  }
+  edges_ = CylinderWalls<D>(std::move(edges), gravity);
+}
+
+template <int D>
+std::string PlaneWalls<D>::name(int s) const {
+  if (s < planes()) return "boundary.plane[" + std::to_string(s) + "]";
+  return edge_names_[static_cast<std::size_t>(s - planes())];
+}
+
+// The plane's own contact (the solver of an unbounded plane) where the particle comes from the
+// front; from beside the strip (within a radius of its level or below it: in an orifice) the
+// contact can only come after the particle has risen above the level and falls back, the later
+// root of the quadratic. Either counts only where its foot lies within the strip; a parabola
+// crosses the level downwards once, so a crossing beside the strip means none at all (the edges
+// are surfaces of their own).
+template <int D>
+double PlaneWalls<D>::strip_event_time(const PlaneWall<D>& p, const Vec<D>& x, const Vec<D>& v,
+                                       double radius, double horizon) const {
+  const double nx = dot(p.normal, x), nv = dot(p.normal, v), ng = dot(p.normal, gravity_);
+  const double height = nx - radius - p.offset;
+  double when = kNever;
+  if (height >= 0.0 || p.covers(x, nx - p.offset)) {
+    when = fixed_plane_event_time(NormalMotion{nx - radius, nv, ng}, p.offset, horizon);
+  } else if (ng < 0.0 && nv > 0.0) {
+    const double c = 0.5 * ng, disc = nv * nv - 4.0 * height * c;
+    if (disc > 0.0) when = within_horizon((-nv - std::sqrt(disc)) / (2.0 * c), horizon);
+  }
+  if (!(when < kNever)) return kNever;
+  const Vec<D> at = x + when * v + (0.5 * when * when) * gravity_;
+  return p.covers(at, radius) ? when : kNever;
+}
 
 // Along the normal the particle's height above the plane is n.x - R, moving at n.v with
 // acceleration n.g; the plane's offset moves at u = n.velocity (plus its vibration): the
@@ -23,7 +74,9 @@ PlaneWalls<D>::PlaneWalls(std::vector<PlaneWall<D>> planes, const Vec<D>& box,
 template <int D>
 double PlaneWalls<D>::event_time(int s, const Vec<D>& x, const Vec<D>& v, double radius, double t,
                                  double horizon) const {
+  if (s >= planes()) return edges_.event_time(s - planes(), x, v, radius, t, horizon);
   const PlaneWall<D>& p = plane(s);
+  if (p.spanned()) return strip_event_time(p, x, v, radius, horizon);
   const NormalMotion m{dot(p.normal, x) - radius, dot(p.normal, v), dot(p.normal, gravity_)};
   const double u = p.normal_speed();
   const double d = p.offset + (u != 0.0 ? u * t : 0.0);
@@ -40,6 +93,7 @@ double PlaneWalls<D>::event_time(int s, const Vec<D>& x, const Vec<D>& v, double
 // The lowest n.x over the cell (its outer layers along a bounded axis reach to infinity).
 template <int D>
 bool PlaneWalls<D>::reaches(int s, CellCode cell, const CellGrid<D>& grid) const {
+  if (s >= planes()) return edges_.reaches(s - planes(), cell, grid);
   const PlaneWall<D>& p = plane(s);
   if (p.normal_speed() != 0.0) return true;
   double lowest = 0.0;
@@ -54,9 +108,12 @@ bool PlaneWalls<D>::reaches(int s, CellCode cell, const CellGrid<D>& grid) const
 }
 
 template <int D>
-ContactResult<D> PlaneWalls<D>::resolve(int s, const Vec<D>& /*x*/, double t, double mass,
+ContactResult<D> PlaneWalls<D>::resolve(int s, const Vec<D>& x, double t, double mass,
                                         double radius, double inertia_factor, bool force_elastic,
                                         Vec<D>& v, Spin<D>& w) const {
+  if (s >= planes()) {
+    return edges_.resolve(s - planes(), x, t, mass, radius, inertia_factor, force_elastic, v, w);
+  }
   const PlaneWall<D>& p = plane(s);
   return resolve_surface_contact<D>(p.wall.contact, p.normal, p.surface_velocity(t), mass, radius,
                                     inertia_factor, force_elastic, v, w);
@@ -64,7 +121,8 @@ ContactResult<D> PlaneWalls<D>::resolve(int s, const Vec<D>& /*x*/, double t, do
 
 template <int D>
 void PlaneWalls<D>::check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const {
-  for (int s = 0; s < surfaces(); ++s) {
+  edges_.check_start(x, radius, t, id);
+  for (int s = 0; s < planes(); ++s) {
     const double g = gap(s, x, t);
     if (g < radius * (1.0 - 1e-12)) {
       throw InputError(fmt::format(
@@ -85,12 +143,13 @@ constexpr double kPlaneSqueezeMargin = 1e-3;
 // 1 + margin) before that side, no particle fits. Other planes are not counted: they can only
 // squeeze the particles sooner, which the run drivers' frozen-clock watch reports.
 template <int D>
-void PlaneWalls<D>::prepare(const CellGrid<D>& /*grid*/, double rmax, double /*particle_volume*/,
-                            bool /*uniform*/) {
+void PlaneWalls<D>::prepare(const CellGrid<D>& grid, double rmax, double particle_volume,
+                            bool uniform) {
+  edges_.prepare(grid, rmax, particle_volume, uniform);
   rmax_ = rmax;
   squeeze_time_ = kNever;
   squeeze_plane_ = -1;
-  for (int s = 0; s < surfaces(); ++s) {
+  for (int s = 0; s < planes(); ++s) {
     const PlaneWall<D>& p = plane(s);
     const double u = p.normal_speed();
     if (!(u > 0.0)) continue;

@@ -11,6 +11,13 @@
 // The domain is the box less the half-spaces behind the planes. A plane must not cut a periodic
 // axis (the normal's component along it is 0, checked by Environment::check): across a periodic
 // face the plane would not meet its own image.
+//
+// A still plane may be cut to a strip (span_axis, span_min, span_max: it is there only where
+// its points' coordinate along that axis lies in [span_min, span_max]): the floor of a silo
+// beside its orifice, the sides of a hopper. Its ends are edges (lines along a box axis in 3D,
+// points in 2D), surfaces of their own: a zero-radius outside cylinder each (RoundWalls), after
+// all the planes in this component's numbering. A strip is one-sided as every plane: behind it
+// is outside the domain where it is, and nothing beside it (docs/physics.md#strips-and-edges).
 #pragma once
 
 #include <array>
@@ -20,6 +27,7 @@
 #include <utility>
 #include <vector>
 
+#include "boundaries/cylinder_walls.hpp"
 #include "boundaries/face_wall.hpp"
 #include "core/vec.hpp"
 #include "dynamics/collision_time.hpp"
@@ -35,6 +43,34 @@ struct PlaneWall {
   Vec<D> normal{};      // unit, into the domain
   double offset = 0.0;  // c0: the plane is n . x = c0 at t = 0
   Wall<D> wall;         // contact law, velocity (sliding and along n), vibration along n
+  // A strip: where the plane is, along a box axis (-1: everywhere).
+  int span_axis = -1;
+  double span_min = -kNever, span_max = kNever;
+
+  bool spanned() const { return span_axis >= 0; }
+  // The axis a strip's edges run along (3D: the one besides the span axis the normal has no
+  // component along; 2D: out of the plane, D - 1 by the cylinders' convention) and the axis
+  // across it in the plane of the normal; -1 for either when there is none (Environment::check
+  // refuses such a strip).
+  std::pair<int, int> edge_axes() const {
+    if constexpr (D == 2) {
+      const int across = 1 - span_axis;
+      return {D - 1, normal[across] != 0.0 ? across : -1};
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        if (k == span_axis || normal[k] != 0.0) continue;
+        const int across = 3 - k - span_axis;
+        return {k, normal[across] != 0.0 ? across : -1};
+      }
+      return {-1, -1};
+    }
+  }
+  // Whether the foot of x on the plane (x less its distance along n) lies within the strip.
+  bool covers(const Vec<D>& x, double distance) const {
+    if (span_axis < 0) return true;
+    const double u = x[span_axis] - distance * normal[span_axis];
+    return u >= span_min && u <= span_max;
+  }
 
   double normal_speed() const { return dot(normal, wall.velocity); }
   // c(t): where the plane lies along its normal at time t.
@@ -64,28 +100,37 @@ class PlaneWalls {
   PlaneWalls(std::vector<PlaneWall<D>> planes, const Vec<D>& box,
              const std::array<Face<D>, 2 * D>& faces, const Vec<D>& gravity);
 
-  // The boundary interface (model/boundaries.hpp): surface s is plane s.
+  // The boundary interface (model/boundaries.hpp): surface s < planes() is plane s, the rest
+  // the strips' edges (edges_, in the order of their planes, low end first).
   bool any() const { return !planes_.empty(); }
-  int surfaces() const { return static_cast<int>(planes_.size()); }
+  int surfaces() const { return planes() + edges_.surfaces(); }
+  int planes() const { return static_cast<int>(planes_.size()); }
   bool is_surface(int /*s*/) const { return true; }
   const PlaneWall<D>& plane(int s) const { return planes_[static_cast<std::size_t>(s)]; }
-  std::string name(int s) const { return "boundary.plane[" + std::to_string(s) + "]"; }
-  const ContactModel& contact(int s) const { return plane(s).wall.contact; }
-  double approach_speed(int s) const { return plane(s).normal_speed(); }
-
-  double gap(int s, const Vec<D>& x, double t) const {
-    return dot(plane(s).normal, x) - plane(s).position(t);
+  std::string name(int s) const;
+  const ContactModel& contact(int s) const {
+    return s < planes() ? plane(s).wall.contact : edges_.contact(s - planes());
   }
-  Vec<D> normal(int s, const Vec<D>& /*x*/, double /*t*/) const { return plane(s).normal; }
+  double approach_speed(int s) const { return s < planes() ? plane(s).normal_speed() : 0.0; }
+
+  // Beside a strip (its foot outside it) a plane is not there: no gap.
+  double gap(int s, const Vec<D>& x, double t) const {
+    if (s >= planes()) return edges_.gap(s - planes(), x, t);
+    const double g = dot(plane(s).normal, x) - plane(s).position(t);
+    return plane(s).covers(x, g) ? g : kNever;
+  }
+  Vec<D> normal(int s, const Vec<D>& x, double t) const {
+    return s < planes() ? plane(s).normal : edges_.normal(s - planes(), x, t);
+  }
   Vec<D> velocity(int s, const Vec<D>& /*x*/, double t) const {
-    return plane(s).surface_velocity(t);
+    return s < planes() ? plane(s).surface_velocity(t) : Vec<D>{};
   }
   bool holds_still(int s) const {
-    return !plane(s).wall.vibrates() && norm2(plane(s).wall.velocity) == 0.0;
+    return s >= planes() || (!plane(s).wall.vibrates() && norm2(plane(s).wall.velocity) == 0.0);
   }
-  bool surface_moves(int s) const { return plane(s).plane_moves(); }
-  bool accelerates(int s) const { return plane(s).wall.vibrates(); }
-  bool flat(int /*s*/) const { return true; }
+  bool surface_moves(int s) const { return s < planes() && plane(s).plane_moves(); }
+  bool accelerates(int s) const { return s < planes() && plane(s).wall.vibrates(); }
+  bool flat(int s) const { return s < planes(); }
 
   // Relative time from t of the contact of a particle of this radius (at x with velocity v at
   // t) with plane s; kNever if after t + horizon.
@@ -110,7 +155,13 @@ class PlaneWalls {
   [[noreturn]] void throw_squeezed(double t, double dmax, bool uniform) const;
 
  private:
+  // A strip's contact: the plane's, where its foot lies within the strip (a still plane).
+  double strip_event_time(const PlaneWall<D>& p, const Vec<D>& x, const Vec<D>& v, double radius,
+                          double horizon) const;
+
   std::vector<PlaneWall<D>> planes_;
+  CylinderWalls<D> edges_;  // the strips' ends: outside cylinders of radius 0
+  std::vector<std::string> edge_names_;
   Vec<D> box_{};
   std::array<Face<D>, 2 * D> faces_{};
   Vec<D> gravity_{};

@@ -57,6 +57,9 @@ struct EventCounters {
   std::uint64_t elastic_by_rule = 0;     // made elastic by the TC model or elastic_below_speed
   std::uint64_t sliding_collisions = 0;  // Coulomb-limited (Walton) contacts that slid
   std::uint64_t fell_asleep = 0;         // particles put to sleep (resting under gravity)
+  // Sleepers woken because the sleeper under them woke and nothing else held them up (not
+  // part of the state: counted from the start of this engine).
+  std::uint64_t lost_support = 0;
   std::uint64_t driving_kicks = 0;       // velocities set by a thermostat or random kick
   // Kinetic energy (translational + rotational) dissipated in particle-particle and in
   // particle-wall collisions, and the work moving walls did on the particles.
@@ -88,6 +91,12 @@ struct EventCounters {
   // (FrozenContact::deferred) are not in it: theirs follows from their velocities
   // (EventEngine::potential_energy() adds it).
   double soft_contact_energy = 0.0;
+  // Outlets (boundaries/outlets.hpp): particles that passed through one and were put back, their
+  // mass, and the energy they took out (kinetic + rotational + the field's potential energy
+  // before the pass less after it).
+  std::uint64_t outlet_passes = 0;
+  double outlet_mass = 0.0;
+  double outlet_energy = 0.0;
 };
 
 // A bond of a molecule (chain): particles i and j (the caller's numbering) interact through

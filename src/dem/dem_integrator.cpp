@@ -189,6 +189,8 @@ void DemIntegrator<D>::set_walls(const Environment<D>& env) {
     walls_[static_cast<std::size_t>(f)] = env.faces[static_cast<std::size_t>(f)].wall;
     any_wall_ = any_wall_ || kind == FaceKind::kWall;
   }
+  if (!env.outlets.empty())
+    throw InputError("DEM: boundary.outlet: the DEM integrator has no outlets yet");
   boundaries_ = Boundaries<D>(env, box_);
   wall_shear_.assign(static_cast<std::size_t>(boundaries_.surfaces()), {});
   for (int s = 2 * D; s < boundaries_.surfaces(); ++s)

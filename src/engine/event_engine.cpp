@@ -65,6 +65,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   setup_environment(s);
   setup_soft(s);
   if (massive_walls_) check_massive_walls(s, mode);
+  if (outlets_) check_outlets(s);
 
   // Internal numbering: the stored one when resuming, else the caller's (renumbered below).
   id_.resize(n);
@@ -349,6 +350,7 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
         D == 3 ? 4.0 / 3.0 * M_PI * k.radius * k.radius * k.radius : M_PI * k.radius * k.radius;
   boundaries_.prepare(cells_.grid(), rmax, particle_volume, uniform_radius_);
   massive_walls_ = boundaries_.any_massive();
+  outlets_ = boundaries_.any_passes();
   boundaries_.restore(s.wall_motion, time_);
   if (time_ >= boundaries_.squeeze_time()) throw_squeezed(time_);
   // Shear (sliding images) and steps (zones) keep full scans.
@@ -879,8 +881,10 @@ EventKind EventEngine<D, Queue>::step() {
       queue_.update(i, predict(i, t));
       return EventKind::kStale;
     }
-    hit_wall(i, e.code.wall_face(), t);
-    return EventKind::kWallCollision;
+    const int surface = e.code.wall_face();
+    hit_wall(i, surface, t);
+    return outlets_ && boundaries_.passes(surface) ? EventKind::kOutletPass
+                                                   : EventKind::kWallCollision;
   }
   if (hot_[e.code.partner()].collisions != e.partner_count) {
     ++counters_.stale_events;

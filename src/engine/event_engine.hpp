@@ -60,6 +60,7 @@ namespace kairos {
 // kSoftRelease: a soft contact ended, its frozen pair got its post-contact velocities.
 // kWallLayer: the plane of a wall with mass entered another layer of cells, and the particles
 // it can now reach were looked at again.
+// kOutletPass: a particle's centre crossed an outlet and was put back in its insertion region.
 enum class EventKind {
   kNone,
   kCollision,
@@ -68,7 +69,8 @@ enum class EventKind {
   kWallCollision,
   kImageShift,
   kSoftRelease,
-  kWallLayer
+  kWallLayer,
+  kOutletPass
 };
 
 // How an engine starts: predict every event from the state, or resume the scheduler state the
@@ -295,6 +297,16 @@ class EventEngine {
   // The particle's soonest wall contact from time t before t + horizon: (relative time, face).
   std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
   void hit_wall(std::uint32_t i, int surface, double t);
+  // Outlets (boundaries/outlets.hpp; engine/outlet_passes.cpp): particle i crossed outlet
+  // `surface` at time t and is put back at a free place of its insertion region.
+  void pass_outlet(std::uint32_t i, int surface, double t);
+  // Whether particle i (its radius) fits at x at time t: inside every wall, apart from every
+  // other particle.
+  bool free_place(std::uint32_t i, const Vec<D>& x, double t);
+  // Translational and rotational energy plus the field's potential energy -m g.x.
+  double mechanical_energy(std::uint32_t i, double t) const;
+  // What outlets cannot be combined with (InputError naming the keys).
+  void check_outlets(const ParticleSystem<D>& s) const;
   // Walls with mass (boundaries/wall_body.hpp): a wall event predicted before the wall's
   // motion last changed is stale; when the plane enters a new layer of cells, every particle
   // it can now reach gets the contact as its event if that comes first (wall_moved).
@@ -511,6 +523,7 @@ class EventEngine {
   Vec<D> half_gravity_{};
   bool walls_ = false;                   // boundaries_.any()
   bool massive_walls_ = false;           // some face wall has mass
+  bool outlets_ = false;                 // some surface is an outlet (boundaries_.any_passes())
   bool bounded_ = false;                 // some axis has walls or open faces
   bool granular_contacts_ = false;       // some contact law is not elastic and smooth
   HugeVector<AngularVelocity<D>> spin_;  // rough particles only

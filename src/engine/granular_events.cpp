@@ -166,6 +166,10 @@ std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i,
 template <int D, class Queue>
 void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t) {
   if (t >= boundaries_.squeeze_time()) throw_squeezed(t);
+  if (outlets_ && boundaries_.passes(surface)) [[unlikely]] {
+    pass_outlet(i, surface, t);
+    return;
+  }
   if (soft_) [[unlikely]] {
     hit_wall_soft(i, surface, t);
     return;
@@ -273,10 +277,41 @@ void EventEngine<D, Queue>::fall_asleep(std::uint32_t i, double t) {
   ++counters_.fell_asleep;
 }
 
+// A sleeper that wakes may have held others up: every sleeping neighbour it touched that no
+// longer rests on a support (a still surface, a fixed grain, the sleepers left) wakes too, at
+// rest where it slept, and so on up the pile. Otherwise a sleeper whose support was knocked away
+// (a grain above a silo's orifice) would hang in the air for good. Each one woken here is
+// predicted afresh and its counter bumped (predictions against it as a sleeper are stale); the
+// caller predicts i.
 template <int D, class Queue>
 void EventEngine<D, Queue>::wake(std::uint32_t i, double t) {
   resting_.wake(i);
   hot_[i].time = t;  // at rest where it slept
+  std::vector<std::uint32_t> woken{i}, touching;
+  while (!woken.empty()) {
+    const std::uint32_t j = woken.back();
+    woken.pop_back();
+    CandidateList& list = cells_.list(1);
+    gather(hot_[j].cell, list);
+    touching.clear();
+    for (std::uint32_t k = 0; k < list.count; ++k) {
+      const std::uint32_t p = list.ids[k];
+      if (p == j || !is_asleep(p) || resting_.fixed(p)) continue;
+      Vec<D> r = hot_[p].pos - hot_[j].pos;
+      if (list.n_shifts > 1) r = r - list.shifts[list.shift[k]];
+      const double gap = std::sqrt(norm2(r)) - (radius_of(p) + radius_of(j));
+      if (gap < resting_.support_distance(radius_of(p))) touching.push_back(p);
+    }
+    for (const std::uint32_t p : touching) {
+      if (!is_asleep(p) || resting_on_support(p, t)) continue;
+      resting_.wake(p);
+      hot_[p].time = t;
+      ++hot_[p].collisions;
+      ++counters_.lost_support;
+      queue_.update(p, predict(p, t));
+      woken.push_back(p);
+    }
+  }
 }
 
 template <int D, class Queue>
@@ -327,7 +362,8 @@ bool EventEngine<D, Queue>::resting_on_support(std::uint32_t i, double t) {
   std::array<Vec<D>, kMaxSupports> normals;
   int count = 0;
   for (int s = 0; s < boundaries_.surfaces() && count < kMaxSupports; ++s) {
-    if (!boundaries_.is_surface(s) || !boundaries_.holds_still(s)) continue;
+    if (!boundaries_.is_surface(s) || !boundaries_.holds_still(s) || boundaries_.passes(s))
+      continue;
     if (boundaries_.gap(s, x, t) - radius_of(i) < eps) {
       normals[count++] = boundaries_.normal(s, x, t);
       if (resting_.holds_up(normals[count - 1])) return true;

@@ -44,6 +44,8 @@ class ImageCounters {
   const Image& of(std::uint32_t k) const { return image_[k]; }
   // Particle k's position moved by `delta` boxes along `axis` (delta = -1: it was wrapped from
   // the high face to the low one), so its image moves the other way.
+  // Particle k was put somewhere else (an outlet's insertion): it starts a new path.
+  void reset(std::uint32_t k) { image_[k] = Image{}; }
   void wrapped(std::uint32_t k, int axis, int delta) {
     image_[k][axis] -= static_cast<std::int32_t>(delta);
   }

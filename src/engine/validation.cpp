@@ -55,7 +55,7 @@ void EventEngine<D, Queue>::validate() {
     const HotRecord<D>& h = hot_[i];
     const Vec<D> x = position(i, t);
     for (int f = 0; f < boundaries_.surfaces(); ++f) {
-      if (!boundaries_.is_surface(f)) continue;
+      if (!boundaries_.is_surface(f) || boundaries_.passes(f)) continue;
       const double gap = boundaries_.gap(f, x, t);
       if (gap >= radius_of(i) * (1.0 - 1e-9)) continue;
       // A soft contact overlaps its wall while frozen and after its release, leaving; turned

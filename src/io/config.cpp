@@ -91,6 +91,7 @@ class Reader : public KeyReader {
     check_fixed_species(root, config);
     check_wall_masses(root, config);
     check_container(root, config);
+    check_outlet(root, config);
     check_trajectory_keys(root, config);
     if (config.system.chain_length > 0 && config.bonds.empty()) {
       fail(nullptr, "system.chain_length",
@@ -354,6 +355,27 @@ class Reader : public KeyReader {
     }
     read_contact(pt, prefix, plane.wall.contact);
     read_group(pt, prefix, wall_keys(), &plane.wall, &dimension);
+    // A strip: an axis of the box, and at least one end below the other.
+    if (plane.span_axis.empty()) {
+      for (const char* key : {"span_min", "span_max"}) {
+        if (pt.get(key) != nullptr) {
+          fail(pt.get(key), prefix + "." + key,
+               fmt::format("{}.{}: a span needs its axis ({}.span_axis)", prefix, key, prefix));
+        }
+      }
+    } else if (!axes(dimension).contains(plane.span_axis)) {
+      fail(pt.get("span_axis"), prefix + ".span_axis",
+           fmt::format("{}.span_axis: '{}' is not an axis of the box ({})", prefix, plane.span_axis,
+                       axes(dimension).names(", ", " or ")));
+    } else if (!(plane.span_min < plane.span_max)) {
+      fail(pt.get("span_max"), prefix + ".span_max",
+           fmt::format("{}.span_max: must be above span_min ({} <= {})", prefix, plane.span_max,
+                       plane.span_min));
+    } else if (std::isinf(plane.span_min) && std::isinf(plane.span_max)) {
+      fail(pt.get("span_axis"), prefix + ".span_axis",
+           fmt::format("{}.span_axis: give span_min, span_max or both (where the strip ends)",
+                       prefix));
+    }
     return plane;
   }
 
@@ -393,6 +415,35 @@ class Reader : public KeyReader {
     }
     read_contact(ct, prefix, cylinder.contact);
     return cylinder;
+  }
+
+  // [boundary.outlet]: its plane and insertion region (required together), the velocity and
+  // seed of the particles put back. Whether the plane cuts a periodic axis and where the region
+  // lies are checked with the box (Environment::check).
+  void read_outlet(const toml::table& t, int dimension, OutletConfig& outlet) const {
+    const toml::node* n = t.get("outlet");
+    if (n == nullptr) return;
+    const toml::table* table = n->as_table();
+    if (table == nullptr) {
+      fail(n, "boundary.outlet",
+           fmt::format("boundary.outlet: expected a table ([boundary.outlet]), found {}",
+                       describe(*n)));
+    }
+    check_keys(*table, "boundary.outlet");
+    read_group(*table, "boundary.outlet", outlet_keys(), &outlet, &dimension);
+    for (const char* key : {"normal", "point", "insert_lower", "insert_upper"}) {
+      if (table->get(key) == nullptr) {
+        fail(table, fmt::format("boundary.outlet.{}", key),
+             fmt::format("missing required key 'boundary.outlet.{}' ({} numbers)", key, dimension));
+      }
+    }
+    double n2 = 0.0;
+    for (const double c : outlet.normal) n2 += c * c;
+    if (!(n2 > 0.0) || !std::isfinite(n2)) {
+      fail(table->get("normal"), "boundary.outlet.normal",
+           "boundary.outlet.normal: must be a nonzero vector (it points to the side the "
+           "particles come from)");
+    }
   }
 
   void read_boundary(const toml::table& t, int dimension, const ContactConfig& contact,
@@ -458,6 +509,7 @@ class Reader : public KeyReader {
       check_keys(*container, "boundary.container");
     }
     read_group(*container, "boundary.container", container_keys(), &b.container, &dimension);
+    read_outlet(t, dimension, b.outlet);
     const toml::node* n_open = t.get("open");
     for (std::size_t i = 0; i < b.open.size(); ++i) {
       const std::string& face = b.open[i];
@@ -782,6 +834,27 @@ class Reader : public KeyReader {
       if (along != 0.0)
         conflict(prefix + ".velocity", "a fixed grain would not see the moving wall coming");
     }
+  }
+
+  // [boundary.outlet]: what a particle that jumps back to the insertion region cannot be
+  // combined with (yet).
+  void check_outlet(const toml::table& root, const Config& c) const {
+    if (c.boundary.outlet.normal.empty()) return;
+    const auto conflict = [&](std::string_view other, std::string_view why) {
+      const toml::node* n = node_at(root, other);
+      fail(n != nullptr ? n : node_at(root, "boundary.outlet"), std::string(other),
+           fmt::format("{}: an outlet (boundary.outlet) cannot be combined with {} ({})", other,
+                       other, why));
+    };
+    if (c.soft.enabled()) conflict("soft.model", "soft contacts and the DEM have no outlets yet");
+    if (c.boundary.shear_rate != 0.0) conflict("boundary.shear_rate", "not combined yet");
+    if (!c.potentials.empty())
+      conflict("potential", "a particle put back would break the zones of its pairs");
+    if (!c.bonds.empty()) conflict("bond", "a particle put back would break its bonds");
+    const char* why = "a particle put back jumps, so its displacement means nothing";
+    if (c.analysis.transport) conflict("analysis.transport", why);
+    if (c.analysis.msd) conflict("analysis.msd", why);
+    if (c.analysis.mutual_diffusion) conflict("analysis.mutual_diffusion", why);
   }
 
   // What a wall with mass (a lid, a container) cannot be combined with (yet), each passed to

@@ -113,6 +113,11 @@ struct PlaneConfig {
   std::vector<double> point;   // D components: a point of the plane at t = 0
   WallConfig wall;             // its contact law and motion: the keys of [[boundary.wall]]
                                // but face
+  // A strip: the plane only where its points' coordinate along span_axis lies in
+  // [span_min, span_max] ("": everywhere; an end left out is unbounded).
+  std::string span_axis;
+  double span_min = -std::numeric_limits<double>::infinity();
+  double span_max = std::numeric_limits<double>::infinity();
 
   bool operator==(const PlaneConfig&) const = default;
 };
@@ -143,9 +148,23 @@ struct ContainerConfig {
   bool operator==(const ContainerConfig&) const = default;
 };
 
+// An outlet particles pass through, put back at once in an insertion region ([boundary.outlet],
+// boundaries/outlets.hpp): the recirculating silo. Absent when normal is empty.
+struct OutletConfig {
+  std::vector<double> normal;           // D components, towards the particles (not normalised)
+  std::vector<double> point;            // D components: a point of the plane
+  std::vector<double> insert_lower;     // D components: the insertion region's low corner
+  std::vector<double> insert_upper;     // D components: its high corner
+  std::vector<double> insert_velocity;  // D components; empty: at rest
+  std::uint64_t seed = 1;               // of the places drawn
+
+  bool operator==(const OutletConfig&) const = default;
+};
+
 struct BoundaryConfig {
   std::vector<WallConfig> walls;          // [[boundary.wall]]
   ContainerConfig container;              // [boundary.container]
+  OutletConfig outlet;                    // [boundary.outlet]
   std::vector<PlaneConfig> planes;        // [[boundary.plane]]
   std::vector<CylinderConfig> cylinders;  // [[boundary.cylinder]]
   std::vector<CylinderConfig> spheres;    // [[boundary.sphere]]: axis is the rotation's

@@ -345,6 +345,60 @@ constexpr KeyDecl kContainer[] = {
      .doc = "the anchor's phase"},
 };
 
+const OutletConfig kOutletDefaults{};
+constexpr KeyDecl kOutlet[] = {
+    {.name = "normal",
+     .type = KeyType::kVector,
+     .member = field<&OutletConfig::normal>,
+     .range = {.by_rule = true},  // not zero, no component along a periodic axis
+     .default_text = "**required**",
+     .doc = "the outlet plane's normal, pointing to the side the particles come from "
+            "(normalised); a centre crossing the plane the other way passes"},
+    {.name = "point",
+     .type = KeyType::kVector,
+     .member = field<&OutletConfig::point>,
+     .range = {.by_rule = true},  // finite
+     .default_text = "**required**",
+     .unit = "length",
+     .doc = "a point of the outlet's plane"},
+    {.name = "insert_lower",
+     .type = KeyType::kVector,
+     .member = field<&OutletConfig::insert_lower>,
+     .range = {.by_rule = true},  // finite, on the particles' side of the plane
+     .default_text = "**required**",
+     .unit = "length",
+     .doc = "the low corner of the insertion region, where a particle that passed is put back "
+            "(its centre, at a random free place)"},
+    {.name = "insert_upper",
+     .type = KeyType::kVector,
+     .member = field<&OutletConfig::insert_upper>,
+     .range = {.by_rule = true},  // finite, not below insert_lower
+     .default_text = "**required**",
+     .unit = "length",
+     .doc = "the high corner of the insertion region"},
+    {.name = "insert_velocity",
+     .type = KeyType::kVector,
+     .member = field<&OutletConfig::insert_velocity>,
+     .range = {.by_rule = true},  // finite
+     .default_text = "at rest",
+     .unit = "length / time",
+     .doc = "the velocity a particle is put back with (no spin)"},
+    {.name = "seed",
+     .type = KeyType::kUnsigned,
+     .member = field<&OutletConfig::seed>,
+     .doc = "seeds the places drawn in the insertion region"},
+};
+
+bool span_given(const void* p) {
+  return !static_cast<const PlaneConfig*>(p)->span_axis.empty();
+}
+bool span_min_given(const void* p) {
+  return std::isfinite(static_cast<const PlaneConfig*>(p)->span_min);
+}
+bool span_max_given(const void* p) {
+  return std::isfinite(static_cast<const PlaneConfig*>(p)->span_max);
+}
+
 const PlaneConfig kPlaneDefaults{};
 constexpr KeyDecl kPlane[] = {
     {.name = "normal",
@@ -360,6 +414,30 @@ constexpr KeyDecl kPlane[] = {
      .default_text = "**required**",
      .unit = "length",
      .doc = "a point of the plane at t = 0"},
+    {.name = "span_axis",
+     .type = KeyType::kString,
+     .member = field<&PlaneConfig::span_axis>,
+     .range = {.by_rule = true},  // a bounded axis the plane runs along; a still plane
+     .choices = &choices_in<&axes>,
+     .doc = "cut the plane to a strip along this axis, with edges at its ends (a silo's floor "
+            "beside its orifice, a hopper's side); \"\": the whole plane",
+     .written = &span_given},
+    {.name = "span_min",
+     .type = KeyType::kFloat,
+     .member = field<&PlaneConfig::span_min>,
+     .range = {.by_rule = true},  // below span_max
+     .default_text = "unbounded",
+     .unit = "length",
+     .doc = "the strip's low end along span_axis (of the plane's points)",
+     .written = &span_min_given},
+    {.name = "span_max",
+     .type = KeyType::kFloat,
+     .member = field<&PlaneConfig::span_max>,
+     .range = {.by_rule = true},  // above span_min
+     .default_text = "unbounded",
+     .unit = "length",
+     .doc = "the strip's high end along span_axis",
+     .written = &span_max_given},
 };
 
 const CylinderConfig kCylinderDefaults{};
@@ -1044,6 +1122,7 @@ constexpr KeyGroup kBoundaryGroup{"boundary", kBoundary, &kBoundaryDefaults};
 constexpr KeyGroup kWallGroup{"wall", kWall, &kWallDefaults};
 constexpr KeyGroup kPlaneGroup{"plane", kPlane, &kPlaneDefaults};
 constexpr KeyGroup kContainerGroup{"container", kContainer, &kContainerDefaults};
+constexpr KeyGroup kOutletGroup{"outlet", kOutlet, &kOutletDefaults};
 constexpr KeyGroup kCylinderGroup{"cylinder", kCylinder, &kCylinderDefaults};
 constexpr KeyGroup kFieldGroup{"field", kField, &kFieldDefaults};
 constexpr KeyGroup kDrivingGroup{"driving", kDriving, &kDrivingDefaults};
@@ -1089,6 +1168,7 @@ std::vector<DeclaredKey> build() {
        KeyType::kTableArray,
        {{&kWallFaceGroup}, {&kContactLawGroup, "contact"}, {&kWallGroup}}},
       {"boundary.container", KeyType::kTable, {{&kContainerGroup}}},
+      {"boundary.outlet", KeyType::kTable, {{&kOutletGroup}}},
       {"boundary.plane",
        KeyType::kTableArray,
        {{&kPlaneGroup}, {&kContactLawGroup, "contact"}, {&kWallGroup, "boundary.wall"}}},
@@ -1235,6 +1315,9 @@ const KeyGroup& plane_keys() {
 }
 const KeyGroup& container_keys() {
   return kContainerGroup;
+}
+const KeyGroup& outlet_keys() {
+  return kOutletGroup;
 }
 const KeyGroup& cylinder_keys() {
   return kCylinderGroup;

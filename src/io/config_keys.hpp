@@ -187,6 +187,7 @@ const KeyGroup& wall_keys();            // [[boundary.wall]] (after face and the
                                         // and [[boundary.plane]] (after its own keys)
 const KeyGroup& plane_keys();           // [[boundary.plane]]: normal, point
 const KeyGroup& container_keys();       // [boundary.container]
+const KeyGroup& outlet_keys();          // [boundary.outlet]
 const KeyGroup& cylinder_keys();        // [[boundary.cylinder]]: axis, center, radius, ...
 const KeyGroup& field_keys();           // [field]
 const KeyGroup& driving_keys();         // [driving]

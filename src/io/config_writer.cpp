@@ -150,6 +150,10 @@ std::string to_toml(const Config& config) {
     out +=
         group_toml(container_keys(), &config.boundary.container, "boundary.container", dimension);
   }
+  if (!config.boundary.outlet.normal.empty()) {
+    out += "\n[boundary.outlet]\n";
+    out += group_toml(outlet_keys(), &config.boundary.outlet, "boundary.outlet", dimension);
+  }
   for (const bool sphere : {false, true}) {
     const std::string name = sphere ? "boundary.sphere" : "boundary.cylinder";
     for (const CylinderConfig& c : sphere ? config.boundary.spheres : config.boundary.cylinders) {

@@ -423,6 +423,11 @@ void write_restart(const std::filesystem::path& path, const StateBlocks<D>& bloc
       w.write_chunk("kairos/state/shear_work", 1, 1, &s.counters.work_by_shear);
     const std::uint64_t steps[2] = {s.counters.step_crossings, s.counters.step_bounces};
     w.write_chunk("kairos/state/step_counters", 2, 1, steps);
+    if (s.counters.outlet_passes > 0) {
+      const double sums[2] = {s.counters.outlet_mass, s.counters.outlet_energy};
+      w.write_chunk("kairos/state/outlet_passes", 1, 1, &s.counters.outlet_passes);
+      w.write_chunk("kairos/state/outlet_sums", 2, 1, sums);
+    }
     if (s.zones) {
       // The count marks the list as present (also when empty); the pairs follow when any.
       const std::uint64_t nz = s.zones->size();
@@ -640,6 +645,13 @@ ParticleSystem<D> read_restart(const std::filesystem::path& path, std::mt19937_6
     const auto steps = require<std::uint64_t>(r, f, "kairos/state/step_counters", path, 2);
     s.counters.step_crossings = steps[0];
     s.counters.step_bounces = steps[1];
+  }
+  if (r.find(f, "kairos/state/outlet_passes")) {
+    s.counters.outlet_passes =
+        require<std::uint64_t>(r, f, "kairos/state/outlet_passes", path, 1)[0];
+    const auto sums = require<double>(r, f, "kairos/state/outlet_sums", path, 2);
+    s.counters.outlet_mass = sums[0];
+    s.counters.outlet_energy = sums[1];
   }
   if (r.find(f, "kairos/state/soft_counters")) {
     const auto soft = require<std::uint64_t>(r, f, "kairos/state/soft_counters", path, 4);

@@ -60,6 +60,7 @@
 
 #include "boundaries/cylinder_walls.hpp"
 #include "boundaries/face_walls.hpp"
+#include "boundaries/outlets.hpp"
 #include "boundaries/plane_walls.hpp"
 #include "boundaries/wall_body.hpp"
 #include "core/error.hpp"
@@ -220,6 +221,20 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
       return c.resolve(k, x, t, mass, radius, inertia_factor, force_elastic, v, w);
     });
   }
+  // Whether particles pass through surface s (an outlet: no contact, no support, no overlap);
+  // a component says so with a member passes(s), which the others lack.
+  bool passes(int s) const {
+    return at(s, [](const auto& c, int k) -> bool {
+      if constexpr (requires { c.passes(k); }) return c.passes(k);
+      return false;
+    });
+  }
+  // Whether some surface is one particles pass through.
+  bool any_passes() const {
+    bool any = false;
+    for (int s = 0; s < surfaces_; ++s) any = any || (is_surface(s) && passes(s));
+    return any;
+  }
   // Whether some surface moves (a sleeper predicts no events of its own and would not see it
   // coming).
   bool any_surface_moves() const {
@@ -257,8 +272,11 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
     bool any = false;
     int first = 0;
     for_each([&](const auto& c) {
-      for (int k = 0; k < c.surfaces() && !any; ++k)
+      for (int k = 0; k < c.surfaces() && !any; ++k) {
+        if constexpr (requires { c.passes(k); })
+          if (c.passes(k)) continue;
         any = first + k != skip && c.is_surface(k) && c.gap(k, x, t) < radius;
+      }
       first += c.surfaces();
     });
     return any;
@@ -452,19 +470,31 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
 // in the constructor, which makes each from the run's model (its specification lives in the
 // Environment).
 template <int D>
-class Boundaries
-    : public BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>, SphereWalls<D>> {
+class Boundaries : public BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>,
+                                      SphereWalls<D>, Outlets<D>> {
  public:
   Boundaries() = default;
   Boundaries(const Environment<D>& environment, const Vec<D>& box)
-      : BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>, SphereWalls<D>>(
+      : BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>, SphereWalls<D>, Outlets<D>>(
             FaceWalls<D>(environment.faces, box, environment.gravity),
             PlaneWalls<D>(environment.planes, box, environment.faces, environment.gravity),
             CylinderWalls<D>(environment.cylinders, environment.gravity),
-            SphereWalls<D>(environment.spheres, environment.gravity)) {}
+            SphereWalls<D>(environment.spheres, environment.gravity),
+            Outlets<D>(environment.outlets, environment.gravity)) {}
 
   const FaceWalls<D>& faces() const { return this->template get<FaceWalls<D>>(); }
   FaceWalls<D>& faces() { return this->template get<FaceWalls<D>>(); }
+  const Outlets<D>& outlets() const { return this->template get<Outlets<D>>(); }
+  // The outlet (its number in outlets()) of surface s, which passes(s).
+  int outlet_index(int s) const {
+    int first = 0;
+    bool reached = false;
+    this->for_each([&](const auto& c) {
+      reached = reached || std::is_same_v<std::remove_cvref_t<decltype(c)>, Outlets<D>>;
+      if (!reached) first += c.surfaces();
+    });
+    return s - first;
+  }
 };
 
 }  // namespace kairos

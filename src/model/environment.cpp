@@ -57,6 +57,74 @@ bool Environment<D>::plain() const {
   return contact.empty();
 }
 
+// A plane cut to a strip (span_axis): still, across a bounded axis, with edges along a box axis.
+template <int D>
+void Environment<D>::check_strip(const PlaneWall<D>& p, const std::string& name) const {
+  if (p.span_axis >= D) throw InputError(name + ".span_axis: not an axis of the box");
+  const std::string axis(1, "xyz"[p.span_axis]);
+  if (periodic(p.span_axis)) {
+    throw InputError(name + ".span_axis: " + axis +
+                     " is periodic; a strip must end across a bounded axis (walls or open faces)");
+  }
+  if (!(p.span_min < p.span_max) || std::isnan(p.span_min) || std::isnan(p.span_max))
+    throw InputError(name + ": span_min must be below span_max");
+  if (p.plane_moves() || norm2(p.wall.velocity) != 0.0) {
+    throw InputError(name +
+                     ": a strip (span_axis) must hold still: no velocity or vibration (its "
+                     "edges do not move)");
+  }
+  const auto [along, across] = p.edge_axes();
+  if (across < 0) {
+    throw InputError(name + ".span_axis: the plane is perpendicular to " + axis +
+                     ", so it cannot be cut along it; choose an axis the plane runs along");
+  }
+  if (along < 0) {
+    throw InputError(name +
+                     ".span_axis: in 3D a strip's edges run along a box axis, so the normal "
+                     "must have no component along one of the two axes besides " +
+                     axis);
+  }
+}
+
+// An outlet's plane, like a plane wall's, must not cut a periodic axis; its insertion region is
+// a box on the particles' side of it (a particle put back behind it would pass again at once).
+template <int D>
+void Environment<D>::check_outlets() const {
+  for (const Outlet<D>& o : outlets) {
+    const std::string name = "boundary.outlet";
+    double n2 = 0.0;
+    for (int a = 0; a < D; ++a) {
+      if (!std::isfinite(o.normal[a])) throw InputError(name + ".normal must be finite");
+      n2 += o.normal[a] * o.normal[a];
+      if (o.normal[a] != 0.0 && periodic(a)) {
+        throw InputError(name + ".normal has a component along the periodic axis " +
+                         std::string(1, "xyz"[a]) +
+                         ": the outlet's plane must not cut a periodic axis; make that axis "
+                         "bounded (walls or open faces) or the normal perpendicular to it");
+      }
+      if (!std::isfinite(o.insert_lower[a]) || !std::isfinite(o.insert_upper[a]) ||
+          !std::isfinite(o.insert_velocity[a]))
+        throw InputError(name + ": insert_lower, insert_upper and insert_velocity must be finite");
+      if (!(o.insert_lower[a] <= o.insert_upper[a])) {
+        throw InputError(name + ": insert_lower must not exceed insert_upper (along " +
+                         std::string(1, "xyz"[a]) + ")");
+      }
+    }
+    if (!(std::abs(n2 - 1.0) <= 1e-12)) throw InputError(name + ".normal must be a unit vector");
+    if (!std::isfinite(o.offset)) throw InputError(name + ".point must be finite");
+    // The region's corner nearest the plane, along the normal.
+    double nearest = 0.0;
+    for (int a = 0; a < D; ++a)
+      nearest += o.normal[a] * (o.normal[a] > 0.0 ? o.insert_lower[a] : o.insert_upper[a]);
+    if (!(nearest > o.offset)) {
+      throw InputError(name +
+                       ": the insertion region (insert_lower to insert_upper) reaches the "
+                       "outlet's plane or beyond it: a particle put back there would pass "
+                       "again; move the region to the side the normal points to");
+    }
+  }
+}
+
 template <int D>
 void Environment<D>::check() const {
   for (int a = 0; a < D; ++a) {
@@ -83,6 +151,7 @@ void Environment<D>::check() const {
     if (!(std::abs(n2 - 1.0) <= 1e-12))
       throw InputError(name + ": the normal must be a unit vector");
     if (!std::isfinite(p.offset)) throw InputError(name + ": point must be finite");
+    if (p.spanned()) check_strip(p, name);
     for (int a = 0; a < D; ++a) {
       if (p.normal[a] != 0.0 && periodic(a)) {
         throw InputError(name + ": the normal has a component along the periodic axis " +
@@ -93,7 +162,9 @@ void Environment<D>::check() const {
       }
     }
   }
-  const std::size_t surfaces = 2 * D + planes.size() + cylinders.size() + spheres.size();
+  check_outlets();
+  const std::size_t surfaces =
+      2 * D + planes.size() + cylinders.size() + spheres.size() + outlets.size() + 2 * strips();
   if (surfaces > static_cast<std::size_t>(EventCode<D>::kWallCodes)) {
     throw InputError("boundary: " + std::to_string(surfaces - 2 * D) +
                      " plane, cylinder and sphere walls; at most " +

@@ -20,6 +20,7 @@
 
 #include "boundaries/cylinder_walls.hpp"
 #include "boundaries/face_wall.hpp"
+#include "boundaries/outlets.hpp"
 #include "boundaries/plane_walls.hpp"
 #include "interactions/granular_contact.hpp"
 #include "interactions/soft_contact.hpp"
@@ -45,6 +46,9 @@ struct Environment {
   std::vector<PlaneWall<D>> planes;
   std::vector<CylinderWall<D>> cylinders;  // boundaries/cylinder_walls.hpp
   std::vector<CylinderWall<D>> spheres;    // the same, round in every direction
+  // Outlets particles pass through, to be put back in an insertion region
+  // (boundaries/outlets.hpp); not walls.
+  std::vector<Outlet<D>> outlets;
   // Contact law of species pair (a, b) at contact[a * species + b] (symmetric); empty: every
   // pair collides elastically and smoothly.
   std::vector<ContactModel> contact;
@@ -145,6 +149,15 @@ struct Environment {
   // Throws InputError naming the first inconsistency (an axis periodic on one face only, a
   // velocity that is not finite, a negative amplitude, contact table size...).
   void check() const;
+
+ private:
+  void check_outlets() const;
+  void check_strip(const PlaneWall<D>& p, const std::string& name) const;
+  std::size_t strips() const {
+    std::size_t n = 0;
+    for (const PlaneWall<D>& p : planes) n += p.spanned() ? 1 : 0;
+    return n;
+  }
 };
 
 }  // namespace kairos

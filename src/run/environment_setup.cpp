@@ -318,6 +318,26 @@ Wall<D> make_wall(const WallConfig& wc, const std::string& where) {
   wall.force = wc.force;
   return wall;
 }
+
+// An outlet from its keys: the plane through `point` with the unit normal, and the insertion
+// region (the reader made sure every vector has its D components; the velocity may be empty).
+template <int D>
+Outlet<D> make_outlet(const OutletConfig& oc) {
+  const auto vec = [](const std::vector<double>& v) {
+    Vec<D> out{};
+    for (int a = 0; a < D && a < static_cast<int>(v.size()); ++a) out[a] = v[a];
+    return out;
+  };
+  Outlet<D> outlet;
+  outlet.normal = vec(oc.normal);
+  outlet.normal = (1.0 / std::sqrt(norm2(outlet.normal))) * outlet.normal;  // not 0: the reader
+  outlet.offset = dot(outlet.normal, vec(oc.point));
+  outlet.insert_lower = vec(oc.insert_lower);
+  outlet.insert_upper = vec(oc.insert_upper);
+  outlet.insert_velocity = vec(oc.insert_velocity);
+  outlet.seed = oc.seed;
+  return outlet;
+}
 }  // namespace
 
 template <int D>
@@ -378,6 +398,11 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
     for (int a = 0; a < D && a < static_cast<int>(pc.point.size()); ++a) point[a] = pc.point[a];
     plane.offset = dot(plane.normal, point);
     plane.wall = make_wall<D>(pc.wall, fmt::format("boundary.plane[{}]", k));
+    if (!pc.span_axis.empty()) {
+      plane.span_axis = static_cast<int>(axes(D).at(pc.span_axis));
+      plane.span_min = pc.span_min;
+      plane.span_max = pc.span_max;
+    }
     env.planes.push_back(plane);
   }
   for (const bool sphere : {false, true}) {
@@ -399,6 +424,8 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
   }
   for (const std::string& open : config.boundary.open)
     env.faces[face_index(open, D)].kind = FaceKind::kOpen;
+  if (const OutletConfig& oc = config.boundary.outlet; !oc.normal.empty())
+    env.outlets.push_back(make_outlet<D>(oc));
   if (const ContainerConfig& box = config.boundary.container; !box.axis.empty()) {
     // Both walls of the axis become one body (boundaries/wall_spring.hpp).
     const int axis = static_cast<int>(axes(D).at(box.axis));

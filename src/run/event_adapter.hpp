@@ -109,6 +109,11 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   std::vector<WallReading> walls_with_mass() const override {
     return engine_.boundaries().readings(engine_.time());
   }
+  std::optional<typename Integrator<D>::OutletReading> outlet() const override {
+    if (engine_.environment().outlets.empty()) return std::nullopt;
+    const EventCounters& c = engine_.counters();
+    return typename Integrator<D>::OutletReading{c.outlet_passes, c.outlet_mass, c.outlet_energy};
+  }
   Vec<D> momentum() const override { return engine_.momentum(); }
   double momentum_scale() const override;
   double max_overlap() const override;

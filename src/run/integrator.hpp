@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -145,6 +146,13 @@ class Integrator {
   virtual double work_by_walls() const = 0;
   // The walls with mass now (boundaries/wall_body.hpp), box faces in order: none by default.
   virtual std::vector<WallReading> walls_with_mass() const { return {}; }
+  // Outlets (boundary.outlet): the particles that passed and were put back so far, their mass
+  // and the energy they took out (EventCounters::outlet_*); nullopt without an outlet.
+  struct OutletReading {
+    std::uint64_t passes = 0;
+    double mass = 0.0, energy = 0.0;
+  };
+  virtual std::optional<OutletReading> outlet() const { return std::nullopt; }
   virtual Vec<D> momentum() const = 0;
   // Sum of m |v| over the particles: the scale of the momentum drift.
   virtual double momentum_scale() const = 0;

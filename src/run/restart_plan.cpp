@@ -96,6 +96,9 @@ Effect effect_of(const std::string& key) {
     if (std::find(kWallLaw.begin(), kWallLaw.end(), leaf) != kWallLaw.end()) return Effect::kResume;
     return Effect::kRepredict;
   }
+  // Where and how an outlet puts particles back decides what happens at a pass, not when.
+  if (starts_with(k, "boundary.outlet.insert_") || k == "boundary.outlet.seed")
+    return Effect::kResume;
   // The maps' tables and their cache decide how a future contact ends, not when.
   if (k == "soft.table_cache" || k == "soft.tables" || k == "soft.table_tolerance")
     return Effect::kResume;

@@ -180,5 +180,43 @@ TEST(SettlingPile, SphereSlidesOffASteepSlope) {
   EXPECT_GE(std::hypot(x[1][0] - 4.0, x[1][1] - 4.0), 1.0 - 1e-9);  // beside the other
 }
 
+// A tower of three disks on the floor, and a fourth beside it on the floor touching the bottom
+// one, settle and sleep; a thermostat's kick then moves the bottom disk of the tower away (up a
+// little: a kick along the floor is stopped at once by the wedged rule). The
+// two above it have lost their support and must wake and fall (before, they hung in the air for
+// good), the disk beside it still rests on the floor and stays asleep; all four end asleep on
+// the floor or on each other, nothing overlapping, every prediction checked on the way.
+TEST(SettlingPile, SleepersWhoseSupportWakesFallInsteadOfHanging) {
+  constexpr int D = 2;
+  ParticleSystem<D> s;
+  s.box = {12.0, 8.0};
+  s.kinematics = {{{4.0, 0.5}, {0.0, 0.0}, 0.0, 0.5},
+                  {{4.0, 1.5 + 1e-6}, {0.0, 0.0}, 0.0, 0.5},
+                  {{4.0, 2.5 + 3e-6}, {0.0, 0.0}, 0.0, 0.5},
+                  {{5.0 + 1e-7, 0.5}, {0.0, 0.0}, 0.0, 0.5}};
+  s.mass = {1.0, 1.0, 1.0, 1.0};
+  s.species = {0, 0, 0, 0};
+  s.species_names = {"A"};
+  EngineOptions keep_order;
+  keep_order.renumber_interval = 0.0;  // internal index = the caller's
+  Engine<D> engine(s, StartMode::kPredict, keep_order, testing::gravity_container<D>(0.5, 0.0));
+  for (int k = 0; k < 2000 && engine.sleeping() < 4; ++k)
+    ASSERT_NE(engine.step(), EventKind::kNone);
+  ASSERT_EQ(engine.sleeping(), 4u);
+  const double t = engine.time();
+  engine.set_velocity(0, t, {-3.0, 0.3});  // the tower's bottom disk, away from the fourth
+  EXPECT_EQ(engine.counters().lost_support, 2u);
+  EXPECT_EQ(engine.sleeping(), 1u);  // the disk beside it is still held by the floor
+  int events = 0;
+  while (engine.step() != EventKind::kNone) {
+    ASSERT_LT(++events, 100000) << "stalled at t = " << engine.time();
+    if (events % 7 == 0) engine.validate();
+  }
+  EXPECT_EQ(engine.sleeping(), 4u);
+  EXPECT_LT(engine.max_overlap_now(), 1e-10);
+  // The upper two have come down: no centre is left at the tower's top height.
+  for (const Vec<D>& x : engine.current_positions()) EXPECT_LT(x[1], 2.0) << x[0];
+}
+
 }  // namespace
 }  // namespace kairos

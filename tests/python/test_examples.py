@@ -41,6 +41,9 @@ EXAMPLES = {
     # Measured in time: the container swings up within a few cycles.
     "spring_damper_3d.toml": ("plot_spring_damper.py", [
         "run.equilibration_time=4", "run.time=8"]),
+    # Measured in time: the first disks pass the outlet after about 8 time units.
+    "silo_2d.toml": ("plot_silo.py", ["run.equilibration_time=8", "run.time=8",
+                                      "output.trajectory_interval=4"]),
     "shear_flow_2d.toml": ("plot_shear_flow_2d.py", [
         "system.particles=2000", "run.equilibration_collisions_per_particle=2",
         "run.collisions_per_particle=5", "output.trajectory_interval=2",
@@ -168,6 +171,16 @@ class GranularExamples(kt.KairosTestCase):
         self.assertGreater(swing, 4.0)  # the anchor (A = 2) drives it at resonance
         self.assertLess(swing, 20.1)  # ... and the grains hold it below its swing alone
         self.draw_picture("spring_damper_3d.toml", out)
+
+    def test_silo_2d(self):
+        out, s = self.check_run("silo_2d.toml")
+        # Disks pass through the orifice and come back: the count is in thermo.tsv and summary.
+        outlet = s["granular"]["outlet"]
+        self.assertGreater(outlet["production_rate"], 5.0)
+        header, rows, _ = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        self.assertEqual(int(rows[-1][header.index("outlet_passes")]),
+                         outlet["total_passes_since_start"])
+        self.draw_picture("silo_2d.toml", out)
 
     def test_shear_flow_2d(self):
         out, s = self.check_run("shear_flow_2d.toml")

@@ -13,12 +13,13 @@ void ThermoOutput<D>::open(const RunContext<D>& run) {
   const std::filesystem::path path = run.directory() / name();
   std::string header(kHeader);
   const std::vector<WallReading> walls = integrator.walls_with_mass();
-  if (!walls.empty()) {
+  if (!walls.empty() || integrator.outlet()) {
     header.pop_back();  // its newline
     for (const WallReading& w : walls) {
       header += fmt::format("\twall_{0}_position\twall_{0}_speed\twall_{0}_energy", w.face);
       if (w.sprung) header += fmt::format("\twall_{0}_drive_work\twall_{0}_dashpot", w.face);
     }
+    if (integrator.outlet()) header += "\toutlet_passes\toutlet_mass\toutlet_energy";
     header += '\n';
   }
   // A new file, or (a continued run) the existing one cut to the rows the continued state had
@@ -46,7 +47,7 @@ bool ThermoOutput<D>::pending(const RunContext<D>& run) const {
          (run.timed() && integrator.time() > stats_->last().time);
 }
 
-// The columns of the walls with mass (empty without).
+// The columns of the walls with mass and of the outlet (empty without).
 template <int D>
 std::string wall_columns(const Integrator<D>& integrator) {
   std::string out;
@@ -54,6 +55,8 @@ std::string wall_columns(const Integrator<D>& integrator) {
     out += fmt::format("\t{:.17g}\t{:.17g}\t{:.17g}", w.position, w.speed, w.energy);
     if (w.sprung) out += fmt::format("\t{:.17g}\t{:.17g}", w.drive_work, w.dashpot);
   }
+  if (const auto outlet = integrator.outlet())
+    out += fmt::format("\t{}\t{:.17g}\t{:.17g}", outlet->passes, outlet->mass, outlet->energy);
   return out;
 }
 
