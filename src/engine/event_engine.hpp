@@ -552,6 +552,10 @@ class EventEngine {
   LeesEdwards<D> shear_;       // Lees-Edwards images (boundaries/lees_edwards.hpp)
   Environment<D> env_;         // the hot members above share fewer cache lines
   ImageCounters<D> images_;    // cold: written at wraps, read at export
+  // wake()'s lists, kept so that a wake allocates nothing.
+  struct WakeScratch {
+    std::vector<std::uint32_t> woken, touching;
+  } wake_scratch_;
   HelfandMoments<D> helfand_;  // cold: pair events only, when a transport analysis asks
 };
 

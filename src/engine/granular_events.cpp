@@ -287,7 +287,9 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::wake(std::uint32_t i, double t) {
   resting_.wake(i);
   hot_[i].time = t;  // at rest where it slept
-  std::vector<std::uint32_t> woken{i}, touching;
+  std::vector<std::uint32_t>& woken = wake_scratch_.woken;
+  std::vector<std::uint32_t>& touching = wake_scratch_.touching;
+  woken.assign(1, i);
   while (!woken.empty()) {
     const std::uint32_t j = woken.back();
     woken.pop_back();
