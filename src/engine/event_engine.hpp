@@ -548,10 +548,10 @@ class EventEngine {
   bool soft_ = false;
   SoftContactState<D> soft_state_;
 
-  Boundaries<D> boundaries_;   // every wall (model/boundaries.hpp: the face walls so far)
-  LeesEdwards<D> shear_;       // Lees-Edwards images (boundaries/lees_edwards.hpp)
-  Environment<D> env_;         // the hot members above share fewer cache lines
-  ImageCounters<D> images_;    // cold: written at wraps, read at export
+  Boundaries<D> boundaries_;  // every wall (model/boundaries.hpp: the face walls so far)
+  LeesEdwards<D> shear_;      // Lees-Edwards images (boundaries/lees_edwards.hpp)
+  Environment<D> env_;        // the hot members above share fewer cache lines
+  ImageCounters<D> images_;   // cold: written at wraps, read at export
   // wake()'s lists, kept so that a wake allocates nothing.
   struct WakeScratch {
     std::vector<std::uint32_t> woken, touching;
