@@ -76,7 +76,8 @@ void EventEngine<D, Queue>::pass_outlet(std::uint32_t i, int surface, double t) 
     throw InputError(fmt::format(
         "boundary.outlet: at t = {:.10g} particle {} passed the outlet, but no free place for "
         "it was found in the insertion region (insert_lower to insert_upper) in {} tries: the "
-        "region is full; make it larger, or place it where the particles leave room",
+        "region is full, or lies outside the walls; make it larger, or place it inside the "
+        "walls where the particles leave room",
         t, id_[i], kInsertionAttempts));
   }
   HotRecord<D>& h = hot_[i];
