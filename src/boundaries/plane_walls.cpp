@@ -44,27 +44,37 @@ std::string PlaneWalls<D>::name(int s) const {
   return edge_names_[static_cast<std::size_t>(s - planes())];
 }
 
-// The plane's own contact (the solver of an unbounded plane) where the particle comes from the
-// front; from beside the strip (within a radius of its level or below it: in an orifice) the
-// contact can only come after the particle has risen above the level and falls back, the later
-// root of the quadratic. Either counts only where its foot lies within the strip; a parabola
-// crosses the level downwards once, so a crossing beside the strip means none at all (the edges
-// are surfaces of their own).
+// A strip is a thin plate with two faces, n.x = c met from the front and -n.x = -c from behind,
+// each only where the foot lies within the strip (the edges close its ends). For one face (unit
+// normal m towards the particle's side, offset d) the height h = m.x - R - d moves as
+// h0 + b t + a t^2/2: from in front of the face (h0 >= 0, or round-off below it) the plane's
+// own root; from behind it (a particle beside the strip: in an orifice, or past its other face)
+// only a rise and fall back can meet it, the later root (a < 0 < b). A parabola crosses a face's
+// level towards it once, so a crossing beside the strip means none with that face at all.
 template <int D>
-double PlaneWalls<D>::strip_event_time(const PlaneWall<D>& p, const Vec<D>& x, const Vec<D>& v,
-                                       double radius, double horizon) const {
-  const double nx = dot(p.normal, x), nv = dot(p.normal, v), ng = dot(p.normal, gravity_);
-  const double height = nx - radius - p.offset;
+double PlaneWalls<D>::face_event_time(const PlaneWall<D>& p, double side, const Vec<D>& x,
+                                      const Vec<D>& v, double radius, double horizon) const {
+  const Vec<D> m = side * p.normal;
+  const double d = side * p.offset;
+  const double mx = dot(m, x), b = dot(m, v), a = dot(m, gravity_);
+  const double height = mx - radius - d;
   double when = kNever;
-  if (height >= 0.0 || p.covers(x, nx - p.offset)) {
-    when = fixed_plane_event_time(NormalMotion{nx - radius, nv, ng}, p.offset, horizon);
-  } else if (ng < 0.0 && nv > 0.0) {
-    const double c = 0.5 * ng, disc = nv * nv - 4.0 * height * c;
-    if (disc > 0.0) when = within_horizon((-nv - std::sqrt(disc)) / (2.0 * c), horizon);
+  if (height >= -kStripRoundOff * radius) {
+    when = fixed_plane_event_time(NormalMotion{mx - radius, b, a}, d, horizon);
+  } else if (a < 0.0 && b > 0.0) {
+    const double c = 0.5 * a, disc = b * b - 4.0 * height * c;
+    if (disc > 0.0) when = within_horizon((-b - std::sqrt(disc)) / (2.0 * c), horizon);
   }
   if (!(when < kNever)) return kNever;
   const Vec<D> at = x + when * v + (0.5 * when * when) * gravity_;
-  return p.covers(at, radius) ? when : kNever;
+  return p.covers(at, side * radius) ? when : kNever;
+}
+
+template <int D>
+double PlaneWalls<D>::strip_event_time(const PlaneWall<D>& p, const Vec<D>& x, const Vec<D>& v,
+                                       double radius, double horizon) const {
+  return std::min(face_event_time(p, 1.0, x, v, radius, horizon),
+                  face_event_time(p, -1.0, x, v, radius, horizon));
 }
 
 // Along the normal the particle's height above the plane is n.x - R, moving at n.v with
@@ -115,6 +125,10 @@ ContactResult<D> PlaneWalls<D>::resolve(int s, const Vec<D>& x, double t, double
     return edges_.resolve(s - planes(), x, t, mass, radius, inertia_factor, force_elastic, v, w);
   }
   const PlaneWall<D>& p = plane(s);
+  if (p.spanned()) {  // a still plate, met on either face
+    return resolve_surface_contact<D>(p.wall.contact, normal(s, x, t), Vec<D>{}, mass, radius,
+                                      inertia_factor, force_elastic, v, w);
+  }
   return resolve_surface_contact<D>(p.wall.contact, p.normal, p.surface_velocity(t), mass, radius,
                                     inertia_factor, force_elastic, v, w);
 }

@@ -16,8 +16,8 @@
 // its points' coordinate along that axis lies in [span_min, span_max]): the floor of a silo
 // beside its orifice, the sides of a hopper. Its ends are edges (lines along a box axis in 3D,
 // points in 2D), surfaces of their own: a zero-radius outside cylinder each (RoundWalls), after
-// all the planes in this component's numbering. A strip is one-sided as every plane: behind it
-// is outside the domain where it is, and nothing beside it (docs/physics.md#strips-and-edges).
+// all the planes in this component's numbering. A strip is a thin plate, met on both faces, and
+// nothing beside it (docs/physics.md#outlets-and-strips).
 #pragma once
 
 #include <array>
@@ -113,14 +113,19 @@ class PlaneWalls {
   }
   double approach_speed(int s) const { return s < planes() ? plane(s).normal_speed() : 0.0; }
 
-  // Beside a strip (its foot outside it) a plane is not there: no gap.
+  // A strip is a plate with two faces: the distance from it on either side, and none beside it
+  // (its foot outside it).
   double gap(int s, const Vec<D>& x, double t) const {
     if (s >= planes()) return edges_.gap(s - planes(), x, t);
     const double g = dot(plane(s).normal, x) - plane(s).position(t);
-    return plane(s).covers(x, g) ? g : kNever;
+    if (!plane(s).spanned()) return g;
+    return plane(s).covers(x, g) ? std::abs(g) : kNever;
   }
+  // A strip's normal points to the side x is on.
   Vec<D> normal(int s, const Vec<D>& x, double t) const {
-    return s < planes() ? plane(s).normal : edges_.normal(s - planes(), x, t);
+    if (s >= planes()) return edges_.normal(s - planes(), x, t);
+    const PlaneWall<D>& p = plane(s);
+    return p.spanned() && dot(p.normal, x) < p.offset ? -1.0 * p.normal : p.normal;
   }
   Vec<D> velocity(int s, const Vec<D>& /*x*/, double t) const {
     return s < planes() ? plane(s).surface_velocity(t) : Vec<D>{};
@@ -155,9 +160,15 @@ class PlaneWalls {
   [[noreturn]] void throw_squeezed(double t, double dmax, bool uniform) const;
 
  private:
-  // A strip's contact: the plane's, where its foot lies within the strip (a still plane).
+  // A strip's contact: with either face of the plate, where its foot lies within the strip (a
+  // still plane); side +1 the front (n), -1 the back.
   double strip_event_time(const PlaneWall<D>& p, const Vec<D>& x, const Vec<D>& v, double radius,
                           double horizon) const;
+  double face_event_time(const PlaneWall<D>& p, double side, const Vec<D>& x, const Vec<D>& v,
+                         double radius, double horizon) const;
+  // How far (in radii) a particle may sit inside a strip's face by round-off and still be in
+  // front of it.
+  static constexpr double kStripRoundOff = 1e-9;
 
   std::vector<PlaneWall<D>> planes_;
   CylinderWalls<D> edges_;  // the strips' ends: outside cylinders of radius 0

@@ -3,6 +3,7 @@
 // old predictions become stale by its collision counter, as after a collision; its new one
 // scans its new neighbourhood, which covers every pair it forms there (the engine's invariant
 // needs no more: the sooner of two partners' events bounds their contact).
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -19,6 +20,8 @@ namespace kairos {
 namespace {
 // Tries for a free place before the region is declared full.
 constexpr std::uint32_t kInsertionAttempts = 100000;
+// Draws of the region at the start, looking for room inside the walls.
+constexpr std::uint32_t kRegionProbes = 1000;
 }  // namespace
 
 template <int D, class Queue>
@@ -31,6 +34,27 @@ void EventEngine<D, Queue>::check_outlets(const ParticleSystem<D>& /*s*/) const 
   if (sheared_) refuse("Lees-Edwards shear (boundary.shear_rate)");
   if (options_.track_helfand)
     refuse("transport analyses (analysis.transport): a particle put back jumps");
+  // A region outside the walls (or behind a plane) would only show at the first pass, after
+  // every draw failed: draws of the region must find room for the largest particle somewhere.
+  double rmax = 0.0;
+  for (const ParticleKind& kind : kinds_) rmax = std::max(rmax, kind.radius);
+  const Outlets<D>& outlets = boundaries_.outlets();
+  for (int k = 0; k < outlets.surfaces(); ++k) {
+    bool inside = false;
+    for (std::uint32_t attempt = 0; attempt < kRegionProbes && !inside; ++attempt) {
+      Vec<D> x = outlets.insertion_point(k, ~std::uint64_t{0}, attempt);
+      for (int a = 0; a < D; ++a)
+        if (cells_.grid().periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
+      inside = !boundaries_.overlaps(x, rmax, time_);
+    }
+    if (!inside) {
+      throw InputError(fmt::format(
+          "boundary.outlet: no place in the insertion region (insert_lower to insert_upper) "
+          "leaves room for a particle of radius {:.6g} inside the walls ({} draws): the region "
+          "lies outside the box's walls or behind a plane; move it inside",
+          rmax, kRegionProbes));
+    }
+  }
 }
 
 template <int D, class Queue>
@@ -85,6 +109,7 @@ void EventEngine<D, Queue>::pass_outlet(std::uint32_t i, int surface, double t) 
   h.vel = outlet.insert_velocity;
   h.time = t;
   if (!spin_.empty()) spin_[i] = AngularVelocity<D>{};
+  if (!last_collision_.empty()) last_collision_[i] = -kNever;  // the TC model: a new start
   relocate(i);
   if (images_.on()) images_.reset(i);  // a new path: its image flags start again
   ++h.collisions;                      // predictions made against its old motion are stale

@@ -54,28 +54,23 @@ double sampled_contact(const Component& c, int s, const Vec<D>& x, const Vec<D>&
 }
 
 // The first time the particle's surface reaches any surface of the component, sampled in steps
-// of h, and which. A strip is one-sided, as every plane: a particle that passes beside it and
-// comes under it from beyond its back (centre more than a radius behind) is outside the domain
-// and meets nothing there.
+// of h, and which (a strip's gap is the distance from the plate on either side).
 template <int D, class Component>
 std::pair<double, int> sampled_first_contact(const Component& c, const Vec<D>& x, const Vec<D>& v,
                                              const Vec<D>& g, double radius, double h,
                                              double horizon) {
   for (double tau = h; tau <= horizon; tau += h) {
     const Vec<D> at = x + tau * v + (0.5 * tau * tau) * g;
-    for (int s = 0; s < c.surfaces(); ++s) {
-      const double gap = c.gap(s, at, 0.0);
-      if (gap - radius < 0.0 && gap > -radius) return {tau, s};
-    }
+    for (int s = 0; s < c.surfaces(); ++s)
+      if (c.gap(s, at, 0.0) - radius < 0.0) return {tau, s};
   }
   return {kNever, -1};
 }
 
-// Particles thrown from above the floor and from inside the orifice (their centre within a
-// radius of the floor's level, beside the strip): the soonest contact with the strip or either
-// edge, as the engine takes it, against dense sampling of all three; the strip is met only
-// where it is, and a particle in the orifice meets an edge before it could reach under the
-// strip.
+// Particles thrown from above the floor, from inside the orifice (their centre within a radius
+// of the floor's level, beside the strip) and from under the floor: the soonest contact with
+// the strip (a plate, met on either face) or either edge, as the engine takes it, against dense
+// sampling of all three; the strip is met only where it is.
 TEST(Strips, EventTimesOfTheStripAndItsEdgesAgreeWithDenseSampling) {
   const Vec<2> box{10.0, 10.0}, g{0.0, -1.0};
   const PlaneWalls<2> planes({floor_strip<2>(2.0, 4.0, 6.5)}, box, side_walls_and_floor<2>(), g);
@@ -84,23 +79,30 @@ TEST(Strips, EventTimesOfTheStripAndItsEdgesAgreeWithDenseSampling) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double r = 0.5, h = 2e-5;
   int met[3] = {0, 0, 0};
-  for (int k = 0; k < 300; ++k) {
+  int from_below = 0;
+  for (int k = 0; k < 450; ++k) {
     Vec<2> x;
-    if (k % 2 == 0) {
+    if (k % 3 == 0) {
       x = {5.0 + 3.0 * u(rng), 3.5 + u(rng)};  // above the floor
+    } else if (k % 3 == 2) {
+      x = {5.0 + 3.0 * u(rng), 0.6 + 0.8 * std::abs(u(rng))};  // under it
     } else {
       // In the orifice beside either end, at least a radius from the edge.
       const bool left = u(rng) < 0.0;
       x = {left ? 3.4 - 0.4 * std::abs(u(rng)) : 7.1 + 0.4 * std::abs(u(rng)), 2.0 + 0.45 * u(rng)};
       if (std::hypot(x[0] - (left ? 4.0 : 6.5), x[1] - 2.0) < r) continue;
     }
-    const Vec<2> v{1.5 * u(rng), 2.0 * u(rng)};
+    const Vec<2> v{1.5 * u(rng), k % 3 == 2 ? 3.0 * std::abs(u(rng)) : 2.0 * u(rng)};
     const auto [sampled, which] = sampled_first_contact<2>(planes, x, v, g, r, h, 4.0);
     double predicted = kNever;
     for (int s = 0; s < 3; ++s)
       predicted = std::min(predicted, planes.event_time(s, x, v, r, 0.0, 4.0));
-    if (testing::agrees_with_sampling(predicted, sampled, h, k)) ++met[which];
+    if (testing::agrees_with_sampling(predicted, sampled, h, k)) {
+      ++met[which];
+      from_below += k % 3 == 2 && which == 0 ? 1 : 0;
+    }
   }
+  EXPECT_GT(from_below, 20);  // the plate's back face
   EXPECT_GT(met[0], 40);
   EXPECT_GT(met[1], 10);
   EXPECT_GT(met[2], 10);
@@ -288,6 +290,31 @@ TEST(OutletsInTheEngine, GrainsDrainThroughTheOrificeAndComeBackAtTheTop) {
   }
 }
 
+// The outlet three diameters below the floor: disks that leave the orifice spread under the
+// floor and meet the plate's back face, never passing through it; every prediction checked.
+TEST(OutletsInTheEngine, DisksUnderTheFloorMeetItsUnderside) {
+  Environment<D> env = silo(0.8);
+  env.outlets[0].offset = 1.0;
+  Engine engine(grains_above_the_floor(5), StartMode::kPredict, EngineOptions{}, env);
+  int under = 0;
+  for (int k = 0; k < 60000; ++k) {
+    ASSERT_NE(engine.step(), EventKind::kNone);
+    if (k % 97 == 0) engine.validate();
+    if (k % 1000 == 0) {
+      for (const Vec<D>& p : engine.current_positions()) {
+        const bool beside = p[0] > 5.5 && p[0] < 10.5;
+        under += !beside && p[1] < 4.0 ? 1 : 0;
+        if (!beside) {
+          ASSERT_TRUE(p[1] >= 4.5 - 1e-9 || p[1] <= 3.5 + 1e-9) << p[0] << " " << p[1];
+        }
+      }
+    }
+  }
+  engine.validate();
+  EXPECT_GT(under, 0);  // some were under the floor, beside the orifice
+  EXPECT_GT(engine.counters().outlet_passes, 10u);
+}
+
 TEST(OutletsInTheEngine, AResumedSiloContinuesBitForBit) {
   const Environment<D> env = silo(0.7);
   Engine a(grains_above_the_floor(2), StartMode::kPredict, EngineOptions{}, env);
@@ -302,16 +329,36 @@ TEST(OutletsInTheEngine, AResumedSiloContinuesBitForBit) {
 
 TEST(OutletsInTheEngine, AFullInsertionRegionIsAnErrorNamingIt) {
   Environment<D> env = silo(0.8, 6.0);
-  // A region no particle fits in: within a radius of the side wall.
-  env.outlets[0].insert_lower = {0.1, 25.0};
-  env.outlets[0].insert_upper = {0.3, 25.2};
+  // A region no particle fits in: around a fixed grain.
+  env.species = 2;
+  env.contact.assign(4, env.contact[0]);
+  env.fixed = {0, 1};
+  env.outlets[0].insert_lower = {7.95, 24.95};
+  env.outlets[0].insert_upper = {8.05, 25.05};
+  ParticleSystem<D> s = grains_above_the_floor(3);
+  s.kinematics[0].pos = {8.0, 25.0};
+  s.kinematics[0].vel = {};
+  s.species[0] = 1;
+  s.species_names = {"A", "B"};
   try {
-    Engine engine(grains_above_the_floor(3), StartMode::kPredict, EngineOptions{}, env);
+    Engine engine(std::move(s), StartMode::kPredict, EngineOptions{}, env);
     for (int k = 0; k < 200000; ++k) ASSERT_NE(engine.step(), EventKind::kNone);
     FAIL() << "no error";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("boundary.outlet"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("no free place"), std::string::npos) << e.what();
+  }
+}
+
+TEST(OutletsInTheEngine, ARegionOutsideTheWallsIsRefusedAtTheStart) {
+  Environment<D> env = silo(0.8);
+  env.outlets[0].insert_lower = {17.0, 20.0};  // beyond the side wall at x = 16
+  env.outlets[0].insert_upper = {19.0, 25.0};
+  try {
+    Engine engine(grains_above_the_floor(3), StartMode::kPredict, EngineOptions{}, env);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("inside the walls"), std::string::npos) << e.what();
   }
 }
 

@@ -245,10 +245,10 @@ class Outlets(kt.KairosTestCase):
             (mixture, ["analysis.msd", "boundary.outlet"]),
             (outlet(point=[0.0, 30.0], insert_lower=[1.0, 40.0], insert_upper=[22.0, 44.0]),
              ["boundary.outlet", "starts beyond the outlet"]),
-            # A region of one point, inside the wall x-: the first grain through has nowhere
-            # to go.
+            # A region of one point, inside the wall x-: refused at the start, before any
+            # grain passes.
             (outlet(insert_lower=[0.2, 40.0], insert_upper=[0.2, 40.0]),
-             ["boundary.outlet", "no free place", "in the insertion region"]),
+             ["boundary.outlet", "insertion region", "inside the walls"]),
             (plane(span_axis=None), ["boundary.plane[0].span_max", "span_axis"]),
             (plane(span_axis="z"), ["boundary.plane[0].span_axis", "'z' is not an axis"]),
             (plane(span_min=5.0, span_max=5.0),
