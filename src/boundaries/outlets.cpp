@@ -40,16 +40,7 @@ double Outlets<D>::event_time(int s, const Vec<D>& x, const Vec<D>& v, double /*
 // infinity).
 template <int D>
 bool Outlets<D>::reaches(int s, CellCode cell, const CellGrid<D>& grid) const {
-  const Outlet<D>& o = outlet(s);
-  double lowest = 0.0;
-  for (int a = 0; a < D; ++a) {
-    const double n = o.normal[a];
-    if (n == 0.0) continue;
-    const double edge = n > 0.0 ? grid.lower_bound(cell, a) : grid.upper_bound(cell, a);
-    if (!std::isfinite(edge)) return true;
-    lowest += n * edge;
-  }
-  return lowest <= o.offset;
+  return grid.lowest_along(cell, outlet(s).normal) <= outlet(s).offset;
 }
 
 template <int D>

@@ -106,15 +106,7 @@ bool PlaneWalls<D>::reaches(int s, CellCode cell, const CellGrid<D>& grid) const
   if (s >= planes()) return edges_.reaches(s - planes(), cell, grid);
   const PlaneWall<D>& p = plane(s);
   if (p.normal_speed() != 0.0) return true;
-  double lowest = 0.0;
-  for (int a = 0; a < D; ++a) {
-    const double n = p.normal[a];
-    if (n == 0.0) continue;
-    const double edge = n > 0.0 ? grid.lower_bound(cell, a) : grid.upper_bound(cell, a);
-    if (!std::isfinite(edge)) return true;
-    lowest += n * edge;
-  }
-  return lowest - (p.offset + p.wall.amplitude) < rmax_;
+  return grid.lowest_along(cell, p.normal) - (p.offset + p.wall.amplitude) < rmax_;
 }
 
 template <int D>

@@ -42,10 +42,8 @@ void EventEngine<D, Queue>::check_outlets(const ParticleSystem<D>& /*s*/) const 
   for (int k = 0; k < outlets.surfaces(); ++k) {
     bool inside = false;
     for (std::uint32_t attempt = 0; attempt < kRegionProbes && !inside; ++attempt) {
-      Vec<D> x = outlets.insertion_point(k, ~std::uint64_t{0}, attempt);
-      for (int a = 0; a < D; ++a)
-        if (cells_.grid().periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
-      inside = !boundaries_.overlaps(x, rmax, time_);
+      inside =
+          !boundaries_.overlaps(insertion_candidate(k, ~std::uint64_t{0}, attempt), rmax, time_);
     }
     if (!inside) {
       throw InputError(fmt::format(
@@ -55,6 +53,16 @@ void EventEngine<D, Queue>::check_outlets(const ParticleSystem<D>& /*s*/) const 
           rmax, kRegionProbes));
     }
   }
+}
+
+// The outlet's draw, wrapped into the box along its periodic axes.
+template <int D, class Queue>
+Vec<D> EventEngine<D, Queue>::insertion_candidate(int k, std::uint64_t pass,
+                                                  std::uint32_t attempt) const {
+  Vec<D> x = boundaries_.outlets().insertion_point(k, pass, attempt);
+  for (int a = 0; a < D; ++a)
+    if (cells_.grid().periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
+  return x;
 }
 
 template <int D, class Queue>
@@ -82,18 +90,15 @@ bool EventEngine<D, Queue>::free_place(std::uint32_t i, const Vec<D>& x, double 
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::pass_outlet(std::uint32_t i, int surface, double t) {
-  const Outlets<D>& outlets = boundaries_.outlets();
   const int k = boundaries_.outlet_index(surface);
-  const Outlet<D>& outlet = outlets.outlet(k);
+  const Outlet<D>& outlet = boundaries_.outlets().outlet(k);
   advance_to(i, t);
   const double before = mechanical_energy(i, t);
   const std::uint64_t pass = counters_.outlet_passes;
   Vec<D> x{};
   bool placed = false;
   for (std::uint32_t attempt = 0; attempt < kInsertionAttempts && !placed; ++attempt) {
-    x = outlets.insertion_point(k, pass, attempt);
-    for (int a = 0; a < D; ++a)
-      if (cells_.grid().periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
+    x = insertion_candidate(k, pass, attempt);
     placed = free_place(i, x, t);
   }
   if (!placed) {

@@ -417,19 +417,26 @@ class Reader : public KeyReader {
     return cylinder;
   }
 
+  // The table `key` of `t` (named `path` in messages), its keys checked; nullptr when absent,
+  // an error naming it when it is not a table.
+  const toml::table* sub_table(const toml::table& t, std::string_view key,
+                               const std::string& path) const {
+    const toml::node* n = t.get(key);
+    if (n == nullptr) return nullptr;
+    const toml::table* table = n->as_table();
+    if (table == nullptr) {
+      fail(n, path, fmt::format("{}: expected a table ([{}]), found {}", path, path, describe(*n)));
+    }
+    check_keys(*table, path);
+    return table;
+  }
+
   // [boundary.outlet]: its plane and insertion region (required together), the velocity and
   // seed of the particles put back. Whether the plane cuts a periodic axis and where the region
   // lies are checked with the box (Environment::check).
   void read_outlet(const toml::table& t, int dimension, OutletConfig& outlet) const {
-    const toml::node* n = t.get("outlet");
-    if (n == nullptr) return;
-    const toml::table* table = n->as_table();
-    if (table == nullptr) {
-      fail(n, "boundary.outlet",
-           fmt::format("boundary.outlet: expected a table ([boundary.outlet]), found {}",
-                       describe(*n)));
-    }
-    check_keys(*table, "boundary.outlet");
+    const toml::table* table = sub_table(t, "outlet", "boundary.outlet");
+    if (table == nullptr) return;
     read_group(*table, "boundary.outlet", outlet_keys(), &outlet, &dimension);
     for (const char* key : {"normal", "point", "insert_lower", "insert_upper"}) {
       if (table->get(key) == nullptr) {
@@ -498,17 +505,9 @@ class Reader : public KeyReader {
 
     read_group(t, std::string(p), boundary_keys(), &b, &dimension);
     const toml::table none;
-    const toml::table* container = &none;
-    if (const toml::node* n = t.get("container"); n != nullptr) {
-      container = n->as_table();
-      if (container == nullptr) {
-        fail(n, "boundary.container",
-             fmt::format("boundary.container: expected a table ([boundary.container]), found {}",
-                         describe(*n)));
-      }
-      check_keys(*container, "boundary.container");
-    }
-    read_group(*container, "boundary.container", container_keys(), &b.container, &dimension);
+    const toml::table* container = sub_table(t, "container", "boundary.container");
+    read_group(container != nullptr ? *container : none, "boundary.container", container_keys(),
+               &b.container, &dimension);
     read_outlet(t, dimension, b.outlet);
     const toml::node* n_open = t.get("open");
     for (std::size_t i = 0; i < b.open.size(); ++i) {

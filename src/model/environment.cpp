@@ -57,6 +57,29 @@ bool Environment<D>::plain() const {
   return contact.empty();
 }
 
+// The plane n.x = offset of a wall or an outlet (`name`): a finite unit normal, a finite point,
+// and not across a periodic axis (it would not meet its own periodic image).
+template <int D>
+void Environment<D>::check_plane(const Vec<D>& normal, double offset,
+                                 const std::string& name) const {
+  double n2 = 0.0;
+  for (int a = 0; a < D; ++a) {
+    if (!std::isfinite(normal[a])) throw InputError(name + ".normal must be finite");
+    n2 += normal[a] * normal[a];
+  }
+  if (!(std::abs(n2 - 1.0) <= 1e-12)) throw InputError(name + ".normal must be a unit vector");
+  if (!std::isfinite(offset)) throw InputError(name + ".point must be finite");
+  for (int a = 0; a < D; ++a) {
+    if (normal[a] != 0.0 && periodic(a)) {
+      throw InputError(name + ".normal has a component along the periodic axis " +
+                       std::string(1, "xyz"[a]) +
+                       ": a plane must not cut a periodic axis (it would not meet its own "
+                       "periodic image); make that axis bounded (walls or open faces) or the "
+                       "normal perpendicular to it");
+    }
+  }
+}
+
 // A plane cut to a strip (span_axis): still, across a bounded axis, with edges along a box axis.
 template <int D>
 void Environment<D>::check_strip(const PlaneWall<D>& p, const std::string& name) const {
@@ -92,16 +115,8 @@ template <int D>
 void Environment<D>::check_outlets() const {
   for (const Outlet<D>& o : outlets) {
     const std::string name = "boundary.outlet";
-    double n2 = 0.0;
+    check_plane(o.normal, o.offset, name);
     for (int a = 0; a < D; ++a) {
-      if (!std::isfinite(o.normal[a])) throw InputError(name + ".normal must be finite");
-      n2 += o.normal[a] * o.normal[a];
-      if (o.normal[a] != 0.0 && periodic(a)) {
-        throw InputError(name + ".normal has a component along the periodic axis " +
-                         std::string(1, "xyz"[a]) +
-                         ": the outlet's plane must not cut a periodic axis; make that axis "
-                         "bounded (walls or open faces) or the normal perpendicular to it");
-      }
       if (!std::isfinite(o.insert_lower[a]) || !std::isfinite(o.insert_upper[a]) ||
           !std::isfinite(o.insert_velocity[a]))
         throw InputError(name + ": insert_lower, insert_upper and insert_velocity must be finite");
@@ -110,8 +125,6 @@ void Environment<D>::check_outlets() const {
                          std::string(1, "xyz"[a]) + ")");
       }
     }
-    if (!(std::abs(n2 - 1.0) <= 1e-12)) throw InputError(name + ".normal must be a unit vector");
-    if (!std::isfinite(o.offset)) throw InputError(name + ".point must be finite");
     // The region's corner nearest the plane, along the normal.
     double nearest = 0.0;
     for (int a = 0; a < D; ++a)
@@ -143,24 +156,8 @@ void Environment<D>::check() const {
     const PlaneWall<D>& p = planes[s];
     const std::string name = "boundary.plane[" + std::to_string(s) + "]";
     check_wall_motion(p.wall, name);
-    double n2 = 0.0;
-    for (int a = 0; a < D; ++a) {
-      if (!std::isfinite(p.normal[a])) throw InputError(name + ": normal must be finite");
-      n2 += p.normal[a] * p.normal[a];
-    }
-    if (!(std::abs(n2 - 1.0) <= 1e-12))
-      throw InputError(name + ": the normal must be a unit vector");
-    if (!std::isfinite(p.offset)) throw InputError(name + ": point must be finite");
+    check_plane(p.normal, p.offset, name);
     if (p.spanned()) check_strip(p, name);
-    for (int a = 0; a < D; ++a) {
-      if (p.normal[a] != 0.0 && periodic(a)) {
-        throw InputError(name + ": the normal has a component along the periodic axis " +
-                         std::string(1, "xyz"[a]) +
-                         ": a plane must not cut a periodic axis (it would not meet its own "
-                         "periodic image); make that axis bounded (walls or open faces) or "
-                         "the normal perpendicular to it");
-      }
-    }
   }
   check_outlets();
   const std::size_t surfaces =

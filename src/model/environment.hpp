@@ -152,6 +152,7 @@ struct Environment {
 
  private:
   void check_outlets() const;
+  void check_plane(const Vec<D>& normal, double offset, const std::string& name) const;
   void check_strip(const PlaneWall<D>& p, const std::string& name) const;
   std::size_t strips() const {
     std::size_t n = 0;

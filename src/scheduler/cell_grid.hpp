@@ -166,6 +166,18 @@ class CellGrid {
     const int x = coordinate(c, k);
     return x == n_[k] - 1 ? high_edge_[k] : (x + 1) * width_[k];
   }
+  // The least n . x over cell c (n need not be unit): where a plane of normal n reaches into it
+  // first; -infinity for an outer layer extending without end against n.
+  double lowest_along(CellCode c, const Vec<D>& n) const {
+    double lowest = 0.0;
+    for (int k = 0; k < D; ++k) {
+      if (n[k] == 0.0) continue;
+      const double edge = n[k] > 0.0 ? lower_bound(c, k) : upper_bound(c, k);
+      if (!std::isfinite(edge)) return -std::numeric_limits<double>::infinity();
+      lowest += n[k] * edge;
+    }
+    return lowest;
+  }
   // Whether some axis is not periodic.
   bool bounded() const {
     for (int k = 0; k < D; ++k)
