@@ -1,7 +1,9 @@
 #!/usr/bin/python3
-"""Picture of examples/silo_2d.toml: a recirculating 2D silo discharging through an orifice.
+"""Picture of examples/silo_2d.toml and silo_3d.toml: a recirculating silo discharging through an
+orifice (in 3D a slot through the periodic depth, seen from the side: x against z, the spheres
+of all depths drawn, the front ones last).
 
-Left: the disks of a trajectory frame (the last by default), coloured by their speed, with the
+Left: the grains of a trajectory frame (the last by default), coloured by their speed, with the
 floor's strips, the orifice's edges and the outlet (dashed). Right: the count through the outlet
 against time (thermo.tsv's outlet_passes) and the straight line of the production part's rate
 (summary.json's granular.outlet.production_rate).
@@ -23,10 +25,11 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import kairos_output as ko
 
 
-def draw_boundaries(ax, config, width):
-    """The strips of [[boundary.plane]] (horizontal ones) and the outlet's plane."""
+def draw_boundaries(ax, config, width, up):
+    """The strips of [[boundary.plane]] (horizontal ones) and the outlet's plane; `up` is the
+    vertical axis (the last)."""
     for plane in config["boundary"].get("plane", []):
-        y = plane["point"][1]
+        y = plane["point"][up]
         lo = plane.get("span_min", 0.0)
         hi = plane.get("span_max", width)
         ax.plot([max(lo, 0.0), min(hi, width)], [y, y], color="k", lw=2)
@@ -35,10 +38,10 @@ def draw_boundaries(ax, config, width):
                 ax.plot([end], [y], "ko", ms=3)
     outlet = config["boundary"].get("outlet")
     if outlet:
-        ax.axhline(outlet["point"][1], color="C3", ls="--", lw=1, label="outlet")
+        ax.axhline(outlet["point"][up], color="C3", ls="--", lw=1, label="outlet")
         lo, hi = outlet["insert_lower"], outlet["insert_upper"]
-        ax.add_patch(plt.Rectangle(lo[:2], hi[0] - lo[0], hi[1] - lo[1], fill=False, ls=":",
-                                   color="C2", label="insertion region"))
+        ax.add_patch(plt.Rectangle((lo[0], lo[up]), hi[0] - lo[0], hi[up] - lo[up], fill=False,
+                                   ls=":", color="C2", label="insertion region"))
 
 
 def main():
@@ -53,20 +56,25 @@ def main():
     summary = ko.read_summary(args.outdir)
     snap = ko.Frame(args.outdir, args.frame)
     box = snap.box
-    # GSD positions are centred: back to the box's frame, where the planes are given.
-    pos = snap.pos[:, :2] + 0.5 * np.array(box[:2])
-    speed = np.hypot(snap.vel[:, 0], snap.vel[:, 1])
+    # GSD positions are centred: back to the box's frame, where the planes are given. In 3D the
+    # side view x-z, the spheres at the back drawn first.
+    up = 2 if config["system"].get("dimension", 3) == 3 else 1
+    centres = snap.pos + 0.5 * np.array(box[:snap.pos.shape[1]])
+    order = np.argsort(-centres[:, 1]) if up == 2 else np.arange(len(centres))
+    pos = centres[order][:, [0, up]]
+    speed = np.linalg.norm(snap.vel, axis=1)[order]
+    diameter = np.asarray(snap.diameter)[order]
 
     fig, axes = plt.subplots(1, 2, figsize=(12, 7), gridspec_kw={"width_ratios": [1.1, 1]})
     ax = axes[0]
-    disks = EllipseCollection(snap.diameter, snap.diameter, np.zeros(len(pos)), units="xy",
+    disks = EllipseCollection(diameter, diameter, np.zeros(len(pos)), units="xy",
                               offsets=pos, offset_transform=ax.transData, cmap="viridis")
     disks.set_array(speed)
     disks.set_clim(0.0, np.percentile(speed, 98))
     ax.add_collection(disks)
-    draw_boundaries(ax, config, box[0])
+    draw_boundaries(ax, config, box[0], up)
     ax.set_xlim(0, box[0])
-    ax.set_ylim(0, box[1])
+    ax.set_ylim(0, box[up])
     ax.set_aspect("equal")
     ax.set_title(f"t = {snap.traj.time(snap.index):.4g}")
     ax.legend(loc="upper right", fontsize=8)

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "boundaries/outlet_placement.hpp"
 #include "core/error.hpp"
 #include "core/periodic.hpp"
 
@@ -189,9 +190,8 @@ void DemIntegrator<D>::set_walls(const Environment<D>& env) {
     walls_[static_cast<std::size_t>(f)] = env.faces[static_cast<std::size_t>(f)].wall;
     any_wall_ = any_wall_ || kind == FaceKind::kWall;
   }
-  if (!env.outlets.empty())
-    throw InputError("DEM: boundary.outlet: the DEM integrator has no outlets yet");
   boundaries_ = Boundaries<D>(env, box_);
+  any_outlet_ = boundaries_.outlets().any();
   wall_shear_.assign(static_cast<std::size_t>(boundaries_.surfaces()), {});
   for (int s = 2 * D; s < boundaries_.surfaces(); ++s)
     any_surface_ = any_surface_ || boundaries_.is_surface(s);
@@ -257,6 +257,9 @@ void DemIntegrator<D>::init(const DemOptions& options) {
   wall_collisions_ = system.counters.wall_collisions;
   dissipated_walls_ = system.counters.dissipated_at_walls;
   work_by_walls_ = system.counters.work_by_walls;
+  outlet_passes_ = system.counters.outlet_passes;
+  outlet_mass_ = system.counters.outlet_mass;
+  outlet_energy_ = system.counters.outlet_energy;
 
   const std::size_t n = system.size();
   if (n == 0) throw InputError("DEM: the system has no particles");
@@ -373,6 +376,15 @@ void DemIntegrator<D>::init(const DemOptions& options) {
       throw InputError(fmt::format(
           "DEM: box length {} along axis {} (between walls) must exceed the largest diameter {}",
           box_[k], k, max_diameter_));
+  }
+
+  if (any_outlet_) {
+    for (std::size_t i = 0; i < n; ++i) {
+      Vec<D> x;
+      for (int k = 0; k < D; ++k) x[k] = x_[k][i];
+      boundaries_.outlets().check_start(x, radius_[i], time_, i);
+    }
+    check_outlet_regions<D>(boundaries_, 0.5 * max_diameter_, time_, periodic_, box_);
   }
 
   if (options.dt > 0.0) {
@@ -906,6 +918,77 @@ void DemIntegrator<D>::compute_forces_for(bool count_collisions) {
   collisions_ += entered;
 }
 
+// Particles pass at the end of a step, once the forces at the new positions are known, and only
+// a particle that touches nothing (free_place at its own position): its force is then zero and
+// its elastic energy nothing, so the energy it takes out, (1/2) m v^2 + (1/2) I w^2 - m g.x with
+// v = u + (dt/2) (f / m + g), is exact, and the forces of the others hold with it moved. A
+// particle beyond the plane that still touches a neighbour (a jet's dense head) waits for the
+// first step it is free (outlet_waiting() counts those waiting). It is put back with u = v_out -
+// (dt/2) g (no force at a free place: v = v_out at once) and no spin; its springs are gone already
+// (reset whenever a contact is not touching).
+template <int D>
+bool DemIntegrator<D>::pass_outlets(double t) {
+  const Outlets<D>& outlets = boundaries_.outlets();
+  const double h = 0.5 * dt_;
+  bool passed = false;
+  outlet_waiting_ = 0;
+  for (std::size_t i = 0; i < size(); ++i) {
+    Vec<D> x;
+    for (int a = 0; a < D; ++a) x[a] = x_[a][i];
+    for (int k = 0; k < outlets.surfaces(); ++k) {
+      if (!(outlets.gap(k, x, t) < 0.0)) continue;
+      if (!free_place(i, x, t)) {
+        ++outlet_waiting_;
+        break;
+      }
+      const double m = mass_[i];
+      Vec<D> v;
+      for (int a = 0; a < D; ++a) v[a] = u_[a][i] + h * (inv_mass_[i] * f_[a][i] + gravity_[a]);
+      double before = 0.5 * m * norm2(v) - m * dot(gravity_, x);
+      if (friction_) {
+        for (int c = 0; c < kSpin; ++c) {
+          const double w = uw_[c][i] + h * inv_inertia_[i] * tq_[c][i];
+          before += 0.5 * inertia_[i] * w * w;
+          uw_[c][i] = 0.0;
+        }
+      }
+      x = outlet_place<D>(outlets, k, outlet_passes_, periodic_, box_, t, id_[i],
+                          [&](const Vec<D>& place) { return free_place(i, place, t); });
+      const Vec<D>& out = outlets.outlet(k).insert_velocity;
+      for (int a = 0; a < D; ++a) {
+        x_[a][i] = x[a];
+        u_[a][i] = out[a] - h * gravity_[a];
+      }
+      ++outlet_passes_;
+      outlet_mass_ += m;
+      outlet_energy_ += before - (0.5 * m * norm2(out) - m * dot(gravity_, x));
+      passed = true;
+      break;  // the place is on every outlet's own side
+    }
+  }
+  return passed;
+}
+
+// At least R from every wall and R + R_j from every other particle (the minimum image along
+// periodic axes): a search over all particles, for passes are rare next to steps.
+template <int D>
+bool DemIntegrator<D>::free_place(std::size_t i, const Vec<D>& x, double t) const {
+  const double R = radius_[i];
+  if (boundaries_.overlaps(x, R, t)) return false;
+  const Vec<D> half = half_box();
+  for (std::size_t j = 0; j < size(); ++j) {
+    if (j == i) continue;
+    double r2 = 0.0;
+    for (int a = 0; a < D; ++a) {
+      const double d = min_image_once(x[a] - x_[a][j], half[a], box_[a]);
+      r2 += d * d;
+    }
+    const double sigma = R + radius_[j];
+    if (r2 < sigma * sigma) return false;
+  }
+  return true;
+}
+
 template <int D>
 Vec<D> DemIntegrator<D>::half_box() const {
   Vec<D> half;
@@ -1009,8 +1092,11 @@ template <int D>
 void DemIntegrator<D>::add_surface_forces(bool count_collisions, double t, WallSums& sums) {
   int first = 0;
   boundaries_.for_each([&](const auto& c) {
-    // The faces have their own loop (compute_wall_forces).
-    if constexpr (!std::is_same_v<std::decay_t<decltype(c)>, FaceWalls<D>>)
+    // The faces have their own loop (compute_wall_forces); particles pass through outlets
+    // (pass_outlets).
+    using Component = std::decay_t<decltype(c)>;
+    if constexpr (!std::is_same_v<Component, FaceWalls<D>> &&
+                  !std::is_same_v<Component, Outlets<D>>)
       add_component_forces(c, first, count_collisions, t, sums);
     first += c.surfaces();
   });
@@ -1183,6 +1269,8 @@ long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
     ++steps_;
     ++s;
     time_ = time_at(steps_);
+    // A particle put back jumped: the list no longer holds its neighbours.
+    if (any_outlet_ && pass_outlets(time_)) moved_since_build_ = skin_;
   }
   synchronise(/*from_half_step=*/true);
   return s;
@@ -1282,6 +1370,9 @@ ParticleSystem<D> DemIntegrator<D>::export_state() const {
   s.counters.wall_collisions = wall_collisions_;
   s.counters.dissipated_at_walls = dissipated_walls_;
   s.counters.work_by_walls = work_by_walls_;
+  s.counters.outlet_passes = outlet_passes_;
+  s.counters.outlet_mass = outlet_mass_;
+  s.counters.outlet_energy = outlet_energy_;
   return s;
 }
 

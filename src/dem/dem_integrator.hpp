@@ -55,6 +55,15 @@
 // dissipation of a contact is what the tangential force took from the slip beyond what its
 // spring holds. Without friction the smooth loops run, unchanged.
 //
+// Outlets (boundary.outlet, boundaries/outlets.hpp; docs/physics.md#outlets): at the end of a
+// step, a particle whose centre is beyond an outlet's plane and that touches nothing is put
+// back at a free place of the insertion region (the event engine's rule and draws,
+// boundaries/outlet_placement.hpp; free: at least R from every wall, R + R_j from every
+// particle now), with the set velocity and no spin; the neighbour list is rebuilt. One still
+// touching a neighbour waits for its first free step (outlet_waiting()), so that the energy a
+// pass takes out (kinetic, rotational and gravitational: no elastic part) is exact and enters
+// the energy budget. The passes and their mass are counted as the engine counts them.
+//
 // Neighbours: a half neighbour list (pairs closer than d_max + skin), built from a linked-cell
 // grid (cells >= d_max + skin) and rebuilt when the particles may have moved skin/2.
 // Hot data are structure-of-arrays (x, y, z, vx, ... separately), renumbered into cell order at
@@ -161,6 +170,15 @@ class DemIntegrator {
   double field_energy() const;
   // Time integral of sum over pairs of r_ij F_ij (F > 0 repulsive), including the system's.
   double virial() const { return virial_; }
+  // Outlets: the particles that passed and were put back, their mass and the energy they took
+  // out, each continuing the constructor's system's counters (EventCounters::outlet_*).
+  bool any_outlet() const { return any_outlet_; }
+  std::uint64_t outlet_passes() const { return outlet_passes_; }
+  double outlet_mass() const { return outlet_mass_; }
+  double outlet_energy() const { return outlet_energy_; }
+  // Particles beyond an outlet's plane at the end of the last step that still touched something
+  // (they pass at their first free step).
+  std::size_t outlet_waiting() const { return outlet_waiting_; }
   Vec<D> momentum() const;
   long neighbour_list_builds() const { return builds_; }
 
@@ -211,6 +229,10 @@ class DemIntegrator {
   Vec<D> half_box() const;
   long advance(long n, std::uint64_t collisions);
   void build_neighbours();
+  // Outlets: every particle whose centre is beyond an outlet's plane at the end of the step (time
+  // t) and that touches nothing put back; returns whether one was.
+  bool pass_outlets(double t);
+  bool free_place(std::size_t i, const Vec<D>& x, double t) const;
   // Forces, potential_, power_, virial_power_, contacts_ at x with the predicted velocity;
   // counts pairs entering contact when count_collisions.
   void compute_forces(bool count_collisions, double t);
@@ -273,6 +295,10 @@ class DemIntegrator {
   double wall_loss_power_ = 0.0, dissipated_walls_ = 0.0;
   double wall_work_power_ = 0.0, work_by_walls_ = 0.0;
   std::uint64_t wall_collisions_ = 0;
+  bool any_outlet_ = false;
+  std::uint64_t outlet_passes_ = 0;
+  double outlet_mass_ = 0.0, outlet_energy_ = 0.0;
+  std::size_t outlet_waiting_ = 0;
 
   // Friction (see the header comment): per species pair and per species against the walls
   // mu, k_t / k_n and gamma_t / gamma_n; the springs of the list entries and, per wall face,

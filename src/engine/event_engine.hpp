@@ -303,8 +303,6 @@ class EventEngine {
   // Whether particle i (its radius) fits at x at time t: inside every wall, apart from every
   // other particle.
   bool free_place(std::uint32_t i, const Vec<D>& x, double t);
-  // Outlet k's attempt-th place for its pass number `pass`, wrapped into the box.
-  Vec<D> insertion_candidate(int k, std::uint64_t pass, std::uint32_t attempt) const;
   // Translational and rotational energy plus the field's potential energy -m g.x.
   double mechanical_energy(std::uint32_t i, double t) const;
   // What outlets cannot be combined with (InputError naming the keys).

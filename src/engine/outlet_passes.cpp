@@ -7,8 +7,7 @@
 #include <cmath>
 #include <string>
 
-#include <fmt/format.h>
-
+#include "boundaries/outlet_placement.hpp"
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "scheduler/binary_heap_queue.hpp"
@@ -16,13 +15,6 @@
 #include "scheduler/tournament_tree_queue.hpp"
 
 namespace kairos {
-
-namespace {
-// Tries for a free place before the region is declared full.
-constexpr std::uint32_t kInsertionAttempts = 100000;
-// Draws of the region at the start, looking for room inside the walls.
-constexpr std::uint32_t kRegionProbes = 1000;
-}  // namespace
 
 template <int D, class Queue>
 void EventEngine<D, Queue>::check_outlets(const ParticleSystem<D>& /*s*/) const {
@@ -34,35 +26,9 @@ void EventEngine<D, Queue>::check_outlets(const ParticleSystem<D>& /*s*/) const 
   if (sheared_) refuse("Lees-Edwards shear (boundary.shear_rate)");
   if (options_.track_helfand)
     refuse("transport analyses (analysis.transport): a particle put back jumps");
-  // A region outside the walls (or behind a plane) would only show at the first pass, after
-  // every draw failed: draws of the region must find room for the largest particle somewhere.
   double rmax = 0.0;
   for (const ParticleKind& kind : kinds_) rmax = std::max(rmax, kind.radius);
-  const Outlets<D>& outlets = boundaries_.outlets();
-  for (int k = 0; k < outlets.surfaces(); ++k) {
-    bool inside = false;
-    for (std::uint32_t attempt = 0; attempt < kRegionProbes && !inside; ++attempt) {
-      inside =
-          !boundaries_.overlaps(insertion_candidate(k, ~std::uint64_t{0}, attempt), rmax, time_);
-    }
-    if (!inside) {
-      throw InputError(fmt::format(
-          "boundary.outlet: no place in the insertion region (insert_lower to insert_upper) "
-          "leaves room for a particle of radius {:.6g} inside the walls ({} draws): the region "
-          "lies outside the box's walls or behind a plane; move it inside",
-          rmax, kRegionProbes));
-    }
-  }
-}
-
-// The outlet's draw, wrapped into the box along its periodic axes.
-template <int D, class Queue>
-Vec<D> EventEngine<D, Queue>::insertion_candidate(int k, std::uint64_t pass,
-                                                  std::uint32_t attempt) const {
-  Vec<D> x = boundaries_.outlets().insertion_point(k, pass, attempt);
-  for (int a = 0; a < D; ++a)
-    if (cells_.grid().periodic(a)) x[a] = wrap_into_box(x[a], box_[a]);
-  return x;
+  check_outlet_regions<D>(boundaries_, rmax, time_, periodic_axes(), box_);
 }
 
 template <int D, class Queue>
@@ -94,21 +60,9 @@ void EventEngine<D, Queue>::pass_outlet(std::uint32_t i, int surface, double t) 
   const Outlet<D>& outlet = boundaries_.outlets().outlet(k);
   advance_to(i, t);
   const double before = mechanical_energy(i, t);
-  const std::uint64_t pass = counters_.outlet_passes;
-  Vec<D> x{};
-  bool placed = false;
-  for (std::uint32_t attempt = 0; attempt < kInsertionAttempts && !placed; ++attempt) {
-    x = insertion_candidate(k, pass, attempt);
-    placed = free_place(i, x, t);
-  }
-  if (!placed) {
-    throw InputError(fmt::format(
-        "boundary.outlet: at t = {:.10g} particle {} passed the outlet, but no free place for "
-        "it was found in the insertion region (insert_lower to insert_upper) in {} tries: the "
-        "region is full, or lies outside the walls; make it larger, or place it inside the "
-        "walls where the particles leave room",
-        t, id_[i], kInsertionAttempts));
-  }
+  const Vec<D> x =
+      outlet_place<D>(boundaries_.outlets(), k, counters_.outlet_passes, periodic_axes(), box_, t,
+                      id_[i], [&](const Vec<D>& place) { return free_place(i, place, t); });
   HotRecord<D>& h = hot_[i];
   h.pos = x;
   h.vel = outlet.insert_velocity;

@@ -845,7 +845,10 @@ class Reader : public KeyReader {
            fmt::format("{}: an outlet (boundary.outlet) cannot be combined with {} ({})", other,
                        other, why));
     };
-    if (c.soft.enabled()) conflict("soft.model", "soft contacts and the DEM have no outlets yet");
+    if (c.soft.enabled() && !integrators().is(c.run.integrator, IntegratorKind::kDem))
+      conflict("soft.model",
+               "the event engine's soft spheres have no outlets yet; the DEM, run.integrator = "
+               "\"dem\", has");
     if (c.boundary.shear_rate != 0.0) conflict("boundary.shear_rate", "not combined yet");
     if (!c.potentials.empty())
       conflict("potential", "a particle put back would break the zones of its pairs");

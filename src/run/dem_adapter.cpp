@@ -174,8 +174,8 @@ ParticleSample<D> DemAdapter<D>::particles() const {
 template <int D>
 double DemAdapter<D>::total_energy() const {
   return dem_.kinetic_energy() + dem_.rotational_energy() + dem_.potential_energy() +
-         dem_.field_energy() + dem_.dissipated_energy() + dem_.dissipated_at_walls() -
-         dem_.work_by_walls();
+         dem_.field_energy() + dem_.dissipated_energy() + dem_.dissipated_at_walls() +
+         dem_.outlet_energy() - dem_.work_by_walls();
 }
 
 template <int D>

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -57,6 +58,11 @@ class DemAdapter final : public Integrator<D> {
     return dem_.dissipated_energy() + dem_.dissipated_at_walls();
   }
   double work_by_walls() const override { return dem_.work_by_walls(); }
+  std::optional<typename Integrator<D>::OutletReading> outlet() const override {
+    if (!dem_.any_outlet()) return std::nullopt;
+    return typename Integrator<D>::OutletReading{dem_.outlet_passes(), dem_.outlet_mass(),
+                                                 dem_.outlet_energy()};
+  }
   Vec<D> momentum() const override { return dem_.momentum(); }
   double momentum_scale() const override;
   double max_overlap() const override;
@@ -78,8 +84,9 @@ class DemAdapter final : public Integrator<D> {
   // Time steps of the runs this one continues (the state's event counter at the start).
   std::uint64_t base_events() const { return base_events_; }
   bool time_step_automatic() const { return time_step_automatic_; }
-  // Kinetic plus elastic plus gravitational energy plus what the damping took, less what the
-  // walls gave: constant to O(dt^2) (NaN with gravity along a periodic axis).
+  // Kinetic plus elastic plus gravitational energy plus what the damping took and the outlets
+  // took out, less what the walls gave: constant to O(dt^2) (NaN with gravity along a periodic
+  // axis).
   double total_energy() const;
   // What summary.json's energy budget covers: damping, friction, walls or gravity; particles
   // that spin (friction); damping; moving walls.

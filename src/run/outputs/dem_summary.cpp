@@ -15,6 +15,8 @@ void DemSummary<D>::open(const RunContext<D>&) {
   dissipated_start_ = dem.dissipated_energy();
   dissipated_walls_start_ = dem.dissipated_at_walls();
   work_walls_start_ = dem.work_by_walls();
+  outlet_energy_start_ = dem.outlet_energy();
+  if (const auto outlet = dem_.outlet()) outlet_.open(*outlet, dem.time());
 }
 
 template <int D>
@@ -58,8 +60,9 @@ void DemSummary<D>::summarize(nlohmann::json& j, const RunContext<D>& run) const
   const double dissipated = dem.dissipated_energy() - dissipated_start_;
   const double at_walls = dem.dissipated_at_walls() - dissipated_walls_start_;
   const double by_walls = dem.work_by_walls() - work_walls_start_;
-  const double scale =
-      std::max({std::abs(energy_start_), dissipated + at_walls, std::abs(by_walls)});
+  const double outlet_energy = dem.outlet_energy() - outlet_energy_start_;  // taken out
+  const double scale = std::max({std::abs(energy_start_), dissipated + at_walls, std::abs(by_walls),
+                                 std::abs(outlet_energy)});
   nlohmann::json g;
   g["rotating"] = kind.rotating;
   g["dissipative"] = kind.dissipative;
@@ -87,6 +90,7 @@ void DemSummary<D>::summarize(nlohmann::json& j, const RunContext<D>& run) const
   g["dissipated_at_walls"] = at_walls;
   g["work_by_walls"] = by_walls;
   g["wall_collisions"] = dem.wall_collisions();
+  if (const auto outlet = dem_.outlet()) g["outlet"] = outlet_.summary(*outlet, dem.time());
   set_or_explain(j, g, "energy_start", energy_start_, unbounded, "granular.energy_start");
   set_or_explain(j, g, "energy_end", energy, unbounded, "granular.energy_end");
   set_or_explain(j, g, "energy_balance_relative",

@@ -8,34 +8,8 @@
 
 namespace kairos {
 
-// The outlet's passes in this invocation and their rate over its simulated time: the
-// discharge rate of a recirculating silo (the count per unit time, and the mass).
 template <int D>
-nlohmann::json GranularSummary<D>::outlet_summary(const EventCounters& c,
-                                                  const RunContext<D>& /*run*/) const {
-  nlohmann::json o;
-  const auto passes = c.outlet_passes - start_.outlet_passes;
-  const double mass = c.outlet_mass - start_.outlet_mass;
-  const double span = engine_.time() - time_start_;
-  o["passes"] = passes;
-  o["mass"] = mass;
-  o["energy_taken"] = c.outlet_energy - start_.outlet_energy;
-  o["time"] = span;
-  o["rate"] = span > 0.0 ? static_cast<double>(passes) / span : 0.0;
-  o["mass_rate"] = span > 0.0 ? mass / span : 0.0;
-  o["total_passes_since_start"] = c.outlet_passes;
-  // The steady discharge: over production only, when it started in this invocation.
-  const double production_span = engine_.time() - production_time_;
-  if (in_production_ && production_span > 0.0) {
-    o["production_rate"] =
-        static_cast<double>(c.outlet_passes - production_.outlet_passes) / production_span;
-    o["production_mass_rate"] = (c.outlet_mass - production_.outlet_mass) / production_span;
-  }
-  return o;
-}
-
-template <int D>
-void GranularSummary<D>::summarize(nlohmann::json& j, const RunContext<D>& run) const {
+void GranularSummary<D>::summarize(nlohmann::json& j, const RunContext<D>& /*run*/) const {
   const EventCounters& c = engine_.counters();
   const typename EventIntegrator<D>::Kind& kind = engine_.kind();
   const double dissipated = (c.dissipated_in_collisions - start_.dissipated_in_collisions) +
@@ -82,7 +56,7 @@ void GranularSummary<D>::summarize(nlohmann::json& j, const RunContext<D>& run) 
   g["work_by_driving"] = c.work_by_driving - start_.work_by_driving;
   g["driving_kicks"] = c.driving_kicks - start_.driving_kicks;
   g["work_by_shear"] = c.work_by_shear - start_.work_by_shear;
-  if (engine_.outlet()) g["outlet"] = outlet_summary(c, run);
+  if (const auto outlet = engine_.outlet()) g["outlet"] = outlet_.summary(*outlet, engine_.time());
   const std::string unbounded =
       std::isfinite(energy) && std::isfinite(energy_start_)
           ? ""

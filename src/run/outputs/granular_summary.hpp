@@ -10,6 +10,7 @@
 
 #include "run/event_adapter.hpp"
 #include "run/outputs/observer.hpp"
+#include "run/outputs/outlet_tally.hpp"
 
 namespace kairos {
 
@@ -22,26 +23,18 @@ class GranularSummary final : public Observer<D> {
   void open(const RunContext<D>&) override {
     start_ = engine_.counters();
     energy_start_ = engine_.total_energy();
-    time_start_ = engine_.time();
+    if (const auto outlet = engine_.outlet()) outlet_.open(*outlet, engine_.time());
   }
   void production_starts(const RunContext<D>&) override {
-    production_ = engine_.counters();
-    production_time_ = engine_.time();
-    in_production_ = true;
+    if (const auto outlet = engine_.outlet()) outlet_.production_starts(*outlet, engine_.time());
   }
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 
  private:
-  nlohmann::json outlet_summary(const EventCounters& c, const RunContext<D>& run) const;
-
   const EventIntegrator<D>& engine_;
   EventCounters start_;
   double energy_start_ = 0.0;
-  double time_start_ = 0.0;
-  // The counters where production started in this invocation (the outlet's rate).
-  EventCounters production_;
-  double production_time_ = 0.0;
-  bool in_production_ = false;
+  OutletTally<D> outlet_;
 };
 
 }  // namespace kairos
