@@ -147,8 +147,9 @@ void FaceWalls<D>::restore(const std::vector<WallMotion>& motion, double t) {
     bodies_[f].work = {};
     bodies_[f].version = 0;
   }
+  const bool cells = cells_along_[0] > 0;  // prepare() has run (not in the DEM)
   for (int f = 0; f < 2 * D; ++f)
-    if (massive(f)) layer_[f] = layer_of(f, position(f, t));
+    if (massive(f) && cells) layer_[f] = layer_of(f, position(f, t));
   for (const WallMotion& m : motion) {
     const int f = static_cast<int>(m.face);
     if (f >= 2 * D || !massive(f) || !own_body(f)) {
@@ -189,14 +190,14 @@ void FaceWalls<D>::restore(const std::vector<WallMotion>& motion, double t) {
     // either), unless the state does not say or the grid differs. A container's high wall:
     // from its place (the state holds one row per body).
     for (const int g : {f, f ^ 1}) {
-      if (g != f && !faces_[f].wall.joined) continue;
+      if (!cells || (g != f && !faces_[f].wall.joined)) continue;
       const int layer = g == f ? m.layer : -1;
       const bool kept = layer >= 0 && layer < cells_along_[g / 2] &&
                         std::abs(layer_of(g, position(g, t)) - layer) <= 1;
       layer_[g] = kept ? layer : layer_of(g, position(g, t));
     }
   }
-  find_next_change(t);
+  if (cells) find_next_change(t);
 }
 
 template <int D>

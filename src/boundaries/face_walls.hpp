@@ -116,12 +116,18 @@ class FaceWalls {
   std::uint32_t event_version(int f) const { return massive(f) ? body(f).version : 0u; }
   // Sets the walls' motion from a state at time t (`motion` empty: each wall with mass at rest
   // on its face). Throws InputError for a motion of a face without mass, or one that is not
-  // finite. Call after prepare().
+  // finite. Call after prepare(), or without it where there are no cells (the DEM: no layers).
   void restore(const std::vector<WallMotion>& motion, double t);
   std::vector<WallMotion> motion() const;
   // The impulse a contact gave the particle (ContactResult::impulse) at time t moves wall f
   // (and the other wall of a container with it).
   void push(int f, double t, const Vec<D>& impulse_on_particle);
+  // An impulse along its axis on wall f's body at time t, without the layers' bookkeeping of
+  // push: for the DEM, which has no cells and kicks the walls with the contacts' forces at
+  // every time step (dem/dem_integrator.hpp).
+  void kick(int f, double t, double impulse_along_axis) {
+    bodies_[body_index(f)].kick(t, impulse_along_axis);
+  }
   // visit(s) for each wall whose plane a push on wall f may have brought nearer the particles
   // at some later time, so that particles near it must be looked at again: none for a free
   // lid (the push moves it away at every later time), the wall itself on a spring (which

@@ -181,11 +181,10 @@ void DemIntegrator<D>::set_walls(const Environment<D>& env) {
     if (kind == FaceKind::kOpen)
       throw InputError(fmt::format(
           "DEM: face {} of the box is open (particles leaving the box are not supported)", f));
-    if (kind == FaceKind::kWall && env.faces[static_cast<std::size_t>(f)].wall.massive())
-      throw InputError(fmt::format(
-          "DEM: the wall on face {}{} has mass (boundary.wall.mass): the DEM integrator moves "
-          "no wall with mass yet",
-          "xyz"[f / 2], f % 2 == 0 ? '-' : '+'));
+    if (kind == FaceKind::kWall && env.faces[static_cast<std::size_t>(f)].wall.massive()) {
+      any_massive_ = true;
+      lightest_wall_ = std::min(lightest_wall_, env.faces[static_cast<std::size_t>(f)].wall.mass);
+    }
     wall_on_[static_cast<std::size_t>(f)] = kind == FaceKind::kWall;
     walls_[static_cast<std::size_t>(f)] = env.faces[static_cast<std::size_t>(f)].wall;
     any_wall_ = any_wall_ || kind == FaceKind::kWall;
@@ -407,9 +406,13 @@ void DemIntegrator<D>::init(const DemOptions& options) {
         dt_ = std::min(dt_, dem_default_time_step(laws_[a * species_ + b], mu, v_ref,
                                                   options.steps_per_contact));
       }
-      if (any_wall_ && std::isfinite(m_min[a])) {  // the wall's mass is infinite: mu = m
-        dt_ = std::min(
-            dt_, dem_default_time_step(wall_laws_[a], m_min[a], v_ref, options.steps_per_contact));
+      if (any_wall_ && std::isfinite(m_min[a])) {  // a wall of infinite mass: mu = m
+        // A wall with mass M: the contact is shorter, at mu = m M / (m + M).
+        const double mu = std::isfinite(lightest_wall_)
+                              ? m_min[a] * lightest_wall_ / (m_min[a] + lightest_wall_)
+                              : m_min[a];
+        dt_ = std::min(dt_,
+                       dem_default_time_step(wall_laws_[a], mu, v_ref, options.steps_per_contact));
       }
     }
   }
@@ -419,6 +422,10 @@ void DemIntegrator<D>::init(const DemOptions& options) {
   for (std::size_t i = 0; i < n; ++i) id_[i] = slot_[i] = static_cast<std::uint32_t>(i);
   time_origin_ = system.time;
   step_base_ = 0;
+  // Walls with mass: their motion from the state (at rest on their faces without one); an
+  // InputError for a motion of a face without mass.
+  if (any_massive_ || !system.wall_motion.empty())
+    boundaries_.template get<FaceWalls<D>>().restore(system.wall_motion, time_);
   if (!system.dem.empty() && resume(system.dem)) return;
   build_neighbours();
   compute_forces(/*count_collisions=*/false, time_);  // also rejects absurd initial overlaps
@@ -470,6 +477,9 @@ DemResume DemIntegrator<D>::checkpoint() const {
   r.scalars[kPotential] = potential_;
   r.scalars[kContacts] = static_cast<double>(contacts_);
   r.scalars[kFriction] = friction_ ? 1.0 : 0.0;
+  // Walls with mass: the contacts' force on each face at the last evaluation (the next step's
+  // opening kick), after the fixed scalars.
+  if (any_massive_) r.scalars.insert(r.scalars.end(), wall_force_.begin(), wall_force_.end());
   const std::size_t n = size(), stride = resume_stride();
   r.particles.resize(n * stride);
   for (std::size_t i = 0; i < n; ++i) {
@@ -509,8 +519,14 @@ std::size_t DemIntegrator<D>::resume_stride() const {
 template <int D>
 bool DemIntegrator<D>::resume(const DemResume& r) {
   const std::size_t n = size();
-  if (r.scalars.size() != kScalars || r.scalars[kLayout] != kDemLayout)
+  const std::size_t scalars = kScalars + (any_massive_ ? 2 * D : 0);
+  if (r.scalars.size() < kScalars || r.scalars[kLayout] != kDemLayout)
     throw InputError("DEM: the saved integrator state has an unknown layout");
+  if (r.scalars.size() != scalars) {
+    throw InputError(
+        "DEM: the saved integrator state does not fit this run's walls with mass (saved with "
+        "walls with mass and continued without, or the other way round)");
+  }
   if (r.scalars[kTimeStep] != dt_) return false;
   const std::size_t stride = resume_stride();
   const auto bad = [](const char* what) {
@@ -595,6 +611,8 @@ bool DemIntegrator<D>::resume(const DemResume& r) {
   wall_spring_energy_ = r.scalars[kWallSpring];
   potential_ = r.scalars[kPotential];
   contacts_ = static_cast<std::size_t>(r.scalars[kContacts]);
+  for (std::size_t f = 0; f < wall_force_.size() && any_massive_; ++f)
+    wall_force_[f] = r.scalars[kScalars + f];
   time_ = time_at(0);
   return true;
 }
@@ -1019,8 +1037,8 @@ bool DemIntegrator<D>::touches(std::size_t i, int s, double gap, double t,
 // One wall contact of slot i (both loops): the normal force of its species' wall law, its
 // energy split and the surface's work, and with friction the tangential spring.
 template <int D>
-void DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, Vec<D>* spring,
-                                        bool count_collisions, WallSums& sums) {
+double DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, Vec<D>* spring,
+                                          bool count_collisions, WallSums& sums) {
   const std::size_t s = sp_[i];
   const double kk = wall_stiffness_[s], damping = wall_damping_[s];
   const bool hertz = wall_hertz_[s] != 0;
@@ -1035,7 +1053,7 @@ void DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, Vec
   } else {
     for (int a = 0; a < D; ++a) f_[a][i] += F * c.normal[a];
   }
-  if (!friction_ || !(friction_wall_[s].coefficient > 0.0)) return;
+  if (!friction_ || !(friction_wall_[s].coefficient > 0.0)) return F;
   const SoftFriction& fr = friction_wall_[s];
   Vec<D> v;
   for (int a = 0; a < D; ++a) v[a] = vp_[a][i];
@@ -1048,6 +1066,17 @@ void DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, Vec
   for (int a = 0; a < D; ++a) f_[a][i] += ft[a];
   add_spin(tq_, i, -c.gap * cross(c.normal, ft));
   sums.work += dot(ft, c.velocity);  // a sliding wall drags (and heats) by friction
+  return F;
+}
+
+// Half a kick (dt/2 times the contacts' force of the last evaluation) on every wall with mass at
+// time t; between kicks each moves by its own closed-form motion (boundaries/wall_body.hpp).
+template <int D>
+void DemIntegrator<D>::kick_walls(double t) {
+  FaceWalls<D>& faces = boundaries_.template get<FaceWalls<D>>();
+  for (int f = 0; f < 2 * D; ++f)
+    if (wall_on_[static_cast<std::size_t>(f)] && faces.massive(f))
+      faces.kick(f, t, 0.5 * dt_ * wall_force_[static_cast<std::size_t>(f)]);
 }
 
 template <int D>
@@ -1059,15 +1088,24 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
     const int k = f / 2;
     const double sign = f % 2 == 0 ? 1.0 : -1.0;  // the wall's normal (into the box) along k
     const Wall<D>& wall = walls_[static_cast<std::size_t>(f)];
-    const double p = wall.plane_position(f, box_, t), w = wall.plane_speed(f, t);
-    const double p_before = wall.plane_position(f, box_, t - dt_);
+    // A wall with mass: where its body has taken it (the opening half kick at the step's start,
+    // then its own motion), and that body's speed, as the particles' predicted velocities.
+    const bool massive = wall.massive();
+    const FaceWalls<D>& faces = face_walls();
+    const double p = massive ? faces.position(f, t) : wall.plane_position(f, box_, t);
+    const double w = massive ? faces.body(f).speed_at(t) : wall.plane_speed(f, t);
+    const double p_before =
+        massive ? faces.position(f, t - dt_) : wall.plane_position(f, box_, t - dt_);
+    double on_wall = 0.0;  // the contacts' force on it along the axis
     const double* const x = x_[k].data();
     // The wall's velocity (sliding in its plane, moving along its normal) and normal.
     WallContact c{.axis = k};
     c.velocity = wall.velocity;
     c.velocity[k] = w;
     c.normal[k] = sign;
-    c.normal_speed = sign * w;
+    // A wall with mass: its work on the particles is counted below, at its speed after the
+    // step's kicks (the predicted one would bias it by dt F^2 / 2M per step).
+    c.normal_speed = massive ? 0.0 : sign * w;
     std::vector<Vec<D>>& springs = wall_shear_[static_cast<std::size_t>(f)];
     for (std::size_t i = 0; i < n; ++i) {
       c.gap = sign * (x[i] - p);  // the centre's distance from the plane
@@ -1076,8 +1114,20 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
       if (count_collisions && sign * (x[i] - dt_ * u_[k][i] - p_before) >= radius_[i])
         ++sums.entered;
       c.rdot = sign * (vp_[k][i] - w);  // the gap's rate of change
-      add_wall_contact(i, c, friction_ ? &springs[i] : nullptr, count_collisions, sums);
+      on_wall -=
+          sign * add_wall_contact(i, c, friction_ ? &springs[i] : nullptr, count_collisions, sums);
     }
+    wall_force_[static_cast<std::size_t>(f)] = on_wall;
+  }
+  if (any_massive_) {
+    // The closing half kick of the walls with mass (a time step's, not the set-up's
+    // evaluation), after which each body has its velocity at t (velocity Verlet's v(t)), with
+    // which its work on the particles, minus its force times its speed, is counted.
+    if (count_collisions) kick_walls(t);
+    const FaceWalls<D>& faces = face_walls();
+    for (int f = 0; f < 2 * D; ++f)
+      if (wall_on_[static_cast<std::size_t>(f)] && faces.massive(f))
+        sums.work -= wall_force_[static_cast<std::size_t>(f)] * faces.body(f).speed_at(t);
   }
   if (any_surface_) add_surface_forces(count_collisions, t, sums);
   potential_ += sums.potential + sums.spring;
@@ -1241,6 +1291,10 @@ long DemIntegrator<D>::advance(long n, std::uint64_t collisions) {
   // less); v_ holds v(t), made from u, between calls. The same pass clears the forces for the
   // next evaluation.
   while (s < n && collisions_ < collisions) {
+    // The opening half kick of the walls with mass, at the step's start, by the forces of the
+    // last evaluation (with the closing one of the step before: one kick by dt, as the
+    // particles' fused kick).
+    if (any_massive_) kick_walls(time_);
     double vmax2 = 0.0, vsum2 = 0.0;
     if (gravity_on_) {
       any_wall_ ? kick_drift<true, true>(vmax2, vsum2) : kick_drift<true, false>(vmax2, vsum2);
@@ -1370,6 +1424,7 @@ ParticleSystem<D> DemIntegrator<D>::export_state() const {
   s.counters.wall_collisions = wall_collisions_;
   s.counters.dissipated_at_walls = dissipated_walls_;
   s.counters.work_by_walls = work_by_walls_;
+  s.wall_motion = face_walls().motion();
   s.counters.outlet_passes = outlet_passes_;
   s.counters.outlet_mass = outlet_mass_;
   s.counters.outlet_energy = outlet_energy_;

@@ -39,11 +39,20 @@
 // piston's constant speed, a vibration A sin(w t + phi): Environment's Wall); plane walls
 // anywhere ([[boundary.plane]], boundaries/plane_walls.hpp) move the same ways. A
 // particle of species s closer to a wall than its radius feels the normal force of the law
-// soft_wall[s] with the reduced mass of the particle alone (the wall's mass is infinite), the
+// soft_wall[s] (the law of the particle alone: a spring on the particle's own mass), the
 // overlap R - d and the gap's rate of change, clipped at zero like a pair's. The wall's work on
 // the particles (force times the plane's normal velocity) and the energy the wall contacts
 // dissipate are accumulated by the same trapezoidal rule as the pairs'. Gravity is a constant
 // acceleration in the kicks; its potential energy is field_energy().
+//
+// Walls with mass (a face's Wall::mass: a lid, a container; FaceWalls' bodies,
+// boundaries/wall_body.hpp): the contacts' force on the body along its axis kicks it by dt/2 at
+// the start of a step (last evaluation's force) and at its end (the new one), and between kicks
+// it moves by its own closed form (constant acceleration, or the driven damped oscillator):
+// velocity Verlet for the wall with the closed-form part exact, second order, the momentum
+// exchanged exactly. Its work on the particles is counted at its velocity after the closing
+// kick (docs/physics.md#walls-with-mass-in-the-dem). Its motion travels in the exported state
+// (wall_motion) and the last force in the checkpoint, so a restart is bit-identical.
 //
 // Friction (env.soft_friction / soft_wall_friction with a coefficient > 0; SoftFriction in
 // interactions/soft_contact.hpp): a tangential spring per contact on the slip of the contact
@@ -72,6 +81,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/particle_system.hpp"
@@ -170,6 +180,9 @@ class DemIntegrator {
   double field_energy() const;
   // Time integral of sum over pairs of r_ij F_ij (F > 0 repulsive), including the system's.
   double virial() const { return virial_; }
+  // Walls with mass: what outputs show of each now (FaceWalls::readings), none without.
+  std::vector<WallReading> walls_with_mass() const { return face_walls().readings(time_); }
+  bool any_wall_with_mass() const { return any_massive_; }
   // Outlets: the particles that passed and were put back, their mass and the energy they took
   // out, each continuing the constructor's system's counters (EventCounters::outlet_*).
   bool any_outlet() const { return any_outlet_; }
@@ -211,9 +224,12 @@ class DemIntegrator {
   // contact's tangential spring (friction only; null without).
   [[gnu::always_inline]] inline bool touches(std::size_t i, int surface, double gap, double t,
                                              std::vector<Vec<D>>& springs);
-  [[gnu::always_inline]] inline void add_wall_contact(std::size_t i, const WallContact& c,
-                                                      Vec<D>* spring, bool count_collisions,
-                                                      WallSums& sums);
+  // Returns the normal force's size F (along c.normal on the particle).
+  [[gnu::always_inline]] inline double add_wall_contact(std::size_t i, const WallContact& c,
+                                                        Vec<D>* spring, bool count_collisions,
+                                                        WallSums& sums);
+  const FaceWalls<D>& face_walls() const { return boundaries_.template get<FaceWalls<D>>(); }
+  void kick_walls(double t);
   // The contacts with the surfaces of the boundary components other than the box faces (plane
   // walls): the faces' force law through the boundary interface (gap, normal and velocity at
   // the contact), component by component (static dispatch).
@@ -295,6 +311,11 @@ class DemIntegrator {
   double wall_loss_power_ = 0.0, dissipated_walls_ = 0.0;
   double wall_work_power_ = 0.0, work_by_walls_ = 0.0;
   std::uint64_t wall_collisions_ = 0;
+  // Walls with mass (the faces' bodies in boundaries_, FaceWalls): the contacts' force on each
+  // face along its axis at the last evaluation, the lightest wall's mass.
+  bool any_massive_ = false;
+  std::array<double, 2 * D> wall_force_{};
+  double lightest_wall_ = std::numeric_limits<double>::infinity();
   bool any_outlet_ = false;
   std::uint64_t outlet_passes_ = 0;
   double outlet_mass_ = 0.0, outlet_energy_ = 0.0;

@@ -863,8 +863,11 @@ class Reader : public KeyReader {
   // conflict(key, why), which names the wall's own key.
   template <class Conflict>
   static void refuse_with_moving_mass(const Config& c, Conflict&& conflict) {
-    if (c.soft.enabled())
-      conflict("soft.model", "soft contacts and the DEM meet no wall with mass yet");
+    if (c.soft.enabled() && !integrators().is(c.run.integrator, IntegratorKind::kDem)) {
+      conflict("soft.model",
+               "the event engine's soft spheres meet no wall with mass yet; the DEM, "
+               "run.integrator = \"dem\", does");
+    }
     if (c.boundary.shear_rate != 0.0) conflict("boundary.shear_rate", "not combined yet");
     if (c.analysis.transport) conflict("analysis.transport", "momentum is not conserved");
   }

@@ -58,6 +58,7 @@ class DemAdapter final : public Integrator<D> {
     return dem_.dissipated_energy() + dem_.dissipated_at_walls();
   }
   double work_by_walls() const override { return dem_.work_by_walls(); }
+  std::vector<WallReading> walls_with_mass() const override { return dem_.walls_with_mass(); }
   std::optional<typename Integrator<D>::OutletReading> outlet() const override {
     if (!dem_.any_outlet()) return std::nullopt;
     return typename Integrator<D>::OutletReading{dem_.outlet_passes(), dem_.outlet_mass(),
