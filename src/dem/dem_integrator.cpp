@@ -377,6 +377,10 @@ void DemIntegrator<D>::init(const DemOptions& options) {
           box_[k], k, max_diameter_));
   }
 
+  // Walls with mass: their motion from the state (at rest on their faces without one), before
+  // anything asks where the walls are; an InputError for a motion of a face without mass.
+  if (any_massive_ || !system.wall_motion.empty())
+    boundaries_.template get<FaceWalls<D>>().restore(system.wall_motion, time_);
   if (any_outlet_) {
     for (std::size_t i = 0; i < n; ++i) {
       Vec<D> x;
@@ -394,9 +398,16 @@ void DemIntegrator<D>::init(const DemOptions& options) {
       throw InputError(fmt::format("DEM: reference_speed must be >= 0, got {}", v_ref));
     if (v_ref == 0.0) {
       v_ref = v_max > 0.0 ? 2.0 * v_max : 1.0;
-      // Under gravity particles speed up: a fall across the box sets the impact speed.
+      // Under gravity particles speed up: a fall across the box sets the impact speed; a wall
+      // with mass pushed across the box by its force and the field, likewise.
       for (int k = 0; k < D; ++k)
         v_ref = std::max(v_ref, std::sqrt(2.0 * std::abs(gravity_[k]) * box_[k]));
+      for (int f = 0; f < 2 * D; ++f) {
+        if (!wall_on_[static_cast<std::size_t>(f)] || !face_walls().massive(f)) continue;
+        const Wall<D>& w = walls_[static_cast<std::size_t>(f)];
+        const double push = std::abs(w.inward_push(f, gravity_)) / w.mass;
+        v_ref = std::max(v_ref, std::sqrt(2.0 * push * box_[f / 2]));
+      }
     }
     dt_ = std::numeric_limits<double>::infinity();
     for (std::size_t a = 0; a < species_; ++a) {
@@ -422,10 +433,6 @@ void DemIntegrator<D>::init(const DemOptions& options) {
   for (std::size_t i = 0; i < n; ++i) id_[i] = slot_[i] = static_cast<std::uint32_t>(i);
   time_origin_ = system.time;
   step_base_ = 0;
-  // Walls with mass: their motion from the state (at rest on their faces without one); an
-  // InputError for a motion of a face without mass.
-  if (any_massive_ || !system.wall_motion.empty())
-    boundaries_.template get<FaceWalls<D>>().restore(system.wall_motion, time_);
   if (!system.dem.empty() && resume(system.dem)) return;
   build_neighbours();
   compute_forces(/*count_collisions=*/false, time_);  // also rejects absurd initial overlaps
@@ -967,11 +974,12 @@ bool DemIntegrator<D>::pass_outlets(double t) {
         for (int c = 0; c < kSpin; ++c) {
           const double w = uw_[c][i] + h * inv_inertia_[i] * tq_[c][i];
           before += 0.5 * inertia_[i] * w * w;
-          uw_[c][i] = 0.0;
         }
       }
       x = outlet_place<D>(outlets, k, outlet_passes_, periodic_, box_, t, id_[i],
                           [&](const Vec<D>& place) { return free_place(i, place, t); });
+      if (friction_)
+        for (int c = 0; c < kSpin; ++c) uw_[c][i] = 0.0;
       const Vec<D>& out = outlets.outlet(k).insert_velocity;
       for (int a = 0; a < D; ++a) {
         x_[a][i] = x[a];
@@ -1029,7 +1037,8 @@ bool DemIntegrator<D>::touches(std::size_t i, int s, double gap, double t,
   if (overlap > max_overlap_fraction_ * R)
     throw InputError(fmt::format(
         "DEM: particle {} overlaps the wall {} by {} (more than {} of its radius) at t = {}: "
-        "time step dt = {} too large, the wall too fast or the initial state outside",
+        "time step dt = {} too large, the wall too fast, the contacts too soft for the load on "
+        "them (a wall's force, the field) or the initial state outside",
         id_[i], boundaries_.name(s), overlap, max_overlap_fraction_, t, dt_));
   return true;
 }
@@ -1038,9 +1047,10 @@ bool DemIntegrator<D>::touches(std::size_t i, int s, double gap, double t,
 // energy split and the surface's work, and with friction the tangential spring.
 template <int D>
 double DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, Vec<D>* spring,
-                                          bool count_collisions, WallSums& sums) {
+                                          bool count_collisions, WallSums& sums,
+                                          double damping_scale) {
   const std::size_t s = sp_[i];
-  const double kk = wall_stiffness_[s], damping = wall_damping_[s];
+  const double kk = wall_stiffness_[s], damping = wall_damping_[s] * damping_scale;
   const bool hertz = wall_hertz_[s] != 0;
   const NormalForce nf = normal_force(hertz, kk, damping, radius_[i] - c.gap, c.rdot);
   const double F = nf.force;
@@ -1074,15 +1084,40 @@ double DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, V
 template <int D>
 void DemIntegrator<D>::kick_walls(double t) {
   FaceWalls<D>& faces = boundaries_.template get<FaceWalls<D>>();
-  for (int f = 0; f < 2 * D; ++f)
-    if (wall_on_[static_cast<std::size_t>(f)] && faces.massive(f))
-      faces.kick(f, t, 0.5 * dt_ * wall_force_[static_cast<std::size_t>(f)]);
+  for_each_massive_face(
+      [&](int f) { faces.kick(f, t, 0.5 * dt_ * wall_force_[static_cast<std::size_t>(f)]); });
+}
+
+// The factor on a wall law's damping coefficient for particle i against a wall of mass M: the
+// dimensionless damping that sets the restitution is the dashpot's gamma / (2 sqrt(mu k)) and
+// the viscoelastic law's A (rho / mu)^(2/5) v^(1/5) (Schwager & Poeschel, Phys. Rev. E 57, 650
+// (1998)), so keeping it at mu = m M / (m + M) instead of m scales gamma by sqrt(mu / m) and A
+// by (mu / m)^(2/5).
+template <int D>
+double DemIntegrator<D>::reduced_mass_damping(std::size_t i, double wall_mass) const {
+  const double ratio = wall_mass / (mass_[i] + wall_mass);  // mu / m
+  return wall_hertz_[sp_[i]] != 0 ? std::pow(ratio, 0.4) : std::sqrt(ratio);
 }
 
 template <int D>
 void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
   const std::size_t n = size();
   WallSums sums;
+  // The walls with mass's predicted velocity at t, as the particles' (v = u + (dt/2) a with the
+  // last evaluation's force): its speed after the opening half kick and its own motion, plus
+  // the half kick still to come from the forces of the last evaluation on its body (both faces
+  // of a container), for the contacts' damping. The set-up's evaluation (no kick yet) reads the
+  // body's speed as it is, its last force being 0.
+  if (any_massive_) {
+    for_each_massive_face([&](int f) {
+      const FaceWalls<D>& faces = face_walls();
+      const Wall<D>& wall = walls_[static_cast<std::size_t>(f)];
+      double force = wall_force_[static_cast<std::size_t>(f)];
+      if (wall.joined) force += wall_force_[static_cast<std::size_t>(f ^ 1)];
+      predicted_wall_speed_[static_cast<std::size_t>(f)] =
+          faces.body(f).speed_at(t) + (count_collisions ? 0.5 * dt_ * force / wall.mass : 0.0);
+    });
+  }
   for (int f = 0; f < 2 * D; ++f) {
     if (!wall_on_[static_cast<std::size_t>(f)]) continue;
     const int k = f / 2;
@@ -1093,7 +1128,8 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
     const bool massive = wall.massive();
     const FaceWalls<D>& faces = face_walls();
     const double p = massive ? faces.position(f, t) : wall.plane_position(f, box_, t);
-    const double w = massive ? faces.body(f).speed_at(t) : wall.plane_speed(f, t);
+    const double w =
+        massive ? predicted_wall_speed_[static_cast<std::size_t>(f)] : wall.plane_speed(f, t);
     const double p_before =
         massive ? faces.position(f, t - dt_) : wall.plane_position(f, box_, t - dt_);
     double on_wall = 0.0;  // the contacts' force on it along the axis
@@ -1114,8 +1150,11 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
       if (count_collisions && sign * (x[i] - dt_ * u_[k][i] - p_before) >= radius_[i])
         ++sums.entered;
       c.rdot = sign * (vp_[k][i] - w);  // the gap's rate of change
-      on_wall -=
-          sign * add_wall_contact(i, c, friction_ ? &springs[i] : nullptr, count_collisions, sums);
+      // Against a wall with mass M the contact's damping is the law's at the reduced mass
+      // m M / (m + M), so that the two-body restitution is the law's (as the event engine's).
+      const double scale = massive ? reduced_mass_damping(i, wall.mass) : 1.0;
+      on_wall -= sign * add_wall_contact(i, c, friction_ ? &springs[i] : nullptr, count_collisions,
+                                         sums, scale);
     }
     wall_force_[static_cast<std::size_t>(f)] = on_wall;
   }
@@ -1124,10 +1163,9 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
     // evaluation), after which each body has its velocity at t (velocity Verlet's v(t)), with
     // which its work on the particles, minus its force times its speed, is counted.
     if (count_collisions) kick_walls(t);
-    const FaceWalls<D>& faces = face_walls();
-    for (int f = 0; f < 2 * D; ++f)
-      if (wall_on_[static_cast<std::size_t>(f)] && faces.massive(f))
-        sums.work -= wall_force_[static_cast<std::size_t>(f)] * faces.body(f).speed_at(t);
+    for_each_massive_face([&](int f) {
+      sums.work -= wall_force_[static_cast<std::size_t>(f)] * face_walls().body(f).speed_at(t);
+    });
   }
   if (any_surface_) add_surface_forces(count_collisions, t, sums);
   potential_ += sums.potential + sums.spring;

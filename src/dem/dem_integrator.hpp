@@ -131,8 +131,9 @@ class DemIntegrator {
   // particles of species s, and
   // env.gravity. The system's periodic axes and gravity must be the environment's. InputError
   // for what the DEM does not integrate: open faces, shear, stepped potentials, no soft laws.
-  // The default time step also covers the wall contacts (reduced mass m_min) and, under
-  // gravity, impacts at the speed of a fall across the box.
+  // The default time step also covers the wall contacts (reduced mass m_min, with a wall's mass
+  // M: m_min M / (m_min + M)) and, under gravity or a wall's force, impacts at the speed of a
+  // fall (or a wall's push) across the box.
   DemIntegrator(const ParticleSystem<D>& system, const Environment<D>& env,
                 const DemOptions& options = {});
 
@@ -224,10 +225,18 @@ class DemIntegrator {
   // contact's tangential spring (friction only; null without).
   [[gnu::always_inline]] inline bool touches(std::size_t i, int surface, double gap, double t,
                                              std::vector<Vec<D>>& springs);
-  // Returns the normal force's size F (along c.normal on the particle).
+  // Returns the normal force's size F (along c.normal on the particle); the law's damping
+  // coefficient times damping_scale (reduced_mass_damping against a wall with mass).
   [[gnu::always_inline]] inline double add_wall_contact(std::size_t i, const WallContact& c,
                                                         Vec<D>* spring, bool count_collisions,
-                                                        WallSums& sums);
+                                                        WallSums& sums, double damping_scale = 1.0);
+  double reduced_mass_damping(std::size_t i, double wall_mass) const;
+  template <class F>
+  void for_each_massive_face(F&& visit) const {
+    for (int f = 0; f < 2 * D; ++f)
+      if (wall_on_[static_cast<std::size_t>(f)] && walls_[static_cast<std::size_t>(f)].massive())
+        visit(f);
+  }
   const FaceWalls<D>& face_walls() const { return boundaries_.template get<FaceWalls<D>>(); }
   void kick_walls(double t);
   // The contacts with the surfaces of the boundary components other than the box faces (plane
@@ -315,6 +324,7 @@ class DemIntegrator {
   // face along its axis at the last evaluation, the lightest wall's mass.
   bool any_massive_ = false;
   std::array<double, 2 * D> wall_force_{};
+  std::array<double, 2 * D> predicted_wall_speed_{};  // at the evaluation (compute_wall_forces)
   double lightest_wall_ = std::numeric_limits<double>::infinity();
   bool any_outlet_ = false;
   std::uint64_t outlet_passes_ = 0;

@@ -62,7 +62,8 @@ class DemAdapter final : public Integrator<D> {
   std::optional<typename Integrator<D>::OutletReading> outlet() const override {
     if (!dem_.any_outlet()) return std::nullopt;
     return typename Integrator<D>::OutletReading{dem_.outlet_passes(), dem_.outlet_mass(),
-                                                 dem_.outlet_energy()};
+                                                 dem_.outlet_energy(),
+                                                 static_cast<std::int64_t>(dem_.outlet_waiting())};
   }
   Vec<D> momentum() const override { return dem_.momentum(); }
   double momentum_scale() const override;

@@ -151,6 +151,9 @@ class Integrator {
   struct OutletReading {
     std::uint64_t passes = 0;
     double mass = 0.0, energy = 0.0;
+    // The DEM: particles beyond an outlet's plane that still touch something and wait to pass
+    // (DemIntegrator::outlet_waiting); -1 for the event engine, which passes them at once.
+    std::int64_t waiting = -1;
   };
   virtual std::optional<OutletReading> outlet() const { return std::nullopt; }
   virtual Vec<D> momentum() const = 0;

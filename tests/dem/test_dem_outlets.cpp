@@ -217,6 +217,31 @@ TEST(DemOutlets, AResumedSiloContinuesBitForBit) {
   }
 }
 
+// An outlet laid across a bed: six disks stacked on the floor, the outlet's plane a hair below
+// the bottom disk's centre (0.49999 above the floor). The column's weight presses the bottom
+// disk 6e-5 into the floor, its centre beyond the plane while it touches the floor and the disk
+// above: it never passes, and the summary's waiting count says so (the event engine, whose
+// hard disks do not sink, would never see it beyond the plane).
+TEST(DemOutlets, ADiskBeyondThePlaneThatStillTouchesWaits) {
+  std::vector<Vec<D>> at, v;
+  for (int j = 0; j < 6; ++j) {
+    at.push_back({8.0, 4.5 + j});
+    v.push_back({0.0, 0.0});
+  }
+  Environment<D> env = silo(5.0, false);
+  env.planes.clear();
+  PlaneWall<D> floor;
+  floor.normal = {0.0, 1.0};
+  floor.offset = 4.0;
+  env.planes.push_back(floor);
+  env.outlets[0].offset = 4.49999;
+  DemIntegrator<D> dem(disks(at, v), env);
+  dem.step(20000);
+  EXPECT_EQ(dem.outlet_passes(), 0u);
+  EXPECT_EQ(dem.outlet_waiting(), 1u);
+  EXPECT_LT(dem.position(0)[1], 4.49999);
+}
+
 TEST(DemOutlets, AStartBeyondTheOutletIsRefusedNamingTheParticle) {
   try {
     DemIntegrator<D> dem(disks({{8.0, 10.0}, {8.0, 3.0}}, {{0.0, 0.0}, {0.0, 0.0}}),

@@ -36,6 +36,9 @@ class OutletTally {
     o["rate"] = span > 0.0 ? static_cast<double>(passes) / span : 0.0;
     o["mass_rate"] = span > 0.0 ? mass / span : 0.0;
     o["total_passes_since_start"] = now.passes;
+    // The DEM's particles beyond the plane still touching something: many, or the same ones
+    // for long, mean the outlet lies in the bed, not where the grains fall free.
+    if (now.waiting >= 0) o["waiting_now"] = now.waiting;
     const double production_span = t - production_time_;
     if (in_production_ && production_span > 0.0) {
       o["production_rate"] = static_cast<double>(now.passes - production_.passes) / production_span;
