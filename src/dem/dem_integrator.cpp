@@ -1143,19 +1143,28 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
     // step's kicks (the predicted one would bias it by dt F^2 / 2M per step).
     c.normal_speed = massive ? 0.0 : sign * w;
     std::vector<Vec<D>>& springs = wall_shear_[static_cast<std::size_t>(f)];
-    for (std::size_t i = 0; i < n; ++i) {
-      c.gap = sign * (x[i] - p);  // the centre's distance from the plane
-      if (!touches(i, f, c.gap, t, springs)) continue;
-      // Apart one step earlier (u_ holds the drift velocity)?
-      if (count_collisions && sign * (x[i] - dt_ * u_[k][i] - p_before) >= radius_[i])
-        ++sums.entered;
-      c.rdot = sign * (vp_[k][i] - w);  // the gap's rate of change
-      // Against a wall with mass M the contact's damping is the law's at the reduced mass
-      // m M / (m + M), so that the two-body restitution is the law's (as the event engine's).
-      const double scale = massive ? reduced_mass_damping(i, wall.mass) : 1.0;
-      on_wall -= sign * add_wall_contact(i, c, friction_ ? &springs[i] : nullptr, count_collisions,
-                                         sums, scale);
-    }
+    // One loop per kind of wall (a wall of infinite mass pays nothing for the other's terms).
+    const auto contacts = [&](auto with_mass) {
+      for (std::size_t i = 0; i < n; ++i) {
+        c.gap = sign * (x[i] - p);  // the centre's distance from the plane
+        if (!touches(i, f, c.gap, t, springs)) continue;
+        // Apart one step earlier (u_ holds the drift velocity)?
+        if (count_collisions && sign * (x[i] - dt_ * u_[k][i] - p_before) >= radius_[i])
+          ++sums.entered;
+        c.rdot = sign * (vp_[k][i] - w);  // the gap's rate of change
+        Vec<D>* spring = friction_ ? &springs[i] : nullptr;
+        if constexpr (decltype(with_mass)::value) {
+          // Against a wall with mass M the contact's damping is the law's at the reduced mass
+          // m M / (m + M), so that the two-body restitution is the law's (as the event
+          // engine's).
+          on_wall -= sign * add_wall_contact(i, c, spring, count_collisions, sums,
+                                             reduced_mass_damping(i, wall.mass));
+        } else {
+          add_wall_contact(i, c, spring, count_collisions, sums);
+        }
+      }
+    };
+    massive ? contacts(std::true_type{}) : contacts(std::false_type{});
     wall_force_[static_cast<std::size_t>(f)] = on_wall;
   }
   if (any_massive_) {
