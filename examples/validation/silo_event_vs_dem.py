@@ -23,12 +23,12 @@ import argparse
 import math
 import os
 import re
-import subprocess
 import tempfile
-import time
 
 import numpy as np
 from scipy.optimize import curve_fit
+
+from cached_runs import run_one
 
 CENTRE = 25.585  # the orifice's centre along x (the example's box is 51.17 wide)
 BLOCKS = 6
@@ -47,17 +47,6 @@ def configs(example, width, seed):
     dem = dem.replace("[run]\n", "[run]\nintegrator = \"dem\"\n")
     assert "[soft]" in dem and 'face = "y+"' in dem
     return {"event": text, "dem": dem}
-
-
-def run(kairos, tmp, name, text):
-    out = os.path.join(tmp, name)
-    path = out + ".toml"
-    with open(path, "w") as f:
-        f.write(text)
-    start = time.monotonic()
-    subprocess.run([kairos, "run", path, "-o", out, "--overwrite", "--set",
-                    'output.progress="never"'], check=True, stdout=subprocess.DEVNULL)
-    return out, time.monotonic() - start
 
 
 def rate(out):
@@ -90,7 +79,8 @@ def main():
         for width in args.widths:
             for seed in range(1, args.seeds + 1):
                 for kind, text in configs(example, width, seed).items():
-                    out, seconds = run(kairos, tmp, f"{kind}_{width:g}_{seed}", text)
+                    out, seconds = run_one(kairos, os.path.join(tmp, f"{kind}_{width:g}_{seed}"),
+                                           text, overwrite=True)
                     w, e = rate(out)
                     results.setdefault((kind, width), []).append((w, e, seconds))
     print("D/d   event W            dem W              dem/event        wall s (event, dem)")
@@ -116,6 +106,8 @@ def main():
               f"{ratio:5.3f} +- {ratio_err:5.3f}    {se:5.1f}  {sd:5.1f}")
     print(f"(W: passes per unit time over production, seeds combined; errors from {BLOCKS} time "
           "blocks per run)")
+    if len(args.widths) < 3:
+        return  # two parameters need three widths at least
     print("\nBeverloo W = A (D - k d)^(3/2):")
     for kind in ("event", "dem"):
         d = np.array(args.widths)
