@@ -21,13 +21,17 @@ For each run:
   in its error ("drift") show whether the flow is steady; the longest run of rows without a
   pass ("stall") shows a clog (none is expected through a slot 20 d long);
 - the bed's packing fraction phi_b, from the trajectory frames of the production (every 5 time
-  units): the number of sphere centres in a region of the bed away from the slot and the walls
-  (x at least 6 d from the slot's centre line and 1.5 d from the walls, z = 7.5 to 12.5, i.e.
-  1.5 to 6.5 d above the floor, the whole depth) per volume, times the sphere volume pi/6: the
-  stagnant shoulders beside the slot, the same region at every width. (profile.tsv's packing
-  fraction over the same z, output.profile_axis = "z", is over the whole width with the flowing
-  channel and is printed for comparison; it also gives the bed's top, where it falls below
-  half of phi_b.)
+  units): the fraction of a region of the bed away from the slot and the walls (x at least
+  6 d from the slot's centre line and 1.5 d from the walls, z = 7.5 to 12.5, i.e. 1.5 to 6.5 d
+  above the floor, the whole depth: the stagnant shoulders beside the slot, the same region at
+  every width) that lies inside a sphere, by 200 000 random points per frame (a k-d tree,
+  periodic in y; 0.001 per frame). Not the count of centres in the region times pi/6: the
+  spheres are layered against the walls and the floor (the second layer's centres lie at 1.3
+  to 1.5 d from a wall), so a count of centres depends on where the region's edges cut the
+  layers, 0.554 to 0.61 in the same frames for edges moved by half a diameter; the volume
+  inside the region does not (0.60 for the same edges). (profile.tsv's packing fraction over
+  the same z, output.profile_axis = "z", is over the whole width with the flowing channel and
+  is printed for comparison; it also gives the bed's top, where it falls below half of phi_b.)
 
 Seeds combined as in silo_event_vs_dem.py: the mean, whose error is the larger of the block
 errors' (root sum of squares over the number of seeds) and the seeds' scatter (their standard
@@ -78,6 +82,7 @@ TRAJ_INTERVAL = 5.0
 # phi_b region: at least this far from the slot's centre line and from the x walls, this z band
 SLOT_CLEARANCE, WALL_CLEARANCE, BAND = 6.0, 1.5, (FLOOR + 1.5, FLOOR + 6.5)
 SPHERE = math.pi / 6.0  # the sphere's volume (d = 1); mass 1: material density 6/pi
+POINTS = 200000  # random points per frame for phi_b
 # The wide silo of the width check
 WIDE_PARTICLES, WIDE_SCALE, WIDE_EQUILIBRATION = 12000, (1.45, 1.0, 1.25), 30.0
 
@@ -181,13 +186,16 @@ def rate(out, length):
 
 
 def packing(out, width, wide=False):
-    """(phi_b from the production frames' centres in the region away from slot and walls,
-    profile.tsv's packing fraction over the same z band, the bed's top above the floor)."""
+    """(phi_b: the fraction of the region away from the slot and the walls inside a sphere,
+    averaged over the production's frames; profile.tsv's packing fraction over the same z band
+    (the whole width); the bed's top above the floor; the number of frames)."""
     import gsd.hoomd
     box_x, depth = geometry(wide)
     centre = 0.5 * box_x
     equilibration = WIDE_EQUILIBRATION if wide else EQUILIBRATION
-    counts, volume = [], None
+    from scipy.spatial import cKDTree
+    rng = np.random.default_rng(12345)
+    fractions = []
     with gsd.hoomd.open(os.path.join(out, "trajectory.gsd")) as traj:
         for frame in traj:
             tlog = frame.log.get("time")
@@ -196,20 +204,26 @@ def packing(out, width, wide=False):
             box = frame.configuration.box
             assert abs(box[0] - box_x) < 1e-3 and abs(box[1] - depth) < 1e-3, box
             p = frame.particles.position.astype(float) + 0.5 * box[:3]  # to the box's frame
-            x, z = p[:, 0], p[:, 2]
-            inside = ((np.abs(x - centre) >= SLOT_CLEARANCE) & (x >= WALL_CLEARANCE)
-                      & (x <= box_x - WALL_CLEARANCE) & (z >= BAND[0]) & (z <= BAND[1]))
-            counts.append(np.count_nonzero(inside))
-            span = (centre - SLOT_CLEARANCE - WALL_CLEARANCE) * 2.0
-            volume = span * box[1] * (BAND[1] - BAND[0])
-    phi_b = float(np.mean(counts)) * SPHERE / volume
+            p[:, 1] = np.mod(p[:, 1], box[1])
+            p[p[:, 1] >= box[1], 1] = 0.0  # a rounding of -0 to the box's length
+            radius = 0.5 * frame.particles.diameter.astype(float)
+            assert np.allclose(radius, 0.5)
+            # only y is periodic: the other edges of the tree's box are far away
+            tree = cKDTree(p, boxsize=[1e6, box[1], 1e6])
+            x = rng.uniform(WALL_CLEARANCE, centre - SLOT_CLEARANCE, POINTS)
+            x = np.where(rng.integers(0, 2, POINTS) == 1, box_x - x, x)  # left or right
+            points = np.stack([x, rng.uniform(0.0, box[1], POINTS),
+                               rng.uniform(BAND[0], BAND[1], POINTS)], axis=1)
+            dist, _ = tree.query(points)
+            fractions.append(float(np.mean(dist < 0.5)))
+    phi_b = float(np.mean(fractions))
     header, rows = read_tsv(os.path.join(out, "profile.tsv"))
     zpos = np.array([float(r[header.index("position")]) for r in rows])
     phi = np.array([float(r[header.index("packing_fraction")]) for r in rows])
     band = (zpos >= BAND[0]) & (zpos <= BAND[1])
     above = np.nonzero((zpos > BAND[1]) & (phi < 0.5 * phi_b))[0]
     top = zpos[above[0]] - FLOOR if len(above) else float("nan")
-    return phi_b, float(phi[band].mean()), float(top), len(counts)
+    return phi_b, float(phi[band].mean()), float(top), len(fractions)
 
 
 def beverloo(d, a, k):
@@ -328,6 +342,8 @@ def main():
           % (chi2, dof, chi2 / dof, chi2_dist.sf(chi2, dof)))
     print("phi_b = %.4f +- %.4f (mean over the widths), rho_b = phi_b 6/pi = %.4f:"
           "  C = A / (rho_b sqrt(g)) = %.4f +- %.4f" % (phi_b, phi_err, rho_b, c, c_err))
+    print("  (phi_b from %.4f at D = %g to %.4f at D = %g: C from %.4f to %.4f with those)"
+          % (phis[0], d[0], phis[-1], d[-1], a / (phis[0] / SPHERE), a / (phis[-1] / SPHERE)))
     free = None
     if len(d) > 3:
         try:

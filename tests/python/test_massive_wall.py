@@ -103,14 +103,15 @@ class MassiveWall(kt.KairosTestCase):
         # (an undamped spring of k = 10^5, e = 1) with the DEM: the lid settles at the height
         # where the gas's pressure is F / A, the same in both within what the soft spheres'
         # smaller effective size and the energy their contacts hold can move it (measured
-        # 10.80 +- 0.02 against 10.85 +- 0.02, 0.5 %); the DEM's lid energy plus its work on the gas constant to O(dt^2); its
+        # 10.80 +- 0.03 against 10.86 +- 0.04, 0.6 %); the DEM's lid energy plus its work on the gas constant to O(dt^2); its
         # own degree of freedom at the gas's temperature; a continued DEM run bit for bit.
-        long = {"equilibration_time": 40.0, "time": 200.0}
+        long = {"equilibration_time": 20.0, "time": 100.0}
         event, dem = self.path("event"), self.path("dem")
         self.run_ok("run", self.write_config(lid_config(run=long), "event.toml"), "-o", event)
         soft = lid_config(run=dict(long, integrator="dem"),
                           soft={"model": "dashpot", "stiffness": 1e5, "restitution": 1.0})
-        self.run_ok("run", self.write_config(soft, "dem.toml"), "-o", dem)
+        # About 5 s, a minute or more under the sanitizers.
+        self.run_ok("run", self.write_config(soft, "dem.toml"), "-o", dem, timeout=900)
         e, d = (self.summary(o)["walls_with_mass"][0] for o in (event, dem))
         self.assertAlmostEqual(d["position_mean"] / e["position_mean"], 1.0, delta=0.012,
                                msg="lid at %.4f (DEM) and %.4f (event)" % (d["position_mean"],

@@ -386,9 +386,10 @@ class InterruptLargeSetup(kt.KairosTestCase):
                 _, stderr = proc.communicate(timeout=60)
                 if proc.returncode == 0:
                     # Kairos's clock (from its reading of the config) says the setup was over
-                    # before the limit, or within its last few milliseconds after the last poll.
+                    # before the limit, or within its last few milliseconds after the last poll;
+                    # the run (a few hundred collisions) then met the limit or finished first.
                     s = self.summary(out)
-                    self.assertEqual(s["stop_reason"], "wall_time_limit")
+                    self.assertIn(s["stop_reason"], ("wall_time_limit", "completed"))
                     self.assertLess(s["setup_wall_seconds"], limit + self.SETUP_TAIL_SECONDS,
                                     "the setup went on past the limit")
                     continue
