@@ -197,7 +197,7 @@ class SummaryValues(kt.KairosTestCase):
                 if name == "rotating_drum_3d.toml":  # in time, a dense bed: a short one
                     args += ["--set", "run.time=2"]
                 if name in ("free_piston_3d.toml", "spring_damper_3d.toml",
-                            "silo_2d.toml"):  # lengths in time
+                            "silo_2d.toml", "silo_3d.toml"):  # lengths in time
                     args += ["--set", "run.equilibration_time=1", "--set", "run.time=3",
                              "--set", "output.thermo_interval=0.5"]
                 result = self.run_ok(*args)
