@@ -95,13 +95,14 @@ import json
 import math
 import os
 import re
-import subprocess
 import tempfile
 import time
 
 import numpy as np
 from scipy.optimize import curve_fit
 from scipy.stats import chi2 as chi2_dist
+
+from cached_runs import run_one
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 EXAMPLE = os.path.join(HERE, "..", "silo_3d.toml")
@@ -163,23 +164,12 @@ def config(width, seed, production, wide=False):
 
 
 def run(kairos, outdir, text):
-    """Runs kairos on `text` into outdir unless a finished run of the same input is there;
-    returns the wall seconds (0 when reused)."""
-    cfg = os.path.join(outdir, "input.toml")
-    if (os.path.exists(os.path.join(outdir, "summary.json")) and os.path.exists(cfg)
-            and open(cfg).read() == text):
-        return 0.0
-    os.makedirs(outdir, exist_ok=True)
-    with open(cfg, "w") as f:
-        f.write(text)
-    start = time.monotonic()
-    result = subprocess.run([kairos, "run", cfg, "-o", outdir, "--overwrite"],
-                            capture_output=True, text=True)
-    if result.returncode != 0:
-        raise RuntimeError("kairos failed in %s:\n%s" % (outdir, result.stderr[-3000:]))
-    seconds = time.monotonic() - start
-    with open(os.path.join(outdir, "wall_seconds"), "w") as f:
-        f.write("%.1f\n" % seconds)
+    """cached_runs.run_one (a finished run of the same input is reused: 0 s), its wall seconds
+    also kept in outdir/wall_seconds for a later reuse to report."""
+    _, seconds = run_one(kairos, outdir, text, overwrite=True)
+    if seconds > 0.0:
+        with open(os.path.join(outdir, "wall_seconds"), "w") as f:
+            f.write("%.1f\n" % seconds)
     return seconds
 
 

@@ -80,11 +80,12 @@ import argparse
 import json
 import math
 import os
-import subprocess
 import tempfile
 import time
 
 import numpy as np
+
+from cached_runs import run_one
 
 WIDTH = 50.0  # the silo's inner width (x from 0 to WIDTH)
 FLOOR = 10.0  # the floor's height
@@ -207,14 +208,7 @@ profile_bins = {int(height)}
 
 
 def run(kairos, directory, name, text):
-    out = os.path.join(directory, name)
-    path = out + ".toml"
-    with open(path, "w") as f:
-        f.write(text)
-    start = time.monotonic()
-    subprocess.run([kairos, "run", path, "-o", out, "--overwrite"], check=True,
-                   stdout=subprocess.DEVNULL)
-    return out, time.monotonic() - start
+    return run_one(kairos, os.path.join(directory, name), text, overwrite=True)
 
 
 def read_tsv(path):

@@ -181,16 +181,16 @@ void DemIntegrator<D>::set_walls(const Environment<D>& env) {
     if (kind == FaceKind::kOpen)
       throw InputError(fmt::format(
           "DEM: face {} of the box is open (particles leaving the box are not supported)", f));
-    if (kind == FaceKind::kWall && env.faces[static_cast<std::size_t>(f)].wall.massive()) {
-      any_massive_ = true;
-      lightest_wall_ = std::min(lightest_wall_, env.faces[static_cast<std::size_t>(f)].wall.mass);
-    }
     wall_on_[static_cast<std::size_t>(f)] = kind == FaceKind::kWall;
     walls_[static_cast<std::size_t>(f)] = env.faces[static_cast<std::size_t>(f)].wall;
     any_wall_ = any_wall_ || kind == FaceKind::kWall;
   }
   boundaries_ = Boundaries<D>(env, box_);
   any_outlet_ = boundaries_.outlets().any();
+  any_massive_ = boundaries_.any_massive();
+  for_each_massive_face([&](int f) {
+    lightest_wall_ = std::min(lightest_wall_, walls_[static_cast<std::size_t>(f)].mass);
+  });
   wall_shear_.assign(static_cast<std::size_t>(boundaries_.surfaces()), {});
   for (int s = 2 * D; s < boundaries_.surfaces(); ++s)
     any_surface_ = any_surface_ || boundaries_.is_surface(s);
@@ -379,8 +379,7 @@ void DemIntegrator<D>::init(const DemOptions& options) {
 
   // Walls with mass: their motion from the state (at rest on their faces without one), before
   // anything asks where the walls are; an InputError for a motion of a face without mass.
-  if (any_massive_ || !system.wall_motion.empty())
-    boundaries_.template get<FaceWalls<D>>().restore(system.wall_motion, time_);
+  if (any_massive_ || !system.wall_motion.empty()) boundaries_.restore(system.wall_motion, time_);
   if (any_outlet_) {
     for (std::size_t i = 0; i < n; ++i) {
       Vec<D> x;
@@ -402,12 +401,11 @@ void DemIntegrator<D>::init(const DemOptions& options) {
       // with mass pushed across the box by its force and the field, likewise.
       for (int k = 0; k < D; ++k)
         v_ref = std::max(v_ref, std::sqrt(2.0 * std::abs(gravity_[k]) * box_[k]));
-      for (int f = 0; f < 2 * D; ++f) {
-        if (!wall_on_[static_cast<std::size_t>(f)] || !face_walls().massive(f)) continue;
+      for_each_massive_face([&](int f) {
         const Wall<D>& w = walls_[static_cast<std::size_t>(f)];
         const double push = std::abs(w.inward_push(f, gravity_)) / w.mass;
         v_ref = std::max(v_ref, std::sqrt(2.0 * push * box_[f / 2]));
-      }
+      });
     }
     dt_ = std::numeric_limits<double>::infinity();
     for (std::size_t a = 0; a < species_; ++a) {
@@ -1083,7 +1081,7 @@ double DemIntegrator<D>::add_wall_contact(std::size_t i, const WallContact& c, V
 // time t; between kicks each moves by its own closed-form motion (boundaries/wall_body.hpp).
 template <int D>
 void DemIntegrator<D>::kick_walls(double t) {
-  FaceWalls<D>& faces = boundaries_.template get<FaceWalls<D>>();
+  FaceWalls<D>& faces = boundaries_.faces();
   for_each_massive_face(
       [&](int f) { faces.kick(f, t, 0.5 * dt_ * wall_force_[static_cast<std::size_t>(f)]); });
 }
@@ -1110,7 +1108,7 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
   // body's speed as it is, its last force being 0.
   if (any_massive_) {
     for_each_massive_face([&](int f) {
-      const FaceWalls<D>& faces = face_walls();
+      const FaceWalls<D>& faces = boundaries_.faces();
       const Wall<D>& wall = walls_[static_cast<std::size_t>(f)];
       double force = wall_force_[static_cast<std::size_t>(f)];
       if (wall.joined) force += wall_force_[static_cast<std::size_t>(f ^ 1)];
@@ -1126,7 +1124,7 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
     // A wall with mass: where its body has taken it (the opening half kick at the step's start,
     // then its own motion), and that body's speed, as the particles' predicted velocities.
     const bool massive = wall.massive();
-    const FaceWalls<D>& faces = face_walls();
+    const FaceWalls<D>& faces = boundaries_.faces();
     const double p = massive ? faces.position(f, t) : wall.plane_position(f, box_, t);
     const double w =
         massive ? predicted_wall_speed_[static_cast<std::size_t>(f)] : wall.plane_speed(f, t);
@@ -1173,7 +1171,8 @@ void DemIntegrator<D>::compute_wall_forces(bool count_collisions, double t) {
     // which its work on the particles, minus its force times its speed, is counted.
     if (count_collisions) kick_walls(t);
     for_each_massive_face([&](int f) {
-      sums.work -= wall_force_[static_cast<std::size_t>(f)] * face_walls().body(f).speed_at(t);
+      sums.work -=
+          wall_force_[static_cast<std::size_t>(f)] * boundaries_.faces().body(f).speed_at(t);
     });
   }
   if (any_surface_) add_surface_forces(count_collisions, t, sums);
@@ -1471,7 +1470,7 @@ ParticleSystem<D> DemIntegrator<D>::export_state() const {
   s.counters.wall_collisions = wall_collisions_;
   s.counters.dissipated_at_walls = dissipated_walls_;
   s.counters.work_by_walls = work_by_walls_;
-  s.wall_motion = face_walls().motion();
+  s.wall_motion = boundaries_.motion();
   s.counters.outlet_passes = outlet_passes_;
   s.counters.outlet_mass = outlet_mass_;
   s.counters.outlet_energy = outlet_energy_;

@@ -182,7 +182,7 @@ class DemIntegrator {
   // Time integral of sum over pairs of r_ij F_ij (F > 0 repulsive), including the system's.
   double virial() const { return virial_; }
   // Walls with mass: what outputs show of each now (FaceWalls::readings), none without.
-  std::vector<WallReading> walls_with_mass() const { return face_walls().readings(time_); }
+  std::vector<WallReading> walls_with_mass() const { return boundaries_.readings(time_); }
   bool any_wall_with_mass() const { return any_massive_; }
   // Outlets: the particles that passed and were put back, their mass and the energy they took
   // out, each continuing the constructor's system's counters (EventCounters::outlet_*).
@@ -237,7 +237,6 @@ class DemIntegrator {
       if (wall_on_[static_cast<std::size_t>(f)] && walls_[static_cast<std::size_t>(f)].massive())
         visit(f);
   }
-  const FaceWalls<D>& face_walls() const { return boundaries_.template get<FaceWalls<D>>(); }
   void kick_walls(double t);
   // The contacts with the surfaces of the boundary components other than the box faces (plane
   // walls): the faces' force law through the boundary interface (gap, normal and velocity at

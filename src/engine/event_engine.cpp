@@ -881,10 +881,7 @@ EventKind EventEngine<D, Queue>::step() {
       queue_.update(i, predict(i, t));
       return EventKind::kStale;
     }
-    const int surface = e.code.wall_face();
-    hit_wall(i, surface, t);
-    return outlets_ && boundaries_.passes(surface) ? EventKind::kOutletPass
-                                                   : EventKind::kWallCollision;
+    return hit_wall(i, e.code.wall_face(), t);
   }
   if (hot_[e.code.partner()].collisions != e.partner_count) {
     ++counters_.stale_events;

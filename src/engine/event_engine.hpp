@@ -296,7 +296,8 @@ class EventEngine {
   Vec<D> flight_velocity(const HotRecord<D>& h, double t) const;
   // The particle's soonest wall contact from time t before t + horizon: (relative time, face).
   std::pair<double, int> next_wall_contact(std::uint32_t i, double t, double horizon) const;
-  void hit_wall(std::uint32_t i, int surface, double t);
+  // A wall event: the contact, or for an outlet the pass (the event's kind says which).
+  EventKind hit_wall(std::uint32_t i, int surface, double t);
   // Outlets (boundaries/outlets.hpp; engine/outlet_passes.cpp): particle i crossed outlet
   // `surface` at time t and is put back at a free place of its insertion region.
   void pass_outlet(std::uint32_t i, int surface, double t);

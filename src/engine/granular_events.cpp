@@ -164,15 +164,15 @@ std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i,
 // (sliding and normal) plus its vibration velocity, so restitution applies to the normal
 // velocity relative to the wall.
 template <int D, class Queue>
-void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t) {
+EventKind EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t) {
   if (t >= boundaries_.squeeze_time()) throw_squeezed(t);
   if (outlets_ && boundaries_.passes(surface)) [[unlikely]] {
     pass_outlet(i, surface, t);
-    return;
+    return EventKind::kOutletPass;
   }
   if (soft_) [[unlikely]] {
     hit_wall_soft(i, surface, t);
-    return;
+    return EventKind::kWallCollision;
   }
   const bool again = wedged(i, t);
   advance_to(i, t);
@@ -210,9 +210,10 @@ void EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t) {
     boundaries_.push(surface, t, res.impulse);
     queue_.update(i, predict(i, t));
     boundaries_.for_each_disturbed(surface, [&](int s) { wall_moved(s, t); });
-    return;
+    return EventKind::kWallCollision;
   }
   queue_.update(i, predict(i, t));
+  return EventKind::kWallCollision;
 }
 
 // The plane of wall `face` (with mass) entered another layer of cells at time t, or its

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <initializer_list>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -341,18 +342,8 @@ class Reader : public KeyReader {
     PlaneConfig plane;
     plane.wall.contact = contact;
     read_group(pt, prefix, plane_keys(), &plane, &dimension);
-    for (const char* key : {"normal", "point"}) {
-      if (pt.get(key) == nullptr) {
-        fail(&pt, prefix + "." + key,
-             fmt::format("missing required key '{}.{}' ({} numbers)", prefix, key, dimension));
-      }
-    }
-    double n2 = 0.0;
-    for (const double c : plane.normal) n2 += c * c;
-    if (!(n2 > 0.0) || !std::isfinite(n2)) {
-      fail(pt.get("normal"), prefix + ".normal",
-           fmt::format("{}.normal: must be a nonzero vector (it points into the domain)", prefix));
-    }
+    require_vectors(pt, prefix, {"normal", "point"}, dimension);
+    require_nonzero(pt, prefix, "normal", plane.normal, "it points into the domain");
     read_contact(pt, prefix, plane.wall.contact);
     read_group(pt, prefix, wall_keys(), &plane.wall, &dimension);
     // A strip: an axis of the box, and at least one end below the other.
@@ -417,6 +408,30 @@ class Reader : public KeyReader {
     return cylinder;
   }
 
+  // Vector keys a table must have (a plane's normal and point, an outlet's region): an error
+  // naming the first one missing.
+  void require_vectors(const toml::table& t, const std::string& prefix,
+                       std::initializer_list<const char*> keys, int dimension) const {
+    for (const char* key : keys) {
+      if (t.get(key) == nullptr) {
+        fail(&t, prefix + "." + key,
+             fmt::format("missing required key '{}.{}' ({} numbers)", prefix, key, dimension));
+      }
+    }
+  }
+
+  // A direction that must not be the zero vector (a normal, normalised later); `meaning` says
+  // which way it points.
+  void require_nonzero(const toml::table& t, const std::string& prefix, const char* key,
+                       const std::vector<double>& v, std::string_view meaning) const {
+    double n2 = 0.0;
+    for (const double c : v) n2 += c * c;
+    if (!(n2 > 0.0) || !std::isfinite(n2)) {
+      fail(t.get(key), prefix + "." + key,
+           fmt::format("{}.{}: must be a nonzero vector ({})", prefix, key, meaning));
+    }
+  }
+
   // The table `key` of `t` (named `path` in messages), its keys checked; nullptr when absent,
   // an error naming it when it is not a table.
   const toml::table* sub_table(const toml::table& t, std::string_view key,
@@ -438,19 +453,10 @@ class Reader : public KeyReader {
     const toml::table* table = sub_table(t, "outlet", "boundary.outlet");
     if (table == nullptr) return;
     read_group(*table, "boundary.outlet", outlet_keys(), &outlet, &dimension);
-    for (const char* key : {"normal", "point", "insert_lower", "insert_upper"}) {
-      if (table->get(key) == nullptr) {
-        fail(table, fmt::format("boundary.outlet.{}", key),
-             fmt::format("missing required key 'boundary.outlet.{}' ({} numbers)", key, dimension));
-      }
-    }
-    double n2 = 0.0;
-    for (const double c : outlet.normal) n2 += c * c;
-    if (!(n2 > 0.0) || !std::isfinite(n2)) {
-      fail(table->get("normal"), "boundary.outlet.normal",
-           "boundary.outlet.normal: must be a nonzero vector (it points to the side the "
-           "particles come from)");
-    }
+    require_vectors(*table, "boundary.outlet", {"normal", "point", "insert_lower", "insert_upper"},
+                    dimension);
+    require_nonzero(*table, "boundary.outlet", "normal", outlet.normal,
+                    "it points to the side the particles come from");
   }
 
   void read_boundary(const toml::table& t, int dimension, const ContactConfig& contact,

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 #include <numeric>
+#include <tuple>
+#include <utility>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -304,13 +306,30 @@ ContactModel make_contact_model(const ContactConfig& c, const std::string& where
 }
 
 namespace {
+// A vector key (the reader made sure it has D components, or none: then zero).
+template <int D>
+Vec<D> to_vec(const std::vector<double>& v) {
+  Vec<D> out{};
+  for (int a = 0; a < D && a < static_cast<int>(v.size()); ++a) out[a] = v[a];
+  return out;
+}
+
+// The plane through `point` with the given normal (not 0: the reader), as (unit normal, offset)
+// of n . x = offset: a plane wall's or an outlet's.
+template <int D>
+std::pair<Vec<D>, double> plane_through(const std::vector<double>& normal,
+                                        const std::vector<double>& point) {
+  Vec<D> n = to_vec<D>(normal);
+  n = (1.0 / std::sqrt(norm2(n))) * n;
+  return {n, dot(n, to_vec<D>(point))};
+}
+
 // A wall's contact law and motion from its keys (a face wall's or a plane's).
 template <int D>
 Wall<D> make_wall(const WallConfig& wc, const std::string& where) {
   Wall<D> wall;
   wall.contact = make_contact_model(wc.contact, where);
-  for (int a = 0; a < D && a < static_cast<int>(wc.velocity.size()); ++a)
-    wall.velocity[a] = wc.velocity[a];
+  wall.velocity = to_vec<D>(wc.velocity);
   wall.amplitude = wc.amplitude;
   wall.angular_frequency = 2.0 * std::numbers::pi * wc.frequency;
   wall.phase = wc.phase;
@@ -323,18 +342,11 @@ Wall<D> make_wall(const WallConfig& wc, const std::string& where) {
 // region (the reader made sure every vector has its D components; the velocity may be empty).
 template <int D>
 Outlet<D> make_outlet(const OutletConfig& oc) {
-  const auto vec = [](const std::vector<double>& v) {
-    Vec<D> out{};
-    for (int a = 0; a < D && a < static_cast<int>(v.size()); ++a) out[a] = v[a];
-    return out;
-  };
   Outlet<D> outlet;
-  outlet.normal = vec(oc.normal);
-  outlet.normal = (1.0 / std::sqrt(norm2(outlet.normal))) * outlet.normal;  // not 0: the reader
-  outlet.offset = dot(outlet.normal, vec(oc.point));
-  outlet.insert_lower = vec(oc.insert_lower);
-  outlet.insert_upper = vec(oc.insert_upper);
-  outlet.insert_velocity = vec(oc.insert_velocity);
+  std::tie(outlet.normal, outlet.offset) = plane_through<D>(oc.normal, oc.point);
+  outlet.insert_lower = to_vec<D>(oc.insert_lower);
+  outlet.insert_upper = to_vec<D>(oc.insert_upper);
+  outlet.insert_velocity = to_vec<D>(oc.insert_velocity);
   outlet.seed = oc.seed;
   return outlet;
 }
@@ -391,12 +403,7 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
   for (std::size_t k = 0; k < config.boundary.planes.size(); ++k) {
     const PlaneConfig& pc = config.boundary.planes[k];
     PlaneWall<D> plane;
-    for (int a = 0; a < D && a < static_cast<int>(pc.normal.size()); ++a)
-      plane.normal[a] = pc.normal[a];
-    plane.normal = (1.0 / std::sqrt(norm2(plane.normal))) * plane.normal;  // not 0: the reader
-    Vec<D> point{};
-    for (int a = 0; a < D && a < static_cast<int>(pc.point.size()); ++a) point[a] = pc.point[a];
-    plane.offset = dot(plane.normal, point);
+    std::tie(plane.normal, plane.offset) = plane_through<D>(pc.normal, pc.point);
     plane.wall = make_wall<D>(pc.wall, fmt::format("boundary.plane[{}]", k));
     if (!pc.span_axis.empty()) {
       plane.span_axis = static_cast<int>(axes(D).at(pc.span_axis));
@@ -412,8 +419,7 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
       const CylinderConfig& cc = given[k];
       CylinderWall<D> round;
       round.axis = D == 2 ? D - 1 : static_cast<int>(axes(3).at(cc.axis));
-      for (int a = 0; a < D && a < static_cast<int>(cc.center.size()); ++a)
-        round.center[a] = cc.center[a];
+      round.center = to_vec<D>(cc.center);
       round.radius = cc.radius;
       round.inside = cc.inside;
       round.angular_velocity = cc.angular_velocity;
@@ -437,8 +443,7 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
                   2.0 * std::numbers::pi * box.drive_frequency, box.drive_phase};
     }
   }
-  for (int a = 0; a < D && a < static_cast<int>(config.field.gravity.size()); ++a)
-    env.gravity[a] = config.field.gravity[a];
+  env.gravity = to_vec<D>(config.field.gravity);
   env.shear_rate = config.boundary.shear_rate;
   add_step_potentials(config, state, env);
   add_soft_laws(config, state, env);
