@@ -33,6 +33,33 @@ inline double quadratic_contact_time(double a, double b, double c) {
   return t > 0.0 ? t : 0.0;  // a <= 0: overlapping and approaching -> now
 }
 
+// Growing spheres (Lubachevsky-Stillinger compression): the contact distance grows as
+// sigma + u t (u = d sigma / dt >= 0), so f(t) = |r + g t|^2 - (sigma + u t)^2 = a + 2 h t + c t^2
+// with a = r^2 - sigma^2, h = r.g - sigma u (half of b) and c = g^2 - u^2, which is negative when
+// the growth outruns the approach. The stable event rule (Bannerman et al. 2014;
+// docs/physics.md#growing-spheres): the earliest t >= 0 with f <= 0 and f' < 0.
+inline double growing_contact_time(double a, double h, double c) {
+  if (c > 0.0) {  // the hard-sphere case: only an approach (h < 0) can meet
+    if (h >= 0.0) return kNever;
+    const double disc = h * h - a * c;
+    if (disc <= 0.0) return kNever;
+    const double t = a / (-h + std::sqrt(disc));
+    return t > 0.0 ? t : 0.0;
+  }
+  if (c == 0.0) {  // f is linear
+    if (h >= 0.0) return kNever;
+    return a > 0.0 ? -a / (2.0 * h) : 0.0;
+  }
+  // c < 0: f ends negative whatever the pair does; it meets once f' < 0 with f <= 0.
+  const double disc = h * h - a * c;
+  if (disc <= 0.0) {  // f never positive (overlapping): the event is where f' turns negative
+    const double t = -h / c;
+    return t > 0.0 ? t : 0.0;
+  }
+  const double t = h > 0.0 ? (-h - std::sqrt(disc)) / c : a / (-h + std::sqrt(disc));
+  return t > 0.0 ? t : 0.0;
+}
+
 // Convenience form from the relative state (vectors given as pointers to D components).
 template <int D>
 inline double pair_contact_time(const double* r, const double* g, double sigma) {

@@ -99,6 +99,34 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
   return found;
 }
 
+// scan_candidates_scalar for growing spheres (engine/growth.hpp): the contact distance is the
+// loops' sigma (the radii at the growth's origin) times `scale`, growing at sigma * rate.
+// Scalar only: compression is not the hot path the AVX-512 loop was written for. `self` (the
+// predicted particle) is skipped: with itself, a growing particle would overlap at once.
+template <int D>
+std::uint32_t scan_candidates_growing(const CandidateScan<D>& s, std::uint32_t self, double t,
+                                      const Vec<D>& xi, const Vec<D>& vi, double scale, double rate,
+                                      double& best) {
+  std::uint32_t found = kNoCandidate;
+  const Vec<D> no_shift{};
+  for (std::uint32_t k = 0; k < s.count; ++k) {
+    const std::uint32_t j = s.candidates[k];
+    if (j == self) continue;
+    double dtj;
+    const double* rec = record_at(s, k, t, dtj);
+    if (rec == nullptr) [[unlikely]]
+      continue;
+    const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
+    const RelativeMotion p = relative_motion_at<D>(xi, vi, rec, dtj, shift);
+    const double sigma0 = s.uniform ? s.sigma : s.radius_i + s.kind_radius[s.kind[j]];
+    double dt;
+    if (!growing_contact_before(p, sigma0 * scale, sigma0 * rate, best, dt)) continue;
+    best = dt;
+    found = k;
+  }
+  return found;
+}
+
 // The start of a soft contact (EventEngine::try_place), in one pass over the candidates: does
 // the placed particle (at `placed`, frozen at `frozen_velocity` for `span` from time t) overlap a
 // candidate now (overlap), or meet one while frozen (met)? With `predict`, also the soonest

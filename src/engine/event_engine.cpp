@@ -66,6 +66,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   setup_soft(s);
   if (massive_walls_) check_massive_walls(s, mode);
   if (outlets_) check_outlets(s);
+  if (options_.growth_rate != 0.0) start_growth();
 
   // Internal numbering: the stored one when resuming, else the caller's (renumbered below).
   id_.resize(n);
@@ -331,7 +332,7 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   std::array<bool, D> periodic;
   for (int a = 0; a < D; ++a) {
     periodic[a] = env_.periodic(a);
-    min_width[a] = range;
+    min_width[a] = std::max(range, options_.min_cell_width);
   }
   // A box with walls or open faces is often mostly empty (a bed under open headroom, a pile):
   // the cap on cells per particle, meant to bound memory, would make the occupied cells wide.
@@ -560,7 +561,10 @@ std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, 
   std::uint32_t delayed = 0;  // candidates in deferred soft contacts, listed in list.delayed
   const CandidateScan<D> scan = scan_of(list, i, &delayed);
   std::uint32_t k;
-  if (accelerated_) {
+  if (growing_) [[unlikely]] {
+    k = scan_candidates_growing<D>(scan, i, t, xi, hot_[i].vel, growth_.scale(t), growth_.rate(),
+                                   best);
+  } else if (accelerated_) {
     const Vec<D> vi = flight_velocity(hot_[i], t);
     k = vector_scan_ ? scan_candidates_avx512<D, true>(scan, t, xi, vi, best)
                      : scan_candidates_scalar<D, true>(scan, t, xi, vi, best);
@@ -711,6 +715,12 @@ bool EventEngine<D, Queue>::kept_contact_time(std::uint32_t i, std::uint32_t p, 
       accelerated_ ? relative_motion_at<D, true>(xi, vi, rec, t - hp.time, shift,
                                                  half_gravity_.data(), env_.gravity.data())
                    : relative_motion_at<D>(xi, vi, rec, t - hp.time, shift);
+  if (growing_) [[unlikely]] {
+    const double sigma0 = radius_of(i) + radius_of(p);
+    if (!growing_contact_before(m, sigma0 * growth_.scale(t), growth_.speed(sigma0), kNever, dt))
+      dt = kNever;
+    return true;
+  }
   const double sigma = radius_of(i) + radius_of(p);
   if (!contact_before(m, sigma * sigma, kNever, dt)) dt = kNever;
   return true;
@@ -759,7 +769,11 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
     collide_granular(i, j, t, r, r2);
   } else {
     const double mi = mass_of(i), mj = mass_of(j);
-    const double s = HardSphere::impulse_factor(g_dot_r, r2, mi * mj / (mi + mj));  // J = s r
+    const double mu = mi * mj / (mi + mj);
+    const double s =  // J = s r
+        growing_ ? HardSphere::growing_impulse_factor(g_dot_r, r2, mu,
+                                                      growth_.speed(radius_of(i) + radius_of(j)))
+                 : HardSphere::impulse_factor(g_dot_r, r2, mu);
     for (int a = 0; a < D; ++a) {
       hi.vel[a] += s * r[a] / mi;
       hj.vel[a] -= s * r[a] / mj;
@@ -794,6 +808,75 @@ void EventEngine<D, Queue>::set_velocity(std::uint32_t k, double t, const Vec<D>
   ++h.collisions;
   ++counters_.driving_kicks;
   queue_.update(k, predict(k, t));
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::rescale_velocities(double t, double factor) {
+  if (!(t >= time_) || !(t <= next_event_time()))
+    throw std::logic_error("rescale_velocities: time outside [time(), next_event_time()]");
+  if (soft_ || resting_.count() > 0)
+    throw std::logic_error("rescale_velocities: not with soft contacts or resting particles");
+  time_ = t;
+  const auto n = static_cast<std::uint32_t>(size());
+  for (std::uint32_t k = 0; k < n; ++k) {
+    advance_to(k, t);
+    hot_[k].vel = factor * hot_[k].vel;
+    ++hot_[k].collisions;  // every prediction made against it is stale
+  }
+  std::vector<double> times(n);
+  for (std::uint32_t k = 0; k < n; ++k) times[k] = predict(k, t);
+  queue_.reset(times);
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::set_growth_rate(double t, double rate) {
+  if (!growing_ || !(rate > 0.0) || !std::isfinite(rate))
+    throw std::logic_error("set_growth_rate: not growing, or not a positive rate");
+  if (!(t >= time_) || !(t <= next_event_time()))
+    throw std::logic_error("set_growth_rate: time outside [time(), next_event_time()]");
+  time_ = t;
+  growth_ = growth_.changed_at(t, rate);
+  update_growth_limit();
+  const auto n = static_cast<std::uint32_t>(size());
+  for (std::uint32_t k = 0; k < n; ++k) {
+    advance_to(k, t);
+    ++hot_[k].collisions;  // every prediction is stale
+  }
+  std::vector<double> times(n);
+  for (std::uint32_t k = 0; k < n; ++k) times[k] = predict(k, t);
+  queue_.reset(times);
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::update_growth_limit() {
+  double rmax = 0.0;
+  for (const ParticleKind& sh : kinds_) rmax = std::max(rmax, sh.radius);
+  double width = kNever;
+  for (int a = 0; a < D; ++a) width = std::min(width, cells_.grid().width(a));
+  growth_fits_until_ = growth_.fits_until(2.0 * rmax, width);
+}
+
+// Growing particles (docs/physics.md#growing-spheres): what growth composes with, and how long
+// the cells hold it.
+template <int D, class Queue>
+void EventEngine<D, Queue>::start_growth() {
+  const auto refuse = [](const std::string& what) {
+    throw InputError("growing particles (compression) cannot be combined with " + what);
+  };
+  if (!(options_.growth_rate > 0.0) || !std::isfinite(options_.growth_rate))
+    throw InputError("the growth rate must be positive and finite");
+  if (bounded_) refuse("walls or open faces: every axis must be periodic");
+  if (accelerated_) refuse("gravity (field.gravity)");
+  if (sheared_) refuse("Lees-Edwards shear (boundary.shear_rate)");
+  if (stepped_) refuse("stepped potentials or bonds");
+  if (soft_) refuse("soft spheres (soft.model)");
+  if (granular_contacts_) refuse("inelastic or rough contacts or the TC model ([contact])");
+  if (env_.has_fixed_grains()) refuse("fixed grains");
+  growth_ = Growth(options_.growth_rate, time_);
+  growing_ = true;
+  vector_scan_ = false;  // the growing loop is scalar
+  row_loads_ = false;
+  update_growth_limit();
 }
 
 template <int D, class Queue>

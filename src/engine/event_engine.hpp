@@ -43,6 +43,7 @@
 #include "dynamics/collision_time.hpp"
 #include "engine/candidate_scan.hpp"
 #include "engine/cell_neighbourhood.hpp"
+#include "engine/growth.hpp"
 #include "engine/helfand_moments.hpp"
 #include "engine/hot_record.hpp"
 #include "engine/image_counters.hpp"
@@ -112,6 +113,12 @@ struct EngineOptions {
   ListGather list_gather = ListGather::kAuto;
   // Used by the AVX-512 loops only.
   RecordLoads record_loads = RecordLoads::kAuto;
+  // Growing particles (engine/growth.hpp, Lubachevsky-Stillinger): every diameter grows by this
+  // fraction of its value at the engine's start per unit time (0: none). Elastic, smooth hard
+  // spheres in a periodic box only; the scalar loops are used.
+  double growth_rate = 0.0;
+  // Cells at least this wide (0: as wide as the largest contact): room for growth.
+  double min_cell_width = 0.0;
 };
 
 template <int D, class Queue>
@@ -266,6 +273,18 @@ class EventEngine {
   const char* queue_name() const { return Queue::name(); }
   const CellGrid<D>& grid() const { return cells_.grid(); }
 
+  // Growing particles (EngineOptions::growth_rate): the growth, and the last moment the cells
+  // still hold every pair that can touch (kNever without growth); events must not be taken
+  // beyond it (the caller rebuilds the engine with wider cells).
+  const Growth& growth() const { return growth_; }
+  double growth_fits_until() const { return growth_fits_until_; }
+  // Multiplies every velocity by `factor` at time t (time() <= t <= next_event_time()), as a
+  // thermostat's rescaling does, and predicts every particle again.
+  void rescale_velocities(double t, double factor);
+  // Growing particles: from time t on (time() <= t <= next_event_time()) the diameters grow at
+  // `rate` (relative to the radii at the engine's start; > 0); every particle is predicted again.
+  void set_growth_rate(double t, double rate);
+
  private:
   using Code = EventCode<D>;
   using PendingEvent = kairos::PendingEvent<D>;
@@ -347,6 +366,12 @@ class EventEngine {
   void collide_granular(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
   void separate(std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2);
   double radius_of(std::uint32_t i) const { return kinds_[kind_.empty() ? 0 : kind_[i]].radius; }
+  // The pair's contact distance at time t (radii grow with growth_).
+  double contact_distance(std::uint32_t i, std::uint32_t j, double t) const {
+    return (radius_of(i) + radius_of(j)) * growth_.scale(t);
+  }
+  void start_growth();
+  void update_growth_limit();
   double mass_of(std::uint32_t i) const { return kinds_[kind_.empty() ? 0 : kind_[i]].mass; }
   void advance_to(std::uint32_t i, double t);
   Crossing next_crossing(const HotRecord<D>& h) const;
@@ -521,6 +546,7 @@ class EventEngine {
   bool row_loads_ = false;        // CandidateScan::row_loads (RecordLoads, cpu_gathers_fast)
   HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
   bool accelerated_ = false;      // uniform gravity
+  bool growing_ = false;          // growth_.on(): growing particles
   Vec<D> half_gravity_{};
   bool walls_ = false;                   // boundaries_.any()
   bool massive_walls_ = false;           // some face wall has mass
@@ -558,6 +584,8 @@ class EventEngine {
     std::vector<std::uint32_t> woken, touching;
   } wake_scratch_;
   HelfandMoments<D> helfand_;  // cold: pair events only, when a transport analysis asks
+  Growth growth_;              // growing particles (compression) only
+  double growth_fits_until_ = kNever;
 };
 
 // Small members every event path uses, visible to each of the engine's files.

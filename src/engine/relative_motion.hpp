@@ -70,6 +70,19 @@ inline bool contact_before(const RelativeMotion& p, double sigma2, double best, 
   return true;
 }
 
+// contact_before() for growing spheres: contact distance sigma now, growing at u
+// (dynamics/collision_time.hpp growing_contact_time). The cheap bound applies when the growth
+// is slower than the approach (g^2 > u^2): the root a / (-h + sqrt(h^2 - a c)) >= a / (-2 h).
+inline bool growing_contact_before(const RelativeMotion& p, double sigma, double u, double best,
+                                   double& dt) {
+  const double gap = p.r2 - sigma * sigma;
+  const double h = p.rg - sigma * u;
+  const double c = p.g2 - u * u;
+  if (c > 0.0 && (!(h < 0.0) || gap > -2.0 * h * best)) return false;
+  dt = growing_contact_time(gap, h, c);
+  return dt < best;
+}
+
 // The contact time of a pair in state p at distance sigma by the quadratic's rule
 // (dynamics/collision_time.hpp quadratic_contact_time, as pair_contact_time takes it): the
 // loops that test pairs one by one against an unknown best (sheared lists).

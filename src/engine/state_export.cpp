@@ -145,9 +145,10 @@ void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
   const ParticleKind& sh = kinds_[kind_.empty() ? 0 : kind_[k]];
   if ((fields & Blocks::kKinematics) != 0) {
     const HotRecord<D>& h = hot_[k];
-    out.kinematics[c] = {h.pos, h.vel, h.time, sh.radius};
+    const double radius = sh.radius * growth_.scale(time_);  // grown to now
+    out.kinematics[c] = {h.pos, h.vel, h.time, radius};
     if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
-      out.kinematics[c] = {position(k, time_), frozen_velocity_of(k), time_, sh.radius};
+      out.kinematics[c] = {position(k, time_), frozen_velocity_of(k), time_, radius};
     if (resting_.count() > 0) out.asleep[c] = resting_.flag(k);
     if (images_.on()) out.image[c] = images_.of(k);
   }
@@ -232,8 +233,10 @@ double EventEngine<D, Queue>::max_overlap_now() const {
     for (std::uint32_t c = 0; c < list.count; ++c) {
       const std::uint32_t j = list.ids[c];
       if (j <= i) continue;  // each pair once (a small grid may list a cell twice: no matter)
-      worst = std::max(worst, pair_overlap<D>(box_, xi, wrapped_position_now(j), 2.0 * radius_of(i),
-                                              2.0 * radius_of(j), &periodic));
+      const double grown = 2.0 * growth_.scale(time_);
+      worst =
+          std::max(worst, pair_overlap<D>(box_, xi, wrapped_position_now(j), grown * radius_of(i),
+                                          grown * radius_of(j), &periodic));
     }
   }
   return worst;

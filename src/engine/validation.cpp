@@ -102,7 +102,8 @@ void EventEngine<D, Queue>::validate() {
             h.time + boundaries_.event_time(f, h.pos, h.vel, radius_of(i), h.time, kNever);
         const double speed = std::abs(
             dot(h.vel - boundaries_.velocity(f, h.pos, due), boundaries_.normal(f, h.pos, due)));
-        if (std::isfinite(due) && late(queue_.time_of(i), due, speed))
+        // Beyond growth_fits_until_ the cells no longer hold the pairs: the caller stops there.
+        if (std::isfinite(due) && due <= growth_fits_until_ && late(queue_.time_of(i), due, speed))
           fail("particle " + name(i) + " meets wall " + std::to_string(f) +
                " after its deferred release before its pending event");
       }
@@ -130,7 +131,8 @@ void EventEngine<D, Queue>::validate() {
         fail("particle " + name(i) + " has an event with wall " + std::to_string(f) + " at " +
              std::to_string(queue_.time_of(i)) + " before its contact at " + std::to_string(due));
       }
-      if (std::isfinite(due) && late(pending, due, speed_at_contact)) {
+      // Beyond growth_fits_until_ the cells no longer hold the pairs: the caller stops there.
+      if (std::isfinite(due) && due <= growth_fits_until_ && late(pending, due, speed_at_contact)) {
         fail("particle " + name(i) + " meets wall " + std::to_string(f) + " at " +
              std::to_string(due) + " before its pending event (at " +
              std::to_string(queue_.time_of(i)) + ", partner code " +
@@ -253,7 +255,25 @@ void EventEngine<D, Queue>::validate() {
         return;
       }
     }
-    const double sigma = radius_of(i) + radius_of(j);
+    const double sigma = contact_distance(i, j, t);
+    if (growing_) {  // a straight-line pair whose contact distance grows
+      const double u = growth_.speed(radius_of(i) + radius_of(j));
+      const double due = t + growing_contact_time(norm2(r) - sigma * sigma, dot(r, g) - sigma * u,
+                                                  norm2(g) - u * u);
+      const double dt = due - t;
+      const double normal_speed = std::abs(dot(r + dt * g, g) / (sigma + u * dt) - u);
+      // Beyond growth_fits_until_ the cells no longer hold the pairs: the caller stops there.
+      if (std::isfinite(due) && due <= growth_fits_until_ &&
+          late(std::min(queue_.time_of(i), queue_.time_of(j)), due, normal_speed)) {
+        std::ostringstream os;
+        os.precision(17);
+        os << "growing pair " << name(i) << "," << name(j) << " (" << which << ") meets at " << due
+           << " but no pending event comes first (theirs: " << queue_.time_of(i) << ", "
+           << queue_.time_of(j) << ")";
+        fail(os.str());
+      }
+      return;
+    }
     if (in_deferred_contact(i, t) || in_deferred_contact(j, t)) {
       if (!frozen_pair(i, j)) check_deferred_covered(i, j, r, sigma, which);
       return;
@@ -291,7 +311,7 @@ void EventEngine<D, Queue>::validate() {
     const Vec<D> xi = position(i, t);
     const std::uint32_t ci = hot_[i].cell;
     for (std::uint32_t j = i + 1; j < n; ++j) {
-      const double sigma = radius_of(i) + radius_of(j);
+      const double sigma = contact_distance(i, j, t);
       if (sheared_) {
         Vec<D> u;
         const Vec<D> r = sheared_separation(i, j, t, u);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -16,6 +17,7 @@
 #include "core/periodic.hpp"
 #include "core/stop_flag.hpp"
 #include "init/insertion_grid.hpp"
+#include "io/config_choices.hpp"
 
 namespace kairos {
 namespace {
@@ -136,6 +138,13 @@ constexpr LatticeSpec kLattices[] = {
 // Random sequential insertion jams near 0.38 (3D) / 0.547 (2D); beyond these it is refused.
 constexpr double kRandomMaxPacking3 = 0.35;
 constexpr double kRandomMaxPacking2 = 0.50;
+}  // namespace
+
+double random_insertion_limit(int dimension) {
+  return dimension == 3 ? kRandomMaxPacking3 : kRandomMaxPacking2;
+}
+
+namespace {
 constexpr std::uint64_t kMaxInsertionAttempts = 1'000'000;  // per particle
 
 // "fcc, bcc, sc" / "square, hex", plus ", random" when asked.
@@ -207,7 +216,7 @@ struct Layout {
 
 template <int D>
 Layout<D> make_layout(const std::vector<SpeciesConfig>& species, std::uint64_t N, double eta,
-                      const LatticeSpec* lattice) {
+                      const LatticeSpec* lattice, double solid_volume = 0.0) {
   Layout<D> out;
   std::vector<double> fractions;
   for (const auto& s : species) fractions.push_back(s.fraction);
@@ -216,6 +225,7 @@ Layout<D> make_layout(const std::vector<SpeciesConfig>& species, std::uint64_t N
     out.solid_volume +=
         static_cast<double>(out.counts[s]) * particle_volume<D>(species[s].diameter);
   }
+  if (solid_volume > 0.0) out.solid_volume = solid_volume;  // drawn diameters
   const double volume = out.solid_volume / eta;
   out.lattice = lattice;
   if (lattice == nullptr) {
@@ -777,6 +787,67 @@ double packing_fraction(const InitialState<D>& state) {
   return solid / box_volume<D>(state.box);
 }
 
+// Particles in order of decreasing diameter (ties keep their order): random insertion places
+// the largest first. Before positions exist.
+template <int D>
+void sort_by_diameter(InitialState<D>& state) {
+  const std::size_t n = state.diameter.size();
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return state.diameter[a] > state.diameter[b];
+  });
+  const InitialState<D> old = state;
+  for (std::size_t i = 0; i < n; ++i) {
+    state.species[i] = old.species[order[i]];
+    state.diameter[i] = old.diameter[order[i]];
+    state.mass[i] = old.mass[order[i]];
+  }
+}
+
+// One factor of the size distribution (mean 1, relative standard deviation delta;
+// docs/config.md, system.size_distribution).
+double size_factor(SizeDistribution kind, double delta, std::mt19937_64& rng,
+                   NormalSource& normal) {
+  switch (kind) {
+    case SizeDistribution::kUniform:
+      return 1.0 + std::sqrt(3.0) * delta * (2.0 * uniform01(rng) - 1.0);
+    case SizeDistribution::kGaussian:
+      for (;;) {  // truncated to (0, 2): symmetric, so the mean stays 1
+        const double x = 1.0 + delta * normal(rng);
+        if (x > 0.0 && x < 2.0) return x;
+      }
+    case SizeDistribution::kLognormal: {
+      const double s2 = std::log1p(delta * delta);
+      return std::exp(-0.5 * s2 + std::sqrt(s2) * normal(rng));
+    }
+    case SizeDistribution::kNone:
+      break;
+  }
+  return 1.0;
+}
+
+// Each species' drawn diameters (its diameter times the distribution's factors), `counts[s]`
+// of them, largest first; empty without a distribution.
+std::vector<std::vector<double>> draw_diameters(const SystemConfig& system,
+                                                const std::vector<SpeciesConfig>& species,
+                                                const std::vector<std::uint64_t>& counts,
+                                                std::mt19937_64& rng) {
+  const SizeDistribution kind = size_distributions().at(system.size_distribution);
+  if (kind == SizeDistribution::kNone) return {};
+  std::vector<std::vector<double>> out(species.size());
+  NormalSource normal;
+  for (std::size_t s = 0; s < species.size(); ++s) {
+    out[s].reserve(counts[s]);
+    for (std::uint64_t k = 0; k < counts[s]; ++k) {
+      poll_stop(k);
+      out[s].push_back(species[s].diameter * size_factor(kind, system.polydispersity, rng, normal));
+    }
+    std::sort(out[s].begin(), out[s].end(), std::greater<>());
+  }
+  return out;
+}
+
 template <int D>
 InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& rng, RunKind kind) {
   static_assert(D == 2 || D == 3);
@@ -820,6 +891,21 @@ InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& 
   }
   double dmax = 0.0;
   for (const auto& s : species) dmax = std::max(dmax, s.diameter);
+  // A size distribution: the diameters are drawn first, so that the box holds exactly the
+  // packing fraction asked of the diameters drawn.
+  std::vector<std::vector<double>> drawn;
+  double drawn_volume = 0.0;
+  {
+    std::vector<double> fractions;
+    for (const auto& sp : species) fractions.push_back(sp.fraction);
+    drawn = draw_diameters(system, species, largest_remainder_counts(fractions, N), rng);
+    for (const auto& per_species : drawn) {
+      for (double d : per_species) {
+        drawn_volume += particle_volume<D>(d);
+        dmax = std::max(dmax, d);
+      }
+    }
+  }
 
   if (lattice == nullptr) {
     const double limit = D == 3 ? kRandomMaxPacking3 : kRandomMaxPacking2;
@@ -831,7 +917,7 @@ InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& 
     }
   }
 
-  const Layout<D> layout = make_layout<D>(species, N, eta, lattice);
+  const Layout<D> layout = make_layout<D>(species, N, eta, lattice, drawn_volume);
   const bool lattice_fits = fits_lattice(layout, dmax);
   if (!fits_cell_list(layout, dmax)) {
     // The smallest larger N whose box is wide enough and whose lattice fits the diameters (a
@@ -906,10 +992,13 @@ InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& 
   }
   state.diameter.resize(N);
   state.mass.resize(N);
+  std::vector<std::size_t> next_drawn(species.size(), 0);
   for (std::size_t i = 0; i < N; ++i) {
-    state.diameter[i] = species[state.species[i]].diameter;
-    state.mass[i] = species[state.species[i]].mass;
+    const std::uint32_t sp = state.species[i];
+    state.diameter[i] = drawn.empty() ? species[sp].diameter : drawn[sp][next_drawn[sp]++];
+    state.mass[i] = species[sp].mass;
   }
+  if (!drawn.empty() && lattice == nullptr) sort_by_diameter(state);  // the largest inserted first
   if (lattice != nullptr) {
     place_on_lattice(layout, state);
   } else {

@@ -58,6 +58,11 @@ struct InitialState {
 template <int D>
 double packing_fraction(const InitialState<D>& state);
 
+// The densest packing fraction random insertion is asked for (it jams a little above); a run
+// asking for more with lattice = "random" inserts at this and grows the particles to its
+// packing fraction (run/compression.hpp).
+double random_insertion_limit(int dimension);
+
 // Builds positions, species, diameters and masses from config.system (lattice or random
 // insertion) and Maxwell-Boltzmann velocities at config.system.temperature.
 //

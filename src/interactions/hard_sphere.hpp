@@ -5,6 +5,8 @@
 // new interaction supplies the same two functions.
 #pragma once
 
+#include <cmath>
+
 #include "dynamics/collision_time.hpp"
 
 namespace kairos {
@@ -19,6 +21,14 @@ struct HardSphere {
   // centres. Written with r instead of the unit normal to avoid a square root.
   static double impulse_factor(double g_dot_r, double r2, double reduced_mass) {
     return -2.0 * reduced_mass * g_dot_r / r2;
+  }
+
+  // Growing spheres (Lubachevsky-Stillinger): the contact distance grows at u, so the pair
+  // leaves the contact as fast, relative to the growing surfaces, as it came:
+  // g_n - u -> -(g_n - u), i.e. s = -2 mu (g.r - u |r|) / r^2. The kinetic energy grows by the
+  // work of the growth (docs/physics.md#growing-spheres).
+  static double growing_impulse_factor(double g_dot_r, double r2, double reduced_mass, double u) {
+    return -2.0 * reduced_mass * (g_dot_r - u * std::sqrt(r2)) / r2;
   }
 };
 

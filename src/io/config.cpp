@@ -83,6 +83,8 @@ class Reader : public KeyReader {
     resolve_interval_unit(section(root, "output", empty), config.run, config.output);
     read_group(section(root, "analysis", empty), "analysis", analysis_keys(), &config.analysis,
                nullptr);
+    read_group(section(root, "compress", empty), "compress", compress_keys(), &config.compress,
+               nullptr);
     read_potentials(root, config.system.species, config.potentials);
     read_bonds(root, config.bonds);
     if (root.contains("soft")) {
@@ -93,6 +95,7 @@ class Reader : public KeyReader {
     check_wall_masses(root, config);
     check_container(root, config);
     check_outlet(root, config);
+    check_compress(root, config);
     check_trajectory_keys(root, config);
     if (config.system.chain_length > 0 && config.bonds.empty()) {
       fail(nullptr, "system.chain_length",
@@ -121,6 +124,37 @@ class Reader : public KeyReader {
 
   // ----- sections
 
+  // system.size_distribution and system.polydispersity: both or neither, within the range the
+  // distribution keeps positive diameters in.
+  void check_size_distribution(const toml::table& t, const SystemConfig& s) const {
+    const SizeDistribution kind = size_distributions().at(s.size_distribution);
+    const toml::node* n = t.get("polydispersity");
+    if (kind == SizeDistribution::kNone) {
+      if (s.polydispersity != 0.0)
+        fail(n, "system.polydispersity",
+             "system.polydispersity: set system.size_distribution (uniform, gaussian or "
+             "lognormal) for it to act");
+      return;
+    }
+    const double limit = kind == SizeDistribution::kUniform    ? 1.0 / std::sqrt(3.0)
+                         : kind == SizeDistribution::kGaussian ? 0.3
+                                                               : 1.0;
+    if (!(s.polydispersity > 0.0) || !(s.polydispersity < limit)) {
+      fail(n != nullptr ? n : t.get("size_distribution"), "system.polydispersity",
+           fmt::format("system.polydispersity = {} is outside (0, {:.4g}) for "
+                       "size_distribution = \"{}\"{}",
+                       s.polydispersity, limit, s.size_distribution,
+                       kind == SizeDistribution::kUniform
+                           ? " (the smallest diameter would not be positive)"
+                       : kind == SizeDistribution::kGaussian
+                           ? " (a wider normal would be cut much at 0 and 2 d)"
+                           : ""));
+    }
+    if (s.chain_length > 0)
+      fail(n, "system.size_distribution",
+           "system.size_distribution: chains are built of equal beads");
+  }
+
   void read_system(const toml::table& t, SystemConfig& s) const {
     read_group(t, "system", system_keys(), &s, &s.dimension);
     const toml::node* n_particles = t.get("particles");
@@ -133,6 +167,7 @@ class Reader : public KeyReader {
            "system.chain_length: a chain needs at least 2 beads (0: no chains)");
     }
     read_species(t, s.species);
+    check_size_distribution(t, s);
 
     const bool from_file = !s.initial_state.empty();
     if (!from_file) {
@@ -865,6 +900,31 @@ class Reader : public KeyReader {
     if (c.analysis.mutual_diffusion) conflict("analysis.mutual_diffusion", why);
   }
 
+  // [compress] (docs/physics.md#growing-spheres): a target, and a periodic box of hard cores.
+  void check_compress(const toml::table& root, const Config& c) const {
+    const CompressConfig& k = c.compress;
+    if (root.contains("compress") && !k.on()) {
+      fail(node_at(root, "compress"), "compress",
+           "compress: give what to grow to: compress.packing_fraction, compress.pressure or "
+           "compress.jammed = true");
+    }
+    if (!k.on()) return;
+    const auto conflict = [&](std::string_view other, std::string_view why) {
+      const toml::node* n = node_at(root, other);
+      fail(n != nullptr ? n : node_at(root, "compress"), std::string(other),
+           fmt::format("{}: compression ([compress]) cannot be combined with {} ({})", other, other,
+                       why));
+    };
+    if (const auto obstacle = compression_obstacle(c)) conflict(obstacle->key, obstacle->why);
+    if (k.packing_fraction > 0.0 && c.system.initial_state.empty() &&
+        !(k.packing_fraction > c.system.packing_fraction)) {
+      fail(node_at(root, "compress.packing_fraction"), "compress.packing_fraction",
+           fmt::format("compress.packing_fraction = {} is not above system.packing_fraction = {}: "
+                       "compression only grows the particles",
+                       k.packing_fraction, c.system.packing_fraction));
+    }
+  }
+
   // What a wall with mass (a lid, a container) cannot be combined with (yet), each passed to
   // conflict(key, why), which names the wall's own key.
   template <class Conflict>
@@ -1312,6 +1372,27 @@ class Reader : public KeyReader {
 };
 
 }  // namespace
+
+std::optional<TransportObstacle> compression_obstacle(const Config& c) {
+  const auto refuse = [](std::string key, std::string why) {
+    return TransportObstacle{std::move(key), std::move(why)};
+  };
+  const char* box = "the particles grow in a periodic box";
+  if (!c.boundary.walls.empty()) return refuse("boundary.wall", box);
+  if (!c.boundary.planes.empty()) return refuse("boundary.plane", box);
+  if (!c.boundary.cylinders.empty()) return refuse("boundary.cylinder", box);
+  if (!c.boundary.spheres.empty()) return refuse("boundary.sphere", box);
+  if (!c.boundary.open.empty()) return refuse("boundary.open", box);
+  if (c.boundary.shear_rate != 0.0) return refuse("boundary.shear_rate", box);
+  if (std::any_of(c.field.gravity.begin(), c.field.gravity.end(),
+                  [](double g) { return g != 0.0; }))
+    return refuse("field.gravity", box);
+  if (!c.bonds.empty() || c.system.chain_length > 0)
+    return refuse("bond", "bonded particles would stretch their bonds as they grow");
+  for (const SpeciesConfig& sp : c.system.species)
+    if (sp.fixed) return refuse("system.species.fixed", "fixed grains cannot be pushed aside");
+  return std::nullopt;
+}
 
 std::optional<TransportObstacle> transport_obstacle(const Config& c) {
   const auto refuse = [](std::string key, std::string why) {

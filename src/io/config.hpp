@@ -58,6 +58,10 @@ struct SystemConfig {
   // spacing chain_spacing (0: the largest diameter) along a snake path. Bonds use [bond].
   std::uint64_t chain_length = 0;
   double chain_spacing = 0.0;
+  // Per-particle diameters (docs/config.md): each particle's species diameter times a factor of
+  // mean 1 and relative standard deviation `polydispersity`, drawn from this distribution.
+  std::string size_distribution = "none";  // none | uniform | gaussian | lognormal
+  double polydispersity = 0.0;
 
   bool operator==(const SystemConfig&) const = default;
 };
@@ -352,6 +356,23 @@ struct SoftConfig {
   bool operator==(const SoftConfig&) const = default;
 };
 
+// [compress]: before the run, the particles of a generated start grow (Lubachevsky-Stillinger,
+// docs/physics.md#growing-spheres) until a packing fraction, a reduced pressure or jamming.
+struct CompressConfig {
+  double packing_fraction = 0.0;  // grow to this packing fraction (0: no such target)
+  double pressure = 0.0;          // until the reduced pressure Z = PV/(NkT) reaches this (0: none)
+  bool jammed = false;            // until jammed (Z above jammed_pressure)
+  double growth_rate = 0.01;      // d sigma / dt over the starting diameter
+  double thermostat_interval = 10.0;  // collisions per particle between velocity rescalings
+  double jammed_pressure = 1e12;
+  double slowdown_pressure = 100.0;  // above it the growth slows as sqrt(slowdown / Z) (0: never)
+  double slowdown_floor = 0.1;       // ... to at least this fraction of growth_rate
+  double contact_gap = 0.0;          // contact network: relative gap tolerance (0: 1e4 / Z)
+
+  bool on() const { return packing_fraction > 0.0 || pressure > 0.0 || jammed; }
+  bool operator==(const CompressConfig&) const = default;
+};
+
 struct Config {
   SystemConfig system;
   std::vector<PairPotentialConfig> potentials;  // [[potential]]
@@ -364,6 +385,7 @@ struct Config {
   DrivingConfig driving;           // [driving]
   SoftConfig soft;                 // [soft]
   AnalysisConfig analysis;         // [analysis]
+  CompressConfig compress;         // [compress]
 
   bool operator==(const Config&) const = default;  // memberwise (exact doubles)
 };
@@ -397,6 +419,10 @@ struct TransportObstacle {
   std::string key, why;
 };
 std::optional<TransportObstacle> transport_obstacle(const Config& config);
+
+// What keeps a start state from being grown (compression, run/compression.hpp: a periodic box
+// of hard cores): the first obstacle by its key and why; nothing when it can be.
+std::optional<TransportObstacle> compression_obstacle(const Config& config);
 
 // Default lattice for a dimension: "fcc" in 3D, "hex" in 2D; std::invalid_argument otherwise.
 std::string default_lattice(int dimension);

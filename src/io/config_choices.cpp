@@ -83,6 +83,14 @@ constexpr ChoiceEntry<MsdTime> kMsdTimes[] = {
     {"time", MsdTime::kTime, "simulated time"},
     {"collisions", MsdTime::kCollisions, "collisions per particle"},
 };
+constexpr ChoiceEntry<SizeDistribution> kSizeDistributions[] = {
+    {"none", SizeDistribution::kNone, "every particle has its species' diameter"},
+    {"uniform", SizeDistribution::kUniform, "uniform on [1 - sqrt(3) p, 1 + sqrt(3) p] d"},
+    {"gaussian", SizeDistribution::kGaussian,
+     "normal, mean d, standard deviation p d, cut to (0, 2d)"},
+    {"lognormal", SizeDistribution::kLognormal,
+     "log-normal with mean d and standard deviation p d"},
+};
 constexpr ChoiceEntry<BoxFace> kFaces[] = {
     {"x-", BoxFace::kXLow, "x = 0"},      {"x+", BoxFace::kXHigh, "x = L_x"},
     {"y-", BoxFace::kYLow, "y = 0"},      {"y+", BoxFace::kYHigh, "y = L_y"},
@@ -165,6 +173,11 @@ const Choices<SoftCollisions>& soft_collision_modes() {
 
 const Choices<MsdTime>& msd_time_scales() {
   static constexpr Choices<MsdTime> choices("MSD time scale", kMsdTimes);
+  return choices;
+}
+
+const Choices<SizeDistribution>& size_distributions() {
+  static constexpr Choices<SizeDistribution> choices("size distribution", kSizeDistributions);
   return choices;
 }
 

@@ -38,6 +38,8 @@ enum class BoxFace { kXLow, kXHigh, kYLow, kYHigh, kZLow, kZHigh };
 enum class Axis { kX, kY, kZ };
 // analysis.msd_time: the MSD's clock (auto: collisions for a freely cooling gas, else time).
 enum class MsdTime { kAuto, kTime, kCollisions };
+// system.size_distribution: per-particle diameters about each species' diameter.
+enum class SizeDistribution { kNone, kUniform, kGaussian, kLognormal };
 
 // system.lattice in a 3D or 2D box (dimension 2 or 3).
 const Choices<Lattice>& lattices(int dimension);
@@ -55,7 +57,8 @@ const Choices<TrajectoryPhases>& trajectory_phases();
 const Choices<TrajectoryPrecision>& trajectory_precisions();
 const Choices<TrajectorySpacing>& trajectory_spacings();
 const Choices<TrajectoryField>& trajectory_fields();
-const Choices<MsdTime>& msd_time_scales();  // analysis.msd_time
+const Choices<MsdTime>& msd_time_scales();              // analysis.msd_time
+const Choices<SizeDistribution>& size_distributions();  // system.size_distribution
 // boundary.wall[].face and boundary.open: the faces of a box of `dimension` (2 or 3), or all
 // six (dimension 0).
 const Choices<BoxFace>& box_faces(int dimension = 0);

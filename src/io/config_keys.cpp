@@ -96,6 +96,16 @@ constexpr KeyDecl kSystem[] = {
      .type = KeyType::kUnsigned,
      .member = field<&SystemConfig::seed>,
      .doc = "seeds all randomness of the run"},
+    {.name = "size_distribution",
+     .type = KeyType::kString,
+     .member = field<&SystemConfig::size_distribution>,
+     .choices = &choices_of<&size_distributions>,
+     .doc = "per-particle diameters: the species' diameter times a factor of mean 1"},
+    {.name = "polydispersity",
+     .type = KeyType::kFloat,
+     .member = field<&SystemConfig::polydispersity>,
+     .range = by_rule({.lo = 0.0, .hi = 1.0}),
+     .doc = "the relative standard deviation of the diameters (size_distribution)"},
     {.name = "initial_state",
      .type = KeyType::kString,
      .member = field<&SystemConfig::initial_state>,
@@ -685,6 +695,58 @@ constexpr KeyDecl kOutput[] = {
 
 // ----- [analysis]
 
+const CompressConfig kCompressDefaults{};
+constexpr KeyDecl kCompress[] = {
+    {.name = "packing_fraction",
+     .type = KeyType::kFloat,
+     .member = field<&CompressConfig::packing_fraction>,
+     .range = {.lo = 0.0, .hi = 1.0, .hi_open = true},
+     .doc = "grow until this packing fraction (0: no such target)"},
+    {.name = "pressure",
+     .type = KeyType::kFloat,
+     .member = field<&CompressConfig::pressure>,
+     .range = up_to(1e15, Scale::kNone),
+     .doc = "grow until the reduced pressure Z = PV/(NkT) reaches this (0: no such target)"},
+    {.name = "jammed",
+     .type = KeyType::kBoolean,
+     .member = field<&CompressConfig::jammed>,
+     .doc = "grow until jammed (Z above jammed_pressure)"},
+    {.name = "growth_rate",
+     .type = KeyType::kFloat,
+     .member = field<&CompressConfig::growth_rate>,
+     .range = {.lo = 1e-9, .hi = 10.0},
+     .unit = "per unit time",
+     .doc = "d sigma / dt over the starting diameter (diameters grow linearly)"},
+    {.name = "thermostat_interval",
+     .type = KeyType::kFloat,
+     .member = field<&CompressConfig::thermostat_interval>,
+     .range = {.lo = 1e-3, .hi = 1e6},
+     .unit = "collisions per particle",
+     .doc = "between rescalings of the velocities to system.temperature"},
+    {.name = "jammed_pressure",
+     .type = KeyType::kFloat,
+     .member = field<&CompressConfig::jammed_pressure>,
+     .range = {.lo = 10.0, .hi = 1e15},
+     .doc = "the reduced pressure above which the packing is jammed"},
+    {.name = "slowdown_pressure",
+     .type = KeyType::kFloat,
+     .member = field<&CompressConfig::slowdown_pressure>,
+     .range = up_to(1e15, Scale::kNone),
+     .doc = "above this reduced pressure the growth slows as sqrt(slowdown_pressure / Z), so "
+            "that loose regions settle before jamming (0: never)"},
+    {.name = "slowdown_floor",
+     .type = KeyType::kFloat,
+     .member = field<&CompressConfig::slowdown_floor>,
+     .range = {.lo = 1e-6, .hi = 1.0},
+     .doc = "the slowest growth, as a fraction of growth_rate"},
+    {.name = "contact_gap",
+     .type = KeyType::kFloat,
+     .member = field<&CompressConfig::contact_gap>,
+     .range = up_to(0.1, Scale::kNone),
+     .doc = "contact network: pairs closer than this gap over their contact distance touch "
+            "(0: 1e4 / Z, Z the final reduced pressure)"},
+};
+
 const AnalysisConfig kAnalysisDefaults{};
 constexpr KeyDecl kAnalysis[] = {
     {.name = "msd",
@@ -1133,6 +1195,7 @@ constexpr KeyGroup kSpringDashpotGroup{"spring_dashpot", kSpringDashpot, &kPoten
 constexpr KeyGroup kSoftLawGroup{"soft law", kSoftLaw, &kSoftLawDefaults};
 constexpr KeyGroup kSoftGroup{"soft", kSoft, &kSoftDefaults};
 constexpr KeyGroup kAnalysisGroup{"analysis", kAnalysis, &kAnalysisDefaults};
+constexpr KeyGroup kCompressGroup{"compress", kCompress, &kCompressDefaults};
 constexpr KeyGroup kPairSpeciesGroup{"pair", kPairSpecies, nullptr};
 constexpr KeyGroup kPotentialSpeciesGroup{"potential species", kPotentialSpecies, nullptr};
 constexpr KeyGroup kWallFaceGroup{"wall face", kWallFace, nullptr};
@@ -1185,6 +1248,7 @@ std::vector<DeclaredKey> build() {
       {"soft.pair", KeyType::kTableArray, {{&kPairSpeciesGroup}, {&kSoftLawGroup, "soft"}}},
       {"output", KeyType::kTable, {{&kOutputGroup}}},
       {"analysis", KeyType::kTable, {{&kAnalysisGroup}}},
+      {"compress", KeyType::kTable, {{&kCompressGroup}}},
   };
   std::vector<DeclaredKey> out, last;
   for (const Placement& p : placements) {
@@ -1348,6 +1412,9 @@ const KeyGroup& soft_keys() {
 }
 const KeyGroup& analysis_keys() {
   return kAnalysisGroup;
+}
+const KeyGroup& compress_keys() {
+  return kCompressGroup;
 }
 
 std::string type_text(const KeyDecl& d) {

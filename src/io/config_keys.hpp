@@ -198,6 +198,7 @@ const KeyGroup& spring_dashpot_keys();  // [[potential]] with kind = "spring_das
 const KeyGroup& soft_law_keys();        // [soft] and [[soft.pair]]
 const KeyGroup& soft_keys();            // [soft] alone
 const KeyGroup& analysis_keys();        // [analysis]
+const KeyGroup& compress_keys();        // [compress]
 
 // How docs/config.md writes a key's type, default and range ("float", "`1.0`", "in [0, 1]").
 std::string type_text(const KeyDecl& decl);

@@ -182,6 +182,8 @@ std::string to_toml(const Config& config) {
   // wrote before [analysis] existed.
   if (config.analysis != AnalysisConfig{})
     out += table("analysis", analysis_keys(), &config.analysis);
+  if (config.compress != CompressConfig{})
+    out += table("compress", compress_keys(), &config.compress);
   return out;
 }
 

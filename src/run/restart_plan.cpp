@@ -75,6 +75,8 @@ constexpr std::array<std::string_view, 7> kWallLaw = {
 
 Effect effect_of(const std::string& key) {
   const std::string k = generic(key);
+  // Compression builds a fresh start; a continued run does not compress again.
+  if (starts_with(k, "compress.")) return Effect::kIgnore;
   if (k == "system.dimension") return Effect::kRefuse;
   if (starts_with(k, "system.species.")) {
     if (k == "system.species.inertia_factor") return Effect::kResume;  // a contact law's

@@ -43,6 +43,11 @@ RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& res
   resumed_ = start.resumed;
   plan_ = start.plan;
   const std::string restart_name = start.restart_name();
+  SetupOutcome<D> setup;
+  if (start.compression) {
+    setup.compression = std::make_shared<const CompressionReport>(std::move(*start.compression));
+    setup.packing = std::make_shared<const ParticleSystem<D>>(start.state);
+  }
   // Soft spheres: the lookup tables of the collision map, built now or read from the cache.
   const bool tell = progress_modes().at(config_.output.progress) != ProgressMode::kOff;
   std::string building;
@@ -74,7 +79,7 @@ RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& res
   directory_.emplace(config_.output.directory, lineage, options.overwrite);
   // The effective configuration (after a restart, the configuration as run).
   write_text_atomically(directory_->path() / "config.toml", to_toml(config_));
-  observers_ = make_observers<D>(config_, *integrator_);
+  observers_ = make_observers<D>(config_, *integrator_, setup);
 }
 
 template <int D>

@@ -113,8 +113,17 @@ auto named_restart_errors(const RunStart<D>& start, Make&& make) {
 template <int D>
 RunStart<D> start_run(const Config& config, const std::optional<fs::path>& restart_file,
                       std::string_view integrator) {
-  RunStart<D> start{config, restart_file, {}, {}, std::mt19937_64(config.system.seed), {}};
+  RunStart<D> start{config, restart_file, {}, {}, std::mt19937_64(config.system.seed), {}, {}};
   start.state = build_start_state<D>(config, restart_file, start.rng, start.resumed);
+  if (!restart_file) {
+    CompressConfig compress = config.compress;
+    if (!compress.on() && grows_random_start(config))
+      compress.packing_fraction = config.system.packing_fraction;
+    if (compress.on()) {
+      const bool tell = progress_modes().at(config.output.progress) != ProgressMode::kOff;
+      start.compression = compress_start<D>(start.state, compress, config.system.temperature, tell);
+    }
+  }
   check_restart_integrator(restart_file, start.resumed, integrator);
   if (restart_file) {
     start.plan = plan_continuation<D>(config, start.state, start.resumed, restart_file->string());

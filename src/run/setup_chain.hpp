@@ -24,6 +24,7 @@
 #include "core/particle_system.hpp"
 #include "io/config.hpp"
 #include "model/environment.hpp"
+#include "run/compression.hpp"
 #include "run/integrator.hpp"
 #include "run/restart_plan.hpp"
 #include "run/run_progress.hpp"
@@ -42,6 +43,8 @@ struct RunStart {
   std::optional<RestartPlan> plan;  // a restart: how it uses the changed configuration
   std::mt19937_64 rng;              // the run's RNG, after drawing the start state
   ParticleSystem<D> state;
+  // A new run's compression ([compress], or a random start denser than insertion reaches).
+  std::optional<CompressionReport> compression;
 
   bool restarted() const { return restart_file.has_value(); }
   // A restart whose stored predictions stay valid: continued bit-identically.

@@ -274,6 +274,12 @@ void move_inside_walls(const Config& config, ParticleSystem<D>& s, std::mt19937_
 
 }  // namespace
 
+bool grows_random_start(const Config& config) {
+  const SystemConfig& s = config.system;
+  return s.initial_state.empty() && s.lattice == "random" && !compression_obstacle(config) &&
+         s.packing_fraction > random_insertion_limit(s.dimension);
+}
+
 template <int D>
 ParticleSystem<D> build_start_state(const Config& config,
                                     const std::optional<fs::path>& restart_file,
@@ -342,7 +348,10 @@ ParticleSystem<D> build_start_state(const Config& config,
     }
     return to_particle_system<D>(std::move(init));
   }
-  InitialState<D> init = make_initial_state<D>(config.system, rng, kind);
+  // Denser than random insertion reaches: inserted at its limit, grown by start_run.
+  SystemConfig system = config.system;
+  if (grows_random_start(config)) system.packing_fraction = random_insertion_limit(D);
+  InitialState<D> init = make_initial_state<D>(system, rng, kind);
   std::array<bool, D> periodic;
   periodic.fill(true);  // generated in a periodic box; make_room_for_walls then adds the gaps
   // A lattice at its close packing has its neighbours in contact to within round-off.

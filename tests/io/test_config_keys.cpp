@@ -116,6 +116,9 @@ std::string concrete(const std::string& path) {
 
 std::string base_for(const std::string& path) {
   if (path.starts_with("soft") || path == "run.time_step") return std::string(kEveryTableSoft);
+  // Compression grows in a periodic box; it needs a target (two, so either may be unset).
+  if (path.starts_with("compress."))
+    return std::string(kMinimal) + "\n[compress]\njammed = true\npressure = 1e6\n";
   // An analysis's own keys act only with that analysis on; those of log-spaced frames with
   // them.
   const bool analysis = path.starts_with("analysis.");

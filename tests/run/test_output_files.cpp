@@ -30,7 +30,8 @@ TEST(OutputFiles, EveryFileARunWritesIsListed) {
       dir.string() +
       "\"\n"
       "[analysis]\nmsd = true\nvacf = true\ntransport = true\nrdf = true\n"
-      "structure_factor = true\nbond_order = true\nvelocity_distribution = true\n";
+      "structure_factor = true\nbond_order = true\nvelocity_distribution = true\n"
+      "[compress]\npacking_fraction = 0.31\n";
   const RunOutcome outcome = run_simulation(parse_config(text, "<test>"));
   ASSERT_TRUE(outcome.error.empty()) << outcome.error;
   const auto& listed = output_file_names();

@@ -5,6 +5,7 @@
 #include "run/dem_adapter.hpp"
 #include "run/event_adapter.hpp"
 #include "run/outputs/bond_order_output.hpp"
+#include "run/outputs/compression_output.hpp"
 #include "run/outputs/dem_summary.hpp"
 #include "run/outputs/event_summary.hpp"
 #include "run/outputs/granular_summary.hpp"
@@ -41,8 +42,10 @@ T& add(ObserverList<D>& list, Args&&... args) {
 // `config`: for an output registered only under some configuration (every one here decides for
 // itself at open(), so that summary.json lists a file an earlier run left).
 template <int D>
-ObserverList<D> make_observers(const Config& config, const Integrator<D>& integrator) {
+ObserverList<D> make_observers(const Config& config, const Integrator<D>& integrator,
+                               const SetupOutcome<D>& setup) {
   ObserverList<D> list;
+  if (setup.compression) add<CompressionOutput<D>>(list, setup.compression, setup.packing);
   // The order matters where one output records another: the row and the frame due at one
   // moment come before the restart file that records them, and every file before summary.json.
   const ThermoOutput<D>& thermo = add<ThermoOutput<D>>(list);
@@ -90,11 +93,16 @@ const std::vector<std::string>& output_file_names() {
                                                  "rdf.tsv",
                                                  "sk.tsv",
                                                  "bond_order.tsv",
-                                                 "velocity_distribution.tsv"};
+                                                 "velocity_distribution.tsv",
+                                                 "compress.tsv",
+                                                 "packing.gsd",
+                                                 "contacts.tsv"};
   return names;
 }
 
-template ObserverList<2> make_observers<2>(const Config&, const Integrator<2>&);
-template ObserverList<3> make_observers<3>(const Config&, const Integrator<3>&);
+template ObserverList<2> make_observers<2>(const Config&, const Integrator<2>&,
+                                           const SetupOutcome<2>&);
+template ObserverList<3> make_observers<3>(const Config&, const Integrator<3>&,
+                                           const SetupOutcome<3>&);
 
 }  // namespace kairos

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "io/config.hpp"
+#include "run/compression.hpp"
 #include "run/integrator.hpp"
 #include "run/outputs/observer.hpp"
 
@@ -16,9 +17,17 @@ namespace kairos {
 template <int D>
 using ObserverList = std::vector<std::unique_ptr<Observer<D>>>;
 
+// What a new run's setup did that its outputs report: its compression, and the packing it left.
+template <int D>
+struct SetupOutcome {
+  std::shared_ptr<const CompressionReport> compression;  // null: none
+  std::shared_ptr<const ParticleSystem<D>> packing;
+};
+
 // The observers of a run of `config` by `integrator` (which they read; it outlives them).
 template <int D>
-ObserverList<D> make_observers(const Config& config, const Integrator<D>& integrator);
+ObserverList<D> make_observers(const Config& config, const Integrator<D>& integrator,
+                               const SetupOutcome<D>& setup = {});
 
 // Every file an output or analysis of make_observers may write into the output directory,
 // whatever the configuration (an earlier run's may have had others): the files the

@@ -1,0 +1,115 @@
+#!/usr/bin/env python3
+"""Draws a compression (docs/outputs.md, "Compression"): the reduced pressure against the packing
+fraction from compress.tsv, with the free-volume law Z = D / (1 - phi / phi_J) and, in 3D, the
+fluid's equation of state (Kolafa, Labik and Malijevsky, PCCP 6, 2335 (2004)); and the packing
+of packing.gsd with its contact network from contacts.tsv (2D: every disk; 3D: a slab through the
+middle of the box). Rattlers are drawn open.
+
+  examples/plot/plot_compression.py OUTDIR [-o compress.png]
+"""
+
+import argparse
+import json
+import os
+
+import gsd.hoomd
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+KLM = [1, 4, 6, 2.3647684, -0.8698551, 1.1062803, -1.1014221, 0.66605866, -0.03633431, 0,
+       -0.20965164, 0, 0, 0, 0.10555569, 0, 0, 0, 0, 0, 0, 0, -0.00872380]
+
+
+def klm_pressure(eta):
+    x = eta / (1.0 - eta)
+    return sum(c * x**k for k, c in enumerate(KLM))
+
+
+def read_rows(path):
+    rows = np.loadtxt(path, comments="#", ndmin=2)
+    return rows[:, 1], rows[:, 2]
+
+
+def read_contacts(path):
+    pairs, rattler = [], set()
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#"):
+                continue
+            i, j, _, ri, rj = line.split()
+            pairs.append((int(i), int(j)))
+            if ri == "1":
+                rattler.add(int(i))
+            if rj == "1":
+                rattler.add(int(j))
+    return pairs, rattler
+
+
+def draw_pressure(ax, out, dimension, summary):
+    phi, z = read_rows(os.path.join(out, "compress.tsv"))
+    ax.semilogy(phi, z, ".", ms=2, label="Kairos, per thermostat interval")
+    c = summary.get("compression", {})
+    phi_j = c.get("free_volume_jamming_density")
+    if phi_j:
+        grid = np.linspace(max(phi.min(), 0.5 * phi_j), phi_j * (1 - 1e-12), 400)
+        ax.semilogy(grid, dimension / (1 - grid / phi_j), "k--", lw=1,
+                    label=f"free volume, $\\varphi_J$ = {phi_j:.4f}")
+    if dimension == 3:
+        grid = np.linspace(phi.min(), min(0.55, phi.max()), 200)
+        ax.semilogy(grid, [klm_pressure(e) for e in grid], "r-", lw=1, label="fluid (KLM)")
+    ax.set_xlabel("packing fraction $\\varphi$")
+    ax.set_ylabel("reduced pressure $Z = PV/NkT$")
+    ax.legend(fontsize=8)
+
+
+def draw_packing(ax, out, dimension):
+    frame = gsd.hoomd.open(os.path.join(out, "packing.gsd"))[0]
+    box = frame.configuration.box[:dimension]
+    x = frame.particles.position[:, :dimension] + 0.5 * box  # HOOMD's box is centred
+    d = frame.particles.diameter
+    pairs, rattler = read_contacts(os.path.join(out, "contacts.tsv"))
+    shown = np.ones(len(d), bool)
+    if dimension == 3:
+        z = frame.particles.position[:, 2]
+        shown = np.abs(z) < 0.75 * d.max()
+    for i in np.nonzero(shown)[0]:
+        open_circle = i in rattler
+        ax.add_patch(plt.Circle(x[i], 0.5 * d[i], fill=not open_circle, lw=0.5,
+                                fc="#9ecae1", ec="#08519c" if not open_circle else "r"))
+    for i, j in pairs:
+        if not (shown[i] and shown[j]):
+            continue
+        r = x[j] - x[i]
+        r -= box * np.round(r / box)
+        ax.plot([x[i][0], x[i][0] + r[0]], [x[i][1], x[i][1] + r[1]], "k-", lw=0.6)
+    ax.set_xlim(0, box[0])
+    ax.set_ylim(0, box[1])
+    ax.set_aspect("equal")
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.set_title("packing and contacts" + (" (slab |z| < 0.75 d)" if dimension == 3 else "")
+                 + ", rattlers red", fontsize=9)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", help="the run's output directory")
+    parser.add_argument("-o", "--output", help="PNG file (default OUT/compress.png)")
+    args = parser.parse_args()
+    with open(os.path.join(args.out, "summary.json")) as f:
+        summary = json.load(f)
+    dimension = summary["dimension"]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5))
+    draw_pressure(axes[0], args.out, dimension, summary)
+    draw_packing(axes[1], args.out, dimension)
+    fig.tight_layout()
+    target = args.output or os.path.join(args.out, "compress.png")
+    fig.savefig(target, dpi=110)
+    print(target)
+
+
+if __name__ == "__main__":
+    main()

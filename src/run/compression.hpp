@@ -1,0 +1,88 @@
+// Compression by growth (Lubachevsky-Stillinger; docs/physics.md#growing-spheres): every diameter
+// grows as sigma_i(t) = sigma_i(0) (1 + rate t) in a periodic box of elastic hard spheres, the
+// velocities are rescaled to a set temperature at intervals, and the run stops at a target
+// packing fraction, a target reduced pressure, or when the packing jams (the reduced pressure
+// above a threshold). The event engine moves the particles (EngineOptions::growth_rate); this
+// protocol owns the rescalings, the pressure per interval, the stopping rules, and rebuilds the
+// engine with wider cells when the grown particles no longer fit its cells.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "analysis/contact_network.hpp"
+#include "core/particle_system.hpp"
+#include "io/config.hpp"
+
+namespace kairos {
+
+struct CompressionSettings {
+  double growth_rate = 0.01;             // relative growth of the starting diameters per unit time
+  double temperature = 1.0;              // kT the velocities are rescaled to
+  double thermostat_interval = 10.0;     // collisions per particle between rescalings
+  double target_packing_fraction = 0.0;  // stop there (0: no target)
+  double target_pressure = 0.0;          // stop at this reduced pressure Z = PV/(NkT) (0: none)
+  double jammed_pressure = 1e12;         // jammed: Z above this
+  // Above this reduced pressure the growth slows as sqrt(slowdown_pressure / Z) (0: never):
+  // near jamming, loose regions need time to settle before the growth closes their gaps, or
+  // the packing jams with fewer contacts than isostatic.
+  double slowdown_pressure = 100.0;
+  double slowdown_floor = 0.1;  // ... down to this fraction of growth_rate
+  double cell_margin = 0.1;     // cells this fraction wider than the largest diameter: growth room
+};
+
+// One thermostat interval: the moment of its rescaling and what it measured.
+struct CompressionRow {
+  double time = 0.0;              // compression time at the interval's end
+  double packing_fraction = 0.0;  // at its end
+  double pressure = 0.0;          // reduced pressure Z = PV/(NkT) over the interval
+  double temperature = 0.0;       // kT at its end, before the rescaling
+  std::uint64_t collisions = 0;   // since the compression began
+};
+
+struct CompressionResult {
+  std::vector<CompressionRow> rows;
+  std::string stop_reason;  // "packing_fraction", "pressure" or "jammed"
+  double packing_fraction = 0.0;
+  double pressure = 0.0;  // the last interval's (0 if it ended before the first)
+  double time = 0.0;
+  std::uint64_t collisions = 0;
+  std::uint64_t rebuilds = 0;  // engines built with wider cells after the first
+  std::uint64_t rescalings = 0;
+  double initial_packing_fraction = 0.0;
+};
+
+// Sum of the particle volumes over the box volume.
+template <int D>
+double state_packing_fraction(const ParticleSystem<D>& state);
+
+// Grows the particles of `state` (a periodic box; the start state of a run) until a stop rule
+// holds. The state comes back as a fresh start: positions and velocities at time 0, grown
+// radii, no scheduler state, counters zero, velocities at `temperature`. InputError for a
+// system growth cannot run (walls, a target below the start) or bad settings; polls the stop
+// flag at every interval (Interrupted). `row` sees each interval as it ends.
+template <int D>
+CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& settings,
+                           const std::function<void(const CompressionRow&)>& row = {});
+
+// A run's compression ([compress]): what it was asked, what it did, and the contact network
+// of the packing it left (docs/outputs.md, "Compression").
+struct CompressionReport {
+  CompressionSettings settings;
+  CompressionResult result;
+  ContactNetwork network;
+  double wall_seconds = 0.0;
+};
+
+// The settings of [compress] for a start at temperature kT.
+CompressionSettings compression_settings(const CompressConfig& config, double temperature);
+
+// Compresses the start state of a run as [compress] asks and analyses the packing. `tell`:
+// a line on stderr every ten seconds (a long compression is not silent).
+template <int D>
+CompressionReport compress_start(ParticleSystem<D>& state, const CompressConfig& config,
+                                 double temperature, bool tell);
+
+}  // namespace kairos

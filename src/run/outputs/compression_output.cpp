@@ -1,0 +1,89 @@
+#include "run/outputs/compression_output.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "io/atomic_file.hpp"
+#include "io/gsd_file.hpp"
+#include "io/gsd_snapshot.hpp"
+#include "run/outputs/summary_values.hpp"
+
+namespace kairos {
+
+template <int D>
+void CompressionOutput<D>::open(const RunContext<D>& run) {
+  const CompressionResult& r = report_->result;
+  std::string rows =
+      "# time\tpacking_fraction\treduced_pressure\tkT_before_rescaling\tcollisions\n";
+  for (const CompressionRow& row : r.rows) {
+    rows += fmt::format("{:.17g}\t{:.17g}\t{:.10g}\t{:.10g}\t{}\n", row.time, row.packing_fraction,
+                        row.pressure, row.temperature, row.collisions);
+  }
+  write_text_atomically(run.directory() / "compress.tsv", rows);
+
+  const ContactNetwork& net = report_->network;
+  std::string contacts = fmt::format(
+      "# contacts of the packing in packing.gsd: relative gap (r - sigma_ij) / sigma_ij below "
+      "{:.3g}; "
+      "rattler_i/j: 1 for a rattler (docs/outputs.md)\n# i\tj\tgap\trattler_i\trattler_j\n",
+      net.gap_tolerance);
+  for (const Contact& c : net.contacts) {
+    contacts += fmt::format("{}\t{}\t{:.6g}\t{}\t{}\n", c.i, c.j, c.gap, int{net.rattler[c.i]},
+                            int{net.rattler[c.j]});
+  }
+  write_text_atomically(run.directory() / "contacts.tsv", contacts);
+
+  TrajectoryLayout layout;
+  layout.double_precision = true;
+  replace_file_atomically(run.directory() / "packing.gsd", [&](const std::filesystem::path& tmp) {
+    auto w = gsd::Writer::create(tmp, "kairos " KAIROS_VERSION);
+    append_trajectory_frame(w, *packing_, layout);
+    w.close();
+  });
+}
+
+template <int D>
+void CompressionOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) const {
+  const CompressionResult& r = report_->result;
+  const CompressionSettings& s = report_->settings;
+  const ContactNetwork& net = report_->network;
+  nlohmann::json& c = summary["compression"];
+  c["stop_reason"] = r.stop_reason;
+  c["initial_packing_fraction"] = r.initial_packing_fraction;
+  c["packing_fraction"] = r.packing_fraction;
+  set_or_explain(summary, c, "reduced_pressure", r.pressure,
+                 r.rows.empty() ? "no thermostat interval ended during the compression" : "",
+                 "compression.reduced_pressure");
+  // The free-volume law p = D / (1 - phi / phi_J) (Salsburg and Wood 1962) read backwards:
+  // the jamming density the pressure points at (docs/physics.md#jammed-packings).
+  const double phi_j = r.packing_fraction / (1.0 - D / r.pressure);
+  set_or_explain(summary, c, "free_volume_jamming_density", phi_j,
+                 r.pressure > 100.0 ? "" : "the reduced pressure is below 100: far from jamming",
+                 "compression.free_volume_jamming_density");
+  c["growth_rate"] = s.growth_rate;
+  c["thermostat_interval"] = s.thermostat_interval;
+  c["time"] = r.time;
+  c["collisions"] = r.collisions;
+  c["rescalings"] = r.rescalings;
+  c["rebuilds"] = r.rebuilds;
+  c["wall_seconds"] = report_->wall_seconds;
+  nlohmann::json& k = c["contacts"];
+  k["gap_tolerance"] = net.gap_tolerance;
+  k["contacts"] = net.contacts.size();
+  k["coordination"] = net.coordination;
+  k["rattlers"] = net.rattlers;
+  k["rattler_fraction"] = net.rattler_fraction;
+  k["backbone_contacts"] = net.backbone_contacts;
+  k["backbone_coordination"] = net.backbone_coordination;
+  k["isostatic_excess"] = net.excess_contacts;
+  k["largest_contact_gap"] = net.largest_contact_gap;
+  set_or_explain(summary, k, "smallest_open_gap", net.smallest_open_gap,
+                 std::isfinite(net.smallest_open_gap) ? "" : "no open pair within 1.1 sigma",
+                 "compression.contacts.smallest_open_gap");
+}
+
+template class CompressionOutput<2>;
+template class CompressionOutput<3>;
+
+}  // namespace kairos

@@ -1,0 +1,35 @@
+// A new run's compression ([compress], docs/outputs.md "Compression"): compress.tsv (one row
+// per thermostat interval: time, packing fraction, reduced pressure, kT before the rescaling,
+// collisions), packing.gsd (the grown packing, the run's start, in float64: a start for any
+// other run), contacts.tsv (its contact network: pairs, gaps, rattlers) and summary.json's
+// `compression`. Written when the run opens: the compression happened in its setup.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/particle_system.hpp"
+#include "run/compression.hpp"
+#include "run/outputs/observer.hpp"
+
+namespace kairos {
+
+template <int D>
+class CompressionOutput final : public Observer<D> {
+ public:
+  // The report and the packing it left (copied before the run takes the state over).
+  CompressionOutput(std::shared_ptr<const CompressionReport> report,
+                    std::shared_ptr<const ParticleSystem<D>> packing)
+      : report_(std::move(report)), packing_(std::move(packing)) {}
+  std::string name() const override { return "compress.tsv"; }
+  std::vector<std::string> more_files() const override { return {"packing.gsd", "contacts.tsv"}; }
+  void open(const RunContext<D>& run) override;
+  void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
+
+ private:
+  std::shared_ptr<const CompressionReport> report_;
+  std::shared_ptr<const ParticleSystem<D>> packing_;
+};
+
+}  // namespace kairos

@@ -1,0 +1,118 @@
+// Growing particles (EngineOptions::growth_rate; docs/physics.md#growing-spheres): the engine's
+// schedule checked against brute force after every event while the particles grow, in 2D and
+// 3D, one size and two; momentum kept, energy only gained, radii exported as grown; what growth
+// refuses.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/error.hpp"
+#include "engine/event_engine.hpp"
+#include "engine_fixtures.hpp"
+#include "scheduler/calendar_queue.hpp"
+
+namespace kairos {
+namespace {
+
+using testing::lattice_system;
+
+template <int D>
+EngineOptions growing(double rate, const ParticleSystem<D>& s, double room) {
+  EngineOptions o;
+  o.growth_rate = rate;
+  double rmax = 0.0;
+  for (const auto& k : s.kinematics) rmax = std::max(rmax, k.radius);
+  o.min_cell_width = 2.0 * rmax * room;
+  return o;
+}
+
+// Runs until `events` events or the cells' limit; validates after each. Returns the engine's
+// time at the end.
+template <int D>
+double run_validated_growth(const ParticleSystem<D>& start, double rate, int events,
+                            double room = 1.2) {
+  const EngineOptions o = growing<D>(rate, start, room);
+  EventEngine<D, CalendarQueue> engine(start, StartMode::kPredict, o);
+  engine.validate();
+  const Vec<D> p0 = engine.momentum();
+  double energy = engine.kinetic_energy();
+  int e = 0;
+  for (; e < events && engine.next_event_time() < engine.growth_fits_until(); ++e) {
+    const std::uint64_t before = engine.counters().collisions;
+    engine.step();
+    engine.validate();
+    const double now = engine.kinetic_energy();
+    if (engine.counters().collisions > before) {
+      EXPECT_GT(now, energy) << "a growing collision gives energy";
+    } else {
+      EXPECT_EQ(now, energy);
+    }
+    energy = now;
+  }
+  EXPECT_GT(engine.counters().collisions, 100u);
+  for (int a = 0; a < D; ++a) EXPECT_NEAR(engine.momentum()[a], p0[a], 1e-11);
+  // Radii exported as grown, to the engine's time.
+  const ParticleSystem<D> out = engine.export_state();
+  const double scale = engine.growth().scale(engine.time());
+  for (std::size_t i = 0; i < out.size(); ++i)
+    EXPECT_DOUBLE_EQ(out.kinematics[i].radius, start.kinematics[i].radius * scale);
+  EXPECT_LT(engine.max_overlap_now(), 1e-12);  // touching pairs: round-off only
+  return engine.time();
+}
+
+TEST(Growth, ValidatedAgainstBruteForce3D) {
+  run_validated_growth<3>(lattice_system<3>(5, 0.3, 11), 0.05, 3000);
+}
+
+TEST(Growth, ValidatedAgainstBruteForce2D) {
+  run_validated_growth<2>(lattice_system<2>(9, 0.4, 12), 0.05, 3000);
+}
+
+TEST(Growth, ValidatedBinaryMixtureGrowingFast) {
+  // Diameter ratio 1.4, fast growth: pairs are often reached by the growth alone.
+  run_validated_growth<3>(lattice_system<3>(6, 0.2, 13, 1.0, 1.4), 0.5, 3000, 1.6);
+  run_validated_growth<2>(lattice_system<2>(10, 0.3, 14, 2.0, 1.4), 0.5, 3000, 1.6);
+}
+
+TEST(Growth, StopsBeforeTheCellsAreTooNarrow) {
+  // The cells are at least 1.2 diameters wide: growth at rate 1 fits until they are full.
+  const auto s = lattice_system<3>(5, 0.2, 15);
+  EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, growing<3>(1.0, s, 1.2));
+  double width = kNever;
+  for (int a = 0; a < 3; ++a) width = std::min(width, engine.grid().width(a));
+  EXPECT_GE(width, 1.2);
+  EXPECT_NEAR(engine.growth_fits_until(), width / 1.0 - 1.0, 1e-12);
+}
+
+TEST(Growth, RescaledVelocitiesArePredictedAgain) {
+  const auto s = lattice_system<3>(5, 0.3, 16);
+  EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, growing<3>(0.05, s, 1.2));
+  for (int e = 0; e < 500; ++e) engine.step();
+  const double before = engine.kinetic_energy();
+  engine.rescale_velocities(engine.time(), 0.5);
+  EXPECT_NEAR(engine.kinetic_energy(), 0.25 * before, 1e-12 * before);
+  engine.validate();
+  for (int e = 0; e < 500 && engine.next_event_time() < engine.growth_fits_until(); ++e) {
+    engine.step();
+    engine.validate();
+  }
+}
+
+TEST(Growth, RefusesWhatItCannotGrowIn) {
+  const auto s = lattice_system<3>(5, 0.3, 17);
+  const auto refused = [&](const Environment<3>& env, const char* what) {
+    try {
+      EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, growing<3>(0.1, s, 1.2), env);
+      ADD_FAILURE() << "accepted " << what;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("growing particles"), std::string::npos) << e.what();
+    }
+  };
+  refused(testing::walls_on_last_axis<3>(), "walls");
+  Environment<3> inelastic = testing::walls_on_last_axis<3>(0.9);
+  for (int f = 0; f < 6; ++f) inelastic.faces[f] = Environment<3>{}.faces[f];
+  refused(inelastic, "inelastic contacts");
+}
+
+}  // namespace
+}  // namespace kairos
