@@ -54,7 +54,11 @@ SMALLER = {"granular_clustering_2d.toml": ["system.particles=20000"],
            # Measured in time; the first disks pass the outlet after about 8 time units.
            "silo_2d.toml": ["run.equilibration_time=5", "run.time=7"],
            # Measured in time; the first spheres pass after about 7 time units.
-           "silo_3d.toml": ["run.equilibration_time=6", "run.time=3"]}
+           "silo_3d.toml": ["run.equilibration_time=6", "run.time=3"],
+           # The compression examples: fewer particles, jammed at Z = 1e6.
+           "jammed_spheres_3d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
+           "jammed_disks_2d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
+           "polydisperse_glass_3d.toml": ["system.particles=400"]}
 # Restart chunks that are the run's bookkeeping rather than its state: the run's id, the stored
 # configuration (it names the output directory), the checksum over both.
 RESTART_SKIPPED = ["kairos/run/id", "kairos/run/config", "kairos/checksum"]

@@ -9,15 +9,15 @@ middle of the box). Rattlers are drawn open.
 """
 
 import argparse
-import json
 import os
 
-import gsd.hoomd
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+from kairos_output import GsdFile, read_summary  # noqa: E402
 
 KLM = [1, 4, 6, 2.3647684, -0.8698551, 1.1062803, -1.1014221, 0.66605866, -0.03633431, 0,
        -0.20965164, 0, 0, 0, 0.10555569, 0, 0, 0, 0, 0, 0, 0, -0.00872380]
@@ -33,19 +33,21 @@ def read_rows(path):
     return rows[:, 1], rows[:, 2]
 
 
-def read_contacts(path):
-    pairs, rattler = [], set()
+def read_contacts(path, n):
+    """The contact pairs and the rattlers: every particle not flagged 0 in some contact row
+    (a particle with no contact at all is a rattler too)."""
+    pairs, held = [], set()
     with open(path) as f:
         for line in f:
             if line.startswith("#"):
                 continue
             i, j, _, ri, rj = line.split()
             pairs.append((int(i), int(j)))
-            if ri == "1":
-                rattler.add(int(i))
-            if rj == "1":
-                rattler.add(int(j))
-    return pairs, rattler
+            if ri == "0":
+                held.add(int(i))
+            if rj == "0":
+                held.add(int(j))
+    return pairs, set(range(n)) - held
 
 
 def draw_pressure(ax, out, dimension, summary):
@@ -66,15 +68,19 @@ def draw_pressure(ax, out, dimension, summary):
 
 
 def draw_packing(ax, out, dimension):
-    frame = gsd.hoomd.open(os.path.join(out, "packing.gsd"))[0]
-    box = frame.configuration.box[:dimension]
-    x = frame.particles.position[:, :dimension] + 0.5 * box  # HOOMD's box is centred
-    d = frame.particles.diameter
-    pairs, rattler = read_contacts(os.path.join(out, "contacts.tsv"))
-    shown = np.ones(len(d), bool)
+    packing = GsdFile(os.path.join(out, "packing.gsd"))
+    box = packing.chunk("configuration/box")[:dimension]
+    position = packing.chunk("particles/position")
+    x = position[:, :dimension] + 0.5 * box  # HOOMD's box is centred
+    d = packing.chunk("particles/diameter")
+    pairs, rattler = read_contacts(os.path.join(out, "contacts.tsv"), len(d))
+    # A window of at most 24 diameters (the whole box when smaller); in 3D a slab through the
+    # middle.
+    window = np.minimum(box, 24.0 * d.mean())
+    shown = np.all(x < window, axis=1)
     if dimension == 3:
-        z = frame.particles.position[:, 2]
-        shown = np.abs(z) < 0.75 * d.max()
+        z = position[:, 2]
+        shown &= np.abs(z) < 0.75 * d.max()
     for i in np.nonzero(shown)[0]:
         open_circle = i in rattler
         ax.add_patch(plt.Circle(x[i], 0.5 * d[i], fill=not open_circle, lw=0.5,
@@ -85,29 +91,29 @@ def draw_packing(ax, out, dimension):
         r = x[j] - x[i]
         r -= box * np.round(r / box)
         ax.plot([x[i][0], x[i][0] + r[0]], [x[i][1], x[i][1] + r[1]], "k-", lw=0.6)
-    ax.set_xlim(0, box[0])
-    ax.set_ylim(0, box[1])
+    ax.set_xlim(0, window[0])
+    ax.set_ylim(0, window[1])
     ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])
-    ax.set_title("packing and contacts" + (" (slab |z| < 0.75 d)" if dimension == 3 else "")
-                 + ", rattlers red", fontsize=9)
+    ax.set_title(f"packing and contacts ({len(rattler)} rattlers of {len(d)}, drawn red)"
+                 + ("\nslab |z| < 0.75 d" if dimension == 3 else ""), fontsize=9)
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", help="the run's output directory")
     parser.add_argument("-o", "--output", help="PNG file (default OUT/compress.png)")
+    parser.add_argument("--dpi", type=int, default=110)
     args = parser.parse_args()
-    with open(os.path.join(args.out, "summary.json")) as f:
-        summary = json.load(f)
+    summary = read_summary(args.out)
     dimension = summary["dimension"]
     fig, axes = plt.subplots(1, 2, figsize=(11, 5))
     draw_pressure(axes[0], args.out, dimension, summary)
     draw_packing(axes[1], args.out, dimension)
     fig.tight_layout()
     target = args.output or os.path.join(args.out, "compress.png")
-    fig.savefig(target, dpi=110)
+    fig.savefig(target, dpi=args.dpi)
     print(target)
 
 

@@ -38,10 +38,11 @@ struct CandidateScan {
   std::uint32_t count = 0;
   // Contact distance: sigma_i + radius of the candidate (radius from its kind), or a constant.
   bool uniform = true;
-  double sigma = 0.0;                   // uniform: the pair contact distance
-  double radius_i = 0.0;                // non-uniform: this particle's radius
-  const std::uint16_t* kind = nullptr;  // non-uniform: per particle
-  const double* kind_radius = nullptr;  // non-uniform: per kind
+  double sigma = 0.0;                       // uniform: the pair contact distance
+  double radius_i = 0.0;                    // non-uniform: this particle's radius
+  const std::uint16_t* kind = nullptr;      // non-uniform: per particle
+  const double* kind_radius = nullptr;      // non-uniform: per kind
+  const double* particle_radius = nullptr;  // non-uniform, per particle (then kinds unused)
   // Uniform acceleration (gravity) felt by every candidate: their positions and velocities at
   // time t gain g dt^2/2 and g dt. The pair's relative motion stays a straight line.
   const double* accel = nullptr;       // g (kAccelerated loops only)
@@ -55,6 +56,12 @@ struct CandidateScan {
 };
 
 inline constexpr std::uint32_t kNoCandidate = 0xffffffffu;
+
+// A non-uniform scan's radius of particle j: its own, or its kind's.
+template <int D>
+inline double radius_of_candidate(const CandidateScan<D>& s, std::uint32_t j) {
+  return s.particle_radius != nullptr ? s.particle_radius[j] : s.kind_radius[s.kind[j]];
+}
 
 // Candidate k's record and its time to t (dtj); null for a record whose local time lies after t
 // (a deferred soft contact), which is listed in s.delayed instead.
@@ -88,7 +95,7 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
     const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
     const RelativeMotion p =
         relative_motion_at<D, kAccelerated>(xi, vi, rec, dtj, shift, s.half_accel, s.accel);
-    const double sigma = s.uniform ? s.sigma : s.radius_i + s.kind_radius[s.kind[j]];
+    const double sigma = s.uniform ? s.sigma : s.radius_i + radius_of_candidate(s, j);
     double dt;
     if (!contact_before(p, sigma * sigma, best, dt)) continue;
     if (dt < best) {
@@ -118,7 +125,7 @@ std::uint32_t scan_candidates_growing(const CandidateScan<D>& s, std::uint32_t s
       continue;
     const Vec<D>& shift = s.any_shift ? s.shifts[s.shift_index[k]] : no_shift;
     const RelativeMotion p = relative_motion_at<D>(xi, vi, rec, dtj, shift);
-    const double sigma0 = s.uniform ? s.sigma : s.radius_i + s.kind_radius[s.kind[j]];
+    const double sigma0 = s.uniform ? s.sigma : s.radius_i + radius_of_candidate(s, j);
     double dt;
     if (!growing_contact_before(p, sigma0 * scale, sigma0 * rate, best, dt)) continue;
     best = dt;
@@ -166,7 +173,7 @@ ContactProbeResult probe_contact_scalar(const CandidateScan<D>& s, double t,
     // The placed particle, frozen, and its motion after the release.
     const RelativeMotion placed =
         relative_motion_at<D>(probe.placed, probe.frozen_velocity, rec, dtj, shift);
-    const double sigma = s.uniform ? s.sigma : s.radius_i + s.kind_radius[s.kind[j]];
+    const double sigma = s.uniform ? s.sigma : s.radius_i + radius_of_candidate(s, j);
     const double sigma2 = sigma * sigma;
     const double gap_placed = placed.r2 - sigma2;
     if (gap_placed < 0.0) {

@@ -55,7 +55,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   bond_types_ = s.bond_types;
   // The vector loop indexes records with 32-bit offsets.
   vector_scan_ = options_.vector_scan && cpu_has_avx512() &&
-                 static_cast<double>(n) * sizeof(HotRecord<D>) < 2e9;
+                 static_cast<double>(n) * sizeof(HotRecord<D>) < 2e9 && radius_.empty();
   vector_gather_ =
       vector_scan_ && (options_.list_gather == ListGather::kVector ||
                        (options_.list_gather == ListGather::kAuto && cpu_gathers_fast()));
@@ -85,6 +85,11 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   if (!kind_by_id.empty()) {
     kind_.resize(n + 1);  // one spare entry: the vector loop reads kinds 4 bytes at a time
     for (std::size_t k = 0; k < n; ++k) kind_[k] = kind_by_id[id_[k]];
+  }
+  if (!radius_.empty()) {
+    HugeVector<double> radius_by_id = std::move(radius_);
+    radius_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) radius_[k] = radius_by_id[id_[k]];
   }
   for (const ParticleKind& sh : kinds_) kind_radius_.push_back(sh.radius);
   const bool has_counts = s.collision_count.size() == n;
@@ -126,6 +131,7 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   if (accelerated_ && (walls_ || env_.has_fixed_grains()) && !moving && !stepped_) {
     double dmin = kNever;
     for (const ParticleKind& sh : kinds_) dmin = std::min(dmin, 2.0 * sh.radius);
+    for (const double r : radius_) dmin = std::min(dmin, 2.0 * r);
     const double speed = Resting::speed_for(env_.sleep_speed, env_.gravity, dmin);
     if (speed > 0.0) {
       resting_ = Resting(n, speed, env_.gravity);
@@ -257,34 +263,58 @@ void EventEngine<D, Queue>::start_helfand() {
     helfand_.add_particle(mass_of(k), hot_[k].vel, helfand_energy(k));
 }
 
-// Distinct (radius, mass, species) triples; particles store a 2-byte index into them.
+// Distinct (radius, mass, species) triples; particles store a 2-byte index into them. More
+// than 65 536 of them (a continuous size distribution), or when asked: each particle keeps its
+// radius, and the kinds are the (mass, species) pairs, with the largest radius of each.
 template <int D, class Queue>
 void EventEngine<D, Queue>::build_kinds(const ParticleSystem<D>& s) {
-  std::map<std::tuple<double, double, std::uint32_t>, std::uint16_t> index;
-  HugeVector<std::uint16_t> kind(s.size());
   for (std::size_t i = 0; i < s.size(); ++i) {
     const double r = s.kinematics[i].radius, m = s.mass[i];
     if (!(r > 0.0) || !std::isfinite(r) || !(m > 0.0) || !std::isfinite(m)) {
       throw InputError("particle " + std::to_string(i) +
                        " needs a finite positive radius and mass");
     }
-    const auto key = std::make_tuple(r, m, s.species[i]);
-    auto it = index.find(key);
-    if (it == index.end()) {
-      if (kinds_.size() == 0x10000) {
-        throw InputError(
-            "more than 65536 distinct (diameter, mass, species) combinations: Kairos keeps a "
-            "2-byte kind index per particle; round the diameters to fewer distinct values");
-      }
-      it = index.emplace(key, static_cast<std::uint16_t>(kinds_.size())).first;
-      kinds_.push_back({r, m, s.species[i]});
+  }
+  bool per_particle = options_.per_particle_radii;
+  if (!per_particle && !index_kinds(s, /*with_radius=*/true)) per_particle = true;
+  if (per_particle) {
+    kinds_.clear();
+    if (!index_kinds(s, /*with_radius=*/false)) {
+      throw InputError(
+          "more than 65536 distinct (mass, species) combinations: Kairos keeps a 2-byte kind "
+          "index per particle; use fewer distinct masses");
     }
-    kind[i] = it->second;
+    radius_.resize(s.size());  // the caller's numbering; permuted by the caller
+    for (std::size_t i = 0; i < s.size(); ++i) radius_[i] = s.kinematics[i].radius;
+    uniform_radius_ = false;
+    return;
   }
   uniform_radius_ = std::all_of(kinds_.begin(), kinds_.end(), [&](const ParticleKind& sh) {
     return sh.radius == kinds_[0].radius;
   });
+}
+
+// Fills kinds_ and kind_ by (radius, mass, species), or by (mass, species) with each kind's
+// largest radius; false (kinds_ partly filled) when there would be more than 65 536.
+template <int D, class Queue>
+bool EventEngine<D, Queue>::index_kinds(const ParticleSystem<D>& s, bool with_radius) {
+  std::map<std::tuple<double, double, std::uint32_t>, std::uint16_t> index;
+  HugeVector<std::uint16_t> kind(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double r = s.kinematics[i].radius, m = s.mass[i];
+    const auto key = std::make_tuple(with_radius ? r : 0.0, m, s.species[i]);
+    auto it = index.find(key);
+    if (it == index.end()) {
+      if (kinds_.size() == 0x10000) return false;
+      it = index.emplace(key, static_cast<std::uint16_t>(kinds_.size())).first;
+      kinds_.push_back({r, m, s.species[i]});
+    }
+    kind[i] = it->second;
+    kinds_[it->second].radius = std::max(kinds_[it->second].radius, r);
+  }
+  kind_.clear();
   if (kinds_.size() > 1) kind_ = std::move(kind);  // caller's numbering; permuted by caller
+  return true;
 }
 
 // Checks the environment against the particles and sizes the cell grid for it: periodic axes
@@ -319,6 +349,11 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
     throw InputError("the state has bonds but no bond potential is given ([bond])");
   stepped_ = env_.stepped();
   double range = 2.0 * rmax;
+  if (stepped_ && !radius_.empty()) {
+    throw InputError(
+        "stepped potentials need the particles' diameters as at most 65536 distinct values (one "
+        "step table per pair of kinds); this state has more");
+  }
   if (stepped_) {
     if (!env_.pair_table.empty() && env_.species < species) {
       throw InputError("the step potentials cover " + std::to_string(env_.species) +
@@ -436,6 +471,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(pending_);
   permute(id_);
   permute(kind_);  // its spare last entry stays
+  permute(radius_);
   permute(spin_);
   permute(last_collision_);
   images_.permute(order, done);
@@ -546,6 +582,7 @@ CandidateScan<D> EventEngine<D, Queue>::scan_of(const CandidateList& list, std::
                           .radius_i = r,
                           .kind = kind_.data(),
                           .kind_radius = kind_radius_.data(),
+                          .particle_radius = radius_.empty() ? nullptr : radius_.data(),
                           .accel = accelerated_ ? env_.gravity.data() : nullptr,
                           .half_accel = accelerated_ ? half_gravity_.data() : nullptr,
                           .delayed = soft_ ? list.delayed.data() : nullptr,
@@ -1043,7 +1080,8 @@ double EventEngine<D, Queue>::bytes_per_particle() const {
   const double kinds =
       static_cast<double>(kinds_.size() * sizeof(ParticleKind)) / static_cast<double>(size());
   return static_cast<double>(sizeof(HotRecord<D>) + sizeof(PendingEvent) + sizeof(std::uint32_t) +
-                             (kind_.empty() ? 0 : sizeof(std::uint16_t))) +
+                             (kind_.empty() ? 0 : sizeof(std::uint16_t)) +
+                             (radius_.empty() ? 0 : sizeof(double))) +
          kinds + cells_.grid().bytes_per_particle() + images_.bytes_per_particle() +
          helfand_.bytes_per_particle() + static_cast<double>(queue_.bytes_per_particle());
 }

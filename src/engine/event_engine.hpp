@@ -119,6 +119,11 @@ struct EngineOptions {
   double growth_rate = 0.0;
   // Cells at least this wide (0: as wide as the largest contact): room for growth.
   double min_cell_width = 0.0;
+  // Keep each particle's radius (8 bytes per particle) instead of a kind per radius: chosen by
+  // itself when the particles have more than 65 536 distinct (radius, mass, species) kinds (a
+  // continuous size distribution); true forces it (the same trajectories either way). The
+  // scalar candidate loop is used.
+  bool per_particle_radii = false;
 };
 
 template <int D, class Queue>
@@ -305,6 +310,7 @@ class EventEngine {
   static constexpr double kBoundedCellsPerParticle = 8.0;
 
   void build_kinds(const ParticleSystem<D>& s);
+  bool index_kinds(const ParticleSystem<D>& s, bool with_radius);
   void setup_environment(const ParticleSystem<D>& s);
   std::uint32_t species_of(std::uint32_t i) const {
     return kinds_[kind_.empty() ? 0 : kind_[i]].species;
@@ -365,7 +371,9 @@ class EventEngine {
   void resolve_pair(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
   void collide_granular(std::uint32_t i, std::uint32_t j, double t, const Vec<D>& r, double r2);
   void separate(std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2);
-  double radius_of(std::uint32_t i) const { return kinds_[kind_.empty() ? 0 : kind_[i]].radius; }
+  double radius_of(std::uint32_t i) const {
+    return radius_.empty() ? kinds_[kind_.empty() ? 0 : kind_[i]].radius : radius_[i];
+  }
   // The pair's contact distance at time t (radii grow with growth_).
   double contact_distance(std::uint32_t i, std::uint32_t j, double t) const {
     return (radius_of(i) + radius_of(j)) * growth_.scale(t);
@@ -541,6 +549,9 @@ class EventEngine {
   std::vector<ParticleKind> kinds_;
   bool uniform_radius_ = true;
   std::vector<double> kind_radius_;  // radius per kind, for the candidate loops
+  // Per particle (EngineOptions::per_particle_radii), else empty; then a kind's radius is the
+  // largest of its particles'.
+  HugeVector<double> radius_;
   bool vector_scan_ = false;
   bool vector_gather_ = false;    // gather_lists_avx512 for the cell lists (cpu_gathers_fast)
   bool row_loads_ = false;        // CandidateScan::row_loads (RecordLoads, cpu_gathers_fast)

@@ -145,7 +145,7 @@ void EventEngine<D, Queue>::export_particle(std::uint32_t k, std::uint32_t c,
   const ParticleKind& sh = kinds_[kind_.empty() ? 0 : kind_[k]];
   if ((fields & Blocks::kKinematics) != 0) {
     const HotRecord<D>& h = hot_[k];
-    const double radius = sh.radius * growth_.scale(time_);  // grown to now
+    const double radius = radius_of(k) * growth_.scale(time_);  // grown to now
     out.kinematics[c] = {h.pos, h.vel, h.time, radius};
     if (in_deferred_contact(k, time_)) [[unlikely]]  // where it is, frozen, now
       out.kinematics[c] = {position(k, time_), frozen_velocity_of(k), time_, radius};

@@ -496,8 +496,12 @@ class VoxelSampler {
 
 // Random sequential insertion in the order of the particles (largest diameters first).
 template <int D>
+// class_width: particles (sorted by decreasing diameter) whose diameters lie within this
+// fraction of the first of a class share one voxel sampler (0: one per distinct diameter); a
+// voxel is dropped only when it is covered for the class's smallest diameter, so the sampled
+// points stay uniform over the free space of every particle of the class.
 void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state,
-                     std::mt19937_64& rng) {
+                     std::mt19937_64& rng, double class_width) {
   const std::size_t N = state.position.size();
   const double dmax = *std::max_element(state.diameter.begin(), state.diameter.end());
   InsertionGrid<D> grid(layout.box, dmax, N);
@@ -505,6 +509,7 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
   const std::size_t max_voxels = std::max<std::size_t>(8 * N, 1024);
   std::optional<VoxelSampler<D>> voxels;
   std::uint64_t tries = 0, hits = 0;  // since the last (re)start or refinement of the voxels
+  double class_floor = 0.0, class_smallest = 0.0;
   const auto fail = [&](std::size_t i, std::string_view why) {
     return InputError(fmt::format(
         "system.packing_fraction = {} could not be reached by random insertion: particle {} of "
@@ -515,11 +520,12 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
     // SIGINT ends a long insertion (near jamming one particle may take 10^6 tries, see below).
     if ((i & 1023u) == 1023u) throw_if_stop_requested();
     const double di = state.diameter[i];
-    // Whether the exclusion zone (for diameter di) of one placed particle covers the voxel.
+    // Whether the exclusion zone (for the class's smallest diameter) of one placed particle
+    // covers the voxel.
     const auto covered = [&](std::uint64_t voxel) {
       const std::array<double, D> c = voxels->centre(voxel);
       return grid.for_each_neighbour(grid.coords(c), [&](std::uint32_t j) {
-        return voxels->covered(c, state.position[j], 0.5 * (di + state.diameter[j]));
+        return voxels->covered(c, state.position[j], 0.5 * (class_smallest + state.diameter[j]));
       });
     };
     // The exclusion spheres (for diameter di) of the placed particles near a point.
@@ -530,9 +536,13 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
         return false;
       });
     };
-    if (i == 0 || di != state.diameter[i - 1]) {
+    if (i == 0 || di < class_floor) {
       // Exclusion radii depend on the inserted diameter: start over with all voxels live.
-      voxels.emplace(layout.box, 0.5 * di, max_voxels);
+      class_floor = class_width > 0.0 ? (1.0 - class_width) * di : di;
+      std::size_t last = i;
+      while (last + 1 < N && state.diameter[last + 1] >= class_floor) ++last;
+      class_smallest = state.diameter[last];
+      voxels.emplace(layout.box, 0.5 * class_smallest, max_voxels);
       tries = hits = 0;
     }
     bool placed = false;
@@ -1002,7 +1012,7 @@ InitialState<D> make_initial_state(const SystemConfig& system, std::mt19937_64& 
   if (lattice != nullptr) {
     place_on_lattice(layout, state);
   } else {
-    insert_randomly(layout, eta, state, rng);
+    insert_randomly(layout, eta, state, rng, drawn.empty() ? 0.0 : 0.05);
     sort_spatially(state);  // neighbours close in memory: fewer cache misses in the engine
   }
   assign_maxwell_boltzmann_velocities(state, system.temperature, rng);

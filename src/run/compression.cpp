@@ -119,6 +119,7 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
   double rate = settings.growth_rate;  // now: d sigma / dt over sigma(0)
   bool done = false;
   while (!done) {
+    make_fresh_start(state);  // each engine starts at time 0 with its counters at zero
     double rmax = 0.0;
     for (const Kinematics<D>& k : state.kinematics) rmax = std::max(rmax, k.radius);
     const double phi_start = state_packing_fraction(state);
@@ -271,10 +272,9 @@ CompressionReport compress_start(ParticleSystem<D>& state, const CompressConfig&
     c.radius.push_back(state.kinematics[i].radius);
   }
   const double z = report.result.pressure;
-  const double tolerance = config.contact_gap > 0.0 ? config.contact_gap
-                           : z > 1.0                ? std::min(0.1, 1e4 / z)
-                                                    : 0.1;
-  report.network = contact_network(c, tolerance);
+  report.has_network = config.contact_gap > 0.0 || z >= 1e4;
+  if (report.has_network)
+    report.network = contact_network(c, config.contact_gap > 0.0 ? config.contact_gap : 1e4 / z);
   return report;
 }
 

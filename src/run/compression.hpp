@@ -72,6 +72,9 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
 struct CompressionReport {
   CompressionSettings settings;
   CompressionResult result;
+  // The contact network, when the packing is near jamming (Z at least 10^4) or contact_gap was
+  // given: far from jamming touching and open pairs are not told apart by their gaps.
+  bool has_network = false;
   ContactNetwork network;
   double wall_seconds = 0.0;
 };

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
@@ -112,6 +113,32 @@ TEST(Growth, RefusesWhatItCannotGrowIn) {
   Environment<3> inelastic = testing::walls_on_last_axis<3>(0.9);
   for (int f = 0; f < 6; ++f) inelastic.faces[f] = Environment<3>{}.faces[f];
   refused(inelastic, "inelastic contacts");
+}
+
+// Per-particle radii (EngineOptions::per_particle_radii, chosen by itself beyond 65 536 kinds):
+// the same trajectory as with a kind per radius, to the bit, growing or not.
+TEST(PerParticleRadii, SameTrajectoryAsKinds) {
+  auto s = lattice_system<3>(6, 0.3, 18);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.4, 0.55);
+  for (auto& k : s.kinematics) k.radius = u(rng);  // 216 distinct radii
+  for (const double rate : {0.0, 0.05}) {
+    EngineOptions kinds = rate > 0.0 ? growing<3>(rate, s, 1.3) : EngineOptions{};
+    EngineOptions own = kinds;
+    own.per_particle_radii = true;
+    EventEngine<3, CalendarQueue> a(s, StartMode::kPredict, kinds), b(s, StartMode::kPredict, own);
+    for (int e = 0; e < 4000 && a.next_event_time() < a.growth_fits_until(); ++e) {
+      ASSERT_EQ(a.step(), b.step()) << "event " << e;
+      ASSERT_EQ(a.time(), b.time()) << "event " << e;
+      if (e % 500 == 0) b.validate();
+    }
+    const auto x = a.export_state(), y = b.export_state();
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      ASSERT_EQ(x.kinematics[i].pos, y.kinematics[i].pos) << i;
+      ASSERT_EQ(x.kinematics[i].radius, y.kinematics[i].radius) << i;
+    }
+    EXPECT_GT(a.counters().collisions, 500u);
+  }
 }
 
 }  // namespace

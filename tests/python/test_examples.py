@@ -69,6 +69,17 @@ STEPPED_EXAMPLES = {
 }
 
 
+# Compression examples (docs/examples.md, section 9): config -> overrides that make a quick run
+# (fewer particles; jammed at Z = 1e6 instead of 1e12).
+COMPRESSION_EXAMPLES = {
+    "jammed_spheres_3d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
+    "jammed_disks_2d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
+    "polydisperse_glass_3d.toml": ["system.particles=400",
+                                   "run.equilibration_collisions_per_particle=1",
+                                   "run.collisions_per_particle=4"],
+}
+
+
 def have_matplotlib():
     try:
         import matplotlib  # noqa: F401
@@ -362,6 +373,78 @@ class SteppedExamples(kt.KairosTestCase):
                 t for name, (script, _) in STEPPED_EXAMPLES.items()
                 for t in ("examples/" + name, "examples/plot/" + script)]:
             self.assertTrue(text in doc, "%s is not in docs/examples.md" % text)
+
+
+
+class CompressionExamples(kt.KairosTestCase):
+    """The compression examples, shortened: the packing, its contacts and its picture."""
+
+    def run_example(self, name):
+        out = self.path(name.replace(".toml", ""))
+        args = ["run", kt.example(name), "-o", out, "--set", "output.progress=never"]
+        for override in COMPRESSION_EXAMPLES[name]:
+            args += ["--set", override]
+        self.run_ok(*args)
+        self.assert_outputs_exist(out)
+        return out, self.summary(out)
+
+    def check_packing(self, out, s, dimension):
+        import gsd.hoomd
+        c = s["compression"]
+        frame = gsd.hoomd.open(os.path.join(out, "packing.gsd"))[0]
+        self.assertEqual(frame.particles.position.dtype, np.float64)
+        self.assertEqual(frame.particles.N, s["particles"])
+        box = frame.configuration.box[:dimension]
+        volume = np.prod(box)
+        d = frame.particles.diameter.astype(float)
+        solid = np.sum(np.pi * d**3 / 6 if dimension == 3 else np.pi * d**2 / 4)
+        self.assertAlmostEqual(solid / volume, c["packing_fraction"], delta=1e-9)
+        with open(os.path.join(out, "contacts.tsv")) as f:
+            rows = [line for line in f if not line.startswith("#")]
+        self.assertEqual(len(rows), c["contacts"]["contacts"] if c["contacts"] else 0)
+        return frame
+
+    def draw(self, out):
+        if not have_matplotlib():
+            self.skipTest("python3-matplotlib not installed: plotting script not run")
+        png = self.path("compress.png")
+        script = os.path.join(kt.SOURCE_DIR, "examples", "plot", "plot_compression.py")
+        result = subprocess.run([sys.executable, script, out, "-o", png, "--dpi", "40"],
+                                capture_output=True, text=True, timeout=kt.RUN_TIMEOUT)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        with open(png, "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+
+    def test_jammed_spheres_3d(self):
+        out, s = self.run_example("jammed_spheres_3d.toml")
+        c = s["compression"]
+        self.assertEqual(c["stop_reason"], "jammed")
+        self.assertGreater(c["packing_fraction"], 0.62)
+        self.assertLess(c["packing_fraction"], 0.67)
+        self.assertLess(s["max_overlap"], 1e-9)
+        self.check_packing(out, s, 3)
+        self.draw(out)
+
+    def test_jammed_disks_2d(self):
+        out, s = self.run_example("jammed_disks_2d.toml")
+        c = s["compression"]
+        self.assertEqual(c["stop_reason"], "jammed")
+        self.assertGreater(c["packing_fraction"], 0.81)
+        self.assertLess(c["packing_fraction"], 0.86)
+        self.check_packing(out, s, 2)
+        self.draw(out)
+
+    def test_polydisperse_glass_3d(self):
+        out, s = self.run_example("polydisperse_glass_3d.toml")
+        c = s["compression"]
+        # A random start above insertion's limit: grown to system.packing_fraction exactly.
+        self.assertEqual(c["stop_reason"], "packing_fraction")
+        self.assertAlmostEqual(c["packing_fraction"], 0.6, delta=1e-12)
+        self.assertAlmostEqual(s["packing_fraction"], 0.6, delta=1e-9)
+        frame = self.check_packing(out, s, 3)
+        d = frame.particles.diameter.astype(float)
+        self.assertAlmostEqual(np.std(d) / np.mean(d), 0.1, delta=0.02)
+        self.draw(out)
 
 
 if __name__ == "__main__":

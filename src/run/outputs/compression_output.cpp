@@ -23,6 +23,11 @@ void CompressionOutput<D>::open(const RunContext<D>& run) {
   write_text_atomically(run.directory() / "compress.tsv", rows);
 
   const ContactNetwork& net = report_->network;
+  if (!report_->has_network) {
+    write_text_atomically(run.directory() / "contacts.tsv",
+                          "# no contact network: the packing is not near jamming (reduced pressure "
+                          "below 1e4) and compress.contact_gap is 0\n");
+  }
   std::string contacts = fmt::format(
       "# contacts of the packing in packing.gsd: relative gap (r - sigma_ij) / sigma_ij below "
       "{:.3g}; "
@@ -32,7 +37,7 @@ void CompressionOutput<D>::open(const RunContext<D>& run) {
     contacts += fmt::format("{}\t{}\t{:.6g}\t{}\t{}\n", c.i, c.j, c.gap, int{net.rattler[c.i]},
                             int{net.rattler[c.j]});
   }
-  write_text_atomically(run.directory() / "contacts.tsv", contacts);
+  if (report_->has_network) write_text_atomically(run.directory() / "contacts.tsv", contacts);
 
   TrajectoryLayout layout;
   layout.double_precision = true;
@@ -68,6 +73,13 @@ void CompressionOutput<D>::summarize(nlohmann::json& summary, const RunContext<D
   c["rescalings"] = r.rescalings;
   c["rebuilds"] = r.rebuilds;
   c["wall_seconds"] = report_->wall_seconds;
+  if (!report_->has_network) {
+    c["contacts"] = nullptr;
+    summary["undefined"]["compression.contacts"] =
+        "the packing is not near jamming (reduced pressure below 1e4): touching and open pairs "
+        "are not told apart by their gaps (compress.contact_gap sets a tolerance)";
+    return;
+  }
   nlohmann::json& k = c["contacts"];
   k["gap_tolerance"] = net.gap_tolerance;
   k["contacts"] = net.contacts.size();
