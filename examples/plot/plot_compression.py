@@ -39,6 +39,8 @@ def read_contacts(path, n):
     pairs, held = [], set()
     with open(path) as f:
         for line in f:
+            if line.startswith("# no contact network"):
+                return None, set()
             if line.startswith("#"):
                 continue
             i, j, _, ri, rj = line.split()
@@ -61,7 +63,7 @@ def draw_pressure(ax, out, dimension, summary):
                     label=f"free volume, $\\varphi_J$ = {phi_j:.4f}")
     if dimension == 3:
         grid = np.linspace(phi.min(), min(0.55, phi.max()), 200)
-        ax.semilogy(grid, [klm_pressure(e) for e in grid], "r-", lw=1, label="fluid (KLM)")
+        ax.semilogy(grid, [klm_pressure(e) for e in grid], "r-", lw=1, label="fluid, one size (KLM)")
     ax.set_xlabel("packing fraction $\\varphi$")
     ax.set_ylabel("reduced pressure $Z = PV/NkT$")
     ax.legend(fontsize=8)
@@ -85,7 +87,7 @@ def draw_packing(ax, out, dimension):
         open_circle = i in rattler
         ax.add_patch(plt.Circle(x[i], 0.5 * d[i], fill=not open_circle, lw=0.5,
                                 fc="#9ecae1", ec="#08519c" if not open_circle else "r"))
-    for i, j in pairs:
+    for i, j in pairs or []:
         if not (shown[i] and shown[j]):
             continue
         r = x[j] - x[i]
@@ -96,7 +98,8 @@ def draw_packing(ax, out, dimension):
     ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])
-    ax.set_title(f"packing and contacts ({len(rattler)} rattlers of {len(d)}, drawn red)"
+    ax.set_title((f"packing and contacts ({len(rattler)} rattlers of {len(d)}, drawn red)"
+                  if pairs is not None else "packing (not jammed: no contact network)")
                  + ("\nslab |z| < 0.75 d" if dimension == 3 else ""), fontsize=9)
 
 

@@ -809,7 +809,8 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
     const double mu = mi * mj / (mi + mj);
     const double s =  // J = s r
         growing_ ? HardSphere::growing_impulse_factor(g_dot_r, r2, mu,
-                                                      growth_.speed(radius_of(i) + radius_of(j)))
+                                                      growth_.speed(radius_of(i) + radius_of(j)),
+                                                      contact_distance(i, j, t))
                  : HardSphere::impulse_factor(g_dot_r, r2, mu);
     for (int a = 0; a < D; ++a) {
       hi.vel[a] += s * r[a] / mi;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -838,7 +837,8 @@ double size_factor(SizeDistribution kind, double delta, std::mt19937_64& rng,
 }
 
 // Each species' drawn diameters (its diameter times the distribution's factors), `counts[s]`
-// of them, largest first; empty without a distribution.
+// of them in the order drawn (a lattice takes them so; random insertion sorts the particles);
+// empty without a distribution.
 std::vector<std::vector<double>> draw_diameters(const SystemConfig& system,
                                                 const std::vector<SpeciesConfig>& species,
                                                 const std::vector<std::uint64_t>& counts,
@@ -853,7 +853,6 @@ std::vector<std::vector<double>> draw_diameters(const SystemConfig& system,
       poll_stop(k);
       out[s].push_back(species[s].diameter * size_factor(kind, system.polydispersity, rng, normal));
     }
-    std::sort(out[s].begin(), out[s].end(), std::greater<>());
   }
   return out;
 }

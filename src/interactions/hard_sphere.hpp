@@ -23,12 +23,14 @@ struct HardSphere {
     return -2.0 * reduced_mass * g_dot_r / r2;
   }
 
-  // Growing spheres (Lubachevsky-Stillinger): the contact distance grows at u, so the pair
-  // leaves the contact as fast, relative to the growing surfaces, as it came:
-  // g_n - u -> -(g_n - u), i.e. s = -2 mu (g.r - u |r|) / r^2. The kinetic energy grows by the
-  // work of the growth (docs/physics.md#growing-spheres).
-  static double growing_impulse_factor(double g_dot_r, double r2, double reduced_mass, double u) {
-    return -2.0 * reduced_mass * (g_dot_r - u * std::sqrt(r2)) / r2;
+  // Growing spheres (Lubachevsky-Stillinger): the contact distance sigma grows at u, so the
+  // pair leaves the contact as fast, relative to the growing surfaces, as it came:
+  // g_n - u -> -(g_n - u), i.e. s = -2 mu (g.r - u sigma) / r^2 (sigma rather than |r|: then
+  // r.g - sigma u changes sign exactly, so a pair a round-off inside its contact still leaves).
+  // The kinetic energy grows by the work of the growth (docs/physics.md#growing-spheres).
+  static double growing_impulse_factor(double g_dot_r, double r2, double reduced_mass, double u,
+                                       double sigma) {
+    return -2.0 * reduced_mass * (g_dot_r - u * sigma) / r2;
   }
 };
 

@@ -705,7 +705,7 @@ constexpr KeyDecl kCompress[] = {
     {.name = "pressure",
      .type = KeyType::kFloat,
      .member = field<&CompressConfig::pressure>,
-     .range = up_to(1e15, Scale::kNone),
+     .range = up_to(1e13, Scale::kNone),
      .doc = "grow until the reduced pressure Z = PV/(NkT) reaches this (0: no such target)"},
     {.name = "jammed",
      .type = KeyType::kBoolean,
@@ -726,7 +726,7 @@ constexpr KeyDecl kCompress[] = {
     {.name = "jammed_pressure",
      .type = KeyType::kFloat,
      .member = field<&CompressConfig::jammed_pressure>,
-     .range = {.lo = 10.0, .hi = 1e15},
+     .range = {.lo = 10.0, .hi = 1e13},
      .doc = "the reduced pressure above which the packing is jammed"},
     {.name = "slowdown_pressure",
      .type = KeyType::kFloat,
@@ -744,7 +744,7 @@ constexpr KeyDecl kCompress[] = {
      .member = field<&CompressConfig::contact_gap>,
      .range = up_to(0.1, Scale::kNone),
      .doc = "contact network: pairs closer than this gap over their contact distance touch "
-            "(0: 1e4 / Z, Z the final reduced pressure)"},
+            "(0: 1e4 / Z, at most 1e-3, Z the final reduced pressure)"},
 };
 
 const AnalysisConfig kAnalysisDefaults{};
@@ -1460,7 +1460,7 @@ std::string doc_number(double v) {
   if (v < 0.0) return "−" + doc_number(-v);
   if (v == kMaxParticles) return "2³¹ − 1";
   if (v == 1e-12 || v == 1e-10 || v == 1e-9 || v == 1e-6 || v == 1e3 || v == 1e6 || v == 1e9 ||
-      v == 1e15) {
+      v == 1e13 || v == 1e15) {
     const int e = static_cast<int>(std::lround(std::log10(v)));
     std::string out = "10";
     if (e < 0) out += "⁻";

@@ -138,7 +138,8 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
       const Growth& g = engine.growth();
       target = target_scale < kNever ? g.origin() + (target_scale - g.scale(g.origin())) / g.rate()
                                      : kNever;
-      limit = std::min(engine.growth_fits_until(), target);
+      // Never before now (a rate changed at the old limit may round it below).
+      limit = std::max(engine.time(), std::min(engine.growth_fits_until(), target));
     };
     update_limits();
     double virial_mark = 0.0, time_mark = 0.0;
@@ -168,9 +169,21 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
       CompressionRow r;
       r.time = out.time + engine.time();
       r.packing_fraction = phi_now();
-      r.pressure = interval_time > 0.0 ? 1.0 + interval_virial / (D * n * kT_mean * interval_time)
-                                       : std::numeric_limits<double>::infinity();
+      if (!(interval_time > 0.0)) {
+        throw InputError(fmt::format(
+            "compression: {} collisions at one instant at packing fraction {:.9f}: the clock "
+            "stopped (gaps below what double precision resolves); lower compress.jammed_pressure "
+            "or compress.pressure",
+            interval_collisions, phi_now()));
+      }
+      r.pressure = 1.0 + interval_virial / (D * n * kT_mean * interval_time);
       r.temperature = kT_end;
+      // Near jamming the mean free time falls towards 1e-12: rebuild (the clock starts at 0
+      // again) before the clock's resolution comes within 1e-3 of it.
+      const double mean_free_time =
+          interval_time * n / (2.0 * static_cast<double>(interval_collisions));
+      const bool rebase =
+          std::nextafter(engine.time(), kNever) - engine.time() > 1e-3 * mean_free_time;
       r.collisions = out.collisions + c.collisions;
       out.rows.push_back(r);
       out.pressure = r.pressure;
@@ -205,6 +218,7 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
         out.stop_reason = "pressure";
         break;
       }
+      if (rebase) break;  // a rebuild: the clock at 0
     }
     const EventCounters& c = engine.counters();
     interval_virial += c.virial - virial_mark;
@@ -216,7 +230,8 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
     state = engine.export_state(/*with_zones=*/false);
     if (!done) ++out.rebuilds;
   }
-  if (out.stop_reason == "jammed" && settings.target_packing_fraction > 0.0) {
+  if (out.stop_reason == "jammed" && settings.target_packing_fraction > 0.0 &&
+      !settings.jammed_is_a_target) {
     throw InputError(fmt::format(
         "the packing jammed at packing fraction {:.6f} (reduced pressure {:.3g}) before reaching "
         "{}: that is beyond jamming at growth rate {}; ask for less, or grow more slowly "
@@ -225,6 +240,17 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
         settings.growth_rate));
   }
   make_fresh_start(state);
+  // Lengths back in the starting diameters: the box and the positions shrink by the growth
+  // instead (the same packing; the configuration's diameters and potentials keep their
+  // meaning).
+  const double shrink = 1.0 / diameter_scale;
+  for (int a = 0; a < D; ++a) state.box[a] *= shrink;
+  for (Kinematics<D>& k : state.kinematics) {
+    k.pos = shrink * k.pos;
+    k.radius *= shrink;
+    for (int a = 0; a < D; ++a) k.pos[a] = wrap_into_box(k.pos[a], state.box[a]);
+  }
+  out.diameter_scale = diameter_scale;
   const double f = std::sqrt(kT / temperature_of(state));
   for (Kinematics<D>& k : state.kinematics) k.vel = f * k.vel;
   out.packing_fraction = state_packing_fraction(state);
@@ -241,6 +267,7 @@ CompressionSettings compression_settings(const CompressConfig& config, double te
   s.jammed_pressure = config.jammed_pressure;
   s.slowdown_pressure = config.slowdown_pressure;
   s.slowdown_floor = config.slowdown_floor;
+  s.jammed_is_a_target = config.jammed;
   return s;
 }
 
@@ -272,9 +299,12 @@ CompressionReport compress_start(ParticleSystem<D>& state, const CompressConfig&
     c.radius.push_back(state.kinematics[i].radius);
   }
   const double z = report.result.pressure;
-  report.has_network = config.contact_gap > 0.0 || z >= 1e4;
-  if (report.has_network)
-    report.network = contact_network(c, config.contact_gap > 0.0 ? config.contact_gap : 1e4 / z);
+  report.has_network = config.contact_gap > 0.0 || z >= 1e6;
+  if (report.has_network) {
+    const double tolerance =
+        config.contact_gap > 0.0 ? config.contact_gap : std::min(1e-3, 1e4 / z);
+    report.network = contact_network(c, tolerance);
+  }
   return report;
 }
 

@@ -25,6 +25,8 @@ struct CompressionSettings {
   double target_packing_fraction = 0.0;  // stop there (0: no target)
   double target_pressure = 0.0;          // stop at this reduced pressure Z = PV/(NkT) (0: none)
   double jammed_pressure = 1e12;         // jammed: Z above this
+  // Jamming is one of the targets: reaching it before target_packing_fraction is no error.
+  bool jammed_is_a_target = false;
   // Above this reduced pressure the growth slows as sqrt(slowdown_pressure / Z) (0: never):
   // near jamming, loose regions need time to settle before the growth closes their gaps, or
   // the packing jams with fewer contacts than isostatic.
@@ -52,6 +54,9 @@ struct CompressionResult {
   std::uint64_t rebuilds = 0;  // engines built with wider cells after the first
   std::uint64_t rescalings = 0;
   double initial_packing_fraction = 0.0;
+  // How much the diameters grew: the state comes back with its starting diameters in a box
+  // (and positions) shrunk by this factor.
+  double diameter_scale = 1.0;
 };
 
 // Sum of the particle volumes over the box volume.
@@ -60,7 +65,9 @@ double state_packing_fraction(const ParticleSystem<D>& state);
 
 // Grows the particles of `state` (a periodic box; the start state of a run) until a stop rule
 // holds. The state comes back as a fresh start: positions and velocities at time 0, grown
-// radii, no scheduler state, counters zero, velocities at `temperature`. InputError for a
+// packing and its starting diameters (the box and the positions shrunk by the growth, so that
+// lengths keep their unit), no scheduler state, counters zero, velocities at `temperature`.
+// InputError for a
 // system growth cannot run (walls, a target below the start) or bad settings; polls the stop
 // flag at every interval (Interrupted). `row` sees each interval as it ends.
 template <int D>

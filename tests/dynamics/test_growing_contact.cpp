@@ -105,13 +105,13 @@ TEST(GrowingContact, ImpulseReversesTheApproachRelativeToTheGrowth) {
   // g_n - u = +(0.7 + 0.3), i.e. g_n = 1.3; the tangential part is untouched.
   const double mi = 1.0, mj = 3.0, mu = mi * mj / (mi + mj);
   const double r[3] = {1.0, 0.0, 0.0}, g[3] = {-0.7, 0.2, 0.0};
-  const double s = HardSphere::growing_impulse_factor(-0.7, 1.0, mu, 0.3);
+  const double s = HardSphere::growing_impulse_factor(-0.7, 1.0, mu, 0.3, 1.0);
   double after[3];
   for (int a = 0; a < 3; ++a) after[a] = g[a] + s * r[a] * (1.0 / mi + 1.0 / mj);
   EXPECT_NEAR(after[0], 1.3, 1e-15);
   EXPECT_EQ(after[1], 0.2);
   // Without growth it is the elastic rule.
-  EXPECT_EQ(HardSphere::growing_impulse_factor(-0.7, 1.0, mu, 0.0),
+  EXPECT_EQ(HardSphere::growing_impulse_factor(-0.7, 1.0, mu, 0.0, 1.0),
             HardSphere::impulse_factor(-0.7, 1.0, mu));
 }
 

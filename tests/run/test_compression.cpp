@@ -9,6 +9,7 @@
 
 #include "analysis/contact_network.hpp"
 #include "core/error.hpp"
+#include "core/periodic.hpp"
 #include "init/initial_state.hpp"
 #include "run/compression.hpp"
 
@@ -50,18 +51,11 @@ Configuration<D> configuration_of(const ParticleSystem<D>& s) {
 template <int D>
 double max_overlap(const ParticleSystem<D>& s) {
   double worst = 0.0;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    for (std::size_t j = i + 1; j < s.size(); ++j) {
-      double r2 = 0.0;
-      for (int a = 0; a < D; ++a) {
-        double d = s.kinematics[i].pos[a] - s.kinematics[j].pos[a];
-        d -= s.box[a] * std::round(d / s.box[a]);
-        r2 += d * d;
-      }
-      const double sigma = s.kinematics[i].radius + s.kinematics[j].radius;
-      worst = std::max(worst, sigma - std::sqrt(r2));
-    }
-  }
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (std::size_t j = i + 1; j < s.size(); ++j)
+      worst = std::max(worst, pair_overlap<D>(s.box, s.kinematics[i].pos, s.kinematics[j].pos,
+                                              2.0 * s.kinematics[i].radius,
+                                              2.0 * s.kinematics[j].radius));
   return worst;
 }
 
