@@ -143,6 +143,13 @@ bool holds_exact_positions(const fs::path& path) {
 
 // When the state comes from a file, the generating keys do not apply; say so if they disagree.
 void note_ignored_system_keys(const Config& config, std::size_t n, const std::string& source) {
+  if (config.system.size_distribution != "none") {
+    std::fputs(fmt::format("kairos: note: {} gives every particle its diameter; "
+                           "system.size_distribution and system.polydispersity are not used\n",
+                           source)
+                   .c_str(),
+               stderr);
+  }
   if (config.system.particles != 0 && config.system.particles != n) {
     std::fputs(
         fmt::format("kairos: note: {} holds {} particles; system.particles = {} and the other "
@@ -276,8 +283,21 @@ void move_inside_walls(const Config& config, ParticleSystem<D>& s, std::mt19937_
 
 bool grows_random_start(const Config& config) {
   const SystemConfig& s = config.system;
-  return s.initial_state.empty() && s.lattice == "random" && !compression_obstacle(config) &&
-         s.packing_fraction > random_insertion_limit(s.dimension);
+  const bool grows = s.initial_state.empty() && s.lattice == "random" &&
+                     !compression_obstacle(config) &&
+                     s.packing_fraction > random_insertion_limit(s.dimension);
+  // [compress] with a packing fraction or pressure of its own would silently replace the
+  // start's density (inserted at the limit, grown to the other target): refused.
+  const CompressConfig& k = config.compress;
+  if (grows && (k.packing_fraction > 0.0 || k.pressure > 0.0)) {
+    throw InputError(fmt::format(
+        "system.packing_fraction = {} is above what random insertion reaches ({}), so the start "
+        "would be grown to it, but [compress] has its own target (compress.packing_fraction or "
+        "compress.pressure): start at most at {} and let [compress] grow it, or drop [compress]",
+        s.packing_fraction, random_insertion_limit(s.dimension),
+        random_insertion_limit(s.dimension)));
+  }
+  return grows;
 }
 
 template <int D>

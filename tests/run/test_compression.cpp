@@ -11,7 +11,9 @@
 #include "core/error.hpp"
 #include "core/periodic.hpp"
 #include "init/initial_state.hpp"
+#include "io/config.hpp"
 #include "run/compression.hpp"
+#include "run/start_state.hpp"
 
 namespace kairos {
 namespace {
@@ -53,9 +55,9 @@ double max_overlap(const ParticleSystem<D>& s) {
   double worst = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i)
     for (std::size_t j = i + 1; j < s.size(); ++j)
-      worst = std::max(worst, pair_overlap<D>(s.box, s.kinematics[i].pos, s.kinematics[j].pos,
-                                              2.0 * s.kinematics[i].radius,
-                                              2.0 * s.kinematics[j].radius));
+      worst = std::max(worst,
+                       pair_overlap<D>(s.box, s.kinematics[i].pos, s.kinematics[j].pos,
+                                       2.0 * s.kinematics[i].radius, 2.0 * s.kinematics[j].radius));
   return worst;
 }
 
@@ -189,6 +191,25 @@ TEST(Compression, RefusesWhatItCannotDo) {
   walled.periodic[2] = false;
   c.target_packing_fraction = 0.4;
   EXPECT_THROW(compress(walled, c), InputError);
+}
+
+// A random start denser than insertion reaches is grown to system.packing_fraction; [compress]
+// with a density or pressure target of its own beside it is refused (it would silently replace
+// the start's density); with jammed = true it grows through it.
+TEST(Compression, RandomStartsAboveInsertionAreGrown) {
+  const auto config = [](const std::string& compress) {
+    return parse_config(
+        "[system]\nparticles = 500\npacking_fraction = 0.5\nlattice = "
+        "\"random\"\n" +
+            compress,
+        "test.toml");
+  };
+  EXPECT_TRUE(grows_random_start(config("")));
+  EXPECT_TRUE(grows_random_start(config("[compress]\njammed = true\n")));
+  EXPECT_THROW(grows_random_start(config("[compress]\npressure = 100.0\n")), InputError);
+  EXPECT_THROW(grows_random_start(config("[compress]\npacking_fraction = 0.6\n")), InputError);
+  EXPECT_FALSE(grows_random_start(parse_config(
+      "[system]\nparticles = 500\npacking_fraction = 0.3\nlattice = \"random\"\n", "t")));
 }
 
 }  // namespace
