@@ -88,6 +88,18 @@ def have_matplotlib():
         return False
 
 
+def draw_png(test, script, out, png):
+    """Runs examples/plot/SCRIPT on the output directory OUT and checks it drew PNG."""
+    if not have_matplotlib():
+        test.skipTest("python3-matplotlib not installed: plotting script not run")
+    script = os.path.join(kt.SOURCE_DIR, "examples", "plot", script)
+    result = subprocess.run([sys.executable, script, out, "-o", png, "--dpi", "40"],
+                            capture_output=True, text=True, timeout=kt.RUN_TIMEOUT)
+    test.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+    with open(png, "rb") as f:
+        test.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+
+
 class GranularExamples(kt.KairosTestCase):
 
     def plot_dir(self):
@@ -115,15 +127,7 @@ class GranularExamples(kt.KairosTestCase):
         self.draw_picture(name, out)
 
     def draw_picture(self, name, out):
-        if not have_matplotlib():
-            self.skipTest("python3-matplotlib not installed: plotting script not run")
-        png = self.path(name.replace(".toml", ".png"))
-        script = os.path.join(self.plot_dir(), EXAMPLES[name][0])
-        result = subprocess.run([sys.executable, script, out, "-o", png, "--dpi", "40"],
-                                capture_output=True, text=True, timeout=kt.RUN_TIMEOUT)
-        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
-        with open(png, "rb") as f:
-            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        draw_png(self, EXAMPLES[name][0], out, self.path(name.replace(".toml", ".png")))
 
     def test_clustering_2d(self):
         self.check_example("granular_clustering_2d.toml")
@@ -405,15 +409,7 @@ class CompressionExamples(kt.KairosTestCase):
         return frame
 
     def draw(self, out):
-        if not have_matplotlib():
-            self.skipTest("python3-matplotlib not installed: plotting script not run")
-        png = self.path("compress.png")
-        script = os.path.join(kt.SOURCE_DIR, "examples", "plot", "plot_compression.py")
-        result = subprocess.run([sys.executable, script, out, "-o", png, "--dpi", "40"],
-                                capture_output=True, text=True, timeout=kt.RUN_TIMEOUT)
-        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
-        with open(png, "rb") as f:
-            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        draw_png(self, "plot_compression.py", out, self.path("compress.png"))
 
     def test_jammed_spheres_3d(self):
         out, s = self.run_example("jammed_spheres_3d.toml")
