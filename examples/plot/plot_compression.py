@@ -29,7 +29,11 @@ def klm_pressure(eta):
 
 
 def read_rows(path):
-    rows = np.loadtxt(path, comments="#", ndmin=2)
+    with open(path) as f:
+        lines = [line for line in f if not line.startswith("#")]
+    if not lines:  # the compression ended before its first thermostat interval
+        return np.zeros(0), np.zeros(0)
+    rows = np.loadtxt(lines, ndmin=2)
     return rows[:, 1], rows[:, 2]
 
 
@@ -54,6 +58,9 @@ def read_contacts(path, n):
 
 def draw_pressure(ax, out, dimension, summary):
     phi, z = read_rows(os.path.join(out, "compress.tsv"))
+    if len(phi) == 0:
+        ax.set_title("no thermostat interval ended", fontsize=9)
+        return
     ax.semilogy(phi, z, ".", ms=2, label="Kairos, per thermostat interval")
     c = summary.get("compression", {})
     phi_j = c.get("free_volume_jamming_density")

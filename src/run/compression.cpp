@@ -126,7 +126,17 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
     EngineOptions options;
     // The starting diameters grow at a constant speed: relative to this engine's radii, slower.
     options.growth_rate = rate / diameter_scale;
-    options.min_cell_width = 2.0 * rmax * (1.0 + settings.cell_margin);
+    // Room to grow, but never less than 3 cells per axis (the cell list's minimum).
+    double shortest = state.box[0];
+    for (int a = 1; a < D; ++a) shortest = std::min(shortest, state.box[a]);
+    const double room = std::min(settings.cell_margin, shortest / (6.0 * rmax) - 1.0);
+    if (!(room > 1e-6)) {
+      throw InputError(fmt::format(
+          "compression: at packing fraction {:.6g} the box edge {:.6g} holds fewer than 3 of the "
+          "grown diameter {:.6g} (the cell list needs 3 cells per axis): use more particles",
+          state_packing_fraction(state), shortest, 2.0 * rmax));
+    }
+    options.min_cell_width = 2.0 * rmax * (1.0 + room);
     EventEngine<D, CalendarQueue> engine(std::move(state), StartMode::kPredict, options);
     // The scale of this engine's radii at the target packing fraction.
     const double target_scale =

@@ -187,6 +187,16 @@ TEST(Compression, RefusesWhatItCannotDo) {
     EXPECT_NE(std::string(e.what()).find("jammed at packing fraction"), std::string::npos)
         << e.what();
   }
+  // Too few particles for 3 cells of the grown diameter per axis: a clear error, not the cell
+  // list's.
+  auto few = random_start<3>(20, 0.3, 9);
+  CompressionSettings jam;
+  try {
+    compress(few, jam);
+    ADD_FAILURE() << "jammed 20 spheres";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("use more particles"), std::string::npos) << e.what();
+  }
   auto walled = random_start<3>(200, 0.3, 8);
   walled.periodic[2] = false;
   c.target_packing_fraction = 0.4;
