@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -17,6 +18,12 @@
 #include "core/vec.hpp"
 
 namespace kairos {
+
+// The volume of a sphere (3D) or area of a disk (2D) of radius r.
+template <int D>
+constexpr double ball_volume(double r) {
+  return D == 3 ? 4.0 / 3.0 * M_PI * r * r * r : M_PI * r * r;
+}
 
 template <int D>
 struct Kinematics {
@@ -60,7 +67,7 @@ struct EventCounters {
   // Sleepers woken because the sleeper under them woke and nothing else held them up (not
   // part of the state: counted from the start of this engine).
   std::uint64_t lost_support = 0;
-  std::uint64_t driving_kicks = 0;       // velocities set by a thermostat or random kick
+  std::uint64_t driving_kicks = 0;  // velocities set by a thermostat or random kick
   // Kinetic energy (translational + rotational) dissipated in particle-particle and in
   // particle-wall collisions, and the work moving walls did on the particles.
   double dissipated_in_collisions = 0.0;

@@ -381,9 +381,7 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   shear_ = LeesEdwards<D>(env_.shear_rate, box_, cells_.grid(), time_);
   sheared_ = shear_.on();
   double particle_volume = 0.0;
-  for (const Kinematics<D>& k : s.kinematics)
-    particle_volume +=
-        D == 3 ? 4.0 / 3.0 * M_PI * k.radius * k.radius * k.radius : M_PI * k.radius * k.radius;
+  for (const Kinematics<D>& k : s.kinematics) particle_volume += ball_volume<D>(k.radius);
   boundaries_.prepare(cells_.grid(), rmax, particle_volume, uniform_radius_);
   massive_walls_ = boundaries_.any_massive();
   outlets_ = boundaries_.any_passes();

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/periodic.hpp"
 #include "core/stop_flag.hpp"
@@ -17,11 +18,6 @@
 namespace kairos {
 
 namespace {
-
-template <int D>
-double particle_volume(double radius) {
-  return D == 3 ? 4.0 / 3.0 * M_PI * radius * radius * radius : M_PI * radius * radius;
-}
 
 // The state at its present time as a fresh start: positions (wrapped) and velocities at time
 // 0, no scheduler state, no counters.
@@ -44,11 +40,19 @@ void make_fresh_start(ParticleSystem<D>& state) {
 }
 
 template <int D>
+Thermodynamics thermodynamics_of(const ParticleSystem<D>& state) {
+  double volume = 1.0;
+  for (int a = 0; a < D; ++a) volume *= state.box[a];
+  return Thermodynamics(D, state.size(), volume);
+}
+
+// kT of the state by the run's one definition (analysis/thermodynamics).
+template <int D>
 double temperature_of(const ParticleSystem<D>& state) {
-  double twice_kinetic = 0.0;
+  double kinetic = 0.0;
   for (std::size_t i = 0; i < state.size(); ++i)
-    twice_kinetic += state.mass[i] * norm2(state.kinematics[i].vel);
-  return twice_kinetic / (D * static_cast<double>(state.size()));
+    kinetic += 0.5 * state.mass[i] * norm2(state.kinematics[i].vel);
+  return thermodynamics_of(state).temperature(kinetic);
 }
 
 void check_settings(const CompressionSettings& s) {
@@ -80,7 +84,7 @@ void check_state(const ParticleSystem<D>& state) {
 template <int D>
 double state_packing_fraction(const ParticleSystem<D>& state) {
   double volume = 0.0;
-  for (const Kinematics<D>& k : state.kinematics) volume += particle_volume<D>(k.radius);
+  for (const Kinematics<D>& k : state.kinematics) volume += ball_volume<D>(k.radius);
   double box = 1.0;
   for (int a = 0; a < D; ++a) box *= state.box[a];
   return volume / box;
@@ -101,6 +105,7 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
         settings.target_packing_fraction, out.initial_packing_fraction));
   }
   make_fresh_start(state);
+  const Thermodynamics thermo = thermodynamics_of(state);  // the box never changes
   const double kT = settings.temperature;
   {
     const double t0 = temperature_of(state);
@@ -174,7 +179,7 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
       interval_virial += c.virial - virial_mark;
       interval_time += engine.time() - time_mark;
       interval_collisions += c.collisions - collision_mark;
-      const double kT_end = 2.0 * engine.kinetic_energy() / (D * n);
+      const double kT_end = thermo.temperature(engine.kinetic_energy());
       const double kT_mean = 0.5 * (kT + kT_end);
       CompressionRow r;
       r.time = out.time + engine.time();
@@ -186,7 +191,7 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
             "or compress.pressure",
             interval_collisions, phi_now()));
       }
-      r.pressure = 1.0 + interval_virial / (D * n * kT_mean * interval_time);
+      r.pressure = thermo.compressibility(interval_virial, kT_mean, interval_time);
       r.temperature = kT_end;
       // Near jamming the mean free time falls towards 1e-12: rebuild (the clock starts at 0
       // again) before the clock's resolution comes within 1e-3 of it.

@@ -264,8 +264,7 @@ void EventEngineAdapter<D, Queue>::check_collisions_can_happen(double collisions
         [&](const ParticleSystem<D>& part, std::size_t) {
           for (std::size_t j = 0; j < part.size(); ++j) {
             if (env.fixed_species(part.species.empty() ? 0u : part.species[j])) continue;
-            const double r = part.kinematics[j].radius;
-            particle_volume += D == 3 ? 4.0 / 3.0 * M_PI * r * r * r : M_PI * r * r;
+            particle_volume += ball_volume<D>(part.kinematics[j].radius);
             mass += part.mass[j];
           }
         },
