@@ -354,6 +354,113 @@ template std::uint32_t scan_candidates_avx512<2, true>(const CandidateScan<2>&, 
 template std::uint32_t scan_candidates_avx512<3, true>(const CandidateScan<3>&, double,
                                                        const Vec<3>&, const Vec<3>&, double&);
 
+// -x, exactly as the scalar unary minus (the sign bit flipped: -(+0) is -0).
+[[gnu::always_inline]] inline __m512d negated(__m512d x) {
+  return _mm512_castsi512_pd(_mm512_xor_si512(
+      _mm512_castpd_si512(x), _mm512_set1_epi64(static_cast<long long>(0x8000000000000000ull))));
+}
+
+// The contact distances sigma0 (at the growth's origin) of mixed sizes: radius_i plus each
+// candidate's own radius, or its kind's.
+template <int D>
+[[gnu::always_inline]] inline __m512d growing_sigma0(const CandidateScan<D>& s, __m256i ids,
+                                                     __mmask8 live, __m512d vradius_i) {
+  if (s.particle_radius != nullptr) {
+    const __m512d rj =
+        _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live, ids, s.particle_radius, 8);
+    return _mm512_add_pd(vradius_i, rj);
+  }
+  const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(live),
+                                                  _mm512_castsi256_si512(ids), s.kind, 2);
+  const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
+  return _mm512_add_pd(vradius_i,
+                       _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live, shp, s.kind_radius, 8));
+}
+
+// scan_candidates_growing, eight candidates per iteration: every lane evaluates the branches of
+// growing_contact_before / growing_contact_time (dynamics/collision_time.hpp) with the same
+// operations in the same order, and a mask picks each lane's branch.
+template <int D>
+std::uint32_t scan_candidates_growing_avx512(const CandidateScan<D>& s, std::uint32_t self,
+                                             double t, const Vec<D>& xi, const Vec<D>& vi,
+                                             double scale, double rate, double& best) {
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
+  const __m512d vt = _mm512_set1_pd(t);
+  const __m512d vscale = _mm512_set1_pd(scale), vrate = _mm512_set1_pd(rate);
+  const __m512d two = _mm512_set1_pd(2.0), minus_two = _mm512_set1_pd(-2.0);
+  __m512d vxi[D], vvi[D];
+  for (int a = 0; a < D; ++a) {
+    vxi[a] = _mm512_set1_pd(xi[a]);
+    vvi[a] = _mm512_set1_pd(vi[a]);
+  }
+  const __m512d vsigma0 = _mm512_set1_pd(s.sigma);
+  const __m512d vradius_i = _mm512_set1_pd(s.radius_i);
+  const __m256i vstride = _mm256_set1_epi32(s.stride);
+  const __m256i vself = _mm256_set1_epi32(static_cast<int>(self));
+  std::uint32_t found = kNoCandidate;
+  for (std::uint32_t k = 0; k < s.count; k += 8) {
+    const std::uint32_t left = s.count - k;
+    __mmask8 live = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
+    const __m256i ids = _mm256_maskz_loadu_epi32(live, s.candidates + k);
+    live = _mm256_mask_cmpneq_epu32_mask(live, ids, vself);
+    const __m256i base = _mm256_mullo_epi32(ids, vstride);
+    __m512d r2, rg, g2, dtj;
+    pair_terms<D, false>(s, k, record_columns(s, ids, base, live), live, vt, vxi, vvi, r2, rg, g2,
+                         dtj);
+    const __m512d sigma0 = s.uniform ? vsigma0 : growing_sigma0<D>(s, ids, live, vradius_i);
+    const __m512d sigma = _mm512_mul_pd(sigma0, vscale);
+    const __m512d u = _mm512_mul_pd(sigma0, vrate);
+    const __m512d gap = _mm512_sub_pd(r2, _mm512_mul_pd(sigma, sigma));
+    const __m512d h = _mm512_sub_pd(rg, _mm512_mul_pd(sigma, u));
+    const __m512d c = _mm512_sub_pd(g2, _mm512_mul_pd(u, u));
+    const __mmask8 growth_wins = _mm512_mask_cmp_pd_mask(live, c, zero, _CMP_NGT_UQ);
+    const __mmask8 approach = _mm512_mask_cmp_pd_mask(live, h, zero, _CMP_LT_OQ);
+    // c > 0: the hard-sphere case, with its cheap bound gap <= -2 h best.
+    const __m512d bound = _mm512_mul_pd(_mm512_mul_pd(minus_two, h), _mm512_set1_pd(best));
+    const __mmask8 hard = _mm512_mask_cmp_pd_mask(static_cast<__mmask8>(approach & ~growth_wins),
+                                                  gap, bound, _CMP_NGT_UQ);
+    const __mmask8 flat = _mm512_mask_cmp_pd_mask(live, c, zero, _CMP_EQ_OQ);
+    const __mmask8 shrinking = _mm512_mask_cmp_pd_mask(live, c, zero, _CMP_LT_OQ);
+    const __mmask8 rooted = static_cast<__mmask8>(hard | shrinking);
+    if ((rooted | (flat & approach)) == 0) continue;
+    const __m512d disc = _mm512_sub_pd(_mm512_mul_pd(h, h), _mm512_mul_pd(gap, c));
+    const __mmask8 real = _mm512_mask_cmp_pd_mask(rooted, disc, zero, _CMP_NLE_UQ);
+    const __m512d root = _mm512_sqrt_pd(_mm512_mask_blend_pd(real, zero, disc));
+    const __m512d neg_h = negated(h);
+    // a / (-h + sqrt(disc)): the stable root of an approach (c > 0, or c < 0 with h <= 0).
+    const __m512d approach_root = _mm512_div_pd(gap, _mm512_add_pd(neg_h, root));
+    // c < 0 and h > 0: (-h - sqrt(disc)) / c; c < 0 without a real root: -h / c.
+    const __m512d receding_root = _mm512_div_pd(_mm512_sub_pd(neg_h, root), c);
+    const __m512d turn = _mm512_div_pd(neg_h, c);
+    const __mmask8 h_positive = _mm512_cmp_pd_mask(h, zero, _CMP_GT_OQ);
+    __m512d dt = _mm512_mask_blend_pd(h_positive, approach_root, receding_root);
+    dt = _mm512_mask_blend_pd(static_cast<__mmask8>(shrinking & ~real), dt, turn);
+    dt = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(dt, zero, _CMP_GT_OQ), zero, dt);
+    // c == 0: f is linear; -a / (2 h) when a > 0, else now.
+    const __m512d linear = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(gap, zero, _CMP_GT_OQ), zero,
+                                                _mm512_div_pd(negated(gap), _mm512_mul_pd(two, h)));
+    dt = _mm512_mask_blend_pd(flat, dt, linear);
+    // Lanes with an event: c > 0 with a real root, c < 0, or c == 0 approaching.
+    const __mmask8 valid = static_cast<__mmask8>((hard & real) | shrinking | (flat & approach));
+    dt = _mm512_mask_blend_pd(valid, inf, dt);
+    const double m = _mm512_reduce_min_pd(dt);
+    if (m < best) {
+      const __mmask8 at = _mm512_mask_cmp_pd_mask(valid, dt, _mm512_set1_pd(m), _CMP_EQ_OQ);
+      best = m;
+      found = k + static_cast<std::uint32_t>(__builtin_ctz(at));
+    }
+  }
+  return found;
+}
+
+template std::uint32_t scan_candidates_growing_avx512<2>(const CandidateScan<2>&, std::uint32_t,
+                                                         double, const Vec<2>&, const Vec<2>&,
+                                                         double, double, double&);
+template std::uint32_t scan_candidates_growing_avx512<3>(const CandidateScan<3>&, std::uint32_t,
+                                                         double, const Vec<3>&, const Vec<3>&,
+                                                         double, double, double&);
+
 // The stepped loop, eight candidates per iteration. Every lane computes r.r, r.g and g.g as
 // the scalar loop does. Zone-0 lanes (unlisted: the most) then take the hard-sphere loop's cheap
 // bound and the approach to their outermost boundary. Listed lanes (zone >= 1) are compressed
@@ -566,6 +673,19 @@ std::uint32_t scan_stepped_avx512(const SteppedScan<D>&, double, const Vec<D>&, 
                                   double&) {
   return kNoCandidate;  // never called: cpu_has_avx512() is false on this platform
 }
+
+template <int D>
+std::uint32_t scan_candidates_growing_avx512(const CandidateScan<D>&, std::uint32_t, double,
+                                             const Vec<D>&, const Vec<D>&, double, double,
+                                             double&) {
+  return kNoCandidate;  // never called: cpu_has_avx512() is false on this platform
+}
+template std::uint32_t scan_candidates_growing_avx512<2>(const CandidateScan<2>&, std::uint32_t,
+                                                         double, const Vec<2>&, const Vec<2>&,
+                                                         double, double, double&);
+template std::uint32_t scan_candidates_growing_avx512<3>(const CandidateScan<3>&, std::uint32_t,
+                                                         double, const Vec<3>&, const Vec<3>&,
+                                                         double, double, double&);
 
 template std::uint32_t scan_stepped_avx512<2, false>(const SteppedScan<2>&, double, const Vec<2>&,
                                                      const Vec<2>&, double&);

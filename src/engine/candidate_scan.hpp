@@ -108,8 +108,8 @@ std::uint32_t scan_candidates_scalar(const CandidateScan<D>& s, double t, const 
 
 // scan_candidates_scalar for growing spheres (engine/growth.hpp): the contact distance is the
 // loops' sigma (the radii at the growth's origin) times `scale`, growing at sigma * rate.
-// Scalar only: compression is not the hot path the AVX-512 loop was written for. `self` (the
-// predicted particle) is skipped: with itself, a growing particle would overlap at once.
+// `self` (the predicted particle) is skipped: with itself, a growing particle would overlap at
+// once. scan_candidates_growing_avx512 gives the same bits.
 template <int D>
 std::uint32_t scan_candidates_growing(const CandidateScan<D>& s, std::uint32_t self, double t,
                                       const Vec<D>& xi, const Vec<D>& vi, double scale, double rate,
@@ -236,6 +236,14 @@ bool cpu_gathers_fast();
 template <int D, bool kAccelerated = false>
 std::uint32_t scan_candidates_avx512(const CandidateScan<D>& s, double t, const Vec<D>& xi,
                                      const Vec<D>& vi, double& best);
+
+// AVX-512 loop for growing spheres (candidate_scan.cpp); the same contract and result as
+// scan_candidates_growing, per-particle radii (s.particle_radius) included. No deferred soft
+// contacts: growth refuses soft spheres.
+template <int D>
+std::uint32_t scan_candidates_growing_avx512(const CandidateScan<D>& s, std::uint32_t self,
+                                             double t, const Vec<D>& xi, const Vec<D>& vi,
+                                             double scale, double rate, double& best);
 
 // The candidate loop of stepped potentials (EventEngine::scan_stepped): the hard-sphere loop's
 // records and candidates (`base`: its contact-distance fields are not read), the predicted

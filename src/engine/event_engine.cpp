@@ -597,8 +597,10 @@ std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, 
   const CandidateScan<D> scan = scan_of(list, i, &delayed);
   std::uint32_t k;
   if (growing_) [[unlikely]] {
-    k = scan_candidates_growing<D>(scan, i, t, xi, hot_[i].vel, growth_.scale(t), growth_.rate(),
-                                   best);
+    k = vector_growing_ ? scan_candidates_growing_avx512<D>(scan, i, t, xi, hot_[i].vel,
+                                                            growth_.scale(t), growth_.rate(), best)
+                        : scan_candidates_growing<D>(scan, i, t, xi, hot_[i].vel, growth_.scale(t),
+                                                     growth_.rate(), best);
   } else if (accelerated_) {
     const Vec<D> vi = flight_velocity(hot_[i], t);
     k = vector_scan_ ? scan_candidates_avx512<D, true>(scan, t, xi, vi, best)
@@ -805,11 +807,16 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
   } else {
     const double mi = mass_of(i), mj = mass_of(j);
     const double mu = mi * mj / (mi + mj);
-    const double s =  // J = s r
-        growing_ ? HardSphere::growing_impulse_factor(g_dot_r, r2, mu,
-                                                      growth_.speed(radius_of(i) + radius_of(j)),
-                                                      contact_distance(i, j, t))
-                 : HardSphere::impulse_factor(g_dot_r, r2, mu);
+    double s;  // J = s r
+    if (growing_) [[unlikely]] {
+      // Beyond this the cells may have missed a pair: the caller must rebuild first.
+      if (t > growth_fits_until_)
+        throw std::logic_error("collide: growing particles no longer fit the cells");
+      s = HardSphere::growing_impulse_factor(
+          g_dot_r, r2, mu, growth_.speed(radius_of(i) + radius_of(j)), contact_distance(i, j, t));
+    } else {
+      s = HardSphere::impulse_factor(g_dot_r, r2, mu);
+    }
     for (int a = 0; a < D; ++a) {
       hi.vel[a] += s * r[a] / mi;
       hj.vel[a] -= s * r[a] / mj;
@@ -847,12 +854,18 @@ void EventEngine<D, Queue>::set_velocity(std::uint32_t k, double t, const Vec<D>
 }
 
 template <int D, class Queue>
-void EventEngine<D, Queue>::rescale_velocities(double t, double factor) {
+void EventEngine<D, Queue>::rescale_velocities(double t, double factor, double growth_rate) {
   if (!(t >= time_) || !(t <= next_event_time()))
     throw std::logic_error("rescale_velocities: time outside [time(), next_event_time()]");
   if (soft_ || resting_.count() > 0)
     throw std::logic_error("rescale_velocities: not with soft contacts or resting particles");
+  if (growth_rate != 0.0 && (!growing_ || !(growth_rate > 0.0) || !std::isfinite(growth_rate)))
+    throw std::logic_error("rescale_velocities: a growth rate while not growing, or not positive");
   time_ = t;
+  if (growth_rate != 0.0) {
+    growth_ = growth_.changed_at(t, growth_rate);
+    update_growth_limit();
+  }
   const auto n = static_cast<std::uint32_t>(size());
   for (std::uint32_t k = 0; k < n; ++k) {
     advance_to(k, t);
@@ -868,19 +881,7 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::set_growth_rate(double t, double rate) {
   if (!growing_ || !(rate > 0.0) || !std::isfinite(rate))
     throw std::logic_error("set_growth_rate: not growing, or not a positive rate");
-  if (!(t >= time_) || !(t <= next_event_time()))
-    throw std::logic_error("set_growth_rate: time outside [time(), next_event_time()]");
-  time_ = t;
-  growth_ = growth_.changed_at(t, rate);
-  update_growth_limit();
-  const auto n = static_cast<std::uint32_t>(size());
-  for (std::uint32_t k = 0; k < n; ++k) {
-    advance_to(k, t);
-    ++hot_[k].collisions;  // every prediction is stale
-  }
-  std::vector<double> times(n);
-  for (std::uint32_t k = 0; k < n; ++k) times[k] = predict(k, t);
-  queue_.reset(times);
+  rescale_velocities(t, 1.0, rate);
 }
 
 template <int D, class Queue>
@@ -889,7 +890,8 @@ void EventEngine<D, Queue>::update_growth_limit() {
   for (const ParticleKind& sh : kinds_) rmax = std::max(rmax, sh.radius);
   double width = kNever;
   for (int a = 0; a < D; ++a) width = std::min(width, cells_.grid().width(a));
-  growth_fits_until_ = growth_.fits_until(2.0 * rmax, width);
+  // Never before now: a rate changed at the old limit may round the new one just below it.
+  growth_fits_until_ = std::max(time_, growth_.fits_until(2.0 * rmax, width));
 }
 
 // Growing particles (docs/physics.md#growing-spheres): what growth composes with, and how long
@@ -910,8 +912,13 @@ void EventEngine<D, Queue>::start_growth() {
   if (env_.has_fixed_grains()) refuse("fixed grains");
   growth_ = Growth(options_.growth_rate, time_);
   growing_ = true;
-  vector_scan_ = false;  // the growing loop is scalar
-  row_loads_ = false;
+  // The growing loop reads per-particle radii too (the other vector loops read kinds only).
+  vector_growing_ = options_.vector_scan && cpu_has_avx512() &&
+                    static_cast<double>(hot_.size()) * sizeof(HotRecord<D>) < 2e9;
+  row_loads_ =
+      vector_growing_ && (options_.record_loads == RecordLoads::kRows ||
+                          (options_.record_loads == RecordLoads::kAuto && !cpu_gathers_fast()));
+  vector_scan_ = false;  // no other loop runs while growing
   update_growth_limit();
 }
 

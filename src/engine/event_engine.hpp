@@ -284,10 +284,12 @@ class EventEngine {
   const Growth& growth() const { return growth_; }
   double growth_fits_until() const { return growth_fits_until_; }
   // Multiplies every velocity by `factor` at time t (time() <= t <= next_event_time()), as a
-  // thermostat's rescaling does, and predicts every particle again.
-  void rescale_velocities(double t, double factor);
+  // thermostat's rescaling does, and predicts every particle again. Growing particles: a
+  // growth_rate > 0 also sets the growth rate from t on (as set_growth_rate), in the same pass.
+  void rescale_velocities(double t, double factor, double growth_rate = 0.0);
   // Growing particles: from time t on (time() <= t <= next_event_time()) the diameters grow at
   // `rate` (relative to the radii at the engine's start; > 0); every particle is predicted again.
+  // A collision beyond growth_fits_until() is refused (std::logic_error): the caller rebuilds.
   void set_growth_rate(double t, double rate);
 
  private:
@@ -557,6 +559,7 @@ class EventEngine {
   bool row_loads_ = false;        // CandidateScan::row_loads (RecordLoads, cpu_gathers_fast)
   HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
   bool accelerated_ = false;      // uniform gravity
+  bool vector_growing_ = false;   // the growing loop in AVX-512
   bool growing_ = false;          // growth_.on(): growing particles
   Vec<D> half_gravity_{};
   bool walls_ = false;                   // boundaries_.any()

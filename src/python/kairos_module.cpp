@@ -28,6 +28,7 @@
 #include "core/error.hpp"
 #include "core/stop_flag.hpp"
 #include "io/config.hpp"
+#include "run/outputs/compression_output.hpp"
 #include "run/run.hpp"
 #include "run/simulation.hpp"
 #include "run/simulation_analyses.hpp"
@@ -385,6 +386,38 @@ class PySimulation {
   }
   double potential_energy() const {
     return visit([](const auto& s) { return s.potential_energy(); });
+  }
+  // summary.json's `compression` (and what it leaves undefined) with the history of compress.tsv
+  // as NumPy columns; None if the start state was not compressed.
+  py::object compression() const {
+    return visit([](const auto& s) -> py::object {
+      const CompressionReport* report = s.compression();
+      if (report == nullptr) return py::none();
+      nlohmann::json summary;
+      summarize_compression(*report, dimension_of(s), summary);
+      py::dict out = py::module_::import("json").attr("loads")(summary["compression"].dump());
+      if (summary.contains("undefined")) {
+        out["undefined"] = py::module_::import("json").attr("loads")(summary["undefined"].dump());
+      }
+      const std::vector<CompressionRow>& rows = report->result.rows;
+      const auto column = [&](auto field) {
+        py::array_t<double> a(static_cast<py::ssize_t>(rows.size()));
+        auto v = a.mutable_unchecked<1>();
+        for (std::size_t k = 0; k < rows.size(); ++k)
+          v(static_cast<py::ssize_t>(k)) = static_cast<double>(field(rows[k]));
+        return a;
+      };
+      py::dict history;
+      history["time"] = column([](const CompressionRow& r) { return r.time; });
+      history["packing_fraction"] =
+          column([](const CompressionRow& r) { return r.packing_fraction; });
+      history["reduced_pressure"] = column([](const CompressionRow& r) { return r.pressure; });
+      history["kT_before_rescaling"] =
+          column([](const CompressionRow& r) { return r.temperature; });
+      history["collisions"] = column([](const CompressionRow& r) { return r.collisions; });
+      out["history"] = history;
+      return out;
+    });
   }
   py::list walls_with_mass() const {
     const std::vector<WallReading> walls = visit([](const auto& s) { return s.walls_with_mass(); });
@@ -1016,6 +1049,10 @@ PYBIND11_MODULE(kairos, m) {
            "velocities relative to the flow.")
       .def("potential_energy", &PySimulation::potential_energy,
            "Of the stepped potentials, or the elastic energy of soft contacts in progress.")
+      .def("compression", &PySimulation::compression,
+           "The compression that made the start state ([compress], or a random start denser "
+           "than insertion reaches) as summary.json's `compression` (contacts included) with "
+           "`history`: compress.tsv's columns as arrays. None if the start was not compressed.")
       .def("walls_with_mass", &PySimulation::walls_with_mass,
            "The walls with mass now (boundary.wall.mass): one dict each, face, position (of its "
            "plane along its axis), speed and energy, as thermo.tsv's columns.")

@@ -204,8 +204,9 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
       out.pressure = r.pressure;
       if (row) row(r);
       throw_if_stop_requested();
-      engine.rescale_velocities(engine.time(), std::sqrt(kT / kT_end));
-      // Near jamming, slower growth (see CompressionSettings::slowdown_pressure).
+      // Near jamming, slower growth (see CompressionSettings::slowdown_pressure), set with the
+      // rescaling (one prediction of every particle for both).
+      double new_rate = 0.0;
       if (settings.slowdown_pressure > 0.0 && r.pressure > settings.slowdown_pressure &&
           std::isfinite(r.pressure)) {
         const double wanted =
@@ -213,10 +214,11 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
             std::max(settings.slowdown_floor, std::sqrt(settings.slowdown_pressure / r.pressure));
         if (wanted < 0.8 * rate) {
           rate = wanted;
-          engine.set_growth_rate(engine.time(), rate / diameter_scale);
-          update_limits();
+          new_rate = rate / diameter_scale;
         }
       }
+      engine.rescale_velocities(engine.time(), std::sqrt(kT / kT_end), new_rate);
+      if (new_rate > 0.0) update_limits();
       ++out.rescalings;
       interval_virial = interval_time = 0.0;
       interval_collisions = 0;

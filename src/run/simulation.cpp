@@ -46,6 +46,7 @@ Simulation<D>::Simulation(const Config& config,
     }
   }
   progress_ = start.resumed;
+  compression_ = start.compression;
   const std::optional<RestartPlan> plan = start.plan;
   n_ = start.state.size();
   mass_ = start.state.mass;

@@ -102,6 +102,9 @@ class Simulation {
   const std::array<double, 9>& virial_tensor() const;
   // The engine under the run driver's interface, for the analyses (run/simulation_analyses.hpp).
   const EventIntegrator<D>& integrator() const;
+  // The compression that made the start state ([compress], or a random start denser than
+  // insertion reaches): what it did and the packing's contact network; null if none.
+  const CompressionReport* compression() const { return compression_ ? &*compression_ : nullptr; }
   // The effective configuration (after a restart: as continued).
   const Config& config() const { return config_; }
   // A restart file (atomically) that `kairos run --restart` continues bit-identically.
@@ -116,6 +119,7 @@ class Simulation {
   Config config_;
   std::unique_ptr<EventEngineAdapter<D, CalendarQueue>> engine_;
   RunProgress progress_;
+  std::optional<CompressionReport> compression_;
   std::size_t n_ = 0;
   std::vector<double> mass_, radius_;
   std::vector<std::uint32_t> species_;

@@ -2,6 +2,8 @@
 // same bits for every pair, the first candidate among equal times, the bound respected.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -144,6 +146,111 @@ TEST(CandidateScan, FirstOfEqualContactTimesWins) {
       EXPECT_EQ(best, 1.0);
     }
   }
+}
+
+// The growing loops (Lubachevsky-Stillinger): the contact time of every pair from
+// growing_contact_time, the soonest kept; scalar and AVX-512 loops to the bit, for one radius,
+// radii by kind and radii per particle, scale and rate such that the growth outruns some pairs'
+// approach (c < 0), and, in one trial of three, dyadic states with c == 0 exactly.
+template <int D>
+void check_growing_loops() {
+  std::mt19937_64 rng(99 + D);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), rate_of(0.0, 1.5), radius_of(0.3, 0.6);
+  int found_some = 0, vector_trials = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const int n = 1 + trial % 37;
+    Records<D> r = random_records<D>(rng, n);
+    const bool flat = trial % 3 == 2;  // c == 0: |g| == u exactly
+    Vec<D> xi, vi;
+    for (int a = 0; a < D; ++a) {
+      xi[a] = flat ? 0.0 : u(rng);
+      vi[a] = flat ? 0.0 : u(rng);
+    }
+    double scale = 0.8 + 0.4 * (u(rng) + 1.0), rate = rate_of(rng);
+    const int sizes = trial % 4;  // 0, 1: one radius; 2: by kind; 3: per particle
+    std::vector<double> particle_radius(static_cast<std::size_t>(n) + 1);
+    std::vector<std::uint16_t> kind(static_cast<std::size_t>(n) + 2);
+    double kind_radius[3] = {0.45, 0.3, 0.6};
+    for (int j = 0; j < n; ++j) {
+      particle_radius[j] = radius_of(rng);
+      kind[j] = static_cast<std::uint16_t>(j % 3);
+    }
+    if (flat) {  // sigma0 = 1, scale 1, rate 0.5, g = (+-0.5, 0...), records at time t
+      scale = 1.0;
+      rate = 0.5;
+      for (int j = 0; j < n; ++j) {
+        double* rec = r.data.data() + j * Records<D>::kStride;
+        for (int a = 0; a < D; ++a) {
+          rec[a] = std::ldexp(std::round(std::ldexp(rec[a], 4)), -4);
+          rec[D + a] = a == 0 ? (j % 2 == 0 ? 0.5 : -0.5) : 0.0;
+        }
+        rec[2 * D] = 0.25;
+      }
+    }
+    const std::uint32_t self = static_cast<std::uint32_t>(trial % (n + 3));  // sometimes absent
+    CandidateScan<D> s;
+    s.records = r.data.data();
+    s.stride = Records<D>::kStride;
+    s.candidates = r.ids.data();
+    s.shift_index = r.shift_index.data();
+    s.shifts = r.shifts;
+    s.any_shift = trial % 2 == 1 && !flat;
+    s.count = static_cast<std::uint32_t>(n);
+    s.uniform = sizes < 2 || flat;
+    s.sigma = flat ? 1.0 : 0.9;
+    s.radius_i = 0.45;
+    s.kind = kind.data();
+    s.kind_radius = kind_radius;
+    s.particle_radius = sizes == 3 ? particle_radius.data() : nullptr;
+    const double bound = trial % 5 == 0 ? 0.5 : kNever;
+    // The reference: each pair by growing_contact_time.
+    double best_ref = bound;
+    std::uint32_t want = kNoCandidate;
+    for (std::uint32_t k = 0; k < s.count; ++k) {
+      const std::uint32_t j = s.candidates[k];
+      if (j == self) continue;
+      const double* rec = r.data.data() + j * Records<D>::kStride;
+      const Vec<D> shift = s.any_shift ? r.shifts[r.shift_index[k]] : Vec<D>{};
+      double r2 = 0, rg = 0, g2 = 0;
+      for (int a = 0; a < D; ++a) {
+        const double d = xi[a] - ((rec[a] + rec[D + a] * (0.25 - rec[2 * D])) + shift[a]);
+        const double g = vi[a] - rec[D + a];
+        r2 += d * d;
+        rg += d * g;
+        g2 += g * g;
+      }
+      const double sigma0 = s.uniform    ? s.sigma
+                            : sizes == 3 ? s.radius_i + particle_radius[j]
+                                         : s.radius_i + kind_radius[kind[j]];
+      const double sigma = sigma0 * scale, speed = sigma0 * rate;
+      const double dt =
+          growing_contact_time(r2 - sigma * sigma, rg - sigma * speed, g2 - speed * speed);
+      if (dt < best_ref) {
+        best_ref = dt;
+        want = k;
+      }
+    }
+    double best = bound;
+    const std::uint32_t got = scan_candidates_growing<D>(s, self, 0.25, xi, vi, scale, rate, best);
+    ASSERT_EQ(got, want) << "scalar, trial " << trial;
+    ASSERT_EQ(best, best_ref) << "scalar, trial " << trial;
+    found_some += want != kNoCandidate ? 1 : 0;
+    if (!cpu_has_avx512()) continue;
+    double best_vector = bound;
+    const std::uint32_t got_vector =
+        scan_candidates_growing_avx512<D>(s, self, 0.25, xi, vi, scale, rate, best_vector);
+    ASSERT_EQ(got_vector, want) << "AVX-512, trial " << trial;
+    ASSERT_EQ(std::memcmp(&best_vector, &best_ref, sizeof best), 0)
+        << "AVX-512, trial " << trial << ": " << best_vector << " vs " << best_ref;
+    ++vector_trials;
+  }
+  EXPECT_GT(found_some, 1000);
+  EXPECT_EQ(vector_trials, cpu_has_avx512() ? 3000 : 0);
+}
+
+TEST(CandidateScan, GrowingLoopsMatchTheReferenceContactTime) {
+  check_growing_loops<3>();
+  check_growing_loops<2>();
 }
 
 }  // namespace

@@ -85,6 +85,56 @@ TEST(Growth, StopsBeforeTheCellsAreTooNarrow) {
   EXPECT_NEAR(engine.growth_fits_until(), width / 1.0 - 1.0, 1e-12);
 }
 
+TEST(Growth, NoCollisionBeyondTheCellsLimit) {
+  // Fast growth in cells with little room: stepping on past growth_fits_until() is refused at
+  // the first collision there (the cells may have missed a pair), never taken silently.
+  const auto s = lattice_system<3>(5, 0.3, 17);
+  EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, growing<3>(0.5, s, 1.05));
+  const double limit = engine.growth_fits_until();
+  ASSERT_LT(limit, 1.0);
+  bool refused = false;
+  for (int e = 0; e < 100000 && !refused; ++e) {
+    const std::uint64_t collisions = engine.counters().collisions;
+    try {
+      engine.step();
+    } catch (const std::logic_error& error) {
+      EXPECT_GT(engine.next_event_time(), limit);
+      EXPECT_EQ(engine.counters().collisions, collisions);
+      refused = true;
+    }
+    if (!refused && engine.counters().collisions > collisions) {
+      EXPECT_LE(engine.time(), limit);
+    }
+  }
+  EXPECT_TRUE(refused);
+}
+
+TEST(Growth, RescaledVelocitiesAndANewRateInOnePass) {
+  // rescale_velocities with a growth rate: the same schedule as a rescaling followed by
+  // set_growth_rate at the same time (the protocol's slowdown), to the bit.
+  const auto s = lattice_system<3>(5, 0.3, 18);
+  EventEngine<3, CalendarQueue> a(s, StartMode::kPredict, growing<3>(0.05, s, 1.2));
+  EventEngine<3, CalendarQueue> b(s, StartMode::kPredict, growing<3>(0.05, s, 1.2));
+  for (int e = 0; e < 500; ++e) {
+    a.step();
+    b.step();
+  }
+  a.rescale_velocities(a.time(), 0.7);
+  a.set_growth_rate(a.time(), 0.02);
+  b.rescale_velocities(b.time(), 0.7, 0.02);
+  EXPECT_EQ(a.growth_fits_until(), b.growth_fits_until());
+  for (int e = 0; e < 2000 && a.next_event_time() < a.growth_fits_until(); ++e) {
+    ASSERT_EQ(a.next_event_time(), b.next_event_time()) << "event " << e;
+    a.step();
+    b.step();
+  }
+  const ParticleSystem<3> xa = a.export_state(), xb = b.export_state();
+  for (std::size_t i = 0; i < xa.size(); ++i) {
+    for (int d = 0; d < 3; ++d) ASSERT_EQ(xa.kinematics[i].pos[d], xb.kinematics[i].pos[d]);
+  }
+  b.validate();
+}
+
 TEST(Growth, RescaledVelocitiesArePredictedAgain) {
   const auto s = lattice_system<3>(5, 0.3, 16);
   EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, growing<3>(0.05, s, 1.2));

@@ -232,6 +232,39 @@ class Module(kt.KairosTestCase):
         self.assertEqual(sim.events, 3_000_000)
         self.assertEqual(sim.positions().shape, (4000, 3))
 
+    def test_a_compressed_start_reports_as_the_cli_does(self):
+        # A random start grown to 0.55 ([compress]): the Simulation starts from the same packing
+        # as `kairos run` (bit for bit), and compression() holds summary.json's `compression`
+        # with compress.tsv's rows; a start that was not compressed has none.
+        config = hard_config(time=0.2)
+        config["system"]["packing_fraction"] = 0.3
+        config["compress"] = {"packing_fraction": 0.55, "growth_rate": 0.05}
+        cfg = self.write_config(config)
+        out = self.path("compressed")
+        self.run_ok("run", cfg, "-o", out)
+        sim = kairos.Simulation(cfg)
+        report = sim.compression()
+        summary = self.summary(out)["compression"]
+        for key in ("stop_reason", "packing_fraction", "reduced_pressure", "time", "collisions",
+                    "rescalings", "rebuilds", "diameter_scale", "contacts"):
+            self.assertEqual(report[key], summary[key], key)
+        self.assertEqual(report["stop_reason"], "packing_fraction")
+        self.assertAlmostEqual(report["packing_fraction"], 0.55, delta=1e-12)
+        self.assertAlmostEqual(report["diameter_scale"], (0.55 / 0.3) ** (1 / 3), delta=1e-12)
+        rows = np.loadtxt(os.path.join(out, "compress.tsv"), ndmin=2)
+        history = report["history"]
+        self.assertEqual(len(history["time"]), len(rows))
+        self.assertTrue(np.array_equal(history["packing_fraction"], rows[:, 1]))
+        self.assertTrue(np.array_equal(history["collisions"], rows[:, 4]))
+        # The packing the CLI wrote (float64, GSD's box centred on 0) is the Simulation's start.
+        packing = kt.restart_chunk(os.path.join(out, "packing.gsd"), "particles/position")
+        self.assertEqual(packing.dtype, np.float64)
+        d = sim.positions() - sim.box / 2 - packing  # positions() lie in [0, L)
+        d -= sim.box * np.round(d / sim.box)
+        self.assertLess(np.abs(d).max(), 1e-12 * sim.box.max())
+        self.assertIsNone(kairos.Simulation(self.write_config(hard_config(), "plain.toml"))
+                          .compression())
+
     def test_run_returns_the_summary(self):
         out = self.path("out")
         summary = kairos.run(self.write_config(hard_config()), output=out,

@@ -26,7 +26,7 @@ void CompressionOutput<D>::open(const RunContext<D>& run) {
   if (!report_->has_network) {
     write_text_atomically(run.directory() / "contacts.tsv",
                           "# no contact network: the packing is not near jamming (reduced pressure "
-                          "below 1e4) and compress.contact_gap is 0\n");
+                          "below 1e6) and compress.contact_gap is 0\n");
   }
   std::string contacts = fmt::format(
       "# contacts of the packing in packing.gsd: relative gap (r - sigma_ij) / sigma_ij below "
@@ -48,11 +48,12 @@ void CompressionOutput<D>::open(const RunContext<D>& run) {
   });
 }
 
-template <int D>
-void CompressionOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) const {
-  const CompressionResult& r = report_->result;
-  const CompressionSettings& s = report_->settings;
-  const ContactNetwork& net = report_->network;
+void summarize_compression(const CompressionReport& report, int dimension,
+                           nlohmann::json& summary) {
+  const CompressionResult& r = report.result;
+  const CompressionSettings& s = report.settings;
+  const ContactNetwork& net = report.network;
+  const int D = dimension;
   nlohmann::json& c = summary["compression"];
   c["stop_reason"] = r.stop_reason;
   c["initial_packing_fraction"] = r.initial_packing_fraction;
@@ -72,11 +73,12 @@ void CompressionOutput<D>::summarize(nlohmann::json& summary, const RunContext<D
   c["collisions"] = r.collisions;
   c["rescalings"] = r.rescalings;
   c["rebuilds"] = r.rebuilds;
-  c["wall_seconds"] = report_->wall_seconds;
-  if (!report_->has_network) {
+  c["diameter_scale"] = r.diameter_scale;
+  c["wall_seconds"] = report.wall_seconds;
+  if (!report.has_network) {
     c["contacts"] = nullptr;
     summary["undefined"]["compression.contacts"] =
-        "the packing is not near jamming (reduced pressure below 1e4): touching and open pairs "
+        "the packing is not near jamming (reduced pressure below 1e6): touching and open pairs "
         "are not told apart by their gaps (compress.contact_gap sets a tolerance)";
     return;
   }
@@ -93,6 +95,11 @@ void CompressionOutput<D>::summarize(nlohmann::json& summary, const RunContext<D
   set_or_explain(summary, k, "smallest_open_gap", net.smallest_open_gap,
                  std::isfinite(net.smallest_open_gap) ? "" : "no open pair within 1.1 sigma",
                  "compression.contacts.smallest_open_gap");
+}
+
+template <int D>
+void CompressionOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) const {
+  summarize_compression(*report_, D, summary);
 }
 
 template class CompressionOutput<2>;

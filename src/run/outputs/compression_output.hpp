@@ -15,6 +15,10 @@
 
 namespace kairos {
 
+// summary.json's `compression` (and its `undefined` entries) from a report: the observer's
+// part, and kairos.Simulation's compression().
+void summarize_compression(const CompressionReport& report, int dimension, nlohmann::json& summary);
+
 template <int D>
 class CompressionOutput final : public Observer<D> {
  public:
