@@ -8,8 +8,17 @@
 // only. The cell each particle is in is kept in its record (HotRecord::cell), so restart files
 // store it with the record; validate() checks the lists against the records. Hot code: every
 // function is defined here, inline, for the engine's translation unit.
+//
+// Wide size distributions take two levels (use_levels): the small particles in the grid, sized
+// for their contact distance, the big ones in a coarse grid whose cells group whole fine cells.
+// A small particle's candidates are the 3^D fine cells around it and the 3^D coarse cells around
+// the coarse cell holding its own; a big particle's, the fine cells within its reach (a block of
+// (2 reach + 1)^D) and the same 3^D coarse cells. Every particle crosses fine cells only, so its
+// coarse cell changes only at a crossing (Ogarko and Luding, Comput. Phys. Commun. 183, 931
+// (2012), for the hierarchical grid; docs/performance.md#wide-size-distributions-the-limit).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -67,6 +76,49 @@ class CellNeighbourhood {
   const CellGrid<D>& grid() const { return grid_; }
   CandidateList<D>& list(int k) { return lists_[k]; }
 
+  // Two levels (see the file's comment): `coarse` lists the particles flagged in `big`; its cell
+  // c holds fine cells group*c ... group*(c + 1) - 1 along each axis (the last also the rest);
+  // a big particle searches `reach` fine cells around its own. `box`: the periodic shifts.
+  struct Levels {
+    CellGrid<D> coarse;
+    std::array<int, D> group{};
+    std::array<int, D> reach{};
+    std::vector<std::uint8_t> big;  // per particle
+    Vec<D> box{};
+    double small_radius = 0.0;  // the largest radius in the fine cells
+  };
+  void use_levels(Levels levels) {
+    levels_ = std::move(levels);
+    two_level_ = true;
+  }
+  bool two_level() const { return two_level_; }
+  bool big(std::uint32_t i) const { return two_level_ && levels_.big[i] != 0; }
+  const Levels& levels() const { return levels_; }
+  std::vector<std::uint8_t>& big_flags() { return levels_.big; }
+  // The coarse cell holding fine cell `cell`.
+  CellCode coarse_of(CellCode cell) const {
+    std::array<int, D> c;
+    for (int a = 0; a < D; ++a) {
+      c[a] =
+          std::min(grid_.coordinate(cell, a) / levels_.group[a], levels_.coarse.cells_along(a) - 1);
+    }
+    return levels_.coarse.code_at(c);
+  }
+  // Particle i's candidates (it sits in fine cell `cell`): gather() with one level.
+  void gather_particle(std::uint32_t i, CellCode cell, CandidateList<D>& list,
+                       const HotRecord<D>* hot) const {
+    if (!two_level_) {
+      gather(cell, list, hot);
+      return;
+    }
+    if (levels_.big[i] != 0) {
+      gather_block(cell, list, hot);
+    } else {
+      gather(cell, list, hot);
+    }
+    append_coarse(cell, list, hot);
+  }
+
   // The members of the 3^D cells around `cell` as candidates. Cells away from the box faces
   // (most) need no periodic shifts and take a loop over fixed index offsets.
   void gather(CellCode cell, CandidateList<D>& list, const HotRecord<D>* hot) const {
@@ -88,10 +140,29 @@ class CellNeighbourhood {
   // in increasing index order.
   void insert_all(const HotRecord<D>* hot, std::uint32_t n) {
     grid_.clear();
+    if (two_level_) {
+      levels_.coarse.clear();
+      for (auto k = n; k-- > 0;) {
+        if (levels_.big[k] != 0) {
+          levels_.coarse.insert(k, coarse_of(hot[k].cell));
+        } else {
+          grid_.insert(k, hot[k].cell);
+        }
+      }
+      return;
+    }
     for (auto k = n; k-- > 0;) grid_.insert(k, hot[k].cell);
   }
   // Particle i moves from cell `from` to cell `to`.
   void move(std::uint32_t i, CellCode from, CellCode to) {
+    if (two_level_ && levels_.big[i] != 0) [[unlikely]] {
+      const CellCode a = coarse_of(from), b = coarse_of(to);
+      if (a != b) {
+        levels_.coarse.erase(i, a);
+        levels_.coarse.insert(i, b);
+      }
+      return;
+    }
     grid_.erase(i, from);
     grid_.insert(i, to);
   }
@@ -114,7 +185,19 @@ class CellNeighbourhood {
   void append_members(std::uint32_t p, const Links& links, CandidateList<D>& list, std::uint32_t& n,
                       std::uint32_t*& cand, std::uint32_t& cap) const;
 
+  // Two levels: the fine cells within a big particle's reach; the coarse 3^D cells around the
+  // coarse cell of fine cell `cell`, appended (both with every candidate's shift written).
+  void gather_block(CellCode cell, CandidateList<D>& list, const HotRecord<D>* hot) const;
+  void append_coarse(CellCode cell, CandidateList<D>& list, const HotRecord<D>* hot) const;
+  // The slot of periodic shift `shift` in list.shifts (added if new); a first nonzero shift
+  // writes the zero slot into the candidates listed before it (their slots were not written).
+  static std::uint32_t shift_slot(CandidateList<D>& list, const Vec<D>& shift);
+  void append_list(std::uint32_t first, std::uint32_t slot, CandidateList<D>& list,
+                   std::uint32_t end, const std::uint32_t* next, const HotRecord<D>* hot) const;
+
   CellGrid<D> grid_;
+  bool two_level_ = false;
+  Levels levels_;
   bool vector_gather_ = false;
   CandidateList<D> lists_[2];  // last: large (their shift arrays), touched less than the grid
 };
@@ -273,6 +356,87 @@ inline void CellNeighbourhood<D>::gather_vector(CellCode cell, const std::uint8_
 }
 
 template <int D>
+inline std::uint32_t CellNeighbourhood<D>::shift_slot(CandidateList<D>& list, const Vec<D>& shift) {
+  bool zero = true;
+  for (int a = 0; a < D; ++a) zero = zero && shift[a] == 0.0;
+  if (zero) return 0;
+  for (std::uint32_t k = 1; k < list.n_shifts; ++k) {
+    bool same = true;
+    for (int a = 0; a < D; ++a) same = same && list.shifts[k][a] == shift[a];
+    if (same) return k;
+  }
+  if (list.n_shifts == 1) {  // the slots of the candidates so far were not written
+    for (std::uint32_t k = 0; k < list.count; ++k) list.shift[k] = 0;
+  }
+  list.shifts[list.n_shifts] = shift;
+  return list.n_shifts++;
+}
+
+template <int D>
+inline void CellNeighbourhood<D>::append_list(std::uint32_t first, std::uint32_t slot,
+                                              CandidateList<D>& list, std::uint32_t end,
+                                              const std::uint32_t* next,
+                                              const HotRecord<D>* hot) const {
+  for (std::uint32_t p = first; p != end; p = next[p]) {
+    if (list.ids.size() - list.count < kCandidateSlack) [[unlikely]]
+      grow(list);
+    __builtin_prefetch(hot + p);
+    list.ids[list.count] = p;
+    list.shift[list.count++] = slot;
+  }
+}
+
+template <int D>
+void CellNeighbourhood<D>::gather_block(CellCode cell, CandidateList<D>& list,
+                                        const HotRecord<D>* hot) const {
+  list.count = 0;
+  list.n_shifts = 1;
+  list.shifts[0] = Vec<D>{};
+  std::array<int, D> base, off, at;
+  for (int a = 0; a < D; ++a) {
+    base[a] = grid_.coordinate(cell, a);
+    off[a] = -levels_.reach[a];
+  }
+  while (true) {
+    Vec<D> shift{};
+    for (int a = 0; a < D; ++a) {
+      const int n = grid_.cells_along(a);
+      at[a] = base[a] + off[a];
+      if (at[a] < 0) {
+        at[a] += n;
+        shift[a] = -levels_.box[a];
+      } else if (at[a] >= n) {
+        at[a] -= n;
+        shift[a] = levels_.box[a];
+      }
+    }
+    const std::uint32_t slot = shift_slot(list, shift);
+    append_list(grid_.first(grid_.index(grid_.code_at(at))), slot, list, grid_.end(), grid_.links(),
+                hot);
+    int a = 0;
+    for (; a < D; ++a) {
+      if (++off[a] <= levels_.reach[a]) break;
+      off[a] = -levels_.reach[a];
+    }
+    if (a == D) break;
+  }
+}
+
+template <int D>
+void CellNeighbourhood<D>::append_coarse(CellCode cell, CandidateList<D>& list,
+                                         const HotRecord<D>* hot) const {
+  const CellGrid<D>& coarse = levels_.coarse;
+  const CellCode home = coarse_of(cell);
+  for (int n = 0; n < CellGrid<D>::kNeighbourCells; ++n) {
+    const typename CellGrid<D>::Neighbour nb = coarse.neighbour(home, n);
+    const std::uint32_t first = coarse.first(nb.cell);
+    if (first == coarse.end()) continue;
+    const std::uint32_t slot = nb.shifted ? shift_slot(list, nb.shift) : 0;
+    append_list(first, slot, list, coarse.end(), coarse.links(), hot);
+  }
+}
+
+template <int D>
 template <class Fail, class Name>
 void CellNeighbourhood<D>::validate(const HotRecord<D>* hot, std::uint32_t n, Fail&& fail,
                                     Name&& name) const {
@@ -283,6 +447,18 @@ void CellNeighbourhood<D>::validate(const HotRecord<D>* hot, std::uint32_t n, Fa
       if (p >= n || ++steps > n) fail("cell " + std::to_string(c) + " has a broken list");
       if (grid_.index(hot[p].cell) != c)
         fail("particle " + name(p) + " listed in a cell it is not in");
+      if (big(p)) fail("big particle " + name(p) + " listed in a fine cell");
+      ++listed[p];
+    }
+  }
+  const CellGrid<D>& coarse = levels_.coarse;
+  for (std::uint32_t c = 0; two_level_ && c < coarse.cell_count(); ++c) {
+    std::uint32_t steps = 0;
+    for (std::uint32_t p = coarse.first(c); p != coarse.end(); p = coarse.next(p)) {
+      if (p >= n || ++steps > n) fail("coarse cell " + std::to_string(c) + " has a broken list");
+      if (!big(p)) fail("small particle " + name(p) + " listed in a coarse cell");
+      if (coarse.index(coarse_of(hot[p].cell)) != c)
+        fail("particle " + name(p) + " listed in a coarse cell it is not in");
       ++listed[p];
     }
   }

@@ -105,6 +105,15 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   // Read (kinds_ hold the radii): released before the queue and the renumbering take their
   // memory (docs/performance.md, "Memory").
   std::vector<Kinematics<D>>().swap(s.kinematics);
+  if (levels_room_ > 0.0) {
+    plan_size_levels(levels_room_, levels_cells_per_particle_);
+    if (cells_.two_level()) {
+      // A crossing rescans the whole neighbourhood: the coarse cell may change, and a big
+      // particle's new layer is a slab of its block.
+      incremental_crossings_ = false;
+      if (growing_) update_growth_limit();
+    }
+  }
   restore_frozen(s, mode);
   // Spins are tracked when contacts can change them, or when the state carries them.
   if (env_.rotates() || !s.angular_velocity.empty()) {
@@ -378,6 +387,12 @@ void EventEngine<D, Queue>::setup_environment(const ParticleSystem<D>& s) {
   cells_ =
       Cells(CellGrid<D>(box_, min_width, periodic, s.size(), cells_per_particle), vector_gather_);
   bounded_ = bounded;
+  // Two cell levels are planned once the particles are read (plan_size_levels).
+  if (options_.size_levels && !bounded && !walls_ && !stepped_ && bonds_.empty() &&
+      !env_.soft_spheres() && env_.shear_rate == 0.0 && !env_.has_fixed_grains()) {
+    levels_room_ = std::max(1.0, options_.min_cell_width / range);
+    levels_cells_per_particle_ = cells_per_particle;
+  }
   shear_ = LeesEdwards<D>(env_.shear_rate, box_, cells_.grid(), time_);
   sheared_ = shear_.on();
   double particle_volume = 0.0;
@@ -468,6 +483,7 @@ void EventEngine<D, Queue>::renumber(bool queue_filled) {
   permute(hot_);
   permute(pending_);
   permute(id_);
+  if (cells_.two_level()) permute(cells_.big_flags());
   permute(kind_);  // its spare last entry stays
   permute(radius_);
   permute(spin_);
@@ -621,7 +637,7 @@ std::uint32_t EventEngine<D, Queue>::test_candidates(const CandidateList& list, 
 // comes before the particle leaves its cell, else the crossing. Stores it; returns its time.
 template <int D, class Queue>
 double EventEngine<D, Queue>::predict(std::uint32_t i, double t) {
-  gather(hot_[i].cell, cells_.list(0));
+  gather_of(i, cells_.list(0));
   return predict_from(cells_.list(0), i, t);
 }
 
@@ -890,8 +906,101 @@ void EventEngine<D, Queue>::update_growth_limit() {
   for (const ParticleKind& sh : kinds_) rmax = std::max(rmax, sh.radius);
   double width = kNever;
   for (int a = 0; a < D; ++a) width = std::min(width, cells_.grid().width(a));
+  double fits = growth_.fits_until(2.0 * rmax, width);
+  if (cells_.two_level()) {
+    // Small pairs within fine cells, any pair with a big one within coarse cells, a big one's
+    // small partners within its reach.
+    const auto& levels = cells_.levels();
+    fits = kNever;
+    for (int a = 0; a < D; ++a) {
+      const double w = cells_.grid().width(a);
+      fits = std::min({fits, growth_.fits_until(2.0 * levels.small_radius, w),
+                       growth_.fits_until(2.0 * rmax, levels.group[a] * w),
+                       growth_.fits_until(levels.small_radius + rmax, levels.reach[a] * w)});
+    }
+  }
   // Never before now: a rate changed at the old limit may round the new one just below it.
-  growth_fits_until_ = std::max(time_, growth_.fits_until(2.0 * rmax, width));
+  growth_fits_until_ = std::max(time_, fits);
+}
+
+// Two cell levels when the size distribution is wide (EngineOptions::size_levels): the small
+// particles (within twice the 10th percentile of the radii) in the fine grid sized for them,
+// the others in a coarse grid whose cells group whole fine cells and hold the largest contact.
+// Radii at the engine's start; `room` widens both (growth).
+template <int D, class Queue>
+void EventEngine<D, Queue>::plan_size_levels(double room, double cells_per_particle) {
+  const auto n = static_cast<std::uint32_t>(size());
+  if (n < 2) return;
+  std::vector<double> radii(n);
+  for (std::uint32_t k = 0; k < n; ++k) radii[k] = radius_of(k);
+  std::vector<double> sorted = radii;
+  const auto tenth = sorted.begin() + n / 10;
+  std::nth_element(sorted.begin(), tenth, sorted.end());
+  const double split = 2.0 * *tenth;
+  double small = 0.0, largest = 0.0;
+  for (const double r : radii) {
+    largest = std::max(largest, r);
+    if (r <= split) small = std::max(small, r);
+  }
+  if (!(largest > 2.5 * small)) return;
+  std::array<bool, D> periodic;
+  periodic.fill(true);
+  Vec<D> fine_width;
+  fine_width.fill(2.0 * small * room);
+  // The big particles fill much of the box: up to 8 fine cells per particle (32 bytes) rather
+  // than the one-level cap, which would widen the fine cells towards the big ones.
+  CellGrid<D> fine(box_, fine_width, periodic, n, std::max(cells_per_particle, 8.0));
+  typename Cells::Levels levels;
+  Vec<D> coarse_width;
+  for (int a = 0; a < D; ++a) {
+    const double w = fine.width(a);
+    const double wanted = 2.0 * largest * room, reach = (small + largest) * room;
+    levels.group[a] = static_cast<int>(std::ceil(wanted / w));
+    while (levels.group[a] * w < wanted) ++levels.group[a];
+    levels.reach[a] = static_cast<int>(std::ceil(reach / w));
+    while (levels.reach[a] * w < reach) ++levels.reach[a];
+    const int coarse = fine.cells_along(a) / levels.group[a];
+    // Three coarse cells per axis, and a block that meets no cell twice; else one level.
+    if (coarse < 3 || fine.cells_along(a) < 2 * levels.reach[a] + 1) return;
+    coarse_width[a] = box_[a] / (coarse + 0.5);  // exactly `coarse` cells
+  }
+  // Two levels only where they pay: the candidates and cells a prediction visits, weighted by
+  // how often each particle is predicted (its collision rate, taken as (r + mean r)^2), against
+  // one level's (measured: a uniform 1:14 distribution of diameters runs faster on one level,
+  // most of its particles being mid-sized; docs/performance.md).
+  double volume = 1.0, fine_volume = 1.0, coarse_volume = 1.0, block = 1.0, one_cell = 1.0;
+  for (int a = 0; a < D; ++a) {
+    volume *= box_[a];
+    fine_volume *= fine.width(a);
+    coarse_volume *= levels.group[a] * fine.width(a);
+    block *= 2 * levels.reach[a] + 1;
+    one_cell *= cells_.grid().width(a);
+  }
+  std::size_t bigs = 0;
+  double mean = 0.0;
+  for (const double r : radii) {
+    bigs += r > small ? 1 : 0;
+    mean += r / n;
+  }
+  const double per_fine = static_cast<double>(n - bigs) / volume * fine_volume;
+  const double per_coarse = static_cast<double>(bigs) / volume * coarse_volume;
+  const double around = CellGrid<D>::kNeighbourCells;
+  const double coarse_cost = around * (1.0 + per_coarse);
+  double one = 0.0, two = 0.0;
+  for (const double r : radii) {
+    const double often = (r + mean) * (r + mean);
+    one += often * around * (1.0 + static_cast<double>(n) / volume * one_cell);
+    two +=
+        often * (coarse_cost + (r > small ? block * (1.0 + per_fine) : around * (1.0 + per_fine)));
+  }
+  if (!(two < 0.7 * one)) return;
+  levels.coarse = CellGrid<D>(box_, coarse_width, periodic, n, cells_per_particle);
+  levels.box = box_;
+  levels.small_radius = small;
+  levels.big.resize(n);
+  for (std::uint32_t k = 0; k < n; ++k) levels.big[k] = radii[k] > small ? 1 : 0;
+  cells_ = Cells(std::move(fine), vector_gather_);
+  cells_.use_levels(std::move(levels));
 }
 
 // Growing particles (docs/physics.md#growing-spheres): what growth composes with, and how long
@@ -1088,8 +1197,10 @@ double EventEngine<D, Queue>::bytes_per_particle() const {
   return static_cast<double>(sizeof(HotRecord<D>) + sizeof(PendingEvent) + sizeof(std::uint32_t) +
                              (kind_.empty() ? 0 : sizeof(std::uint16_t)) +
                              (radius_.empty() ? 0 : sizeof(double))) +
-         kinds + cells_.grid().bytes_per_particle() + images_.bytes_per_particle() +
-         helfand_.bytes_per_particle() + static_cast<double>(queue_.bytes_per_particle());
+         kinds + cells_.grid().bytes_per_particle() +
+         (cells_.two_level() ? cells_.levels().coarse.bytes_per_particle() + 1.0 : 0.0) +
+         images_.bytes_per_particle() + helfand_.bytes_per_particle() +
+         static_cast<double>(queue_.bytes_per_particle());
 }
 
 template class EventEngine<2, BinaryHeapQueue>;

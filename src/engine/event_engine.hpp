@@ -115,8 +115,14 @@ struct EngineOptions {
   RecordLoads record_loads = RecordLoads::kAuto;
   // Growing particles (engine/growth.hpp, Lubachevsky-Stillinger): every diameter grows by this
   // fraction of its value at the engine's start per unit time (0: none). Elastic, smooth hard
-  // spheres in a periodic box only; the scalar loops are used.
+  // spheres in a periodic box only.
   double growth_rate = 0.0;
+  // Wide size distributions (the largest radius above 2.5 times the small particles', those
+  // within twice the 10th percentile) in a periodic box without walls, steps, bonds, soft
+  // contacts, shear or fixed grains: two cell levels (engine/cell_neighbourhood.hpp), small
+  // particles in fine cells and big ones in coarse cells. false: one level, cells sized for the
+  // largest diameter (the same physics; for comparison).
+  bool size_levels = true;
   // Cells at least this wide (0: as wide as the largest contact): room for growth.
   double min_cell_width = 0.0;
   // Keep each particle's radius (8 bytes per particle) instead of a kind per radius: chosen by
@@ -233,6 +239,8 @@ class EventEngine {
   // cells new to the particle's neighbourhood (EngineOptions::incremental_crossings).
   std::uint64_t incremental_crossing_scans() const { return incremental_scans_; }
   bool incremental_crossings() const { return incremental_crossings_; }
+  // Two cell levels (EngineOptions::size_levels) are in use.
+  bool two_level_cells() const { return cells_.two_level(); }
   // Whether the AVX-512 loops read candidates' records by rows (EngineOptions::record_loads).
   bool candidate_row_loads() const { return row_loads_; }
   Vec<D> momentum() const;
@@ -382,6 +390,17 @@ class EventEngine {
   }
   void start_growth();
   void update_growth_limit();
+  // Two cell levels for a wide size distribution (EngineOptions::size_levels), if they apply;
+  // `room`: the cells' width over the contact distance they must hold (growth).
+  void plan_size_levels(double room, double cells_per_particle);
+  // Particle i's candidates into `list` (cells_.gather_particle: its level's neighbourhood).
+  void gather_of(std::uint32_t i, CandidateList& list) {
+    if (cells_.two_level()) [[unlikely]] {
+      cells_.gather_particle(i, hot_[i].cell, list, hot_.data());
+    } else {
+      gather(hot_[i].cell, list);
+    }
+  }
   double mass_of(std::uint32_t i) const { return kinds_[kind_.empty() ? 0 : kind_[i]].mass; }
   void advance_to(std::uint32_t i, double t);
   Crossing next_crossing(const HotRecord<D>& h) const;
@@ -560,7 +579,9 @@ class EventEngine {
   HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
   bool accelerated_ = false;      // uniform gravity
   bool vector_growing_ = false;   // the growing loop in AVX-512
-  bool growing_ = false;          // growth_.on(): growing particles
+  // plan_size_levels's room and cells per particle when two levels may apply (0: they do not).
+  double levels_room_ = 0.0, levels_cells_per_particle_ = 0.0;
+  bool growing_ = false;  // growth_.on(): growing particles
   Vec<D> half_gravity_{};
   bool walls_ = false;                   // boundaries_.any()
   bool massive_walls_ = false;           // some face wall has mass
@@ -670,9 +691,9 @@ inline void EventEngine<D, Queue>::helfand_after(std::uint32_t i, std::uint32_t 
 // records prefetched) before either is tested; partners in one cell share one list.
 template <int D, class Queue>
 inline void EventEngine<D, Queue>::predict_pair(std::uint32_t i, std::uint32_t j, double t) {
-  gather(hot_[i].cell, cells_.list(0));
-  const bool shared = hot_[j].cell == hot_[i].cell;
-  if (!shared) gather(hot_[j].cell, cells_.list(1));
+  gather_of(i, cells_.list(0));
+  const bool shared = hot_[j].cell == hot_[i].cell && cells_.big(i) == cells_.big(j);
+  if (!shared) gather_of(j, cells_.list(1));
   queue_.update(i, predict_from(cells_.list(0), i, t));
   queue_.update(j, predict_from(cells_.list(shared ? 0 : 1), j, t));
 }

@@ -228,7 +228,7 @@ double EventEngine<D, Queue>::max_overlap_now() const {
   Cells::size_list(list);
   double worst = 0.0;
   for (std::uint32_t i = 0; i < size(); ++i) {
-    cells_.gather(hot_[i].cell, list, hot_.data());
+    cells_.gather_particle(i, hot_[i].cell, list, hot_.data());
     const Vec<D> xi = wrapped_position_now(i);
     for (std::uint32_t c = 0; c < list.count; ++c) {
       const std::uint32_t j = list.ids[c];

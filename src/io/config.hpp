@@ -193,7 +193,8 @@ struct RunConfig {
   double equilibration_time = -1.0;
   std::string event_queue = "calendar";  // calendar | heap | tree
   double max_wall_seconds = 0.0;         // 0 = no limit; stop cleanly when exceeded
-  bool validate = false;  // debug: check neighbour structure and queue against brute force
+  bool validate = false;    // debug: check neighbour structure and queue against brute force
+  bool size_levels = true;  // two cell levels for wide size distributions (auto)
   // event: the event-driven engine; dem: the force-based velocity Verlet integrator (needs
   // [soft], periodic boxes only).
   std::string integrator = "event";

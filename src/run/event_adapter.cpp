@@ -79,6 +79,7 @@ EngineOptions engine_options(const Config& config, const EngineTracking& trackin
   // Trajectory frames carry particles/image (and so does the restart file, for the next run).
   options.track_images = config.output.trajectory || config.analysis.msd || tracking.images;
   options.track_helfand = config.analysis.transport || tracking.helfand;
+  options.size_levels = config.run.size_levels;
   return options;
 }
 

@@ -36,6 +36,8 @@ class EventIntegrator : public Integrator<D> {
   virtual const Environment<D>& environment() const = 0;
   virtual const char* queue_name() const = 0;
   virtual double bytes_per_particle() const = 0;
+  // Two cell levels for a wide size distribution (EngineOptions::size_levels).
+  virtual bool two_level_cells() const = 0;
   virtual std::uint64_t incremental_crossing_scans() const = 0;
   virtual bool stepped() const = 0;            // [[potential]] or [[bond]]: stepped potentials
   virtual bool soft() const = 0;               // soft spheres by the collision map
@@ -133,6 +135,7 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   const Environment<D>& environment() const override { return engine_.environment(); }
   const char* queue_name() const override { return engine_.queue_name(); }
   double bytes_per_particle() const override { return engine_.bytes_per_particle(); }
+  bool two_level_cells() const override { return engine_.two_level_cells(); }
   std::uint64_t incremental_crossing_scans() const override {
     return engine_.incremental_crossing_scans();
   }

@@ -29,6 +29,7 @@ void EventSummary<D>::summarize(nlohmann::json& j, const RunContext<D>&) const {
                                kinetic_start_
                          : 0.0;
   j["bytes_per_particle"] = engine_.bytes_per_particle();
+  j["cell_levels"] = engine_.two_level_cells() ? 2 : 1;
 }
 
 template class EventSummary<2>;
