@@ -28,6 +28,15 @@ def klm_pressure(eta):
     return sum(c * x**k for k, c in enumerate(KLM))
 
 
+def bmcsl_pressure(phi, d):
+    """Boublik-Mansoori-Carnahan-Starling-Leland Z at packing fractions phi for diameters d."""
+    m = [np.mean(d**k) for k in range(4)]
+    xi = [phi * m[k] / m[3] for k in range(4)]  # xi_k = (pi/6) rho <d^k>, xi_3 = phi
+    x0, x1, x2 = [xi[k] * 1.0 for k in range(3)]
+    return (1 / (1 - phi) + 3 * x1 * x2 / (x0 * (1 - phi)**2)
+            + x2**3 * (3 - phi) / (x0 * (1 - phi)**3))
+
+
 def read_rows(path):
     with open(path) as f:
         lines = [line for line in f if not line.startswith("#")]
@@ -68,9 +77,13 @@ def draw_pressure(ax, out, dimension, summary):
         grid = np.linspace(max(phi.min(), 0.5 * phi_j), phi_j * (1 - 1e-12), 400)
         ax.semilogy(grid, dimension / (1 - grid / phi_j), "k--", lw=1,
                     label=f"free volume, $\\varphi_J$ = {phi_j:.4f}")
-    if dimension == 3:
+    d = GsdFile(os.path.join(out, "packing.gsd")).chunk("particles/diameter").astype(float)
+    if dimension == 3 and d.max() == d.min():
         grid = np.linspace(phi.min(), min(0.55, phi.max()), 200)
         ax.semilogy(grid, [klm_pressure(e) for e in grid], "r-", lw=1, label="fluid, one size (KLM)")
+    elif dimension == 3:
+        grid = np.linspace(phi.min(), min(0.55, phi.max()), 200)
+        ax.semilogy(grid, bmcsl_pressure(grid, d), "r-", lw=1, label="fluid mixture (BMCSL)")
     ax.set_xlabel("packing fraction $\\varphi$")
     ax.set_ylabel("reduced pressure $Z = PV/NkT$")
     ax.legend(fontsize=8)
@@ -83,16 +96,23 @@ def draw_packing(ax, out, dimension):
     x = position[:, :dimension] + 0.5 * box  # HOOMD's box is centred
     d = packing.chunk("particles/diameter")
     pairs, rattler = read_contacts(os.path.join(out, "contacts.tsv"), len(d))
-    # A window of at most 24 diameters (the whole box when smaller); in 3D a slab through the
-    # middle.
-    window = np.minimum(box, 24.0 * d.mean())
+    # A window of at most 24 diameters (the whole box when smaller; four of the largest for a
+    # wide mixture); in 3D a slab through the middle, or for a wide mixture the cut through the
+    # plane z = 0 (each sphere it meets as its circle of intersection).
+    wide = d.max() > 2.0 * d.min()
+    window = np.minimum(box, max(24.0 * d.mean(), 4.0 * d.max() if wide else 0.0))
     shown = np.all(x < window, axis=1)
+    drawn = 0.5 * d
     if dimension == 3:
         z = position[:, 2]
-        shown &= np.abs(z) < 0.75 * d.max()
+        if wide:
+            shown &= np.abs(z) < 0.5 * d
+            drawn = np.sqrt(np.maximum(0.25 * d**2 - z**2, 0.0))
+        else:
+            shown &= np.abs(z) < 0.75 * d.max()
     for i in np.nonzero(shown)[0]:
         open_circle = i in rattler
-        ax.add_patch(plt.Circle(x[i], 0.5 * d[i], fill=not open_circle, lw=0.5,
+        ax.add_patch(plt.Circle(x[i], drawn[i], fill=not open_circle, lw=0.5,
                                 fc="#9ecae1", ec="#08519c" if not open_circle else "r"))
     for i, j in pairs or []:
         if not (shown[i] and shown[j]):
@@ -107,7 +127,8 @@ def draw_packing(ax, out, dimension):
     ax.set_yticks([])
     ax.set_title((f"packing and contacts ({len(rattler)} rattlers of {len(d)}, drawn red)"
                   if pairs is not None else "packing (not jammed: no contact network)")
-                 + ("\nslab |z| < 0.75 d" if dimension == 3 else ""), fontsize=9)
+                 + (("\nthe cut at z = 0" if wide else "\nslab |z| < 0.75 d")
+                    if dimension == 3 else ""), fontsize=9)
 
 
 def main():

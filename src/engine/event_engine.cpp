@@ -54,8 +54,9 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   bonds_ = s.bonds;
   bond_types_ = s.bond_types;
   // The vector loop indexes records with 32-bit offsets.
-  vector_scan_ = options_.vector_scan && cpu_has_avx512() &&
-                 static_cast<double>(n) * sizeof(HotRecord<D>) < 2e9 && radius_.empty();
+  records_fit_32_bits_ = static_cast<double>(n) * sizeof(HotRecord<D>) < 2e9;
+  vector_scan_ =
+      options_.vector_scan && cpu_has_avx512() && records_fit_32_bits_ && radius_.empty();
   vector_gather_ =
       vector_scan_ && (options_.list_gather == ListGather::kVector ||
                        (options_.list_gather == ListGather::kAuto && cpu_gathers_fast()));
@@ -106,7 +107,8 @@ EventEngine<D, Queue>::EventEngine(ParticleSystem<D> s, StartMode mode, EngineOp
   // memory (docs/performance.md, "Memory").
   std::vector<Kinematics<D>>().swap(s.kinematics);
   if (levels_room_ > 0.0) {
-    plan_size_levels(levels_room_, levels_cells_per_particle_);
+    plan_size_levels(levels_room_, levels_cells_per_particle_,
+                     mode == StartMode::kResume && s.cell.size() == n ? &s.cell : nullptr);
     if (cells_.two_level()) {
       // A crossing rescans the whole neighbourhood: the coarse cell may change, and a big
       // particle's new layer is a slab of its block.
@@ -429,7 +431,9 @@ void EventEngine<D, Queue>::check_restored_cell(std::uint32_t i) const {
   }
   if (!ok) {
     throw InputError("restart state is inconsistent: particle " + std::to_string(id_[i]) +
-                     " is not inside its stored cell " + std::to_string(c));
+                     " is not inside its stored cell " + std::to_string(c) +
+                     " (a file written on two cell levels continues only with run.size_levels = "
+                     "true)");
   }
 }
 
@@ -825,9 +829,6 @@ void EventEngine<D, Queue>::collide(std::uint32_t i, std::uint32_t j, double t) 
     const double mu = mi * mj / (mi + mj);
     double s;  // J = s r
     if (growing_) [[unlikely]] {
-      // Beyond this the cells may have missed a pair: the caller must rebuild first.
-      if (t > growth_fits_until_)
-        throw std::logic_error("collide: growing particles no longer fit the cells");
       s = HardSphere::growing_impulse_factor(
           g_dot_r, r2, mu, growth_.speed(radius_of(i) + radius_of(j)), contact_distance(i, j, t));
     } else {
@@ -919,8 +920,10 @@ void EventEngine<D, Queue>::update_growth_limit() {
                        growth_.fits_until(levels.small_radius + rmax, levels.reach[a] * w)});
     }
   }
-  // Never before now: a rate changed at the old limit may round the new one just below it.
-  growth_fits_until_ = std::max(time_, fits);
+  // Never before now by round-off: a rate changed at the old limit may round the new one just
+  // below it. Further below, the limit stays passed (a collision beyond it is refused).
+  growth_fits_until_ =
+      fits >= time_ - 1e-12 * std::max(1.0, std::abs(time_)) ? std::max(time_, fits) : fits;
 }
 
 // Two cell levels when the size distribution is wide (EngineOptions::size_levels): the small
@@ -928,15 +931,16 @@ void EventEngine<D, Queue>::update_growth_limit() {
 // the others in a coarse grid whose cells group whole fine cells and hold the largest contact.
 // Radii at the engine's start; `room` widens both (growth).
 template <int D, class Queue>
-void EventEngine<D, Queue>::plan_size_levels(double room, double cells_per_particle) {
+void EventEngine<D, Queue>::plan_size_levels(double room, double cells_per_particle,
+                                             const std::vector<CellCode>* stored) {
   const auto n = static_cast<std::uint32_t>(size());
   if (n < 2) return;
   std::vector<double> radii(n);
   for (std::uint32_t k = 0; k < n; ++k) radii[k] = radius_of(k);
-  std::vector<double> sorted = radii;
-  const auto tenth = sorted.begin() + n / 10;
-  std::nth_element(sorted.begin(), tenth, sorted.end());
-  const double split = 2.0 * *tenth;
+  // Sorted: the choice (sums over the radii included) does not depend on the particles' order,
+  // so a resumed engine makes the one its run made.
+  std::sort(radii.begin(), radii.end());
+  const double split = 2.0 * radii[n / 10];
   double small = 0.0, largest = 0.0;
   for (const double r : radii) {
     largest = std::max(largest, r);
@@ -993,12 +997,25 @@ void EventEngine<D, Queue>::plan_size_levels(double room, double cells_per_parti
     two +=
         often * (coarse_cost + (r > small ? block * (1.0 + per_fine) : around * (1.0 + per_fine)));
   }
-  if (!(two < 0.7 * one)) return;
-  levels.coarse = CellGrid<D>(box_, coarse_width, periodic, n, cells_per_particle);
+  if (!(two < 0.7 * one) && !options_.force_size_levels) return;
+  levels.coarse = CellGrid<D>(box_, coarse_width, periodic, n, kNever);  // no cap: few cells
+  for (int a = 0; a < D; ++a) {
+    if (levels.coarse.cells_along(a) != fine.cells_along(a) / levels.group[a]) return;
+  }
   levels.box = box_;
   levels.small_radius = small;
   levels.big.resize(n);
-  for (std::uint32_t k = 0; k < n; ++k) levels.big[k] = radii[k] > small ? 1 : 0;
+  for (std::uint32_t k = 0; k < n; ++k) levels.big[k] = radius_of(k) > small ? 1 : 0;
+  // A resumed state keeps the cells it was written with: two levels only if every stored cell
+  // is a fine cell holding its particle (a file written on one level continues on one).
+  for (std::uint32_t k = 0; stored != nullptr && k < n; ++k) {
+    const CellCode c = (*stored)[id_[k]];
+    if (!fine.valid(c)) return;
+    for (int a = 0; a < D; ++a) {
+      const double x = hot_[k].pos[a], tol = 1e-9 * box_[a];
+      if (x < fine.lower_bound(c, a) - tol || x > fine.upper_bound(c, a) + tol) return;
+    }
+  }
   cells_ = Cells(std::move(fine), vector_gather_);
   cells_.use_levels(std::move(levels));
 }
@@ -1022,8 +1039,7 @@ void EventEngine<D, Queue>::start_growth() {
   growth_ = Growth(options_.growth_rate, time_);
   growing_ = true;
   // The growing loop reads per-particle radii too (the other vector loops read kinds only).
-  vector_growing_ = options_.vector_scan && cpu_has_avx512() &&
-                    static_cast<double>(hot_.size()) * sizeof(HotRecord<D>) < 2e9;
+  vector_growing_ = options_.vector_scan && cpu_has_avx512() && records_fit_32_bits_;
   row_loads_ =
       vector_growing_ && (options_.record_loads == RecordLoads::kRows ||
                           (options_.record_loads == RecordLoads::kAuto && !cpu_gathers_fast()));
@@ -1093,6 +1109,10 @@ EventKind EventEngine<D, Queue>::step() {
   const std::uint32_t i = queue_.top();
   const double t = queue_.top_time();
   if (!std::isfinite(t)) return EventKind::kNone;
+  // Growing: beyond this the cells may have missed a pair; refused before anything changes
+  // (the caller rebuilds the engine first).
+  if (growing_ && t > growth_fits_until_) [[unlikely]]
+    throw std::logic_error("step: growing particles no longer fit the cells (growth_fits_until)");
   time_ = t;
   ++counters_.events;
   if constexpr (requires { queue_.likely_next(); }) {

@@ -123,6 +123,8 @@ struct EngineOptions {
   // particles in fine cells and big ones in coarse cells. false: one level, cells sized for the
   // largest diameter (the same physics; for comparison).
   bool size_levels = true;
+  // Two levels whenever they are possible, without the estimate of their cost (tests).
+  bool force_size_levels = false;
   // Cells at least this wide (0: as wide as the largest contact): room for growth.
   double min_cell_width = 0.0;
   // Keep each particle's radius (8 bytes per particle) instead of a kind per radius: chosen by
@@ -392,7 +394,9 @@ class EventEngine {
   void update_growth_limit();
   // Two cell levels for a wide size distribution (EngineOptions::size_levels), if they apply;
   // `room`: the cells' width over the contact distance they must hold (growth).
-  void plan_size_levels(double room, double cells_per_particle);
+  // `stored`: a resumed state's cells (by the caller's numbering), which decide.
+  void plan_size_levels(double room, double cells_per_particle,
+                        const std::vector<CellCode>* stored);
   // Particle i's candidates into `list` (cells_.gather_particle: its level's neighbourhood).
   void gather_of(std::uint32_t i, CandidateList& list) {
     if (cells_.two_level()) [[unlikely]] {
@@ -574,11 +578,12 @@ class EventEngine {
   // largest of its particles'.
   HugeVector<double> radius_;
   bool vector_scan_ = false;
-  bool vector_gather_ = false;    // gather_lists_avx512 for the cell lists (cpu_gathers_fast)
-  bool row_loads_ = false;        // CandidateScan::row_loads (RecordLoads, cpu_gathers_fast)
-  HugeVector<std::uint32_t> id_;  // internal index -> the caller's particle number
-  bool accelerated_ = false;      // uniform gravity
-  bool vector_growing_ = false;   // the growing loop in AVX-512
+  bool vector_gather_ = false;        // gather_lists_avx512 for the cell lists (cpu_gathers_fast)
+  bool row_loads_ = false;            // CandidateScan::row_loads (RecordLoads, cpu_gathers_fast)
+  HugeVector<std::uint32_t> id_;      // internal index -> the caller's particle number
+  bool accelerated_ = false;          // uniform gravity
+  bool vector_growing_ = false;       // the growing loop in AVX-512
+  bool records_fit_32_bits_ = false;  // the vector loops index records with 32-bit offsets
   // plan_size_levels's room and cells per particle when two levels may apply (0: they do not).
   double levels_room_ = 0.0, levels_cells_per_particle_ = 0.0;
   bool growing_ = false;  // growth_.on(): growing particles

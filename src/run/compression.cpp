@@ -129,6 +129,7 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
     for (const Kinematics<D>& k : state.kinematics) rmax = std::max(rmax, k.radius);
     const double phi_start = state_packing_fraction(state);
     EngineOptions options;
+    options.size_levels = settings.size_levels;
     // The starting diameters grow at a constant speed: relative to this engine's radii, slower.
     options.growth_rate = rate / diameter_scale;
     // Room to grow, but never less than 3 cells per axis (the cell list's minimum).
@@ -290,10 +291,11 @@ CompressionSettings compression_settings(const CompressConfig& config, double te
 
 template <int D>
 CompressionReport compress_start(ParticleSystem<D>& state, const CompressConfig& config,
-                                 double temperature, bool tell) {
+                                 double temperature, bool tell, bool size_levels) {
   using Clock = std::chrono::steady_clock;
   CompressionReport report;
   report.settings = compression_settings(config, temperature);
+  report.settings.size_levels = size_levels;
   const auto start = Clock::now();
   auto next_note = start + std::chrono::seconds(10);
   report.result = compress(state, report.settings, [&](const CompressionRow& r) {
@@ -332,8 +334,8 @@ template CompressionResult compress<2>(ParticleSystem<2>&, const CompressionSett
 template CompressionResult compress<3>(ParticleSystem<3>&, const CompressionSettings&,
                                        const std::function<void(const CompressionRow&)>&);
 template CompressionReport compress_start<2>(ParticleSystem<2>&, const CompressConfig&, double,
-                                             bool);
+                                             bool, bool);
 template CompressionReport compress_start<3>(ParticleSystem<3>&, const CompressConfig&, double,
-                                             bool);
+                                             bool, bool);
 
 }  // namespace kairos

@@ -33,6 +33,7 @@ struct CompressionSettings {
   double slowdown_pressure = 100.0;
   double slowdown_floor = 0.1;  // ... down to this fraction of growth_rate
   double cell_margin = 0.1;     // cells this fraction wider than the largest diameter: growth room
+  bool size_levels = true;      // EngineOptions::size_levels (run.size_levels)
 };
 
 // One thermostat interval: the moment of its rescaling and what it measured.
@@ -91,8 +92,9 @@ CompressionSettings compression_settings(const CompressConfig& config, double te
 
 // Compresses the start state of a run as [compress] asks and analyses the packing. `tell`:
 // a line on stderr every ten seconds (a long compression is not silent).
+// size_levels: run.size_levels (EngineOptions::size_levels).
 template <int D>
 CompressionReport compress_start(ParticleSystem<D>& state, const CompressConfig& config,
-                                 double temperature, bool tell);
+                                 double temperature, bool tell, bool size_levels = true);
 
 }  // namespace kairos

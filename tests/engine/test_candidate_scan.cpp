@@ -236,6 +236,7 @@ void check_growing_loops() {
     ASSERT_EQ(best, best_ref) << "scalar, trial " << trial;
     found_some += want != kNoCandidate ? 1 : 0;
     if (!cpu_has_avx512()) continue;
+    s.row_loads = trial % 2 == 0;  // records by rows and a transpose, or by gathers
     double best_vector = bound;
     const std::uint32_t got_vector =
         scan_candidates_growing_avx512<D>(s, self, 0.25, xi, vi, scale, rate, best_vector);

@@ -95,11 +95,18 @@ TEST(Growth, NoCollisionBeyondTheCellsLimit) {
   bool refused = false;
   for (int e = 0; e < 100000 && !refused; ++e) {
     const std::uint64_t collisions = engine.counters().collisions;
+    const std::uint64_t events = engine.counters().events;
+    const double before = engine.time();
     try {
       engine.step();
     } catch (const std::logic_error& error) {
+      // Refused before anything changed: the caller can still stop the clock at the limit.
       EXPECT_GT(engine.next_event_time(), limit);
       EXPECT_EQ(engine.counters().collisions, collisions);
+      EXPECT_EQ(engine.counters().events, events);
+      EXPECT_EQ(engine.time(), before);
+      engine.advance_clock(limit);
+      engine.validate();
       refused = true;
     }
     if (!refused && engine.counters().collisions > collisions) {

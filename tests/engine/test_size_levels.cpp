@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "scheduler/calendar_queue.hpp"
 
@@ -19,7 +20,7 @@ namespace {
 // velocities (zero momentum), masses by volume.
 template <int D>
 ParticleSystem<D> wide_mixture(double L, int bigs_along, double big, double small_fraction,
-                               std::uint64_t seed) {
+                               std::uint64_t seed, double big_mass = 0.0) {
   ParticleSystem<D> s;
   s.box.fill(L);
   s.species_names = {"small", "big"};
@@ -31,7 +32,7 @@ ParticleSystem<D> wide_mixture(double L, int bigs_along, double big, double smal
     for (int a = 0; a < D; ++a) k.vel[a] = v(rng);
     k.radius = 0.5 * d;
     s.kinematics.push_back(k);
-    s.mass.push_back(std::pow(d, D));
+    s.mass.push_back(species == 1 && big_mass > 0.0 ? big_mass : std::pow(d, D));
     s.species.push_back(species);
   };
   int count = 1;
@@ -120,6 +121,58 @@ TEST(SizeLevels, ValidatedAgainstBruteForce2D) {
   ASSERT_TRUE(engine.two_level_cells());
   const std::vector<double> times = run_validated(engine, 2000);
   EXPECT_GT(times.size(), 500u);
+}
+
+TEST(SizeLevels, BigParticlesMeetEachOther) {
+  // 16 light big disks (diameter 6, mass 1) 1.75 apart among a few small ones, on two levels
+  // whatever their cost: big-big contacts through the coarse cells, validated after every event.
+  const auto s = wide_mixture<2>(31.0, 4, 6.0, 0.05, 28, 1.0);
+  EngineOptions o;
+  o.force_size_levels = true;
+  EventEngine<2, CalendarQueue> engine(s, StartMode::kPredict, o);
+  ASSERT_TRUE(engine.two_level_cells());
+  run_validated(engine, 3000);
+  // Big pairs came close (they start 1.75 apart): within 0.5 of contact at the end.
+  const ParticleSystem<2> out = engine.export_state();
+  int touching = 0;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    for (std::size_t j = i + 1; j < out.size(); ++j) {
+      if (out.species[i] != 1 || out.species[j] != 1) continue;
+      double r2 = 0.0;
+      for (int a = 0; a < 2; ++a) {
+        double d = out.kinematics[i].pos[a] - out.kinematics[j].pos[a];
+        d -= out.box[a] * std::round(d / out.box[a]);
+        r2 += d * d;
+      }
+      touching += r2 < 6.5 * 6.5 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(touching, 0) << "no big pair came within reach";
+}
+
+TEST(SizeLevels, ResumedOnTheLevelsItWasWrittenWith) {
+  // A state written on one level continues on one (bit for bit), whatever the default; a state
+  // written on two refuses to continue on one, saying why.
+  const auto s = wide_mixture<3>(13.0, 2, 4.0, 0.15, 29);
+  EngineOptions one;
+  one.size_levels = false;
+  EventEngine<3, CalendarQueue> a(s, StartMode::kPredict, one);
+  for (int e = 0; e < 2000; ++e) a.step();
+  EventEngine<3, CalendarQueue> b(a.export_state(), StartMode::kResume);
+  EXPECT_FALSE(b.two_level_cells());
+  for (int e = 0; e < 2000; ++e) {
+    ASSERT_EQ(a.step(), b.step()) << e;
+    ASSERT_EQ(a.time(), b.time()) << e;
+  }
+  EventEngine<3, CalendarQueue> c(s, StartMode::kPredict);
+  ASSERT_TRUE(c.two_level_cells());
+  for (int e = 0; e < 2000; ++e) c.step();
+  try {
+    EventEngine<3, CalendarQueue> d(c.export_state(), StartMode::kResume, one);
+    FAIL() << "a two-level state resumed on one level";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("run.size_levels"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SizeLevels, ValidatedWhileGrowing) {
