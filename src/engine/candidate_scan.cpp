@@ -354,6 +354,20 @@ template std::uint32_t scan_candidates_avx512<2, true>(const CandidateScan<2>&, 
 template std::uint32_t scan_candidates_avx512<3, true>(const CandidateScan<3>&, double,
                                                        const Vec<3>&, const Vec<3>&, double&);
 
+// The eight candidates k..k+7 of a list of `count` (lanes past the end masked) with the
+// predicted particle `self` masked out, and their records' offsets: the block the growing and
+// stepped loops start each iteration with.
+[[gnu::always_inline]] inline __mmask8 load_block(const std::uint32_t* candidates,
+                                                  std::uint32_t count, std::uint32_t k,
+                                                  __m256i vself, __m256i vstride, __m256i& ids,
+                                                  __m256i& base) {
+  const std::uint32_t left = count - k;
+  const __mmask8 all = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
+  ids = _mm256_maskz_loadu_epi32(all, candidates + k);
+  base = _mm256_mullo_epi32(ids, vstride);
+  return _mm256_mask_cmpneq_epu32_mask(all, ids, vself);
+}
+
 // -x, exactly as the scalar unary minus (the sign bit flipped: -(+0) is -0).
 [[gnu::always_inline]] inline __m512d negated(__m512d x) {
   return _mm512_castsi512_pd(_mm512_xor_si512(
@@ -400,11 +414,8 @@ std::uint32_t scan_candidates_growing_avx512(const CandidateScan<D>& s, std::uin
   const __m256i vself = _mm256_set1_epi32(static_cast<int>(self));
   std::uint32_t found = kNoCandidate;
   for (std::uint32_t k = 0; k < s.count; k += 8) {
-    const std::uint32_t left = s.count - k;
-    __mmask8 live = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
-    const __m256i ids = _mm256_maskz_loadu_epi32(live, s.candidates + k);
-    live = _mm256_mask_cmpneq_epu32_mask(live, ids, vself);
-    const __m256i base = _mm256_mullo_epi32(ids, vstride);
+    __m256i ids, base;
+    const __mmask8 live = load_block(s.candidates, s.count, k, vself, vstride, ids, base);
     __m512d r2, rg, g2, dtj;
     pair_terms<D, false>(s, k, record_columns(s, ids, base, live), live, vt, vxi, vvi, r2, rg, g2,
                          dtj);
@@ -490,11 +501,8 @@ std::uint32_t scan_stepped_avx512(const SteppedScan<D>& s, double t, const Vec<D
   std::uint32_t found = kNoCandidate;
   std::uint32_t held = 0;
   for (std::uint32_t k = 0; k < c.count; k += 8) {
-    const std::uint32_t left = c.count - k;
-    __mmask8 live = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
-    const __m256i ids = _mm256_maskz_loadu_epi32(live, c.candidates + k);
-    live = _mm256_mask_cmpneq_epu32_mask(live, ids, vself);
-    const __m256i base = _mm256_mullo_epi32(ids, vstride);
+    __m256i ids, base;
+    __mmask8 live = load_block(c.candidates, c.count, k, vself, vstride, ids, base);
     __m512d r2, rg, g2, dtj;  // no deferred soft contacts under steps: dtj >= 0
     pair_terms<D, kAccelerated>(c, k, record_columns(c, ids, base, live), live, vt, vxi, vvi, r2,
                                 rg, g2, dtj);
