@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "analysis/structure.hpp"
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/periodic.hpp"
@@ -324,6 +325,9 @@ CompressionReport compress_start(ParticleSystem<D>& state, const CompressConfig&
         config.contact_gap > 0.0 ? config.contact_gap : std::min(1e-3, 1e4 / z);
     report.network = contact_network(c, tolerance);
   }
+  const BondOrderValues<D> order = bond_order(c, CompressionReport::kBondCutoff);
+  report.order_names = order.names;
+  report.order = order.global;
   return report;
 }
 

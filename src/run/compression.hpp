@@ -80,10 +80,16 @@ CompressionResult compress(ParticleSystem<D>& state, const CompressionSettings& 
 struct CompressionReport {
   CompressionSettings settings;
   CompressionResult result;
-  // The contact network, when the packing is near jamming (Z at least 10^4) or contact_gap was
+  // The contact network, when the packing is near jamming (Z at least 10^6) or contact_gap was
   // given: far from jamming touching and open pairs are not told apart by their gaps.
   bool has_network = false;
   ContactNetwork network;
+  // The packing's global bond order (analysis/structure.hpp bond_order: q4, q6 in 3D, psi6 in
+  // 2D), neighbours closer than kBondCutoff contact distances (analysis.bond_cutoff's default):
+  // glass or crystal.
+  static constexpr double kBondCutoff = 1.4;
+  std::vector<std::string> order_names;
+  std::vector<double> order;
   double wall_seconds = 0.0;
 };
 

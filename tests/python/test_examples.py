@@ -418,6 +418,7 @@ class CompressionExamples(kt.KairosTestCase):
     def test_jammed_spheres_3d(self):
         out, s = self.run_example("jammed_spheres_3d.toml")
         c = s["compression"]
+        self.assertLess(c["bond_order"]["q6"], 0.15)  # a glass: fcc has 0.575
         self.assertEqual(c["stop_reason"], "jammed")
         self.assertGreater(c["packing_fraction"], 0.62)
         self.assertLess(c["packing_fraction"], 0.67)
@@ -428,6 +429,7 @@ class CompressionExamples(kt.KairosTestCase):
     def test_jammed_disks_2d(self):
         out, s = self.run_example("jammed_disks_2d.toml")
         c = s["compression"]
+        self.assertLess(c["bond_order"]["psi6"], 0.3)  # bidisperse: no hexatic order
         self.assertEqual(c["stop_reason"], "jammed")
         self.assertGreater(c["packing_fraction"], 0.81)
         self.assertLess(c["packing_fraction"], 0.86)
@@ -437,6 +439,10 @@ class CompressionExamples(kt.KairosTestCase):
     def test_polydisperse_glass_3d(self):
         out, s = self.run_example("polydisperse_glass_3d.toml")
         c = s["compression"]
+        # A glass, not a crystal: the packing's q6 far below fcc's 0.575.
+        self.assertEqual(c["bond_order"]["cutoff"], 1.4)
+        self.assertLess(c["bond_order"]["q6"], 0.15)
+        self.assertGreater(c["bond_order"]["q6"], 0.0)
         # A random start above insertion's limit: grown to system.packing_fraction exactly.
         self.assertEqual(c["stop_reason"], "packing_fraction")
         self.assertAlmostEqual(c["packing_fraction"], 0.6, delta=1e-12)

@@ -75,6 +75,13 @@ void summarize_compression(const CompressionReport& report, int dimension,
   c["rebuilds"] = r.rebuilds;
   c["diameter_scale"] = r.diameter_scale;
   c["wall_seconds"] = report.wall_seconds;
+  nlohmann::json& order = c["bond_order"];
+  order["cutoff"] = CompressionReport::kBondCutoff;
+  for (std::size_t k = 0; k < report.order_names.size(); ++k) {
+    set_or_explain(summary, order, report.order_names[k], report.order[k],
+                   std::isfinite(report.order[k]) ? "" : "no particle has a neighbour",
+                   "compression.bond_order." + report.order_names[k]);
+  }
   if (!report.has_network) {
     c["contacts"] = nullptr;
     summary["undefined"]["compression.contacts"] =
