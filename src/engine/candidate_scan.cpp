@@ -170,17 +170,29 @@ template <int D>
   *s.delayed_count += static_cast<std::uint32_t>(__builtin_popcount(lanes));
 }
 
-// The squared contact distances (radius_i + the candidate's radius)^2 of mixed sizes. Shape
-// numbers are 16-bit: gather 32 bits at each and keep the low half (the array is padded by the
-// engine so the last read stays inside it).
+// The contact distances radius_i + the candidate's radius of mixed sizes: its own radius
+// (s.particle_radius, growing loop only) or its kind's. Kinds are 16-bit: gather 32 bits at each
+// and keep the low half (the array is padded by the engine so the last read stays inside it).
 template <int D>
-[[gnu::always_inline]] inline __m512d contact_distance2(const CandidateScan<D>& s, __m256i ids,
-                                                        __mmask8 live, __m512d vradius_i) {
+[[gnu::always_inline]] inline __m512d contact_distance(const CandidateScan<D>& s, __m256i ids,
+                                                       __mmask8 live, __m512d vradius_i) {
+  if (s.particle_radius != nullptr) {
+    const __m512d rj =
+        _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live, ids, s.particle_radius, 8);
+    return _mm512_add_pd(vradius_i, rj);
+  }
   const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(live),
                                                   _mm512_castsi256_si512(ids), s.kind, 2);
   const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
   const __m512d rj = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live, shp, s.kind_radius, 8);
-  const __m512d sigma = _mm512_add_pd(vradius_i, rj);
+  return _mm512_add_pd(vradius_i, rj);
+}
+
+// Their squares, for the hard-sphere loops.
+template <int D>
+[[gnu::always_inline]] inline __m512d contact_distance2(const CandidateScan<D>& s, __m256i ids,
+                                                        __mmask8 live, __m512d vradius_i) {
+  const __m512d sigma = contact_distance<D>(s, ids, live, vradius_i);
   return _mm512_mul_pd(sigma, sigma);
 }
 
@@ -374,23 +386,6 @@ template std::uint32_t scan_candidates_avx512<3, true>(const CandidateScan<3>&, 
       _mm512_castpd_si512(x), _mm512_set1_epi64(static_cast<long long>(0x8000000000000000ull))));
 }
 
-// The contact distances sigma0 (at the growth's origin) of mixed sizes: radius_i plus each
-// candidate's own radius, or its kind's.
-template <int D>
-[[gnu::always_inline]] inline __m512d growing_sigma0(const CandidateScan<D>& s, __m256i ids,
-                                                     __mmask8 live, __m512d vradius_i) {
-  if (s.particle_radius != nullptr) {
-    const __m512d rj =
-        _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live, ids, s.particle_radius, 8);
-    return _mm512_add_pd(vradius_i, rj);
-  }
-  const __m512i raw = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(live),
-                                                  _mm512_castsi256_si512(ids), s.kind, 2);
-  const __m256i shp = _mm256_and_si256(_mm512_castsi512_si256(raw), _mm256_set1_epi32(0xffff));
-  return _mm512_add_pd(vradius_i,
-                       _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live, shp, s.kind_radius, 8));
-}
-
 // scan_candidates_growing, eight candidates per iteration: every lane evaluates the branches of
 // growing_contact_before / growing_contact_time (dynamics/collision_time.hpp) with the same
 // operations in the same order, and a mask picks each lane's branch.
@@ -419,7 +414,7 @@ std::uint32_t scan_candidates_growing_avx512(const CandidateScan<D>& s, std::uin
     __m512d r2, rg, g2, dtj;
     pair_terms<D, false>(s, k, record_columns(s, ids, base, live), live, vt, vxi, vvi, r2, rg, g2,
                          dtj);
-    const __m512d sigma0 = s.uniform ? vsigma0 : growing_sigma0<D>(s, ids, live, vradius_i);
+    const __m512d sigma0 = s.uniform ? vsigma0 : contact_distance<D>(s, ids, live, vradius_i);
     const __m512d sigma = _mm512_mul_pd(sigma0, vscale);
     const __m512d u = _mm512_mul_pd(sigma0, vrate);
     const __m512d gap = _mm512_sub_pd(r2, _mm512_mul_pd(sigma, sigma));

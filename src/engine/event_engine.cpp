@@ -19,6 +19,7 @@
 #include "dynamics/collision_time.hpp"
 #include "dynamics/trajectory_events.hpp"
 #include "engine/candidate_scan.hpp"
+#include "engine/size_levels.hpp"
 #include "interactions/granular_contact.hpp"
 #include "interactions/hard_sphere.hpp"
 #include "scheduler/binary_heap_queue.hpp"
@@ -934,78 +935,15 @@ template <int D, class Queue>
 void EventEngine<D, Queue>::plan_size_levels(double room, double cells_per_particle,
                                              const std::vector<CellCode>* stored) {
   const auto n = static_cast<std::uint32_t>(size());
-  if (n < 2) return;
   std::vector<double> radii(n);
   for (std::uint32_t k = 0; k < n; ++k) radii[k] = radius_of(k);
-  // Sorted: the choice (sums over the radii included) does not depend on the particles' order,
-  // so a resumed engine makes the one its run made.
-  std::sort(radii.begin(), radii.end());
-  const double split = 2.0 * radii[n / 10];
-  double small = 0.0, largest = 0.0;
-  for (const double r : radii) {
-    largest = std::max(largest, r);
-    if (r <= split) small = std::max(small, r);
-  }
-  if (!(largest > 2.5 * small)) return;
-  std::array<bool, D> periodic;
-  periodic.fill(true);
-  Vec<D> fine_width;
-  fine_width.fill(2.0 * small * room);
-  // The big particles fill much of the box: up to 8 fine cells per particle (32 bytes) rather
-  // than the one-level cap, which would widen the fine cells towards the big ones.
-  CellGrid<D> fine(box_, fine_width, periodic, n, std::max(cells_per_particle, 8.0));
-  typename Cells::Levels levels;
-  Vec<D> coarse_width;
-  for (int a = 0; a < D; ++a) {
-    const double w = fine.width(a);
-    const double wanted = 2.0 * largest * room, reach = (small + largest) * room;
-    levels.group[a] = static_cast<int>(std::ceil(wanted / w));
-    while (levels.group[a] * w < wanted) ++levels.group[a];
-    levels.reach[a] = static_cast<int>(std::ceil(reach / w));
-    while (levels.reach[a] * w < reach) ++levels.reach[a];
-    const int coarse = fine.cells_along(a) / levels.group[a];
-    // Three coarse cells per axis, and a block that meets no cell twice; else one level.
-    if (coarse < 3 || fine.cells_along(a) < 2 * levels.reach[a] + 1) return;
-    coarse_width[a] = box_[a] / (coarse + 0.5);  // exactly `coarse` cells
-  }
-  // Two levels only where they pay: the candidates and cells a prediction visits, weighted by
-  // how often each particle is predicted (its collision rate, taken as (r + mean r)^2), against
-  // one level's (measured: a uniform 1:14 distribution of diameters runs faster on one level,
-  // most of its particles being mid-sized; docs/performance.md).
-  double volume = 1.0, fine_volume = 1.0, coarse_volume = 1.0, block = 1.0, one_cell = 1.0;
-  for (int a = 0; a < D; ++a) {
-    volume *= box_[a];
-    fine_volume *= fine.width(a);
-    coarse_volume *= levels.group[a] * fine.width(a);
-    block *= 2 * levels.reach[a] + 1;
-    one_cell *= cells_.grid().width(a);
-  }
-  std::size_t bigs = 0;
-  double mean = 0.0;
-  for (const double r : radii) {
-    bigs += r > small ? 1 : 0;
-    mean += r / n;
-  }
-  const double per_fine = static_cast<double>(n - bigs) / volume * fine_volume;
-  const double per_coarse = static_cast<double>(bigs) / volume * coarse_volume;
-  const double around = CellGrid<D>::kNeighbourCells;
-  const double coarse_cost = around * (1.0 + per_coarse);
-  double one = 0.0, two = 0.0;
-  for (const double r : radii) {
-    const double often = (r + mean) * (r + mean);
-    one += often * around * (1.0 + static_cast<double>(n) / volume * one_cell);
-    two +=
-        often * (coarse_cost + (r > small ? block * (1.0 + per_fine) : around * (1.0 + per_fine)));
-  }
-  if (!(two < 0.7 * one) && !options_.force_size_levels) return;
-  levels.coarse = CellGrid<D>(box_, coarse_width, periodic, n, kNever);  // no cap: few cells
-  for (int a = 0; a < D; ++a) {
-    if (levels.coarse.cells_along(a) != fine.cells_along(a) / levels.group[a]) return;
-  }
-  levels.box = box_;
-  levels.small_radius = small;
+  std::optional<SizeLevelPlan<D>> plan = plan_cell_levels<D>(
+      std::move(radii), box_, cells_.grid(), room, cells_per_particle, options_.force_size_levels);
+  if (!plan) return;
+  CellGrid<D>& fine = plan->fine;
+  typename Cells::Levels& levels = plan->levels;
   levels.big.resize(n);
-  for (std::uint32_t k = 0; k < n; ++k) levels.big[k] = radius_of(k) > small ? 1 : 0;
+  for (std::uint32_t k = 0; k < n; ++k) levels.big[k] = radius_of(k) > levels.small_radius ? 1 : 0;
   // A resumed state keeps the cells it was written with: two levels only if every stored cell
   // is a fine cell holding its particle (a file written on one level continues on one).
   for (std::uint32_t k = 0; stored != nullptr && k < n; ++k) {
