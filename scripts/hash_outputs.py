@@ -58,6 +58,7 @@ SMALLER = {"granular_clustering_2d.toml": ["system.particles=20000"],
            # The compression examples: fewer particles, jammed at Z = 1e6.
            "jammed_spheres_3d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
            "jammed_disks_2d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
+           "jammed_disks_box_2d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
            "polydisperse_glass_3d.toml": ["system.particles=400"],
            # Its 1:10 box needs its 20 000 spheres: a shorter compression instead.
            "asymmetric_mixture_3d.toml": ["compress.packing_fraction=0.35"]}

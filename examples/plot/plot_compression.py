@@ -47,22 +47,26 @@ def read_rows(path):
 
 
 def read_contacts(path, n):
-    """The contact pairs and the rattlers: every particle not flagged 0 in some contact row
-    (a particle with no contact at all is a rattler too)."""
-    pairs, held = [], set()
+    """The contact pairs, the wall contacts (particle, face such as "x-") and the rattlers:
+    every particle not flagged 0 in some contact row (a particle with no contact at all is a
+    rattler too)."""
+    pairs, walls, held = [], [], set()
     with open(path) as f:
         for line in f:
             if line.startswith("# no contact network"):
-                return None, set()
+                return None, [], set()
             if line.startswith("#"):
                 continue
             i, j, _, ri, rj = line.split()
-            pairs.append((int(i), int(j)))
+            if j[-1] in "+-":
+                walls.append((int(i), j))
+            else:
+                pairs.append((int(i), int(j)))
+                if rj == "0":
+                    held.add(int(j))
             if ri == "0":
                 held.add(int(i))
-            if rj == "0":
-                held.add(int(j))
-    return pairs, set(range(n)) - held
+    return pairs, walls, set(range(n)) - held
 
 
 def draw_pressure(ax, out, dimension, summary):
@@ -95,7 +99,7 @@ def draw_packing(ax, out, dimension):
     position = packing.chunk("particles/position")
     x = position[:, :dimension] + 0.5 * box  # HOOMD's box is centred
     d = packing.chunk("particles/diameter")
-    pairs, rattler = read_contacts(os.path.join(out, "contacts.tsv"), len(d))
+    pairs, walls, rattler = read_contacts(os.path.join(out, "contacts.tsv"), len(d))
     # A window of at most 24 diameters (the whole box when smaller; four of the largest for a
     # wide mixture); in 3D a slab through the middle, or for a wide mixture the cut through the
     # plane z = 0 (each sphere it meets as its circle of intersection).
@@ -120,8 +124,24 @@ def draw_packing(ax, out, dimension):
         r = x[j] - x[i]
         r -= box * np.round(r / box)
         ax.plot([x[i][0], x[i][0] + r[0]], [x[i][1], x[i][1] + r[1]], "k-", lw=0.6)
-    ax.set_xlim(0, window[0])
-    ax.set_ylim(0, window[1])
+    # A packing grown between walls: each wall contact to its wall, the walls drawn.
+    for i, face in walls:
+        a = "xyz".index(face[0])
+        if not shown[i] or a > 1:
+            continue
+        end = np.array(x[i][:2])
+        end[a] = 0.0 if face[1] == "-" else box[a]
+        ax.plot([x[i][0], end[0]], [x[i][1], end[1]], "k-", lw=0.6)
+    for face in {f for _, f in walls}:
+        a = "xyz".index(face[0])
+        if a > 1:
+            continue
+        at = 0.0 if face[1] == "-" else box[a]
+        ax.plot([at, at] if a == 0 else [0, window[0]], [0, window[1]] if a == 0 else [at, at],
+                "k-", lw=2.5)
+    margin = 0.02 * window.max() if walls else 0.0
+    ax.set_xlim(-margin, window[0] + margin)
+    ax.set_ylim(-margin, window[1] + margin)
     ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])

@@ -68,6 +68,10 @@ struct EventCounters {
   // part of the state: counted from the start of this engine).
   std::uint64_t lost_support = 0;
   std::uint64_t driving_kicks = 0;  // velocities set by a thermostat or random kick
+  // The normal impulse each wall on a box face (face 2k: the low face of axis k) gave the
+  // particles in hard contacts: their pressure on it, summed (not written to restart files: a
+  // continued run counts from its start; compression reads a container's pressure from it).
+  std::array<double, 6> face_wall_impulse{};
   // Kinetic energy (translational + rotational) dissipated in particle-particle and in
   // particle-wall collisions, and the work moving walls did on the particles.
   double dissipated_in_collisions = 0.0;

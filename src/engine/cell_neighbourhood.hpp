@@ -246,7 +246,7 @@ inline void CellNeighbourhood<D>::gather_cells(CellCode cell, const std::uint8_t
     const std::int32_t* delta = grid_.neighbour_deltas();
     for (int c = 0; c < count; ++c) cells[c] = centre + static_cast<std::uint32_t>(delta[which[c]]);
     list.n_shifts = 1;
-    walk_lists<false>(cells, tags, count, list, hot);
+    walk_lists<false>(cells, nullptr, count, list, hot);  // no shifts: tags unread
   } else {
     std::uint32_t n_shifts = 1;  // shifts[0] is the zero shift
     for (int c = 0; c < count; ++c) {

@@ -967,7 +967,7 @@ void EventEngine<D, Queue>::start_growth() {
   };
   if (!(options_.growth_rate > 0.0) || !std::isfinite(options_.growth_rate))
     throw InputError("the growth rate must be positive and finite");
-  if (bounded_) refuse("walls or open faces: every axis must be periodic");
+  check_growth_boundaries();
   if (accelerated_) refuse("gravity (field.gravity)");
   if (sheared_) refuse("Lees-Edwards shear (boundary.shear_rate)");
   if (stepped_) refuse("stepped potentials or bonds");
@@ -983,6 +983,35 @@ void EventEngine<D, Queue>::start_growth() {
                           (options_.record_loads == RecordLoads::kAuto && !cpu_gathers_fast()));
   vector_scan_ = false;  // no other loop runs while growing
   update_growth_limit();
+}
+
+// Growing particles meet fixed, elastic, smooth walls on the box's faces only: a growing radius
+// against a plane is a velocity along its normal (Boundaries::next_contact), which holds for
+// no curved surface, and the contact must send the particle off at the growth speed (no
+// dissipation, no spin). The cells need nothing more: a particle can touch a wall only from
+// the outer layer while two grown radii fit a cell (update_growth_limit).
+template <int D, class Queue>
+void EventEngine<D, Queue>::check_growth_boundaries() const {
+  const auto refuse = [](const std::string& what) {
+    throw InputError("growing particles (compression) cannot be combined with " + what);
+  };
+  for (int a = 0; a < D; ++a) {
+    for (int f = 2 * a; f < 2 * a + 2; ++f) {
+      if (env_.faces[f].kind == FaceKind::kOpen)
+        refuse("open faces (boundary.open): a growing packing needs walls or periodic faces");
+    }
+  }
+  for (int s = 0; s < boundaries_.surfaces(); ++s) {
+    if (!boundaries_.is_surface(s)) continue;
+    const std::string name = "the wall " + boundaries_.name(s);
+    if (s >= 2 * D || !boundaries_.flat(s) || boundaries_.passes(s))
+      refuse(name + ": only walls on the box's faces (boundary.wall) grow a packing");
+    if (boundaries_.surface_moves(s) || boundaries_.accelerates(s) || boundaries_.massive(s))
+      refuse(name + ", which moves (a velocity along its normal, a vibration or a mass)");
+    const ContactModel& law = boundaries_.contact(s);
+    if (!law.normal.always_elastic() || !law.tangential.is_smooth())
+      refuse(name + ", whose contact is inelastic or rough (its restitution)");
+  }
 }
 
 template <int D, class Queue>

@@ -390,7 +390,10 @@ class EventEngine {
   double contact_distance(std::uint32_t i, std::uint32_t j, double t) const {
     return (radius_of(i) + radius_of(j)) * growth_.scale(t);
   }
+  // The particle's radius at time t (it grows with growth_).
+  double radius_at(std::uint32_t i, double t) const { return radius_of(i) * growth_.scale(t); }
   void start_growth();
+  void check_growth_boundaries() const;
   void update_growth_limit();
   // Two cell levels for a wide size distribution (EngineOptions::size_levels), if they apply;
   // `room`: the cells' width over the contact distance they must hold (growth).

@@ -156,6 +156,10 @@ std::pair<double, int> EventEngine<D, Queue>::next_wall_contact(std::uint32_t i,
     const Code partner = Code::from_bits(soft_state_.partner(i));
     if (partner.is_wall()) frozen_against = partner.wall_face();
   }
+  if (growing_) [[unlikely]] {  // the radius at t, growing (flat surfaces only: start_growth)
+    return boundaries_.next_contact(h.pos + (t - h.time) * h.vel, h.vel, radius_at(i, t), h.cell,
+                                    cells_.grid(), t, horizon, -1, growth_.speed(radius_of(i)));
+  }
   return boundaries_.next_contact(flight_position(h, t), flight_velocity(h, t), radius_of(i),
                                   h.cell, cells_.grid(), t, horizon, frozen_against);
 }
@@ -184,10 +188,24 @@ EventKind EventEngine<D, Queue>::hit_wall(std::uint32_t i, int surface, double t
   }
   Spin<D> wi{};
   if (!spin_.empty()) wi = to_spin<D>(spin_[i]);
+  // A growing particle meets a plane (start_growth) as one of its radius at t whose velocity
+  // is less the growth speed along the normal: the contact reverses that, so the particle
+  // leaves at the growth speed beyond the mirror image of its own
+  // (docs/physics.md#growing-spheres).
+  const Vec<D> growth_velocity =
+      growing_ ? growth_.speed(radius_of(i)) * boundaries_.normal(surface, h.pos, t) : Vec<D>{};
+  if (growing_) [[unlikely]]
+    h.vel = h.vel - growth_velocity;
   const ContactResult<D> res =
-      boundaries_.resolve(surface, h.pos, t, mass_of(i), radius_of(i),
+      boundaries_.resolve(surface, h.pos, t, mass_of(i), growing_ ? radius_at(i, t) : radius_of(i),
                           env_.inertia_factor_of(species_of(i)), elastic, h.vel, wi);
+  // (The work of the growth, 2 m rdot (rdot - v.n), is not in work_by_walls: resolve saw
+  // the shifted velocity, whose energy a still wall keeps. Growth's work on pairs is not
+  // counted either; the compression's thermostat removes it.)
+  if (growing_) [[unlikely]]
+    h.vel = h.vel + growth_velocity;
   if (!spin_.empty()) spin_[i] = from_spin<D>(wi);
+  if (surface < 2 * D) counters_.face_wall_impulse[surface] += res.normal_impulse;
   counters_.dissipated_at_walls += res.dissipated;
   counters_.work_by_walls += work_on_particle(res);
   if (resting_.on() && !boundaries_.accelerates(surface)) {

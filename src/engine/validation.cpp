@@ -57,7 +57,7 @@ void EventEngine<D, Queue>::validate() {
     for (int f = 0; f < boundaries_.surfaces(); ++f) {
       if (!boundaries_.is_surface(f) || boundaries_.passes(f)) continue;
       const double gap = boundaries_.gap(f, x, t);
-      if (gap >= radius_of(i) * (1.0 - 1e-9)) continue;
+      if (gap >= radius_at(i, t) * (1.0 - 1e-9)) continue;
       // A soft contact overlaps its wall while frozen and after its release, leaving; turned
       // back towards the wall (by a third body), it meets the wall now.
       const double leaving =
@@ -112,10 +112,13 @@ void EventEngine<D, Queue>::validate() {
     const Vec<D> x = position(i, t), v = velocity(i, t);
     for (int f = 0; f < boundaries_.surfaces(); ++f) {
       if (!boundaries_.is_surface(f)) continue;
-      const double due = t + boundaries_.event_time(f, x, v, radius_of(i), t, kNever);
+      // A growing radius is a velocity towards the plane (Boundaries::next_contact).
+      const Vec<D> v_surface =
+          growing_ ? v - growth_.speed(radius_of(i)) * boundaries_.normal(f, x, t) : v;
+      const double due = t + boundaries_.event_time(f, x, v_surface, radius_at(i, t), t, kNever);
       const Vec<D> x_due = x + (due - t) * v;  // near enough for the surface's normal there
       const double speed_at_contact =
-          std::abs(dot(v + (due - t) * env_.gravity - boundaries_.velocity(f, x_due, due),
+          std::abs(dot(v_surface + (due - t) * env_.gravity - boundaries_.velocity(f, x_due, due),
                        boundaries_.normal(f, x_due, due)));
       // A wall with mass is looked for only by the particles in its band of cells until its
       // plane changes layer (EventEngine::wall_moved); a particle outside the band meets it

@@ -78,6 +78,11 @@ class NormalRestitution {
   static NormalRestitution table(std::vector<double> speeds, std::vector<double> values);
 
   double operator()(double impact_speed) const;
+  // e = 1 at every speed (a constant 1, the default).
+  bool always_elastic() const {
+    const auto* c = std::get_if<Constant>(&model_);
+    return c != nullptr && c->e == 1.0;
+  }
 
  private:
   struct Constant {

@@ -1377,8 +1377,7 @@ std::optional<TransportObstacle> compression_obstacle(const Config& c) {
   const auto refuse = [](std::string key, std::string why) {
     return TransportObstacle{std::move(key), std::move(why)};
   };
-  const char* box = "the particles grow in a periodic box";
-  if (!c.boundary.walls.empty()) return refuse("boundary.wall", box);
+  const char* box = "the particles grow in a periodic box or between walls on its faces";
   if (!c.boundary.planes.empty()) return refuse("boundary.plane", box);
   if (!c.boundary.cylinders.empty()) return refuse("boundary.cylinder", box);
   if (!c.boundary.spheres.empty()) return refuse("boundary.sphere", box);

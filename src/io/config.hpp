@@ -366,9 +366,10 @@ struct CompressConfig {
   double growth_rate = 0.01;      // d sigma / dt over the starting diameter
   double thermostat_interval = 10.0;  // collisions per particle between velocity rescalings
   double jammed_pressure = 1e12;
-  double slowdown_pressure = 100.0;  // above it the growth slows as sqrt(slowdown / Z) (0: never)
-  double slowdown_floor = 0.1;       // ... to at least this fraction of growth_rate
-  double contact_gap = 0.0;          // contact network: relative gap tolerance (0: 1e4 / Z)
+  double jammed_collision_rate = 0.0;  // also jammed above this collision rate (0: not used)
+  double slowdown_pressure = 100.0;    // above it the growth slows as sqrt(slowdown / Z) (0: never)
+  double slowdown_floor = 0.1;         // ... to at least this fraction of growth_rate
+  double contact_gap = 0.0;            // contact network: relative gap tolerance (0: 1e4 / Z)
 
   bool on() const { return packing_fraction > 0.0 || pressure > 0.0 || jammed; }
   bool operator==(const CompressConfig&) const = default;

@@ -732,6 +732,14 @@ constexpr KeyDecl kCompress[] = {
      .member = field<&CompressConfig::jammed_pressure>,
      .range = {.lo = 10.0, .hi = 1e13},
      .doc = "the reduced pressure above which the packing is jammed"},
+    {.name = "jammed_collision_rate",
+     .type = KeyType::kFloat,
+     .member = field<&CompressConfig::jammed_collision_rate>,
+     .range = up_to(1e15, Scale::kNone),
+     .unit = "per sqrt(kT/m)/sigma",
+     .doc = "jammed also when the collisions per particle per unit time exceed this, in units "
+            "of sqrt(kT/m) over the mean diameter (0: not used): the collision rate diverges at "
+            "jamming"},
     {.name = "slowdown_pressure",
      .type = KeyType::kFloat,
      .member = field<&CompressConfig::slowdown_pressure>,

@@ -250,16 +250,23 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
   }
   // The soonest contact of a particle in `cell` with any surface but `skip` (a soft contact's
   // wall while the particle is frozen against it; -1: none) from time t before t + horizon:
-  // (relative time, surface), surface -1 if none.
+  // (relative time, surface), surface -1 if none. A radius growing at `radius_speed` (growing
+  // particles; flat surfaces only) brings the particle's surface nearer a plane as a velocity
+  // radius_speed towards it would: the contact of a particle of the radius at t moving at
+  // v - radius_speed n.
   std::pair<double, int> next_contact(const Vec<D>& x, const Vec<D>& v, double radius,
                                       CellCode cell, const CellGrid<D>& grid, double t,
-                                      double horizon, int skip = -1) const {
+                                      double horizon, int skip = -1,
+                                      double radius_speed = 0.0) const {
     std::pair<double, int> best{horizon, -1};
     int first = 0;
     for_each([&](const auto& c) {
       for (int k = 0; k < c.surfaces(); ++k) {
         if (first + k == skip || !c.reaches(k, cell, grid)) continue;
-        const double when = c.event_time(k, x, v, radius, t, best.first);
+        const double when =
+            radius_speed == 0.0
+                ? c.event_time(k, x, v, radius, t, best.first)
+                : c.event_time(k, x, v - radius_speed * c.normal(k, x, t), radius, t, best.first);
         if (when < best.first) best = {when, first + k};
       }
       first += c.surfaces();

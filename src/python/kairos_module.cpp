@@ -415,6 +415,7 @@ class PySimulation {
       history["kT_before_rescaling"] =
           column([](const CompressionRow& r) { return r.temperature; });
       history["collisions"] = column([](const CompressionRow& r) { return r.collisions; });
+      history["collision_rate"] = column([](const CompressionRow& r) { return r.collision_rate; });
       out["history"] = history;
       return out;
     });

@@ -121,8 +121,9 @@ RunStart<D> start_run(const Config& config, const std::optional<fs::path>& resta
       compress.packing_fraction = config.system.packing_fraction;
     if (compress.on()) {
       const bool tell = progress_modes().at(config.output.progress) != ProgressMode::kOff;
-      start.compression = compress_start<D>(start.state, compress, config.system.temperature, tell,
-                                            config.run.size_levels);
+      start.compression = compress_start<D>(
+          start.state, compress, config.system.temperature, tell, config.run.size_levels,
+          growth_environment(make_environment<D>(config, start.state)));
     }
   }
   check_restart_integrator(restart_file, start.resumed, integrator);

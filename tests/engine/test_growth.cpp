@@ -31,19 +31,19 @@ EngineOptions growing(double rate, const ParticleSystem<D>& s, double room) {
 // time at the end.
 template <int D>
 double run_validated_growth(const ParticleSystem<D>& start, double rate, int events,
-                            double room = 1.2) {
+                            double room = 1.2, const Environment<D>& env = {}) {
   const EngineOptions o = growing<D>(rate, start, room);
-  EventEngine<D, CalendarQueue> engine(start, StartMode::kPredict, o);
+  EventEngine<D, CalendarQueue> engine(start, StartMode::kPredict, o, env);
   engine.validate();
   const Vec<D> p0 = engine.momentum();
   double energy = engine.kinetic_energy();
   int e = 0;
   for (; e < events && engine.next_event_time() < engine.growth_fits_until(); ++e) {
-    const std::uint64_t before = engine.counters().collisions;
+    const std::uint64_t before = engine.counters().collisions + engine.counters().wall_collisions;
     engine.step();
     engine.validate();
     const double now = engine.kinetic_energy();
-    if (engine.counters().collisions > before) {
+    if (engine.counters().collisions + engine.counters().wall_collisions > before) {
       EXPECT_GT(now, energy) << "a growing collision gives energy";
     } else {
       EXPECT_EQ(now, energy);
@@ -51,7 +51,12 @@ double run_validated_growth(const ParticleSystem<D>& start, double rate, int eve
     energy = now;
   }
   EXPECT_GT(engine.counters().collisions, 100u);
-  for (int a = 0; a < D; ++a) EXPECT_NEAR(engine.momentum()[a], p0[a], 1e-11);
+  // Momentum is kept along the periodic axes (walls take it up along theirs).
+  for (int a = 0; a < D; ++a) {
+    if (env.periodic(a)) {
+      EXPECT_NEAR(engine.momentum()[a], p0[a], 1e-11);
+    }
+  }
   // Radii exported as grown, to the engine's time.
   const ParticleSystem<D> out = engine.export_state();
   const double scale = engine.growth().scale(engine.time());
@@ -73,6 +78,54 @@ TEST(Growth, ValidatedBinaryMixtureGrowingFast) {
   // Diameter ratio 1.4, fast growth: pairs are often reached by the growth alone.
   run_validated_growth<3>(lattice_system<3>(6, 0.2, 13, 1.0, 1.4), 0.5, 3000, 1.6);
   run_validated_growth<2>(lattice_system<2>(10, 0.3, 14, 2.0, 1.4), 0.5, 3000, 1.6);
+}
+
+// Growth between walls: a radius growing against a plane is a velocity towards it; checked
+// against brute force (every wall contact, every pair) after every event.
+TEST(Growth, ValidatedBetweenWalls3D) {
+  const double t = run_validated_growth<3>(testing::gas_between_walls<3>(5, 0.3, 21), 0.05, 4000,
+                                           1.2, testing::walls_on_last_axis<3>());
+  EXPECT_GT(t, 0.0);
+}
+
+TEST(Growth, ValidatedInAClosedBox2D) {
+  Environment<2> box;
+  for (int f = 0; f < 4; ++f) box.faces[f].kind = FaceKind::kWall;
+  run_validated_growth<2>(testing::gas_between_walls<2>(9, 0.4, 22), 0.5, 4000, 1.6, box);
+}
+
+// One sphere at rest, its surface reached by the growth alone: it touches the wall when its
+// radius equals its centre's distance, and leaves at twice the growth speed (the mirror image
+// of -r0 rate, plus the growth speed).
+TEST(Growth, AWallSendsAGrowingParticleOffAtTwiceItsGrowthSpeed) {
+  // Spheres 1.46 apart, the lowest layer 0.73 above the z- wall.
+  ParticleSystem<3> s = testing::gas_between_walls<3>(3, 0.05, 23);
+  for (Kinematics<3>& k : s.kinematics) k.vel = Vec<3>{};
+  s.kinematics[0].pos[2] = 0.6;  // radius 0.5: touches the z- wall first, once grown by 0.1
+  s.kinematics[1].vel = {0.01, 0.0, 0.0};  // something moves (the box is far from full)
+  const double rate = 0.1;
+  EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, growing<3>(rate, s, 1.2),
+                                       testing::walls_on_last_axis<3>());
+  const double contact = (0.6 / 0.5 - 1.0) / rate;  // 0.5 (1 + rate t) = 0.6
+  bool met = false;
+  while (!met && engine.next_event_time() < engine.growth_fits_until()) {
+    const std::uint64_t walls = engine.counters().wall_collisions;
+    engine.step();
+    met = engine.counters().wall_collisions > walls;
+  }
+  ASSERT_TRUE(met);
+  EXPECT_NEAR(engine.time(), contact, 1e-12);
+  const ParticleSystem<3> out = engine.export_state();
+  // The engine may renumber: the particle that was at z = 0.6 is the one now moving along z.
+  int found = 0;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (out.kinematics[i].vel[2] == 0.0) continue;
+    ++found;
+    EXPECT_NEAR(out.kinematics[i].vel[2], 2.0 * 0.5 * rate, 1e-15);
+    EXPECT_NEAR(out.kinematics[i].pos[2], out.kinematics[i].radius, 1e-12);
+  }
+  EXPECT_EQ(found, 1);
+  EXPECT_NEAR(engine.counters().face_wall_impulse[4], 2.0 * 0.5 * rate, 1e-15);
 }
 
 TEST(Growth, StopsBeforeTheCellsAreTooNarrow) {
@@ -166,10 +219,29 @@ TEST(Growth, RefusesWhatItCannotGrowIn) {
       EXPECT_NE(std::string(e.what()).find("growing particles"), std::string::npos) << e.what();
     }
   };
-  refused(testing::walls_on_last_axis<3>(), "walls");
   Environment<3> inelastic = testing::walls_on_last_axis<3>(0.9);
+  refused(inelastic, "inelastic walls and contacts");
   for (int f = 0; f < 6; ++f) inelastic.faces[f] = Environment<3>{}.faces[f];
   refused(inelastic, "inelastic contacts");
+  Environment<3> lossy_wall = testing::walls_on_last_axis<3>();
+  lossy_wall.faces[5].wall.contact.normal = NormalRestitution::constant(0.8);
+  refused(lossy_wall, "an inelastic wall");
+  Environment<3> piston = testing::walls_on_last_axis<3>();
+  piston.faces[5].wall.velocity[2] = -0.1;
+  refused(piston, "a piston");
+  Environment<3> shaken = testing::walls_on_last_axis<3>();
+  shaken.faces[4].wall.amplitude = 0.05;
+  shaken.faces[4].wall.angular_frequency = 10.0;
+  refused(shaken, "a vibrating wall");
+  Environment<3> open = testing::walls_on_last_axis<3>();
+  open.faces[5].kind = FaceKind::kOpen;
+  refused(open, "an open face");
+  Environment<3> plane;
+  plane.faces[4].kind = plane.faces[5].kind = FaceKind::kWall;
+  plane.planes.push_back(PlaneWall<3>{});
+  plane.planes.back().normal = {0.0, 0.0, 1.0};
+  plane.planes.back().offset = 0.01;
+  refused(plane, "a plane wall");
 }
 
 // Per-particle radii (EngineOptions::per_particle_radii, chosen by itself beyond 65 536 kinds):

@@ -246,7 +246,7 @@ class Module(kt.KairosTestCase):
         report = sim.compression()
         summary = self.summary(out)["compression"]
         for key in ("stop_reason", "packing_fraction", "reduced_pressure", "time", "collisions",
-                    "rescalings", "rebuilds", "diameter_scale", "contacts"):
+                    "rescalings", "rebuilds", "diameter_scale", "contacts", "collision_rate"):
             self.assertEqual(report[key], summary[key], key)
         self.assertEqual(report["stop_reason"], "packing_fraction")
         self.assertAlmostEqual(report["packing_fraction"], 0.55, delta=1e-12)
@@ -256,6 +256,7 @@ class Module(kt.KairosTestCase):
         self.assertEqual(len(history["time"]), len(rows))
         self.assertTrue(np.array_equal(history["packing_fraction"], rows[:, 1]))
         self.assertTrue(np.array_equal(history["collisions"], rows[:, 4]))
+        self.assertTrue(np.allclose(history["collision_rate"], rows[:, 5], rtol=1e-9, atol=0))
         # The packing the CLI wrote (float64, GSD's box centred on 0) is the Simulation's start.
         packing = kt.restart_chunk(os.path.join(out, "packing.gsd"), "particles/position")
         self.assertEqual(packing.dtype, np.float64)

@@ -74,6 +74,7 @@ STEPPED_EXAMPLES = {
 COMPRESSION_EXAMPLES = {
     "jammed_spheres_3d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
     "jammed_disks_2d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
+    "jammed_disks_box_2d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
     "polydisperse_glass_3d.toml": ["system.particles=400",
                                    "run.equilibration_collisions_per_particle=1",
                                    "run.collisions_per_particle=4"],
@@ -396,7 +397,7 @@ class CompressionExamples(kt.KairosTestCase):
         self.assert_outputs_exist(out)
         return out, self.summary(out)
 
-    def check_packing(self, out, s, dimension):
+    def check_packing(self, out, s, dimension, walls=False):
         import gsd.hoomd
         c = s["compression"]
         frame = gsd.hoomd.open(os.path.join(out, "packing.gsd"))[0]
@@ -408,8 +409,13 @@ class CompressionExamples(kt.KairosTestCase):
         solid = np.sum(np.pi * d**3 / 6 if dimension == 3 else np.pi * d**2 / 4)
         self.assertAlmostEqual(solid / volume, c["packing_fraction"], delta=1e-9)
         with open(os.path.join(out, "contacts.tsv")) as f:
-            rows = [line for line in f if not line.startswith("#")]
-        self.assertEqual(len(rows), c["contacts"]["contacts"] if c["contacts"] else 0)
+            rows = [line.split() for line in f if not line.startswith("#")]
+        pairs = [row for row in rows if row[1][-1] not in "+-"]
+        self.assertEqual(len(pairs), c["contacts"]["contacts"] if c["contacts"] else 0)
+        self.assertEqual(len(rows) - len(pairs),
+                         c["contacts"]["wall_contacts"] if c["contacts"] else 0)
+        if not walls:
+            self.assertEqual(len(rows), len(pairs))
         return frame
 
     def draw(self, out):
@@ -434,6 +440,27 @@ class CompressionExamples(kt.KairosTestCase):
         self.assertGreater(c["packing_fraction"], 0.81)
         self.assertLess(c["packing_fraction"], 0.86)
         self.check_packing(out, s, 2)
+        self.draw(out)
+
+    def test_jammed_disks_box_2d(self):
+        # Jammed between walls on every face: the walls hold it as its disks do.
+        out, s = self.run_example("jammed_disks_box_2d.toml")
+        c = s["compression"]
+        self.assertEqual(c["stop_reason"], "jammed")
+        self.assertGreater(c["contacts"]["wall_contacts"], 10)
+        # Isostatic with the walls' contacts, which hold the translations: D N'.
+        k = c["contacts"]
+        self.assertLessEqual(abs(k["isostatic_excess"]),
+                             0.03 * (k["backbone_contacts"] + k["wall_contacts"]))
+        self.check_packing(out, s, 2, walls=True)
+        # No disk beyond a wall (the packing's own box is the walls' box).
+        import gsd.hoomd
+        frame = gsd.hoomd.open(os.path.join(out, "packing.gsd"))[0]
+        box = frame.configuration.box[:2]
+        x = frame.particles.position[:, :2] + 0.5 * box
+        r = 0.5 * frame.particles.diameter.astype(float)[:, None]
+        self.assertGreaterEqual(np.min(x - r), -1e-12 * box.max())
+        self.assertGreaterEqual(np.min(box - x - r), -1e-12 * box.max())
         self.draw(out)
 
     def test_polydisperse_glass_3d(self):

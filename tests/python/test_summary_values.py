@@ -201,7 +201,7 @@ class SummaryValues(kt.KairosTestCase):
                     args += ["--set", "run.equilibration_time=1", "--set", "run.time=3",
                              "--set", "output.thermo_interval=0.5"]
                 if name in ("jammed_spheres_3d.toml", "jammed_disks_2d.toml",
-                            "polydisperse_glass_3d.toml"):  # the compression, shortened
+                            "jammed_disks_box_2d.toml", "polydisperse_glass_3d.toml"):  # the compression, shortened
                     args += ["--set", "system.particles=300"]
                 if name == "asymmetric_mixture_3d.toml":  # 1:10 needs its box: shorter
                     args += ["--set", "compress.packing_fraction=0.35"]

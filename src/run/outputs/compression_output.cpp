@@ -15,10 +15,12 @@ template <int D>
 void CompressionOutput<D>::open(const RunContext<D>& run) {
   const CompressionResult& r = report_->result;
   std::string rows =
-      "# time\tpacking_fraction\treduced_pressure\tkT_before_rescaling\tcollisions\n";
+      "# time\tpacking_fraction\treduced_pressure\tkT_before_rescaling\tcollisions\t"
+      "collision_rate\n";
   for (const CompressionRow& row : r.rows) {
-    rows += fmt::format("{:.17g}\t{:.17g}\t{:.10g}\t{:.10g}\t{}\n", row.time, row.packing_fraction,
-                        row.pressure, row.temperature, row.collisions);
+    rows += fmt::format("{:.17g}\t{:.17g}\t{:.10g}\t{:.10g}\t{}\t{:.10g}\n", row.time,
+                        row.packing_fraction, row.pressure, row.temperature, row.collisions,
+                        row.collision_rate);
   }
   write_text_atomically(run.directory() / "compress.tsv", rows);
 
@@ -36,6 +38,11 @@ void CompressionOutput<D>::open(const RunContext<D>& run) {
   for (const Contact& c : net.contacts) {
     contacts += fmt::format("{}\t{}\t{:.6g}\t{}\t{}\n", c.i, c.j, c.gap, int{net.rattler[c.i]},
                             int{net.rattler[c.j]});
+  }
+  // A wall contact names the wall's face as j (x-, ..., z+), its gap relative to the diameter.
+  for (const WallContact& c : net.wall_contacts) {
+    contacts += fmt::format("{}\t{}{}\t{:.6g}\t{}\t0\n", c.i, "xyz"[c.face / 2],
+                            c.face % 2 == 0 ? '-' : '+', c.gap, int{net.rattler[c.i]});
   }
   if (report_->has_network) write_text_atomically(run.directory() / "contacts.tsv", contacts);
 
@@ -61,6 +68,9 @@ void summarize_compression(const CompressionReport& report, int dimension,
   set_or_explain(summary, c, "reduced_pressure", r.pressure,
                  r.rows.empty() ? "no thermostat interval ended during the compression" : "",
                  "compression.reduced_pressure");
+  set_or_explain(summary, c, "collision_rate", r.collision_rate,
+                 r.rows.empty() ? "no thermostat interval ended during the compression" : "",
+                 "compression.collision_rate");
   // The free-volume law p = D / (1 - phi / phi_J) (Salsburg and Wood 1962) read backwards:
   // the jamming density the pressure points at (docs/physics.md#jammed-packings).
   const double phi_j = r.packing_fraction / (1.0 - D / r.pressure);
@@ -92,10 +102,12 @@ void summarize_compression(const CompressionReport& report, int dimension,
   nlohmann::json& k = c["contacts"];
   k["gap_tolerance"] = net.gap_tolerance;
   k["contacts"] = net.contacts.size();
+  k["wall_contacts"] = net.wall_contacts.size();
   k["coordination"] = net.coordination;
   k["rattlers"] = net.rattlers;
   k["rattler_fraction"] = net.rattler_fraction;
   k["backbone_contacts"] = net.backbone_contacts;
+  k["backbone_wall_contacts"] = net.backbone_wall_contacts;
   k["backbone_coordination"] = net.backbone_coordination;
   k["isostatic_excess"] = net.excess_contacts;
   k["largest_contact_gap"] = net.largest_contact_gap;
