@@ -113,9 +113,10 @@ void EventEngine<D, Queue>::validate() {
     for (int f = 0; f < boundaries_.surfaces(); ++f) {
       if (!boundaries_.is_surface(f)) continue;
       // A growing radius is a velocity towards the plane (Boundaries::next_contact).
-      const Vec<D> v_surface =
-          growing_ ? v - growth_.speed(radius_of(i)) * boundaries_.normal(f, x, t) : v;
-      const double due = t + boundaries_.event_time(f, x, v_surface, radius_at(i, t), t, kNever);
+      const double radius_speed = growing_ ? growth_.speed(radius_of(i)) : 0.0;
+      const double due =
+          t + boundaries_.event_time(f, x, v, radius_at(i, t), t, kNever, radius_speed);
+      const Vec<D> v_surface = v - radius_speed * boundaries_.normal(f, x, t);
       const Vec<D> x_due = x + (due - t) * v;  // near enough for the surface's normal there
       const double speed_at_contact =
           std::abs(dot(v_surface + (due - t) * env_.gravity - boundaries_.velocity(f, x_due, due),

@@ -697,7 +697,7 @@ constexpr KeyDecl kOutput[] = {
      .doc = "slabs of the profile"},
 };
 
-// ----- [analysis]
+// ----- [compress], [analysis]
 
 const CompressConfig kCompressDefaults{};
 constexpr KeyDecl kCompress[] = {

@@ -181,9 +181,14 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
   bool is_surface(int s) const {
     return at(s, [](const auto& c, int k) { return c.is_surface(k); });
   }
+  // (radius_speed: a growing radius, as in next_contact; flat surfaces only.)
   double event_time(int s, const Vec<D>& x, const Vec<D>& v, double radius, double t,
-                    double horizon) const {
-    return at(s, [&](const auto& c, int k) { return c.event_time(k, x, v, radius, t, horizon); });
+                    double horizon, double radius_speed = 0.0) const {
+    return at(s, [&](const auto& c, int k) {
+      return radius_speed == 0.0
+                 ? c.event_time(k, x, v, radius, t, horizon)
+                 : c.event_time(k, x, v - radius_speed * c.normal(k, x, t), radius, t, horizon);
+    });
   }
   double gap(int s, const Vec<D>& x, double t) const {
     return at(s, [&](const auto& c, int k) { return c.gap(k, x, t); });

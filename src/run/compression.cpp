@@ -128,8 +128,8 @@ void check_settings(const CompressionSettings& s) {
   if (!(s.cell_margin > 0.0)) throw std::logic_error("compress: cell_margin must be positive");
 }
 
-// The engine refuses what growth cannot meet (open faces, moving or inelastic walls, curved
-// ones); here what the protocol needs besides.
+// The engine refuses what growth cannot meet (EventEngine::check_growth_boundaries: open faces,
+// moving or inelastic walls, planes, curved ones); here what the protocol needs besides.
 template <int D>
 void check_state(const ParticleSystem<D>& state, const Environment<D>& environment) {
   for (int a = 0; a < D; ++a) {
@@ -143,12 +143,6 @@ void check_state(const ParticleSystem<D>& state, const Environment<D>& environme
                       "compression's faces along it are periodic",
                       "xyz"[a]));
     }
-  }
-  if (!environment.planes.empty() || !environment.cylinders.empty() ||
-      !environment.spheres.empty() || !environment.outlets.empty()) {
-    throw InputError(
-        "compression grows packings between walls on the box's faces only (boundary.wall), not "
-        "against planes, cylinders, spheres or outlets");
   }
   if (!state.bonds.empty()) throw InputError("compression cannot grow bonded particles");
 }
