@@ -60,7 +60,11 @@ void HelfandTransport<D>::add(double t, const Moments& m) {
   last_ = now;
   last_time_ = t;
   kinetic_trace_last_ = m.kinetic_trace;
-  if (helfand_.samples() == 0) kinetic_trace_first_ = kinetic_trace_last_;
+  frozen_pair_time_last_ = m.frozen_pair_time;
+  if (helfand_.samples() == 0) {
+    kinetic_trace_first_ = kinetic_trace_last_;
+    frozen_pair_time_first_ = frozen_pair_time_last_;
+  }
   for (int k = 0; k < kComponents; ++k) sample_[k][0] = now[k] - first_[k];
   sample_[bulk][0] -= pressure_offset_ * (t - first_time_);
   helfand_.add(sample_);
@@ -70,7 +74,10 @@ void HelfandTransport<D>::add(double t, const Moments& m) {
 template <int D>
 double HelfandTransport<D>::temperature() const {
   const double span = last_time_ - first_time_;
-  const double dof = D * (static_cast<double>(particles_) - 1.0);
+  // A frozen pair moves as one body: D degrees of freedom fewer while it lasts.
+  const double frozen_pairs =
+      span > 0.0 ? (frozen_pair_time_last_ - frozen_pair_time_first_) / span : 0.0;
+  const double dof = D * (static_cast<double>(particles_) - 1.0 - frozen_pairs);
   return span > 0.0 ? (kinetic_trace_last_ - kinetic_trace_first_) / (span * dof) : std::nan("");
 }
 

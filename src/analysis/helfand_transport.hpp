@@ -41,6 +41,9 @@ class HelfandTransport {
     std::array<double, 9> stress{};
     Vec<D> energy{};
     double kinetic_trace = 0.0;
+    // Soft contacts: the time integral of the number of frozen pairs, whose relative motion
+    // is not in the kinetic trace (kT counts the degrees of freedom that move).
+    double frozen_pair_time = 0.0;
   };
 
   // Samples `interval` apart of a system of `particles` particles in `volume`.
@@ -99,6 +102,7 @@ class HelfandTransport {
   Components first_{}, last_{};
   double pressure_offset_ = 0.0;  // the pressure's moment's rate in the first interval
   double kinetic_trace_first_ = 0.0, kinetic_trace_last_ = 0.0;
+  double frozen_pair_time_first_ = 0.0, frozen_pair_time_last_ = 0.0;
   double first_time_ = 0.0, last_time_ = 0.0;
 };
 

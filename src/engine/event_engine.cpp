@@ -269,6 +269,24 @@ void EventEngine<D, Queue>::start_helfand() {
     for (std::uint32_t m = 0; m < steps_.entry_count(k); ++m)
       helfand_.add_potential_share(k, 0.5 * steps_.table(e[m].zone.table).energy[e[m].zone.zone]);
   }
+  // A frozen soft contact holds its relative kinetic energy until its release (the share
+  // helfand_moments.hpp gives it; deferred contacts' records move as after the release).
+  // The contacts in progress are counted as frozen pairs for the rest of their time.
+  for (std::uint32_t k = 0; soft_ && k < n; ++k) {
+    const std::uint32_t p = soft_state_.partner(k);
+    if (!is_particle(p)) continue;
+    if (soft_state_.awaits_release(k)) {
+      const Vec<D>& after = soft_state_.release_velocity(k);
+      helfand_.set_share(k, 0.5 * mass_of(k) * norm2(after - hot_[k].vel));
+      if (k < p) helfand_.frozen_pair_for(soft_state_.release_time(k) - time_);
+    } else if (in_deferred_contact(k, time_) && k < p) {
+      const Vec<D> v = frozen_velocity_of(k);
+      const double rest = hot_[k].time - time_;
+      helfand_.frozen_pair_for(rest);
+      helfand_.records_ahead(
+          mass_of(k) * norm2(hot_[k].vel - v) + mass_of(p) * norm2(hot_[p].vel - v), rest);
+    }
+  }
   // Velocities are constant in free flight (no field here): no record is advanced, so the
   // run's bits do not depend on whether the moments are kept.
   for (std::uint32_t k = 0; k < n; ++k)

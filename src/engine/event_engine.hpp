@@ -39,6 +39,7 @@
 #include "core/event_code.hpp"
 #include "core/huge_page_allocator.hpp"
 #include "core/particle_system.hpp"
+#include "core/periodic.hpp"
 #include "core/state_blocks.hpp"
 #include "dynamics/collision_time.hpp"
 #include "engine/candidate_scan.hpp"
@@ -365,6 +366,11 @@ class EventEngine {
   double helfand_energy(std::uint32_t k) const;
   void helfand_before(std::uint32_t i, std::uint32_t j, double t);
   void helfand_after(std::uint32_t i, std::uint32_t j, const Vec<D>& r);
+  // A soft contact moves a pair's records at once (placement, release, deferral): the moments
+  // follow through the jump, r = r_i - r_j from the records continued to t (minimum image).
+  Vec<D> record_separation(std::uint32_t i, std::uint32_t j, double t) const;
+  void helfand_jump_before(std::uint32_t i, std::uint32_t j, double t);
+  void helfand_jump_after(std::uint32_t i, std::uint32_t j, double t);
   void fix_grains(bool moving_surfaces);
   void fall_asleep(std::uint32_t i, double t);
   void wake(std::uint32_t i, double t);
@@ -686,6 +692,32 @@ template <int D, class Queue>
 inline void EventEngine<D, Queue>::helfand_before(std::uint32_t i, std::uint32_t j, double t) {
   helfand_.before_pair(t, mass_of(i), hot_[i].vel, helfand_energy(i), mass_of(j), hot_[j].vel,
                        helfand_energy(j));
+}
+
+template <int D, class Queue>
+inline Vec<D> EventEngine<D, Queue>::record_separation(std::uint32_t i, std::uint32_t j,
+                                                       double t) const {
+  const HotRecord<D>& hi = hot_[i];
+  const HotRecord<D>& hj = hot_[j];
+  Vec<D> r;
+  for (int a = 0; a < D; ++a) {
+    const double raw =
+        (hi.pos[a] + (t - hi.time) * hi.vel[a]) - (hj.pos[a] + (t - hj.time) * hj.vel[a]);
+    r[a] = !bounded_ || cells_.grid().periodic(a) ? minimum_image(raw, box_[a]) : raw;
+  }
+  return r;
+}
+
+template <int D, class Queue>
+inline void EventEngine<D, Queue>::helfand_jump_before(std::uint32_t i, std::uint32_t j, double t) {
+  helfand_.before_jump(t, record_separation(i, j, t), mass_of(i), hot_[i].vel, helfand_energy(i),
+                       mass_of(j), hot_[j].vel, helfand_energy(j), counters_.virial_tensor);
+}
+
+template <int D, class Queue>
+inline void EventEngine<D, Queue>::helfand_jump_after(std::uint32_t i, std::uint32_t j, double t) {
+  helfand_.after_jump(record_separation(i, j, t), mass_of(i), hot_[i].vel, helfand_energy(i),
+                      mass_of(j), hot_[j].vel, helfand_energy(j), counters_.virial_tensor);
 }
 
 template <int D, class Queue>

@@ -14,10 +14,23 @@
 // change of potential energy). The collisional part of G_ab is the engine's virial tensor
 // (EventCounters::virial_tensor), kept anyway; the collisional energy moment is kept here.
 //
+// A soft contact (engine/soft_contacts.cpp, the Muller-Poschel map) moves its pair at once: it
+// is placed where the contact ends, and later released or deferred. Between events the moments
+// are the time integrals of the fluxes, and across such a jump they follow the sums themselves:
+// for the pair (r = r_i - r_j, g = v_i - v_j, mu its reduced mass, M its mass)
+//   sum m x c = M R (V - drift) + mu r g,   sum x e = R (e_i + e_j) + r (m_j e_i - m_i e_j) / M,
+// and the centre of mass R, V and the pair's energy stay, so the jump adds
+// mu (r' g' - r g) to G_ab and the change of r (m_j e_i - m_i e_j) / M to G_a (before_jump,
+// after_jump). The virial tensor has already counted the contact's impulse at the mean lever
+// arm (docs/physics.md#pressure-and-compressibility); the rest is kept here (jump_stress), so
+// that the sum is exact once the contact is over, whatever the contact did in between.
+// While a pair is frozen its relative kinetic energy is held as each particle's share:
+// m_k |v_k' - V|^2 / 2 with v_k' its velocity after the release.
+//
 // The moments need a conservative, translation-invariant system (periodic faces, no field,
-// walls, driving, shear or soft contacts; elastic contact laws): the configuration refuses the
-// rest. Off unless EngineOptions::track_helfand; no restart data of its own (rebuilt from the
-// state when a run starts: only differences of the moments are ever used).
+// walls, driving or shear; elastic contact laws): the configuration refuses the rest. Off unless
+// EngineOptions::track_helfand; no restart data of its own (rebuilt from the state when a run
+// starts: only differences of the moments are ever used).
 #pragma once
 
 #include <array>
@@ -37,7 +50,15 @@ class HelfandMoments {
   struct Moments {
     std::array<double, 9> kinetic_stress{};  // integral of sum m c_a c_b (row-major D x D)
     Vec<D> kinetic_energy_flux{};            // integral of sum c e
-    Vec<D> collisional_energy_flux{};        // sum of r_ij de_i
+    Vec<D> collisional_energy_flux{};        // sum of r_ij de_i (and soft contacts' jumps)
+    // Soft contacts: their jumps' part of the collisional G_ab beyond the virial tensor's.
+    std::array<double, 9> jump_stress{};
+    // Soft contacts, for the temperature: the integral of the frozen pairs' count, and what
+    // the kinetic trace's integral holds beyond the particles' frozen motion (a deferred
+    // contact's records move as after the release). Each contact is added whole when it
+    // begins and its unspent part taken back at an early release: exact once it is over.
+    double frozen_pair_time = 0.0;
+    double frozen_kinetic = 0.0;  // to be added to the trace of kinetic_stress
   };
 
   bool on() const { return on_; }
@@ -87,6 +108,43 @@ class HelfandMoments {
     for (int a = 0; a < D; ++a) moments_.collisional_energy_flux[a] += r[a] * de;
   }
 
+  // A soft contact is about to move the pair i, j at time t (r = r_i - r_j, both positions as
+  // their records continue them to t; energies as energy() gives them now; the virial tensor
+  // now).
+  void before_jump(double t, const Vec<D>& r, double mi, const Vec<D>& vi, double ei, double mj,
+                   const Vec<D>& vj, double ej, const std::array<double, 9>& virial) {
+    integrate_to(t);
+    add(mi, vi, -ei, -1.0);
+    add(mj, vj, -ej, -1.0);
+    jump_from_ = pair_moments(r, mi, vi, ei, mj, vj, ej);
+    virial_from_ = virial;
+  }
+  // Particle k's share of a frozen contact's energy (0 once it is released).
+  void set_share(std::uint32_t k, double energy) { share_[k] = energy; }
+  double share(std::uint32_t k) const { return share_[k]; }
+  // A frozen contact lasts `duration` more (negative: an early release takes back the rest).
+  void frozen_pair_for(double duration) { moments_.frozen_pair_time += duration; }
+  // ... during which its records' sum m v^2 exceeds the frozen pair's by `excess` (deferred).
+  void records_ahead(double excess, double duration) {
+    moments_.frozen_kinetic -= excess * duration;
+  }
+  // ... and has moved it (the virial tensor after it: what the jump added there is not added
+  // twice).
+  void after_jump(const Vec<D>& r, double mi, const Vec<D>& vi, double ei, double mj,
+                  const Vec<D>& vj, double ej, const std::array<double, 9>& virial) {
+    add(mi, vi, ei);
+    add(mj, vj, ej);
+    const PairMoments to = pair_moments(r, mi, vi, ei, mj, vj, ej);
+    for (int a = 0; a < D; ++a) {
+      for (int b = 0; b < D; ++b) {
+        const int k = a * D + b;
+        moments_.jump_stress[k] +=
+            (to.stress[k] - jump_from_.stress[k]) - (virial[k] - virial_from_[k]);
+      }
+      moments_.collisional_energy_flux[a] += to.energy[a] - jump_from_.energy[a];
+    }
+  }
+
   Moments at(double t) const {
     Moments m = moments_;
     const double dt = t - time_;
@@ -116,6 +174,24 @@ class HelfandMoments {
     }
   }
 
+  // A pair's own part of sum m x c and sum x e (see above: mu r g and r (m_j e_i - m_i e_j)/M).
+  struct PairMoments {
+    std::array<double, 9> stress{};
+    Vec<D> energy{};
+  };
+  static PairMoments pair_moments(const Vec<D>& r, double mi, const Vec<D>& vi, double ei,
+                                  double mj, const Vec<D>& vj, double ej) {
+    const double total = mi + mj, mu = mi * mj / total;
+    const Vec<D> g = vi - vj;
+    const double weighted = (mj * ei - mi * ej) / total;
+    PairMoments p;
+    for (int a = 0; a < D; ++a) {
+      for (int b = 0; b < D; ++b) p.stress[a * D + b] = mu * r[a] * g[b];
+      p.energy[a] = r[a] * weighted;
+    }
+    return p;
+  }
+
   bool on_ = false;
   double time_ = 0.0;
   Vec<D> drift_{};
@@ -123,6 +199,8 @@ class HelfandMoments {
   Vec<D> energy_rate_{};                 // sum c e now
   Moments moments_;                      // up to time_
   double energy_before_ = 0.0;           // e_i before the pair event in progress
+  PairMoments jump_from_;                // the jumping pair's moments before the jump
+  std::array<double, 9> virial_from_{};  // and the virial tensor then
   HugeVector<double> share_;             // per particle: half its pairs' energies
 };
 

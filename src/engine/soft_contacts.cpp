@@ -276,6 +276,26 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
   if (!soft_state_.awaits_release(i) && !deferred) [[likely]]
     return kNone;
   const std::uint32_t p = soft_state_.partner(i);
+  // The pair's records jump (to the frozen path, or to the post-contact velocities).
+  const bool moments = helfand_.on() && is_particle(p);
+  if (moments) [[unlikely]] {
+    helfand_jump_before(i, p, t);
+    // The part of the contact that will not be spent frozen.
+    const double rest = (deferred ? hot_[i].time : soft_state_.release_time(i)) - t;
+    helfand_.frozen_pair_for(-rest);
+    if (deferred) {
+      const Vec<D> v = frozen_velocity_of(i);
+      helfand_.records_ahead(
+          mass_of(i) * norm2(hot_[i].vel - v) + mass_of(p) * norm2(hot_[p].vel - v), -rest);
+    }
+  }
+  const auto jumped = [&] {
+    if (!moments) [[likely]]
+      return;
+    helfand_.set_share(i, 0.0);
+    helfand_.set_share(p, 0.0);
+    helfand_jump_after(i, p, t);
+  };
   if (deferred) [[unlikely]] {
     // Early: from where the frozen pair is now, with the post-contact velocities.
     auto give_back = [&](std::uint32_t k) {
@@ -287,6 +307,7 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
     };
     give_back(i);
     if (is_particle(p)) give_back(p);
+    jumped();
     if (early) ++counters_.soft_early_releases;
     return p;
   }
@@ -301,6 +322,7 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
   };
   give_back(i);
   if (is_particle(p)) give_back(p);
+  jumped();
   if (early) ++counters_.soft_early_releases;
   return p;
 }
@@ -369,6 +391,8 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
         return false;
     }
   }
+  if (helfand_.on()) [[unlikely]]
+    helfand_jump_before(i, j, t);
   for (int k = 0; k < 2; ++k) {
     HotRecord<D>& h = hot_[both[k]];
     h.pos = end[k];
@@ -383,6 +407,12 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
                                      : conclude_prediction(both[k], t, window.crossing[k],
                                                            window.partner[k], window.best[k]);
   if (when[0] >= until && when[1] >= until) {
+    if (helfand_.on()) [[unlikely]] {  // the records move as after the release: no share held
+      helfand_.records_ahead(2.0 * (helfand_.share(i) + helfand_.share(j)), until - t);
+      helfand_.set_share(i, 0.0);
+      helfand_.set_share(j, 0.0);
+      helfand_jump_after(i, j, t);
+    }
     queue_.update(i, when[0]);
     queue_.update(j, when[1]);
     return true;
@@ -394,6 +424,8 @@ bool EventEngine<D, Queue>::try_defer(std::uint32_t i, std::uint32_t j, double t
     h.time = t;
     soft_state_.set_deferred(both[k], false);
   }
+  if (helfand_.on()) [[unlikely]]
+    helfand_jump_after(i, j, t);  // no jump after all
   return false;
 }
 
@@ -431,6 +463,8 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
     predict_released();
     return;
   }
+  if (helfand_.on()) [[unlikely]]
+    helfand_jump_before(i, j, t);
   const double mi = mass_of(i), mj = mass_of(j), total = mi + mj, mu = mi * mj / total;
   const double l = radius_of(i) + radius_of(j);
   const double distance = std::sqrt(r2);
@@ -478,6 +512,12 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
       counters_.dissipated_in_collisions += ke_before - ke_after;
       hi.vel = V;
       hj.vel = V;
+      if (helfand_.on()) [[unlikely]] {  // the frozen pair holds its relative kinetic energy
+        helfand_.set_share(i, 0.5 * mi * norm2(after_i - V));
+        helfand_.set_share(j, 0.5 * mj * norm2(after_j - V));
+        helfand_jump_after(i, j, t);
+        helfand_.frozen_pair_for(until - t);
+      }
       soft_state_.begin(i, j);
       soft_state_.begin(j, i);
       ++counters_.soft_contacts;
@@ -511,6 +551,8 @@ void EventEngine<D, Queue>::collide_soft(std::uint32_t i, std::uint32_t j, doubl
     add_virial_tensor(r, impulse);
     counters_.dissipated_in_collisions += 0.5 * mu * vn * vn * (1.0 - e * e);
     separate(i, j, r, r2);
+    if (helfand_.on()) [[unlikely]]
+      helfand_jump_after(i, j, t);
   }
   ++counters_.collisions;
   ++hi.collisions;

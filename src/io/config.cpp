@@ -1408,8 +1408,21 @@ std::optional<TransportObstacle> transport_obstacle(const Config& c) {
     if (g != 0.0) return refuse("field.gravity", "a field does not conserve momentum");
   if (!driving_kinds().is(c.driving.kind, DrivingKind::kNone))
     return refuse("driving.kind", "driving does not conserve energy");
-  if (c.soft.enabled())
-    return refuse("soft.model", "soft contacts move particles while they last (not supported yet)");
+  // Soft contacts: elastic laws only (the key that makes one dissipative, if any).
+  const auto dissipative = [](const SoftLawConfig& law) -> const char* {
+    if (law.damping != 0.0) return "damping";
+    if (law.dissipation != 0.0) return "dissipation";
+    if (law.restitution != 0.0 && law.restitution != 1.0) return "restitution";
+    if (law.friction != 0.0) return "friction";
+    return nullptr;
+  };
+  if (c.soft.enabled()) {
+    if (const char* key = dissipative(c.soft.law))
+      return refuse(fmt::format("soft.{}", key), "a dissipative soft contact law");
+    for (std::size_t p = 0; p < c.soft.pairs.size(); ++p)
+      if (const char* key = dissipative(c.soft.pairs[p].law))
+        return refuse(fmt::format("soft.pair[{}].{}", p, key), "a dissipative soft contact law");
+  }
   for (std::size_t s = 0; s < c.system.species.size(); ++s)
     if (c.system.species[s].fixed)
       return refuse(fmt::format("system.species[{}].fixed", s),

@@ -593,8 +593,9 @@ class PySimulation {
       out["time"] = s.time();
       out["kinetic_stress"] = matrix_of(dd, dd, at(m.kinetic_stress));
       out["virial"] = matrix_of(dd, dd, at(virial));
+      out["jump_stress"] = matrix_of(dd, dd, at(m.jump_stress));
       out["stress"] = matrix_of(dd, dd, [&](std::size_t a, std::size_t b) {
-        return m.kinetic_stress[a * dd + b] + virial[a * dd + b];
+        return m.kinetic_stress[a * dd + b] + virial[a * dd + b] + m.jump_stress[a * dd + b];
       });
       std::vector<double> kinetic, collisional, energy;
       for (int a = 0; a < d; ++a) {

@@ -18,7 +18,8 @@ nlohmann::json finite_or_null(double x) {
 
 }  // namespace
 
-// G_ab = kinetic + collisional (the virial tensor), the energy moment likewise.
+// G_ab = kinetic + collisional (the virial tensor, and soft contacts' jumps), the energy moment
+// likewise.
 template <int D>
 typename HelfandTransport<D>::Moments helfand_sample(const EventIntegrator<D>& engine) {
   const typename HelfandMoments<D>::Moments m = engine.helfand_moments();
@@ -26,12 +27,14 @@ typename HelfandTransport<D>::Moments helfand_sample(const EventIntegrator<D>& e
   typename HelfandTransport<D>::Moments out;
   for (int a = 0; a < D; ++a)
     for (int b = 0; b < D; ++b)
-      out.stress[a * D + b] = m.kinetic_stress[a * D + b] + virial[a * D + b];
+      out.stress[a * D + b] =
+          m.kinetic_stress[a * D + b] + virial[a * D + b] + m.jump_stress[a * D + b];
   for (int a = 0; a < D; ++a)
     out.energy[a] = m.kinetic_energy_flux[a] + m.collisional_energy_flux[a];
   double trace = 0.0;
   for (int a = 0; a < D; ++a) trace += m.kinetic_stress[a * D + a];
-  out.kinetic_trace = trace;
+  out.kinetic_trace = trace + m.frozen_kinetic;
+  out.frozen_pair_time = m.frozen_pair_time;
   return out;
 }
 
