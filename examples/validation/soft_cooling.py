@@ -18,11 +18,12 @@ with two errors: the unpaired one sqrt(err_a^2 + err_b^2), and the paired one, t
 deviation over seeds of the per-seed difference / sqrt(seeds) (the runs of one seed share their
 initial state, so early on they are correlated and the paired error is the smaller).
 
-Temperature is the kinetic one, T = 2 K / (3 N) (thermo.tsv `temperature`), and also the
-energy one, T_E = 2 (K + U) / (3 N) with U the energy held by contacts in progress (thermo.tsv
+Temperature is the kinetic one (thermo.tsv `temperature`: 2 K over the degrees of freedom that
+move, a frozen event-driven pair counting as one body), and also the energy one,
+T_E = 2 (K + U) / (3 (N - 1)) with U the energy held by contacts in progress (thermo.tsv
 `potential_energy`): an event-driven pair in contact holds its whole relative kinetic energy
-until its release, a DEM pair only part of it, so the kinetic T of the two differ by a few
-t_c / tau_f of T; T_E does not have that offset.
+until its release, a DEM pair only part of it, so the kinetic T of the two may differ by a
+fraction of t_c / tau_f of T; T_E does not have that offset.
 
 Theory (no fit): e(v) from the head-on viscoelastic ODE integrated here (RK4; checked against
 the values of docs/physics.md#viscoelastic-head-on to 1e-6), with the dissipation fixed by
@@ -243,10 +244,11 @@ class RunSet:
     def temperatures(self, column, energy):
         """Per run: (x, T) with x = `time` or `collisions_per_particle`; energy: T_E."""
         out = []
-        for th in self.thermo:
+        for th, summary in zip(self.thermo, self.summaries):
             t = th["temperature"].copy()
-            if energy:
-                t = t * (1.0 + th["potential_energy"] / th["kinetic_energy"])
+            if energy:  # over every degree of freedom, D (N - 1)
+                t = 2.0 * (th["kinetic_energy"] + th["potential_energy"]) / (
+                    3.0 * (summary["particles"] - 1))
             out.append((th[column], t))
         return out
 

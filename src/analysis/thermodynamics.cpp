@@ -10,8 +10,8 @@ Thermodynamics::Thermodynamics(int dimension, std::size_t particles, double volu
       free_particles_(held_frame ? n_ : n_ - 1.0),
       volume_(volume) {}
 
-double Thermodynamics::temperature(double kinetic_energy) const {
-  return 2.0 * kinetic_energy / (dimension_ * free_particles_);
+double Thermodynamics::temperature(double kinetic_energy, double held) const {
+  return 2.0 * kinetic_energy / (dimension_ * free_particles_ - held);
 }
 
 double Thermodynamics::compressibility(double virial, double kT, double duration) const {
@@ -32,12 +32,13 @@ double Thermodynamics::per_particle(std::uint64_t collisions) const {
   return 2.0 * static_cast<double>(collisions) / n_;
 }
 
-ThermoRow Thermodynamics::row(const ThermoPoint& now, double kinetic_energy, bool production) {
+ThermoRow Thermodynamics::row(const ThermoPoint& now, double kinetic_energy, bool production,
+                              double held) {
   ThermoRow r;
   r.at = now;
   r.collisions_per_particle = per_particle(now.collisions);
   r.kinetic_energy = kinetic_energy;
-  r.temperature = temperature(kinetic_energy);
+  r.temperature = temperature(kinetic_energy, held);
   const double duration = now.time - last_.time;
   r.compressibility = compressibility(now.virial - last_.virial, r.temperature, duration);
   r.pressure = pressure(r.compressibility, r.temperature);

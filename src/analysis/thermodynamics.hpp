@@ -1,6 +1,8 @@
 // Thermodynamics of a hard-particle run from its event counters (docs/outputs.md):
-//   kT = 2 K / (D (N - 1))                 (total momentum fixed: D (N - 1) degrees of freedom;
-//                                           D N with fixed grains, which take up momentum)
+//   kT = 2 K / (D (N - 1) - H)             (total momentum fixed: D (N - 1) degrees of freedom;
+//                                           D N with fixed grains, which take up momentum; H
+//                                           held by soft contacts in progress, which the
+//                                           event engine freezes: D per pair, 1 at a wall)
 //   Z  = 1 + W / (D N kT t)                W = sum over collisions of r_ij . J_i
 //   P  = Z N kT / V,  mean free time = N t / (2 N_coll),  c = 2 N_coll / N.
 // Rows cover the interval since the previous row; production rows feed the block averages.
@@ -38,7 +40,9 @@ class Thermodynamics {
   // freedom are free: kT = 2 K / (D N) (N: the particles that move).
   Thermodynamics(int dimension, std::size_t particles, double volume, bool held_frame = false);
 
-  double temperature(double kinetic_energy) const;
+  // `held`: degrees of freedom that contacts in progress hold still (Integrator::
+  // held_degrees_of_freedom), not counted.
+  double temperature(double kinetic_energy, double held = 0.0) const;
   double compressibility(double virial, double kT, double duration) const;
   double pressure(double compressibility, double kT) const;
   double mean_free_time(double duration, std::uint64_t collisions) const;
@@ -48,7 +52,7 @@ class Thermodynamics {
   void mark(const ThermoPoint& p) { last_ = p; }
   const ThermoPoint& last() const { return last_; }
   // The row for the interval from the last mark to `now`; starts the next interval at `now`.
-  ThermoRow row(const ThermoPoint& now, double kinetic_energy, bool production);
+  ThermoRow row(const ThermoPoint& now, double kinetic_energy, bool production, double held = 0.0);
 
   BlockAverage compressibility_blocks() const { return block_average(z_samples_); }
   BlockAverage mean_free_time_blocks() const { return block_average(mft_samples_); }

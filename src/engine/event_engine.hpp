@@ -231,6 +231,9 @@ class EventEngine {
   bool soft() const { return soft_; }
   // How many particles sit in a frozen soft contact now.
   std::uint32_t frozen() const;
+  // The degrees of freedom those contacts hold still: D per frozen pair (it moves as one
+  // body), 1 per particle frozen against a wall (along its normal).
+  double held_degrees_of_freedom() const;
   bool stepped() const { return stepped_; }
   // Pairs that crossed the outermost step of their potential inwards since this engine was
   // built (not part of the state): the contacts of a stepped soft potential (spring_dashpot).
@@ -500,6 +503,8 @@ class EventEngine {
   bool in_deferred_contact(std::uint32_t i, double t) const {
     return soft_state_.defers() && t < hot_[i].time;
   }
+  // In a soft contact now (frozen, or deferred and not yet over).
+  bool in_soft_contact(std::uint32_t k) const;
   // A pair contact frozen at `velocity` until `until` (see try_place). With `predict` (a contact
   // that may be deferred), try_place also finds each particle's soonest event after the release
   // (post-contact velocity after[k], k = 0 for i, 1 for j): partner and time from t.

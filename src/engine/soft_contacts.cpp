@@ -143,13 +143,25 @@ void EventEngine<D, Queue>::restore_frozen(const ParticleSystem<D>& s, StartMode
 }
 
 template <int D, class Queue>
+bool EventEngine<D, Queue>::in_soft_contact(std::uint32_t k) const {
+  const bool stale = soft_state_.deferred(k) && !in_deferred_contact(k, time_);
+  return soft_state_.partner(k) != kNone && !stale;
+}
+
+template <int D, class Queue>
 std::uint32_t EventEngine<D, Queue>::frozen() const {
   std::uint32_t count = 0;
-  for (std::uint32_t k = 0; k < soft_state_.size(); ++k) {
-    const bool stale = soft_state_.deferred(k) && !in_deferred_contact(k, time_);
-    count += soft_state_.partner(k) != kNone && !stale ? 1u : 0u;
-  }
+  for (std::uint32_t k = 0; k < soft_state_.size(); ++k) count += in_soft_contact(k) ? 1u : 0u;
   return count;
+}
+
+template <int D, class Queue>
+double EventEngine<D, Queue>::held_degrees_of_freedom() const {
+  double held = 0.0;
+  for (std::uint32_t k = 0; k < soft_state_.size(); ++k) {
+    if (in_soft_contact(k)) held += is_particle(soft_state_.partner(k)) ? 0.5 * D : 1.0;
+  }
+  return held;
 }
 
 template <int D, class Queue>

@@ -120,7 +120,11 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   double momentum_scale() const override;
   double max_overlap() const override;
   bool bulk() const override { return bulk_; }
-  bool temperature_from_rows() const override { return engine_.stepped() || this->kind_.driven; }
+  bool temperature_from_rows() const override {
+    // Soft contacts hold kinetic energy while they last, as steps do.
+    return engine_.stepped() || engine_.soft() || this->kind_.driven;
+  }
+  double held_degrees_of_freedom() const override { return engine_.held_degrees_of_freedom(); }
 
   StateBlocks<D> state_blocks() const override { return engine_.state_blocks(false); }
   ParticleSample<D> particles() const override;

@@ -139,6 +139,10 @@ class Integrator {
   // velocities relative to the flow). dissipated: in collisions and at walls since the
   // simulation began (the DEM: the work of the damping forces); work_by_walls likewise.
   virtual double thermal_energy() const = 0;
+  // Degrees of freedom that contacts in progress hold still, which the temperature does not
+  // count (the event engine's frozen soft contacts: D per pair, 1 against a wall; in
+  // equilibrium the rest carry kT/2 each: docs/physics.md#temperature).
+  virtual double held_degrees_of_freedom() const { return 0.0; }
   virtual double kinetic_energy() const = 0;
   virtual double rotational_energy() const = 0;
   virtual double potential_energy() const = 0;

@@ -194,7 +194,7 @@ double Simulation<D>::temperature() const {
   // kT as thermo.tsv gives it (under shear: of the velocities relative to the flow).
   const std::size_t moving = engine_->mobile();
   return Thermodynamics(D, moving, engine_->volume(), moving < n_)
-      .temperature(engine_->thermal_energy());
+      .temperature(engine_->thermal_energy(), engine_->held_degrees_of_freedom());
 }
 template <int D>
 double Simulation<D>::potential_energy() const {

@@ -66,7 +66,9 @@ class SoftCooling(kt.KairosTestCase):
         return sc.read_thermo(self.path(name, "thermo.tsv")), self.summary(self.path(name))
 
     def energy_temperature(self, th):
-        return th["temperature"] * (1.0 + th["potential_energy"] / th["kinetic_energy"])
+        # 2 (K + U) / (3 (N - 1)): the kinetic energy and the contacts' over every degree of
+        # freedom (thermo.tsv's temperature leaves out those a contact holds still).
+        return 2.0 * (th["kinetic_energy"] + th["potential_energy"]) / (3.0 * (PARTICLES - 1))
 
     def test_event_driven_and_dem_cool_alike_and_slower_than_haff(self):
         sc = self.sc

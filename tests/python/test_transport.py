@@ -120,10 +120,10 @@ class Transport(kt.KairosTestCase):
     def test_elastic_soft_spheres_at_the_fluids_temperature(self):
         # Hertz spheres (Y = 1e6): the Muller-Poschel map moves pairs at once (the jumps enter
         # the moments) and holds a contact's relative motion while it lasts. The temperature of
-        # the coefficients counts a frozen pair as one body: it must be the fluid's, which a
-        # force-based (DEM) run from the same start and energy measures directly, while the
-        # plain kinetic temperature of the event run is lower by about the fraction of
-        # particles in contact (5 % here).
+        # the coefficients, and thermo.tsv's, count a frozen pair as one body: they must be the
+        # fluid's, which a force-based (DEM) run from the same start and energy measures
+        # directly (the kinetic energy over all D (N - 1) degrees of freedom is lower by about
+        # the fraction of particles in contact, 5 % here), and so must Z.
         soft = {"model": "hertz", "young": 1e6, "poisson": 0.3}
         config = kt.base_config(particles=400, packing_fraction=0.3, seed=15, equilibration=50,
                                 production=3000, output={"trajectory": False}, soft=soft,
@@ -145,8 +145,14 @@ class Transport(kt.KairosTestCase):
         fluid = rows["temperature"][rows["time"] >= 5.0].mean()
         self.assertAlmostEqual(t["temperature"], fluid, delta=0.01 * fluid)
         rows = thermo(out)
-        plain = rows["temperature"][rows["phase"] == "production"].mean()
-        self.assertLess(plain, fluid - 0.03)
+        production = rows[rows["phase"] == "production"]
+        self.assertAlmostEqual(production["temperature"].mean(), fluid, delta=0.01 * fluid)
+        all_degrees = 2.0 * production["kinetic_energy"].mean() / (3.0 * (400 - 1))
+        self.assertLess(all_degrees, fluid - 0.03)
+        rows = thermo(dem_out)
+        z_dem = rows["compressibility"][rows["time"] >= 5.0].mean()
+        z = self.summary(out)["compressibility"]["mean"]
+        self.assertAlmostEqual(z, z_dem, delta=0.03 * z_dem)
 
     def test_a_mixture_says_why_it_has_no_conductivity(self):
         config = kt.base_config(particles=300, packing_fraction=0.2, lattice="random", seed=14,

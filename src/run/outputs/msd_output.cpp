@@ -410,7 +410,8 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
       for (int a = 1; a < D; ++a) cubic = cubic && box[a] == box[0];
       if (cubic) {
         constexpr double kXi = 2.837297;
-        const double kt = stats_.temperature(engine_.thermal_energy());
+        const double kt =
+            stats_.temperature(engine_.thermal_energy(), engine_.held_degrees_of_freedom());
         s["coefficient_infinite_size"] =
             fits[g]->coefficient + kXi * kt / (6.0 * M_PI * viscosity * box[0]);
         s["infinite_size_temperature"] = kt;

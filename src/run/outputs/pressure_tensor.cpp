@@ -62,7 +62,8 @@ void PressureTensor<D>::summarize(nlohmann::json& j, const RunContext<D>&) const
   s["viscosity_stderr"] = p.stderr_ / std::abs(rate);
   s["samples"] = p.samples;
   s["temperature_production_start"] = thermo_.production_temperature(engine_);
-  s["temperature"] = thermo_.statistics().temperature(engine_.thermal_energy());
+  s["temperature"] =
+      thermo_.statistics().temperature(engine_.thermal_energy(), engine_.held_degrees_of_freedom());
   j["shear"] = s;
 }
 

@@ -70,7 +70,8 @@ void ThermoOutput<D>::write_row(const RunContext<D>& run, const std::string& pha
   const Integrator<D>& integrator = run.integrator();
   const bool production = phase == "production";
   if (production) run.sample_production_row();
-  const ThermoRow r = stats_->row(integrator.point(), integrator.thermal_energy(), production);
+  const ThermoRow r = stats_->row(integrator.point(), integrator.thermal_energy(), production,
+                                  integrator.held_degrees_of_freedom());
   if (production) {
     production_temperatures_.push_back(r.temperature);
     production_potential_energies_.push_back(integrator.potential_energy());
@@ -100,6 +101,7 @@ template <int D>
 void ThermoOutput<D>::production_starts(const RunContext<D>& run) {
   production_start_ = run.integrator().point();
   production_ke_ = run.integrator().thermal_energy();
+  production_held_ = run.integrator().held_degrees_of_freedom();
 }
 
 template <int D>
@@ -121,7 +123,7 @@ template <int D>
 double ThermoOutput<D>::production_temperature(const Integrator<D>& integrator) const {
   if (integrator.temperature_from_rows() && !production_temperatures_.empty())
     return block_average(production_temperatures_).mean;
-  return stats_->temperature(production_ke_);
+  return stats_->temperature(production_ke_, production_held_);
 }
 
 template <int D>
@@ -164,7 +166,7 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
   j["setup_wall_seconds"] = run.setup_wall_seconds();
   j["events_per_second"] = wall > 0 ? static_cast<double>(events) / wall : 0.0;
   j["collisions_per_second"] = wall > 0 ? static_cast<double>(collisions) / wall : 0.0;
-  j["temperature"] = th.temperature(ke);
+  j["temperature"] = th.temperature(ke, integrator.held_degrees_of_freedom());
   j["kinetic_energy"] = ke;
   std::string why;
   if (!integrator.bulk())

@@ -70,7 +70,8 @@ class ThermoOutput final : public Observer<D> {
   std::uint64_t rows_kept_ = 0;
   ThermoPoint kept_mark_;
   ThermoPoint production_start_;
-  double production_ke_ = 0.0;  // thermal energy at the start of production
+  double production_ke_ = 0.0;    // thermal energy at the start of production
+  double production_held_ = 0.0;  // degrees of freedom held still then (soft contacts)
   std::vector<double> production_temperatures_;
   // U at each production row: the slow variable Z's and the mean free time's rows may hide
   // under their fast noise, so their error bars are reliable only when its own is.
