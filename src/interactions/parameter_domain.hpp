@@ -1,6 +1,6 @@
 // The physical domains of the contact laws' parameters, each written once. The factories of
 // interactions/ check their arguments against them (the library's contract, whoever calls), and
-// the configuration's key declarations (io/config_keys.cpp) take their ranges from them, so that
+// the configuration's key declarations (io/keys/) take their ranges from them, so that
 // the reader rejects a value by its key with the same bounds before any factory sees it
 // (docs/architecture.md, "Each key declared once"). The config's other ranges are sanity bounds
 // in the run's units (up to 1e9 kT, ...), narrower than these domains, and live only there.

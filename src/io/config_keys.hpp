@@ -11,7 +11,8 @@
 // vs [contact], ...) stay named functions of the reader.
 //
 // Adding a key: a member in io/config.hpp (its initialiser is the default), one KeyDecl in the
-// group of its struct in io/config_keys.cpp, one row in the table of docs/config.md. The reader
+// group of its struct in io/keys/ (one file per part of the config; io/config_keys.cpp places
+// the groups into tables), one row in the table of docs/config.md. The reader
 // and the writer then handle it; a rule that involves other keys goes into the reader.
 #pragma once
 

@@ -39,7 +39,7 @@ std::string short_number(double v) {
   return fmt::format("{:g}", v);
 }
 
-// The range declared for a key (io/config_keys.cpp), by its path ("contact.pair[0].tc").
+// The range declared for a key (io/keys/), by its path ("contact.pair[0].tc").
 const Range& declared(const std::string& key) {
   return find_declared(key)->decl->range;
 }
