@@ -71,6 +71,7 @@ SKIPPED_CHUNKS = []
 # summary.json keys that differ between two runs of one binary, or that a layout change may
 # move without changing a trajectory (the engine's own bytes per particle).
 VOLATILE = {"wall_seconds", "collisions_per_second", "events_per_second", "steps_per_second",
+            "provenance",
             "peak_rss_bytes", "run_id", "bytes_per_particle", "kairos_version",
             "setup_wall_seconds", "timing", "ns_per_particle_step"}
 

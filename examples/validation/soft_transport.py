@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Einstein-Helfand transport coefficients of elastic soft (Hertz) spheres approach the hard-sphere
-values as the contacts stiffen (docs/validation.md, "Transport coefficients of soft spheres").
+values as the contacts stiffen (docs/validation.md, "Transport coefficients of elastic soft
+spheres").
 
 For each Young's modulus: an event-driven run with [analysis] transport (the Muller-Poschel map,
 docs/physics.md#einstein-helfand-transport-coefficients) and a force-based DEM run of the same

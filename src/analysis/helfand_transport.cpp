@@ -77,7 +77,9 @@ double HelfandTransport<D>::temperature() const {
   // A frozen pair moves as one body: D degrees of freedom fewer while it lasts.
   const double frozen_pairs =
       span > 0.0 ? (frozen_pair_time_last_ - frozen_pair_time_first_) / span : 0.0;
-  const double dof = D * (static_cast<double>(particles_) - 1.0 - frozen_pairs);
+  const double dof =
+      D * (static_cast<double>(particles_) - 1.0 -
+           (frozen_pairs < static_cast<double>(particles_) - 1.0 ? frozen_pairs : 0.0));
   return span > 0.0 ? (kinetic_trace_last_ - kinetic_trace_first_) / (span * dof) : std::nan("");
 }
 

@@ -11,7 +11,10 @@ Thermodynamics::Thermodynamics(int dimension, std::size_t particles, double volu
       volume_(volume) {}
 
 double Thermodynamics::temperature(double kinetic_energy, double held) const {
-  return 2.0 * kinetic_energy / (dimension_ * free_particles_ - held);
+  // Every degree of freedom held (two particles, one frozen pair): no temperature to count
+  // them out of, so all of them are counted.
+  const double moving = dimension_ * free_particles_ - held;
+  return 2.0 * kinetic_energy / (moving > 0.0 ? moving : dimension_ * free_particles_);
 }
 
 double Thermodynamics::compressibility(double virial, double kT, double duration) const {

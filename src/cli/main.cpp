@@ -33,6 +33,7 @@
 #include "io/config_keys.hpp"
 #include "io/progress.hpp"
 #include "run/config_ranges.hpp"
+#include "run/provenance.hpp"
 #include "run/run.hpp"
 
 namespace {
@@ -379,6 +380,7 @@ int main(int argc, char** argv) {
         restart.empty() ? std::nullopt : std::optional<std::filesystem::path>(restart);
     kairos::RunOptions options;
     options.overwrite = overwrite;
+    options.command_line = kairos::shell_command_line(std::vector<std::string>(argv, argv + argc));
     // run.max_wall_seconds from now on, so that a long table build stops too.
     const kairos::ScopedStopDeadline setup_limit(config.run.max_wall_seconds);
     const kairos::RunOutcome outcome = kairos::run_simulation(config, restart_file, options);

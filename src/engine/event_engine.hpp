@@ -198,7 +198,7 @@ class EventEngine {
   bool tracks_images() const { return images_.on(); }
   bool tracks_helfand() const { return helfand_.on(); }
   // The Helfand moments now (options track_helfand; their collisional momentum part is
-  // counters().virial_tensor).
+  // counters().virial_tensor plus the moments' jump_stress).
   typename HelfandMoments<D>::Moments helfand_moments() const { return helfand_.at(time_); }
   // Their velocities now, likewise.
   void velocities(const std::vector<std::uint32_t>& slot, std::vector<Vec<D>>& out) const;

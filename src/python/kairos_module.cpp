@@ -594,6 +594,8 @@ class PySimulation {
       out["kinetic_stress"] = matrix_of(dd, dd, at(m.kinetic_stress));
       out["virial"] = matrix_of(dd, dd, at(virial));
       out["jump_stress"] = matrix_of(dd, dd, at(m.jump_stress));
+      out["frozen_pair_time"] = m.frozen_pair_time;
+      out["frozen_kinetic"] = m.frozen_kinetic;
       out["stress"] = matrix_of(dd, dd, [&](std::size_t a, std::size_t b) {
         return m.kinetic_stress[a * dd + b] + virial[a * dd + b] + m.jump_stress[a * dd + b];
       });
@@ -996,6 +998,7 @@ PYBIND11_MODULE(kairos, m) {
           py::gil_scoped_release release;  // the run is C++ throughout
           kairos::RunOptions options;
           options.overwrite = overwrite;
+          options.command_line = "kairos.run (the Python module)";
           return kairos::run_simulation(c, restart, options);
         }();
         if (outcome.summary.value("stop_reason", "") == "signal") {

@@ -30,6 +30,8 @@ struct RunOutcome {
 // How one invocation treats its output directory (run/output_directory.hpp).
 struct RunOptions {
   bool overwrite = false;  // a new run may replace the outputs an earlier run left there
+  // How the run was invoked, for its provenance (summary.json, config.toml); "": not said.
+  std::string command_line;
 };
 
 // Runs the whole simulation. Throws InputError for anything the user must fix.

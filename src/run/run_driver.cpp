@@ -78,7 +78,10 @@ RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& res
   if (restart_file_) lineage = RestartLineage{*restart_file_, resumed_.run_id};
   directory_.emplace(config_.output.directory, lineage, options.overwrite);
   // The effective configuration (after a restart, the configuration as run).
-  write_text_atomically(directory_->path() / "config.toml", to_toml(config_));
+  // Its provenance on top: comments, which a restart (it stores to_toml alone) leaves out.
+  provenance_ = provenance_now(options.command_line, restart_file_);
+  write_text_atomically(directory_->path() / "config.toml",
+                        toml_comment(provenance_) + to_toml(config_));
   observers_ = make_observers<D>(config_, *integrator_, setup);
 }
 

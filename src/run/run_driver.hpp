@@ -63,6 +63,7 @@ class RunDriver final : public RunContext<D> {
   const std::optional<RestartPlan>& plan() const override { return plan_; }
   const OutputContinuation& continuation() const override { return continuation_; }
   const std::string& run_id() const override { return run_id_; }
+  const Provenance& provenance() const override { return provenance_; }
   const std::string& phase() const override { return phase_; }
   bool timed() const override { return timed_; }
   double per_particle(std::uint64_t collisions) const override {
@@ -101,7 +102,8 @@ class RunDriver final : public RunContext<D> {
   RunProgress resumed_;
   std::optional<RestartPlan> plan_;
   std::unique_ptr<Integrator<D>> integrator_;
-  std::string run_id_;                        // the lineage of the outputs (kept by continued runs)
+  std::string run_id_;  // the lineage of the outputs (kept by continued runs)
+  Provenance provenance_;
   std::optional<OutputDirectory> directory_;  // claimed (locked) while the run lasts
   OutputContinuation continuation_;
   ObserverList<D> observers_;

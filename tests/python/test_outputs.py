@@ -8,6 +8,7 @@ files written by python-gsd; a config with only the essential keys.
 import json
 import math
 import os
+import shlex
 
 import numpy as np
 import gsd.fl
@@ -205,6 +206,33 @@ class RunOutputs(OutputChecks):
         s = self.check_summary(out, n, 3)
         self.assertAlmostEqual(s["packing_fraction"], 0.3, places=9)
 
+    def test_provenance_names_program_time_host_command_and_restart(self):
+        cfg = self.write_config(kt.base_config(particles=108, production=5.0))
+        out = self.path("it's here")  # a word the shell must quote
+        self.run_ok("run", cfg, "-o", out, "--set", "system.seed=3")
+        p = self.summary(out)["provenance"]
+        self.assertEqual(p["version"], self.summary(out)["kairos_version"])
+        self.assertRegex(p["commit"], r"^([0-9a-f]{7,40}|unknown)$")
+        self.assertRegex(p["date"], r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ$")
+        self.assertTrue(p["host"])
+        self.assertEqual(p["restart_file"], "")
+        # The command line splits back into the words kairos was given.
+        words = shlex.split(p["command_line"])
+        self.assertEqual(words[1:], ["run", cfg, "-o", out, "--set", "system.seed=3"])
+        with open(os.path.join(out, "config.toml")) as f:
+            head = f.read().splitlines()[:2]
+        self.assertEqual(head[0], "# Written by kairos %s (commit %s) on %s, %s." % (
+            p["version"], p["commit"], p["host"], p["date"]))
+        self.assertEqual(head[1], "# Command: " + p["command_line"])
+        # A continued run names the file it continued, as an absolute path.
+        more = self.path("more")
+        self.run_ok("run", os.path.join(out, "config.toml"), "-o", more, "--restart",
+                    os.path.join(out, "restart.gsd"), "--set", "run.collisions_per_particle=8")
+        q = self.summary(more)["provenance"]
+        self.assertEqual(q["restart_file"], os.path.abspath(os.path.join(out, "restart.gsd")))
+        with open(os.path.join(more, "config.toml")) as f:
+            self.assertIn("# Continued from: " + q["restart_file"], f.read())
+
     def test_config_toml_reruns_identically(self):
         cfg = self.write_config(kt.base_config(particles=300, packing_fraction=0.35, seed=99,
                                                equilibration=2.0, production=10.0))
@@ -223,10 +251,20 @@ class RunOutputs(OutputChecks):
         sb = kt.read_exact_state(self.path("second", "restart.gsd"))
         for name in kt.EXACT_CHUNKS:
             self.assertTrue(np.array_equal(sa[name], sb[name]), name)
-        # The effective config of the re-run is the same file (but for the directory).
+        # The effective config of the re-run is the same file (but for the directory and the
+        # provenance comments on top: when, where and how each run was started).
         with open(self.path("second", "config.toml")) as f:
             again = f.read()
-        self.assertEqual(again.replace(self.path("second"), self.path("first")), text)
+
+        def keys(config_text):
+            return "\n".join(line for line in config_text.splitlines()
+                             if not line.startswith(("# Written by", "# Command:",
+                                                     "# Continued from:")))
+
+        self.assertEqual(keys(again.replace(self.path("second"), self.path("first"))),
+                         keys(text))
+        self.assertIn("# Command: ", text)
+
 
     def test_same_seed_same_run_different_seed_different_run(self):
         cfg = self.write_config(kt.base_config(particles=256, production=5.0,

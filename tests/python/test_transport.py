@@ -178,6 +178,8 @@ class Transport(kt.KairosTestCase):
                                  "soft.restitution"),
             "soft damping": ({"soft": {"model": "dashpot", "stiffness": 1e4, "damping": 1.0}},
                              "soft.damping"),
+            "soft dissipation": ({"soft": {"model": "hertz", "young": 1e6, "dissipation": 1e-4}},
+                                 "soft.dissipation"),
         }
         for name, (sections, key) in cases.items():
             config = kt.base_config(analysis={"transport": True}, **sections)

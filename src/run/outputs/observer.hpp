@@ -31,6 +31,7 @@
 #include "io/config.hpp"
 #include "run/integrator.hpp"
 #include "run/output_directory.hpp"
+#include "run/provenance.hpp"
 #include "run/restart_plan.hpp"
 #include "run/run_progress.hpp"
 #include "run/trigger.hpp"
@@ -53,6 +54,8 @@ class RunContext {
   // Where a continued run picks up its lineage's files (output_directory.hpp).
   virtual const OutputContinuation& continuation() const = 0;
   virtual const std::string& run_id() const = 0;
+  // Where the outputs came from (version, commit, date, host, command, restart file).
+  virtual const Provenance& provenance() const = 0;
   // "equilibration" or "production": the phase running, or the last one run.
   virtual const std::string& phase() const = 0;
   // Some length or the output intervals are in simulated time: rows and frames are also due

@@ -15,6 +15,7 @@ void RunSummary<D>::summarize(nlohmann::json& j, const RunContext<D>& run) const
   j["number_density"] = static_cast<double>(n) / integrator.volume();
   j["integrator"] = integrator.name();
   j["run_id"] = run.run_id();
+  j["provenance"] = to_json(run.provenance());
   j["restarted"] = run.restarted();
   if (const auto& plan = run.plan()) {
     j["restart"] = {{"mode", plan->repredict ? "new_physics" : "resumed"},
