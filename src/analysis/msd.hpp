@@ -18,6 +18,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -27,6 +28,12 @@
 #include "core/vec.hpp"
 
 namespace kairos {
+
+// The MSD follows every step-th particle that moves, so that at most `wanted` of `mobile` are
+// followed (analysis.msd_particles; wanted = 0: all).
+inline std::size_t msd_follow_step(std::size_t mobile, std::size_t wanted) {
+  return wanted == 0 || mobile <= wanted ? 1 : (mobile + wanted - 1) / wanted;
+}
 
 template <int D>
 class MsdCorrelator {

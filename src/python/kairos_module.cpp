@@ -554,14 +554,23 @@ class PySimulation {
 
   py::dict msd(const py::object& interval_arg, const py::object& duration_arg,
                const py::object& fit_from_arg, const py::object& fit_to_arg,
-               const py::object& vacf_arg) {
+               const py::object& vacf_arg, const py::object& particles_arg) {
     CorrelationRequest request =
         correlation_request(interval_arg, duration_arg, fit_from_arg, fit_to_arg, "msd");
     const bool vacf = flag_from(vacf_arg, "msd: vacf");
+    std::size_t particles = 0;  // all
+    if (!particles_arg.is_none()) {
+      const double wanted = number_from(particles_arg, "msd: particles");
+      if (!(wanted >= 1.0) || wanted != std::floor(wanted) || wanted > 1e9)
+        throw InputError("msd: particles: a whole number >= 1 (or None: every particle)");
+      particles = static_cast<std::size_t>(wanted);
+    }
     return visit([&](auto& s) {
-      const auto m = advancing([&] { return measure_msd(s, request, vacf, python_keeps_going); });
+      const auto m =
+          advancing([&] { return measure_msd(s, request, vacf, python_keeps_going, particles); });
       py::dict out = lags_dict(*m.msd, true, "msd");
       out["species"] = m.species;
+      out["particles_followed"] = m.followed;
       py::dict fits = fits_dict(m.diffusion);
       out["diffusion"] = fits["coefficient"];
       out["diffusion_stderr"] = fits["stderr"];
@@ -1088,11 +1097,12 @@ PYBIND11_MODULE(kairos, m) {
            "kurtosis, Sonine a2 and tail ratio.")
       .def("msd", &PySimulation::msd, py::arg("interval"), py::arg("duration"),
            py::arg("fit_from") = py::none(), py::arg("fit_to") = py::none(),
-           py::arg("vacf") = false,
+           py::arg("vacf") = false, py::arg("particles") = py::none(),
            "ADVANCES the simulation by `duration`, sampling the unwrapped positions at the "
            "multiples of `interval` (None: automatic) as analysis.msd does; returns the MSD "
            "per species on log-spaced lags and D fitted over [fit_from, fit_to] (None: "
-           "automatic), with the VACF and Green-Kubo D if vacf=True.")
+           "automatic), with the VACF and Green-Kubo D if vacf=True. Follows every moving "
+           "particle, or every k-th so that at most `particles` are (as analysis.msd_particles).")
       .def("helfand_moments", &PySimulation::helfand_moments,
            "The Helfand moments now (needs helfand=True): kinetic_stress, virial, stress (D, D), "
            "energy_kinetic, energy_collisional, energy (D,).")

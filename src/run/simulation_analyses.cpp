@@ -138,7 +138,8 @@ VelocityDistribution<D> velocity_distribution_now(const Simulation<D>& sim) {
 
 template <int D>
 MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& request, bool vacf,
-                              const typename Simulation<D>::KeepGoing& keep_going) {
+                              const typename Simulation<D>::KeepGoing& keep_going,
+                              std::size_t particles) {
   if (!sim.tracks_images()) {
     throw InputError(
         "msd: the mean-square displacement needs image counters: this Simulation keeps none "
@@ -151,21 +152,34 @@ MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& requ
   }
   MsdMeasurement<D> m;
   m.span = begin_span(sim, request);
-  // Every particle, grouped by species (analysis.msd with at most msd_particles particles).
+  // Every step-th particle that moves, grouped by species (analysis.msd: at most
+  // msd_particles of them; fixed grains never move).
   m.species = sim.species_names();
   if (m.species.empty()) m.species = {"A"};
   const std::size_t n = sim.size();
-  std::vector<std::uint32_t> group(n, 0u), slot(n);
+  const EventIntegrator<D>& engine = sim.integrator();
+  const auto species_of = [&](std::size_t i) {
+    return i < sim.species().size() ? sim.species()[i] : 0u;
+  };
+  const auto moves = [&](std::size_t i) {
+    return !engine.environment().fixed_species(species_of(i));
+  };
+  std::size_t mobile = 0;
+  for (std::size_t i = 0; i < n; ++i) mobile += moves(i) ? 1 : 0;
+  const std::size_t step = msd_follow_step(mobile, particles);
+  std::vector<std::uint32_t> group, slot(n, ~0u);  // slot: ~0u = not followed
+  std::size_t moving = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    slot[i] = static_cast<std::uint32_t>(i);
-    if (i < sim.species().size()) group[i] = sim.species()[i];
-    while (group[i] >= m.species.size()) m.species.push_back(std::to_string(m.species.size()));
+    if (!moves(i) || moving++ % step != 0) continue;
+    slot[i] = static_cast<std::uint32_t>(group.size());
+    group.push_back(species_of(i));
+    while (group.back() >= m.species.size()) m.species.push_back(std::to_string(m.species.size()));
   }
+  m.followed = group.size();
   const auto groups = static_cast<std::uint32_t>(m.species.size());
   m.msd.emplace(group, groups, m.span.interval);
   if (vacf) m.vacf.emplace(group, groups, m.span.interval, MsdCorrelator<D>::Statistic::kProduct);
-  std::vector<Vec<D>> sample(n);
-  const EventIntegrator<D>& engine = sim.integrator();
+  std::vector<Vec<D>> sample(group.size());
   m.span.completed = sim.sample_every(
       m.span.interval, request.duration,
       [&] {
@@ -215,7 +229,8 @@ TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationR
   template BondOrderValues<D> bond_order_now<D>(const Simulation<D>&, double, const std::string&); \
   template VelocityDistribution<D> velocity_distribution_now<D>(const Simulation<D>&);             \
   template MsdMeasurement<D> measure_msd<D>(Simulation<D>&, const CorrelationRequest&, bool,       \
-                                            const typename Simulation<D>::KeepGoing&);             \
+                                            const typename Simulation<D>::KeepGoing&,              \
+                                            std::size_t);                                          \
   template TransportMeasurement<D> measure_transport<D>(Simulation<D>&, const CorrelationRequest&, \
                                                         const typename Simulation<D>::KeepGoing&);
 KAIROS_SIMULATION_ANALYSES(2)

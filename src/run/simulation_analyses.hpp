@@ -101,14 +101,18 @@ template <int D>
 struct MsdMeasurement {
   SampledSpan span;
   std::vector<std::string> species;
+  std::size_t followed = 0;  // particles followed
   std::optional<MsdCorrelator<D>> msd, vacf;
   double sampled_from = 0.0, sampled_to = 0.0;  // first and last sample's times
   std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> diffusion, green_kubo;
 };
 // Advances `sim` by request.duration. InputError without image counters or under shear.
+// Follows every `step`-th particle that moves, at most `particles` of them (0: all), as
+// analysis.msd_particles does; fixed grains are never followed.
 template <int D>
 MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& request, bool vacf,
-                              const typename Simulation<D>::KeepGoing& keep_going = {});
+                              const typename Simulation<D>::KeepGoing& keep_going = {},
+                              std::size_t particles = 0);
 
 // The Einstein-Helfand transport coefficients (analysis.transport), as summary.json's
 // `transport` gives them.

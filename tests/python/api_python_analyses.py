@@ -56,6 +56,25 @@ def numpy_rdf(x, box, bins, r_max):
 class Analyses(kt.KairosTestCase):
     # ----- time correlations: the CLI's numbers
 
+    def test_msd_of_every_kth_particle_equals_the_cli(self):
+        interval, duration = 0.05, 5.0
+        config = gas_config(time=duration, analysis={
+            "msd": True, "msd_interval": interval, "msd_particles": 37, "msd_fit_from": 0.5,
+            "msd_fit_to": 1.25})
+        cfg = self.write_config(config)
+        out = self.path("cli")
+        self.run_ok("run", cfg, "-o", out)
+        cli = self.summary(out)["diffusion"]
+        m = kairos.Simulation(cfg).msd(interval, duration, fit_from=0.5, fit_to=1.25,
+                                       particles=37)
+        self.assertEqual(m["particles_followed"], cli["particles_followed"])
+        self.assertEqual(m["particles_followed"], 200 // 6 + 1)  # every 6th of 200
+        self.assertEqual(m["diffusion"][0], cli["species"]["A"]["coefficient"])
+        every = kairos.Simulation(cfg).msd(interval, duration, fit_from=0.5, fit_to=1.25)
+        self.assertEqual(every["particles_followed"], 200)
+        with self.assertRaises(kairos.InputError):
+            kairos.Simulation(cfg).msd(interval, duration, particles=0)
+
     def test_msd_and_transport_equal_the_cli_bit_for_bit(self):
         interval, duration = 0.05, 10.0
         config = gas_config(time=duration, analysis={

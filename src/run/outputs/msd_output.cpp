@@ -43,7 +43,7 @@ MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
   const auto wanted = static_cast<std::size_t>(config_.msd_particles);
   // Every step-th particle that moves (fixed grains are not followed).
   const std::size_t mobile = engine.mobile();
-  const std::size_t step = mobile <= wanted ? 1 : (mobile + wanted - 1) / wanted;
+  const std::size_t step = msd_follow_step(mobile, wanted);
   slot_.assign(n, ~0u);  // not followed
   species_of_.assign(n, 0u);
   double radius = -1.0, mass = -1.0;
