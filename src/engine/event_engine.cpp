@@ -280,11 +280,9 @@ void EventEngine<D, Queue>::start_helfand() {
       helfand_.set_share(k, 0.5 * mass_of(k) * norm2(after - hot_[k].vel));
       if (k < p) helfand_.frozen_pair_for(soft_state_.release_time(k) - time_);
     } else if (in_deferred_contact(k, time_) && k < p) {
-      const Vec<D> v = frozen_velocity_of(k);
       const double rest = hot_[k].time - time_;
       helfand_.frozen_pair_for(rest);
-      helfand_.records_ahead(
-          mass_of(k) * norm2(hot_[k].vel - v) + mass_of(p) * norm2(hot_[p].vel - v), rest);
+      helfand_.records_ahead(deferred_excess(k, p), rest);
     }
   }
   // Velocities are constant in free flight (no field here): no record is advanced, so the

@@ -540,6 +540,12 @@ class EventEngine {
     return (1.0 / (ma + mb)) * (ma * hot_[a].vel + mb * hot_[b].vel);
   }
   double deferred_contact_energy() const;
+  // A deferred pair's sum m |v - V|^2: what its records' kinetic trace holds beyond the frozen
+  // motion until the release (the Helfand moments' temperature, helfand_moments.hpp).
+  double deferred_excess(std::uint32_t i, std::uint32_t p) const {
+    const Vec<D> v = frozen_velocity_of(i);
+    return mass_of(i) * norm2(hot_[i].vel - v) + mass_of(p) * norm2(hot_[p].vel - v);
+  }
   // The map from the table, or integrated directly outside it (counted).
   CollisionMap soft_map(const SoftMapTable* table, const CollisionUnits& units);
   // Places i at xi (and j at xj, unless j is kNoPartner) at time t unless that overlaps a third

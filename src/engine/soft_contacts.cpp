@@ -295,11 +295,7 @@ std::uint32_t EventEngine<D, Queue>::release(std::uint32_t i, double t, bool ear
     // The part of the contact that will not be spent frozen.
     const double rest = (deferred ? hot_[i].time : soft_state_.release_time(i)) - t;
     helfand_.frozen_pair_for(-rest);
-    if (deferred) {
-      const Vec<D> v = frozen_velocity_of(i);
-      helfand_.records_ahead(
-          mass_of(i) * norm2(hot_[i].vel - v) + mass_of(p) * norm2(hot_[p].vel - v), -rest);
-    }
+    if (deferred) helfand_.records_ahead(deferred_excess(i, p), -rest);
   }
   const auto jumped = [&] {
     if (!moments) [[likely]]

@@ -413,19 +413,6 @@ Config load_config(const std::filesystem::path& path,
 // itself.
 std::string to_toml(const Config& config);
 
-// What keeps the Einstein-Helfand moments (engine/helfand_moments.hpp) from being measured in
-// a system: they need a conservative, translation-invariant one. The first obstacle found, by
-// its key ("boundary.wall", "contact.restitution", ...) and why; nothing for a system that has
-// none. analysis.transport is refused for it (and so are the Python module's moments).
-struct TransportObstacle {
-  std::string key, why;
-};
-std::optional<TransportObstacle> transport_obstacle(const Config& config);
-
-// What keeps a start state from being grown (compression, run/compression.hpp: a periodic box
-// of hard cores): the first obstacle by its key and why; nothing when it can be.
-std::optional<TransportObstacle> compression_obstacle(const Config& config);
-
 // Default lattice for a dimension: "fcc" in 3D, "hex" in 2D; std::invalid_argument otherwise.
 std::string default_lattice(int dimension);
 

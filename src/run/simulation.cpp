@@ -12,6 +12,7 @@
 #include "core/state_blocks.hpp"
 #include "core/stop_flag.hpp"
 #include "io/config_choices.hpp"
+#include "io/config_obstacles.hpp"
 #include "run/event_adapter.hpp"
 #include "run/output_directory.hpp"
 #include "run/setup_chain.hpp"

@@ -17,6 +17,7 @@
 #include "init/initial_state_file.hpp"
 #include "init/insertion_grid.hpp"
 #include "io/config_choices.hpp"
+#include "io/config_obstacles.hpp"
 #include "io/gsd_file.hpp"
 #include "model/boundaries.hpp"
 #include "run/environment_setup.hpp"

@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/stop_flag.hpp"
 #include "io/config.hpp"
+#include "io/config_obstacles.hpp"
 #include "run/run.hpp"
 #include "run/simulation.hpp"
 #include "run/simulation_analyses.hpp"

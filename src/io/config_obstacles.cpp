@@ -1,0 +1,83 @@
+#include "io/config_obstacles.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "io/config_choices.hpp"
+
+namespace kairos {
+
+std::optional<TransportObstacle> compression_obstacle(const Config& c) {
+  const auto refuse = [](std::string key, std::string why) {
+    return TransportObstacle{std::move(key), std::move(why)};
+  };
+  const char* box = "the particles grow in a periodic box or between walls on its faces";
+  if (!c.boundary.planes.empty()) return refuse("boundary.plane", box);
+  if (!c.boundary.cylinders.empty()) return refuse("boundary.cylinder", box);
+  if (!c.boundary.spheres.empty()) return refuse("boundary.sphere", box);
+  if (!c.boundary.open.empty()) return refuse("boundary.open", box);
+  if (c.boundary.shear_rate != 0.0) return refuse("boundary.shear_rate", box);
+  if (std::any_of(c.field.gravity.begin(), c.field.gravity.end(),
+                  [](double g) { return g != 0.0; }))
+    return refuse("field.gravity", box);
+  if (!c.bonds.empty() || c.system.chain_length > 0)
+    return refuse("bond", "bonded particles would stretch their bonds as they grow");
+  for (const SpeciesConfig& sp : c.system.species)
+    if (sp.fixed) return refuse("system.species.fixed", "fixed grains cannot be pushed aside");
+  return std::nullopt;
+}
+
+std::optional<TransportObstacle> transport_obstacle(const Config& c) {
+  const auto refuse = [](std::string key, std::string why) {
+    return TransportObstacle{std::move(key), std::move(why)};
+  };
+  if (integrators().is(c.run.integrator, IntegratorKind::kDem))
+    return refuse("run.integrator", "the DEM integrator is not event-driven");
+  if (c.boundary.shear_rate != 0.0)
+    return refuse("boundary.shear_rate", "Lees-Edwards shear is a non-equilibrium state");
+  if (!c.boundary.walls.empty()) return refuse("boundary.wall", "walls do not conserve momentum");
+  if (!c.boundary.open.empty())
+    return refuse("boundary.open", "open faces lose particles' momentum");
+  for (double g : c.field.gravity)
+    if (g != 0.0) return refuse("field.gravity", "a field does not conserve momentum");
+  if (!driving_kinds().is(c.driving.kind, DrivingKind::kNone))
+    return refuse("driving.kind", "driving does not conserve energy");
+  // Soft contacts: elastic laws only (the key that makes one dissipative, if any).
+  const auto dissipative = [](const SoftLawConfig& law) -> const char* {
+    if (law.damping != 0.0) return "damping";
+    if (law.dissipation != 0.0) return "dissipation";
+    if (law.restitution != 0.0 && law.restitution != 1.0) return "restitution";
+    if (law.friction != 0.0) return "friction";
+    return nullptr;
+  };
+  if (c.soft.enabled()) {
+    if (const char* key = dissipative(c.soft.law))
+      return refuse(fmt::format("soft.{}", key), "a dissipative soft contact law");
+    for (std::size_t p = 0; p < c.soft.pairs.size(); ++p)
+      if (const char* key = dissipative(c.soft.pairs[p].law))
+        return refuse(fmt::format("soft.pair[{}].{}", p, key), "a dissipative soft contact law");
+  }
+  for (std::size_t s = 0; s < c.system.species.size(); ++s)
+    if (c.system.species[s].fixed)
+      return refuse(fmt::format("system.species[{}].fixed", s),
+                    "fixed grains do not conserve momentum");
+  const auto conservative = [](const ContactConfig& k) {
+    const bool elastic = k.restitution_model == "constant" && k.restitution == 1.0;
+    const bool tangential = k.tangential_restitution == -1.0 || k.friction == 0.0 ||
+                            (k.tangential_restitution == 1.0 && std::isinf(k.friction));
+    return elastic && tangential;
+  };
+  for (const PairPotentialConfig& p : c.potentials)
+    if (p.potential.kind == "spring_dashpot")
+      return refuse("potential.kind", "a spring-dashpot by steps dissipates energy");
+  if (!conservative(c.interactions.contact))
+    return refuse("contact.restitution", "inelastic or frictional contacts dissipate energy");
+  for (const PairContactConfig& p : c.interactions.pairs)
+    if (!conservative(p.contact))
+      return refuse("contact.pair", "inelastic or frictional contacts dissipate energy");
+  return std::nullopt;
+}
+
+}  // namespace kairos
