@@ -73,7 +73,9 @@ SKIPPED_CHUNKS = []
 VOLATILE = {"wall_seconds", "collisions_per_second", "events_per_second", "steps_per_second",
             "provenance",
             "peak_rss_bytes", "run_id", "bytes_per_particle", "kairos_version",
-            "setup_wall_seconds", "timing", "ns_per_particle_step"}
+            "setup_wall_seconds", "timing", "ns_per_particle_step",
+            # A soft table's: whether and where it was cached, how long its build took.
+            "build_seconds", "from_cache", "cache_file"}
 
 # Cases beyond the examples: (name, config file relative to the repository or None for
 # inline TOML, inline TOML, overrides, a continuation's overrides or None).

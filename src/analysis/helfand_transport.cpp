@@ -1,39 +1,97 @@
 #include "analysis/helfand_transport.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace kairos {
 
 namespace {
 
+// A mixture's groups after the three: per mass moment a, then per a the energy + a, then per
+// pair a < b the sum a + b (D components each).
+std::uint32_t mass_group(std::size_t a) {
+  return static_cast<std::uint32_t>(3 + a);
+}
+std::uint32_t energy_mass_group(std::size_t moments, std::size_t a) {
+  return static_cast<std::uint32_t>(3 + moments + a);
+}
+std::uint32_t mass_pair_group(std::size_t moments, std::size_t a, std::size_t b) {
+  std::size_t before = 0;  // pairs (a', b') with a' < a
+  for (std::size_t k = 0; k < a; ++k) before += moments - 1 - k;
+  return static_cast<std::uint32_t>(3 + 2 * moments + before + (b - a - 1));
+}
+
 template <int D>
-std::vector<std::uint32_t> component_groups() {
+std::vector<std::uint32_t> component_groups(std::size_t moments) {
   using T = HelfandTransport<D>;
   std::vector<std::uint32_t> group;
-  for (int k = 0; k < T::kComponents; ++k) {
-    group.push_back(k < T::kShear    ? T::kShearGroup
-                    : k == T::kShear ? T::kBulkGroup
-                                     : T::kHeatGroup);
-  }
+  for (int k = 0; k < T::kShear; ++k) group.push_back(T::kShearGroup);
+  group.push_back(T::kBulkGroup);
+  const auto add = [&](std::uint32_t g) { group.insert(group.end(), D, g); };
+  add(T::kHeatGroup);
+  for (std::size_t a = 0; a < moments; ++a) add(mass_group(a));
+  for (std::size_t a = 0; a < moments; ++a) add(energy_mass_group(moments, a));
+  for (std::size_t a = 0; a < moments; ++a)
+    for (std::size_t b = a + 1; b < moments; ++b) add(mass_pair_group(moments, a, b));
   return group;
+}
+
+// Solves the symmetric positive definite system A x = b (n x n, row-major) by Cholesky's
+// factorisation; nothing if A is not positive definite.
+std::optional<std::vector<double>> solve_positive_definite(std::vector<double> A,
+                                                           std::vector<double> b) {
+  const std::size_t n = b.size();
+  for (std::size_t j = 0; j < n; ++j) {
+    double d = A[j * n + j];
+    for (std::size_t k = 0; k < j; ++k) d -= A[j * n + k] * A[j * n + k];
+    if (!(d > 0.0)) return std::nullopt;
+    A[j * n + j] = std::sqrt(d);
+    for (std::size_t i = j + 1; i < n; ++i) {
+      double v = A[i * n + j];
+      for (std::size_t k = 0; k < j; ++k) v -= A[i * n + k] * A[j * n + k];
+      A[i * n + j] = v / A[j * n + j];
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {  // L y = b
+    for (std::size_t k = 0; k < i; ++k) b[i] -= A[i * n + k] * b[k];
+    b[i] /= A[i * n + i];
+  }
+  for (std::size_t i = n; i-- > 0;) {  // L^T x = y
+    for (std::size_t k = i + 1; k < n; ++k) b[i] -= A[k * n + i] * b[k];
+    b[i] /= A[i * n + i];
+  }
+  return b;
 }
 
 }  // namespace
 
 template <int D>
-HelfandTransport<D>::HelfandTransport(double interval, std::size_t particles, double volume)
+HelfandTransport<D>::HelfandTransport(double interval, std::size_t particles, double volume,
+                                      std::size_t mass_moments, double mass_scale)
     : particles_(particles),
       volume_(volume),
-      helfand_(component_groups<D>(), 3u, interval),
-      fluxes_(component_groups<D>(), 3u, interval, Correlator::Statistic::kFluxProduct),
-      sample_(kComponents) {}
+      mass_moments_(mass_moments),
+      mass_scale_(mass_scale),
+      components_(component_groups<D>(mass_moments).size()),
+      helfand_(component_groups<D>(mass_moments), groups(), interval),
+      fluxes_(component_groups<D>(mass_moments), groups(), interval,
+              Correlator::Statistic::kFluxProduct),
+      sample_(components_),
+      first_(components_),
+      last_(components_) {}
+
+template <int D>
+std::uint32_t HelfandTransport<D>::groups() const {
+  const std::size_t m = mass_moments_;
+  return static_cast<std::uint32_t>(3 + 2 * m + m * (m - (m > 0 ? 1 : 0)) / 2);
+}
 
 // The estimators of the shear group, the pressure's moment (the trace over D) and the energy
 // moment's components.
 template <int D>
-typename HelfandTransport<D>::Components HelfandTransport<D>::components(const Moments& m) {
+typename HelfandTransport<D>::Components HelfandTransport<D>::components(const Moments& m) const {
   const auto g = [&](int a, int b) { return m.stress[a * D + b]; };
-  Components c{};
+  Components c(components_);
   int k = 0;
   for (int a = 0; a < D; ++a)
     for (int b = a + 1; b < D; ++b) c[k++] = 0.5 * (g(a, b) + g(b, a));
@@ -42,6 +100,16 @@ typename HelfandTransport<D>::Components HelfandTransport<D>::components(const M
   for (int a = 0; a < D; ++a) trace += g(a, a);
   c[k++] = trace / D;
   for (int a = 0; a < D; ++a) c[k++] = m.energy[a];
+  if (m.mass.size() != mass_moments_)
+    throw std::invalid_argument("HelfandTransport: wrong number of mass moments");
+  const auto mass = [&](std::size_t i, int a) { return mass_scale_ * m.mass[i][a]; };
+  for (std::size_t i = 0; i < mass_moments_; ++i)
+    for (int a = 0; a < D; ++a) c[k++] = mass(i, a);
+  for (std::size_t i = 0; i < mass_moments_; ++i)
+    for (int a = 0; a < D; ++a) c[k++] = m.energy[a] + mass(i, a);
+  for (std::size_t i = 0; i < mass_moments_; ++i)
+    for (std::size_t j = i + 1; j < mass_moments_; ++j)
+      for (int a = 0; a < D; ++a) c[k++] = mass(i, a) + mass(j, a);
   return c;
 }
 
@@ -65,7 +133,7 @@ void HelfandTransport<D>::add(double t, const Moments& m) {
     kinetic_trace_first_ = kinetic_trace_last_;
     frozen_pair_time_first_ = frozen_pair_time_last_;
   }
-  for (int k = 0; k < kComponents; ++k) sample_[k][0] = now[k] - first_[k];
+  for (std::size_t k = 0; k < components_; ++k) sample_[k][0] = now[k] - first_[k];
   sample_[bulk][0] -= pressure_offset_ * (t - first_time_);
   helfand_.add(sample_);
   fluxes_.add(sample_);
@@ -97,12 +165,69 @@ double HelfandTransport<D>::scale(int group) const {
 }
 
 template <int D>
-std::string HelfandTransport<D>::why_no_conductivity(std::size_t species) {
-  if (species > 1) {
-    return "a mixture: the heat flux needs the enthalpy carried by interdiffusion removed "
-           "(not measured yet)";
+std::optional<typename HelfandTransport<D>::HeatProjection> HelfandTransport<D>::heat_projection(
+    double from, double to) const {
+  HeatProjection p;
+  p.weight.assign(groups(), 0.0);
+  p.weight[kHeatGroup] = 1.0;
+  const std::size_t n = mass_moments_;
+  if (n == 0) return p;
+  if (helfand_.samples() < 2) return std::nullopt;
+  const auto fits = helfand_.diffusion(from, to);
+  for (const auto& f : fits)
+    if (!f) return std::nullopt;
+  const auto slope = [&](std::uint32_t g) { return fits[g]->coefficient; };
+  // L_ee, L_ea and L_ab (scaled moments) from the groups' slopes: a sum's mean square less
+  // its two parts' is twice the cross correlation.
+  const double l_ee = slope(kHeatGroup);
+  std::vector<double> l_aa(n * n), l_ae(n);
+  for (std::size_t a = 0; a < n; ++a) {
+    l_aa[a * n + a] = slope(mass_group(a));
+    l_ae[a] = 0.5 * (slope(energy_mass_group(n, a)) - l_ee - slope(mass_group(a)));
+    for (std::size_t b = a + 1; b < n; ++b) {
+      l_aa[a * n + b] = l_aa[b * n + a] =
+          0.5 * (slope(mass_pair_group(n, a, b)) - slope(mass_group(a)) - slope(mass_group(b)));
+    }
   }
-  return "";
+  const auto beta = solve_positive_definite(l_aa, l_ae);
+  if (!beta) return std::nullopt;
+  // <dG_q^2> = <dG_e^2> - 2 sum_a beta_a <dG_e dG_a> + sum_ab beta_a beta_b <dG_a dG_b>, each
+  // cross term as its sum's mean square less its parts'.
+  double removed = 0.0;
+  for (std::size_t a = 0; a < n; ++a) {
+    const double b = (*beta)[a];
+    removed += b * l_ae[a];
+    p.weight[energy_mass_group(n, a)] -= b;
+    p.weight[kHeatGroup] += b;
+    p.weight[mass_group(a)] += b + b * b;
+    for (std::size_t c = a + 1; c < n; ++c) {
+      const double bc = b * (*beta)[c];
+      p.weight[mass_pair_group(n, a, c)] += bc;
+      p.weight[mass_group(a)] -= bc;
+      p.weight[mass_group(c)] -= bc;
+    }
+    p.beta.push_back(b * mass_scale_);
+  }
+  p.removed = l_ee > 0.0 ? removed / l_ee : std::nan("");
+  return p;
+}
+
+template <int D>
+std::vector<double> HelfandTransport<D>::heat_weight(double from, double to) const {
+  const auto p = heat_projection(from, to);
+  return p ? p->weight : std::vector<double>{};
+}
+
+// The heat moment's statistic from the groups' (`weight` empty: no projection, NaN).
+template <int D>
+double HelfandTransport<D>::heat_value(const std::vector<double>& mean,
+                                       const std::vector<double>& weight) const {
+  if (mass_moments_ == 0) return mean[kHeatGroup];
+  if (weight.empty()) return std::nan("");
+  double sum = 0.0;
+  for (std::size_t g = 0; g < weight.size(); ++g)
+    if (weight[g] != 0.0) sum += weight[g] * mean[g];
+  return sum;
 }
 
 template <int D>
@@ -116,25 +241,36 @@ std::array<typename HelfandTransport<D>::Fit, 3> HelfandTransport<D>::einstein_h
   const auto about_drift = helfand_.diffusion(from, to, {Vec<1>{}, Vec<1>{drift}}, span);
   out[kShearGroup] = plain[kShearGroup];
   out[kBulkGroup] = about_drift[kBulkGroup];
-  out[kHeatGroup] = plain[kHeatGroup];
+  if (mass_moments_ == 0) {
+    out[kHeatGroup] = plain[kHeatGroup];
+  } else if (const auto p = heat_projection(from, to)) {
+    out[kHeatGroup] = helfand_.combined_diffusion(from, to, p->weight);
+  }
   return out;
 }
 
 template <int D>
-std::array<typename HelfandTransport<D>::Fit, 3> HelfandTransport<D>::green_kubo(double to) const {
+std::array<typename HelfandTransport<D>::Fit, 3> HelfandTransport<D>::green_kubo(double from,
+                                                                                 double to) const {
   std::array<Fit, 3> out;
   if (fluxes_.samples() < 3) return out;
   // The pressure's fluctuation: about its mean flux (sampled less the first interval's rate).
   const double mean = pressure_drift();
   const auto gk = fluxes_.green_kubo(to, {Vec<1>{}, Vec<1>{mean}});
   for (int g = 0; g < 3; ++g) out[g] = gk[g];
+  if (mass_moments_ > 0) {  // the heat flux: projected as the Einstein-Helfand fit's moment
+    const auto p = heat_projection(from, to);
+    out[kHeatGroup] = p ? fluxes_.combined_green_kubo(to, p->weight) : std::nullopt;
+  }
   return out;
 }
 
 template <int D>
-std::vector<typename HelfandTransport<D>::Row> HelfandTransport<D>::helfand_rows() const {
+std::vector<typename HelfandTransport<D>::Row> HelfandTransport<D>::helfand_rows(double from,
+                                                                                 double to) const {
   std::vector<Row> rows;
   if (helfand_.samples() < 2) return rows;
+  const std::vector<double> weight = heat_weight(from, to);
   const double kt = temperature();
   const double span = last_time_ - first_time_;
   const double drift = pressure_drift();
@@ -148,22 +284,25 @@ std::vector<typename HelfandTransport<D>::Row> HelfandTransport<D>::helfand_rows
     Row row;
     row.lag = tau;
     row.origins = lag.origins;
-    row.value = {lag.mean[kShearGroup], bulk, lag.mean[kHeatGroup]};
-    row.coefficient = {lag.mean[kShearGroup] / scale, bulk / scale,
-                       lag.mean[kHeatGroup] / (scale * kt)};
+    const double heat = heat_value(lag.mean, weight);
+    row.value = {lag.mean[kShearGroup], bulk, heat};
+    row.coefficient = {lag.mean[kShearGroup] / scale, bulk / scale, heat / (scale * kt)};
     rows.push_back(row);
   }
   return rows;
 }
 
 template <int D>
-std::vector<typename HelfandTransport<D>::Row> HelfandTransport<D>::green_kubo_rows() const {
+std::vector<typename HelfandTransport<D>::Row> HelfandTransport<D>::green_kubo_rows(
+    double from, double to) const {
   std::vector<Row> rows;
   if (fluxes_.samples() < 2) return rows;
+  const std::vector<double> weight = heat_weight(from, to);
   const double kt = temperature();
   const double drift = pressure_drift();
   const auto lags = fluxes_.lags();
   const auto about_mean = [&](const typename Correlator::Lag& lag, int g) {
+    if (g == kHeatGroup) return heat_value(lag.mean, weight);
     if (g != kBulkGroup) return lag.mean[g];
     return lag.mean[g] - drift * lag.mean_linear[g][0] + drift * drift;
   };

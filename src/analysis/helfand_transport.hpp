@@ -6,6 +6,12 @@
 // of the fluxes, block-averaged over each level's spacing) as the cross-check.
 // docs/physics.md#einstein-helfand-transport-coefficients.
 //
+// In a mixture the thermal conductivity is the heat flux's response at zero diffusion flux:
+// lambda = (L_ee - L_eA L_AA^-1 L_Ae) / (V kT^2), the L the Einstein-Helfand slopes of the
+// energy moment and the species' mass moments G_a (relative to the centre of mass) and of
+// their cross correlations (docs/physics.md#thermal-conductivity-of-a-mixture). The cross
+// correlations come from the mean squares of sums of two moments.
+//
 // What analysis.transport (run/outputs/transport_output.hpp) and the Python module's
 // Simulation.transport compute, from the same code: no run dependency.
 #pragma once
@@ -30,7 +36,8 @@ class HelfandTransport {
   // components and the normal-stress differences, all with the same autocorrelation in an
   // isotropic fluid), the pressure (one), the energy flux (D).
   static constexpr int kShear = D == 3 ? 5 : 2;
-  static constexpr int kComponents = kShear + 1 + D;
+  // Mixtures add D components per mass moment, per (energy + mass moment) and per (mass moment
+  // + mass moment), each set its own group after these.
   enum Group : std::uint32_t { kShearGroup = 0, kBulkGroup = 1, kHeatGroup = 2 };
   using Correlator = MsdCorrelator<1>;
   using Fit = std::optional<typename Correlator::Diffusion>;
@@ -44,10 +51,16 @@ class HelfandTransport {
     // Soft contacts: the time integral of the number of frozen pairs, whose relative motion
     // is not in the kinetic trace (kT counts the degrees of freedom that move).
     double frozen_pair_time = 0.0;
+    // Mixtures: the mass moments G_a = sum_{i in a} m_i x_i - (M_a / M) sum_i m_i x_i
+    // (unwrapped positions) of every species present but the last.
+    std::vector<Vec<D>> mass;
   };
 
-  // Samples `interval` apart of a system of `particles` particles in `volume`.
-  HelfandTransport(double interval, std::size_t particles, double volume);
+  // Samples `interval` apart of a system of `particles` particles in `volume`; a mixture's
+  // `mass_moments` mass moments are scaled by `mass_scale` (an energy per mass, about kT / m:
+  // the sums of moments then add terms of one size).
+  HelfandTransport(double interval, std::size_t particles, double volume,
+                   std::size_t mass_moments = 0, double mass_scale = 1.0);
 
   // The next sample, at time t.
   void add(double t, const Moments& m);
@@ -66,36 +79,56 @@ class HelfandTransport {
   // / (V kT^2)) is the transport coefficient.
   std::array<Fit, 3> einstein_helfand(double from, double to) const;
   // Green-Kubo: the flux autocorrelations integrated up to `to` (the pressure's about its
-  // mean); nothing before 3 samples.
-  std::array<Fit, 3> green_kubo(double to) const;
+  // mean; a mixture's heat flux projected with the fits over [from, to]); nothing before 3
+  // samples.
+  std::array<Fit, 3> green_kubo(double from, double to) const;
   // The scale that turns a fit's coefficient of group g into the transport coefficient.
   double scale(int group) const;
-  // Why there is no thermal conductivity for a system of `species` species ("": there is).
-  static std::string why_no_conductivity(std::size_t species);
+
+  // The heat moment of a mixture: G_q = G_e - sum_a beta_a G_a with beta = L_AA^-1 L_Ae from
+  // the fits over [from, to], whose mean square is that of the energy moment less its part
+  // correlated with interdiffusion (first order in beta's error: beta minimises it). `weight`:
+  // the combination of the correlator's groups that is <dG_q^2> (one species: the energy's).
+  struct HeatProjection {
+    std::vector<double> beta;  // per mass moment: an energy per mass
+    double removed = 0.0;      // the fraction of L_ee removed
+    std::vector<double> weight;
+  };
+  // Nothing when a fit is missing or L_AA is not positive definite.
+  std::optional<HeatProjection> heat_projection(double from, double to) const;
+  std::size_t mass_moments() const { return mass_moments_; }
 
   // Per lag: the three moments' mean squares (helfand.tsv: the pressure's about its drift, over
-  // 1 - lag / span; lags below the sampled span) or the flux autocorrelations (green_kubo.tsv:
-  // the pressure's about its mean), and the running coefficients (Einstein-Helfand:
-  // <dG^2> / (2 lag V kT), kT^2 for the conductivity; Green-Kubo: the running integrals).
+  // 1 - lag / span; lags below the sampled span; a mixture's heat moment projected with the
+  // fits over [from, to]) or the flux autocorrelations (green_kubo.tsv: the pressure's about
+  // its mean), and the running coefficients (Einstein-Helfand: <dG^2> / (2 lag V kT), kT^2 for
+  // the conductivity; Green-Kubo: the running integrals).
   struct Row {
     double lag = 0.0;
     std::uint64_t origins = 0;
     std::array<double, 3> value{}, coefficient{};
   };
-  std::vector<Row> helfand_rows() const;
-  std::vector<Row> green_kubo_rows() const;
+  std::vector<Row> helfand_rows(double from, double to) const;
+  std::vector<Row> green_kubo_rows(double from, double to) const;
 
   std::size_t bytes() const { return helfand_.bytes() + fluxes_.bytes(); }
 
  private:
-  using Components = std::array<double, kComponents>;
-  static Components components(const Moments& m);
+  using Components = std::vector<double>;
+  Components components(const Moments& m) const;
+  std::uint32_t groups() const;
+  // The weights of the heat moment's mean square (one species: the energy's group alone).
+  std::vector<double> heat_weight(double from, double to) const;
+  double heat_value(const std::vector<double>& mean, const std::vector<double>& weight) const;
   // The drift of the pressure's moment left after the first interval's rate was removed: its
   // mean rate over the samples.
   double pressure_drift() const;
 
   std::size_t particles_;
   double volume_;
+  std::size_t mass_moments_;
+  double mass_scale_;
+  std::size_t components_;
   Correlator helfand_;
   Correlator fluxes_;  // the same samples as fluxes (kFluxProduct)
   std::vector<Vec<1>> sample_;

@@ -381,6 +381,83 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
   return out;
 }
 
+namespace {
+
+// sum_g weight[g] value(g) over the weighted groups (NaN if one of them has no value).
+template <class Value>
+double combine(const std::vector<double>& weight, const Value& value) {
+  double sum = 0.0;
+  for (std::uint32_t g = 0; g < weight.size(); ++g)
+    if (weight[g] != 0.0) sum += weight[g] * value(g);
+  return sum;
+}
+
+}  // namespace
+
+template <int D>
+std::optional<typename MsdCorrelator<D>::Diffusion> MsdCorrelator<D>::combined_diffusion(
+    double from, double to, const std::vector<double>& weight) const {
+  if (weight.size() > groups_) throw std::invalid_argument("MsdCorrelator: too many weights");
+  const std::vector<Lag> all = lags();
+  std::vector<double> t, y;
+  for (const Lag& lag : all) {
+    if (lag.lag < from || lag.lag > to) continue;
+    t.push_back(lag.lag);
+    y.push_back(combine(weight, [&](std::uint32_t g) { return lag.mean[g]; }));
+  }
+  if (t.size() < 3) return std::nullopt;
+  Diffusion d;
+  d.lags = static_cast<int>(t.size());
+  d.coefficient = slope(t, y) / (2.0 * D);
+  std::vector<double> by_epoch;
+  for (int e = 0; e < kEpochs; ++e) {
+    std::vector<double> te, ye;
+    for (const Lag& lag : all) {
+      if (lag.lag < from || lag.lag > to) continue;
+      const double value = combine(weight, [&](std::uint32_t g) { return lag.epoch_mean[g][e]; });
+      if (std::isnan(value)) continue;
+      te.push_back(lag.lag);
+      ye.push_back(value);
+    }
+    if (te.size() >= 3) by_epoch.push_back(slope(te, ye) / (2.0 * D));
+  }
+  set_errors(d, {}, by_epoch);
+  return d;
+}
+
+template <int D>
+std::optional<typename MsdCorrelator<D>::Diffusion> MsdCorrelator<D>::combined_green_kubo(
+    double to, const std::vector<double>& weight) const {
+  if (weight.size() > groups_) throw std::invalid_argument("MsdCorrelator: too many weights");
+  if (statistic_ == Statistic::kDisplacement) return std::nullopt;
+  const std::vector<Lag> all = lags();
+  if (all.empty() || all[0].lag != 0.0) return std::nullopt;
+  const auto integral = [&](const auto& value_at) {
+    double total = 0.0;
+    int used = 0;
+    for (std::size_t k = 1; k < all.size() && all[k].lag <= to; ++k, ++used)
+      total += 0.5 * (all[k].lag - all[k - 1].lag) * (value_at(all[k]) + value_at(all[k - 1]));
+    return std::pair{total, used};
+  };
+  const auto [total, used] = integral([&](const Lag& lag) {
+    return combine(weight, [&](std::uint32_t g) { return lag.mean[g]; });
+  });
+  if (used < 2) return std::nullopt;
+  std::vector<double> by_epoch;
+  for (int e = 0; e < kEpochs; ++e) {
+    const double value =
+        integral([&](const Lag& lag) {
+          return combine(weight, [&](std::uint32_t g) { return lag.epoch_mean[g][e]; });
+        }).first;
+    if (std::isfinite(value)) by_epoch.push_back(value / D);  // every lag of the epoch
+  }
+  Diffusion d;
+  d.lags = used + 1;
+  d.coefficient = total / D;
+  set_errors(d, {}, by_epoch);
+  return d;
+}
+
 template <int D>
 std::size_t MsdCorrelator<D>::bytes() const {
   std::size_t b = 0;

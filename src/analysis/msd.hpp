@@ -105,6 +105,15 @@ class MsdCorrelator {
   std::vector<std::optional<Diffusion>> green_kubo(double to,
                                                    const std::vector<Vec<D>>& mean) const;
 
+  // A linear combination sum_g weight[g] mean_g of the groups' statistics (cross correlations
+  // enter by sums of two moments: <(x + y)^2> - <x^2> - <y^2> = 2 <x . y>): its slope as
+  // diffusion() fits one group's, and its Green-Kubo integral as green_kubo() (the products).
+  // The error comes from the time epochs alone (the groups' subsets need not hold the same
+  // components). Nothing when fewer than 3 lags fall in the window.
+  std::optional<Diffusion> combined_diffusion(double from, double to,
+                                              const std::vector<double>& weight) const;
+  std::optional<Diffusion> combined_green_kubo(double to, const std::vector<double>& weight) const;
+
   std::uint64_t samples() const { return samples_; }
   double interval() const { return interval_; }
   std::size_t particles() const { return group_.size(); }

@@ -554,10 +554,19 @@ class PySimulation {
 
   py::dict msd(const py::object& interval_arg, const py::object& duration_arg,
                const py::object& fit_from_arg, const py::object& fit_to_arg,
-               const py::object& vacf_arg, const py::object& particles_arg) {
+               const py::object& vacf_arg, const py::object& particles_arg,
+               const py::object& clock_arg) {
     CorrelationRequest request =
         correlation_request(interval_arg, duration_arg, fit_from_arg, fit_to_arg, "msd");
     const bool vacf = flag_from(vacf_arg, "msd: vacf");
+    if (!py::isinstance<py::str>(clock_arg))
+      throw InputError("msd: clock: one of \"auto\", \"time\", \"collisions\"");
+    const std::string clock_name = clock_arg.cast<std::string>();
+    const auto clock = msd_time_scales().find(clock_name);
+    if (!clock) {
+      throw InputError(fmt::format("msd: clock = \"{}\": one of {}", clock_name,
+                                   msd_time_scales().names(", ", " or ")));
+    }
     std::size_t particles = 0;  // all
     if (!particles_arg.is_none()) {
       const double wanted = number_from(particles_arg, "msd: particles");
@@ -566,8 +575,9 @@ class PySimulation {
       particles = static_cast<std::size_t>(wanted);
     }
     return visit([&](auto& s) {
-      const auto m =
-          advancing([&] { return measure_msd(s, request, vacf, python_keeps_going, particles); });
+      const auto m = advancing([&] {
+        return measure_msd(s, request, vacf, python_keeps_going, particles, clock->value);
+      });
       py::dict out = lags_dict(*m.msd, true, "msd");
       out["species"] = m.species;
       out["particles_followed"] = m.followed;
@@ -579,6 +589,9 @@ class PySimulation {
       out["lags_fitted"] = fits["lags_fitted"];
       out["epochs_fitted"] = fits["epochs_fitted"];
       span_into(out, m.span, m.msd->samples(), m.sampled_from, m.sampled_to);
+      out["clock"] = m.in_collisions ? "collisions" : "time";
+      out["why"] =
+          m.no_coefficient.empty() ? py::object(py::none()) : py::object(py::str(m.no_coefficient));
       if (m.vacf) {
         out["vacf"] = lags_dict(*m.vacf, false, "vacf");
         py::dict gk = fits_dict(m.green_kubo);
@@ -680,9 +693,22 @@ class PySimulation {
         }
         return d;
       };
-      out["helfand"] = rows_dict(t.helfand_rows(), {"shear_moment", "bulk_moment", "heat_moment"});
-      out["green_kubo"] =
-          rows_dict(t.green_kubo_rows(), {"shear_flux_acf", "bulk_flux_acf", "heat_flux_acf"});
+      const double from = m.span.fit_from, to = m.span.fit_to;
+      out["helfand"] =
+          rows_dict(t.helfand_rows(from, to), {"shear_moment", "bulk_moment", "heat_moment"});
+      out["green_kubo"] = rows_dict(t.green_kubo_rows(from, to),
+                                    {"shear_flux_acf", "bulk_flux_acf", "heat_flux_acf"});
+      if (!m.mass_moment_species.empty()) {
+        py::dict beta;
+        for (std::size_t k = 0; k < m.mass_moment_species.size(); ++k) {
+          beta[py::str(m.mass_moment_species[k])] =
+              m.heat_projection ? m.heat_projection->beta[k] : std::nan("");
+        }
+        py::dict d;
+        d["enthalpy_per_mass"] = beta;
+        d["removed_fraction"] = m.heat_projection ? m.heat_projection->removed : std::nan("");
+        out["thermal_conductivity"]["interdiffusion"] = d;
+      }
       return out;
     });
   }
@@ -1097,12 +1123,15 @@ PYBIND11_MODULE(kairos, m) {
            "kurtosis, Sonine a2 and tail ratio.")
       .def("msd", &PySimulation::msd, py::arg("interval"), py::arg("duration"),
            py::arg("fit_from") = py::none(), py::arg("fit_to") = py::none(),
-           py::arg("vacf") = false, py::arg("particles") = py::none(),
+           py::arg("vacf") = false, py::arg("particles") = py::none(), py::arg("clock") = "auto",
            "ADVANCES the simulation by `duration`, sampling the unwrapped positions at the "
            "multiples of `interval` (None: automatic) as analysis.msd does; returns the MSD "
            "per species on log-spaced lags and D fitted over [fit_from, fit_to] (None: "
            "automatic), with the VACF and Green-Kubo D if vacf=True. Follows every moving "
-           "particle, or every k-th so that at most `particles` are (as analysis.msd_particles).")
+           "particle, or every k-th so that at most `particles` are (as analysis.msd_particles). "
+           "clock: \"time\", \"collisions\" (interval, duration, lags and window in collisions "
+           "per particle) or \"auto\" (collisions for a freely cooling gas), as "
+           "analysis.msd_time.")
       .def("helfand_moments", &PySimulation::helfand_moments,
            "The Helfand moments now (needs helfand=True): kinetic_stress, virial, stress (D, D), "
            "energy_kinetic, energy_collisional, energy (D,).")

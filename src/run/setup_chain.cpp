@@ -179,8 +179,15 @@ std::unique_ptr<EventEngineAdapter<D, Queue>> start_event_engine(RunStart<D>&& s
     Environment<D> environment = make_environment<D>(start.config, start.state);
     note_walls_carried_off(environment);
     std::vector<SoftTableUse> tables = start_tables(environment, start, progress);
+    // A mixture's thermal conductivity needs the species' mass moments: unwrapped positions.
+    EngineTracking tracked = tracking;
+    const auto& species = start.state.species;
+    const bool mixture = std::any_of(species.begin(), species.end(),
+                                     [&](std::uint32_t s) { return s != species.front(); });
+    tracked.images =
+        tracked.images || (mixture && (start.config.analysis.transport || tracking.helfand));
     return std::make_unique<EventEngineAdapter<D, Queue>>(std::move(start), environment,
-                                                          std::move(tables), tracking);
+                                                          std::move(tables), tracked);
   });
 }
 

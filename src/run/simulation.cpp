@@ -158,6 +158,24 @@ bool Simulation<D>::sample_every(double interval, double duration,
 }
 
 template <int D>
+bool Simulation<D>::sample_every_collisions(std::uint64_t step, std::uint64_t count,
+                                            const std::function<void()>& sample,
+                                            const KeepGoing& keep_going) {
+  if (step == 0) throw InputError("sampling every 0 collisions: the step must be at least 1");
+  const std::uint64_t end = target_after(collisions(), count);
+  // As the run driver's loop with one trigger in collisions (every step from the start).
+  CollisionTrigger trigger;
+  trigger.step = step;
+  trigger.next = target_after(collisions(), step);
+  while (collisions() < end) {
+    const std::uint64_t stop = std::min(trigger.next, end);
+    if (!advance_collisions(stop - collisions(), keep_going)) return false;
+    if (trigger.due(collisions())) sample();
+  }
+  return true;
+}
+
+template <int D>
 double Simulation<D>::time() const {
   return engine_->engine().time();
 }

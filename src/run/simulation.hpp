@@ -59,6 +59,12 @@ class Simulation {
   // taken at the end), and ends at time() + duration. False if stopped early by keep_going.
   bool sample_every(double interval, double duration, const std::function<void()>& sample,
                     const KeepGoing& keep_going = {});
+  // The same on the collision clock: sample() each `step` collisions after collisions() (the
+  // engine stopped right after that collision), as `kairos run` samples analysis.msd with
+  // msd_time = "collisions" (run/trigger.hpp CollisionTrigger), and ends `count` collisions on.
+  bool sample_every_collisions(std::uint64_t step, std::uint64_t count,
+                               const std::function<void()>& sample,
+                               const KeepGoing& keep_going = {});
 
   double time() const;
   std::uint64_t events() const;

@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "run/event_adapter.hpp"
 #include "run/outputs/bond_order_output.hpp"
+#include "run/outputs/msd_output.hpp"
 #include "run/outputs/rdf_output.hpp"
 #include "run/outputs/sampling_interval.hpp"
 #include "run/outputs/structure_factor_output.hpp"
@@ -139,7 +140,7 @@ VelocityDistribution<D> velocity_distribution_now(const Simulation<D>& sim) {
 template <int D>
 MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& request, bool vacf,
                               const typename Simulation<D>::KeepGoing& keep_going,
-                              std::size_t particles) {
+                              std::size_t particles, MsdTime clock) {
   if (!sim.tracks_images()) {
     throw InputError(
         "msd: the mean-square displacement needs image counters: this Simulation keeps none "
@@ -151,7 +152,15 @@ MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& requ
         "streaming displacement would need subtracting), as analysis.msd");
   }
   MsdMeasurement<D> m;
-  m.span = begin_span(sim, request);
+  const auto& kind = sim.integrator().kind();
+  const bool freely_cooling = kind.dissipative && !kind.driven && !kind.moving_walls;
+  m.in_collisions = clock == MsdTime::kCollisions || (clock == MsdTime::kAuto && freely_cooling);
+  if (m.in_collisions && vacf) {
+    throw InputError(
+        "msd: vacf: no velocity autocorrelation on the collision clock (the velocities of a "
+        "cooling gas decay); pass clock=\"time\"");
+  }
+  if (!m.in_collisions) m.span = begin_span(sim, request);
   // Every step-th particle that moves, grouped by species (analysis.msd: at most
   // msd_particles of them; fixed grains never move).
   m.species = sim.species_names();
@@ -176,25 +185,61 @@ MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& requ
     while (group.back() >= m.species.size()) m.species.push_back(std::to_string(m.species.size()));
   }
   m.followed = group.size();
+  // The collision clock: 2 collisions / moving particles, as MsdOutput's.
+  const auto per_particle = [&] {
+    return 2.0 * static_cast<double>(sim.collisions()) / static_cast<double>(mobile);
+  };
+  CollisionInterval every;
+  if (m.in_collisions) {
+    if (mobile == 0) throw InputError("msd: no particle moves: no collision clock");
+    if (!(request.duration >= 0.0) || !std::isfinite(request.duration))
+      throw InputError("msd: duration: collisions per particle, finite and not negative");
+    every = collision_interval(request.interval == 0.0 ? 0.5 : request.interval, mobile);
+    m.span.interval = every.per_particle;
+    m.span.interval_automatic = request.interval == 0.0;
+    m.span.start_time = sim.time();
+    m.span.collisions = sim.collisions();
+  }
   const auto groups = static_cast<std::uint32_t>(m.species.size());
   m.msd.emplace(group, groups, m.span.interval);
   if (vacf) m.vacf.emplace(group, groups, m.span.interval, MsdCorrelator<D>::Statistic::kProduct);
   std::vector<Vec<D>> sample(group.size());
-  m.span.completed = sim.sample_every(
-      m.span.interval, request.duration,
-      [&] {
-        engine.unwrapped_positions(slot, sample);
-        if (m.msd->samples() == 0) m.sampled_from = sim.time();
-        m.sampled_to = sim.time();
-        m.msd->add(sample);
-        if (m.vacf) {
-          engine.velocities(slot, sample);
-          m.vacf->add(sample);
-        }
-      },
-      keep_going);
-  end_span(sim, request, m.sampled_to - m.sampled_from, m.span);
-  m.diffusion = m.msd->diffusion(m.span.fit_from, m.span.fit_to);
+  const auto take = [&] {
+    engine.unwrapped_positions(slot, sample);
+    const double now = m.in_collisions ? per_particle() : sim.time();
+    if (m.msd->samples() == 0) m.sampled_from = now;
+    m.sampled_to = now;
+    m.msd->add(sample);
+    if (m.vacf) {
+      engine.velocities(slot, sample);
+      m.vacf->add(sample);
+    }
+  };
+  if (m.in_collisions) {
+    const double collisions = std::round(request.duration * static_cast<double>(mobile) / 2.0);
+    m.span.completed = sim.sample_every_collisions(
+        every.step, collisions < 0x1p63 ? static_cast<std::uint64_t>(collisions) : ~0ull, take,
+        keep_going);
+    // Per collision the mean free "time" is one collision per particle by definition.
+    m.span.end_time = sim.time();
+    m.span.collisions = sim.collisions() - m.span.collisions;
+    m.span.mean_free_time = 1.0;
+    const auto [from, to] = correlation_fit_window(m.sampled_to - m.sampled_from, request.fit_from,
+                                                   request.fit_to, 1.0);
+    m.span.fit_from = from;
+    m.span.fit_to = to;
+  } else {
+    m.span.completed = sim.sample_every(m.span.interval, request.duration, take, keep_going);
+    end_span(sim, request, m.sampled_to - m.sampled_from, m.span);
+  }
+  if (freely_cooling && !m.in_collisions) {
+    m.no_coefficient =
+        "the gas cools freely: D(t) decays with sqrt(T) (Haff's law), so no constant D in time "
+        "exists; clock=\"collisions\" (or \"auto\") measures the constant D per collision";
+    m.diffusion.assign(groups, std::nullopt);
+  } else {
+    m.diffusion = m.msd->diffusion(m.span.fit_from, m.span.fit_to);
+  }
   m.green_kubo = m.vacf ? m.vacf->green_kubo(m.span.fit_to)
                         : std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>>(groups);
   return m;
@@ -211,15 +256,27 @@ TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationR
   TransportMeasurement<D> m;
   m.span = begin_span(sim, request);
   const EventIntegrator<D>& engine = sim.integrator();
-  m.transport.emplace(m.span.interval, sim.size(), engine.volume());
+  MassMoments<D> mass(engine);  // a mixture's (the Simulation keeps images for them)
+  m.transport.emplace(m.span.interval, sim.size(), engine.volume(), mass.count(), mass.scale());
   m.span.completed = sim.sample_every(
       m.span.interval, request.duration,
-      [&] { m.transport->add(sim.time(), helfand_sample(engine)); }, keep_going);
+      [&] { m.transport->add(sim.time(), helfand_sample(engine, &mass)); }, keep_going);
   end_span(sim, request, m.transport->last_time() - m.transport->first_time(), m.span);
   m.einstein_helfand = m.transport->einstein_helfand(m.span.fit_from, m.span.fit_to);
-  m.green_kubo = m.transport->green_kubo(m.span.fit_to);
-  m.no_conductivity = HelfandTransport<D>::why_no_conductivity(
-      std::max<std::size_t>(1, sim.species_names().size()));
+  m.green_kubo = m.transport->green_kubo(m.span.fit_from, m.span.fit_to);
+  if (mass.count() > 0) {
+    const std::vector<std::string>& names = sim.species_names();
+    for (std::size_t k = 0; k < mass.count(); ++k) {
+      const std::uint32_t s = mass.species(k);
+      m.mass_moment_species.push_back(s < names.size() ? names[s] : std::to_string(s));
+    }
+    m.heat_projection = m.transport->heat_projection(m.span.fit_from, m.span.fit_to);
+    if (!m.heat_projection && m.transport->samples() >= 2) {
+      m.no_conductivity =
+          "the mass moments' correlations are not positive definite: the sampled span is too "
+          "short for a mixture's heat flux";
+    }
+  }
   return m;
 }
 
@@ -229,8 +286,8 @@ TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationR
   template BondOrderValues<D> bond_order_now<D>(const Simulation<D>&, double, const std::string&); \
   template VelocityDistribution<D> velocity_distribution_now<D>(const Simulation<D>&);             \
   template MsdMeasurement<D> measure_msd<D>(Simulation<D>&, const CorrelationRequest&, bool,       \
-                                            const typename Simulation<D>::KeepGoing&,              \
-                                            std::size_t);                                          \
+                                            const typename Simulation<D>::KeepGoing&, std::size_t, \
+                                            MsdTime);                                              \
   template TransportMeasurement<D> measure_transport<D>(Simulation<D>&, const CorrelationRequest&, \
                                                         const typename Simulation<D>::KeepGoing&);
 KAIROS_SIMULATION_ANALYSES(2)

@@ -22,6 +22,7 @@
 #include "analysis/helfand_transport.hpp"
 #include "analysis/msd.hpp"
 #include "analysis/structure.hpp"
+#include "io/config_choices.hpp"
 #include "run/simulation.hpp"
 
 namespace kairos {
@@ -105,14 +106,19 @@ struct MsdMeasurement {
   std::optional<MsdCorrelator<D>> msd, vacf;
   double sampled_from = 0.0, sampled_to = 0.0;  // first and last sample's times
   std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> diffusion, green_kubo;
+  bool in_collisions = false;  // the clock: collisions per particle
+  std::string no_coefficient;  // why there is no D ("": there is one)
 };
 // Advances `sim` by request.duration. InputError without image counters or under shear.
 // Follows every `step`-th particle that moves, at most `particles` of them (0: all), as
-// analysis.msd_particles does; fixed grains are never followed.
+// analysis.msd_particles does; fixed grains are never followed. On the collision clock
+// (analysis.msd_time: "auto" chooses it for a freely cooling gas) the interval, the duration,
+// the lags and the fit window are in collisions per particle, the samples every
+// collision_interval(interval).step collisions (interval 0: half a collision per particle).
 template <int D>
 MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& request, bool vacf,
                               const typename Simulation<D>::KeepGoing& keep_going = {},
-                              std::size_t particles = 0);
+                              std::size_t particles = 0, MsdTime clock = MsdTime::kTime);
 
 // The Einstein-Helfand transport coefficients (analysis.transport), as summary.json's
 // `transport` gives them.
@@ -122,6 +128,9 @@ struct TransportMeasurement {
   std::optional<HelfandTransport<D>> transport;
   std::array<typename HelfandTransport<D>::Fit, 3> einstein_helfand, green_kubo;
   std::string no_conductivity;  // why there is no thermal conductivity ("": there is)
+  // A mixture: the species of the mass moments and the heat moment's projection.
+  std::vector<std::string> mass_moment_species;
+  std::optional<typename HelfandTransport<D>::HeatProjection> heat_projection;
 };
 // Advances `sim` by request.duration. InputError unless the Helfand moments are kept.
 template <int D>

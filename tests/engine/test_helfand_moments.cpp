@@ -78,19 +78,61 @@ DirectSums<D> direct_sums(const ParticleSystem<D>& s, const Environment<D>& env)
   return d;
 }
 
+// The sums as the moments count them while soft contacts are in progress (from the exported
+// state's contacts): a deferred pair's records already move as after its release (back from
+// its release position), a frozen pair moves with its centre of mass and holds its relative
+// kinetic energy, m_k |v_k' - V|^2 / 2 per particle.
+template <int D>
+DirectSums<D> direct_sums_in_contact(ParticleSystem<D> s, const Environment<D>& env) {
+  std::vector<double> held(s.size(), 0.0);
+  for (const FrozenContact<D>& c : s.frozen) {
+    EXPECT_NE(c.j, FrozenContact<D>::kWall);
+    const std::uint32_t ids[2] = {c.i, c.j};
+    const Vec<D> after[2] = {c.velocity_i, c.velocity_j};
+    const Vec<D> at[2] = {c.release_position_i, c.release_position_j};
+    for (int side = 0; side < 2; ++side) {
+      Kinematics<D>& k = s.kinematics[ids[side]];
+      if (c.deferred) {
+        k = Kinematics<D>{at[side], after[side], c.release_time, k.radius};
+      } else {
+        held[ids[side]] = 0.5 * s.mass[ids[side]] * norm2(after[side] - k.vel);
+      }
+    }
+  }
+  DirectSums<D> d = direct_sums(s, env);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const Vec<D> x = s.position(i, s.time);
+    for (int a = 0; a < D; ++a) d.energy[a] += x[a] * held[i];
+  }
+  return d;
+}
+
 // Runs the cluster with the moments kept until its fastest particle could reach a face, and
-// compares them with the sums.
+// compares them with the sums. With `in_contact` the moments start from a state with soft
+// contacts in progress: a run without them until some are, continued from its exported state.
 template <int D>
 void moments_equal_direct_sums(ParticleSystem<D> s, const Environment<D>& env,
-                               EngineOptions options = {}) {
-  options.track_helfand = true;
+                               EngineOptions options = {}, bool in_contact = false) {
   options.track_images = true;
   options.renumber_interval = 0.5;  // the per-particle shares follow the renumbering
-  Engine<D> engine(s, StartMode::kPredict, options, env);
+  StartMode mode = StartMode::kPredict;
+  if (in_contact) {
+    Engine<D> before(s, StartMode::kPredict, options, env);
+    for (int e = 0; e < 100000 && before.frozen() < 4; ++e) before.step();
+    ASSERT_GE(before.frozen(), 4u) << "no contacts in progress to start from";
+    s = before.export_state();
+    mode = StartMode::kResume;
+  }
+  options.track_helfand = true;
+  Engine<D> engine(s, mode, options, env);
   const ParticleSystem<D> first = engine.export_state();
+  if (in_contact) {
+    ASSERT_GE(first.frozen.size(), 2u);
+  }
   const auto virial0 = engine.counters().virial_tensor;
   const auto m0 = engine.helfand_moments();
-  const DirectSums<D> d0 = direct_sums(first, env);
+  const DirectSums<D> d0 =
+      in_contact ? direct_sums_in_contact(first, env) : direct_sums(first, env);
   const std::uint64_t collisions0 = engine.counters().collisions;
   // Collisions can speed particles up: the positions are looked at every few events.
   const auto near_a_face = [&] {
@@ -192,6 +234,16 @@ TEST(HelfandMoments, EqualTheDirectSumsSoftSpheresWithDeferredReleases) {
   moments_equal_direct_sums<3>(cluster<3>(6, 0.3, 16, 2.0, 1.3), elastic_soft<3>(hertz));
   const SoftContactLaw spring = SoftContactLaw::linear_dashpot(1.0e3, 0.0);
   moments_equal_direct_sums<2>(cluster<2>(14, 0.4, 17, 0.5, 1.2), elastic_soft<2>(spring));
+}
+
+TEST(HelfandMoments, StartedWithSoftContactsInProgressEqualTheDirectSums) {
+  const SoftContactLaw hertz = SoftContactLaw::viscoelastic_hertz(2.0e3, 0.0);
+  moments_equal_direct_sums<3>(cluster<3>(6, 0.3, 16, 2.0, 1.3), elastic_soft<3>(hertz), {}, true);
+  EngineOptions frozen;
+  frozen.defer_soft_releases = false;
+  const SoftContactLaw spring = SoftContactLaw::linear_dashpot(1.0e3, 0.0);
+  moments_equal_direct_sums<2>(cluster<2>(14, 0.4, 19, 0.5, 1.2), elastic_soft<2>(spring), frozen,
+                               true);
 }
 
 TEST(HelfandMoments, EqualTheDirectSumsSoftSpheresWithReleaseEvents) {

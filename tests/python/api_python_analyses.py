@@ -134,6 +134,75 @@ class Analyses(kt.KairosTestCase):
             np.testing.assert_allclose(t["green_kubo"][column], rows[:, k], rtol=1e-9,
                                        atol=1e-12, err_msg=column)
 
+    def test_msd_on_the_collision_clock_equals_the_cli_bit_for_bit(self):
+        # A freely cooling gas: "auto" chooses collisions per particle in both, and samples
+        # every round(0.5 N / 2) collisions from the start.
+        config = kt.base_config(particles=300, packing_fraction=0.1, lattice="random", seed=33,
+                                equilibration=0.0, production=40.0, output={"trajectory": False},
+                                contact={"restitution": 0.9},
+                                analysis={"msd": True, "msd_fit_from": 2.0, "msd_fit_to": 8.0})
+        cfg = self.write_config(config)
+        out = self.path("cli")
+        self.run_ok("run", cfg, "-o", out)
+        d = self.summary(out)["diffusion"]
+        self.assertEqual(d["time_scale"], "collisions")
+        cli = d["species"]["A"]
+        self.assertIsNotNone(cli["coefficient"])
+        sim = kairos.Simulation(cfg)
+        m = sim.msd(None, 40.0, fit_from=2.0, fit_to=8.0)
+        self.assertEqual(m["clock"], "collisions")
+        self.assertIsNone(m["why"])
+        self.assertEqual(sim.collisions, 300 * 40 // 2)
+        self.assertEqual(m["interval"], d["interval"])
+        self.assertEqual(m["interval"], 2 * round(0.5 * 300 / 2) / 300)
+        self.assertEqual(m["samples"], d["samples"])
+        self.assertEqual((m["sampled_from"], m["sampled_to"]), (d["sampled_from"], d["sampled_to"]))
+        self.assertEqual(m["diffusion"][0], cli["coefficient"])
+        self.assertEqual(m["diffusion_stderr"][0], cli["coefficient_stderr"])
+        header, rows = read_table(os.path.join(out, "msd.tsv"))
+        np.testing.assert_allclose(m["lag"], rows[:, 0], rtol=1e-9)
+        np.testing.assert_allclose(m["msd"][:, 0], rows[:, header.index("msd_A")], rtol=1e-9)
+        # In time a cooling gas has no constant D (Haff's law): the CLI gives none either.
+        t = kairos.Simulation(cfg).msd(0.05, 2.0, clock="time")
+        self.assertEqual(t["clock"], "time")
+        self.assertTrue(math.isnan(t["diffusion"][0]))
+        self.assertIn("Haff", t["why"])
+        with self.assertRaisesRegex(kairos.InputError, "vacf"):
+            kairos.Simulation(cfg).msd(None, 4.0, vacf=True)
+        with self.assertRaisesRegex(kairos.InputError, "clock"):
+            kairos.Simulation(cfg).msd(None, 4.0, clock="ticks")
+
+    def test_a_mixtures_conductivity_equals_the_cli_bit_for_bit(self):
+        # 2D, two species: the mass moments come from unwrapped positions, which a Simulation
+        # with helfand=True keeps for a mixture. Sample and thermo times exact in binary: the
+        # CLI takes a sample within 1e-12 (relative) of another output's time at that time.
+        interval, duration = 0.0625, 8.0
+        config = gas_config(dimension=2, particles=200, packing_fraction=0.3, time=duration,
+                            analysis={"transport": True, "transport_interval": interval,
+                                      "transport_fit_from": 0.5, "transport_fit_to": 2.0})
+        config["output"]["thermo_interval"] = 0.25
+        config["system"]["species"] = [{"name": "big", "diameter": 1.0, "fraction": 0.5},
+                                       {"name": "small", "diameter": 0.7, "mass": 0.5,
+                                        "fraction": 0.5}]
+        cfg = self.write_config(config)
+        out = self.path("cli")
+        self.run_ok("run", cfg, "-o", out)
+        cli = self.summary(out)["transport"]["thermal_conductivity"]
+        self.assertIsNotNone(cli["value"], cli)
+        t = kairos.Simulation(cfg, helfand=True).transport(interval, duration, fit_from=0.5,
+                                                          fit_to=2.0)
+        c = t["thermal_conductivity"]
+        for key in ("value", "stderr", "green_kubo", "green_kubo_stderr"):
+            self.assertEqual(c[key], cli[key], key)
+        self.assertEqual(c["interdiffusion"]["enthalpy_per_mass"],
+                         cli["interdiffusion"]["enthalpy_per_mass"])
+        self.assertEqual(list(c["interdiffusion"]["enthalpy_per_mass"]), ["big"])
+        self.assertEqual(c["interdiffusion"]["removed_fraction"],
+                         cli["interdiffusion"]["removed_fraction"])
+        header, rows = read_table(os.path.join(out, "helfand.tsv"))
+        column = header.index("heat_moment")
+        np.testing.assert_allclose(t["helfand"]["heat_moment"], rows[:, column], rtol=1e-9)
+
     def test_msd_is_a_correlator_of_the_unwrapped_positions(self):
         # 2D, a binary mixture: the groups are the species.
         config = gas_config(dimension=2, particles=150, packing_fraction=0.2)

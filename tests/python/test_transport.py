@@ -154,17 +154,56 @@ class Transport(kt.KairosTestCase):
         z = self.summary(out)["compressibility"]["mean"]
         self.assertAlmostEqual(z, z_dem, delta=0.03 * z_dem)
 
-    def test_a_mixture_says_why_it_has_no_conductivity(self):
-        config = kt.base_config(particles=300, packing_fraction=0.2, lattice="random", seed=14,
-                                production=300, output={"trajectory": False},
-                                analysis={"transport": True})
-        text = kt.toml_text(config) + (
+    def mixture_text(self, config, diameter_b, mass_b):
+        return kt.toml_text(config) + (
             '\n[[system.species]]\nname = "A"\nfraction = 0.5\n'
-            '\n[[system.species]]\nname = "B"\nfraction = 0.5\ndiameter = 1.2\nmass = 2.0\n')
-        _, t = self.run_transport("mix", text)
-        self.assertIsNone(t["thermal_conductivity"]["value"])
-        self.assertIn("mixture", t["thermal_conductivity"]["why"])
+            f'\n[[system.species]]\nname = "B"\nfraction = 0.5\ndiameter = {diameter_b}\n'
+            f'mass = {mass_b}\n')
+
+    def test_a_mixture_of_identical_species_conducts_as_one_species(self):
+        # Two labels on identical spheres: interdiffusion carries no energy (beta = 0 in
+        # expectation), so the conductivity at zero diffusion flux is the one-species value.
+        eta = 0.3
+        config = kt.base_config(particles=500, packing_fraction=eta, seed=11, equilibration=100,
+                                production=6000, output={"trajectory": False},
+                                analysis={"transport": True, "transport_fit_to": 4.0})
+        _, t = self.run_transport("labels", self.mixture_text(config, 1.0, 1.0))
+        c = t["thermal_conductivity"]
+        reference = enskog(eta)["thermal_conductivity"]
+        self.assertIsNotNone(c["value"], c)
+        self.assertLess(c["stderr"] / reference, 0.12)
+        # As the one-species test: MD/Enskog about 1.0-1.05 at eta = 0.3.
+        self.assertAlmostEqual(c["value"] / reference, 1.0,
+                               delta=3 * c["stderr"] / reference + 0.08)
+        d = c["interdiffusion"]
+        self.assertEqual(list(d["enthalpy_per_mass"]), ["A"])
+        # A noise-sized correlation: the squared correlation of two independent slopes.
+        self.assertLess(d["removed_fraction"], 0.1)
+        self.assertGreaterEqual(d["removed_fraction"], 0.0)
+        self.assert_green_kubo_agrees(t)
+
+    def test_an_asymmetric_mixture_removes_the_enthalpy_interdiffusion_carries(self):
+        config = kt.base_config(particles=400, packing_fraction=0.2, lattice="random", seed=14,
+                                equilibration=50, production=4000, output={"trajectory": False},
+                                analysis={"transport": True, "transport_fit_from": 0.5,
+                                          "transport_fit_to": 4.0})
+        out, t = self.run_transport("mix", self.mixture_text(config, 1.4, 4.0))
+        c = t["thermal_conductivity"]
+        self.assertIsNotNone(c["value"], c)
         self.assertIsNotNone(t["shear_viscosity"]["value"])
+        d = c["interdiffusion"]
+        # The light species carries more energy per mass than the heavy one: beta_A ~ (5/2)
+        # kT (1/m_A - 1/m_B) for a dilute gas (the enthalpy per mass of each species), and a
+        # sizeable part of the energy moment's slope is interdiffusion's.
+        beta = d["enthalpy_per_mass"]["A"]
+        self.assertGreater(beta, 0.5 * 2.5 * (1.0 - 1.0 / 4.0))
+        self.assertLess(beta, 2.0 * 2.5 * (1.0 - 1.0 / 4.0))
+        self.assertGreater(d["removed_fraction"], 0.05)
+        self.assert_green_kubo_agrees(t)
+        header, rows = read_table(os.path.join(out, "helfand.tsv"))
+        at = np.searchsorted(rows[:, 0], 4.0) - 1
+        column = header.index("thermal_conductivity")
+        self.assertAlmostEqual(rows[at, column] / c["value"], 1.0, delta=0.15)
 
     def test_input_errors(self):
         cases = {

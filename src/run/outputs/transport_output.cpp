@@ -21,7 +21,64 @@ nlohmann::json finite_or_null(double x) {
 // G_ab = kinetic + collisional (the virial tensor, and soft contacts' jumps), the energy moment
 // likewise.
 template <int D>
-typename HelfandTransport<D>::Moments helfand_sample(const EventIntegrator<D>& engine) {
+MassMoments<D>::MassMoments(const EventIntegrator<D>& engine) {
+  const std::size_t n = engine.size();
+  moment_of_.assign(n, ~0u);
+  mass_.assign(n, 0.0);
+  std::vector<std::uint32_t> species(n, 0u);
+  std::vector<double> species_mass;
+  double total = 0.0;
+  engine.state_blocks().for_each(
+      [&](const ParticleSystem<D>& part, std::size_t first) {
+        for (std::size_t j = 0; j < part.size(); ++j) {
+          const std::uint32_t s = part.species.empty() ? 0u : part.species[j];
+          species[first + j] = s;
+          mass_[first + j] = part.mass[j];
+          if (s >= species_mass.size()) species_mass.resize(s + 1, 0.0);
+          species_mass[s] += part.mass[j];
+          total += part.mass[j];
+        }
+      },
+      StateBlocks<D>::kKinematics | StateBlocks<D>::kIdentity);
+  // Every species present but the last: the last one's moment is minus the sum of the others'.
+  std::vector<std::uint32_t> moment(species_mass.size(), ~0u);
+  std::vector<std::uint32_t> present;
+  for (std::uint32_t s = 0; s < species_mass.size(); ++s)
+    if (species_mass[s] > 0.0) present.push_back(s);
+  if (present.size() < 2) return;
+  present.pop_back();
+  for (const std::uint32_t s : present) {
+    moment[s] = static_cast<std::uint32_t>(fraction_.size());
+    fraction_.push_back(species_mass[s] / total);
+    species_.push_back(s);
+  }
+  for (std::size_t id = 0; id < n; ++id) moment_of_[id] = moment[species[id]];
+  every_slot_.resize(n);
+  for (std::size_t id = 0; id < n; ++id) every_slot_[id] = static_cast<std::uint32_t>(id);
+  position_.resize(n);
+  const std::array<double, 9> kinetic = engine.peculiar_kinetic_tensor();
+  double twice_kinetic = 0.0;
+  for (int a = 0; a < D; ++a) twice_kinetic += kinetic[a * D + a];
+  if (twice_kinetic > 0.0) scale_ = twice_kinetic / (D * total);
+}
+
+template <int D>
+void MassMoments<D>::sample(const EventIntegrator<D>& engine, std::vector<Vec<D>>& out) {
+  out.assign(count(), Vec<D>{});
+  if (count() == 0) return;
+  engine.unwrapped_positions(every_slot_, position_);
+  Vec<D> all{};
+  for (std::size_t id = 0; id < position_.size(); ++id) {
+    const Vec<D> p = mass_[id] * position_[id];
+    all = all + p;
+    if (moment_of_[id] != ~0u) out[moment_of_[id]] = out[moment_of_[id]] + p;
+  }
+  for (std::size_t k = 0; k < count(); ++k) out[k] = out[k] - fraction_[k] * all;
+}
+
+template <int D>
+typename HelfandTransport<D>::Moments helfand_sample(const EventIntegrator<D>& engine,
+                                                     MassMoments<D>* mass) {
   const typename HelfandMoments<D>::Moments m = engine.helfand_moments();
   const std::array<double, 9>& virial = engine.counters().virial_tensor;
   typename HelfandTransport<D>::Moments out;
@@ -35,13 +92,15 @@ typename HelfandTransport<D>::Moments helfand_sample(const EventIntegrator<D>& e
   for (int a = 0; a < D; ++a) trace += m.kinetic_stress[a * D + a];
   out.kinetic_trace = trace + m.frozen_kinetic;
   out.frozen_pair_time = m.frozen_pair_time;
+  if (mass != nullptr) mass->sample(engine, out.mass);
   return out;
 }
 
 template <int D>
 TransportOutput<D>::TransportOutput(const Config& config, const EventIntegrator<D>& engine)
     : engine_(engine), config_(config.analysis), stats_(D, engine.size(), engine.volume()) {
-  species_ = std::max<std::size_t>(1, engine.state_blocks().globals().species_names.size());
+  species_names_ = engine.state_blocks().globals().species_names;
+  if (species_names_.empty()) species_names_ = {"A"};
   interval_ = config_.transport_interval;
   if (interval_ == 0.0) {
     automatic_interval_ = true;
@@ -51,7 +110,8 @@ TransportOutput<D>::TransportOutput(const Config& config, const EventIntegrator<
 
 template <int D>
 void TransportOutput<D>::production_starts(const RunContext<D>&) {
-  transport_.emplace(interval_, engine_.size(), engine_.volume());
+  mass_.emplace(engine_);
+  transport_.emplace(interval_, engine_.size(), engine_.volume(), mass_->count(), mass_->scale());
   start_time_ = engine_.time();
   start_collisions_ = engine_.collisions();
 }
@@ -60,7 +120,7 @@ template <int D>
 void TransportOutput<D>::write(const RunContext<D>& run) {
   if (run.phase() != "production") return;
   if (!transport_) production_starts(run);  // continued in its production
-  transport_->add(engine_.time(), helfand_sample(engine_));
+  transport_->add(engine_.time(), helfand_sample(engine_, &*mass_));
 }
 
 template <int D>
@@ -70,11 +130,6 @@ std::pair<double, double> TransportOutput<D>::fit_window() const {
       stats_.mean_free_time(engine_.time() - start_time_, engine_.collisions() - start_collisions_);
   return correlation_fit_window(sampled, config_.transport_fit_from, config_.transport_fit_to, mft,
                                 kTransportFitMeanFreeTimes);
-}
-
-template <int D>
-std::string TransportOutput<D>::why_not_conductivity() const {
-  return Transport::why_no_conductivity(species_);
 }
 
 template <int D>
@@ -91,13 +146,14 @@ void TransportOutput<D>::close(const RunContext<D>& run, bool) {
                        r.origins, r.value[0], r.value[1], r.value[2], r.coefficient[0],
                        r.coefficient[1], r.coefficient[2]);
   };
-  for (const auto& r : transport_->helfand_rows()) text += row(r);
+  const auto [from, to] = fit_window();
+  for (const auto& r : transport_->helfand_rows(from, to)) text += row(r);
   write_text_atomically(run.directory() / name(), text);
   // The flux autocorrelations (the pressure's about its mean) and their running integrals.
   text =
       "lag\torigins\tshear_flux_acf\tbulk_flux_acf\theat_flux_acf\tshear_viscosity\t"
       "bulk_viscosity\tthermal_conductivity\n";
-  for (const auto& r : transport_->green_kubo_rows()) text += row(r);
+  for (const auto& r : transport_->green_kubo_rows(from, to)) text += row(r);
   write_text_atomically(run.directory() / "green_kubo.tsv", text);
 }
 
@@ -122,17 +178,13 @@ void TransportOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&
   std::array<Fit, 3> eh, gk;
   if (transport_) {
     eh = transport_->einstein_helfand(from, to);
-    gk = transport_->green_kubo(to);
+    gk = transport_->green_kubo(from, to);
   }
   const char* names[3] = {"shear_viscosity", "bulk_viscosity", "thermal_conductivity"};
   for (int g = 0; g < 3; ++g) {
     nlohmann::json c;
-    const std::string why = g == Transport::kHeatGroup ? why_not_conductivity() : "";
     const double scale = transport_ ? transport_->scale(g) : std::nan("");
-    if (!why.empty()) {
-      c["value"] = nullptr;
-      c["why"] = why;
-    } else if (eh[g]) {
+    if (eh[g]) {
       c["value"] = eh[g]->coefficient / scale;
       c["stderr"] = finite_or_null(eh[g]->stderr_ / scale);
       c["stderr_epochs"] = finite_or_null(eh[g]->epoch_stderr / scale);
@@ -148,17 +200,48 @@ void TransportOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&
           "(or set analysis.transport_fit_from / transport_fit_to)",
           from, to);
     }
-    if (why.empty() && gk[g]) {
+    if (gk[g]) {
       c["green_kubo"] = gk[g]->coefficient / scale;
       c["green_kubo_stderr"] = finite_or_null(gk[g]->stderr_ / scale);
+    }
+    if (g == Transport::kHeatGroup && mass_ && mass_->count() > 0) {
+      c["interdiffusion"] = interdiffusion(from, to);
+      if (!eh[g] && transport_ && transport_->samples() >= 2 &&
+          !transport_->heat_projection(from, to)) {
+        c["why"] =
+            "the mass moments' correlations are not positive definite: the production is too "
+            "short for a mixture's heat flux";
+      }
     }
     j[names[g]] = c;
   }
   summary["transport"] = j;
 }
 
-template typename HelfandTransport<2>::Moments helfand_sample<2>(const EventIntegrator<2>&);
-template typename HelfandTransport<3>::Moments helfand_sample<3>(const EventIntegrator<3>&);
+// A mixture's heat moment G_e - sum_a beta_a G_a: beta per species (each species but the last
+// present) and the fraction of the energy moment's slope that interdiffusion carried.
+template <int D>
+nlohmann::json TransportOutput<D>::interdiffusion(double from, double to) const {
+  nlohmann::json d;
+  d["frame"] = "mass moments relative to the centre of mass; the last species' is minus the sum";
+  const auto p = transport_ ? transport_->heat_projection(from, to) : std::nullopt;
+  nlohmann::json beta = nlohmann::json::object();
+  for (std::size_t k = 0; k < mass_->count(); ++k) {
+    const std::uint32_t s = mass_->species(k);
+    const std::string name = s < species_names_.size() ? species_names_[s] : std::to_string(s);
+    beta[name] = p ? finite_or_null(p->beta[k]) : nullptr;
+  }
+  d["enthalpy_per_mass"] = beta;
+  d["removed_fraction"] = p ? finite_or_null(p->removed) : nullptr;
+  return d;
+}
+
+template typename HelfandTransport<2>::Moments helfand_sample<2>(const EventIntegrator<2>&,
+                                                                 MassMoments<2>*);
+template typename HelfandTransport<3>::Moments helfand_sample<3>(const EventIntegrator<3>&,
+                                                                 MassMoments<3>*);
+template class MassMoments<2>;
+template class MassMoments<3>;
 template class TransportOutput<2>;
 template class TransportOutput<3>;
 

@@ -18,10 +18,35 @@
 
 namespace kairos {
 
-// The Helfand moments of an event engine now (it keeps them: EngineOptions::track_helfand), as
-// HelfandTransport samples them.
+// A mixture's mass moments G_a = sum_{i in a} m_i x_i - (M_a / M) sum_i m_i x_i of every
+// species present but the last, from the engine's unwrapped positions (it keeps image counters
+// for analysis.transport on a mixture): what the thermal conductivity needs to remove the
+// energy interdiffusion carries (analysis/helfand_transport.hpp).
 template <int D>
-typename HelfandTransport<D>::Moments helfand_sample(const EventIntegrator<D>& engine);
+class MassMoments {
+ public:
+  explicit MassMoments(const EventIntegrator<D>& engine);
+  std::size_t count() const { return fraction_.size(); }
+  std::uint32_t species(std::size_t moment) const { return species_[moment]; }
+  // kT / m now (sum m c^2 / (D M)): HelfandTransport's scale of the moments.
+  double scale() const { return scale_; }
+  void sample(const EventIntegrator<D>& engine, std::vector<Vec<D>>& out);
+
+ private:
+  std::vector<std::uint32_t> moment_of_;  // per particle: its species' moment, or ~0u (last)
+  std::vector<double> mass_;
+  std::vector<double> fraction_;        // per moment: M_a / M
+  std::vector<std::uint32_t> species_;  // per moment: its species
+  std::vector<std::uint32_t> every_slot_;
+  std::vector<Vec<D>> position_;
+  double scale_ = 1.0;
+};
+
+// The Helfand moments of an event engine now (it keeps them: EngineOptions::track_helfand), as
+// HelfandTransport samples them; a mixture's mass moments from `mass` (nullptr: one species).
+template <int D>
+typename HelfandTransport<D>::Moments helfand_sample(const EventIntegrator<D>& engine,
+                                                     MassMoments<D>* mass = nullptr);
 
 template <int D>
 class TransportOutput final : public Observer<D> {
@@ -40,7 +65,7 @@ class TransportOutput final : public Observer<D> {
   using Transport = HelfandTransport<D>;
   using Fit = typename Transport::Fit;
   std::pair<double, double> fit_window() const;
-  std::string why_not_conductivity() const;
+  nlohmann::json interdiffusion(double from, double to) const;
 
   const EventIntegrator<D>& engine_;
   AnalysisConfig config_;
@@ -50,7 +75,8 @@ class TransportOutput final : public Observer<D> {
   std::optional<Transport> transport_;
   double start_time_ = 0.0;
   std::uint64_t start_collisions_ = 0;
-  std::size_t species_ = 1;
+  std::optional<MassMoments<D>> mass_;  // mixtures
+  std::vector<std::string> species_names_;
 };
 
 }  // namespace kairos
