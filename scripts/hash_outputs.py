@@ -7,9 +7,11 @@ continued, a run that is resumed with changed physics, profiles), with the given
 binary, and prints one SHA-256 per case over what a refactor must not change: the exact state
 of restart.gsd (every kairos/state chunk, positions, velocities, time, counters; not the run's
 bookkeeping such as the stored configuration or the checksum, the run's id and
-stored configuration), every chunk of every trajectory frame, thermo.tsv, profile.tsv, the
-structure analyses' files (rdf.tsv, sk.tsv, bond_order.tsv, velocity_distribution.tsv), and
-every value of summary.json except the timings, the memory figures and the run id. A case whose
+stored configuration), every chunk of every trajectory frame (trajectory.gsd, packing.gsd),
+thermo.tsv, profile.tsv, the analyses' files (rdf.tsv, sk.tsv, bond_order.tsv,
+velocity_distribution.tsv, msd.tsv, vacf.tsv, mutual_diffusion.tsv, helfand.tsv, green_kubo.tsv),
+the compression's (compress.tsv, contacts.tsv), and every value of summary.json except the
+timings, the memory figures, the run id, the provenance and a soft table's cache fields. A case whose
 run fails is reported as FAILED (and the script exits with status 1). Compare two builds with
 
     scripts/hash_outputs.py OLD/build/kairos > old.txt
@@ -190,8 +192,12 @@ def hash_outputs(out, h):
     traj = os.path.join(out, "trajectory.gsd")
     if os.path.exists(traj):
         hash_trajectory(traj, h)
+    packing = os.path.join(out, "packing.gsd")
+    if os.path.exists(packing):
+        hash_trajectory(packing, h)
     for name in ("thermo.tsv", "profile.tsv", "rdf.tsv", "sk.tsv", "bond_order.tsv",
-                 "velocity_distribution.tsv"):
+                 "velocity_distribution.tsv", "msd.tsv", "vacf.tsv", "mutual_diffusion.tsv",
+                 "helfand.tsv", "green_kubo.tsv", "compress.tsv", "contacts.tsv"):
         path = os.path.join(out, name)
         if os.path.exists(path):
             with open(path, "rb") as f:

@@ -50,7 +50,7 @@ mixture needs L^(11) only. By-products: the thermal diffusion ratio k_T (> 0 whe
 (q with the kinetic energies m v^2 / 2 in the centre-of-mass frame, i.e. J_e = q' + h J_1 with
 h = (5/2) kT (1/m_1 - 1/m_2)), which is what the energy Helfand moment gives before the
 diffusion correction, and beta = L_e1 / L_11 = h + L_q1 / L_11, the energy per mass that the
-correction G_e - beta G_1 takes out (summary.json's interdiffusion.enthalpy_per_mass, with the
+correction G_e - beta G_1 takes out (summary.json's interdiffusion.energy_per_mass, with the
 kinetic energies as the energy zero).
 
 The checks printed:

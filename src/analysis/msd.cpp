@@ -294,7 +294,7 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
         ys[s].push_back(about_drift(lag.lag, lag.subset_mean[g][s],
                                     drifts ? lag.subset_mean_linear[g][s] : Vec<D>{}));
     }
-    if (t.size() < 3) continue;
+    if (t.size() < 3 || members(g) == 0) continue;  // nothing to fit, or nobody in the group
     Diffusion d;
     d.lags = static_cast<int>(t.size());
     d.coefficient = slope(t, y) / (2.0 * D);
@@ -352,7 +352,7 @@ std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> MsdCorrelator<D
         part[s] += h * (subset_at(all[k], s) + subset_at(all[k - 1], s));
       ++used_lags;
     }
-    if (used_lags < 2 || all.empty() || all[0].lag != 0.0) continue;
+    if (used_lags < 2 || all.empty() || all[0].lag != 0.0 || members(g) == 0) continue;
     // The same integral from the origins of each time epoch that reaches every lag of it (the
     // scatter the particles' subsets miss: a collective flux has few components).
     std::vector<double> by_epoch;
@@ -456,6 +456,13 @@ std::optional<typename MsdCorrelator<D>::Diffusion> MsdCorrelator<D>::combined_g
   d.coefficient = total / D;
   set_errors(d, {}, by_epoch);
   return d;
+}
+
+template <int D>
+std::uint64_t MsdCorrelator<D>::members(std::uint32_t g) const {
+  std::uint64_t count = 0;
+  for (int s = 0; s < kSubsets; ++s) count += group_size_[slot(g, s)];
+  return count;
 }
 
 template <int D>

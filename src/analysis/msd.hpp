@@ -78,7 +78,7 @@ class MsdCorrelator {
 
   // The self-diffusion coefficient of each group from the slope of <|dr|^2> = 2 D_dim D t + c
   // (least squares over the lags in [from, to]), with the standard error from the subsets'
-  // slopes; nothing when fewer than 3 lags fall in the window.
+  // slopes; nothing when fewer than 3 lags fall in the window or the group has no particle.
   struct Diffusion {
     double coefficient = 0.0;
     double stderr_ = 0.0;                              // the larger of the two below
@@ -117,6 +117,7 @@ class MsdCorrelator {
   std::uint64_t samples() const { return samples_; }
   double interval() const { return interval_; }
   std::size_t particles() const { return group_.size(); }
+  std::uint64_t members(std::uint32_t group) const;  // particles in the group
   std::size_t bytes() const;
 
  private:

@@ -1,7 +1,8 @@
-// Where an outlet puts a particle back (boundaries/outlets.hpp, docs/physics.md#outlets): the
-// one rule both integrators follow, so that the event engine (engine/outlet_passes.cpp) and the
-// DEM (dem/dem_integrator.cpp) draw the same places from the same numbers. Each integrator
-// supplies only its own test of a free place (its neighbourhood search).
+// Where an outlet puts a particle back (boundaries/outlets.hpp,
+// docs/physics.md#outlets-and-strips): the one rule both integrators follow, so that the event
+// engine (engine/outlet_passes.cpp) and the DEM (dem/dem_integrator.cpp) draw the same places from
+// the same numbers. Each integrator supplies only its own test of a free place (its neighbourhood
+// search).
 #pragma once
 
 #include <array>

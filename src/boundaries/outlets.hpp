@@ -4,7 +4,7 @@
 // crosses it (leaving that side) is taken out and put back at once at a random free place of
 // the insertion region, an axis-aligned box, with a set velocity and no spin: the recirculating
 // silo of granular-flow studies, where the count through the outlet per unit time is the
-// discharge rate (docs/physics.md#outlets).
+// discharge rate (docs/physics.md#outlets-and-strips).
 //
 // It is a surface of the registry so that the crossing is found as any wall event is (its own
 // event time, its own filter by cells, the brute-force check of validate()), but it is no

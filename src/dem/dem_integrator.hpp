@@ -64,8 +64,8 @@
 // dissipation of a contact is what the tangential force took from the slip beyond what its
 // spring holds. Without friction the smooth loops run, unchanged.
 //
-// Outlets (boundary.outlet, boundaries/outlets.hpp; docs/physics.md#outlets): at the end of a
-// step, a particle whose centre is beyond an outlet's plane and that touches nothing is put
+// Outlets (boundary.outlet, boundaries/outlets.hpp; docs/physics.md#outlets-and-strips): at the end
+// of a step, a particle whose centre is beyond an outlet's plane and that touches nothing is put
 // back at a free place of the insertion region (the event engine's rule and draws,
 // boundaries/outlet_placement.hpp; free: at least R from every wall, R + R_j from every
 // particle now), with the set velocity and no spin; the neighbour list is rebuilt. One still

@@ -1,7 +1,7 @@
-// Outlets in the event engine (boundaries/outlets.hpp, docs/physics.md#outlets): a particle whose
-// centre crosses an outlet is put back at once at a free place of the insertion region. Its
-// old predictions become stale by its collision counter, as after a collision; its new one
-// scans its new neighbourhood, which covers every pair it forms there (the engine's invariant
+// Outlets in the event engine (boundaries/outlets.hpp, docs/physics.md#outlets-and-strips): a
+// particle whose centre crosses an outlet is put back at once at a free place of the insertion
+// region. Its old predictions become stale by its collision counter, as after a collision; its new
+// one scans its new neighbourhood, which covers every pair it forms there (the engine's invariant
 // needs no more: the sooner of two partners' events bounds their contact).
 #include <algorithm>
 #include <cmath>

@@ -29,6 +29,7 @@
 #include "core/stop_flag.hpp"
 #include "io/config.hpp"
 #include "run/outputs/compression_output.hpp"
+#include "run/outputs/transport_output.hpp"
 #include "run/run.hpp"
 #include "run/simulation.hpp"
 #include "run/simulation_analyses.hpp"
@@ -560,7 +561,7 @@ class PySimulation {
         correlation_request(interval_arg, duration_arg, fit_from_arg, fit_to_arg, "msd");
     const bool vacf = flag_from(vacf_arg, "msd: vacf");
     if (!py::isinstance<py::str>(clock_arg))
-      throw InputError("msd: clock: one of \"auto\", \"time\", \"collisions\"");
+      throw py::type_error("msd: clock must be a string: \"auto\", \"time\" or \"collisions\"");
     const std::string clock_name = clock_arg.cast<std::string>();
     const auto clock = msd_time_scales().find(clock_name);
     if (!clock) {
@@ -705,8 +706,9 @@ class PySimulation {
               m.heat_projection ? m.heat_projection->beta[k] : std::nan("");
         }
         py::dict d;
-        d["enthalpy_per_mass"] = beta;
+        d["energy_per_mass"] = beta;
         d["removed_fraction"] = m.heat_projection ? m.heat_projection->removed : std::nan("");
+        d["frame"] = kMassMomentFrame;
         out["thermal_conductivity"]["interdiffusion"] = d;
       }
       return out;

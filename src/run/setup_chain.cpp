@@ -179,11 +179,15 @@ std::unique_ptr<EventEngineAdapter<D, Queue>> start_event_engine(RunStart<D>&& s
     Environment<D> environment = make_environment<D>(start.config, start.state);
     note_walls_carried_off(environment);
     std::vector<SoftTableUse> tables = start_tables(environment, start, progress);
-    // A mixture's thermal conductivity needs the species' mass moments: unwrapped positions.
+    // A mixture's thermal conductivity needs its components' mass moments (a component: one
+    // species and one mass): unwrapped positions.
     EngineTracking tracked = tracking;
-    const auto& species = start.state.species;
-    const bool mixture = std::any_of(species.begin(), species.end(),
-                                     [&](std::uint32_t s) { return s != species.front(); });
+    const ParticleSystem<D>& state = start.state;
+    bool mixture = false;
+    for (std::size_t i = 1; i < state.size() && !mixture; ++i) {
+      mixture = state.mass[i] != state.mass[0] ||
+                (!state.species.empty() && state.species[i] != state.species[0]);
+    }
     tracked.images =
         tracked.images || (mixture && (start.config.analysis.transport || tracking.helfand));
     return std::make_unique<EventEngineAdapter<D, Queue>>(std::move(start), environment,

@@ -264,18 +264,14 @@ TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationR
   end_span(sim, request, m.transport->last_time() - m.transport->first_time(), m.span);
   m.einstein_helfand = m.transport->einstein_helfand(m.span.fit_from, m.span.fit_to);
   m.green_kubo = m.transport->green_kubo(m.span.fit_from, m.span.fit_to);
-  if (mass.count() > 0) {
-    const std::vector<std::string>& names = sim.species_names();
-    for (std::size_t k = 0; k < mass.count(); ++k) {
-      const std::uint32_t s = mass.species(k);
-      m.mass_moment_species.push_back(s < names.size() ? names[s] : std::to_string(s));
-    }
+  if (!mass.why().empty()) {
+    m.no_conductivity = mass.why();
+  } else if (mass.count() > 0) {
+    for (std::size_t k = 0; k < mass.count(); ++k) m.mass_moment_species.push_back(mass.name(k));
     m.heat_projection = m.transport->heat_projection(m.span.fit_from, m.span.fit_to);
-    if (!m.heat_projection && m.transport->samples() >= 2) {
-      m.no_conductivity =
-          "the mass moments' correlations are not positive definite: the sampled span is too "
-          "short for a mixture's heat flux";
-    }
+    // The window holds enough lags (the shear viscosity has them) but no projection.
+    if (!m.heat_projection && m.einstein_helfand[HelfandTransport<D>::kShearGroup])
+      m.no_conductivity = kNotPositiveDefinite;
   }
   return m;
 }

@@ -122,6 +122,25 @@ TEST(MsdCorrelator, ARandomWalkGivesBackItsDiffusionCoefficientWithinItsErrorBar
   EXPECT_GE(within, 8);
 }
 
+// A group with no particle (a species none of whose particles is followed) has no coefficient,
+// not a zero one, while the other groups are fitted.
+TEST(MsdCorrelator, AnEmptyGroupHasNoCoefficient) {
+  MsdCorrelator<1> c({0u, 0u, 2u}, 3, 1.0);
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> step(0.0, 1.0);
+  std::vector<Vec<1>> x(3, Vec<1>{0.0});
+  for (int k = 0; k < 200; ++k) {
+    c.add(x);
+    for (auto& p : x) p[0] += step(rng);
+  }
+  const auto fits = c.diffusion(2.0, 20.0);
+  EXPECT_TRUE(fits[0].has_value());
+  EXPECT_FALSE(fits[1].has_value());
+  EXPECT_TRUE(fits[2].has_value());
+  EXPECT_EQ(c.members(1), 0u);
+  EXPECT_EQ(c.members(0), 2u);
+}
+
 // Walkers that also share one random displacement per step (as the particles of a box share its
 // slow flows): subsets of particles all see it, so only the epochs' scatter measures it.
 TEST(MsdCorrelator, MotionTheParticlesShareIsInTheErrorBar) {

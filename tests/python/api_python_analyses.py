@@ -194,9 +194,9 @@ class Analyses(kt.KairosTestCase):
         c = t["thermal_conductivity"]
         for key in ("value", "stderr", "green_kubo", "green_kubo_stderr"):
             self.assertEqual(c[key], cli[key], key)
-        self.assertEqual(c["interdiffusion"]["enthalpy_per_mass"],
-                         cli["interdiffusion"]["enthalpy_per_mass"])
-        self.assertEqual(list(c["interdiffusion"]["enthalpy_per_mass"]), ["big"])
+        self.assertEqual(c["interdiffusion"]["energy_per_mass"],
+                         cli["interdiffusion"]["energy_per_mass"])
+        self.assertEqual(list(c["interdiffusion"]["energy_per_mass"]), ["big"])
         self.assertEqual(c["interdiffusion"]["removed_fraction"],
                          cli["interdiffusion"]["removed_fraction"])
         header, rows = read_table(os.path.join(out, "helfand.tsv"))

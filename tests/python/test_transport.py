@@ -176,10 +176,9 @@ class Transport(kt.KairosTestCase):
         self.assertAlmostEqual(c["value"] / reference, 1.0,
                                delta=3 * c["stderr"] / reference + 0.08)
         d = c["interdiffusion"]
-        self.assertEqual(list(d["enthalpy_per_mass"]), ["A"])
+        self.assertEqual(list(d["energy_per_mass"]), ["A"])
         # A noise-sized correlation: the squared correlation of two independent slopes.
         self.assertLess(d["removed_fraction"], 0.1)
-        self.assertGreaterEqual(d["removed_fraction"], 0.0)
         self.assert_green_kubo_agrees(t)
 
     def test_an_asymmetric_mixture_removes_the_enthalpy_interdiffusion_carries(self):
@@ -192,10 +191,12 @@ class Transport(kt.KairosTestCase):
         self.assertIsNotNone(c["value"], c)
         self.assertIsNotNone(t["shear_viscosity"]["value"])
         d = c["interdiffusion"]
-        # The light species carries more energy per mass than the heavy one: beta_A ~ (5/2)
-        # kT (1/m_A - 1/m_B) for a dilute gas (the enthalpy per mass of each species), and a
-        # sizeable part of the energy moment's slope is interdiffusion's.
-        beta = d["enthalpy_per_mass"]["A"]
+        # The light species carries more energy per mass than the heavy one: beta_A is about
+        # (5/2) kT (1/m_A - 1/m_B) (the ideal gas's enthalpies per mass) plus a heat of
+        # transport of a few tens of per cent (0.98 for m_B = 2 in the dilute gas against 1.25:
+        # examples/validation/mixture_conductivity_sonine.py), and a sizeable part of the energy
+        # moment's slope is interdiffusion's.
+        beta = d["energy_per_mass"]["A"]
         self.assertGreater(beta, 0.5 * 2.5 * (1.0 - 1.0 / 4.0))
         self.assertLess(beta, 2.0 * 2.5 * (1.0 - 1.0 / 4.0))
         self.assertGreater(d["removed_fraction"], 0.05)

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -16,6 +17,7 @@
 #include "core/stop_flag.hpp"
 #include "io/config.hpp"
 #include "io/config_obstacles.hpp"
+#include "run/outputs/transport_output.hpp"
 #include "run/run.hpp"
 #include "run/simulation.hpp"
 #include "run/simulation_analyses.hpp"
@@ -45,6 +47,54 @@ nlohmann::json run_cli(const std::string& text, const std::string& name) {
   fs::remove_all(dir);
   EXPECT_TRUE(outcome.error.empty()) << outcome.error;
   return outcome.summary;
+}
+
+// A mixture's mass moments (run/outputs/transport_output.hpp) are the components' sums
+// sum_{i in a} m_i x_i - (M_a / M) sum_i m_i x_i of the unwrapped positions, for every
+// component present but the last, whichever species has no particle.
+TEST(SimulationAnalyses, MassMomentsAreTheComponentsMassSumsAboutTheCentreOfMass) {
+  const std::string text =
+      "[system]\nparticles = 100\npacking_fraction = 0.1\nlattice = \"random\"\nseed = 3\n"
+      "[[system.species]]\nname = \"A\"\nfraction = 0.5\n"
+      "[[system.species]]\nname = \"B\"\nfraction = 0.3\nmass = 3.0\n"
+      "[[system.species]]\nname = \"C\"\nfraction = 0.2\nmass = 2.0\ndiameter = 0.8\n"
+      "[[system.species]]\nname = \"E\"\nfraction = 0.001\n"
+      "[run]\nequilibration_time = 0.0\ntime = 5.0\n"
+      "[output]\nprogress = \"never\"\ntrajectory = false\n";
+  Simulation<3> sim(parse_config(text, "<test>"), {}, EngineTracking{.helfand = true});
+  ASSERT_TRUE(sim.tracks_images());  // kept for the mixture's mass moments
+  const std::vector<std::uint32_t>& species = sim.species();
+  ASSERT_EQ(std::count(species.begin(), species.end(), 3u), 0);  // E: none
+  ASSERT_TRUE(sim.advance_to_time(2.0));
+  MassMoments<3> mass(sim.integrator());
+  ASSERT_EQ(mass.count(), 2u);  // A and B; C is the last present
+  EXPECT_EQ(mass.name(0), "A");
+  EXPECT_EQ(mass.name(1), "B");
+  EXPECT_TRUE(mass.why().empty());
+  for (int round = 0; round < 2; ++round) {
+    std::vector<Vec<3>> moments;
+    mass.sample(sim.integrator(), moments);
+    const std::vector<Vec<3>> x = sim.unwrapped_positions();
+    const std::vector<double>& m = sim.masses();
+    Vec<3> all{};
+    double total = 0.0, scale = 0.0;
+    std::array<Vec<3>, 2> sum{};
+    std::array<double, 2> mass_of{};
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      all = all + m[i] * x[i];
+      total += m[i];
+      scale = std::max(scale, m[i] * std::sqrt(norm2(x[i])));
+      if (species[i] < 2) {
+        sum[species[i]] = sum[species[i]] + m[i] * x[i];
+        mass_of[species[i]] += m[i];
+      }
+    }
+    for (std::size_t a = 0; a < 2; ++a) {
+      const Vec<3> expected = sum[a] - (mass_of[a] / total) * all;
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(moments[a][c], expected[c], 1e-12 * scale * 100.0);
+    }
+    ASSERT_TRUE(sim.advance_to_time(4.0));  // the particles cross faces: the images count
+  }
 }
 
 TEST(SimulationAnalyses, MsdAndTransportAreTheClisBitForBit) {

@@ -396,6 +396,9 @@ void MsdOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&) cons
           "the gas cools freely: D(t) decays with sqrt(T) (Haff's law), so no constant D in "
           "time exists; analysis.msd_time = \"collisions\" (or \"auto\") measures the constant D "
           "per collision of the homogeneous cooling state";
+    } else if (std::count(group_.begin(), group_.end(), static_cast<std::uint32_t>(g)) == 0) {
+      s["coefficient"] = nullptr;
+      s["why"] = "no particle of this species is followed (analysis.msd_particles)";
     } else {
       s["coefficient"] = nullptr;
       s["why"] = fmt::format(

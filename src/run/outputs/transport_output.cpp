@@ -25,34 +25,60 @@ MassMoments<D>::MassMoments(const EventIntegrator<D>& engine) {
   const std::size_t n = engine.size();
   moment_of_.assign(n, ~0u);
   mass_.assign(n, 0.0);
-  std::vector<std::uint32_t> species(n, 0u);
-  std::vector<double> species_mass;
+  // The components: particles of one species and one mass (a species whose particles differ
+  // in mass is as many components: each carries its own energy per mass).
+  std::vector<std::pair<std::uint32_t, double>> classes;
+  std::vector<std::uint32_t> class_of(n, 0u);
+  std::vector<double> class_mass;
   double total = 0.0;
   engine.state_blocks().for_each(
       [&](const ParticleSystem<D>& part, std::size_t first) {
         for (std::size_t j = 0; j < part.size(); ++j) {
-          const std::uint32_t s = part.species.empty() ? 0u : part.species[j];
-          species[first + j] = s;
+          const std::pair<std::uint32_t, double> c{part.species.empty() ? 0u : part.species[j],
+                                                   part.mass[j]};
+          auto at = std::find(classes.begin(), classes.end(), c);
+          if (at == classes.end()) {
+            if (classes.size() > kMaxComponents) continue;  // too many: refused below
+            classes.push_back(c);
+            class_mass.push_back(0.0);
+            at = classes.end() - 1;
+          }
+          const auto k = static_cast<std::uint32_t>(at - classes.begin());
+          class_of[first + j] = k;
           mass_[first + j] = part.mass[j];
-          if (s >= species_mass.size()) species_mass.resize(s + 1, 0.0);
-          species_mass[s] += part.mass[j];
+          class_mass[k] += part.mass[j];
           total += part.mass[j];
         }
       },
       StateBlocks<D>::kKinematics | StateBlocks<D>::kIdentity);
-  // Every species present but the last: the last one's moment is minus the sum of the others'.
-  std::vector<std::uint32_t> moment(species_mass.size(), ~0u);
-  std::vector<std::uint32_t> present;
-  for (std::uint32_t s = 0; s < species_mass.size(); ++s)
-    if (species_mass[s] > 0.0) present.push_back(s);
-  if (present.size() < 2) return;
-  present.pop_back();
-  for (const std::uint32_t s : present) {
-    moment[s] = static_cast<std::uint32_t>(fraction_.size());
-    fraction_.push_back(species_mass[s] / total);
-    species_.push_back(s);
+  if (classes.size() > kMaxComponents) {
+    why_ = fmt::format(
+        "more than {} components (distinct species and masses): the heat flux's interdiffusion "
+        "part is not removed for so many",
+        kMaxComponents);
+    return;
   }
-  for (std::size_t id = 0; id < n; ++id) moment_of_[id] = moment[species[id]];
+  if (classes.size() < 2) return;
+  // In the order of the species (then of the masses); every component but the last: its moment
+  // is minus the sum of the others'.
+  std::vector<std::uint32_t> order(classes.size());
+  for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return classes[a] < classes[b]; });
+  order.pop_back();
+  const std::vector<std::string> names = engine.state_blocks().globals().species_names;
+  std::vector<std::uint32_t> moment(classes.size(), ~0u);
+  for (const std::uint32_t k : order) {
+    moment[k] = static_cast<std::uint32_t>(fraction_.size());
+    fraction_.push_back(class_mass[k] / total);
+    const auto [species, mass] = classes[k];
+    std::string name = species < names.size() ? names[species] : std::to_string(species);
+    const bool one_mass = std::count_if(classes.begin(), classes.end(),
+                                        [&](const auto& c) { return c.first == species; }) == 1;
+    if (!one_mass) name += fmt::format(" (m = {:.6g})", mass);
+    names_.push_back(std::move(name));
+  }
+  for (std::size_t id = 0; id < n; ++id) moment_of_[id] = moment[class_of[id]];
   every_slot_.resize(n);
   for (std::size_t id = 0; id < n; ++id) every_slot_[id] = static_cast<std::uint32_t>(id);
   position_.resize(n);
@@ -99,8 +125,6 @@ typename HelfandTransport<D>::Moments helfand_sample(const EventIntegrator<D>& e
 template <int D>
 TransportOutput<D>::TransportOutput(const Config& config, const EventIntegrator<D>& engine)
     : engine_(engine), config_(config.analysis), stats_(D, engine.size(), engine.volume()) {
-  species_names_ = engine.state_blocks().globals().species_names;
-  if (species_names_.empty()) species_names_ = {"A"};
   interval_ = config_.transport_interval;
   if (interval_ == 0.0) {
     automatic_interval_ = true;
@@ -204,34 +228,30 @@ void TransportOutput<D>::summarize(nlohmann::json& summary, const RunContext<D>&
       c["green_kubo"] = gk[g]->coefficient / scale;
       c["green_kubo_stderr"] = finite_or_null(gk[g]->stderr_ / scale);
     }
-    if (g == Transport::kHeatGroup && mass_ && mass_->count() > 0) {
+    if (g == Transport::kHeatGroup && mass_ && !mass_->why().empty()) {
+      c = {{"value", nullptr}, {"why", mass_->why()}};
+    } else if (g == Transport::kHeatGroup && mass_ && mass_->count() > 0) {
       c["interdiffusion"] = interdiffusion(from, to);
-      if (!eh[g] && transport_ && transport_->samples() >= 2 &&
-          !transport_->heat_projection(from, to)) {
-        c["why"] =
-            "the mass moments' correlations are not positive definite: the production is too "
-            "short for a mixture's heat flux";
-      }
+      // The window holds enough lags (the shear viscosity has them) but no projection.
+      if (!eh[g] && eh[Transport::kShearGroup]) c["why"] = kNotPositiveDefinite;
     }
     j[names[g]] = c;
   }
   summary["transport"] = j;
 }
 
-// A mixture's heat moment G_e - sum_a beta_a G_a: beta per species (each species but the last
+// A mixture's heat moment G_e - sum_a beta_a G_a: beta per component (each but the last
 // present) and the fraction of the energy moment's slope that interdiffusion carried.
 template <int D>
 nlohmann::json TransportOutput<D>::interdiffusion(double from, double to) const {
   nlohmann::json d;
-  d["frame"] = "mass moments relative to the centre of mass; the last species' is minus the sum";
+  d["frame"] = kMassMomentFrame;
   const auto p = transport_ ? transport_->heat_projection(from, to) : std::nullopt;
   nlohmann::json beta = nlohmann::json::object();
   for (std::size_t k = 0; k < mass_->count(); ++k) {
-    const std::uint32_t s = mass_->species(k);
-    const std::string name = s < species_names_.size() ? species_names_[s] : std::to_string(s);
-    beta[name] = p ? finite_or_null(p->beta[k]) : nullptr;
+    beta[mass_->name(k)] = p ? finite_or_null(p->beta[k]) : nullptr;
   }
-  d["enthalpy_per_mass"] = beta;
+  d["energy_per_mass"] = beta;
   d["removed_fraction"] = p ? finite_or_null(p->removed) : nullptr;
   return d;
 }

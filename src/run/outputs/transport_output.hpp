@@ -19,15 +19,20 @@
 namespace kairos {
 
 // A mixture's mass moments G_a = sum_{i in a} m_i x_i - (M_a / M) sum_i m_i x_i of every
-// species present but the last, from the engine's unwrapped positions (it keeps image counters
-// for analysis.transport on a mixture): what the thermal conductivity needs to remove the
-// energy interdiffusion carries (analysis/helfand_transport.hpp).
+// component present but the last (a component: the particles of one species and one mass),
+// from the engine's unwrapped positions (it keeps image counters for analysis.transport on a
+// mixture): what the thermal conductivity needs to remove the energy interdiffusion carries
+// (analysis/helfand_transport.hpp).
 template <int D>
 class MassMoments {
  public:
+  static constexpr std::size_t kMaxComponents = 16;
   explicit MassMoments(const EventIntegrator<D>& engine);
   std::size_t count() const { return fraction_.size(); }
-  std::uint32_t species(std::size_t moment) const { return species_[moment]; }
+  // Moment k's component: its species' name, with its mass when the species has several.
+  const std::string& name(std::size_t moment) const { return names_[moment]; }
+  // Why there are no moments for a system of several components ("": none needed, or kept).
+  const std::string& why() const { return why_; }
   // kT / m now (sum m c^2 / (D M)): HelfandTransport's scale of the moments.
   double scale() const { return scale_; }
   void sample(const EventIntegrator<D>& engine, std::vector<Vec<D>>& out);
@@ -35,12 +40,20 @@ class MassMoments {
  private:
   std::vector<std::uint32_t> moment_of_;  // per particle: its species' moment, or ~0u (last)
   std::vector<double> mass_;
-  std::vector<double> fraction_;        // per moment: M_a / M
-  std::vector<std::uint32_t> species_;  // per moment: its species
+  std::vector<double> fraction_;    // per moment: M_a / M
+  std::vector<std::string> names_;  // per moment: its component
+  std::string why_;
   std::vector<std::uint32_t> every_slot_;
   std::vector<Vec<D>> position_;
   double scale_ = 1.0;
 };
+
+// summary.json's and the Python module's words for a mixture's heat moment.
+inline constexpr const char* kMassMomentFrame =
+    "mass moments relative to the centre of mass; the last component's is minus the sum";
+inline constexpr const char* kNotPositiveDefinite =
+    "the mass moments' correlations are not positive definite over the fit window: the "
+    "production is too short for a mixture's heat flux";
 
 // The Helfand moments of an event engine now (it keeps them: EngineOptions::track_helfand), as
 // HelfandTransport samples them; a mixture's mass moments from `mass` (nullptr: one species).
@@ -76,7 +89,6 @@ class TransportOutput final : public Observer<D> {
   double start_time_ = 0.0;
   std::uint64_t start_collisions_ = 0;
   std::optional<MassMoments<D>> mass_;  // mixtures
-  std::vector<std::string> species_names_;
 };
 
 }  // namespace kairos
