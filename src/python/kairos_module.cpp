@@ -269,6 +269,43 @@ py::dict lags_dict(const MsdCorrelator<D>& c, bool displacement, const char* mea
   return out;
 }
 
+// A mixture's interdiffusion, as summary.json's diffusion.mutual: per moment (a species against
+// the other of two, or against the rest) its pair name, mole fraction, coefficient and error
+// (the time epochs'), Darken's estimate for two species; the moments' mean squares per lag.
+template <int D>
+py::dict mutual_dict(const MsdMeasurement<D>& m) {
+  const InterdiffusionMoments<D>& moments = *m.interdiffusion;
+  const double nan = std::nan("");
+  std::vector<std::string> pairs;
+  std::vector<double> fraction, coefficient, error, darken;
+  const auto name = [&](std::uint32_t s) {
+    return s < m.species.size() ? m.species[s] : std::to_string(s);
+  };
+  for (std::size_t k = 0; k < moments.count(); ++k) {
+    const std::uint32_t a = moments.species(k);
+    pairs.push_back(name(a) + "-" + (moments.binary() ? name(moments.partner()) : "rest"));
+    fraction.push_back(moments.mole_fraction(k));
+    const auto& fit = m.mutual_fits[k];
+    coefficient.push_back(fit ? fit->coefficient : nan);
+    error.push_back(fit ? fit->epoch_stderr : nan);
+    double d = nan;
+    const std::uint32_t b = moments.partner();
+    if (moments.binary() && m.diffusion.size() > std::max(a, b) && m.diffusion[a] &&
+        m.diffusion[b]) {
+      const double x = moments.mole_fraction(k);
+      d = (1.0 - x) * m.diffusion[a]->coefficient + x * m.diffusion[b]->coefficient;
+    }
+    darken.push_back(d);
+  }
+  py::dict out = lags_dict(*m.mutual, false, "msd");
+  out["pairs"] = pairs;
+  out["mole_fraction"] = array_of(fraction);
+  out["coefficient"] = array_of(coefficient);
+  out["coefficient_stderr"] = array_of(error);
+  out["darken"] = array_of(darken);
+  return out;
+}
+
 // What a measurement in time sampled, into `out`.
 void span_into(py::dict& out, const SampledSpan& span, std::uint64_t samples, double first,
                double last) {
@@ -556,10 +593,11 @@ class PySimulation {
   py::dict msd(const py::object& interval_arg, const py::object& duration_arg,
                const py::object& fit_from_arg, const py::object& fit_to_arg,
                const py::object& vacf_arg, const py::object& particles_arg,
-               const py::object& clock_arg) {
+               const py::object& clock_arg, const py::object& mutual_arg) {
     CorrelationRequest request =
         correlation_request(interval_arg, duration_arg, fit_from_arg, fit_to_arg, "msd");
     const bool vacf = flag_from(vacf_arg, "msd: vacf");
+    const bool mutual = flag_from(mutual_arg, "msd: mutual");
     if (!py::isinstance<py::str>(clock_arg))
       throw py::type_error("msd: clock must be a string: \"auto\", \"time\" or \"collisions\"");
     const std::string clock_name = clock_arg.cast<std::string>();
@@ -577,7 +615,7 @@ class PySimulation {
     }
     return visit([&](auto& s) {
       const auto m = advancing([&] {
-        return measure_msd(s, request, vacf, python_keeps_going, particles, clock->value);
+        return measure_msd(s, request, vacf, python_keeps_going, particles, clock->value, mutual);
       });
       py::dict out = lags_dict(*m.msd, true, "msd");
       out["species"] = m.species;
@@ -591,6 +629,7 @@ class PySimulation {
       out["epochs_fitted"] = fits["epochs_fitted"];
       span_into(out, m.span, m.msd->samples(), m.sampled_from, m.sampled_to);
       out["clock"] = m.in_collisions ? "collisions" : "time";
+      if (m.mutual) out["mutual"] = mutual_dict(m);
       out["why"] =
           m.no_coefficient.empty() ? py::object(py::none()) : py::object(py::str(m.no_coefficient));
       if (m.vacf) {
@@ -1126,6 +1165,7 @@ PYBIND11_MODULE(kairos, m) {
       .def("msd", &PySimulation::msd, py::arg("interval"), py::arg("duration"),
            py::arg("fit_from") = py::none(), py::arg("fit_to") = py::none(),
            py::arg("vacf") = false, py::arg("particles") = py::none(), py::arg("clock") = "auto",
+           py::arg("mutual") = false,
            "ADVANCES the simulation by `duration`, sampling the unwrapped positions at the "
            "multiples of `interval` (None: automatic) as analysis.msd does; returns the MSD "
            "per species on log-spaced lags and D fitted over [fit_from, fit_to] (None: "
@@ -1133,7 +1173,8 @@ PYBIND11_MODULE(kairos, m) {
            "particle, or every k-th so that at most `particles` are (as analysis.msd_particles). "
            "clock: \"time\", \"collisions\" (interval, duration, lags and window in collisions "
            "per particle) or \"auto\" (collisions for a freely cooling gas), as "
-           "analysis.msd_time.")
+           "analysis.msd_time. mutual=True: the interdiffusion coefficients of a mixture as "
+           "analysis.mutual_diffusion.")
       .def("helfand_moments", &PySimulation::helfand_moments,
            "The Helfand moments now (needs helfand=True): kinetic_stress, virial, stress (D, D), "
            "energy_kinetic, energy_collisional, energy (D,).")

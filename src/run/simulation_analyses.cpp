@@ -140,7 +140,7 @@ VelocityDistribution<D> velocity_distribution_now(const Simulation<D>& sim) {
 template <int D>
 MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& request, bool vacf,
                               const typename Simulation<D>::KeepGoing& keep_going,
-                              std::size_t particles, MsdTime clock) {
+                              std::size_t particles, MsdTime clock, bool mutual) {
   if (!sim.tracks_images()) {
     throw InputError(
         "msd: the mean-square displacement needs image counters: this Simulation keeps none "
@@ -202,10 +202,34 @@ MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& requ
   }
   const auto groups = static_cast<std::uint32_t>(m.species.size());
   m.msd.emplace(group, groups, m.span.interval);
+  std::vector<std::uint32_t> every_slot;
+  std::vector<Vec<D>> every_position, moments;
+  if (mutual) {  // every particle's species and position, as analysis.mutual_diffusion
+    std::vector<std::uint32_t> species_of_particle(n);
+    for (std::size_t i = 0; i < n; ++i) species_of_particle[i] = species_of(i);
+    m.interdiffusion.emplace(species_of_particle);
+    if (m.interdiffusion->count() == 0)
+      throw InputError("msd: mutual: interdiffusion needs particles of two species or more");
+    const auto count = static_cast<std::uint32_t>(m.interdiffusion->count());
+    std::vector<std::uint32_t> own(count);
+    for (std::uint32_t k = 0; k < count; ++k) own[k] = k;
+    m.mutual.emplace(own, count, m.span.interval);
+    every_slot.resize(n);
+    for (std::size_t i = 0; i < n; ++i) every_slot[i] = static_cast<std::uint32_t>(i);
+    every_position.resize(n);
+  }
   if (vacf) m.vacf.emplace(group, groups, m.span.interval, MsdCorrelator<D>::Statistic::kProduct);
   std::vector<Vec<D>> sample(group.size());
   const auto take = [&] {
-    engine.unwrapped_positions(slot, sample);
+    if (m.mutual) {
+      engine.unwrapped_positions(every_slot, every_position);
+      for (std::size_t i = 0; i < n; ++i)
+        if (slot[i] != ~0u) sample[slot[i]] = every_position[i];
+      m.interdiffusion->sample(every_position, moments);
+      m.mutual->add(moments);
+    } else {
+      engine.unwrapped_positions(slot, sample);
+    }
     const double now = m.in_collisions ? per_particle() : sim.time();
     if (m.msd->samples() == 0) m.sampled_from = now;
     m.sampled_to = now;
@@ -237,8 +261,10 @@ MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& requ
         "the gas cools freely: D(t) decays with sqrt(T) (Haff's law), so no constant D in time "
         "exists; clock=\"collisions\" (or \"auto\") measures the constant D per collision";
     m.diffusion.assign(groups, std::nullopt);
+    if (m.mutual) m.mutual_fits.assign(m.interdiffusion->count(), std::nullopt);
   } else {
     m.diffusion = m.msd->diffusion(m.span.fit_from, m.span.fit_to);
+    if (m.mutual) m.mutual_fits = m.mutual->diffusion(m.span.fit_from, m.span.fit_to);
   }
   m.green_kubo = m.vacf ? m.vacf->green_kubo(m.span.fit_to)
                         : std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>>(groups);
@@ -283,7 +309,7 @@ TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationR
   template VelocityDistribution<D> velocity_distribution_now<D>(const Simulation<D>&);             \
   template MsdMeasurement<D> measure_msd<D>(Simulation<D>&, const CorrelationRequest&, bool,       \
                                             const typename Simulation<D>::KeepGoing&, std::size_t, \
-                                            MsdTime);                                              \
+                                            MsdTime, bool);                                        \
   template TransportMeasurement<D> measure_transport<D>(Simulation<D>&, const CorrelationRequest&, \
                                                         const typename Simulation<D>::KeepGoing&);
 KAIROS_SIMULATION_ANALYSES(2)

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "analysis/helfand_transport.hpp"
+#include "analysis/interdiffusion.hpp"
 #include "analysis/msd.hpp"
 #include "analysis/structure.hpp"
 #include "io/config_choices.hpp"
@@ -108,6 +109,11 @@ struct MsdMeasurement {
   std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> diffusion, green_kubo;
   bool in_collisions = false;  // the clock: collisions per particle
   std::string no_coefficient;  // why there is no D ("": there is one)
+  // With `mutual`: the interdiffusion moments (analysis.mutual_diffusion), their correlator and
+  // fits (none for a freely cooling gas in time).
+  std::optional<InterdiffusionMoments<D>> interdiffusion;
+  std::optional<MsdCorrelator<D>> mutual;
+  std::vector<std::optional<typename MsdCorrelator<D>::Diffusion>> mutual_fits;
 };
 // Advances `sim` by request.duration. InputError without image counters or under shear.
 // Follows every `step`-th particle that moves, at most `particles` of them (0: all), as
@@ -118,7 +124,8 @@ struct MsdMeasurement {
 template <int D>
 MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& request, bool vacf,
                               const typename Simulation<D>::KeepGoing& keep_going = {},
-                              std::size_t particles = 0, MsdTime clock = MsdTime::kTime);
+                              std::size_t particles = 0, MsdTime clock = MsdTime::kTime,
+                              bool mutual = false);
 
 // The Einstein-Helfand transport coefficients (analysis.transport), as summary.json's
 // `transport` gives them.

@@ -172,6 +172,45 @@ class Analyses(kt.KairosTestCase):
         with self.assertRaisesRegex(kairos.InputError, "clock"):
             kairos.Simulation(cfg).msd(None, 4.0, clock="ticks")
 
+    def test_mutual_diffusion_equals_the_cli_bit_for_bit(self):
+        # Three species: each against the rest (two would give one moment, A-B).
+        interval, duration = 0.0625, 6.0
+        config = gas_config(particles=240, packing_fraction=0.2, time=duration, analysis={
+            "msd": True, "mutual_diffusion": True, "msd_interval": interval,
+            "msd_fit_from": 0.5, "msd_fit_to": 1.5})
+        config["output"]["thermo_interval"] = 0.25
+        config["system"]["species"] = [
+            {"name": "A", "fraction": 0.5}, {"name": "B", "fraction": 0.3, "mass": 2.0},
+            {"name": "C", "fraction": 0.2, "diameter": 1.3}]
+        cfg = self.write_config(config)
+        out = self.path("cli")
+        self.run_ok("run", cfg, "-o", out)
+        cli = self.summary(out)["diffusion"]["mutual"]["pairs"]
+        m = kairos.Simulation(cfg).msd(interval, duration, fit_from=0.5, fit_to=1.5,
+                                       mutual=True)["mutual"]
+        self.assertEqual(m["pairs"], ["A-rest", "B-rest", "C-rest"])
+        self.assertEqual(sorted(cli), sorted(m["pairs"]))
+        for k, pair in enumerate(m["pairs"]):
+            self.assertIsNotNone(cli[pair]["coefficient"])
+            self.assertEqual(m["coefficient"][k], cli[pair]["coefficient"], pair)
+            self.assertEqual(m["coefficient_stderr"][k], cli[pair]["coefficient_stderr"], pair)
+            self.assertEqual(m["mole_fraction"][k], cli[pair]["mole_fraction"], pair)
+        header, rows = read_table(os.path.join(out, "mutual_diffusion.tsv"))
+        np.testing.assert_allclose(m["msd"], rows[:, 2:], rtol=1e-9)
+        # Two species: one moment, with Darken's estimate beside it.
+        config["system"]["species"] = config["system"]["species"][:2]
+        cfg = self.write_config(config, "two.toml")
+        self.run_ok("run", cfg, "-o", self.path("two"))
+        cli = self.summary(self.path("two"))["diffusion"]["mutual"]["pairs"]["A-B"]
+        m = kairos.Simulation(cfg).msd(interval, duration, fit_from=0.5, fit_to=1.5,
+                                       mutual=True)["mutual"]
+        self.assertEqual(m["pairs"], ["A-B"])
+        self.assertEqual(m["coefficient"][0], cli["coefficient"])
+        self.assertEqual(m["darken"][0], cli["darken"])
+        one = self.write_config(gas_config(particles=100), "one.toml")
+        with self.assertRaisesRegex(kairos.InputError, "two species"):
+            kairos.Simulation(one).msd(0.1, 1.0, mutual=True)
+
     def test_a_mixtures_conductivity_equals_the_cli_bit_for_bit(self):
         # 2D, two species: the mass moments come from unwrapped positions, which a Simulation
         # with helfand=True keeps for a mixture. Sample and thermo times exact in binary: the

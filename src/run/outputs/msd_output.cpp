@@ -115,27 +115,14 @@ MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
   }
 
   if (config_.mutual_diffusion) {
-    std::vector<std::uint64_t> count(species_names_.size(), 0);
-    for (const std::uint32_t s : species_of_) ++count[s];
-    std::vector<std::uint32_t> present;
-    for (std::uint32_t s = 0; s < count.size(); ++s)
-      if (count[s] > 0) present.push_back(s);
-    if (present.size() < 2) {
+    interdiffusion_.emplace(species_of_);
+    if (interdiffusion_->count() == 0) {
       throw InputError(
           "analysis.mutual_diffusion: interdiffusion needs particles of two species or more");
     }
-    // Two species: one moment (the second's is minus the first's); more: each against the rest.
-    if (present.size() == 2) {
-      moment_partner_ = present[1];
-      present.pop_back();
-    }
-    moment_species_ = present;
-    for (const std::uint32_t s : present)
-      mole_fraction_.push_back(static_cast<double>(count[s]) / static_cast<double>(n));
     every_slot_.resize(n);
     for (std::size_t id = 0; id < n; ++id) every_slot_[id] = static_cast<std::uint32_t>(id);
     every_position_.resize(n);
-    moments_.resize(moment_species_.size());
   }
 }
 
@@ -194,7 +181,7 @@ void MsdOutput<D>::production_starts(const RunContext<D>&) {
   if (config_.vacf) vacf_.emplace(group_, groups, interval_, MsdCorrelator<D>::Statistic::kProduct);
   if (config_.mutual_diffusion) {
     // One "particle" per moment, each its own group: its error comes from the time epochs.
-    const auto moments = static_cast<std::uint32_t>(moment_species_.size());
+    const auto moments = static_cast<std::uint32_t>(interdiffusion_->count());
     std::vector<std::uint32_t> own(moments);
     for (std::uint32_t k = 0; k < moments; ++k) own[k] = k;
     mutual_.emplace(own, moments, interval_);
@@ -210,20 +197,9 @@ void MsdOutput<D>::write(const RunContext<D>& run) {
   if (!correlator_) production_starts(run);  // continued in its production
   if (mutual_) {
     engine_.unwrapped_positions(every_slot_, every_position_);
-    std::vector<Vec<D>> sum(species_names_.size(), Vec<D>{});
-    Vec<D> total{};
-    for (std::size_t id = 0; id < every_position_.size(); ++id) {
-      const Vec<D>& r = every_position_[id];
-      sum[species_of_[id]] = sum[species_of_[id]] + r;
-      total = total + r;
-      if (slot_[id] != ~0u) sample_[slot_[id]] = r;
-    }
-    // M_a = sum_{i in a} r_i - x_a sum_i r_i, scaled so that its MSD over 2 d t is D_a,rest.
-    const auto n = static_cast<double>(every_position_.size());
-    for (std::size_t k = 0; k < moment_species_.size(); ++k) {
-      const double x = mole_fraction_[k];
-      moments_[k] = (1.0 / std::sqrt(n * x * (1.0 - x))) * (sum[moment_species_[k]] - x * total);
-    }
+    for (std::size_t id = 0; id < every_position_.size(); ++id)
+      if (slot_[id] != ~0u) sample_[slot_[id]] = every_position_[id];
+    interdiffusion_->sample(every_position_, moments_);
     mutual_->add(moments_);
   } else {
     engine_.unwrapped_positions(slot_, sample_);
@@ -276,9 +252,10 @@ void MsdOutput<D>::close(const RunContext<D>& run, bool) {
   if (mutual_) {
     // The moments' MSD over N x (1 - x): its slope over 2d is the interdiffusion coefficient.
     text = "lag\torigins";
-    for (const std::uint32_t s : moment_species_) {
-      text += fmt::format("\tmsd_{}-{}", species_names_[s],
-                          moment_species_.size() == 1 ? species_names_[moment_partner_] : "rest");
+    const InterdiffusionMoments<D>& m = *interdiffusion_;
+    for (std::size_t k = 0; k < m.count(); ++k) {
+      text += fmt::format("\tmsd_{}-{}", species_names_[m.species(k)],
+                          m.binary() ? species_names_[m.partner()] : "rest");
     }
     text += "\n";
     for (const auto& lag : mutual_->lags()) {
@@ -445,14 +422,15 @@ void MsdOutput<D>::summarize_mutual(nlohmann::json& d, const Fits& self, double 
   nlohmann::json m;
   m["frame"] = "number-averaged (Galilean invariant)";
   const bool no_coefficient = freely_cooling_ && !in_collisions_;
-  const Fits fits = no_coefficient ? Fits(moment_species_.size()) : mutual_->diffusion(from, to);
+  const InterdiffusionMoments<D>& moments = *interdiffusion_;
+  const Fits fits = no_coefficient ? Fits(moments.count()) : mutual_->diffusion(from, to);
   nlohmann::json pairs = nlohmann::json::object();
-  for (std::size_t k = 0; k < moment_species_.size(); ++k) {
-    const std::uint32_t a = moment_species_[k];
-    const bool binary = moment_species_.size() == 1;
-    const std::uint32_t b = binary ? moment_partner_ : a;
+  for (std::size_t k = 0; k < moments.count(); ++k) {
+    const std::uint32_t a = moments.species(k);
+    const bool binary = moments.binary();
+    const std::uint32_t b = binary ? moments.partner() : a;
     nlohmann::json p;
-    p["mole_fraction"] = mole_fraction_[k];
+    p["mole_fraction"] = moments.mole_fraction(k);
     if (fits[k]) {
       p["coefficient"] = fits[k]->coefficient;
       p["coefficient_stderr"] = finite_or_null(fits[k]->epoch_stderr);
@@ -465,7 +443,7 @@ void MsdOutput<D>::summarize_mutual(nlohmann::json& d, const Fits& self, double 
                                 : "fewer than 3 lags in the fit window";
     }
     if (binary && self.size() > std::max(a, b) && self[a] && self[b]) {
-      const double x = mole_fraction_[k];
+      const double x = moments.mole_fraction(k);
       p["darken"] = (1.0 - x) * self[a]->coefficient + x * self[b]->coefficient;
     }
     pairs[species_names_[a] + "-" + (binary ? species_names_[b] : std::string("rest"))] = p;

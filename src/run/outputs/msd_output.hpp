@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "analysis/granular_theory.hpp"
+#include "analysis/interdiffusion.hpp"
 #include "analysis/msd.hpp"
 #include "analysis/thermodynamics.hpp"
 #include "run/event_adapter.hpp"
@@ -78,9 +79,7 @@ class MsdOutput final : public Observer<D> {
   // of the mixture: one for two species) the species and its mole fraction; every particle's
   // unwrapped position; the moments' correlator.
   std::vector<std::uint32_t> species_of_;
-  std::vector<std::uint32_t> moment_species_;
-  std::uint32_t moment_partner_ = 0;  // two species: the second
-  std::vector<double> mole_fraction_;
+  std::optional<InterdiffusionMoments<D>> interdiffusion_;
   std::vector<std::uint32_t> every_slot_;
   std::vector<Vec<D>> every_position_, moments_;
   std::optional<MsdCorrelator<D>> mutual_;
