@@ -100,7 +100,6 @@ x1 = 0.5 and 0.2, and k_T = 0 +- 0.0001.
 About 2 minutes at the defaults on the 2-core VM (one process).
 """
 
-import argparse
 import math
 import os
 import sys
@@ -110,7 +109,8 @@ import numpy as np
 from scipy.special import genlaguerre
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mixture_diffusion_sonine import contact_values, unit_vectors_on_hemisphere  # noqa: E402
+from mixture_diffusion_sonine import (  # noqa: E402
+    contact_values, mixture_arguments, mixture_of, unit_vectors_on_hemisphere)
 
 
 def velocity_basis(v, mass, S):
@@ -271,21 +271,10 @@ def jackknife(batches, estimate):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--eta", type=float, default=0.01, help="packing fraction")
-    ap.add_argument("--diameters", default="1,1.4")
-    ap.add_argument("--masses", default="1,2")
-    ap.add_argument("--fractions", default="0.5,0.5")
-    ap.add_argument("--orders", type=int, default=4, help="Sonine orders: p = 0 .. orders")
-    ap.add_argument("--samples", type=int, default=16_000_000, help="collisions per pair type")
+    ap = mixture_arguments(__doc__.split("\n\n")[0], 16_000_000)
     ap.add_argument("--batches", type=int, default=16, help="for the jackknife error")
-    ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()
-    sigma = [float(s) for s in args.diameters.split(",")]
-    mass = [float(s) for s in args.masses.split(",")]
-    x = [float(s) for s in args.fractions.split(",")]
-    x = [xi / sum(x) for xi in x]
-    n = args.eta / (math.pi / 6 * sum(xi * s ** 3 for xi, s in zip(x, sigma)))
+    sigma, mass, x, n = mixture_of(args)
     chi = contact_values(n, x, sigma)
     start = time.time()
     rng = np.random.default_rng(args.seed)

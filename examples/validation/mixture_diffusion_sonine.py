@@ -116,21 +116,33 @@ def maxwell_stefan(n, x, sigma, mass, orders, samples, rng, enskog=True, chunk=1
     return out, first
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def mixture_arguments(description, samples):
+    """The command line of the dilute-mixture scripts: the mixture, the Sonine orders, the
+    Monte Carlo samples and seed."""
+    ap = argparse.ArgumentParser(description=description)
     ap.add_argument("--eta", type=float, default=0.01, help="packing fraction")
     ap.add_argument("--diameters", default="1,1.4")
     ap.add_argument("--masses", default="1,2")
     ap.add_argument("--fractions", default="0.5,0.5")
-    ap.add_argument("--orders", type=int, default=4)
-    ap.add_argument("--samples", type=int, default=8_000_000)
+    ap.add_argument("--orders", type=int, default=4, help="Sonine orders")
+    ap.add_argument("--samples", type=int, default=samples, help="collisions per pair type")
     ap.add_argument("--seed", type=int, default=1)
-    args = ap.parse_args()
+    return ap
+
+
+def mixture_of(args):
+    """(sigma, mass, x normalised, number density) of the parsed arguments."""
     sigma = [float(s) for s in args.diameters.split(",")]
     mass = [float(s) for s in args.masses.split(",")]
     x = [float(s) for s in args.fractions.split(",")]
     x = [xi / sum(x) for xi in x]
     n = args.eta / (math.pi / 6 * sum(xi * s ** 3 for xi, s in zip(x, sigma)))
+    return sigma, mass, x, n
+
+
+def main():
+    args = mixture_arguments(__doc__.split("\n\n")[0], 8_000_000).parse_args()
+    sigma, mass, x, n = mixture_of(args)
     rng = np.random.default_rng(args.seed)
     values, first = maxwell_stefan(n, x, sigma, mass, args.orders, args.samples, rng)
     print(f"eta = {args.eta}, n = {n:.6g}, diameters {sigma}, masses {mass}, fractions {x}, "
