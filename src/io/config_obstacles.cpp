@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "interactions/potential_spec.hpp"
 #include "io/config_choices.hpp"
 
 namespace kairos {
@@ -64,13 +65,15 @@ std::optional<TransportObstacle> transport_obstacle(const Config& c) {
       return refuse(fmt::format("system.species[{}].fixed", s),
                     "fixed grains do not conserve momentum");
   const auto conservative = [](const ContactConfig& k) {
-    const bool elastic = k.restitution_model == "constant" && k.restitution == 1.0;
+    const bool elastic =
+        restitution_models().is(k.restitution_model, RestitutionModel::kConstant) &&
+        k.restitution == 1.0;
     const bool tangential = k.tangential_restitution == -1.0 || k.friction == 0.0 ||
                             (k.tangential_restitution == 1.0 && std::isinf(k.friction));
     return elastic && tangential;
   };
   for (const PairPotentialConfig& p : c.potentials)
-    if (p.potential.kind == "spring_dashpot")
+    if (potential_kinds().is(p.potential.kind, PotentialKind::kSpringDashpot))
       return refuse("potential.kind", "a spring-dashpot by steps dissipates energy");
   if (!conservative(c.interactions.contact))
     return refuse("contact.restitution", "inelastic or frictional contacts dissipate energy");

@@ -252,10 +252,10 @@ void MsdOutput<D>::close(const RunContext<D>& run, bool) {
   if (mutual_) {
     // The moments' MSD over N x (1 - x): its slope over 2d is the interdiffusion coefficient.
     text = "lag\torigins";
-    const InterdiffusionMoments<D>& m = *interdiffusion_;
-    for (std::size_t k = 0; k < m.count(); ++k) {
-      text += fmt::format("\tmsd_{}-{}", species_names_[m.species(k)],
-                          m.binary() ? species_names_[m.partner()] : "rest");
+    const InterdiffusionMoments<D>& moments = *interdiffusion_;
+    for (std::size_t k = 0; k < moments.count(); ++k) {
+      text += fmt::format("\tmsd_{}-{}", species_names_[moments.species(k)],
+                          moments.binary() ? species_names_[moments.partner()] : "rest");
     }
     text += "\n";
     for (const auto& lag : mutual_->lags()) {
