@@ -110,7 +110,7 @@ from scipy.special import genlaguerre
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from mixture_diffusion_sonine import (  # noqa: E402
-    contact_values, mixture_arguments, mixture_of, unit_vectors_on_hemisphere)
+    contact_values, mixture_arguments, mixture_of, sample_collisions)
 
 
 def velocity_basis(v, mass, S):
@@ -136,16 +136,8 @@ def collision_matrices(n, x, sigma, mass, orders, samples, rng, chi, batches=16,
             sij = (sigma[i] + sigma[j]) / 2
             # (i, j) and (j, i) contribute alike to the symmetric form: sample i <= j, twice i != j
             rate = (1 if i == j else 2) * dens[i] * dens[j] * chi[i, j] * sij ** 2 * math.pi
-            mu = mass[i] * mass[j] / (mass[i] + mass[j])
             for c in range(chunks):
-                v = rng.normal(0, 1 / math.sqrt(mass[i]), (chunk, 3))
-                w = rng.normal(0, 1 / math.sqrt(mass[j]), (chunk, 3))
-                g = v - w
-                gn = np.linalg.norm(g, axis=1)
-                k = unit_vectors_on_hemisphere(rng, g / gn[:, None])
-                gk = np.sum(g * k, axis=1)
-                vp = v - (2 * mu / mass[i] * gk)[:, None] * k  # elastic
-                wp = w + (2 * mu / mass[j] * gk)[:, None] * k
+                v, w, gn, gk, vp, wp = sample_collisions(rng, mass[i], mass[j], chunk)
                 delta = np.zeros((3 * chunk, 2 * K))
                 delta[:, i * K:(i + 1) * K] += (velocity_basis(vp, mass[i], S) -
                                                 velocity_basis(v, mass[i], S))

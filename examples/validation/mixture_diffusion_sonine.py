@@ -69,6 +69,21 @@ def unit_vectors_on_hemisphere(rng, gh):
     return mu[:, None] * gh + (sin * np.cos(phi))[:, None] * e1 + (sin * np.sin(phi))[:, None] * e2
 
 
+def sample_collisions(rng, m_i, m_j, chunk):
+    """`chunk` Maxwellian pairs (kT = 1) of masses m_i, m_j, directions k with density
+    ~ (g . k) on the hemisphere, and their elastic collisions: v, w, |g|, g . k, v', w'."""
+    mu = m_i * m_j / (m_i + m_j)
+    v = rng.normal(0, 1 / math.sqrt(m_i), (chunk, 3))
+    w = rng.normal(0, 1 / math.sqrt(m_j), (chunk, 3))
+    g = v - w
+    gn = np.linalg.norm(g, axis=1)
+    k = unit_vectors_on_hemisphere(rng, g / gn[:, None])
+    gk = np.sum(g * k, axis=1)
+    vp = v - (2 * mu / m_i * gk)[:, None] * k
+    wp = w + (2 * mu / m_j * gk)[:, None] * k
+    return v, w, gn, gk, vp, wp
+
+
 def maxwell_stefan(n, x, sigma, mass, orders, samples, rng, enskog=True, chunk=1_000_000):
     """D12 at 1 .. orders Sonine orders (kT = 1)."""
     S = [genlaguerre(p, 1.5) for p in range(orders)]
@@ -80,16 +95,9 @@ def maxwell_stefan(n, x, sigma, mass, orders, samples, rng, enskog=True, chunk=1
         for j in range(2):
             sij = (sigma[i] + sigma[j]) / 2
             rate = dens[i] * dens[j] * chi[i, j] * sij ** 2 * math.pi  # x <|g|> below
-            mu_ij = mass[i] * mass[j] / (mass[i] + mass[j])
             chunks = max(1, samples // chunk)
             for _ in range(chunks):
-                v = rng.normal(0, 1 / math.sqrt(mass[i]), (chunk, 3))
-                w = rng.normal(0, 1 / math.sqrt(mass[j]), (chunk, 3))
-                g = v - w
-                gn = np.linalg.norm(g, axis=1)
-                k = unit_vectors_on_hemisphere(rng, g / gn[:, None])
-                gk = np.sum(g * k, axis=1)
-                vp = v - (2 * mu_ij / mass[i] * gk)[:, None] * k  # elastic
+                v, w, gn, _, vp, _ = sample_collisions(rng, mass[i], mass[j], chunk)
                 weight = rate * gn  # integral dk Theta (g.k)(g.k) = pi |g| (3D)
                 xv, xw, xvp = (mass[i] * np.sum(v * v, 1) / 2, mass[j] * np.sum(w * w, 1) / 2,
                                mass[i] * np.sum(vp * vp, 1) / 2)

@@ -82,8 +82,8 @@ HelfandTransport<D>::HelfandTransport(double interval, std::size_t particles, do
 
 template <int D>
 std::uint32_t HelfandTransport<D>::groups() const {
-  const std::size_t m = mass_moments_;
-  return static_cast<std::uint32_t>(3 + 2 * m + m * (m - (m > 0 ? 1 : 0)) / 2);
+  const std::size_t m = mass_moments_;  // 3, then m, m energy + mass, m (m - 1) / 2 pairs
+  return static_cast<std::uint32_t>(3 + 2 * m + (m > 1 ? m * (m - 1) / 2 : 0));
 }
 
 // The estimators of the shear group, the pressure's moment (the trace over D) and the energy

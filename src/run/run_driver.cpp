@@ -12,6 +12,7 @@
 #include "core/stop_flag.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config_choices.hpp"
+#include "run/outputs/msd_output.hpp"
 #include "run/setup_chain.hpp"
 
 namespace kairos {
@@ -95,8 +96,7 @@ void RunDriver<D>::add_observer(std::unique_ptr<Observer<D>> observer) {
 
 template <int D>
 std::uint64_t RunDriver<D>::collisions_for(double per_particle) const {
-  return static_cast<std::uint64_t>(
-      std::llround(per_particle * static_cast<double>(integrator_->mobile()) / 2.0));
+  return kairos::collisions_for(per_particle, integrator_->mobile());
 }
 
 template <int D>

@@ -153,8 +153,8 @@ MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& requ
   }
   MsdMeasurement<D> m;
   const auto& kind = sim.integrator().kind();
-  const bool freely_cooling = kind.dissipative && !kind.driven && !kind.moving_walls;
-  m.in_collisions = clock == MsdTime::kCollisions || (clock == MsdTime::kAuto && freely_cooling);
+  const bool cooling = freely_cooling<D>(kind);
+  m.in_collisions = msd_on_collision_clock<D>(clock, kind);
   if (m.in_collisions && vacf) {
     throw InputError(
         "msd: vacf: no velocity autocorrelation on the collision clock (the velocities of a "
@@ -240,10 +240,9 @@ MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& requ
     }
   };
   if (m.in_collisions) {
-    const double collisions = std::round(request.duration * static_cast<double>(mobile) / 2.0);
-    m.span.completed = sim.sample_every_collisions(
-        every.step, collisions < 0x1p63 ? static_cast<std::uint64_t>(collisions) : ~0ull, take,
-        keep_going);
+    const bool countable = request.duration * static_cast<double>(mobile) / 2.0 < 0x1p62;
+    const std::uint64_t collisions = countable ? collisions_for(request.duration, mobile) : ~0ull;
+    m.span.completed = sim.sample_every_collisions(every.step, collisions, take, keep_going);
     // Per collision the mean free "time" is one collision per particle by definition.
     m.span.end_time = sim.time();
     m.span.collisions = sim.collisions() - m.span.collisions;
@@ -256,7 +255,7 @@ MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& requ
     m.span.completed = sim.sample_every(m.span.interval, request.duration, take, keep_going);
     end_span(sim, request, m.sampled_to - m.sampled_from, m.span);
   }
-  if (freely_cooling && !m.in_collisions) {
+  if (cooling && !m.in_collisions) {
     m.no_coefficient =
         "the gas cools freely: D(t) decays with sqrt(T) (Haff's law), so no constant D in time "
         "exists; clock=\"collisions\" (or \"auto\") measures the constant D per collision";

@@ -34,6 +34,10 @@ CollisionInterval collision_interval(double wanted, std::size_t particles) {
   return c;
 }
 
+std::uint64_t collisions_for(double per_particle, std::size_t mobile) {
+  return static_cast<std::uint64_t>(std::llround(per_particle * static_cast<double>(mobile) / 2.0));
+}
+
 template <int D>
 MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
     : engine_(engine),
@@ -80,9 +84,9 @@ MsdOutput<D>::MsdOutput(const Config& config, const EventIntegrator<D>& engine)
   // The clock: collisions per particle for a freely cooling gas, whose D(t) decays with sqrt(T)
   // while D per collision is constant.
   const auto& kind = engine.kind();
-  freely_cooling_ = kind.dissipative && !kind.driven && !kind.moving_walls && !kind.sheared;
+  freely_cooling_ = freely_cooling<D>(kind);
   const MsdTime scale = msd_time_scales().at(config_.msd_time);
-  in_collisions_ = scale == MsdTime::kCollisions || (scale == MsdTime::kAuto && freely_cooling_);
+  in_collisions_ = msd_on_collision_clock<D>(scale, kind);
   time_scale_chosen_ = scale == MsdTime::kAuto;
   if (in_collisions_) {
     const char* why =

@@ -17,6 +17,7 @@
 #include "analysis/interdiffusion.hpp"
 #include "analysis/msd.hpp"
 #include "analysis/thermodynamics.hpp"
+#include "io/config_choices.hpp"
 #include "run/event_adapter.hpp"
 #include "run/outputs/observer.hpp"
 
@@ -30,6 +31,20 @@ struct CollisionInterval {
   double per_particle = 0.0;
 };
 CollisionInterval collision_interval(double wanted, std::size_t particles);
+// `per_particle` collisions per particle among `mobile` moving particles, in collisions.
+std::uint64_t collisions_for(double per_particle, std::size_t mobile);
+
+// A freely cooling gas: dissipative, with nothing feeding energy in; and whether the MSD's clock
+// is collisions per particle (analysis.msd_time: "auto" chooses it for such a gas), for
+// analysis.msd and the Python module's Simulation.msd alike.
+template <int D>
+bool freely_cooling(const typename EventIntegrator<D>::Kind& kind) {
+  return kind.dissipative && !kind.driven && !kind.moving_walls && !kind.sheared;
+}
+template <int D>
+bool msd_on_collision_clock(MsdTime clock, const typename EventIntegrator<D>::Kind& kind) {
+  return clock == MsdTime::kCollisions || (clock == MsdTime::kAuto && freely_cooling<D>(kind));
+}
 
 template <int D>
 class MsdOutput final : public Observer<D> {
