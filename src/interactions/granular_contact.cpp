@@ -21,11 +21,6 @@ void require_tangential(double beta, const char* what) {
   require_in(kTangentialRestitutionDomain, beta, what);
 }
 
-void require_positive(double x, const char* what) {
-  if (!(std::isfinite(x) && x > 0.0))
-    throw InputError(fmt::format("{} must be finite and > 0, got {}", what, x));
-}
-
 void require_non_negative(double x, const char* what) {
   require_in(kNonNegativeDomain, x, what);
 }
@@ -93,16 +88,9 @@ NormalRestitution NormalRestitution::table(std::vector<double> speeds, std::vect
     throw InputError(fmt::format("the restitution table has {} speeds but {} values", speeds.size(),
                                  values.size()));
   for (std::size_t k = 0; k < speeds.size(); ++k) {
-    if (!(std::isfinite(speeds[k]) && speeds[k] >= 0.0))
-      throw InputError(fmt::format("restitution table: speed #{} is {}, not a finite number >= 0",
-                                   k + 1, speeds[k]));
-    if (k > 0 && !(speeds[k] > speeds[k - 1]))
-      throw InputError(fmt::format(
-          "restitution table: speeds must be strictly increasing, but speed #{} ({}) follows {}",
-          k + 1, speeds[k], speeds[k - 1]));
-    if (!kRestitutionDomain.contains(values[k]))
-      throw InputError(fmt::format("restitution table: e = {} at speed {} is not {}", values[k],
-                                   speeds[k], kRestitutionDomain.text()));
+    const auto previous = k > 0 ? std::optional<double>(speeds[k - 1]) : std::nullopt;
+    if (const auto fault = restitution_table_row_fault(speeds[k], previous, values[k]))
+      throw InputError(fmt::format("restitution table, pair #{}: {}", k + 1, fault->why));
   }
   NormalRestitution r;
   r.model_.emplace<Table>(Table{std::move(speeds), std::move(values)});

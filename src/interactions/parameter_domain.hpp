@@ -6,7 +6,9 @@
 // in the run's units (up to 1e9 kT, ...), narrower than these domains, and live only there.
 #pragma once
 
+#include <cstddef>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -40,9 +42,24 @@ inline constexpr ParameterDomain kTangentialRestitutionDomain{.lo = -1.0, .hi = 
 inline constexpr ParameterDomain kPoissonRatioDomain{.lo = -1.0, .hi = 0.5, .lo_open = true};
 // Friction coefficients, damping constants.
 inline constexpr ParameterDomain kNonNegativeDomain{.lo = 0.0};
+// Stiffnesses, lengths, masses, speeds of a law or a potential.
+inline constexpr ParameterDomain kPositiveDomain{.lo = 0.0, .lo_open = true};
 
 // InputError "{prefix}{what} must be {domain.text()}, got {x}" unless domain.contains(x).
 void require_in(const ParameterDomain& domain, double x, std::string_view what,
                 std::string_view prefix = {});
+// The rules of one row (speed, e) of a restitution table, given the previous row's speed: speeds
+// finite, >= 0 and strictly increasing; e in kRestitutionDomain. `entry` says which of the pair
+// is at fault (0 the speed, 1 e), `why` says how; nullopt if the row is fine.
+struct TableRowFault {
+  std::size_t entry = 0;
+  std::string why;
+};
+std::optional<TableRowFault> restitution_table_row_fault(double speed,
+                                                         std::optional<double> previous_speed,
+                                                         double e);
+
+// require_in(kPositiveDomain, ...): "{prefix}{what} must be finite and > 0, got {x}".
+void require_positive(double x, std::string_view what, std::string_view prefix = {});
 
 }  // namespace kairos

@@ -21,8 +21,7 @@ namespace {
 // Input checks: InputError naming the parameter.
 
 void require_positive(double x, const char* what) {
-  if (!(std::isfinite(x) && x > 0.0))
-    throw InputError(fmt::format("soft contact: {} must be finite and > 0, got {}", what, x));
+  kairos::require_positive(x, what, "soft contact: ");
 }
 
 void require_non_negative(double x, const char* what) {

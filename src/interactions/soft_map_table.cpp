@@ -21,6 +21,7 @@
 
 #include "core/error.hpp"
 #include "core/stop_flag.hpp"
+#include "interactions/parameter_domain.hpp"
 
 namespace kairos {
 namespace {
@@ -48,8 +49,7 @@ double end_coefficient(SoftModel model) {
 }
 
 void require_positive(double x, const char* field) {
-  if (!(std::isfinite(x) && x > 0.0))
-    throw InputError(fmt::format("soft map table: {} must be finite and > 0, got {}", field, x));
+  kairos::require_positive(x, field, "soft map table: ");
 }
 
 // ---------------------------------------------------------------------------------------------

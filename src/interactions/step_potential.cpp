@@ -13,6 +13,7 @@
 
 #include "core/error.hpp"
 #include "core/stop_flag.hpp"
+#include "interactions/parameter_domain.hpp"
 
 namespace kairos {
 
@@ -279,21 +280,10 @@ DissipativeStepOutcome dissipative_step_event(double mu, double v_n, double delt
   return {out.crosses, out.impulse, out.crosses ? charge - delta_u : 0.0};
 }
 
-namespace {
-
-void require_positive(const char* what, double value, const char* potential) {
-  if (!(value > 0.0) || !std::isfinite(value)) {
-    throw InputError(
-        fmt::format("{}: {} must be positive and finite, not {}", potential, what, value));
-  }
-}
-
-}  // namespace
-
 ContinuousPotential lennard_jones(double eps, double sigma, double rc, bool shifted) {
-  require_positive("eps", eps, "lennard_jones");
-  require_positive("sigma", sigma, "lennard_jones");
-  require_positive("the cut-off", rc, "lennard_jones");
+  require_positive(eps, "eps", "lennard_jones: ");
+  require_positive(sigma, "sigma", "lennard_jones: ");
+  require_positive(rc, "the cut-off", "lennard_jones: ");
   auto lj = [eps, sigma](double r) {
     const double s6 = std::pow(sigma / r, 6);
     return 4.0 * eps * (s6 * s6 - s6);
@@ -305,8 +295,8 @@ ContinuousPotential lennard_jones(double eps, double sigma, double rc, bool shif
 }
 
 ContinuousPotential wca(double eps, double sigma) {
-  require_positive("eps", eps, "wca");
-  require_positive("sigma", sigma, "wca");
+  require_positive(eps, "eps", "wca: ");
+  require_positive(sigma, "sigma", "wca: ");
   auto u = [eps, sigma](double r) {
     const double s6 = std::pow(sigma / r, 6);
     return 4.0 * eps * (s6 * s6 - s6) + eps;
@@ -317,8 +307,8 @@ ContinuousPotential wca(double eps, double sigma) {
 ContinuousPotential yukawa(double eps, double sigma, double kappa, double rc, bool shifted) {
   if (!(eps != 0.0) || !std::isfinite(eps))
     throw InputError(fmt::format("yukawa: eps must be finite and non-zero, not {}", eps));
-  require_positive("sigma", sigma, "yukawa");
-  require_positive("the cut-off", rc, "yukawa");
+  require_positive(sigma, "sigma", "yukawa: ");
+  require_positive(rc, "the cut-off", "yukawa: ");
   if (!(kappa >= 0.0) || !std::isfinite(kappa))
     throw InputError(fmt::format("yukawa: kappa must be finite and >= 0, not {}", kappa));
   auto y = [eps, sigma, kappa](double r) {
@@ -330,10 +320,10 @@ ContinuousPotential yukawa(double eps, double sigma, double kappa, double rc, bo
 }
 
 ContinuousPotential morse(double eps, double r_min, double alpha, double rc, bool shifted) {
-  require_positive("eps", eps, "morse");
-  require_positive("r_min", r_min, "morse");
-  require_positive("alpha", alpha, "morse");
-  require_positive("the cut-off", rc, "morse");
+  require_positive(eps, "eps", "morse: ");
+  require_positive(r_min, "r_min", "morse: ");
+  require_positive(alpha, "alpha", "morse: ");
+  require_positive(rc, "the cut-off", "morse: ");
   auto m = [eps, r_min, alpha](double r) {
     const double e = -std::expm1(-alpha * (r - r_min));  // 1 - exp(-alpha (r - r_min))
     return eps * (e * e - 1.0);
@@ -344,9 +334,9 @@ ContinuousPotential morse(double eps, double r_min, double alpha, double rc, boo
 }
 
 ContinuousPotential harmonic_spring(double k, double length, double max_length) {
-  require_positive("the stiffness k", k, "spring");
-  require_positive("length", length, "spring");
-  require_positive("max_length", max_length, "spring");
+  require_positive(k, "the stiffness k", "spring: ");
+  require_positive(length, "length", "spring: ");
+  require_positive(max_length, "max_length", "spring: ");
   if (!(length < max_length)) {
     throw InputError(
         fmt::format("spring: length {} must be shorter than max_length {}", length, max_length));
@@ -357,8 +347,8 @@ ContinuousPotential harmonic_spring(double k, double length, double max_length) 
 }
 
 ContinuousPotential repulsive_spring(double k, double length) {
-  require_positive("the stiffness k", k, "spring_dashpot");
-  require_positive("length", length, "spring_dashpot");
+  require_positive(k, "the stiffness k", "spring_dashpot: ");
+  require_positive(length, "length", "spring_dashpot: ");
   return {
       "repulsive spring",
       [k, length](double r) { return r < length ? 0.5 * k * (length - r) * (length - r) : 0.0; },

@@ -423,10 +423,6 @@ class Reader : public KeyReader {
                                                            : std::string(" (> 0)")));
       }
     }
-    if (ct.get("radius") != nullptr && !(cylinder.radius > 0.0)) {
-      fail(ct.get("radius"), prefix + ".radius",
-           fmt::format("{}.radius: must be > 0, got {}", prefix, cylinder.radius));
-    }
     if (!axes(3).contains(cylinder.axis)) {
       fail(ct.get("axis"), prefix + ".axis",
            fmt::format("{}.axis: '{}' is not an axis (x, y or z)", prefix, cylinder.axis));

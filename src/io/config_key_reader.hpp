@@ -404,19 +404,9 @@ class KeyReader {
       }
       const double speed = number_value(*row->get(0), row_path + "[0]");
       const double e = number_value(*row->get(1), row_path + "[1]");
-      if (!(speed >= 0.0)) {
-        fail(row->get(0), row_path,
-             fmt::format("{}: impact speed must be >= 0, got {}", row_path, speed));
-      }
-      if (!out.empty() && !(speed > out.back()[0])) {
-        fail(row->get(0), row_path,
-             fmt::format("{}: impact speeds must be strictly increasing, got {} after {}", row_path,
-                         speed, out.back()[0]));
-      }
-      if (!kRestitutionDomain.contains(e)) {
-        fail(row->get(1), row_path,
-             fmt::format("{}: restitution must be {}, got {}", row_path, kRestitutionDomain.text(),
-                         e));
+      const auto previous = out.empty() ? std::nullopt : std::optional<double>(out.back()[0]);
+      if (const auto fault = restitution_table_row_fault(speed, previous, e)) {
+        fail(row->get(fault->entry), row_path, fmt::format("{}: {}", row_path, fault->why));
       }
       out.push_back({speed, e});
     }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "interactions/parameter_domain.hpp"
 
 namespace kairos {
 
@@ -175,8 +176,7 @@ void Environment<D>::check() const {
       const std::string name =
           std::string(sphere ? "boundary.sphere[" : "boundary.cylinder[") + std::to_string(s) + "]";
       if (c.axis < 0 || c.axis >= D) throw InputError(name + ": axis must be a box axis");
-      if (!(c.radius > 0.0) || !std::isfinite(c.radius))
-        throw InputError(name + ": radius must be finite and > 0");
+      require_positive(c.radius, "radius", name + ": ");
       if (!std::isfinite(c.angular_velocity))
         throw InputError(name + ": angular_velocity must be finite");
       for (int a = 0; a < D; ++a) {

@@ -327,14 +327,8 @@ std::pair<Vec<D>, double> plane_through(const std::vector<double>& normal,
 // A wall's contact law and motion from its keys (a face wall's or a plane's).
 template <int D>
 Wall<D> make_wall(const WallConfig& wc, const std::string& where) {
-  Wall<D> wall;
+  Wall<D> wall = wall_motion<D>(wc);
   wall.contact = make_contact_model(wc.contact, where);
-  wall.velocity = to_vec<D>(wc.velocity);
-  wall.amplitude = wc.amplitude;
-  wall.angular_frequency = 2.0 * std::numbers::pi * wc.frequency;
-  wall.phase = wc.phase;
-  wall.mass = wc.mass;
-  wall.force = wc.force;
   return wall;
 }
 
@@ -451,6 +445,27 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
   return env;
 }
 
+template <int D>
+Wall<D> wall_motion(const WallConfig& wc) {
+  Wall<D> wall;
+  wall.velocity = to_vec<D>(wc.velocity);
+  wall.amplitude = wc.amplitude;
+  wall.angular_frequency = 2.0 * std::numbers::pi * wc.frequency;
+  wall.phase = wc.phase;
+  wall.mass = wc.mass;
+  wall.force = wc.force;
+  return wall;
+}
+
+double face_wall_offset(const WallConfig& wc, int dimension, double t) {
+  const auto offset = [&]<int D>() {
+    return wall_motion<D>(wc).plane_position(face_index(wc.face, D), Vec<D>{}, t);
+  };
+  return dimension == 2 ? offset.template operator()<2>() : offset.template operator()<3>();
+}
+
+template Wall<2> wall_motion<2>(const WallConfig&);
+template Wall<3> wall_motion<3>(const WallConfig&);
 template Environment<2> make_environment<2>(const Config&, const ParticleSystem<2>&);
 template Environment<3> make_environment<3>(const Config&, const ParticleSystem<3>&);
 

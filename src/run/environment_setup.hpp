@@ -23,4 +23,13 @@ ContactModel make_contact_model(const ContactConfig& c, const std::string& where
 template <int D>
 Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s);
 
+// A wall's motion from its keys (velocity, vibration, mass and force), without its contact law.
+template <int D>
+Wall<D> wall_motion(const WallConfig& wc);
+
+// Where the plane of the face wall `wc` lies at time t, less its face's rest position (0 or L):
+// Wall::plane_position from the keys alone, for comparing two configurations before any
+// Environment exists (a restart's, run/restart_plan.cpp).
+double face_wall_offset(const WallConfig& wc, int dimension, double t);
+
 }  // namespace kairos

@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include "core/error.hpp"
+#include "run/environment_setup.hpp"
 
 namespace kairos {
 
@@ -124,20 +125,6 @@ std::string whole_part(const std::string& key, const Flat& other) {
   return key;
 }
 
-// The plane of a wall along its axis at time t, less its face's rest position (0 or L): the
-// normal velocity's drift and the vibration, as Wall::plane_position (boundaries/face_wall.hpp)
-// has them, from the configuration's keys (both configurations are compared before any
-// Environment exists).
-double plane_offset(const WallConfig& w, int dimension, double t) {
-  const int axis = w.face[0] - 'x';
-  const double u =
-      axis < static_cast<int>(w.velocity.size()) && axis < dimension ? w.velocity[axis] : 0.0;
-  const double vibration = w.amplitude > 0.0 && w.frequency > 0.0
-                               ? w.amplitude * std::sin(2.0 * M_PI * w.frequency * t + w.phase)
-                               : 0.0;
-  return u * t + vibration;
-}
-
 // A wall whose plane the new configuration puts elsewhere at the state's time (another normal
 // velocity, amplitude, frequency or phase, or a new moving wall: the plane is a function of
 // the absolute time) would jump through the particles: refused, as a new shear rate is.
@@ -147,8 +134,8 @@ void check_walls_stay(const Config& before, const Config& now, double t,
   for (const WallConfig& w : now.boundary.walls) {
     double was = 0.0;  // a new wall starts from its face
     for (const WallConfig& old : before.boundary.walls)
-      if (old.face == w.face) was = plane_offset(old, before.system.dimension, t);
-    const double is = plane_offset(w, now.system.dimension, t);
+      if (old.face == w.face) was = face_wall_offset(old, before.system.dimension, t);
+    const double is = face_wall_offset(w, now.system.dimension, t);
     if (std::abs(is - was) <= 1e-12 * (1.0 + std::abs(was))) continue;
     throw InputError(fmt::format(
         "restart file '{}': boundary.wall (face {}) would jump at once from {:.6g} to {:.6g} "

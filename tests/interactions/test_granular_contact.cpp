@@ -730,9 +730,9 @@ TEST(NormalRestitution, TableRejectsBadInputNamingTheProblem) {
   EXPECT_NE(message({1, 1}, {0.5, 0.5}).find("strictly increasing"), std::string::npos);
   EXPECT_NE(message({-1, 1}, {0.5, 0.5}).find(">= 0"), std::string::npos);
   EXPECT_NE(message({nan, 1}, {0.5, 0.5}).find("finite"), std::string::npos);
-  EXPECT_NE(message({0, 1}, {0.5, 1.5}).find("not in [0, 1]"), std::string::npos);
-  EXPECT_NE(message({0, 1}, {-0.1, 0.5}).find("not in [0, 1]"), std::string::npos);
-  EXPECT_NE(message({0, 1}, {0.5, nan}).find("not in [0, 1]"), std::string::npos);
+  EXPECT_NE(message({0, 1}, {0.5, 1.5}).find("restitution must be in [0, 1]"), std::string::npos);
+  EXPECT_NE(message({0, 1}, {-0.1, 0.5}).find("restitution must be in [0, 1]"), std::string::npos);
+  EXPECT_NE(message({0, 1}, {0.5, nan}).find("restitution must be in [0, 1]"), std::string::npos);
 }
 
 TEST(NormalRestitution, SpeedDependentRestitutionIsUsedPerCollision) {

@@ -200,11 +200,12 @@ TEST(ContinuousPotentials, FactoriesGiveTheirFormulas) {
 }
 
 TEST(ContinuousPotentials, BadParametersAreRejected) {
-  EXPECT_INPUT_ERROR(wca(0.0, 1.0), "wca: eps must be positive");
-  EXPECT_INPUT_ERROR(lennard_jones(1.0, -1.0, 2.5, true), "lennard_jones: sigma must be positive");
+  EXPECT_INPUT_ERROR(wca(0.0, 1.0), "wca: eps must be finite and > 0");
+  EXPECT_INPUT_ERROR(lennard_jones(1.0, -1.0, 2.5, true),
+                     "lennard_jones: sigma must be finite and > 0");
   EXPECT_INPUT_ERROR(yukawa(0.0, 1.0, 1.0, 3.0, true), "yukawa: eps must be finite and non-zero");
   EXPECT_INPUT_ERROR(yukawa(1.0, 1.0, -1.0, 3.0, true), "yukawa: kappa");
-  EXPECT_INPUT_ERROR(morse(1.0, 1.0, 0.0, 3.0, true), "morse: alpha must be positive");
+  EXPECT_INPUT_ERROR(morse(1.0, 1.0, 0.0, 3.0, true), "morse: alpha must be finite and > 0");
   EXPECT_INPUT_ERROR(harmonic_spring(1.0, 2.0, 1.5), "spring: length 2 must be shorter");
 }
 

@@ -811,7 +811,7 @@ TEST(ConfigGranularErrors, RestitutionTable) {
                {"contact.restitution_table[1]", "strictly increasing"});
   expect_error(minimal_plus("[contact]\nrestitution_model = \"table\"\nrestitution_table = "
                             "[[-1.0, 1.0]]"),
-               {"contact.restitution_table[0]", "impact speed must be >= 0"});
+               {"contact.restitution_table[0]", "impact speed must be finite and >= 0"});
   expect_error(minimal_plus("[contact]\nrestitution_model = \"table\"\nrestitution_table = "
                             "[[0.0, 1.5]]"),
                {"contact.restitution_table[0]", "restitution must be in [0, 1]", "got 1.5"});

@@ -236,7 +236,7 @@ constexpr KeyDecl kCylinder[] = {
     {.name = "radius",
      .type = KeyType::kFloat,
      .member = field<&CylinderConfig::radius>,
-     .range = {.lo = 0.0, .lo_open = true, .by_rule = true},
+     .range = {.lo = 0.0, .lo_open = true},
      .default_text = "**required**",
      .unit = "length",
      .doc = "its radius"},
