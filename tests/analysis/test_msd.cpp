@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "../release_suite_only.hpp"
 #include "analysis/msd.hpp"
 
 namespace kairos {
@@ -96,6 +97,7 @@ MsdCorrelator<3>::Diffusion walk(std::uint64_t seed, double d0) {
 }
 
 TEST(MsdCorrelator, ARandomWalkGivesBackItsDiffusionCoefficientWithinItsErrorBar) {
+  KAIROS_RELEASE_SUITE_ONLY();
   const double d0 = 0.3;
   std::vector<double> values, errors;
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {

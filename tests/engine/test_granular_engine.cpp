@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "../release_suite_only.hpp"
 #include "analysis/granular_theory.hpp"
 #include "engine/event_engine.hpp"
 #include "engine_fixtures.hpp"
@@ -83,6 +84,7 @@ void check_cooling_per_collision(int n, double eta, double e, double c_end, doub
 }
 
 TEST(GranularEngine, CoolingPerCollisionFollowsTheExponentialLaw3D) {
+  KAIROS_RELEASE_SUITE_ONLY();
   check_cooling_per_collision<3>(13, 0.02, 0.9, 10.0, 0.02);
   check_cooling_per_collision<3>(13, 0.02, 0.8, 5.0, 0.02);
 }
@@ -96,6 +98,7 @@ TEST(GranularEngine, CoolingPerCollisionFollowsTheExponentialLaw2D) {
 // g(sigma)) at T0. At eta = 0.02 Enskog is accurate to well below the statistics; the Sonine
 // correction shifts T(tau0) by ~0.3 %.
 TEST(GranularEngine, TemperatureFollowsHaffsLaw3D) {
+  KAIROS_RELEASE_SUITE_ONLY();
   constexpr int D = 3;
   const double e = 0.9, eta = 0.02;
   std::vector<double> times, sum(4, 0.0);
@@ -271,6 +274,7 @@ TEST(GranularEngine, IncrementalCrossingsValidatedInCoolingGases) {
 }
 
 TEST(GranularEngine, RoughSpheresReachTheMeanFieldTemperatureRatio3D) {
+  KAIROS_RELEASE_SUITE_ONLY();
   check_rough_cooling_state<3>(13, 0.9, 0.5, 0.06);
   check_rough_cooling_state<3>(13, 0.9, 0.0, 0.06);
 }

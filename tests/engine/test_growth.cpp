@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "../release_suite_only.hpp"
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "engine_fixtures.hpp"
@@ -75,6 +76,7 @@ TEST(Growth, ValidatedAgainstBruteForce2D) {
 }
 
 TEST(Growth, ValidatedBinaryMixtureGrowingFast) {
+  KAIROS_RELEASE_SUITE_ONLY();
   // Diameter ratio 1.4, fast growth: pairs are often reached by the growth alone.
   run_validated_growth<3>(lattice_system<3>(6, 0.2, 13, 1.0, 1.4), 0.5, 3000, 1.6);
   run_validated_growth<2>(lattice_system<2>(10, 0.3, 14, 2.0, 1.4), 0.5, 3000, 1.6);

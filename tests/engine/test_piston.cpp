@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "../release_suite_only.hpp"
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -200,6 +201,7 @@ ParticleSystem<3> dilute_gas(int n, const Vec<3>& box, std::uint64_t seed, doubl
 // alone (T V^(2/3) const) predicts 3.4 % less here, an isothermal compression 40 % less: the
 // 1 % tolerance tells them apart.
 TEST(Piston, SlowCompressionOfADiluteGasFollowsTheAdiabat) {
+  KAIROS_RELEASE_SUITE_ONLY();
   const int n = 8;
   const double side = 24.0, h0 = 40.0, h1 = 20.0, u = 0.01;
   const double t_end = (h0 - h1) / u;

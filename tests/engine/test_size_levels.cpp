@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "../release_suite_only.hpp"
 #include "core/error.hpp"
 #include "engine/event_engine.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -105,6 +106,7 @@ std::vector<double> run_validated(EventEngine<D, CalendarQueue>& engine, int eve
 }
 
 TEST(SizeLevels, ValidatedAgainstBruteForce3D) {
+  KAIROS_RELEASE_SUITE_ONLY();
   // Diameters 1 and 4: fine cells of about 1, coarse cells of about 4, a big one's reach 3.
   const auto s = wide_mixture<3>(13.0, 2, 4.0, 0.15, 21);
   EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict);

@@ -19,6 +19,7 @@ import subprocess
 import sys
 import tempfile
 import threading
+import time
 import unittest
 import zlib
 
@@ -37,6 +38,15 @@ RUN_TIMEOUT = 120
 SANITIZED = os.environ.get("KAIROS_SANITIZED") == "1"
 SLOWDOWN = 5.0 if SANITIZED else 1.0
 
+
+def release_suite_only(test):
+    """Marks a long physics comparison that only the Release suite runs (`make test`), not the
+    suite under the sanitizers (`make asan`): its code paths are taken there by shorter tests, and
+    a longer run only costs CI's budget (README, "Tests"). tests/release_suite_only.hpp is the C++
+    counterpart."""
+    return unittest.skipIf(SANITIZED, "a long physics comparison: run by the Release suite "
+                           "(make test), not under the sanitizers")(test)
+
 # The float64 chunks that hold the exact state of a restart file.
 EXACT_CHUNKS = ("kairos/state/position", "kairos/velocity", "kairos/time",
                 "kairos/state/local_time")
@@ -53,7 +63,29 @@ def main():
     if not os.access(KAIROS, os.X_OK):
         sys.stderr.write("not an executable: %s\n" % KAIROS)
         sys.exit(2)
-    unittest.main(argv=[sys.argv[0]], verbosity=2)
+    runner = unittest.TextTestRunner(verbosity=2, resultclass=_TimedResult)
+    outcome = unittest.main(argv=[sys.argv[0]], testRunner=runner, exit=False).result
+    # The slowest tests, for whoever keeps the suite inside CI's budget (README, "Tests").
+    for seconds, name in sorted(outcome.durations, reverse=True)[:5]:
+        sys.stderr.write("%8.2f s  %s\n" % (seconds, name))
+    sys.exit(0 if outcome.wasSuccessful() else 1)
+
+
+class _TimedResult(unittest.TextTestResult):
+    """unittest's text result, which also records each test's wall time."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.durations = []
+        self._started = 0.0
+
+    def startTest(self, test):
+        self._started = time.monotonic()
+        super().startTest(test)
+
+    def stopTest(self, test):
+        self.durations.append((time.monotonic() - self._started, test.id()))
+        super().stopTest(test)
 
 
 def example(name):

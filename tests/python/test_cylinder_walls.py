@@ -35,6 +35,7 @@ def drum_validation():
 
 
 class CylinderWalls(kt.KairosTestCase):
+    @kt.release_suite_only
     def test_the_drum_turns_its_bed_inside_the_drum(self):
         out = self.path("drum")
         self.run_ok("run", kt.example("rotating_drum_2d.toml"), "-o", out,
@@ -106,7 +107,7 @@ class CylinderWalls(kt.KairosTestCase):
                        "contact.tc"):
             self.assertIn(needle, result.stderr)
 
-    @unittest.skipIf(kt.SANITIZED, "a physics comparison (40 s under the sanitizers' slowdown x5)")
+    @kt.release_suite_only
     def test_the_drum_slope_is_the_dem_drums(self):
         # docs/validation.md, "The rotating drum against the DEM" (one seed of the two, half as
         # long): the free surface's slope over the middle of the bed in the second half (the

@@ -151,6 +151,7 @@ class GranularExamples(kt.KairosTestCase):
         self.assertEqual(s["kinetic_energy"], 0.0)
         self.draw_picture("granular_pile_3d.toml", out)
 
+    @kt.release_suite_only
     def test_fixed_obstacles_2d(self):
         out, s = self.check_run("fixed_obstacles_2d.toml")
         # Every grain ends asleep, on the floor or on the fixed obstacles, which never moved.
@@ -176,6 +177,7 @@ class GranularExamples(kt.KairosTestCase):
         self.assertLess(lid[-1], lid[0])  # the lid came down onto the gas
         self.draw_picture("free_piston_3d.toml", out)
 
+    @kt.release_suite_only
     def test_rotating_drum_3d(self):
         out, s = self.check_run("rotating_drum_3d.toml")
         self.assertLess(abs(s["granular"]["energy_balance_relative"]), 1e-10)
@@ -204,6 +206,7 @@ class GranularExamples(kt.KairosTestCase):
                          outlet["total_passes_since_start"])
         self.draw_picture("silo_2d.toml", out)
 
+    @kt.release_suite_only
     def test_silo_3d(self):
         out, s = self.check_run("silo_3d.toml")
         # Spheres leave through the slot and come back: the count in thermo.tsv and summary.
@@ -421,6 +424,7 @@ class CompressionExamples(kt.KairosTestCase):
     def draw(self, out):
         draw_png(self, "plot_compression.py", out, self.path("compress.png"))
 
+    @kt.release_suite_only
     def test_jammed_spheres_3d(self):
         out, s = self.run_example("jammed_spheres_3d.toml")
         c = s["compression"]
@@ -479,6 +483,7 @@ class CompressionExamples(kt.KairosTestCase):
         self.assertAlmostEqual(np.std(d) / np.mean(d), 0.1, delta=0.02)
         self.draw(out)
 
+    @kt.release_suite_only
     def test_asymmetric_mixture_3d(self):
         out, s = self.run_example("asymmetric_mixture_3d.toml")
         c = s["compression"]

@@ -80,10 +80,12 @@ class LorentzGas(kt.KairosTestCase):
                         "D / D_Boltzmann = %.4f +- %.4f" % (ratio, error))
         self.assertLess(error, 0.02)
 
+    @kt.release_suite_only
     def test_spheres_diffuse_as_the_boltzmann_lorentz_theory_says(self):
         # n = 0.02: mean free path 63, box 159 (2.5 paths: no corridor along an axis survives).
         self.check(3, 80000, 3000, 158.74, 2500.0, 1)
 
+    @kt.release_suite_only
     def test_disks_diffuse_as_the_boltzmann_lorentz_theory_says(self):
         # n = 0.005: transport path 150, box 600.
         self.check(2, 1800, 2000, 600.0, 30000.0, 2)

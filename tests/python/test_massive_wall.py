@@ -44,6 +44,7 @@ def lid_config(**sections):
 
 
 class MassiveWall(kt.KairosTestCase):
+    @kt.release_suite_only
     def test_the_free_piston_example_holds_the_equation_of_state(self):
         out = self.path("out")
         self.run_ok("run", kt.example("free_piston_3d.toml"), "-o", out)
@@ -98,6 +99,7 @@ class MassiveWall(kt.KairosTestCase):
         position = np.array([r[header.index("wall_z+_position")] for r in rows])
         self.assertLess(position[-1], position[0] - 1.0)
 
+    @kt.release_suite_only
     def test_the_dem_holds_the_lid_where_the_engine_does(self):
         # The same elastic gas under the same lid, hard spheres event-driven and soft ones
         # (an undamped spring of k = 10^5, e = 1) with the DEM: the lid settles at the height

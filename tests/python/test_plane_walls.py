@@ -30,6 +30,7 @@ def small_config(**boundary):
 
 
 class PlaneWalls(kt.KairosTestCase):
+    @kt.release_suite_only
     def test_the_funnel_settles_with_every_grain_on_the_right_side_of_both_planes(self):
         out = self.path("funnel")
         self.run_ok("run", kt.example("funnel_2d.toml"), "-o", out, "--set", "output.trajectory_interval=1")

@@ -29,6 +29,7 @@ def enskog_viscosity(eta, temperature):
 
 
 class Viscosity(kt.KairosTestCase):
+    @kt.release_suite_only
     def test_dilute_elastic_gas_has_the_enskog_viscosity(self):
         # Reduced shear rate rate / collision frequency ~ 0.05: Burnett corrections ~ 0.3 %.
         # Viscous heating warms the gas during the run (eta ~ sqrt(T)): each row is compared

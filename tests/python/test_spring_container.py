@@ -143,6 +143,7 @@ class SpringContainer(kt.KairosTestCase):
         per_cycle = (dissipated[-1] - dissipated[0]) / ((t[keep][-1] - t[keep][0]) / 2.0)
         return per_cycle / (4.0 * (200.0 * 2000.0 / 2200.0) * (amplitude * w) ** 2), amplitude
 
+    @kt.release_suite_only
     def test_the_dem_moves_the_container_too(self):
         outs = {}
         for k in (1e5, 1e6):

@@ -54,6 +54,7 @@ class Transport(kt.KairosTestCase):
             self.assertAlmostEqual(c["green_kubo"], c["value"],
                                    delta=3 * err + slack * abs(c["value"]), msg=name)
 
+    @kt.release_suite_only
     def test_hard_spheres_have_the_enskog_coefficients(self):
         eta = 0.3
         config = kt.base_config(particles=500, packing_fraction=eta, seed=11, equilibration=100,

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "../release_suite_only.hpp"
 #include "analysis/contact_network.hpp"
 #include "core/error.hpp"
 #include "core/periodic.hpp"
@@ -146,6 +147,7 @@ TEST(Compression, GrowsAWideMixtureOnTwoCellLevels) {
 }
 
 TEST(Compression, SlowGrowthFollowsTheEquationOfState) {
+  KAIROS_RELEASE_SUITE_ONLY();
   auto s = random_start<3>(1000, 0.3, 6);
   CompressionSettings c;
   c.growth_rate = 1e-3;
@@ -179,6 +181,7 @@ TEST(Compression, SlowGrowthFollowsTheEquationOfState) {
 // Jammed by the collision rate (compress.jammed_collision_rate): it diverges with the pressure,
 // w = 2 D (Z - 1) / sqrt(pi) up to the departure from a Maxwellian near jamming.
 TEST(Compression, JammedByTheCollisionRate) {
+  KAIROS_RELEASE_SUITE_ONLY();
   auto s = random_start<3>(300, 0.3, 33);
   CompressionSettings c;
   c.jammed_collision_rate = 1e6;
@@ -228,6 +231,7 @@ void expect_jammed(ParticleSystem<D>& s, const CompressionSettings& c, double ph
 }
 
 TEST(Compression, JamsMonodisperseSpheres) {
+  KAIROS_RELEASE_SUITE_ONLY();
   auto s = random_start<3>(400, 0.3, 4);
   expect_jammed<3>(s, CompressionSettings{}, 0.63, 0.66);
 }
@@ -319,6 +323,7 @@ TEST(ContactNetwork, WallContactsHoldParticlesAndTranslations) {
 // with walls: backbone contacts plus backbone wall contacts = D (N - rattlers) (no free
 // translation). The walls' layering leaves the packing looser than in a periodic box.
 TEST(Compression, JamsSpheresInAClosedBox) {
+  KAIROS_RELEASE_SUITE_ONLY();
   auto s = random_start<3>(300, 0.3, 31);
   const Environment<3> env = between_walls<3>(s, {0, 1, 2, 3, 4, 5});
   const CompressionResult r = compress<3>(s, CompressionSettings{}, {}, env);
@@ -387,6 +392,7 @@ double slit_excess(ParticleSystem<3> s, double eta) {
 }
 
 TEST(Compression, SlowGrowthBetweenWallsIsTheBulkPlusASurfaceTerm) {
+  KAIROS_RELEASE_SUITE_ONLY();
   const auto s = random_start<3>(1000, 0.3, 32);
   const double near = slit_excess(s, 0.40), far = slit_excess(stacked(s), 0.40);
   EXPECT_GT(near, 0.03);
@@ -400,12 +406,15 @@ TEST(Compression, RefusesWhatItCannotDo) {
   c.target_packing_fraction = 0.2;
   EXPECT_THROW(compress(s, c), InputError);  // below the start
   c.target_packing_fraction = 0.72;
-  try {
-    compress(s, c);
-    ADD_FAILURE() << "grew past jamming";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("jammed at packing fraction"), std::string::npos)
-        << e.what();
+  // Growing until it jams takes the Release suite 30 s and the sanitized one 2 minutes.
+  if (!testing::kSanitized) {
+    try {
+      compress(s, c);
+      ADD_FAILURE() << "grew past jamming";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("jammed at packing fraction"), std::string::npos)
+          << e.what();
+    }
   }
   // Too few particles for 3 cells of the grown diameter per axis: a clear error, not the cell
   // list's.
