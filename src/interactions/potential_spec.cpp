@@ -67,7 +67,7 @@ std::string prefix(const PotentialSpec& spec) {
 }
 
 void positive(const PotentialSpec& spec, const char* name, double value) {
-  if (!(value > 0.0) || !std::isfinite(value))
+  if (!kPositiveDomain.contains(value))
     fail(spec, fmt::format("{} must be positive and finite, not {}", name, value));
 }
 

@@ -28,7 +28,7 @@ void check_dimension(int dimension) {
 }
 
 void check_temperature(double kT) {
-  if (!(kT > 0.0) || !std::isfinite(kT))
+  if (!kPositiveDomain.contains(kT))
     throw InputError(fmt::format("the temperature kT must be positive and finite, not {}", kT));
 }
 
