@@ -13,13 +13,12 @@ ContactNetwork contact_network(const Configuration<D>& c, double tolerance,
   ContactNetwork out;
   out.gap_tolerance = tolerance;
   const std::size_t n = c.size();
-  double rmax = 0.0;
-  for (double r : c.radius) rmax = std::max(rmax, r);
   out.smallest_open_gap = std::numeric_limits<double>::infinity();
-  // Pairs within 1.1 of the largest contact distance: the contacts and the nearest open gaps.
-  for_each_pair_within(c, 2.2 * rmax, [&](std::size_t i, std::size_t j, const Vec<D>&, double r2) {
+  // Pairs within 1.1 of their contact distance: the contacts and the nearest open gaps.
+  for_each_pair_near_contact(c, 1.1, [&](std::size_t i, std::size_t j, const Vec<D>&, double r2) {
     const double sigma = c.radius[i] + c.radius[j];
     const double gap = (std::sqrt(r2) - sigma) / sigma;
+    if (gap >= 0.1) return;  // beyond 1.1 contact distances: no gap of the packing's
     if (gap < tolerance) {
       out.contacts.push_back({static_cast<std::uint32_t>(std::min(i, j)),
                               static_cast<std::uint32_t>(std::max(i, j)), gap});

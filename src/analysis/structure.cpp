@@ -492,9 +492,6 @@ template <int D>
 BondOrderValues<D> bond_order(const Configuration<D>& c, double cutoff) {
   const std::size_t n = c.size();
   BondOrderValues<D> out;
-  double largest = 0.0;
-  for (const double r : c.radius) largest = std::max(largest, r);
-  const double search = cutoff * 2.0 * largest;
   const auto bonded = [&](std::uint32_t i, std::uint32_t j, double r2) {
     const double reach = cutoff * (c.radius[i] + c.radius[j]);
     return r2 < reach * reach;
@@ -507,8 +504,8 @@ BondOrderValues<D> bond_order(const Configuration<D>& c, double cutoff) {
     out.names = {"psi6"};
     out.local.assign(1, std::vector<double>(n, 0.0));
     std::vector<std::complex<double>> psi(n);
-    for_each_pair_within(
-        c, search, [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2) {
+    for_each_pair_near_contact(
+        c, cutoff, [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2) {
           if (!bonded(i, j, r2)) return;
           const std::complex<double> u = std::complex<double>(r[0], r[1]) / std::sqrt(r2);
           const std::complex<double> u2 = u * u;
@@ -537,23 +534,23 @@ BondOrderValues<D> bond_order(const Configuration<D>& c, double cutoff) {
     // Neighbour lists (two passes: counts, then members), then q_lm per particle.
     out.names = {"q4", "q6"};
     out.local.assign(2, std::vector<double>(n, 0.0));
-    for_each_pair_within(c, search,
-                         [&](std::uint32_t i, std::uint32_t j, const Vec<D>&, double r2) {
-                           if (!bonded(i, j, r2)) return;
-                           ++neighbours[i];
-                           ++neighbours[j];
-                         });
+    for_each_pair_near_contact(c, cutoff,
+                               [&](std::uint32_t i, std::uint32_t j, const Vec<D>&, double r2) {
+                                 if (!bonded(i, j, r2)) return;
+                                 ++neighbours[i];
+                                 ++neighbours[j];
+                               });
     std::vector<std::uint32_t> start(n + 1, 0);
     for (std::size_t i = 0; i < n; ++i) start[i + 1] = start[i] + neighbours[i];
     std::vector<std::uint32_t> list(start[n]);
     {
       std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
-      for_each_pair_within(c, search,
-                           [&](std::uint32_t i, std::uint32_t j, const Vec<D>&, double r2) {
-                             if (!bonded(i, j, r2)) return;
-                             list[next[i]++] = j;
-                             list[next[j]++] = i;
-                           });
+      for_each_pair_near_contact(c, cutoff,
+                                 [&](std::uint32_t i, std::uint32_t j, const Vec<D>&, double r2) {
+                                   if (!bonded(i, j, r2)) return;
+                                   list[next[i]++] = j;
+                                   list[next[j]++] = i;
+                                 });
     }
     out.bonds = start[n] / 2;
     constexpr std::array<int, 2> kL = {4, 6};

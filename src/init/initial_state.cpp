@@ -502,8 +502,7 @@ template <int D>
 void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state,
                      std::mt19937_64& rng, double class_width) {
   const std::size_t N = state.position.size();
-  const double dmax = *std::max_element(state.diameter.begin(), state.diameter.end());
-  InsertionGrid<D> grid(layout.box, dmax, N);
+  InsertionGrid<D> grid(layout.box, state.diameter);
   // Memory: at most 8 N voxel ids at the start of a diameter class, 16 N after refinements.
   const std::size_t max_voxels = std::max<std::size_t>(8 * N, 1024);
   std::optional<VoxelSampler<D>> voxels;
@@ -523,14 +522,14 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
     // covers the voxel.
     const auto covered = [&](std::uint64_t voxel) {
       const std::array<double, D> c = voxels->centre(voxel);
-      return grid.for_each_neighbour(grid.coords(c), [&](std::uint32_t j) {
+      return grid.for_each_near(c, class_smallest, [&](std::uint32_t j) {
         return voxels->covered(c, state.position[j], 0.5 * (class_smallest + state.diameter[j]));
       });
     };
     // The exclusion spheres (for diameter di) of the placed particles near a point.
     const auto gather = [&](const std::array<double, D>& point,
                             std::vector<typename VoxelSampler<D>::Sphere>& out) {
-      grid.for_each_neighbour(grid.coords(point), [&](std::uint32_t j) {
+      grid.for_each_near(point, di, [&](std::uint32_t j) {
         out.push_back({state.position[j], 0.5 * (di + state.diameter[j])});
         return false;
       });
@@ -552,7 +551,7 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
       const std::uint64_t voxel = voxels->voxel(slot);
       const std::array<double, D> x = voxels->point_in(voxel, rng);
       ++tries;
-      const bool is_free = !grid.for_each_neighbour(grid.coords(x), [&](std::uint32_t j) {
+      const bool is_free = !grid.for_each_near(x, di, [&](std::uint32_t j) {
         return pair_overlap<D>(layout.box, x, state.position[j], di, state.diameter[j]) > 0;
       });
       if (is_free) {
@@ -1178,12 +1177,12 @@ double worst_pair(const std::array<double, D>& box, const std::vector<std::array
   }
   if (N < 2 || !(dmax > 0.0)) return 0.0;
 
-  InsertionGrid<D> grid(box, dmax, N);
+  InsertionGrid<D> grid(box, diameter);
   for (std::size_t i = 0; i < N; ++i) grid.insert(static_cast<std::uint32_t>(i), pos[i]);
   double worst = 0.0;
   for (std::size_t i = 0; i < N; ++i) {
     if (interruptible) poll_stop(i);
-    grid.for_each_neighbour(grid.coords(pos[i]), [&](std::uint32_t j) {
+    grid.for_each_near(pos[i], diameter[i], [&](std::uint32_t j) {
       if (j <= i) return false;  // each pair once: j's cell is visited once from i's cell
       const double ov = pair_overlap<D>(box, pos[i], pos[j], diameter[i], diameter[j]);
       if (!(ov > 0.0)) return false;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/periodic.hpp"
+#include "core/size_classes.hpp"
 #include "init/initial_state.hpp"
 
 namespace kairos {
@@ -24,87 +25,118 @@ double box_volume(const std::array<double, D>& box) {
   return v;
 }
 
-// A periodic grid of cells at least `min_width` wide along every axis (at least one cell per
-// axis), with the total number of cells capped near `max_cells` by widening the cells.
-// Particles are kept in per-cell linked lists.
+// One periodic grid of cells per size class (core/size_classes.hpp), each at least as wide as
+// its class's largest diameter along every axis (at least one cell per axis), with its number
+// of cells capped near twice its members by widening the cells. Particles are kept in per-cell
+// linked lists. A search around a point visits, in each class's grid, the cells that may hold
+// a particle touching a sphere of the given diameter there: the 3^D cells around it when the
+// diameters are within a factor 2 of each other (one class), more rings of the finer grids
+// for a large sphere among small ones. Each cell is visited at most once per search.
 template <int D>
 class InsertionGrid {
  public:
-  InsertionGrid(const std::array<double, D>& box, double min_width, std::size_t particles)
-      : box_(box) {
-    const std::size_t max_cells = std::max<std::size_t>(64, 2 * particles);
-    double width = min_width;
-    double total = 1.0;
-    for (int k = 0; k < D; ++k) total *= std::max(1.0, std::floor(box[k] / width));
-    if (total > static_cast<double>(max_cells)) {
-      width = std::max(width, std::pow(box_volume<D>(box) / static_cast<double>(max_cells),
-                                       1.0 / static_cast<double>(D)));
-    }
-    std::size_t cells = 1;
-    for (int k = 0; k < D; ++k) {
-      const double nk =
-          std::min(std::max(1.0, std::floor(box[k] / width)), static_cast<double>(max_cells));
-      n_[k] = static_cast<std::size_t>(nk);
-      cells *= n_[k];
-    }
-    head_.assign(cells, kNoParticle);
-    next_.assign(particles, kNoParticle);
-  }
-
-  std::array<std::size_t, D> coords(const std::array<double, D>& x) const {
-    std::array<std::size_t, D> c{};
-    for (int k = 0; k < D; ++k) {
-      const double u = wrap_into_box(x[k], box_[k]) / box_[k] * static_cast<double>(n_[k]);
-      c[k] = std::min(static_cast<std::size_t>(u), n_[k] - 1);
-    }
-    return c;
-  }
-
-  std::size_t index(const std::array<std::size_t, D>& c) const {
-    std::size_t idx = 0;
-    for (int k = D - 1; k >= 0; --k) idx = idx * n_[k] + c[k];
-    return idx;
+  // `diameters` of every particle that may be inserted, by index.
+  InsertionGrid(const std::array<double, D>& box, const std::vector<double>& diameters)
+      : box_(box), classes_(size_classes(diameters)) {
+    for (std::size_t k = 0; k < classes_.count(); ++k) grids_.push_back(make_grid(k));
+    next_.assign(diameters.size(), kNoParticle);
   }
 
   void insert(std::uint32_t particle, const std::array<double, D>& x) {
-    const std::size_t cell = index(coords(x));
-    next_[particle] = head_[cell];
-    head_[cell] = particle;
+    Grid& g = grids_[classes_.of[particle]];
+    const std::size_t cell = g.index(g.coords(x, box_));
+    next_[particle] = g.head[cell];
+    g.head[cell] = particle;
   }
 
-  // Calls f(particle) for every particle in the cells adjacent to (and including) the cell at
-  // `c`, until f returns true. Along an axis with fewer than 3 cells every cell is visited
-  // exactly once. Returns whether f stopped the iteration.
+  // Calls f(particle) for every particle inserted so far that may touch a sphere of `diameter`
+  // at x (a superset: callers measure the distance), until f returns true. Returns whether f
+  // stopped the iteration.
   template <class F>
-  bool for_each_neighbour(const std::array<std::size_t, D>& c, F&& f) const {
-    std::array<std::array<std::size_t, 3>, D> axis{};
-    std::array<std::size_t, D> count{};
-    for (int k = 0; k < D; ++k) {
-      if (n_[k] >= 3) {
-        axis[k] = {(c[k] + n_[k] - 1) % n_[k], c[k], (c[k] + 1) % n_[k]};
-        count[k] = 3;
-      } else {
-        for (std::size_t m = 0; m < n_[k]; ++m) axis[k][m] = m;
-        count[k] = n_[k];
+  [[gnu::always_inline]] bool for_each_near(const std::array<double, D>& x, double diameter,
+                                            F&& f) const {
+    for (std::size_t k = 0; k < grids_.size(); ++k) {
+      const Grid& g = grids_[k];
+      const std::array<std::size_t, D> c = g.coords(x, box_);
+      const double reach = 0.5 * (diameter + classes_.largest[k]);
+      // Per axis: the rings of cells around c (c - r .. c + r, wrapped) or, where they would
+      // wrap onto themselves, every cell once. Rings from the class's width (at most the
+      // cells' own): one ring exactly when a cell is as wide as the reach.
+      std::array<std::size_t, D> first{}, span{};
+      for (int a = 0; a < D; ++a) {
+        const double r =
+            reach <= g.width || !std::isfinite(reach) ? 1.0 : std::ceil(reach / g.width);
+        const auto rings = static_cast<std::size_t>(std::min(r, static_cast<double>(g.n[a])));
+        const bool whole = g.n[a] < 2 * rings + 1;
+        first[a] = whole ? 0 : (c[a] + g.n[a] - rings) % g.n[a];
+        span[a] = whole ? g.n[a] : 2 * rings + 1;
+      }
+      std::array<std::size_t, D> pick{};
+      while (true) {
+        std::size_t idx = 0;
+        for (int a = D - 1; a >= 0; --a) {
+          std::size_t along = first[a] + pick[a];  // < 2 n: one wrap at most
+          if (along >= g.n[a]) along -= g.n[a];
+          idx = idx * g.n[a] + along;
+        }
+        for (std::uint32_t p = g.head[idx]; p != kNoParticle; p = next_[p]) {
+          if (f(p)) return true;
+        }
+        int a = 0;
+        while (a < D && ++pick[a] == span[a]) pick[a++] = 0;
+        if (a == D) break;
       }
     }
-    std::array<std::size_t, D> pick{};
-    while (true) {
-      std::array<std::size_t, D> cell{};
-      for (int k = 0; k < D; ++k) cell[k] = axis[k][pick[k]];
-      for (std::uint32_t p = head_[index(cell)]; p != kNoParticle; p = next_[p]) {
-        if (f(p)) return true;
-      }
-      int k = 0;
-      while (k < D && ++pick[k] == count[k]) pick[k++] = 0;
-      if (k == D) return false;
-    }
+    return false;
   }
 
  private:
+  struct Grid {
+    double width = 0.0;  // at most a cell's width along every axis
+    std::array<std::size_t, D> n{};
+    std::vector<std::uint32_t> head;
+
+    std::array<std::size_t, D> coords(const std::array<double, D>& x,
+                                      const std::array<double, D>& box) const {
+      std::array<std::size_t, D> c{};
+      for (int k = 0; k < D; ++k) {
+        const double u = wrap_into_box(x[k], box[k]) / box[k] * static_cast<double>(n[k]);
+        c[k] = std::min(static_cast<std::size_t>(u), n[k] - 1);
+      }
+      return c;
+    }
+    std::size_t index(const std::array<std::size_t, D>& c) const {
+      std::size_t idx = 0;
+      for (int k = D - 1; k >= 0; --k) idx = idx * n[k] + c[k];
+      return idx;
+    }
+  };
+
+  Grid make_grid(std::size_t k) const {
+    const std::size_t max_cells = std::max<std::size_t>(64, 2 * classes_.members[k]);
+    double width = classes_.largest[k];
+    double total = 1.0;
+    for (int a = 0; a < D; ++a) total *= std::max(1.0, std::floor(box_[a] / width));
+    if (total > static_cast<double>(max_cells)) {
+      width = std::max(width, std::pow(box_volume<D>(box_) / static_cast<double>(max_cells),
+                                       1.0 / static_cast<double>(D)));
+    }
+    Grid g;
+    g.width = width;
+    std::size_t cells = 1;
+    for (int a = 0; a < D; ++a) {
+      const double na =
+          std::min(std::max(1.0, std::floor(box_[a] / width)), static_cast<double>(max_cells));
+      g.n[a] = static_cast<std::size_t>(na);
+      cells *= g.n[a];
+    }
+    g.head.assign(cells, kNoParticle);
+    return g;
+  }
+
   std::array<double, D> box_;
-  std::array<std::size_t, D> n_{};
-  std::vector<std::uint32_t> head_;
+  SizeClasses classes_;
+  std::vector<Grid> grids_;
   std::vector<std::uint32_t> next_;
 };
 

@@ -226,11 +226,11 @@ void move_inside_walls(const Config& config, ParticleSystem<D>& s, std::mt19937_
       if (walls.is_surface(k) && !(walls.gap(k, x, 0.0) >= r)) return false;
     return true;
   };
-  double dmax = 0.0;
-  for (const Kinematics<D>& k : s.kinematics) dmax = std::max(dmax, 2.0 * k.radius);
-  // The particles in place, in random insertion's grid (cells at least dmax wide, capped in
+  std::vector<double> diameters;
+  for (const Kinematics<D>& k : s.kinematics) diameters.push_back(2.0 * k.radius);
+  // The particles in place, in random insertion's grid (cells per size class, capped in
   // number); those outside a wall are moved one by one.
-  InsertionGrid<D> grid(s.box, dmax, s.kinematics.size());
+  InsertionGrid<D> grid(s.box, diameters);
   std::vector<std::uint32_t> outside;
   for (std::uint32_t i = 0; i < s.kinematics.size(); ++i) {
     const Kinematics<D>& k = s.kinematics[i];
@@ -243,7 +243,7 @@ void move_inside_walls(const Config& config, ParticleSystem<D>& s, std::mt19937_
   // Apart from every particle in place (the grid's cells around x; the minimum image on
   // periodic axes only).
   const auto free_at = [&](const Vec<D>& x, double r) {
-    return !grid.for_each_neighbour(grid.coords(x), [&](std::uint32_t j) {
+    return !grid.for_each_near(x, 2.0 * r, [&](std::uint32_t j) {
       double d2 = 0.0;
       for (int a = 0; a < D; ++a) {
         double dx = x[a] - s.kinematics[j].pos[a];

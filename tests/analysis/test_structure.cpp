@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -137,6 +138,73 @@ TEST(Structure, PairSearchFindsEveryPairOnceAsBruteForce) {
   }
   EXPECT_THROW(check_pairs<3>(ideal_gas<3>(10, {4.0, 4.0, 4.0}, {true, true, true}, rng), 2.5),
                std::invalid_argument);
+}
+
+// The size-aware search: every pair closer than factor (R_i + R_j) once, over size
+// distributions of several classes (and points of radius 0), against brute force; with one
+// class, exactly the calls of for_each_pair_within at 2 factor R_max, in its order.
+template <int D>
+void check_pairs_near_contact(Configuration<D> c, double factor, double decades,
+                              std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (std::size_t i = 0; i < c.size(); ++i)
+    c.radius[i] = i % 17 == 3 ? 0.0 : 0.5 * std::pow(10.0, -decades * u(rng));
+  std::set<std::pair<std::uint32_t, std::uint32_t>> found, want;
+  for_each_pair_near_contact(
+      c, factor, [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2) {
+        EXPECT_TRUE(found.insert({std::min(i, j), std::max(i, j)}).second) << "pair twice";
+        EXPECT_NEAR(norm2(r), r2, 1e-12);
+        double d2 = 0.0;  // r is r_i - r_j
+        for (int a = 0; a < D; ++a) {
+          double d = c.position[i][a] - c.position[j][a];
+          if (c.periodic[a]) d -= c.box[a] * std::round(d / c.box[a]);
+          d2 += (d - r[a]) * (d - r[a]);
+        }
+        EXPECT_LT(d2, 1e-20);
+      });
+  for (std::uint32_t i = 0; i < c.size(); ++i)
+    for (std::uint32_t j = i + 1; j < c.size(); ++j) {
+      double r2 = 0.0;
+      for (int a = 0; a < D; ++a) {
+        double d = c.position[i][a] - c.position[j][a];
+        if (c.periodic[a]) d -= c.box[a] * std::round(d / c.box[a]);
+        r2 += d * d;
+      }
+      const double cut = factor * (c.radius[i] + c.radius[j]);
+      if (r2 < cut * cut) want.insert({i, j});
+    }
+  // The points (radius 0) make several classes: exactly the pairs within reach.
+  EXPECT_EQ(found, want);
+  EXPECT_FALSE(want.empty());
+}
+
+TEST(Structure, SizeAwarePairSearchFindsEveryPairNearContactOnce) {
+  std::mt19937_64 rng(12);
+  for (const double decades : {0.2, 1.0, 2.5}) {
+    SCOPED_TRACE(decades);
+    check_pairs_near_contact<3>(ideal_gas<3>(1500, {10.0, 7.0, 12.0}, {true, true, true}, rng), 1.3,
+                                decades, rng);
+    auto open = ideal_gas<3>(1500, {10.0, 10.0, 10.0}, {true, false, false}, rng);
+    for (std::size_t i = 0; i < 40; ++i) open.position[i][2] += 3.0;  // above an open top
+    check_pairs_near_contact<3>(open, 2.0, decades, rng);
+    check_pairs_near_contact<2>(ideal_gas<2>(1500, {11.0, 10.0}, {true, false}, rng), 1.5, decades,
+                                rng);
+    check_pairs_near_contact<2>(ideal_gas<2>(800, {2.2, 30.0}, {true, true}, rng), 1.1, decades,
+                                rng);
+  }
+  // Sizes within a factor 2: the plain search's calls, in its order.
+  auto c = ideal_gas<3>(500, {8.0, 8.0, 8.0}, {true, true, true}, rng);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (double& r : c.radius) r = 0.3 + 0.29 * u(rng);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> plain, aware;
+  for_each_pair_within(
+      c, 2.0 * 1.2 * *std::max_element(c.radius.begin(), c.radius.end()),
+      [&](std::uint32_t i, std::uint32_t j, const Vec<3>&, double) { plain.emplace_back(i, j); });
+  for_each_pair_near_contact(c, 1.2, [&](std::uint32_t i, std::uint32_t j, const Vec<3>&, double) {
+    aware.emplace_back(i, j);
+  });
+  EXPECT_EQ(aware, plain);
+  EXPECT_FALSE(plain.empty());
 }
 
 // g(r) of uniform random points is 1 in every bin within its error (Poisson, 1/sqrt(expected

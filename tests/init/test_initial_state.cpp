@@ -267,6 +267,17 @@ TEST(InitRandom, BinaryMixture2D) {
   EXPECT_EQ(st.box[0], st.box[1]);
 }
 
+// Sizes 1 : 10 (insertion's grid in two size classes): no overlap, the counts and packing
+// fraction asked for.
+TEST(InitRandom, AsymmetricMixtureOneToTen) {
+  const std::vector<SpeciesConfig> species = {SpeciesConfig{"small", 1.0, 1.0, 200.0},
+                                              SpeciesConfig{"big", 10.0, 100.0, 1.0}};
+  std::mt19937_64 rng(23);
+  const auto st = make_initial_state<2>(make_system(2, 4020, 0.35, "random", species), rng);
+  expect_valid(st, 4020, 0.35);
+  EXPECT_EQ(std::count(st.species.begin(), st.species.end(), 1u), 20);
+}
+
 TEST(InitRandom, NearTheAllowedLimit) {
   std::mt19937_64 rng(23);
   expect_valid(make_initial_state<3>(make_system(3, 1000, 0.35, "random"), rng), 1000, 0.35);
@@ -390,14 +401,17 @@ TEST(InitVelocities, MakeInitialStateUsesTheTemperature) {
 
 // ---------------------------------------------------------------------------------------------
 
+// Diameters uniform in [0.5, 1.5], or log-uniform over `decades` below 1.5 (many size
+// classes: the grid's rings across classes).
 template <int D>
-void compare_overlaps(std::mt19937_64& rng, const std::array<double, D>& box, std::size_t n) {
+void compare_overlaps(std::mt19937_64& rng, const std::array<double, D>& box, std::size_t n,
+                      double decades = 0.0) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<std::array<double, D>> pos(n);
   std::vector<double> diameter(n);
   for (std::size_t i = 0; i < n; ++i) {
     for (int k = 0; k < D; ++k) pos[i][k] = unit(rng) * box[k];
-    diameter[i] = 0.5 + unit(rng);
+    diameter[i] = decades > 0.0 ? 1.5 * std::pow(10.0, -decades * unit(rng)) : 0.5 + unit(rng);
   }
   std::uint32_t wi = 0, wj = 0;
   const double fast = max_overlap<D>(box, pos, diameter, &wi, &wj);
@@ -431,6 +445,18 @@ TEST(InitMaxOverlap, AgreesWithBruteForce2D) {
       {20.0, 20.0}, {13.0, 4.2}, {3.1, 3.1}, {2.2, 2.2}, {1.5, 30.0}, {0.8, 0.8}, {400.0, 400.0}};
   for (const auto& box : boxes) {
     for (std::size_t n : {2u, 5u, 40u, 300u, 1000u}) compare_overlaps<2>(rng, box, n);
+  }
+}
+
+TEST(InitMaxOverlap, AgreesWithBruteForceOverAWideSizeDistribution) {
+  std::mt19937_64 rng(33);
+  for (const double decades : {1.0, 2.0, 3.5}) {
+    for (std::size_t n : {2u, 40u, 400u, 1500u}) {
+      compare_overlaps<3>(rng, {6.0, 7.0, 5.0}, n, decades);
+      compare_overlaps<3>(rng, {2.0, 9.0, 9.0}, n, decades);
+      compare_overlaps<2>(rng, {12.0, 10.0}, n, decades);
+      compare_overlaps<2>(rng, {40.0, 3.0}, n, decades);
+    }
   }
 }
 

@@ -137,16 +137,22 @@ class TimeLengths(kt.KairosTestCase):
                 if integrator == "event":
                     config = timed_config(1.3, 27.2, output={"thermo_interval": 0.7,
                                                              "trajectory_interval": 1.4})
-                    config["system"]["particles"] = 20000
+                    # Long enough for the limit to fall in the equilibration (a quarter of
+                    # it under the sanitizers, which run it several times slower).
+                    config["system"]["particles"] = 5000 if kt.SANITIZED else 20000
                 else:
                     config = soft_dem_config(0.5, output={"thermo_interval": 0.25,
                                                           "trajectory_interval": 0.25})
-                    # 500 / dt = 714285.7: the equilibration ends 0.7 of a step past its end.
-                    config["run"]["equilibration_time"] = 500.0
+                    # 500 / dt = 714285.7: the equilibration ends 0.7 of a step past its end
+                    # (50 / dt = 71428.6 under the sanitizers, 0.6 of a step past: still far
+                    # beyond the 0.3 s limit there, and ten times shorter to run twice).
+                    config["run"]["equilibration_time"] = 50.0 if kt.SANITIZED else 500.0
                 cfg = self.write_config(config, integrator + ".toml")
                 first, second, whole = (self.path(integrator + x) for x in ("1", "2", "w"))
                 self.run_ok("run", cfg, "-o", first, "--set", "run.max_wall_seconds=0.3")
                 self.assertEqual(self.summary(first)["stop_reason"], "wall_time_limit")
+                _, stopped, _ = kt.read_thermo(os.path.join(first, "thermo.tsv"))
+                self.assertEqual(stopped[-1][0], "equilibration", "stopped after it")
                 self.run_ok("run", cfg, "--restart", os.path.join(first, "restart.gsd"),
                             "-o", second)
                 self.run_ok("run", cfg, "-o", whole)
