@@ -179,11 +179,16 @@ def hash_trajectory(path, h):
                     h.update(f.read_chunk(frame=frame, name=name).tobytes())
 
 
+# Files whose contents are the run's wall-clock history, not its results: left out of the
+# outputs summary.json lists (and never hashed).
+WALL_CLOCK_FILES = {"run.log"}
+
+
 def stable(value):
     if isinstance(value, dict):
         return {k: stable(v) for k, v in value.items() if k not in VOLATILE}
     if isinstance(value, list):
-        return [stable(v) for v in value]
+        return [stable(v) for v in value if not (isinstance(v, str) and v in WALL_CLOCK_FILES)]
     return value
 
 

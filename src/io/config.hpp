@@ -226,6 +226,9 @@ struct OutputConfig {
   std::int64_t trajectory_frames_per_decade = 10;
   double trajectory_log_period = 0.0;
   std::string progress = "auto";  // auto (when stderr is a terminal) | always | never
+  // Wall seconds between the progress lines of run.log in the output directory (and of
+  // stdout, when progress is auto and stderr no terminal); 0: no run.log.
+  double log_interval = 60.0;
   // Profiles along an axis (profile.tsv), sampled at every production thermo row: "" = none,
   // else x, y or z, in profile_bins slabs.
   std::string profile_axis;

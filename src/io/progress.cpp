@@ -16,8 +16,24 @@ std::string format_duration(double seconds) {
                    : fmt::format("{:02}:{:02}", s / 60, s % 60);
 }
 
+std::string progress_text(const ProgressInfo& info, double events_per_second,
+                          double phase_seconds) {
+  const double frac = info.total > 0 ? std::min(1.0, info.done / info.total) : 1.0;
+  const double eta = frac > 1e-9 ? phase_seconds * (1.0 - frac) / frac : -1.0;
+  const std::string done = info.in_time
+                               ? fmt::format("{:.4g}/{:.4g} time", info.done, info.total)
+                               : fmt::format("{:.1f}/{:.0f} coll/particle", info.done, info.total);
+  return fmt::format("[{:<13} {:5.1f}%] {} | t = {:.6g} | {:.3g} M events/s | ETA {}", info.phase,
+                     100.0 * frac, done, info.sim_time, events_per_second / 1e6,
+                     format_duration(eta));
+}
+
+bool stderr_is_a_terminal() {
+  return ::isatty(STDERR_FILENO) != 0;
+}
+
 ProgressLine::ProgressLine(ProgressMode mode) {
-  tty_ = ::isatty(STDERR_FILENO) != 0;
+  tty_ = stderr_is_a_terminal();
   enabled_ = mode == ProgressMode::kAlways || (mode == ProgressMode::kAuto && tty_);
 }
 
@@ -37,15 +53,8 @@ void ProgressLine::update(const ProgressInfo& info, bool force) {
   if (since > 0.0) rate_ = static_cast<double>(info.events - last_events_) / since;
   last_ = now;
   last_events_ = info.events;
-  const double frac = info.total > 0 ? std::min(1.0, info.done / info.total) : 1.0;
-  const double elapsed = std::chrono::duration<double>(now - phase_start_).count();
-  const double eta = frac > 1e-9 ? elapsed * (1.0 - frac) / frac : -1.0;
-  const std::string done = info.in_time
-                               ? fmt::format("{:.4g}/{:.4g} time", info.done, info.total)
-                               : fmt::format("{:.1f}/{:.0f} coll/particle", info.done, info.total);
   const std::string line =
-      fmt::format("[{:<13} {:5.1f}%] {} | t = {:.6g} | {:.3g} M events/s | ETA {}", info.phase,
-                  100.0 * frac, done, info.sim_time, rate_ / 1e6, format_duration(eta));
+      progress_text(info, rate_, std::chrono::duration<double>(now - phase_start_).count());
   if (tty_) {
     std::fprintf(stderr, "\r%-100s", line.c_str());
   } else {

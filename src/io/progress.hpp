@@ -45,4 +45,10 @@ class ProgressLine {
 
 std::string format_duration(double seconds);
 
+// The line's text: phase, share done, simulated time, the event rate given, and the ETA from
+// the phase's wall seconds so far (the progress line's, and run.log's: run/run_log.hpp).
+std::string progress_text(const ProgressInfo& info, double events_per_second, double phase_seconds);
+
+bool stderr_is_a_terminal();
+
 }  // namespace kairos

@@ -43,6 +43,8 @@ RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& res
   restart_file_ = start.restart_file;
   resumed_ = start.resumed;
   plan_ = start.plan;
+  const ProgressMode mode = progress_modes().at(config_.output.progress);
+  log_.emplace(config_.output.log_interval, mode == ProgressMode::kAuto && !stderr_is_a_terminal());
   const std::string restart_name = start.restart_name();
   SetupOutcome<D> setup;
   if (start.compression) {
@@ -50,14 +52,14 @@ RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& res
     setup.packing = std::make_shared<const ParticleSystem<D>>(start.state);
   }
   // Soft spheres: the lookup tables of the collision map, built now or read from the cache.
-  const bool tell = progress_modes().at(config_.output.progress) != ProgressMode::kOff;
+  const bool tell = mode != ProgressMode::kOff;
   std::string building;
   integrator_ = start_integrator<D>(std::move(start), [&](const std::string& contact, double) {
-    if (tell && contact != building) {
-      building = contact;
-      std::fputs(fmt::format("building the soft-contact map table of {} ...\n", contact).c_str(),
-                 stderr);
-    }
+    if (contact == building) return;
+    building = contact;
+    const std::string what = fmt::format("building the soft-contact map table of {}", contact);
+    if (tell) std::fputs((what + " ...\n").c_str(), stderr);
+    log_->note("setup: " + what);
   });
   timed_ =
       config_.run.time > 0.0 || config_.run.equilibration_time >= 0.0 || intervals_in_time(config_);
@@ -105,6 +107,7 @@ RunOutcome RunDriver<D>::run() {
   setup_wall_seconds_ = std::chrono::duration<double>(wall_start - created_).count();
   continuation_ = output_continuation(directory_->continues_outputs(), resumed_);
   for (auto& o : observers_) o->open(*this);
+  open_log();
   ProgressLine progress(progress_modes().at(config_.output.progress));
 
   // A restart continues an interrupted equilibration, otherwise goes straight to production.
@@ -156,6 +159,11 @@ RunOutcome RunDriver<D>::run() {
   failures_.attempt("summary.json", [&] {
     write_text_atomically(directory_->path() / "summary.json", outcome.summary.dump(2) + "\n");
   });
+  const std::string run_failed = failures_.any() ? with_outputs() : error_;
+  log_->line(fmt::format("end: {} after {} of wall time; {} events, {} collisions, t = {:.10g}{}",
+                         stop_reason_, format_duration(wall_seconds_), integrator_->events(),
+                         integrator_->collisions(), integrator_->time(),
+                         run_failed.empty() ? "" : "; error: " + run_failed));
   // failures_.error now ends with the summary's failure (error_ holds the earlier ones).
   if (failures_.failed_file("summary.json")) {
     outcome.error = with_outputs();
@@ -216,8 +224,10 @@ bool RunDriver<D>::run_phase(const std::string& phase, PhaseLength length, Progr
     if (!write_due(at_start)) return stopped_because("write_failed");
   }
   const auto report = [&](double done, bool force) {
-    progress.update(
-        {phase, done, length.value, integrator.time(), integrator.events(), length.in_time}, force);
+    const ProgressInfo info{
+        phase, done, length.value, integrator.time(), integrator.events(), length.in_time};
+    progress.update(info, force);
+    log_->progress(info, force);
   };
   report(0.0, false);
   AdvanceLimits limits;
@@ -341,8 +351,25 @@ nlohmann::json RunDriver<D>::outputs_present() const {
     for (const std::string& more : o->more_files())
       if (fs::exists(directory() / more, ec)) list.push_back(more);
   }
+  if (fs::exists(directory() / "run.log", ec)) list.push_back("run.log");
   if (fs::exists(directory() / "config.toml", ec)) list.push_back("config.toml");
   return list;
+}
+
+// run.log's header: the program and how it was invoked, what it continued, the set-up's wall
+// time; then the set-up's noted steps (RunLog::open).
+template <int D>
+void RunDriver<D>::open_log() {
+  std::vector<std::string> header = {fmt::format(
+      "start: kairos {} (commit {}) on {}: {}", provenance_.version, provenance_.commit,
+      provenance_.host,
+      provenance_.command_line.empty() ? "(no command line)" : provenance_.command_line)};
+  if (!provenance_.restart_file.empty())
+    header.push_back(
+        fmt::format("continues {} at t = {:.10g}", provenance_.restart_file, integrator_->time()));
+  header.push_back(fmt::format("setup: {} particles in {}D, {:.3g} s of wall time",
+                               integrator_->mobile(), D, setup_wall_seconds_));
+  log_->open(directory() / "run.log", header);
 }
 
 template <int D>

@@ -31,6 +31,7 @@
 #include "run/outputs/registry.hpp"
 #include "run/phase_length.hpp"
 #include "run/run.hpp"
+#include "run/run_log.hpp"
 #include "run/trigger.hpp"
 
 namespace kairos {
@@ -93,6 +94,7 @@ class RunDriver final : public RunContext<D> {
   bool stopped_because(const char* reason);
   bool wall_time_exceeded() const;
   nlohmann::json outputs_present() const;
+  void open_log();
 
   // The start of the set-up: the origin of run.max_wall_seconds (the front end's
   // ScopedStopDeadline, which also covers table builds before the driver exists).
@@ -105,6 +107,7 @@ class RunDriver final : public RunContext<D> {
   std::string run_id_;  // the lineage of the outputs (kept by continued runs)
   Provenance provenance_;
   std::optional<OutputDirectory> directory_;  // claimed (locked) while the run lasts
+  std::optional<RunLog> log_;                 // run.log (output.log_interval)
   OutputContinuation continuation_;
   ObserverList<D> observers_;
   std::vector<Trigger> triggers_;  // per observer, of the phase running

@@ -131,7 +131,7 @@ TEST_P(Outputs, TheSummaryHasThePartsOfItsIntegrator) {
   EXPECT_TRUE(s.contains("peak_rss_bytes"));
   // The files written, in the list's order (no profile.tsv without a profile axis).
   EXPECT_EQ(s["outputs"], nlohmann::json({"summary.json", "thermo.tsv", "trajectory.gsd",
-                                          "restart.gsd", "config.toml"}));
+                                          "restart.gsd", "run.log", "config.toml"}));
 }
 
 // The structure analyses of [analysis] sample the production only: at its 8 thermo rows, or
@@ -150,7 +150,7 @@ TEST_P(Outputs, AnalysesSampleTheProductionAndWriteTheirFiles) {
   EXPECT_EQ(a["covers"], "the production");
   EXPECT_EQ(s["outputs"], nlohmann::json({"summary.json", "thermo.tsv", "trajectory.gsd",
                                           "restart.gsd", "rdf.tsv", "sk.tsv", "bond_order.tsv",
-                                          "velocity_distribution.tsv", "config.toml"}));
+                                          "velocity_distribution.tsv", "run.log", "config.toml"}));
   const bool dem = std::string(GetParam()) == "dem";
   EXPECT_EQ(a["rdf"]["contact"].is_null(), dem);
   EXPECT_EQ(a["rdf"]["compressibility_from_contact"]["mean"].is_null(), dem);

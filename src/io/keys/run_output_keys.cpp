@@ -180,6 +180,13 @@ constexpr KeyDecl kOutput[] = {
      .member = field<&OutputConfig::progress>,
      .choices = &choices_of<&progress_modes>,
      .doc = "progress line on stderr"},
+    {.name = "log_interval",
+     .type = KeyType::kFloat,
+     .member = field<&OutputConfig::log_interval>,
+     .range = {.lo = 0.0, .hi = 1e9, .why = "(seconds; 0: no run.log)"},
+     .unit = "seconds",
+     .doc = "wall seconds between progress lines in run.log (and on stdout in a batch run; "
+            "0: no run.log)"},
     {.name = "profile_axis",
      .type = KeyType::kString,
      .member = field<&OutputConfig::profile_axis>,

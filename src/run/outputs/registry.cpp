@@ -96,7 +96,8 @@ const std::vector<std::string>& output_file_names() {
                                                  "velocity_distribution.tsv",
                                                  "compress.tsv",
                                                  "packing.gsd",
-                                                 "contacts.tsv"};
+                                                 "contacts.tsv",
+                                                 "run.log"};
   return names;
 }
 

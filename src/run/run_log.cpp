@@ -1,0 +1,97 @@
+#include "run/run_log.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+
+#include <fmt/format.h>
+
+namespace kairos {
+
+namespace {
+
+// The wall-clock time of a line: UTC, ISO 8601, to the second.
+std::string utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+}  // namespace
+
+RunLog::RunLog(double interval_seconds, bool echo)
+    : interval_(interval_seconds > 0.0 ? interval_seconds : 0.0), echo_(echo) {}
+
+RunLog::~RunLog() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void RunLog::note(const std::string& text) {
+  if (!enabled()) return;
+  noted_.push_back(utc_now() + " " + text);
+}
+
+void RunLog::open(const std::filesystem::path& file, const std::vector<std::string>& header) {
+  if (!enabled()) return;
+  file_ = file;
+  fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    std::fprintf(stderr, "kairos: warning: cannot open %s: %s; the run goes on without its log\n",
+                 file.c_str(), std::strerror(errno));
+    interval_ = 0.0;
+    return;
+  }
+  for (const std::string& h : header) line(h);
+  for (const std::string& n : noted_) write(n + "\n");
+  noted_.clear();
+}
+
+void RunLog::progress(const ProgressInfo& info, bool force) {
+  if (!enabled()) return;
+  const auto now = Clock::now();
+  if (info.phase != phase_) {
+    phase_ = info.phase;
+    phase_start_ = last_ = now;
+    last_events_ = info.events;
+    if (!force) return;  // the rate needs an interval
+  }
+  const double since = std::chrono::duration<double>(now - last_).count();
+  if (!force && since < interval_) return;
+  const double rate = since > 0.0 ? static_cast<double>(info.events - last_events_) / since : 0.0;
+  last_ = now;
+  last_events_ = info.events;
+  const double elapsed = std::chrono::duration<double>(now - phase_start_).count();
+  const std::string text = progress_text(info, rate, elapsed);
+  line(text);
+  if (echo_) {
+    std::fprintf(stdout, "%s\n", text.c_str());
+    std::fflush(stdout);
+  }
+}
+
+void RunLog::line(const std::string& text) {
+  if (fd_ < 0) return;
+  write(utc_now() + " " + text + "\n");
+}
+
+// Whole lines by one write(2) each (O_APPEND: a line is never interleaved or torn by a
+// concurrent writer); a short write or an error ends the log.
+void RunLog::write(const std::string& text) {
+  if (fd_ < 0) return;
+  const ssize_t written = ::write(fd_, text.data(), text.size());
+  if (written == static_cast<ssize_t>(text.size())) return;
+  std::fprintf(stderr, "kairos: warning: cannot write %s: %s; no further log lines\n",
+               file_.c_str(), written < 0 ? std::strerror(errno) : "short write");
+  ::close(fd_);
+  fd_ = -1;
+  interval_ = 0.0;
+}
+
+}  // namespace kairos

@@ -1,0 +1,55 @@
+// run.log in the output directory (output.log_interval): what a batch run did, for a reader
+// without its terminal, as LAMMPS's log.lammps. A header (start, program, command line, the
+// restart file continued), the set-up's steps, a progress line every log_interval wall seconds
+// (phase, share done, simulated time, event rate, ETA: the progress line's text), and the end
+// (why it stopped, wall time, events). Appended to by a run continued in the same directory:
+// a log records what happened, so lines of an interrupted part stay. With output.progress =
+// "auto" and stderr not a terminal (a batch job) the progress lines go to stdout too.
+// Nothing here changes a result; a failed write is reported once on stderr and ends the log,
+// not the run.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "io/progress.hpp"
+
+namespace kairos {
+
+class RunLog {
+ public:
+  // interval_seconds 0: no log (every call does nothing); echo: progress lines on stdout too.
+  RunLog(double interval_seconds, bool echo);
+  RunLog(const RunLog&) = delete;
+  RunLog& operator=(const RunLog&) = delete;
+  ~RunLog();
+
+  bool enabled() const { return interval_ > 0.0; }
+  // A line before the file exists (the set-up's steps): kept, written at open().
+  void note(const std::string& text);
+  // Opens (appends to) `file`: the header lines, then the noted ones.
+  void open(const std::filesystem::path& file, const std::vector<std::string>& header);
+  // A progress line, when log_interval wall seconds have passed since the last one (or the
+  // phase began); `force`: now (the end of a phase).
+  void progress(const ProgressInfo& info, bool force = false);
+  // A line now.
+  void line(const std::string& text);
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  void write(const std::string& text);
+
+  double interval_ = 0.0;
+  bool echo_ = false;
+  int fd_ = -1;
+  std::filesystem::path file_;
+  std::vector<std::string> noted_;
+  std::string phase_;
+  Clock::time_point phase_start_{}, last_{};
+  std::uint64_t last_events_ = 0;
+};
+
+}  // namespace kairos
