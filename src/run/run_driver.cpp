@@ -55,11 +55,11 @@ RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& res
   const bool tell = mode != ProgressMode::kOff;
   std::string building;
   integrator_ = start_integrator<D>(std::move(start), [&](const std::string& contact, double) {
+    const std::string what = "building the soft-contact map table of " + contact;
+    log_->setup_step(what);
     if (contact == building) return;
     building = contact;
-    const std::string what = fmt::format("building the soft-contact map table of {}", contact);
     if (tell) std::fputs((what + " ...\n").c_str(), stderr);
-    log_->note("setup: " + what);
   });
   timed_ =
       config_.run.time > 0.0 || config_.run.equilibration_time >= 0.0 || intervals_in_time(config_);
@@ -356,8 +356,8 @@ nlohmann::json RunDriver<D>::outputs_present() const {
   return list;
 }
 
-// run.log's header: the program and how it was invoked, what it continued, the set-up's wall
-// time; then the set-up's noted steps (RunLog::open).
+// run.log's header: the program and how it was invoked, what it continued; then the set-up's
+// noted steps and its wall time (RunLog::open).
 template <int D>
 void RunDriver<D>::open_log() {
   std::vector<std::string> header = {fmt::format(
@@ -367,9 +367,9 @@ void RunDriver<D>::open_log() {
   if (!provenance_.restart_file.empty())
     header.push_back(
         fmt::format("continues {} at t = {:.10g}", provenance_.restart_file, integrator_->time()));
-  header.push_back(fmt::format("setup: {} particles in {}D, {:.3g} s of wall time",
-                               integrator_->mobile(), D, setup_wall_seconds_));
-  log_->open(directory() / "run.log", header);
+  log_->open(directory() / "run.log", header,
+             {fmt::format("setup: {} particles in {}D, {:.3g} s of wall time",
+                          integrator_->mobile(), D, setup_wall_seconds_)});
 }
 
 template <int D>

@@ -15,19 +15,24 @@ namespace kairos {
 namespace {
 
 // The wall-clock time of a line: UTC, ISO 8601, to the second.
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
+std::string utc(std::time_t at) {
   std::tm utc{};
-  gmtime_r(&now, &utc);
+  gmtime_r(&at, &utc);
   char text[32];
   std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
   return text;
 }
 
+std::string utc_now() {
+  return utc(std::time(nullptr));
+}
+
 }  // namespace
 
 RunLog::RunLog(double interval_seconds, bool echo)
-    : interval_(interval_seconds > 0.0 ? interval_seconds : 0.0), echo_(echo) {}
+    : interval_(interval_seconds > 0.0 ? interval_seconds : 0.0),
+      echo_(echo),
+      created_(std::time(nullptr)) {}
 
 RunLog::~RunLog() {
   if (fd_ >= 0) ::close(fd_);
@@ -36,9 +41,29 @@ RunLog::~RunLog() {
 void RunLog::note(const std::string& text) {
   if (!enabled()) return;
   noted_.push_back(utc_now() + " " + text);
+  if (echo_) {
+    std::fprintf(stdout, "%s\n", text.c_str());
+    std::fflush(stdout);
+  }
 }
 
-void RunLog::open(const std::filesystem::path& file, const std::vector<std::string>& header) {
+void RunLog::setup_step(const std::string& step) {
+  if (!enabled()) return;
+  const auto now = Clock::now();
+  if (step != step_) {
+    step_ = step;
+    step_start_ = step_noted_ = now;
+    note("setup: " + step);
+    return;
+  }
+  if (std::chrono::duration<double>(now - step_noted_).count() < interval_) return;
+  step_noted_ = now;
+  note(fmt::format("setup: {}: {} so far", step,
+                   format_duration(std::chrono::duration<double>(now - step_start_).count())));
+}
+
+void RunLog::open(const std::filesystem::path& file, const std::vector<std::string>& header,
+                  const std::vector<std::string>& trailer) {
   if (!enabled()) return;
   file_ = file;
   fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
@@ -48,9 +73,10 @@ void RunLog::open(const std::filesystem::path& file, const std::vector<std::stri
     interval_ = 0.0;
     return;
   }
-  for (const std::string& h : header) line(h);
+  for (const std::string& h : header) write(utc(created_) + " " + h + "\n");
   for (const std::string& n : noted_) write(n + "\n");
   noted_.clear();
+  for (const std::string& t : trailer) line(t);
 }
 
 void RunLog::progress(const ProgressInfo& info, bool force) {

@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <ctime>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -28,10 +29,16 @@ class RunLog {
   ~RunLog();
 
   bool enabled() const { return interval_ > 0.0; }
-  // A line before the file exists (the set-up's steps): kept, written at open().
+  // A line before the file exists (the set-up's steps): kept, written at open(); on stdout at
+  // once in a batch job.
   void note(const std::string& text);
-  // Opens (appends to) `file`: the header lines, then the noted ones.
-  void open(const std::filesystem::path& file, const std::vector<std::string>& header);
+  // A long set-up step, called as it goes on: noted when it begins, and again (with its wall
+  // time so far) when log_interval wall seconds have passed since its last note.
+  void setup_step(const std::string& step);
+  // Opens (appends to) `file`: the header lines (stamped with the time this log was made, early in
+  // the set-up), the noted ones, then the trailer's.
+  void open(const std::filesystem::path& file, const std::vector<std::string>& header,
+            const std::vector<std::string>& trailer);
   // A progress line, when log_interval wall seconds have passed since the last one (or the
   // phase began); `force`: now (the end of a phase).
   void progress(const ProgressInfo& info, bool force = false);
@@ -46,7 +53,10 @@ class RunLog {
   bool echo_ = false;
   int fd_ = -1;
   std::filesystem::path file_;
+  std::time_t created_;
   std::vector<std::string> noted_;
+  std::string step_;
+  Clock::time_point step_start_{}, step_noted_{};
   std::string phase_;
   Clock::time_point phase_start_{}, last_{};
   std::uint64_t last_events_ = 0;

@@ -93,6 +93,28 @@ class RunLog(kt.KairosTestCase):
         again = read_log(out)
         self.assertEqual(sum(l[21:].startswith("start:") for l in again), 1)
 
+    def test_a_table_build_is_logged_as_it_goes(self):
+        # A soft-sphere run building its map table into an empty cache: the step noted when it
+        # begins, again each log_interval, before the set-up's line; a batch job's stdout too.
+        out = self.path("out")
+        result = self.run_ok(
+            "run", os.path.join(kt.SOURCE_DIR, "examples", "soft_viscoelastic_gas_3d.toml"),
+            "-o", out, "--set", "output.log_interval=0.2", "--set", 'output.progress="auto"',
+            "--set", "run.collisions_per_particle=1",
+            "--set", "run.equilibration_collisions_per_particle=0",
+            "--set", 'soft.table_cache="%s"' % self.path("cache"))
+        lines = read_log(out)
+        self.assertRegex(lines[0], STAMP + "start: ")
+        self.assertRegex(lines[1], STAMP + "setup: building the soft-contact map table of A-A$")
+        again = [l for l in lines if re.search("A-A: \d\d:\d\d so far$", l)]
+        self.assertGreaterEqual(len(again), 1, "\n".join(lines))
+        setup = [k for k, l in enumerate(lines) if re.search("setup: 4000 particles", l)]
+        self.assertEqual(setup, [2 + len(again)])
+        self.assertEqual([l[21:] for l in lines[1:setup[0]]],
+                         [l for l in result.stdout.splitlines() if l.startswith("setup:")])
+        stamps = [l[:20] for l in lines]
+        self.assertEqual(stamps, sorted(stamps), "times in order")
+
     def test_an_interrupted_run_ends_its_log(self):
         out = self.path("out")
         proc = subprocess.Popen([kt.KAIROS, "run", self.config("never", 0.05, 1e6), "-o", out],
