@@ -1,0 +1,94 @@
+"""Installation (docs/install.md): `cmake --install` into a prefix and the Debian package from
+cpack hold a CLI that runs an installed example, the library and its headers, the examples and
+docs, and a Python module that a plain python3 imports from the installed place (not the build
+tree). The build is the one under test: its directory is the kairos binary's.
+"""
+
+import os
+import subprocess
+import sys
+
+import kairos_testlib as kt
+
+PYTHON = "/usr/bin/python3"
+SHORT = ["--set", "run.collisions_per_particle=2", "--set",
+         "run.equilibration_collisions_per_particle=0", "--set", "system.particles=500",
+         "--set", 'output.progress="never"']
+
+
+def run(args, **kw):
+    return subprocess.run(args, capture_output=True, text=True, timeout=kt.RUN_TIMEOUT, **kw)
+
+
+class Install(kt.KairosTestCase):
+    def setUp(self):
+        super().setUp()
+        self.build = os.path.dirname(kt.KAIROS)
+        self.module_built = any(f.startswith("kairos.") and f.endswith(".so")
+                                for f in os.listdir(os.path.join(self.build, "python"))) \
+            if os.path.isdir(os.path.join(self.build, "python")) else False
+
+    def check_tree(self, prefix):
+        kairos = os.path.join(prefix, "bin", "kairos")
+        result = run([kairos, "--version"])
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn("kairos", result.stdout)
+        for rel in ("lib/libkairos_core.a", "include/kairos/engine/event_engine.hpp",
+                    "include/kairos/core/vec.hpp", "share/kairos/examples/hard_spheres_3d.toml",
+                    "share/doc/kairos/config.md", "share/doc/kairos/README.md"):
+            self.assertTrue(os.path.isfile(os.path.join(prefix, rel)), rel)
+        self.assertFalse(os.path.exists(os.path.join(prefix, "include/kairos/cli")))
+        # An installed example runs from the installed CLI.
+        out = self.path("run-" + os.path.basename(prefix))
+        example = os.path.join(prefix, "share/kairos/examples/hard_spheres_3d.toml")
+        result = run([kairos, "run", example, "-o", out] + SHORT, cwd=self.tmp)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertEqual(self.summary(out)["stop_reason"], "completed")
+        if not self.module_built:
+            return
+        # A plain python3 imports the installed module: only the installed directory on the
+        # path, started away from the build tree.
+        site = os.path.join(prefix, "lib", "python3.%d" % sys.version_info.minor,
+                            "dist-packages")
+        code = ("import kairos, sys; print(kairos.__file__); "
+                "assert kairos.__file__.startswith(sys.argv[1]), kairos.__file__")
+        result = run([PYTHON, "-c", code, prefix], cwd=self.tmp,
+                     env={"PYTHONPATH": site, "PATH": "/usr/bin:/bin"})
+        self.assertEqual(result.returncode, 0, result.stderr)
+
+    def test_cmake_install_into_a_prefix(self):
+        prefix = self.path("prefix")
+        result = run(["cmake", "--install", self.build, "--prefix", prefix])
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.check_tree(prefix)
+
+    def test_the_debian_package_holds_a_working_tree(self):
+        if not os.path.isfile(os.path.join(self.build, "CPackConfig.cmake")):
+            self.skipTest("no CPack configuration in this build")
+        pkg = self.path("pkg")
+        result = run(["cpack", "-G", "DEB", "-B", pkg, "--config",
+                      os.path.join(self.build, "CPackConfig.cmake")], cwd=self.build)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        debs = [f for f in os.listdir(pkg) if f.endswith(".deb")]
+        self.assertEqual(len(debs), 1, os.listdir(pkg))
+        deb = os.path.join(pkg, debs[0])
+        info = run(["dpkg-deb", "--field", deb, "Package", "Depends"]).stdout
+        self.assertIn("Package: kairos", info)
+        for needed in ("libfmt", "libtomlplusplus", "libstdc++"):
+            self.assertIn(needed, info)
+        if self.module_built:
+            self.assertIn("python3 (>= 3.%d)" % sys.version_info.minor, info)
+        root = self.path("root")
+        result = run(["dpkg-deb", "-x", deb, root])
+        self.assertEqual(result.returncode, 0, result.stderr)
+        # Installed under /usr: the module where Debian's python3 looks (sys.path holds
+        # /usr/lib/python3.X/dist-packages).
+        self.check_tree(os.path.join(root, "usr"))
+        if self.module_built:
+            listed = run([PYTHON, "-c", "import sys; print('\\n'.join(sys.path))"]).stdout
+            self.assertIn("/usr/lib/python3.%d/dist-packages" % sys.version_info.minor,
+                          listed.split())
+
+
+if __name__ == "__main__":
+    kt.main()
