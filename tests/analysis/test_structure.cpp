@@ -104,24 +104,38 @@ TEST(Structure, SpeciesPairsAreNumberedOnce) {
   }
 }
 
+// The tests' reference: r_i - r_j by the minimum image along periodic axes.
+template <int D>
+Vec<D> separation(const Configuration<D>& c, std::uint32_t i, std::uint32_t j) {
+  Vec<D> r;
+  for (int a = 0; a < D; ++a) {
+    r[a] = c.position[i][a] - c.position[j][a];
+    if (c.periodic[a]) r[a] -= c.box[a] * std::round(r[a] / c.box[a]);
+  }
+  return r;
+}
+
+// Every pair i < j with within(i, j, r²), by brute force.
+template <int D, class Within>
+std::set<std::pair<std::uint32_t, std::uint32_t>> brute_force_pairs(const Configuration<D>& c,
+                                                                    Within within) {
+  std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  for (std::uint32_t i = 0; i < c.size(); ++i)
+    for (std::uint32_t j = i + 1; j < c.size(); ++j)
+      if (within(i, j, norm2(separation(c, i, j)))) pairs.insert({i, j});
+  return pairs;
+}
+
 template <int D>
 void check_pairs(const Configuration<D>& c, double cutoff) {
-  std::set<std::pair<std::uint32_t, std::uint32_t>> found, want;
+  std::set<std::pair<std::uint32_t, std::uint32_t>> found;
   for_each_pair_within(
       c, cutoff, [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2) {
         EXPECT_TRUE(found.insert({std::min(i, j), std::max(i, j)}).second) << "pair twice";
         EXPECT_NEAR(norm2(r), r2, 1e-12);
       });
-  for (std::uint32_t i = 0; i < c.size(); ++i)
-    for (std::uint32_t j = i + 1; j < c.size(); ++j) {
-      double r2 = 0.0;
-      for (int a = 0; a < D; ++a) {
-        double d = c.position[i][a] - c.position[j][a];
-        if (c.periodic[a]) d -= c.box[a] * std::round(d / c.box[a]);
-        r2 += d * d;
-      }
-      if (r2 < cutoff * cutoff) want.insert({i, j});
-    }
+  const auto want = brute_force_pairs(
+      c, [&](std::uint32_t, std::uint32_t, double r2) { return r2 < cutoff * cutoff; });
   EXPECT_EQ(found, want);
   EXPECT_FALSE(want.empty());
 }
@@ -149,30 +163,17 @@ void check_pairs_near_contact(Configuration<D> c, double factor, double decades,
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (std::size_t i = 0; i < c.size(); ++i)
     c.radius[i] = i % 17 == 3 ? 0.0 : 0.5 * std::pow(10.0, -decades * u(rng));
-  std::set<std::pair<std::uint32_t, std::uint32_t>> found, want;
+  std::set<std::pair<std::uint32_t, std::uint32_t>> found;
   for_each_pair_near_contact(
       c, factor, [&](std::uint32_t i, std::uint32_t j, const Vec<D>& r, double r2) {
         EXPECT_TRUE(found.insert({std::min(i, j), std::max(i, j)}).second) << "pair twice";
         EXPECT_NEAR(norm2(r), r2, 1e-12);
-        double d2 = 0.0;  // r is r_i - r_j
-        for (int a = 0; a < D; ++a) {
-          double d = c.position[i][a] - c.position[j][a];
-          if (c.periodic[a]) d -= c.box[a] * std::round(d / c.box[a]);
-          d2 += (d - r[a]) * (d - r[a]);
-        }
-        EXPECT_LT(d2, 1e-20);
+        EXPECT_LT(norm2(separation(c, i, j) - r), 1e-20);  // r is r_i - r_j
       });
-  for (std::uint32_t i = 0; i < c.size(); ++i)
-    for (std::uint32_t j = i + 1; j < c.size(); ++j) {
-      double r2 = 0.0;
-      for (int a = 0; a < D; ++a) {
-        double d = c.position[i][a] - c.position[j][a];
-        if (c.periodic[a]) d -= c.box[a] * std::round(d / c.box[a]);
-        r2 += d * d;
-      }
-      const double cut = factor * (c.radius[i] + c.radius[j]);
-      if (r2 < cut * cut) want.insert({i, j});
-    }
+  const auto want = brute_force_pairs(c, [&](std::uint32_t i, std::uint32_t j, double r2) {
+    const double cut = factor * (c.radius[i] + c.radius[j]);
+    return r2 < cut * cut;
+  });
   // The points (radius 0) make several classes: exactly the pairs within reach.
   EXPECT_EQ(found, want);
   EXPECT_FALSE(want.empty());
