@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/cell_rings.hpp"
 #include "core/periodic.hpp"
 #include "core/size_classes.hpp"
 #include "core/vec.hpp"
@@ -35,11 +36,6 @@ struct Configuration {
   }
 };
 
-// Calls f(i, j, r_ij, r_ij^2) once for every unordered pair i != j closer than `cutoff`, with
-// r_ij = r_i - r_j by the minimum image along periodic axes and the plain difference along
-// bounded ones. The minimum image is unique only if the cut-off is at most half of every
-// periodic edge: std::invalid_argument otherwise. Cells at least `cutoff` wide, at most about
-// two per particle; along a bounded axis the outer cells take the particles beyond the box.
 // Cells at least `cutoff` wide along every axis, at most about two per particle; along a
 // bounded axis the outer cells take the particles beyond the box. The particles sorted by cell
 // (a counting sort): cell k holds members[start[k] .. start[k + 1]).
@@ -247,26 +243,11 @@ void for_each_pair_near_contact(const Configuration<D>& c, double factor, F&& f)
         const double ri = part[k].radius[p];
         const double reach = factor * (ri + classes.largest[m]);
         const std::array<std::size_t, D> at = grid.coords(xi);
-        std::array<long long, D> low{}, high{};
-        std::array<bool, D> whole{};
-        for (int a = 0; a < D; ++a) {
-          const auto n = static_cast<long long>(grid.cells[a]);
-          const auto rings = static_cast<long long>(std::ceil(reach / cell_width[a]));
-          whole[a] = c.periodic[a] && n < 2 * rings + 1;
-          low[a] = whole[a] ? 0 : static_cast<long long>(at[a]) - rings;
-          high[a] = whole[a] ? n - 1 : static_cast<long long>(at[a]) + rings;
-          if (!c.periodic[a]) {
-            low[a] = std::max<long long>(low[a], 0);
-            high[a] = std::min<long long>(high[a], n - 1);
-          }
-        }
-        std::array<long long, D> o = low;
-        while (true) {
-          std::size_t cell = 0;
-          for (int a = D - 1; a >= 0; --a) {
-            const auto n = static_cast<long long>(grid.cells[a]);
-            cell = cell * grid.cells[a] + static_cast<std::size_t>(((o[a] % n) + n) % n);
-          }
+        std::array<std::size_t, D> rings{};
+        for (int a = 0; a < D; ++a)
+          rings[a] = static_cast<std::size_t>(
+              std::min(std::ceil(reach / cell_width[a]), static_cast<double>(grid.cells[a])));
+        for_each_cell_in_rings<D>(at, rings, grid.cells, c.periodic, [&](std::size_t cell) {
           for (std::uint32_t q = grid.start[cell]; q < grid.start[cell + 1]; ++q) {
             const std::uint32_t j = grid.members[q];
             Vec<D> r;
@@ -280,10 +261,8 @@ void for_each_pair_near_contact(const Configuration<D>& c, double factor, F&& f)
             const double cut = factor * (ri + part[m].radius[j]);
             if (r2 < cut * cut) f(index_of[k][p], index_of[m][j], r, r2);
           }
-          int a = 0;
-          while (a < D && ++o[a] > high[a]) o[a] = low[a], ++a;
-          if (a == D) break;
-        }
+          return false;
+        });
       }
     }
   }

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/cell_rings.hpp"
 #include "core/periodic.hpp"
 #include "core/size_classes.hpp"
 #include "init/initial_state.hpp"
@@ -59,33 +60,19 @@ class InsertionGrid {
       const Grid& g = grids_[k];
       const std::array<std::size_t, D> c = g.coords(x, box_);
       const double reach = 0.5 * (diameter + classes_.largest[k]);
-      // Per axis: the rings of cells around c (c - r .. c + r, wrapped) or, where they would
-      // wrap onto themselves, every cell once. Rings from the class's width (at most the
-      // cells' own): one ring exactly when a cell is as wide as the reach.
-      std::array<std::size_t, D> first{}, span{};
-      for (int a = 0; a < D; ++a) {
-        const double r =
-            reach <= g.width || !std::isfinite(reach) ? 1.0 : std::ceil(reach / g.width);
-        const auto rings = static_cast<std::size_t>(std::min(r, static_cast<double>(g.n[a])));
-        const bool whole = g.n[a] < 2 * rings + 1;
-        first[a] = whole ? 0 : (c[a] + g.n[a] - rings) % g.n[a];
-        span[a] = whole ? g.n[a] : 2 * rings + 1;
-      }
-      std::array<std::size_t, D> pick{};
-      while (true) {
-        std::size_t idx = 0;
-        for (int a = D - 1; a >= 0; --a) {
-          std::size_t along = first[a] + pick[a];  // < 2 n: one wrap at most
-          if (along >= g.n[a]) along -= g.n[a];
-          idx = idx * g.n[a] + along;
-        }
-        for (std::uint32_t p = g.head[idx]; p != kNoParticle; p = next_[p]) {
-          if (f(p)) return true;
-        }
-        int a = 0;
-        while (a < D && ++pick[a] == span[a]) pick[a++] = 0;
-        if (a == D) break;
-      }
+      // One ring exactly when a cell is as wide as the reach (the class's width is at most
+      // the cells' own along every axis).
+      const double r = reach <= g.width || !std::isfinite(reach) ? 1.0 : std::ceil(reach / g.width);
+      std::array<std::size_t, D> rings{};
+      rings.fill(static_cast<std::size_t>(std::min(r, static_cast<double>(g.head.size()))));
+      const bool stopped =
+          for_each_cell_in_rings<D>(c, rings, g.n, kAllPeriodic, [&](std::size_t cell) {
+            for (std::uint32_t p = g.head[cell]; p != kNoParticle; p = next_[p]) {
+              if (f(p)) return true;
+            }
+            return false;
+          });
+      if (stopped) return true;
     }
     return false;
   }
@@ -133,6 +120,12 @@ class InsertionGrid {
     g.head.assign(cells, kNoParticle);
     return g;
   }
+
+  static constexpr std::array<bool, D> kAllPeriodic = [] {
+    std::array<bool, D> all{};
+    all.fill(true);
+    return all;
+  }();
 
   std::array<double, D> box_;
   SizeClasses classes_;

@@ -37,24 +37,38 @@ ProgressLine::ProgressLine(ProgressMode mode) {
   enabled_ = mode == ProgressMode::kAlways || (mode == ProgressMode::kAuto && tty_);
 }
 
-void ProgressLine::update(const ProgressInfo& info, bool force) {
-  if (!enabled_) return;
-  const auto now = std::chrono::steady_clock::now();
-  if (info.phase != phase_) {
-    if (drawn_ && tty_) std::fputc('\n', stderr);
-    phase_ = info.phase;
-    phase_start_ = last_ = now;
-    last_events_ = info.events;
-    drawn_ = false;
-    return;  // nothing to show yet: the rate needs an interval
-  }
-  const double since = std::chrono::duration<double>(now - last_).count();
-  if (!force && since < (drawn_ ? (tty_ ? 0.25 : 5.0) : 0.25)) return;
+bool PhaseClock::enter(const ProgressInfo& info, Clock::time_point now) {
+  if (info.phase == phase_) return false;
+  phase_ = info.phase;
+  start_ = last_ = now;
+  last_events_ = info.events;
+  rate_ = 0.0;
+  return true;
+}
+
+double PhaseClock::seconds_since_reading(Clock::time_point now) const {
+  return std::chrono::duration<double>(now - last_).count();
+}
+
+std::string PhaseClock::read(const ProgressInfo& info, Clock::time_point now) {
+  const double since = seconds_since_reading(now);
   if (since > 0.0) rate_ = static_cast<double>(info.events - last_events_) / since;
   last_ = now;
   last_events_ = info.events;
-  const std::string line =
-      progress_text(info, rate_, std::chrono::duration<double>(now - phase_start_).count());
+  return progress_text(info, rate_, std::chrono::duration<double>(now - start_).count());
+}
+
+void ProgressLine::update(const ProgressInfo& info, bool force) {
+  if (!enabled_) return;
+  const auto now = PhaseClock::Clock::now();
+  if (clock_.enter(info, now)) {
+    if (drawn_ && tty_) std::fputc('\n', stderr);
+    drawn_ = false;
+    return;  // nothing to show yet: the rate needs an interval
+  }
+  const double since = clock_.seconds_since_reading(now);
+  if (!force && since < (drawn_ ? (tty_ ? 0.25 : 5.0) : 0.25)) return;
+  const std::string line = clock_.read(info, now);
   if (tty_) {
     std::fprintf(stderr, "\r%-100s", line.c_str());
   } else {
@@ -67,7 +81,7 @@ void ProgressLine::update(const ProgressInfo& info, bool force) {
 void ProgressLine::finish() {
   if (enabled_ && drawn_ && tty_) std::fputc('\n', stderr);
   drawn_ = false;
-  phase_.clear();
+  clock_.forget();
 }
 
 }  // namespace kairos

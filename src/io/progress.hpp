@@ -21,6 +21,26 @@ struct ProgressInfo {
   bool in_time = false;      // done and total are simulated time (run.time), not collisions
 };
 
+// A phase's wall clock for progress lines (ProgressLine's and run.log's, each its own): when
+// the phase began, and the event rate between readings.
+class PhaseClock {
+ public:
+  using Clock = std::chrono::steady_clock;
+  // Starts again when `info` names another phase than the last; returns whether it did.
+  bool enter(const ProgressInfo& info, Clock::time_point now);
+  double seconds_since_reading(Clock::time_point now) const;
+  void forget() { phase_.clear(); }  // the next enter() starts again, whatever its phase
+  // The line's text now (progress_text): the rate since the last reading (the last one's if no
+  // time has passed), the ETA from the phase's wall time; now becomes the last reading.
+  std::string read(const ProgressInfo& info, Clock::time_point now);
+
+ private:
+  std::string phase_;
+  Clock::time_point start_{}, last_{};
+  std::uint64_t last_events_ = 0;
+  double rate_ = 0.0;
+};
+
 class ProgressLine {
  public:
   // output.progress: auto (only on a terminal), always or never.
@@ -35,12 +55,8 @@ class ProgressLine {
  private:
   bool enabled_ = false;
   bool tty_ = false;
-  std::chrono::steady_clock::time_point last_{};
-  std::chrono::steady_clock::time_point phase_start_{};
-  std::string phase_;
+  PhaseClock clock_;
   bool drawn_ = false;
-  std::uint64_t last_events_ = 0;
-  double rate_ = 0.0;
 };
 
 std::string format_duration(double seconds);

@@ -41,10 +41,13 @@ RunLog::~RunLog() {
 void RunLog::note(const std::string& text) {
   if (!enabled()) return;
   noted_.push_back(utc_now() + " " + text);
-  if (echo_) {
-    std::fprintf(stdout, "%s\n", text.c_str());
-    std::fflush(stdout);
-  }
+  echo(text);
+}
+
+void RunLog::echo(const std::string& text) const {
+  if (!echo_) return;
+  std::fprintf(stdout, "%s\n", text.c_str());
+  std::fflush(stdout);
 }
 
 void RunLog::setup_step(const std::string& step) {
@@ -82,24 +85,11 @@ void RunLog::open(const std::filesystem::path& file, const std::vector<std::stri
 void RunLog::progress(const ProgressInfo& info, bool force) {
   if (!enabled()) return;
   const auto now = Clock::now();
-  if (info.phase != phase_) {
-    phase_ = info.phase;
-    phase_start_ = last_ = now;
-    last_events_ = info.events;
-    if (!force) return;  // the rate needs an interval
-  }
-  const double since = std::chrono::duration<double>(now - last_).count();
-  if (!force && since < interval_) return;
-  const double rate = since > 0.0 ? static_cast<double>(info.events - last_events_) / since : 0.0;
-  last_ = now;
-  last_events_ = info.events;
-  const double elapsed = std::chrono::duration<double>(now - phase_start_).count();
-  const std::string text = progress_text(info, rate, elapsed);
+  if (clock_.enter(info, now) && !force) return;  // the rate needs an interval
+  if (!force && clock_.seconds_since_reading(now) < interval_) return;
+  const std::string text = clock_.read(info, now);
   line(text);
-  if (echo_) {
-    std::fprintf(stdout, "%s\n", text.c_str());
-    std::fflush(stdout);
-  }
+  echo(text);
 }
 
 void RunLog::line(const std::string& text) {

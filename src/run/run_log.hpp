@@ -46,8 +46,9 @@ class RunLog {
   void line(const std::string& text);
 
  private:
-  using Clock = std::chrono::steady_clock;
+  using Clock = PhaseClock::Clock;
   void write(const std::string& text);
+  void echo(const std::string& text) const;  // on stdout in a batch job
 
   double interval_ = 0.0;
   bool echo_ = false;
@@ -57,9 +58,7 @@ class RunLog {
   std::vector<std::string> noted_;
   std::string step_;
   Clock::time_point step_start_{}, step_noted_{};
-  std::string phase_;
-  Clock::time_point phase_start_{}, last_{};
-  std::uint64_t last_events_ = 0;
+  PhaseClock clock_;
 };
 
 }  // namespace kairos
