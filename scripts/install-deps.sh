@@ -10,6 +10,7 @@ packages=(
   zlib1g-dev
   python3 python3-gsd python3-numpy
   python3-dev pybind11-dev
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()

@@ -3,6 +3,7 @@
 //   kairos run CONFIG.toml [-o OUTDIR] [--set key=value ...] [--restart FILE] [--overwrite]
 //   kairos steps CONFIG.toml [--set key=value ...] [--temperature KT] [-o DIR]
 //   kairos table build|inspect|plot ...   (cli/table_command.hpp)
+//   kairos sweep CONFIG.toml -o DIR --vary KEY=VALUES ...   (cli/sweep_command.hpp)
 //
 // User errors (config, files, impossible requests) print one line "kairos: error: ..." and exit
 // with status 2; SIGINT/SIGTERM finish the current event, write every output and exit 130/143.
@@ -24,6 +25,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "cli/sweep_command.hpp"
 #include "cli/table_command.hpp"
 #include "core/error.hpp"
 #include "core/stop_flag.hpp"
@@ -275,6 +277,8 @@ int main(int argc, char** argv) {
       "[--overwrite]\n"
       "Usage of steps: kairos steps CONFIG.toml [--set key=value ...] [--temperature KT] [-o DIR]\n"
       "Usage of table: kairos table build|inspect|plot ... (soft-sphere collision map tables)\n"
+      "Usage of sweep: kairos sweep CONFIG.toml -o SWEEPDIR --vary KEY=VALUES ... [--workers N] "
+      "(a grid of runs; under mpirun across ranks)\n"
       "Usage of config-keys: kairos config-keys [--markdown] (every config key, declared once)\n"
       "  -o,--output OUTDIR   output directory (overrides output.directory)\n"
       "  --set key=value      override a config key (repeatable)\n"
@@ -335,6 +339,7 @@ int main(int argc, char** argv) {
       "As one markdown table (the declarations docs/config.md is checked against)");
 
   const auto table_command = kairos::cli::add_table_command(app);
+  const auto sweep_command = kairos::cli::add_sweep_command(app);
 
   // Usage errors are user errors too: one line "kairos: error: ...", exit status 2 (not CLI11's
   // own codes and two-line message). --help and --version still print and exit 0.
@@ -363,6 +368,9 @@ int main(int argc, char** argv) {
       throw kairos::InputError("--restart: the restart file name must not be empty");
     }
     if (table_command->parsed()) return table_command->run();
+    if (sweep_command->parsed()) {
+      return sweep_command->run(argc, argv, [] { return g_signal != 0 ? int{g_signal} : SIGINT; });
+    }
     if (config_keys->parsed()) {
       std::fputs((keys_markdown ? kairos::keys_markdown() : kairos::keys_text()).c_str(), stdout);
       return 0;

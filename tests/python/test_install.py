@@ -1,7 +1,8 @@
 """Installation (docs/install.md): `cmake --install` into a prefix and the Debian package from
 cpack hold a CLI that runs an installed example, the library and its headers, the examples and
 docs, and a Python module that a plain python3 imports from the installed place (not the build
-tree). The build is the one under test: its directory is the kairos binary's.
+tree); a CMake project of one's own finds the library (find_package(kairos)) and runs as the CLI
+does. The build is the one under test: its directory is the kairos binary's.
 """
 
 import os
@@ -19,6 +20,31 @@ SHORT = ["--set", "run.collisions_per_particle=2", "--set",
 
 def run(args, **kw):
     return subprocess.run(args, capture_output=True, text=True, timeout=kt.RUN_TIMEOUT, **kw)
+
+
+CONSUMER_CMAKE = """cmake_minimum_required(VERSION 3.20)
+project(own LANGUAGES CXX)
+set(CMAKE_CXX_STANDARD 20)
+find_package(kairos 0.1 REQUIRED)
+add_executable(own main.cpp)
+target_link_libraries(own PRIVATE kairos::core)
+"""
+
+CONSUMER_MAIN = """#include <cstdio>
+
+#include "io/config.hpp"
+#include "run/run.hpp"
+
+int main(int argc, char** argv) {
+  if (argc != 3) return 2;
+  kairos::Config config = kairos::load_config(argv[1]);
+  config.output.directory = argv[2];
+  const kairos::RunOutcome outcome = kairos::run_simulation(config);
+  std::printf("kairos %s: %s\\n", KAIROS_VERSION,
+              outcome.summary["stop_reason"].get<std::string>().c_str());
+  return 0;
+}
+"""
 
 
 @unittest.skipIf(kt.SANITIZED, "installation is checked on the Release build (make test): the "
@@ -64,6 +90,34 @@ class Install(kt.KairosTestCase):
         result = run(["cmake", "--install", self.build, "--prefix", prefix])
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
         self.check_tree(prefix)
+
+    def test_a_program_of_ones_own_builds_against_the_installed_library(self):
+        # find_package(kairos) in a CMake project outside the tree: kairos::core, its headers and
+        # dependencies; the program's run is the CLI's bit for bit (the same rounding flags).
+        prefix = self.path("prefix")
+        result = run(["cmake", "--install", self.build, "--prefix", prefix])
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        project = self.path("consumer")
+        os.makedirs(project)
+        with open(os.path.join(project, "CMakeLists.txt"), "w") as f:
+            f.write(CONSUMER_CMAKE)
+        with open(os.path.join(project, "main.cpp"), "w") as f:
+            f.write(CONSUMER_MAIN)
+        build = os.path.join(project, "build")
+        for args in (["cmake", "-S", project, "-B", build, "-DCMAKE_BUILD_TYPE=Release",
+                      "-DCMAKE_PREFIX_PATH=" + prefix],
+                     ["cmake", "--build", build, "-j", "2"]):
+            result = run(args, cwd=project)
+            self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        config = self.write_config(kt.base_config(particles=256, production=10.0,
+                                                  output={"trajectory": False}))
+        result = run([os.path.join(build, "own"), config, self.path("own-out")], cwd=self.tmp)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn("completed", result.stdout)
+        self.run_ok("run", config, "-o", self.path("cli-out"))
+        own, cli = self.summary(self.path("own-out")), self.summary(self.path("cli-out"))
+        for key in ("sim_time", "events", "kinetic_energy", "compressibility"):
+            self.assertEqual(own[key], cli[key], key)
 
     def test_the_debian_package_holds_a_working_tree(self):
         if not os.path.isfile(os.path.join(self.build, "CPackConfig.cmake")):

@@ -1,0 +1,45 @@
+// A sweep across MPI ranks (`mpirun -np N kairos sweep ...`, docs/sweeps.md). Rank 0
+// coordinates: it hands out the next point to whichever rank asks (dynamic load balance: a rank
+// whose run ends early takes the next one) and runs points itself meanwhile; every rank runs its
+// points as child processes, one at a time unless --workers says more. Rank 0 alone writes
+// sweep.json and the results table. Compiled with MPI when CMake finds it (KAIROS_HAVE_MPI);
+// without, a sweep started by mpirun with more than one rank is refused.
+#pragma once
+
+#include <memory>
+
+#include "sweep/sweep_runner.hpp"
+
+namespace kairos::cli {
+
+// Whether an MPI launcher started this process (mpirun's environment: OMPI_COMM_WORLD_SIZE,
+// PMI_SIZE or PMIX_RANK), and with how many ranks (0: not under MPI).
+int launcher_ranks();
+
+// Whether this kairos was built with MPI.
+bool mpi_built();
+
+// MPI for the lifetime of the object (MPI_Init ... MPI_Finalize).
+class MpiSession {
+ public:
+  MpiSession(int& argc, char**& argv);
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  // Everything is ready on rank 0 (sweep.json written) or it failed: `ok` of rank 0, broadcast.
+  bool agree(bool ok) const;
+  // Waits for every rank without spinning: a rank whose runs have ended would otherwise take a
+  // core from the others' runs in MPI's busy-waiting barrier (or MPI_Finalize).
+  void wait_for_all() const;
+
+ private:
+  int rank_ = 0;
+  int size_ = 1;
+};
+
+// The work source of one rank: rank 0's coordinator, any other rank's requests to it.
+std::unique_ptr<SweepWork> mpi_sweep_work(const MpiSession& session, std::size_t count);
+
+}  // namespace kairos::cli

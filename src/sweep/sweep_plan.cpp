@@ -1,0 +1,178 @@
+#include "sweep/sweep_plan.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/config.hpp"
+
+namespace kairos {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kManifest = "sweep.json";
+
+std::string read_text(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) {
+    throw InputError(fmt::format("{}: no such config file (or not a regular file)", path.string()));
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in && !in.eof()) throw InputError(fmt::format("{}: cannot be read", path.string()));
+  return text.str();
+}
+
+// The dotted key as --set canonicalises it: "system.species[0].diameter" and
+// "system.species.0.diameter" name one key.
+std::string canonical_key(std::string key) {
+  std::string out;
+  for (const char c : key) {
+    if (c == '[') {
+      out += '.';
+    } else if (c != ']') {
+      out += c;
+    }
+  }
+  return out;
+}
+
+std::string override_key(const std::string& text) {
+  return canonical_key(text.substr(0, text.find('=')));
+}
+
+nlohmann::json manifest(const SweepPlan& plan) {
+  nlohmann::json axes = nlohmann::json::array();
+  for (const SweepAxis& a : plan.axes) {
+    axes.push_back({{"key", a.key}, {"spec", a.spec}, {"values", a.values}});
+  }
+  return {{"kairos_sweep", 1},
+          {"config", fs::absolute(plan.config).lexically_normal().string()},
+          {"config_text", plan.config_text},
+          {"set", plan.overrides},
+          {"vary", axes},
+          {"runs", plan.points.size()}};
+}
+
+}  // namespace
+
+std::vector<std::string> SweepPlan::run_arguments(const SweepPoint& point) const {
+  std::vector<std::string> args = {"run", config.string(), "-o", run_directory(point).string()};
+  for (const std::string& s : overrides) {
+    args.push_back("--set");
+    args.push_back(s);
+  }
+  for (const std::string& s : point_overrides(axes, point)) {
+    args.push_back("--set");
+    args.push_back(s);
+  }
+  return args;
+}
+
+SweepPlan plan_sweep(const fs::path& config, const std::vector<std::string>& overrides,
+                     const std::vector<std::string>& vary, const fs::path& directory) {
+  if (directory.empty()) throw InputError("-o/--output: the sweep directory must not be empty");
+  SweepPlan plan;
+  plan.config = config;
+  plan.config_text = read_text(config);
+  plan.overrides = overrides;
+  plan.directory = directory;
+  for (const std::string& v : vary) plan.axes.push_back(parse_sweep_axis(v));
+  std::set<std::string> set_keys;
+  for (const std::string& s : overrides) set_keys.insert(override_key(s));
+  for (const SweepAxis& axis : plan.axes) {
+    const std::string key = canonical_key(axis.key);
+    if (key == "output.directory") {
+      throw InputError(
+          "--vary output.directory: each run of a sweep has its own directory "
+          "(SWEEPDIR/NAME); vary something else");
+    }
+    if (set_keys.count(key) != 0) {
+      throw InputError(fmt::format("--vary {}: the key is also given by --set; give it once", key));
+    }
+  }
+  plan.points = sweep_points(plan.axes);
+  for (const SweepPoint& p : plan.points) {
+    std::vector<std::string> all = overrides;
+    for (const std::string& s : point_overrides(plan.axes, p)) all.push_back(s);
+    try {
+      (void)parse_config(plan.config_text, config.string(), all);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("run {} of the sweep ({}): {}", p.index, p.name, e.what()));
+    }
+  }
+  return plan;
+}
+
+void claim_sweep_directory(const SweepPlan& plan) {
+  std::error_code ec;
+  fs::create_directories(plan.directory, ec);
+  if (ec || !fs::is_directory(plan.directory)) {
+    throw InputError(fmt::format("{}: cannot create the sweep directory: {}",
+                                 plan.directory.string(), ec ? ec.message() : "not a directory"));
+  }
+  const fs::path path = plan.directory / kManifest;
+  const nlohmann::json want = manifest(plan);
+  if (!fs::exists(path, ec)) {
+    write_text_atomically(path, want.dump(2) + "\n");
+    return;
+  }
+  std::ifstream in(path);
+  const nlohmann::json have = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (have.is_discarded() || !have.is_object()) {
+    throw InputError(fmt::format("{}: not a sweep manifest (unreadable JSON)", path.string()));
+  }
+  auto refuse = [&](const std::string& what) {
+    throw InputError(fmt::format(
+        "{} holds another sweep: {} (see its sweep.json); continue it with the command that "
+        "began it, or give another directory",
+        plan.directory.string(), what));
+  };
+  if (have.value("config_text", std::string()) != plan.config_text) {
+    refuse(fmt::format("the config text differs from that of {}",
+                       have.value("config", std::string("its config"))));
+  }
+  if (have.value("set", nlohmann::json::array()) != want["set"]) {
+    refuse(fmt::format("its --set list was {}", have.value("set", nlohmann::json()).dump()));
+  }
+  if (have.value("vary", nlohmann::json::array()) != want["vary"]) {
+    std::string was;
+    for (const auto& a : have.value("vary", nlohmann::json::array())) {
+      was += fmt::format(" --vary {}={}", a.value("key", std::string("?")),
+                         a.value("spec", std::string("?")));
+    }
+    refuse(fmt::format("its grid was{}", was));
+  }
+}
+
+SweepDirectoryLock::SweepDirectoryLock(const fs::path& directory) {
+  const fs::path lock = directory / ".kairos-sweep.lock";
+  fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  if (fd_ < 0) {
+    throw InputError(fmt::format("{}: cannot open: {}", lock.string(), std::strerror(errno)));
+  }
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(fd_);
+    fd_ = -1;
+    throw InputError(fmt::format("{}: in use by another sweep", directory.string()));
+  }
+}
+
+SweepDirectoryLock::~SweepDirectoryLock() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+}  // namespace kairos
