@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/memory_budget.hpp"
 #include "core/periodic.hpp"
+#include "core/setup_progress.hpp"
 #include "core/stop_flag.hpp"
 #include "init/insertion_grid.hpp"
 #include "io/config_choices.hpp"
@@ -514,9 +515,18 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
         "{} {}; use a lower packing fraction or a lattice ({}) and let the run melt it",
         eta, i + 1, N, why, lattice_list(D, false)));
   };
+  // run.log's set-up lines (500 000 spheres at 0.4 take two minutes).
+  const std::string step = fmt::format("random insertion of {} particles", N);
+  const auto report = [&](std::size_t placed) {
+    if (setup_listened()) report_setup_progress(step, fmt::format("{} placed", placed));
+  };
+  report(0);
   for (std::size_t i = 0; i < N; ++i) {
     // SIGINT ends a long insertion (near jamming one particle may take 10^6 tries, see below).
-    if ((i & 1023u) == 1023u) throw_if_stop_requested();
+    if ((i & 1023u) == 1023u) {
+      throw_if_stop_requested();
+      report(i);
+    }
     const double di = state.diameter[i];
     // Whether the exclusion zone (for the class's smallest diameter) of one placed particle
     // covers the voxel.
@@ -545,7 +555,10 @@ void insert_randomly(const Layout<D>& layout, double eta, InitialState<D>& state
     }
     bool placed = false;
     for (std::uint64_t attempt = 0; attempt < kMaxInsertionAttempts && !placed; ++attempt) {
-      if ((attempt & 4095u) == 4095u) throw_if_stop_requested();
+      if ((attempt & 4095u) == 4095u) {
+        throw_if_stop_requested();
+        report(i);
+      }
       if (voxels->empty()) throw fail(i, "found the box jammed");
       const std::size_t slot = voxels->pick(rng);
       const std::uint64_t voxel = voxels->voxel(slot);

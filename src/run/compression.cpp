@@ -12,6 +12,7 @@
 #include "analysis/thermodynamics.hpp"
 #include "core/error.hpp"
 #include "core/periodic.hpp"
+#include "core/setup_progress.hpp"
 #include "core/stop_flag.hpp"
 #include "engine/event_engine.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -387,6 +388,14 @@ CompressionReport compress_start(ParticleSystem<D>& state, const CompressConfig&
   report.result = compress(
       state, report.settings,
       [&](const CompressionRow& r) {
+        if (setup_listened()) {
+          const double target = report.settings.target_packing_fraction;
+          report_setup_progress(
+              target > 0.0 ? fmt::format("compression to packing fraction {}", target)
+                           : std::string("compression"),
+              fmt::format("packing fraction {:.6f}, reduced pressure {:.4g}, {} collisions",
+                          r.packing_fraction, r.pressure, r.collisions));
+        }
         if (!tell || Clock::now() < next_note) return;
         next_note = Clock::now() + std::chrono::seconds(10);
         std::fputs(fmt::format("compressing: packing fraction {:.6f}, reduced pressure {:.4g}, "

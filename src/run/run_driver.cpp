@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "core/setup_progress.hpp"
 #include "core/stop_flag.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config_choices.hpp"
@@ -36,6 +37,13 @@ std::uint64_t peak_rss_bytes() {
 template <int D>
 RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& restart_file,
                         const RunOptions& options) {
+  // The log first: the set-up's long steps (random insertion, compression, soft tables) report
+  // to it as they go ([output] is the given config's, a restart's too).
+  const ProgressMode mode = progress_modes().at(config.output.progress);
+  log_.emplace(config.output.log_interval, mode == ProgressMode::kAuto && !stderr_is_a_terminal());
+  const ScopedSetupListener listen([this](const std::string& step, const std::string& detail) {
+    log_->setup_step(step, detail);
+  });
   RunStart<D> start =
       start_run<D>(config, restart_file,
                    integrators().is(config.run.integrator, IntegratorKind::kDem) ? "dem" : "event");
@@ -43,8 +51,6 @@ RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& res
   restart_file_ = start.restart_file;
   resumed_ = start.resumed;
   plan_ = start.plan;
-  const ProgressMode mode = progress_modes().at(config_.output.progress);
-  log_.emplace(config_.output.log_interval, mode == ProgressMode::kAuto && !stderr_is_a_terminal());
   const std::string restart_name = start.restart_name();
   SetupOutcome<D> setup;
   if (start.compression) {

@@ -50,7 +50,7 @@ void RunLog::echo(const std::string& text) const {
   std::fflush(stdout);
 }
 
-void RunLog::setup_step(const std::string& step) {
+void RunLog::setup_step(const std::string& step, const std::string& detail) {
   if (!enabled()) return;
   const auto now = Clock::now();
   if (step != step_) {
@@ -61,7 +61,7 @@ void RunLog::setup_step(const std::string& step) {
   }
   if (std::chrono::duration<double>(now - step_noted_).count() < interval_) return;
   step_noted_ = now;
-  note(fmt::format("setup: {}: {} so far", step,
+  note(fmt::format("setup: {}: {}{} so far", step, detail.empty() ? "" : detail + ", ",
                    format_duration(std::chrono::duration<double>(now - step_start_).count())));
 }
 

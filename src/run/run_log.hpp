@@ -32,9 +32,10 @@ class RunLog {
   // A line before the file exists (the set-up's steps): kept, written at open(); on stdout at
   // once in a batch job.
   void note(const std::string& text);
-  // A long set-up step, called as it goes on: noted when it begins, and again (with its wall
-  // time so far) when log_interval wall seconds have passed since its last note.
-  void setup_step(const std::string& step);
+  // A long set-up step, called as it goes on: noted when it begins, and again (with `detail`,
+  // how far it is, and its wall time so far) when log_interval wall seconds have passed since
+  // its last note.
+  void setup_step(const std::string& step, const std::string& detail = {});
   // Opens (appends to) `file`: the header lines (stamped with the time this log was made, early in
   // the set-up), the noted ones, then the trailer's.
   void open(const std::filesystem::path& file, const std::vector<std::string>& header,

@@ -105,15 +105,47 @@ class RunLog(kt.KairosTestCase):
             "--set", 'soft.table_cache="%s"' % self.path("cache"))
         lines = read_log(out)
         self.assertRegex(lines[0], STAMP + "start: ")
-        self.assertRegex(lines[1], STAMP + "setup: building the soft-contact map table of A-A$")
+        # The random start's insertion comes first (test below), then the table.
+        first = [k for k, l in enumerate(lines) if "setup: building the soft-contact" in l]
+        self.assertRegex(lines[first[0]],
+                         STAMP + "setup: building the soft-contact map table of A-A$")
         again = [l for l in lines if re.search("A-A: \d\d:\d\d so far$", l)]
         self.assertGreaterEqual(len(again), 1, "\n".join(lines))
         setup = [k for k, l in enumerate(lines) if re.search("setup: 4000 particles", l)]
-        self.assertEqual(setup, [2 + len(again)])
+        self.assertEqual(setup, [first[0] + 1 + len(again)])
         self.assertEqual([l[21:] for l in lines[1:setup[0]]],
                          [l for l in result.stdout.splitlines() if l.startswith("setup:")])
         stamps = [l[:20] for l in lines]
         self.assertEqual(stamps, sorted(stamps), "times in order")
+
+    def test_random_insertion_and_compression_are_logged_as_they_go(self):
+        # A random start (insertion of every particle), then one denser than insertion reaches
+        # (insertion, then a compression): each step noted when it begins and again with how far
+        # it is, before the set-up's line, and echoed in a batch job.
+        for eta, steps in ((0.3, ["random insertion of 3000 particles"]),
+                           (0.56, ["random insertion of 3000 particles",
+                                   "compression to packing fraction 0.56"])):
+            with self.subTest(eta=eta):
+                out = self.path("out-%s" % eta)
+                result = self.run_ok(
+                    "run", self.write_config(kt.base_config(
+                        particles=3000, packing_fraction=eta, lattice="random", production=1.0,
+                        output={"progress": "auto", "log_interval": 1e-4,
+                                "trajectory": False})), "-o", out)
+                lines = read_log(out)
+                setup = [k for k, l in enumerate(lines) if "setup: 3000 particles" in l]
+                self.assertEqual(len(setup), 1, "\n".join(lines))
+                notes = [l[21:] for l in lines[1:setup[0]]]
+                self.assertEqual([n for n in notes if not n.endswith("so far")],
+                                 ["setup: " + step for step in steps])
+                for step in steps:
+                    detail = (r"\d+ placed" if "insertion" in step else
+                              r"packing fraction 0\.\d+, reduced pressure [\d.e+]+, \d+ collisions")
+                    progress = [n for n in notes if re.fullmatch(
+                        "setup: %s: %s, \\d\\d:\\d\\d so far" % (re.escape(step), detail), n)]
+                    self.assertGreaterEqual(len(progress), 1, "\n".join(notes))
+                self.assertEqual(notes, [l for l in result.stdout.splitlines()
+                                         if l.startswith("setup:")][:len(notes)])
 
     def test_an_interrupted_run_ends_its_log(self):
         out = self.path("out")
