@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 
+#include "../release_suite_only.hpp"
 #include "core/error.hpp"
 #include "engine/candidate_scan.hpp"
 #include "engine/event_engine.hpp"
@@ -28,8 +29,9 @@ void run_validated(const ParticleSystem<D>& start, int events, int expect_cells 
   engine.validate();
   for (int e = 0; e < events; ++e) {
     ASSERT_NE(engine.step(), EventKind::kNone);
-    engine.validate();
+    if (e % testing::validation_stride(1) == 0) engine.validate();
   }
+  engine.validate();
   EXPECT_GT(engine.counters().collisions, 0u);
 }
 
@@ -346,7 +348,7 @@ void run_incremental_validated(const ParticleSystem<D>& start, int events, int c
   ASSERT_TRUE(engine.incremental_crossings());
   for (int e = 0; e < events; ++e) {
     ASSERT_NE(engine.step(), EventKind::kNone);
-    if (e % check_every == 0) engine.validate();
+    if (e % testing::validation_stride(check_every) == 0) engine.validate();
   }
   engine.validate();
   EXPECT_GT(engine.incremental_crossing_scans(), engine.counters().cell_crossings / 2);

@@ -262,7 +262,7 @@ void run_granular_validated(const ContactModel& model, std::uint64_t seed) {
   ASSERT_TRUE(engine.incremental_crossings());
   for (int k = 0; k < 2000; ++k) {
     ASSERT_NE(engine.step(), EventKind::kNone);
-    if (k % 11 == 0) engine.validate();
+    if (k % testing::validation_stride(11) == 0) engine.validate();
   }
   EXPECT_GT(engine.incremental_crossing_scans(), engine.counters().cell_crossings / 2);
 }

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "../boundaries/spring_reference.hpp"
+#include "../release_suite_only.hpp"
 #include "engine/event_engine.hpp"
 #include "engine_fixtures.hpp"
 #include "scheduler/calendar_queue.hpp"
@@ -73,7 +74,7 @@ void check_container(int n, double eta, double mass, const WallSpring& spring, d
     ASSERT_NE(kind, EventKind::kNone);
     layer_changes += kind == EventKind::kWallLayer ? 1 : 0;
     wall_hits += kind == EventKind::kWallCollision ? 1 : 0;
-    if (k % validate_every == 0) {
+    if (k % testing::validation_stride(validate_every) == 0) {
       ASSERT_NO_THROW(engine.validate()) << "event " << k;
     }
     lowest = std::min(lowest, walls.position(low, engine.time()));
