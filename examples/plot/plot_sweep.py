@@ -10,12 +10,15 @@ deviation; with one row, its value and --yerr's column as the error bar. Only fi
       [-o plot.png] [--table points.tsv] [--logx] [--logy]
 
 --table writes the points (x, group, mean, error, n) as TSV; without -o nothing is drawn (and
-matplotlib is not needed).
+matplotlib is not needed). The swept keys a point averages over (other than --x and --group)
+are named on stderr: seeds are what the averaging is for.
 """
 
 import argparse
 import csv
+import json
 import math
+import os
 import sys
 
 
@@ -79,6 +82,16 @@ def main():
     pts = points(rows, args.x, args.y, args.yerr, args.group, args.table)
     if not pts:
         sys.exit("%s: no finished run" % args.table)
+    # Which swept keys a point averages over (sweep.json beside the table names the axes): seeds
+    # are what averaging is for; any other axis there is worth a second look.
+    manifest = os.path.join(os.path.dirname(os.path.abspath(args.table)), "sweep.json")
+    if os.path.exists(manifest):
+        with open(manifest) as f:
+            axes = [a["key"] for a in json.load(f)["vary"]]
+        averaged = [k for k in axes if k not in (args.x, args.group)
+                    and len({r[k] for r in rows if r["state"] == "finished"}) > 1]
+        if averaged:
+            sys.stderr.write("plot_sweep: each point averages over %s\n" % ", ".join(averaged))
     if args.points_table:
         with open(args.points_table, "w") as f:
             f.write("%s\t%s\t%s\terror\tn\n" % (args.x, args.group or "group", args.y))

@@ -97,35 +97,52 @@ class Sweep final : public SweepCommand {
     try {
       plan = plan_sweep(config_, overrides_, vary_, directory_);
       if (root) {
-        claim_sweep_directory(*plan);
+        make_sweep_directory(*plan);
         lock.emplace(plan->directory);
+        claim_sweep_directory(*plan);
       }
     } catch (const InputError& e) {
       error = e.what();
     }
-    if (!session.agree(error.empty())) {
-      if (root) std::fprintf(stderr, "kairos: error: %s\n", error.c_str());
+    // Every rank's outcome counts (a config a node cannot read); rank 0's error is printed
+    // once, another rank's with its rank.
+    const MpiSession::Agreement agreement = session.agree(error.empty());
+    if (!agreement.all_ok) {
+      if (!error.empty() && (root || agreement.root_ok)) {
+        std::fprintf(stderr, "kairos: error: %s%s\n",
+                     root ? "" : fmt::format("rank {}: ", session.rank()).c_str(), error.c_str());
+      }
       return 2;
     }
-    const int workers = workers_option_->count() > 0 ? workers_ : 1;
-    if (root) {
-      fmt::print("kairos sweep: {} runs in {}/ on {} MPI ranks, {} at a time on each\n",
-                 plan->points.size(), plan->directory.string(), session.size(), workers);
-      std::fflush(stdout);
-    }
-    const std::unique_ptr<SweepWork> work = mpi_sweep_work(session, plan->points.size());
-    const SweepTally tally = run_sweep(
-        *plan, *work, {this_executable(), workers, fmt::format("rank {}: ", session.rank())});
-    // Rank 0's runner returned once every rank was told that nothing is left (or left): the
-    // runs have ended, and the table can be written while the others wait.
-    if (!root) {
+    // From here on the ranks depend on each other: an error on one ends the whole job
+    // (MPI_Abort) instead of leaving the others waiting for it.
+    try {
+      const int workers = workers_option_->count() > 0 ? workers_ : 1;
+      if (root) {
+        fmt::print("kairos sweep: {} runs in {}/ on {} MPI ranks, {} at a time on each\n",
+                   plan->points.size(), plan->directory.string(), session.size(), workers);
+        std::fflush(stdout);
+      }
+      const std::unique_ptr<SweepWork> work = mpi_sweep_work(session, plan->points.size());
+      const SweepTally tally = run_sweep(
+          *plan, *work, {this_executable(), workers, fmt::format("rank {}: ", session.rank())});
+      // Rank 0's runner returned once every rank was told that nothing is left (or left): the
+      // runs have ended, and the table can be written while the others wait.
+      if (!root) {
+        session.wait_for_all();
+        return 0;
+      }
+      const int status =
+          conclude(*plan, tally, write_sweep_results(plan->directory, plan->axes, plan->points),
+                   stop_signal);
       session.wait_for_all();
-      return 0;
+      return status;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "kairos: error: rank %d: %s (the MPI job is ended)\n", session.rank(),
+                   e.what());
+      session.abort(2);
+      return 2;
     }
-    const int status = conclude(
-        *plan, tally, write_sweep_results(plan->directory, plan->axes, plan->points), stop_signal);
-    session.wait_for_all();
-    return status;
   }
 
   // The last line (from the states of every run as the table has them) and the exit status.
@@ -154,11 +171,14 @@ class Sweep final : public SweepCommand {
       return 2;
     }
     if (finished < static_cast<long>(states.size())) {
-      // Stopped by run.max_wall_seconds or by a signal sent to the runs themselves.
+      // Stopped by run.max_wall_seconds or by a signal sent to the runs themselves, or not
+      // started (a process could not be made).
       std::fprintf(stderr,
-                   "kairos: error: %zu of %zu runs did not finish (state 'stopped' in %s); the "
-                   "same command continues them\n",
+                   "kairos: error: %zu of %zu runs did not finish (%ld stopped, %ld not run: "
+                   "%s); the same command continues them\n",
                    states.size() - static_cast<std::size_t>(finished), states.size(),
+                   static_cast<long>(count(SweepRunState::kStopped)),
+                   static_cast<long>(count(SweepRunState::kNotRun)),
                    (plan.directory / "results.tsv").c_str());
       return 2;
     }

@@ -130,10 +130,16 @@ MpiSession::~MpiSession() {
   MPI_Finalize();
 }
 
-bool MpiSession::agree(bool ok) const {
-  int flag = ok ? 1 : 0;
-  MPI_Bcast(&flag, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  return flag != 0;
+MpiSession::Agreement MpiSession::agree(bool ok) const {
+  int mine = ok ? 1 : 0, all = 0, root = mine;
+  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Bcast(&root, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return {all != 0, root != 0};
+}
+
+void MpiSession::abort(int status) const {
+  MPI_Abort(MPI_COMM_WORLD, status);
+  std::_Exit(status);
 }
 
 void MpiSession::wait_for_all() const {
@@ -159,8 +165,11 @@ MpiSession::MpiSession(int&, char**&) {
       "without MPI (install libopenmpi-dev and rebuild; docs/sweeps.md)");
 }
 MpiSession::~MpiSession() = default;
-bool MpiSession::agree(bool ok) const {
-  return ok;
+MpiSession::Agreement MpiSession::agree(bool ok) const {
+  return {ok, ok};
+}
+void MpiSession::abort(int status) const {
+  std::_Exit(status);
 }
 void MpiSession::wait_for_all() const {}
 std::unique_ptr<SweepWork> mpi_sweep_work(const MpiSession&, std::size_t count) {

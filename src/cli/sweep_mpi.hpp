@@ -28,8 +28,14 @@ class MpiSession {
   MpiSession& operator=(const MpiSession&) = delete;
   int rank() const { return rank_; }
   int size() const { return size_; }
-  // Everything is ready on rank 0 (sweep.json written) or it failed: `ok` of rank 0, broadcast.
-  bool agree(bool ok) const;
+  // Whether every rank is ready (each planned the sweep; rank 0 also claimed the directory).
+  struct Agreement {
+    bool all_ok = true;
+    bool root_ok = true;
+  };
+  Agreement agree(bool ok) const;
+  // Ends every rank of the job with this status (an error after the agreement).
+  [[noreturn]] void abort(int status) const;
   // Waits for every rank without spinning: a rank whose runs have ended would otherwise take a
   // core from the others' runs in MPI's busy-waiting barrier (or MPI_Finalize).
   void wait_for_all() const;

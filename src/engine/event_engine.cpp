@@ -900,10 +900,33 @@ void EventEngine<D, Queue>::rescale_velocities(double t, double factor, double g
     growth_ = growth_.changed_at(t, growth_rate);
     update_growth_limit();
   }
+  change_velocities(t, [factor](std::uint32_t, const Vec<D>& v) { return factor * v; });
+}
+
+template <int D, class Queue>
+void EventEngine<D, Queue>::set_velocities(double t, const std::vector<Vec<D>>& velocity) {
+  if (!(t >= time_) || !(t <= next_event_time()))
+    throw std::logic_error("set_velocities: time outside [time(), next_event_time()]");
+  if (velocity.size() != size())
+    throw std::logic_error("set_velocities: one velocity per particle");
+  if (soft_ || resting_.sleepers() > 0 || helfand_.on())
+    throw std::logic_error(
+        "set_velocities: not with soft contacts, sleeping particles or Helfand moments");
+  for (std::uint32_t k = 0; k < size(); ++k) {
+    if (resting_.fixed(k) && !(velocity[id_[k]] == Vec<D>{}))
+      throw std::logic_error("set_velocities: a fixed grain must stay at rest");
+  }
+  time_ = t;
+  change_velocities(t, [&](std::uint32_t k, const Vec<D>&) { return velocity[id_[k]]; });
+}
+
+template <int D, class Queue>
+template <class NewVelocity>
+void EventEngine<D, Queue>::change_velocities(double t, NewVelocity&& new_velocity) {
   const auto n = static_cast<std::uint32_t>(size());
   for (std::uint32_t k = 0; k < n; ++k) {
     advance_to(k, t);
-    hot_[k].vel = factor * hot_[k].vel;
+    hot_[k].vel = new_velocity(k, hot_[k].vel);
     ++hot_[k].collisions;  // every prediction made against it is stale
   }
   std::vector<double> times(n);

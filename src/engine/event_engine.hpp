@@ -301,6 +301,11 @@ class EventEngine {
   // thermostat's rescaling does, and predicts every particle again. Growing particles: a
   // growth_rate > 0 also sets the growth rate from t on (as set_growth_rate), in the same pass.
   void rescale_velocities(double t, double factor, double growth_rate = 0.0);
+  // Sets every particle's velocity at time t (time() <= t <= next_event_time()), `velocity` in
+  // the caller's numbering, and predicts every particle again. std::logic_error with soft
+  // contacts, sleeping particles or the Helfand moments kept (their state follows the
+  // velocities), or a velocity for a fixed grain.
+  void set_velocities(double t, const std::vector<Vec<D>>& velocity);
   // Growing particles: from time t on (time() <= t <= next_event_time()) the diameters grow at
   // `rate` (relative to the radii at the engine's start; > 0); every particle is predicted again.
   // A collision beyond growth_fits_until() is refused (std::logic_error): the caller rebuilds.
@@ -404,6 +409,9 @@ class EventEngine {
   void start_growth();
   void check_growth_boundaries() const;
   void update_growth_limit();
+  // Advances every particle to t, gives it new_velocity(k, its velocity at t), predicts all anew.
+  template <class NewVelocity>
+  void change_velocities(double t, NewVelocity&& new_velocity);
   // Two cell levels for a wide size distribution (EngineOptions::size_levels), if they apply;
   // `room`: the cells' width over the contact distance they must hold (growth).
   // `stored`: a resumed state's cells (by the caller's numbering), which decide.

@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -19,6 +20,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <utility>
 #include <variant>
@@ -33,6 +35,8 @@
 #include "run/run.hpp"
 #include "run/simulation.hpp"
 #include "run/simulation_analyses.hpp"
+#include "sweep/sweep_plan.hpp"
+#include "sweep/sweep_runner.hpp"
 
 namespace py = pybind11;
 namespace fs = std::filesystem;
@@ -137,6 +141,103 @@ class SigintStopsRun {
  private:
   struct sigaction previous_ {};
 };
+
+// ----- kairos.sweep
+
+// The kairos program that runs a sweep's points: `given`, $KAIROS_BINARY, the build tree's
+// (python/../kairos), an installation's (P/lib/python3.X/dist-packages/../../../bin/kairos), or
+// the first on the PATH.
+fs::path sweep_program(const py::object& given) {
+  auto runnable = [](const fs::path& p) {
+    std::error_code ec;
+    return fs::is_regular_file(p, ec) && ::access(p.c_str(), X_OK) == 0;
+  };
+  if (const auto p = path_from(given, "kairos")) {
+    if (!runnable(*p)) throw InputError(fmt::format("kairos: {} is not a program", p->string()));
+    return fs::absolute(*p);
+  }
+  std::vector<fs::path> candidates;
+  if (const char* env = std::getenv("KAIROS_BINARY")) candidates.emplace_back(env);
+  const fs::path module =
+      fs::path(py::module_::import("kairos").attr("__file__").cast<std::string>()).parent_path();
+  candidates.push_back(module / ".." / "kairos");
+  candidates.push_back(module / ".." / ".." / ".." / "bin" / "kairos");
+  if (const char* path = std::getenv("PATH")) {
+    std::string dirs = path;
+    for (std::size_t start = 0; start <= dirs.size();) {
+      const std::size_t end = std::min(dirs.find(':', start), dirs.size());
+      if (end > start) candidates.push_back(fs::path(dirs.substr(start, end - start)) / "kairos");
+      start = end + 1;
+    }
+  }
+  for (const fs::path& c : candidates) {
+    if (runnable(c)) return fs::absolute(c).lexically_normal();
+  }
+  throw InputError(
+      "kairos.sweep: cannot find the kairos program (beside the module, in an installation's "
+      "bin, or on the PATH); pass kairos=PATH or set KAIROS_BINARY");
+}
+
+// One value of a `vary` list as --set takes it: numbers and booleans as TOML literals, strings
+// as they are, or quoted when a comma, quote or bracket would end or change the value.
+std::string sweep_value_text(const py::handle& item, const std::string& where) {
+  const py::object value = py::reinterpret_borrow<py::object>(item);
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::str>(value)) {
+    const std::string text = value.cast<std::string>();
+    // Quoted too when it could be read as A:B:N or I..J (a one-value list is one string).
+    const bool plain = !text.empty() && text.find_first_of(",\"'[]{}:") == std::string::npos &&
+                       text.find("..") == std::string::npos && text.front() != ' ' &&
+                       text.back() != ' ';
+    if (plain) return text;  // --set takes a bare word as a string
+    std::string quoted = "\"";
+    for (const char c : text) {
+      if (c == '"' || c == '\\') quoted += '\\';
+      quoted += c;
+    }
+    return quoted + "\"";
+  }
+  if (py::hasattr(value, "__index__")) return py::str(py::int_(value)).cast<std::string>();
+  if (py::hasattr(value, "__float__")) {
+    return py::repr(py::float_(value)).cast<std::string>();  // shortest round-trip
+  }
+  throw py::type_error(
+      fmt::format("{} must be a number, a bool or a string, not {}", where, type_name(value)));
+}
+
+// `vary`: {key: "A:B:N" | "I..J" | "V1,V2" | [values...]} as --vary arguments, in order.
+std::vector<std::string> sweep_axes_from(const py::object& vary) {
+  if (!py::isinstance<py::dict>(vary) || py::len(vary) == 0) {
+    throw py::type_error(
+        fmt::format("vary must be a non-empty dict {{key: values}} (e.g. {{\"system.seed\": "
+                    "\"1..4\"}}), not {}",
+                    type_name(vary)));
+  }
+  std::vector<std::string> axes;
+  for (const auto& [key, values] : vary.cast<py::dict>()) {
+    if (!py::isinstance<py::str>(key)) {
+      throw py::type_error(fmt::format("vary: keys must be strings, not {}",
+                                       type_name(py::reinterpret_borrow<py::object>(key))));
+    }
+    const std::string name = key.cast<std::string>();
+    if (py::isinstance<py::str>(values)) {
+      axes.push_back(name + "=" + values.cast<std::string>());
+      continue;
+    }
+    if (!py::isinstance<py::sequence>(values) || py::len(values) == 0) {
+      throw py::type_error(fmt::format(
+          "vary[\"{}\"] must be a string (\"A:B:N\", \"I..J\", \"V1,V2\") or a non-empty list",
+          name));
+    }
+    std::string list;
+    for (const auto& v : values.cast<py::sequence>()) {
+      if (!list.empty()) list += ',';
+      list += sweep_value_text(v, fmt::format("vary[\"{}\"]", name));
+    }
+    axes.push_back(name + "=" + list);
+  }
+  return axes;
+}
 
 py::array_t<double> as_array(const auto& rows, int dimension) {
   py::array_t<double> out({static_cast<py::ssize_t>(rows.size()), py::ssize_t{dimension}});
@@ -385,6 +486,22 @@ class PySimulation {
   }
   py::array_t<double> velocities() const {
     return visit([](const auto& s) { return as_array(s.velocities(), dimension_of(s)); });
+  }
+  void set_velocities(const py::object& values) {
+    visit([&]<int D>(Simulation<D>& s) {
+      const auto array =
+          py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
+      if (!array || array.ndim() != 2 || array.shape(1) != D) {
+        throw py::type_error(
+            fmt::format("set_velocities: velocities must be an (N, {}) array of numbers, not {}", D,
+                        type_name(values)));
+      }
+      const auto view = array.template unchecked<2>();
+      std::vector<Vec<D>> v(static_cast<std::size_t>(array.shape(0)));
+      for (std::size_t i = 0; i < v.size(); ++i)
+        for (int a = 0; a < D; ++a) v[i][a] = view(static_cast<py::ssize_t>(i), a);
+      s.set_velocities(v);
+    });
   }
   py::array_t<double> box() const {
     return visit([](const auto& s) {
@@ -1094,6 +1211,67 @@ PYBIND11_MODULE(kairos, m) {
       "output files and returns summary.json as a dict. Ctrl-C "
       "stops the run cleanly (every output written) and raises KeyboardInterrupt.");
 
+  m.def(
+      "sweep",
+      [](const py::object& config, const py::object& output_arg, const py::object& vary,
+         const py::object& set, const py::object& workers_arg, const py::object& program) {
+        const auto config_path = kairos::path_from(config, "config");
+        if (!config_path) throw py::type_error("config must be a TOML file's path");
+        const std::optional<fs::path> output = kairos::path_from(output_arg, "output");
+        int workers = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+        if (!workers_arg.is_none()) {
+          workers = static_cast<int>(kairos::number_from(workers_arg, "workers"));
+          if (workers < 1 || workers > 4096 ||
+              static_cast<double>(workers) != kairos::number_from(workers_arg, "workers")) {
+            throw kairos::InputError("workers: must be an integer in [1, 4096]");
+          }
+        }
+        const kairos::SweepPlan plan =
+            kairos::plan_sweep(*config_path, kairos::overrides_from(set),
+                               kairos::sweep_axes_from(vary), output.value_or("kairos-sweep"));
+        const fs::path executable = kairos::sweep_program(program);
+        const kairos::LocalSweepOutcome outcome = [&] {
+          kairos::SigintStopsRun sigint;
+          py::gil_scoped_release release;
+          return kairos::run_local_sweep(plan, {executable, workers, ""});
+        }();
+        if (outcome.tally.interrupted) {
+          PyErr_SetNone(PyExc_KeyboardInterrupt);
+          throw py::error_already_set();
+        }
+        const py::object json = py::module_::import("json");
+        const py::object runs =
+            json.attr("loads")(py::module_::import("pathlib")
+                                   .attr("Path")((plan.directory / "results.json").string())
+                                   .attr("read_text")())["runs"];
+        std::string failed;
+        for (const auto& run : runs) {
+          if (run["state"].cast<std::string>() == "failed") {
+            failed += fmt::format("\n  {}: {}", run["directory"].cast<std::string>(),
+                                  run["error"].cast<std::string>());
+          }
+        }
+        if (!failed.empty()) {
+          const std::string message =
+              fmt::format("kairos.sweep: runs failed (state 'failed' in the result):{}", failed);
+          if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) != 0) {
+            throw py::error_already_set();
+          }
+        }
+        return runs;
+      },
+      py::arg("config"), py::arg("output") = py::none(), py::arg("vary") = py::none(),
+      py::arg("set") = py::none(), py::arg("workers") = py::none(), py::arg("kairos") = py::none(),
+      "Runs a grid of simulations as `kairos sweep` does on this machine (docs/sweeps.md). "
+      "config: a TOML file's path; output: the sweep directory (default kairos-sweep); vary: "
+      "{key: values}, values a string as --vary takes it (\"0.1:0.5:9\", \"1..10\", "
+      "\"fcc,sc\") or a list of numbers, bools or strings; set: 'key=value' overrides for every "
+      "run; workers: runs at a time (default: the cores); kairos: the kairos program that runs "
+      "each point (default: found beside the module, in the installation or on the PATH). "
+      "Calling it again continues the sweep. Returns results.json's runs (each: run, directory, "
+      "state, error, values, summary); failed runs raise a RuntimeWarning. Ctrl-C stops the "
+      "running points cleanly and raises KeyboardInterrupt.");
+
   py::class_<PySimulation>(m, "Simulation",
                            "An event-driven simulation in memory: the engine of `kairos run` "
                            "started from the same configuration (bit-identical trajectory), "
@@ -1114,6 +1292,10 @@ PYBIND11_MODULE(kairos, m) {
       .def("positions", &PySimulation::positions,
            "Positions at the present time, an (N, D) array, wrapped into the periodic box.")
       .def("velocities", &PySimulation::velocities, "Velocities at the present time, (N, D).")
+      .def("set_velocities", &PySimulation::set_velocities, py::arg("velocities"),
+           "Gives every particle a new velocity now ((N, D), the numbering of positions()): the "
+           "run goes on as one started with them. Refused (InputError) for a fixed grain given "
+           "a velocity, soft spheres, sleeping particles or helfand=True.")
       .def("masses", &PySimulation::masses)
       .def("radii", &PySimulation::radii)
       .def("species", &PySimulation::species, "Species index of each particle.")

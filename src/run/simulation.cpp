@@ -200,6 +200,34 @@ std::vector<Vec<D>> Simulation<D>::velocities() const {
   return engine_->engine().current_velocities();
 }
 template <int D>
+void Simulation<D>::set_velocities(const std::vector<Vec<D>>& velocities) {
+  EventEngine<D, CalendarQueue>& engine = engine_->engine();
+  if (velocities.size() != n_) {
+    throw InputError(
+        fmt::format("set_velocities: {} velocities for {} particles", velocities.size(), n_));
+  }
+  const auto& species = config_.system.species;
+  for (std::size_t i = 0; i < n_; ++i) {
+    for (int a = 0; a < D; ++a) {
+      if (!std::isfinite(velocities[i][a])) {
+        throw InputError(fmt::format("set_velocities: particle {}: velocity not finite", i));
+      }
+    }
+    if (species[species_[i]].fixed && !(velocities[i] == Vec<D>{})) {
+      throw InputError(fmt::format(
+          "set_velocities: particle {} is a fixed grain (species {}): its velocity stays 0", i,
+          species[species_[i]].name));
+    }
+  }
+  if (engine.soft() || engine.sleeping() > 0 || engine.tracks_helfand()) {
+    throw InputError(
+        "set_velocities: not with soft spheres, sleeping particles or the Helfand moments kept "
+        "(helfand=True): their state follows the velocities");
+  }
+  engine.set_velocities(engine.time(), velocities);
+}
+
+template <int D>
 std::vector<WallReading> Simulation<D>::walls_with_mass() const {
   return engine_->walls_with_mass();
 }

@@ -75,6 +75,12 @@ class Simulation {
   // positions wrapped into the periodic box, velocities.
   std::vector<Vec<D>> positions() const;
   std::vector<Vec<D>> velocities() const;
+  // Gives every particle a new velocity now (in the numbering of positions()); the events are
+  // predicted anew, so the run goes on from the new velocities exactly as one started with them.
+  // InputError naming the particle for a count that differs, a velocity that is not finite or
+  // a fixed grain given one; with soft contacts in progress, sleeping particles or the Helfand
+  // moments kept (their state follows the velocities), InputError saying so.
+  void set_velocities(const std::vector<Vec<D>>& velocities);
   const std::vector<double>& masses() const { return mass_; }
   const std::vector<double>& radii() const { return radius_; }
   const std::vector<std::uint32_t>& species() const { return species_; }

@@ -173,6 +173,16 @@ SweepAxis parse_sweep_axis(const std::string& text) {
       if (v.empty()) throw InputError(fmt::format("--vary {}: an empty value in the list", text));
     }
   }
+  // Two runs of the same values under two names would count twice in every average.
+  std::set<std::string> seen;
+  for (const std::string& v : axis.values) {
+    if (!seen.insert(v).second) {
+      throw InputError(
+          fmt::format("--vary {}: the value {} comes twice (as written, or at 12 "
+                      "significant digits)",
+                      text, v));
+    }
+  }
   return axis;
 }
 

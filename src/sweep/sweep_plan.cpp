@@ -70,7 +70,8 @@ nlohmann::json manifest(const SweepPlan& plan) {
 }  // namespace
 
 std::vector<std::string> SweepPlan::run_arguments(const SweepPoint& point) const {
-  std::vector<std::string> args = {"run", config.string(), "-o", run_directory(point).string()};
+  std::vector<std::string> args = {"run", run_config().string(), "-o",
+                                   run_directory(point).string()};
   for (const std::string& s : overrides) {
     args.push_back("--set");
     args.push_back(s);
@@ -117,16 +118,30 @@ SweepPlan plan_sweep(const fs::path& config, const std::vector<std::string>& ove
   return plan;
 }
 
-void claim_sweep_directory(const SweepPlan& plan) {
+void make_sweep_directory(const SweepPlan& plan) {
   std::error_code ec;
   fs::create_directories(plan.directory, ec);
   if (ec || !fs::is_directory(plan.directory)) {
     throw InputError(fmt::format("{}: cannot create the sweep directory: {}",
                                  plan.directory.string(), ec ? ec.message() : "not a directory"));
   }
+}
+
+void claim_sweep_directory(const SweepPlan& plan) {
+  std::error_code ec;
   const fs::path path = plan.directory / kManifest;
   const nlohmann::json want = manifest(plan);
+  // The copy every run reads, written again if it went missing (its text is the manifest's).
+  auto write_copy = [&] {
+    std::ifstream in(plan.run_config(), std::ios::binary);
+    std::ostringstream have;
+    have << in.rdbuf();
+    if (!in || have.str() != plan.config_text) {
+      write_text_atomically(plan.run_config(), plan.config_text);
+    }
+  };
   if (!fs::exists(path, ec)) {
+    write_copy();
     write_text_atomically(path, want.dump(2) + "\n");
     return;
   }
@@ -156,11 +171,12 @@ void claim_sweep_directory(const SweepPlan& plan) {
     }
     refuse(fmt::format("its grid was{}", was));
   }
+  write_copy();
 }
 
 SweepDirectoryLock::SweepDirectoryLock(const fs::path& directory) {
   const fs::path lock = directory / ".kairos-sweep.lock";
-  fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT, 0666);  // inherited by the runs (header)
   if (fd_ < 0) {
     throw InputError(fmt::format("{}: cannot open: {}", lock.string(), std::strerror(errno)));
   }

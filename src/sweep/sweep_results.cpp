@@ -143,6 +143,7 @@ std::vector<SweepRunState> write_sweep_results(const fs::path& sweep_directory,
     records.push_back(read_sweep_run(sweep_directory / p.name));
     auto& row = rows.emplace_back();
     for (auto& [key, value] : flattened_summary(records.back().summary)) {
+      if (key == "error") continue;  // the table's own error column holds it
       columns.insert(key);
       row[key] = std::move(value);
     }

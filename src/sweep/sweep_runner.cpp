@@ -129,6 +129,7 @@ SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOp
   std::vector<Child> running;
   bool exhausted = false;
   bool stopping = false;
+  bool start_failed = false;
   const std::size_t workers = static_cast<std::size_t>(std::max(1, options.workers));
   auto say = [&](const std::string& line) {
     fmt::print("{}{}\n", options.label, line);
@@ -146,7 +147,9 @@ SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOp
     std::error_code ec;
     fs::create_directories(dir, ec);
     std::vector<std::string> args = plan.run_arguments(point);
-    const bool resume = record.has_restart && record.state != SweepRunState::kNotRun;
+    // Only a stopped run goes on from its restart file: a failed one wrote its restart file
+    // when it failed (at its end, a whole production would be added), and runs again.
+    const bool resume = record.has_restart && record.state == SweepRunState::kStopped;
     if (resume) {
       args.push_back("--restart");
       args.push_back((dir / "restart.gsd").string());
@@ -156,8 +159,13 @@ SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOp
     std::string error;
     const pid_t pid = spawn_run(options.executable, args, dir / kSweepConsoleFile, error);
     if (pid < 0) {
-      ++tally.failed;
-      say(fmt::format("{}: failed: {}", point.name, error));
+      // No process (fork refused, the console not writable): no more are started this
+      // invocation; the others end, and the same command takes the rest up later.
+      ++tally.not_started;
+      start_failed = true;
+      work.stop();
+      say(fmt::format("{}: could not be started: {}; no further runs are started", point.name,
+                      error));
       return;
     }
     running.push_back({pid, index, Clock::now(), false});
@@ -218,7 +226,7 @@ SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOp
         c.signalled = true;
       }
     }
-    while (!stopping && !exhausted && running.size() < workers) {
+    while (!stopping && !start_failed && !exhausted && running.size() < workers) {
       const std::optional<std::size_t> index = work.next();
       if (!index) {
         exhausted = true;
@@ -226,18 +234,18 @@ SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOp
         start(*index);
       }
     }
-    int status = 0;
-    pid_t pid;
-    while ((pid = ::waitpid(-1, &status, WNOHANG)) > 0) {
-      for (auto it = running.begin(); it != running.end(); ++it) {
-        if (it->pid != pid) continue;
-        const Child child = *it;
-        running.erase(it);
-        finish(child, status);
-        break;
+    // Our own children only: a host process (Python) may have children of its own.
+    for (std::size_t c = 0; c < running.size();) {
+      int status = 0;
+      if (::waitpid(running[c].pid, &status, WNOHANG) != running[c].pid) {
+        ++c;
+        continue;
       }
+      const Child child = running[c];
+      running.erase(running.begin() + static_cast<std::ptrdiff_t>(c));
+      finish(child, status);
     }
-    if (running.empty() && (exhausted || stopping) && !work.serving()) break;
+    if (running.empty() && (exhausted || stopping || start_failed) && !work.serving()) break;
     work.serve();
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
@@ -245,8 +253,9 @@ SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOp
 }
 
 LocalSweepOutcome run_local_sweep(const SweepPlan& plan, const SweepRunnerOptions& options) {
-  claim_sweep_directory(plan);
+  make_sweep_directory(plan);
   const SweepDirectoryLock lock(plan.directory);
+  claim_sweep_directory(plan);
   fmt::print("kairos sweep: {} runs in {}/, {} at a time\n", plan.points.size(),
              plan.directory.string(), options.workers);
   std::fflush(stdout);

@@ -3,12 +3,12 @@
 // order for a local sweep, or what the coordinating MPI rank hands out (cli/sweep_mpi.cpp), so
 // that a rank that finishes early takes the next run (dynamic load balance).
 //
-// A finished run is skipped; a stopped one (signal, wall-time limit, killed) is continued from
-// its restart.gsd, which completes its planned production; any other one is run afresh
-// (--overwrite: a failed attempt's outputs go). Each attempt's stdout and stderr are appended to
-// the run's console.log. A stop request (SIGINT/SIGTERM to the sweep) is passed on to the
-// running children as SIGTERM; they write their outputs and restart files, and the same sweep
-// command later continues them.
+// A finished run is skipped; a stopped one (signal, wall-time limit, killed with the sweep) is
+// continued from its restart.gsd, which completes its planned production; any other one (a
+// failed one too) is run afresh (--overwrite: an earlier attempt's outputs go). Each attempt's
+// stdout and stderr are appended to the run's console.log. A stop request (SIGINT/SIGTERM to the
+// sweep) is passed on to the running children as SIGTERM; they write their outputs and restart
+// files, and the same sweep command later continues them.
 #pragma once
 
 #include <cstddef>
@@ -55,8 +55,9 @@ struct SweepTally {
   std::size_t finished = 0;  // this invocation's runs that finished
   std::size_t skipped = 0;   // found finished before
   std::size_t failed = 0;
-  std::size_t stopped = 0;   // stopped by the stop request (continued by the next invocation)
-  bool interrupted = false;  // a stop was requested
+  std::size_t stopped = 0;      // stopped by the stop request (continued by the next invocation)
+  std::size_t not_started = 0;  // its process could not be started (then no further one is)
+  bool interrupted = false;     // a stop was requested
 };
 
 struct SweepRunnerOptions {

@@ -365,6 +365,124 @@ class Module(kt.KairosTestCase):
         sim = kairos.Simulation(cfg, set=("system.particles=100", "system.seed=3"))
         self.assertEqual(len(sim), 100)
 
+    def test_set_velocities_goes_on_from_them_exactly(self):
+        cfg = self.write_config(kt.base_config(particles=200, packing_fraction=0.2,
+                                               lattice="random", seed=5))
+        # Its own velocities given back at the start: the run of no call, bit for bit.
+        a, b = kairos.Simulation(cfg), kairos.Simulation(cfg)
+        a.set_velocities(a.velocities())
+        a.advance(time=2.0)
+        b.advance(time=2.0)
+        np.testing.assert_array_equal(a.positions(), b.positions())
+        self.assertEqual(a.collisions, b.collisions)
+        # New velocities: their kinetic energy, conserved; then reversed, the dynamics runs back
+        # to the start (hard-sphere dynamics is time-reversible; 0.5 time units, ~500
+        # collisions: round-off only).
+        sim = kairos.Simulation(cfg)
+        x0 = sim.positions()
+        v = np.random.default_rng(1).normal(size=x0.shape)
+        v -= v.mean(axis=0)
+        sim.set_velocities(v)
+        np.testing.assert_array_equal(sim.velocities(), v)
+        ke = 0.5 * (v ** 2).sum()
+        self.assertAlmostEqual(sim.kinetic_energy(), ke, delta=1e-12 * ke)
+        sim.advance(time=0.5)
+        self.assertAlmostEqual(sim.kinetic_energy(), ke, delta=1e-12 * ke)
+        self.assertGreater(sim.collisions, 100)
+        sim.set_velocities(-sim.velocities())
+        sim.advance(time=1.0)
+        d = sim.positions() - x0
+        d -= sim.box * np.round(d / sim.box)
+        self.assertLess(np.abs(d).max(), 1e-9)
+        np.testing.assert_allclose(sim.velocities(), -v, atol=1e-9)
+        # Mistakes name the problem.
+        cases = [
+            (lambda: sim.set_velocities(v[:10]), kairos.InputError, "10 velocities for 200"),
+            (lambda: sim.set_velocities(np.zeros((200, 2))), TypeError, "(N, 3)"),
+            (lambda: sim.set_velocities("fast"), TypeError, "(N, 3)"),
+            (lambda: sim.set_velocities(np.where(np.arange(200)[:, None] == 7, np.nan, v)),
+             kairos.InputError, "particle 7"),
+            (lambda: kairos.Simulation(cfg, helfand=True).set_velocities(v), kairos.InputError,
+             "Helfand"),
+        ]
+        for call, error, needle in cases:
+            with self.assertRaises(error) as caught:
+                call()
+            self.assertIn(needle, str(caught.exception))
+        # A fixed grain keeps its rest.
+        fixed = self.write_config(kt.base_config(
+            particles=200, packing_fraction=0.2, lattice="random", seed=5,
+            system={"species": [{"name": "A", "fraction": 0.9},
+                                {"name": "F", "fraction": 0.1, "fixed": True}]}), "fixed.toml")
+        grains = kairos.Simulation(fixed)
+        still = np.flatnonzero(grains.species() == 1)
+        self.assertGreater(len(still), 0)
+        w = grains.velocities()
+        w[still[0]] = [1.0, 0.0, 0.0]
+        with self.assertRaises(kairos.InputError) as caught:
+            grains.set_velocities(w)
+        self.assertIn("particle %d is a fixed grain" % still[0], str(caught.exception))
+        w[still[0]] = 0.0
+        grains.set_velocities(2.0 * w)
+        grains.advance(time=0.5)
+        np.testing.assert_array_equal(grains.velocities()[still], 0.0)
+
+
+class Sweep(kt.KairosTestCase):
+    """kairos.sweep (docs/sweeps.md): the CLI's sweep on this machine, called from Python."""
+
+    def test_a_sweep_from_python_is_the_cli_sweep(self):
+        cfg = self.write_config(kt.base_config(particles=200, equilibration=2.0, production=10.0,
+                                               output={"log_interval": 0.0}))
+        vary = {"system.packing_fraction": [0.2, 0.3], "system.lattice": ["fcc", "sc"]}
+        runs = kairos.sweep(cfg, output=self.path("py"), vary=vary, workers=2)
+        self.assertEqual([r["state"] for r in runs], ["finished"] * 4)
+        self.assertEqual([r["values"] for r in runs],
+                         [{"system.packing_fraction": 0.2, "system.lattice": "fcc"},
+                          {"system.packing_fraction": 0.2, "system.lattice": "sc"},
+                          {"system.packing_fraction": 0.3, "system.lattice": "fcc"},
+                          {"system.packing_fraction": 0.3, "system.lattice": "sc"}])
+        self.assertEqual(runs[1]["directory"], "0001_packing_fraction=0.2_lattice=sc")
+        # The same grid from the command line: the same directories, the same results.
+        self.run_ok("sweep", cfg, "-o", self.path("cli"), "--vary",
+                    "system.packing_fraction=0.2,0.3", "--vary", "system.lattice=fcc,sc")
+        with open(self.path("cli", "results.json")) as f:
+            cli = json.load(f)["runs"]
+        for a, b in zip(runs, cli):
+            self.assertEqual(a["directory"], b["directory"])
+            for key in ("compressibility", "sim_time", "events", "collisions"):
+                self.assertEqual(a["summary"][key], b["summary"][key], key)
+        # Called again, it continues: nothing is run twice.
+        again = kairos.sweep(cfg, output=self.path("py"), vary=vary)
+        self.assertEqual([r["summary"]["run_id"] for r in again],
+                         [r["summary"]["run_id"] for r in runs])
+
+    def test_failures_warn_and_mistakes_raise(self):
+        cfg = self.write_config(kt.base_config(particles=30, production=2.0,
+                                               system={"lattice": "random"},
+                                               output={"log_interval": 0.0}))
+        with self.assertWarns(RuntimeWarning) as caught:
+            runs = kairos.sweep(cfg, output=self.path("s"),
+                                vary={"system.packing_fraction": "0.3,0.66"}, workers=1)
+        self.assertIn("0001_packing_fraction=0.66", str(caught.warning))
+        self.assertEqual([r["state"] for r in runs], ["finished", "failed"])
+        cases = [
+            (lambda: kairos.sweep(cfg, vary=None), TypeError, "vary must be a non-empty dict"),
+            (lambda: kairos.sweep(cfg, vary={"system.seed": 3}), TypeError, "vary[\"system.seed\"]"),
+            (lambda: kairos.sweep(cfg, vary={"system.seed": [None]}), TypeError, "NoneType"),
+            (lambda: kairos.sweep(cfg, vary={"system.seed": "1..2"}, workers=0),
+             kairos.InputError, "workers"),
+            (lambda: kairos.sweep(cfg, vary={"system.seed": "1..2"}, kairos="/nonexistent"),
+             kairos.InputError, "/nonexistent"),
+            (lambda: kairos.sweep(cfg, output=self.path("s"), vary={"system.seed": "1..2"}),
+             kairos.InputError, "holds another sweep"),
+        ]
+        for call, error, needle in cases:
+            with self.assertRaises(error) as caught:
+                call()
+            self.assertIn(needle, str(caught.exception))
+        self.assertFalse(os.path.exists(self.path("kairos-sweep")))
+
 
 if __name__ == "__main__":
     kt.main()

@@ -115,14 +115,17 @@ class Sweep(kt.KairosTestCase):
                              summary["compressibility"]["stderr"])
             self.assertAlmostEqual(summary["packing_fraction"], float(row["system.packing_fraction"]),
                                    places=12)
+            # Each run reads the sweep's copy of the config, as planned.
             self.assertEqual(summary["provenance"]["command_line"].split()[1:4],
-                             ["run", config, "-o"])
+                             ["run", os.path.join(sweep, "sweep-config.toml"), "-o"])
         with open(os.path.join(sweep, "results.json")) as f:
             table = json.load(f)
         self.assertEqual([r["values"]["system.seed"] for r in table["runs"]], [3, 4, 3, 4])
         self.assertEqual(table["runs"][2]["summary"], self.summary(
             os.path.join(sweep, rows[2]["directory"])))
         self.assert_runs_match_by_hand(config, sweep)
+        with open(os.path.join(sweep, "sweep-config.toml")) as f, open(config) as g:
+            self.assertEqual(f.read(), g.read())
         # Run again: nothing to do, every run skipped, the table written again.
         again = self.sweep(config, "-o", sweep, *GRID)
         self.assertEqual(again.returncode, 0, kt.describe(again))

@@ -46,7 +46,8 @@ TEST(SweepGrid, IntegerRangesAndListsAreTakenAsWritten) {
 TEST(SweepGrid, MalformedAxesAreRefusedNamingTheArgument) {
   for (const char* bad :
        {"system.seed", "=1..3", "k=", "k=1..", "k=3..1", "k=a..b", "k=1:2", "k=1:2:0", "k=1:2:x",
-        "k=0:1:3:log", "k=1:2:3:lin", "k=nan:1:3", "k=1,,2", "k=1:2:3:4:5", "k=1..2000000"}) {
+        "k=0:1:3:log", "k=1:2:3:lin", "k=nan:1:3", "k=1,,2", "k=1:2:3:4:5", "k=1..2000000",
+        "k=0.1:0.1:5", "k=1,2,1", "k=0.1:0.1000000000001:2"}) {
     try {
       (void)parse_sweep_axis(bad);
       ADD_FAILURE() << bad << " was accepted";
