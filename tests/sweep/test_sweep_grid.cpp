@@ -24,7 +24,7 @@ TEST(SweepGrid, EvenlySpacedValuesIncludeBothEnds) {
 }
 
 TEST(SweepGrid, LogSpacedValuesAreAGeometricSeries) {
-  const SweepAxis a = parse_sweep_axis("granular.restitution=1e-3:1:4:log");
+  const SweepAxis a = parse_sweep_axis("contact.restitution=1e-3:1:4:log");
   ASSERT_EQ(a.values.size(), 4u);
   for (std::size_t i = 0; i < 4; ++i) {
     EXPECT_NEAR(std::stod(a.values[i]), std::pow(10.0, -3.0 + static_cast<double>(i)),
