@@ -44,8 +44,14 @@ def read_table(sweep):
 
 
 def attempts(run_directory):
+    """The attempts of a run, from its console.log; a sanitizer's report there fails the test
+    (a run's stderr goes to its console, not to the sweep's)."""
     with open(os.path.join(run_directory, "console.log")) as f:
-        return [l for l in f.read().splitlines() if l.startswith("kairos sweep: attempt: ")]
+        text = f.read()
+    for marker in ("runtime error:", "Sanitizer", "internal error"):
+        if marker in text:
+            raise AssertionError("%s in %s/console.log:\n%s" % (marker, run_directory, text))
+    return [l for l in text.splitlines() if l.startswith("kairos sweep: attempt: ")]
 
 
 def mpirun():
