@@ -1407,7 +1407,7 @@ void require_regular_file(const std::filesystem::path& path) {
 
 }  // namespace
 
-Config load_config(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+std::string read_config_text(const std::filesystem::path& path) {
   const auto cannot_read = [&](const std::string& reason) {
     return InputError(fmt::format("cannot read config file '{}': {}", path.string(), reason));
   };
@@ -1421,7 +1421,11 @@ Config load_config(const std::filesystem::path& path, const std::vector<std::str
   std::size_t n = 0;
   while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) text.append(buffer, n);
   if (std::ferror(file.get()) != 0) throw cannot_read(std::strerror(errno));
-  return parse_config(text, path.string(), overrides);
+  return text;
+}
+
+Config load_config(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+  return parse_config(read_config_text(path), path.string(), overrides);
 }
 
 }  // namespace kairos

@@ -405,7 +405,11 @@ struct Config {
 Config parse_config(std::string_view toml_text, std::string_view source_name,
                     const std::vector<std::string>& overrides = {});
 
-// Reads the file (InputError if missing/unreadable) and calls parse_config.
+// A config file's text: InputError naming the file if it is missing, unreadable or not a
+// regular file (a FIFO would block).
+std::string read_config_text(const std::filesystem::path& path);
+
+// Reads the file (read_config_text) and calls parse_config.
 Config load_config(const std::filesystem::path& path,
                    const std::vector<std::string>& overrides = {});
 

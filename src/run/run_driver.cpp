@@ -62,7 +62,7 @@ RunDriver<D>::RunDriver(const Config& config, const std::optional<fs::path>& res
   std::string building;
   integrator_ = start_integrator<D>(std::move(start), [&](const std::string& contact, double) {
     const std::string what = "building the soft-contact map table of " + contact;
-    log_->setup_step(what);
+    report_setup_progress(what, {});  // to run.log, as every long set-up step
     if (contact == building) return;
     building = contact;
     if (tell) std::fputs((what + " ...\n").c_str(), stderr);

@@ -24,18 +24,6 @@ namespace fs = std::filesystem;
 
 constexpr const char* kManifest = "sweep.json";
 
-std::string read_text(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) {
-    throw InputError(fmt::format("{}: no such config file (or not a regular file)", path.string()));
-  }
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) throw InputError(fmt::format("{}: cannot be read", path.string()));
-  return text.str();
-}
-
 // The dotted key as --set canonicalises it: "system.species[0].diameter" and
 // "system.species.0.diameter" name one key.
 std::string canonical_key(std::string key) {
@@ -88,7 +76,7 @@ SweepPlan plan_sweep(const fs::path& config, const std::vector<std::string>& ove
   if (directory.empty()) throw InputError("-o/--output: the sweep directory must not be empty");
   SweepPlan plan;
   plan.config = config;
-  plan.config_text = read_text(config);
+  plan.config_text = read_config_text(config);
   plan.overrides = overrides;
   plan.directory = directory;
   for (const std::string& v : vary) plan.axes.push_back(parse_sweep_axis(v));

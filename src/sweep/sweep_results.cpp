@@ -26,12 +26,14 @@ bool is_failure(const std::string& stop_reason) {
 
 // The last error line of the console's last attempt ("" if none).
 std::string last_console_error(const fs::path& console) {
+  constexpr std::string_view kAttempt = "kairos sweep: attempt";
   std::ifstream in(console);
   std::string line, error;
   while (std::getline(in, line)) {
-    if (line.rfind("kairos sweep: attempt", 0) == 0) error.clear();
-    if (line.rfind("kairos: error: ", 0) == 0) error = line.substr(15);
-    if (line.rfind("kairos sweep: error: ", 0) == 0) error = line.substr(21);
+    if (line.starts_with(kAttempt)) error.clear();
+    for (const std::string_view prefix : {"kairos: error: ", "kairos sweep: error: "}) {
+      if (line.starts_with(prefix)) error = line.substr(prefix.size());
+    }
   }
   return error;
 }
