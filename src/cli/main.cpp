@@ -25,6 +25,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "cli/replica_command.hpp"
 #include "cli/sweep_command.hpp"
 #include "cli/table_command.hpp"
 #include "core/error.hpp"
@@ -279,6 +280,8 @@ int main(int argc, char** argv) {
       "Usage of table: kairos table build|inspect|plot ... (soft-sphere collision map tables)\n"
       "Usage of sweep: kairos sweep CONFIG.toml -o SWEEPDIR --vary KEY=VALUES ... [--workers N] "
       "(a grid of runs; under mpirun across ranks)\n"
+      "Usage of replica-exchange: kairos replica-exchange CONFIG.toml -o DIR --temperatures "
+      "A:B:N:log --interval DT --exchanges N (parallel tempering)\n"
       "Usage of config-keys: kairos config-keys [--markdown] (every config key, declared once)\n"
       "  -o,--output OUTDIR   output directory (overrides output.directory)\n"
       "  --set key=value      override a config key (repeatable)\n"
@@ -340,6 +343,7 @@ int main(int argc, char** argv) {
 
   const auto table_command = kairos::cli::add_table_command(app);
   const auto sweep_command = kairos::cli::add_sweep_command(app);
+  const auto replica_command = kairos::cli::add_replica_command(app);
 
   // Usage errors are user errors too: one line "kairos: error: ...", exit status 2 (not CLI11's
   // own codes and two-line message). --help and --version still print and exit 0.
@@ -370,6 +374,10 @@ int main(int argc, char** argv) {
     if (table_command->parsed()) return table_command->run();
     if (sweep_command->parsed()) {
       return sweep_command->run(argc, argv, [] { return g_signal != 0 ? int{g_signal} : SIGINT; });
+    }
+    if (replica_command->parsed()) {
+      return replica_command->run(argc, argv,
+                                  [] { return g_signal != 0 ? int{g_signal} : SIGINT; });
     }
     if (config_keys->parsed()) {
       std::fputs((keys_markdown ? kairos::keys_markdown() : kairos::keys_text()).c_str(), stdout);

@@ -148,6 +148,21 @@ void MpiSession::wait_for_all() const {
   wait_without_spinning(request, std::chrono::milliseconds(50));
 }
 
+void MpiSession::sum(std::vector<double>& values) const {
+  MPI_Request request;
+  MPI_Iallreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM,
+                 MPI_COMM_WORLD, &request);
+  wait_without_spinning(request, std::chrono::milliseconds(1));
+}
+
+bool MpiSession::any(bool yes) const {
+  int mine = yes ? 1 : 0, all = 0;
+  MPI_Request request;
+  MPI_Iallreduce(&mine, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD, &request);
+  wait_without_spinning(request, std::chrono::milliseconds(1));
+  return all != 0;
+}
+
 std::unique_ptr<SweepWork> mpi_sweep_work(const MpiSession& session, std::size_t count) {
   if (session.rank() == 0) return std::make_unique<Coordinator>(count, session.size());
   return std::make_unique<Requester>();
@@ -161,8 +176,8 @@ bool mpi_built() {
 
 MpiSession::MpiSession(int&, char**&) {
   throw InputError(
-      "kairos sweep was started by an MPI launcher with several ranks, but this kairos was built "
-      "without MPI (install libopenmpi-dev and rebuild; docs/sweeps.md)");
+      "kairos was started by an MPI launcher with several ranks, but was built without MPI "
+      "(install libopenmpi-dev and rebuild; docs/install.md)");
 }
 MpiSession::~MpiSession() = default;
 MpiSession::Agreement MpiSession::agree(bool ok) const {
@@ -172,6 +187,10 @@ void MpiSession::abort(int status) const {
   std::_Exit(status);
 }
 void MpiSession::wait_for_all() const {}
+void MpiSession::sum(std::vector<double>&) const {}
+bool MpiSession::any(bool yes) const {
+  return yes;
+}
 std::unique_ptr<SweepWork> mpi_sweep_work(const MpiSession&, std::size_t count) {
   return std::make_unique<LocalSweepWork>(count);
 }

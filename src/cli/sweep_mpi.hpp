@@ -7,6 +7,7 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "sweep/sweep_runner.hpp"
 
@@ -39,6 +40,10 @@ class MpiSession {
   // Waits for every rank without spinning: a rank whose runs have ended would otherwise take a
   // core from the others' runs in MPI's busy-waiting barrier (or MPI_Finalize).
   void wait_for_all() const;
+  // Element-wise sum over the ranks, in place; whether any rank says yes. Both wait for every
+  // rank without spinning (replica exchange: a rank whose replicas are ahead waits here).
+  void sum(std::vector<double>& values) const;
+  bool any(bool yes) const;
 
  private:
   int rank_ = 0;

@@ -30,6 +30,7 @@
 #include "core/error.hpp"
 #include "core/stop_flag.hpp"
 #include "io/config.hpp"
+#include "replica/replica_exchange.hpp"
 #include "run/outputs/compression_output.hpp"
 #include "run/outputs/transport_output.hpp"
 #include "run/run.hpp"
@@ -502,6 +503,9 @@ class PySimulation {
         for (int a = 0; a < D; ++a) v[i][a] = view(static_cast<py::ssize_t>(i), a);
       s.set_velocities(v);
     });
+  }
+  void set_thermostat_temperature(double temperature) {
+    visit([&](auto& s) { s.set_thermostat_temperature(temperature); });
   }
   py::array_t<double> box() const {
     return visit([](const auto& s) {
@@ -1272,6 +1276,68 @@ PYBIND11_MODULE(kairos, m) {
       "state, error, values, summary); failed runs raise a RuntimeWarning. Ctrl-C stops the "
       "running points cleanly and raises KeyboardInterrupt.");
 
+  m.def(
+      "replica_exchange",
+      [](const py::object& config, const py::object& output_arg, const py::object& temperatures,
+         double interval, std::uint64_t exchanges, std::uint64_t equilibration,
+         const py::object& set, const py::object& workers_arg) {
+        const auto config_path = kairos::path_from(config, "config");
+        if (!config_path) throw py::type_error("config must be a TOML file's path");
+        kairos::ReplicaExchangeSettings settings;
+        settings.config = *config_path;
+        settings.directory = kairos::path_from(output_arg, "output").value_or("kairos-replicas");
+        settings.overrides = kairos::overrides_from(set);
+        if (py::isinstance<py::str>(temperatures)) {
+          settings.temperatures = temperatures.cast<std::string>();
+        } else {
+          for (const auto& t : temperatures) {
+            if (!settings.temperatures.empty()) settings.temperatures += ',';
+            settings.temperatures += fmt::format(
+                "{}", kairos::number_from(py::reinterpret_borrow<py::object>(t), "temperatures"));
+          }
+        }
+        settings.interval = interval;
+        settings.exchanges = exchanges;
+        settings.equilibration = equilibration;
+        settings.workers = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+        if (!workers_arg.is_none()) {
+          const double w = kairos::number_from(workers_arg, "workers");
+          if (!(w >= 1 && w <= 4096) || w != std::floor(w))
+            throw kairos::InputError("workers: must be an integer in [1, 4096]");
+          settings.workers = static_cast<int>(w);
+        }
+        settings.command_line = "kairos.replica_exchange(...)";
+        const kairos::ReplicaExchangePlan plan = kairos::plan_replica_exchange(settings);
+        fs::create_directories(plan.settings.directory);
+        const kairos::SweepDirectoryLock lock(plan.settings.directory);
+        kairos::claim_replica_directory(plan);
+        const kairos::ReplicaExchangeOutcome outcome = [&] {
+          kairos::SigintStopsRun sigint;
+          py::gil_scoped_release release;
+          return kairos::run_replica_exchange(plan, kairos::ReplicaComm{});
+        }();
+        if (outcome.stopped) {
+          PyErr_SetNone(PyExc_KeyboardInterrupt);
+          throw py::error_already_set();
+        }
+        if (outcome.summary.empty()) return py::object(py::none());
+        return py::module_::import("json").attr("loads")(py::module_::import("pathlib")
+                                                             .attr("Path")(outcome.summary.string())
+                                                             .attr("read_text")());
+      },
+      py::arg("config"), py::arg("output") = py::none(), py::arg("temperatures"),
+      py::arg("interval"), py::arg("exchanges"), py::arg("equilibration") = 0,
+      py::arg("set") = py::none(), py::arg("workers") = py::none(),
+      "Parallel tempering as `kairos replica-exchange` does on this machine "
+      "(docs/replica_exchange.md). config: a TOML file's path with [driving] kind = "
+      "\"andersen\"; output: the directory (default kairos-replicas); temperatures: the ladder, "
+      "a list of numbers or a string as --temperatures takes it (\"0.5:2:8:log\"); interval: "
+      "simulated time between exchange rounds; exchanges: rounds in all; equilibration: first "
+      "rounds left out of the statistics; set: 'key=value' overrides; workers: replicas at a "
+      "time (default: the cores). Calling it again continues the ensemble from its checkpoint. "
+      "Returns summary.json as a dict (None if run.max_wall_seconds stopped it first). Ctrl-C "
+      "stops after the current round, with a checkpoint, and raises KeyboardInterrupt.");
+
   py::class_<PySimulation>(m, "Simulation",
                            "An event-driven simulation in memory: the engine of `kairos run` "
                            "started from the same configuration (bit-identical trajectory), "
@@ -1296,6 +1362,10 @@ PYBIND11_MODULE(kairos, m) {
            "Gives every particle a new velocity now ((N, D), the numbering of positions()): the "
            "run goes on as one started with them. Refused (InputError) for a fixed grain given "
            "a velocity, soft spheres, sleeping particles or helfand=True.")
+      .def("set_thermostat_temperature", &PySimulation::set_thermostat_temperature,
+           py::arg("temperature"),
+           "[driving] kind = \"andersen\": the thermostat's temperature from now on (what save() "
+           "stores too); the velocities are not changed.")
       .def("masses", &PySimulation::masses)
       .def("radii", &PySimulation::radii)
       .def("species", &PySimulation::species, "Species index of each particle.")

@@ -139,6 +139,13 @@ double EventEngineAdapter<D, Queue>::draw_kick_interval() {
   return wait(rng_);
 }
 
+template <int D, class Queue>
+void EventEngineAdapter<D, Queue>::set_driving_temperature(double temperature) {
+  if (driving_kind_ != DrivingKind::kAndersen)
+    throw std::logic_error("set_driving_temperature: the run has no Andersen thermostat");
+  driving_.temperature = temperature;
+}
+
 // The kicks due up to the next event, and not after `limit`.
 template <int D, class Queue>
 void EventEngineAdapter<D, Queue>::apply_due_kicks(double limit) {

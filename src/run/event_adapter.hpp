@@ -166,6 +166,9 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   EventEngine<D, Queue>& engine() { return engine_; }
   const EventEngine<D, Queue>& engine() const { return engine_; }
   FrozenClockWatch& clock_watch() { return watch_; }
+  // The Andersen thermostat's temperature from now on (the kicks drawn after this call;
+  // logic_error unless [driving] is andersen). Replica exchange moves a replica to another rung.
+  void set_driving_temperature(double temperature);
 
  private:
   std::vector<std::uint8_t> fixed_;  // per particle (the caller's numbering): a fixed grain

@@ -32,11 +32,6 @@ Simulation<D>::Simulation(const Config& config,
         "DEM with `kairos run` (kairos.run in Python)",
         config.run.integrator));
   }
-  if (driving_kinds().at(config.driving.kind) != DrivingKind::kNone) {
-    throw InputError(
-        "[driving]: an in-memory simulation applies no driving kicks; run driven systems with "
-        "`kairos run` (kairos.run in Python)");
-  }
   RunStart<D> start = start_run<D>(config, restart_file, "event");
   config_ = start.config;
   if (tracking.helfand) {
@@ -325,8 +320,32 @@ const EventIntegrator<D>& Simulation<D>::integrator() const {
 }
 
 template <int D>
+void Simulation<D>::set_thermostat_temperature(double temperature) {
+  if (!driving_kinds().is(config_.driving.kind, DrivingKind::kAndersen)) {
+    throw InputError(fmt::format(
+        "set_thermostat_temperature: the simulation has no Andersen thermostat (driving.kind = "
+        "\"{}\"; set [driving] kind = \"andersen\")",
+        config_.driving.kind));
+  }
+  // driving.temperature's range (docs/config.md), in units of system.temperature.
+  const double kT = config_.system.temperature;
+  if (!std::isfinite(temperature) || !(temperature >= 1e-9 * kT) || !(temperature <= 1e9 * kT)) {
+    throw InputError(fmt::format(
+        "set_thermostat_temperature: driving.temperature = {} must be finite, in [1e-09, 1e+09] "
+        "times system.temperature = {}",
+        temperature, kT));
+  }
+  engine_->set_driving_temperature(temperature);
+  config_.driving.temperature = temperature;
+  progress_.config = to_toml(config_);  // what save() stores: a restart continues at it
+}
+
+template <int D>
 void Simulation<D>::save(const std::filesystem::path& path) const {
-  engine_->write_restart(path, progress_);
+  // The driving's next kick time, as `kairos run` records it before its restart file.
+  RunProgress progress = progress_;
+  engine_->record(progress, 0, 0.0);
+  engine_->write_restart(path, progress);
 }
 
 template class Simulation<2>;

@@ -33,8 +33,9 @@ class CalendarQueue;
 template <int D>
 class Simulation {
  public:
-  // From a configuration (run.integrator "event"; [driving] is refused: its kicks belong to
-  // `kairos run`), or from a restart file with it. InputError for anything the user must fix.
+  // From a configuration (run.integrator "event"; [driving] kicks as `kairos run` draws them,
+  // their random stream and next kick time kept by save()), or from a restart file with it.
+  // InputError for anything the user must fix.
   // `tracking`: image counters and Helfand moments kept beyond what the configuration asks for
   // (the moments: InputError for a system transport_obstacle() names, as analysis.transport).
   explicit Simulation(const Config& config,
@@ -81,6 +82,10 @@ class Simulation {
   // a fixed grain given one; with soft contacts in progress, sleeping particles or the Helfand
   // moments kept (their state follows the velocities), InputError saying so.
   void set_velocities(const std::vector<Vec<D>>& velocities);
+  // [driving] kind "andersen": the thermostat's temperature from now on (the configuration's
+  // driving.temperature, also as save() stores it). InputError without an Andersen thermostat
+  // or for a temperature outside driving.temperature's range. The velocities are not changed.
+  void set_thermostat_temperature(double temperature);
   const std::vector<double>& masses() const { return mass_; }
   const std::vector<double>& radii() const { return radius_; }
   const std::vector<std::uint32_t>& species() const { return species_; }

@@ -65,20 +65,20 @@ std::vector<std::string> spaced_values(const std::string& arg, const std::vector
   long long n = 0;
   const bool log = f.size() == 4;
   if (!parse_number(f[0], a) || !parse_number(f[1], b) || !std::isfinite(a) || !std::isfinite(b)) {
-    throw InputError(fmt::format("--vary {}: A and B of A:B:N must be finite numbers", arg));
+    throw InputError(fmt::format("{}: A and B of A:B:N must be finite numbers", arg));
   }
   if (!parse_number(f[2], n) || n < 1) {
-    throw InputError(fmt::format("--vary {}: N of A:B:N must be an integer >= 1", arg));
+    throw InputError(fmt::format("{}: N of A:B:N must be an integer >= 1", arg));
   }
   if (static_cast<std::size_t>(n) > kMaxRuns) {
     throw InputError(
-        fmt::format("--vary {}: N = {} values is more than a sweep takes ({})", arg, n, kMaxRuns));
+        fmt::format("{}: N = {} values is more than a sweep takes ({})", arg, n, kMaxRuns));
   }
   if (log && f[3] != "log") {
-    throw InputError(fmt::format("--vary {}: the fourth field of A:B:N:log must be 'log'", arg));
+    throw InputError(fmt::format("{}: the fourth field of A:B:N:log must be 'log'", arg));
   }
   if (log && (a <= 0.0 || b <= 0.0)) {
-    throw InputError(fmt::format("--vary {}: A:B:N:log needs A > 0 and B > 0", arg));
+    throw InputError(fmt::format("{}: A:B:N:log needs A > 0 and B > 0", arg));
   }
   std::vector<std::string> values;
   for (long long i = 0; i < n; ++i) {
@@ -94,12 +94,12 @@ std::vector<std::string> integer_values(const std::string& arg, const std::strin
                                         std::size_t dots) {
   long long i = 0, j = 0;
   if (!parse_number(spec.substr(0, dots), i) || !parse_number(spec.substr(dots + 2), j)) {
-    throw InputError(fmt::format("--vary {}: I..J needs two integers", arg));
+    throw InputError(fmt::format("{}: I..J needs two integers", arg));
   }
-  if (i > j) throw InputError(fmt::format("--vary {}: I..J needs I <= J", arg));
+  if (i > j) throw InputError(fmt::format("{}: I..J needs I <= J", arg));
   if (static_cast<unsigned long long>(j - i) >= kMaxRuns) {
-    throw InputError(fmt::format("--vary {}: {}..{} is more values than a sweep takes ({})", arg, i,
-                                 j, kMaxRuns));
+    throw InputError(
+        fmt::format("{}: {}..{} is more values than a sweep takes ({})", arg, i, j, kMaxRuns));
   }
   std::vector<std::string> values;
   for (long long k = i; k <= j; ++k) values.push_back(std::to_string(k));
@@ -134,22 +134,23 @@ std::vector<std::string> short_keys(const std::vector<SweepAxis>& axes) {
 
 }  // namespace
 
-SweepAxis parse_sweep_axis(const std::string& text) {
+SweepAxis parse_sweep_axis(const std::string& text, const std::string& option) {
+  const std::string arg = option + " " + text;
   const auto eq = text.find('=');
   if (eq == std::string::npos || eq == 0) {
     throw InputError(
-        fmt::format("--vary {}: expected KEY=VALUES (e.g. "
+        fmt::format("{}: expected KEY=VALUES (e.g. "
                     "system.packing_fraction=0.1:0.5:9 or system.seed=1..10)",
-                    text));
+                    arg));
   }
   SweepAxis axis;
   axis.key = trimmed(text.substr(0, eq));
   axis.spec = trimmed(text.substr(eq + 1));
-  if (axis.spec.empty()) throw InputError(fmt::format("--vary {}: no values", text));
+  if (axis.spec.empty()) throw InputError(fmt::format("{}: no values", arg));
   const bool has_structure = axis.spec.find_first_of("[{\"'") != std::string::npos;
   const auto dots = axis.spec.find("..");
   if (!has_structure && dots != std::string::npos && axis.spec.find(',') == std::string::npos) {
-    axis.values = integer_values(text, axis.spec, dots);
+    axis.values = integer_values(arg, axis.spec, dots);
   } else if (!has_structure && axis.spec.find(':') != std::string::npos &&
              axis.spec.find(',') == std::string::npos) {
     const std::vector<std::string> fields = [&] {
@@ -164,13 +165,13 @@ SweepAxis parse_sweep_axis(const std::string& text) {
       return f;
     }();
     if (fields.size() != 3 && fields.size() != 4) {
-      throw InputError(fmt::format("--vary {}: expected A:B:N or A:B:N:log", text));
+      throw InputError(fmt::format("{}: expected A:B:N or A:B:N:log", arg));
     }
-    axis.values = spaced_values(text, fields);
+    axis.values = spaced_values(arg, fields);
   } else {
     axis.values = split_list(axis.spec);
     for (const std::string& v : axis.values) {
-      if (v.empty()) throw InputError(fmt::format("--vary {}: an empty value in the list", text));
+      if (v.empty()) throw InputError(fmt::format("{}: an empty value in the list", arg));
     }
   }
   // Two runs of the same values under two names would count twice in every average.
@@ -178,9 +179,9 @@ SweepAxis parse_sweep_axis(const std::string& text) {
   for (const std::string& v : axis.values) {
     if (!seen.insert(v).second) {
       throw InputError(
-          fmt::format("--vary {}: the value {} comes twice (as written, or at 12 "
+          fmt::format("{}: the value {} comes twice (as written, or at 12 "
                       "significant digits)",
-                      text, v));
+                      arg, v));
     }
   }
   return axis;

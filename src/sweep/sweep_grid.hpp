@@ -28,8 +28,9 @@ struct SweepPoint {
   std::string name;                 // its directory's name, unique in the sweep
 };
 
-// "KEY=VALUES" as above; InputError naming the argument for a malformed one.
-SweepAxis parse_sweep_axis(const std::string& text);
+// "KEY=VALUES" as above; InputError naming the argument (after `option`, the command-line
+// option that gave it) for a malformed one.
+SweepAxis parse_sweep_axis(const std::string& text, const std::string& option = "--vary");
 
 // Every combination, in grid order, named "NNNN_key=value_..." (the key's last part; a name
 // character outside [A-Za-z0-9._+=-] becomes '_'). InputError for no axis, a key varied twice,

@@ -106,6 +106,37 @@ class Module(kt.KairosTestCase):
         sim, _ = self.cli_and_module_agree(config, 2.0)
         self.assertLess(sim.temperature(), 1.0)  # inelastic: the gas cooled
 
+    def test_a_thermostat_as_the_cli_has_it(self):
+        # [driving] kicks as `kairos run` draws them; save() keeps their random stream and the
+        # next kick's time, so the CLI continues a saved Simulation as one uninterrupted run.
+        driving = {"kind": "andersen", "rate": 2.0, "temperature": 1.5}
+        sim, cfg = self.cli_and_module_agree(hard_config(time=1.0, driving=driving), 1.0)
+        sim.save(self.path("saved.gsd"))
+        self.run_ok("run", cfg, "--restart", self.path("saved.gsd"), "-o", self.path("continued"))
+        whole = self.write_config(hard_config(time=2.0, driving=driving), "whole.toml")
+        self.run_ok("run", whole, "-o", self.path("whole"))
+        a = kt.read_exact_state(self.path("continued", "restart.gsd"))
+        b = kt.read_exact_state(self.path("whole", "restart.gsd"))
+        for name in kt.EXACT_CHUNKS:
+            self.assertTrue(np.array_equal(a[name], b[name]), name)
+        # A new thermostat temperature: the gas follows it (200 particles, kicked at 2 per
+        # particle per unit time: relaxed well within 10 time units).
+        sim.set_thermostat_temperature(0.5)
+        temperatures = []
+        sim.advance(time=sim.time + 5.0)
+        for _ in range(20):
+            sim.advance(time=sim.time + 0.5)
+            temperatures.append(sim.temperature())
+        self.assertAlmostEqual(np.mean(temperatures), 0.5, delta=0.05)
+        # ...and its restart file says so: a run continued from it is held at 0.5 too.
+        sim.save(self.path("cooled.gsd"))
+        self.assertIn("temperature = 0.5",
+                      kt.restart_chunk(self.path("cooled.gsd"), "kairos/run/config").tobytes()
+                      .decode())
+        with self.assertRaises(kairos.InputError) as caught:
+            sim.set_thermostat_temperature(-1.0)
+        self.assertIn("driving.temperature", str(caught.exception))
+
     def test_the_cli_continues_a_saved_simulation_exactly(self):
         cfg = self.write_config(hard_config(time=1.0))
         sim = kairos.Simulation(cfg)
@@ -313,7 +344,7 @@ class Module(kt.KairosTestCase):
             (lambda: sim.advance(time=1.0, events=3), "exactly one"),
             (lambda: (sim.advance(time=1.0), sim.advance(time=0.5)), "at time 1"),
             (lambda: kairos.Simulation(cfg, set=["run.integrator=dem"]), "integrator"),
-            (lambda: kairos.Simulation(cfg, set=["driving.kind=andersen"]), "[driving]"),
+            (lambda: sim.set_thermostat_temperature(2.0), "no Andersen thermostat"),
             (lambda: kairos.Simulation(cfg, set=["system.packing_fraction=1.5"]),
              "packing_fraction"),
             (lambda: kairos.Simulation("[system]\nparticles = 10\nbogus = 1\n"), "bogus"),
@@ -428,8 +459,30 @@ class Module(kt.KairosTestCase):
         np.testing.assert_array_equal(grains.velocities()[still], 0.0)
 
 
-class Sweep(kt.KairosTestCase):
+class Runners(kt.KairosTestCase):
+    """kairos.sweep and kairos.replica_exchange: the command-line runners from Python."""
+
     """kairos.sweep (docs/sweeps.md): the CLI's sweep on this machine, called from Python."""
+
+    def test_replica_exchange_from_python_is_the_cli_one(self):
+        cfg = self.write_config(
+            "[system]\nparticles = 8\nchain_length = 8\nchain_spacing = 1.1\n"
+            "packing_fraction = 0.001\n\n[[potential]]\nkind = \"square_well\"\nlambda = 1.5\n"
+            "depth = 1.0\n\n[[bond]]\ntype = \"backbone\"\nkind = \"tether\"\nmax_length = 1.25\n\n"
+            "[driving]\nkind = \"andersen\"\nrate = 1.0\n")
+        summary = kairos.replica_exchange(cfg, output=self.path("py"), temperatures=[0.5, 1, 2],
+                                          interval=1.0, exchanges=40, equilibration=10, workers=2)
+        self.assertEqual(summary["replica_exchange"]["rounds"], 40)
+        self.assertEqual([r["temperature"] for r in summary["rungs"]], [0.5, 1.0, 2.0])
+        self.run_ok("replica-exchange", cfg, "-o", self.path("cli"), "--temperatures", "0.5,1,2",
+                    "--interval", "1", "--exchanges", "40", "--equilibration", "10")
+        with open(self.path("py", "exchange.tsv"), "rb") as f, \
+                open(self.path("cli", "exchange.tsv"), "rb") as g:
+            self.assertEqual(f.read(), g.read())
+        with self.assertRaises(kairos.InputError) as caught:
+            kairos.replica_exchange(cfg, output=self.path("bad"), temperatures="2,1",
+                                    interval=1.0, exchanges=10)
+        self.assertIn("ascend", str(caught.exception))
 
     def test_a_sweep_from_python_is_the_cli_sweep(self):
         cfg = self.write_config(kt.base_config(particles=200, equilibration=2.0, production=10.0,

@@ -214,6 +214,36 @@ def signal_name(status):
     return "exit status %d" % status
 
 
+def mpirun():
+    return shutil.which("mpirun")
+
+
+def mpi_env():
+    """The environment of an mpirun started by a test."""
+    env = dict(os.environ)
+    # CI runs as root; OpenMPI refuses that unless told.
+    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+    if SANITIZED:
+        # OpenMPI leaks by design at MPI_Finalize, from components it has unloaded (no module
+        # name to suppress them by). The ranks keep AddressSanitizer and UBSan; the code they
+        # share with the local runs is leak-checked by the other tests.
+        env["ASAN_OPTIONS"] = ":".join(filter(None, [env.get("ASAN_OPTIONS"), "detect_leaks=0"]))
+    return env
+
+
+def mpi_unavailable():
+    """Why MPI tests cannot run here ("" when they can): no mpirun, or an MPI that cannot start
+    two ranks (a container without shared memory, say): the machine's matter, said as a skip."""
+    if not mpirun():
+        return "no mpirun (openmpi-bin)"
+    probe = subprocess.run([mpirun(), "-np", "2", "/bin/true"], capture_output=True, text=True,
+                           timeout=60, env=mpi_env())
+    if probe.returncode != 0:
+        return "mpirun cannot start 2 ranks here: " + probe.stderr[-300:]
+    return ""
+
+
 class KairosTestCase(unittest.TestCase):
     """Each test gets its own temporary directory `self.tmp`, removed afterwards."""
 

@@ -54,23 +54,6 @@ def attempts(run_directory):
     return [l for l in text.splitlines() if l.startswith("kairos sweep: attempt: ")]
 
 
-def mpirun():
-    return shutil.which("mpirun")
-
-
-def mpi_env():
-    env = dict(os.environ)
-    # CI runs as root; OpenMPI refuses that unless told.
-    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
-    if kt.SANITIZED:
-        # OpenMPI leaks by design at MPI_Finalize, from components it has unloaded (no module
-        # name to suppress them by). The ranks keep AddressSanitizer and UBSan; the runner they
-        # share with the local sweep is leak-checked by the other tests.
-        env["ASAN_OPTIONS"] = ":".join(filter(None, [env.get("ASAN_OPTIONS"), "detect_leaks=0"]))
-    return env
-
-
 GRID = ["--vary", "system.packing_fraction=0.2,0.35", "--vary", "system.seed=3..4"]
 
 
@@ -172,22 +155,17 @@ class Sweep(kt.KairosTestCase):
                             "eta = %s: Z = %s +- %s against %s" % (eta, mean, error, z))
 
     def test_mpi_ranks_give_the_same_runs(self):
-        if not mpirun():
-            self.skipTest("no mpirun (openmpi-bin)")
-        # An MPI that cannot start two ranks here (a container without shared memory, say) is
-        # the machine's matter, not the sweep's: say so instead of failing.
-        probe = subprocess.run([mpirun(), "-np", "2", "/bin/true"], capture_output=True,
-                               text=True, timeout=60, env=mpi_env())
-        if probe.returncode != 0:
-            self.skipTest("mpirun cannot start 2 ranks here: " + probe.stderr[-300:])
+        reason = kt.mpi_unavailable()
+        if reason:
+            self.skipTest(reason)
         config = self.config()
         reference = {}
         for ranks in (1, 2, 4):
             sweep = self.path("mpi%d" % ranks)
             result = subprocess.run(
-                [mpirun(), "-np", str(ranks), kt.KAIROS, "sweep", config, "-o", sweep] + GRID,
+                [kt.mpirun(), "-np", str(ranks), kt.KAIROS, "sweep", config, "-o", sweep] + GRID,
                 cwd=self.tmp, capture_output=True, text=True, timeout=kt.RUN_TIMEOUT * 2,
-                env=mpi_env())
+                env=kt.mpi_env())
             self.assertEqual(result.returncode, 0, kt.describe(result))
             self.assertIn("on %d MPI ranks" % ranks, result.stdout)
             self.assertIn("kairos sweep: 4 of 4 runs finished", result.stdout)

@@ -1,0 +1,502 @@
+#include "replica/replica_exchange.hpp"
+
+#include <unistd.h>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "core/stop_flag.hpp"
+#include "io/atomic_file.hpp"
+#include "io/config.hpp"
+#include "io/config_choices.hpp"
+#include "io/line_file.hpp"
+#include "replica/exchange_rule.hpp"
+#include "replica/exchange_statistics.hpp"
+#include "run/provenance.hpp"
+#include "run/simulation.hpp"
+
+namespace kairos {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kManifest = "replica.json";
+constexpr const char* kConfigCopy = "replica-config.toml";
+constexpr const char* kExchangeTable = "exchange.tsv";
+constexpr const char* kCheckpoint = "checkpoint";
+constexpr const char* kCheckpointNew = "checkpoint.new";
+constexpr const char* kCheckpointOld = "checkpoint.old";
+constexpr const char* kEnsembleFile = "ensemble.json";
+
+// Shortest text that reads back as the same double.
+std::string number(double x) {
+  return fmt::format("{}", x);
+}
+
+std::string replica_file(std::size_t r) {
+  return fmt::format("replica_{:03}.gsd", r);
+}
+
+nlohmann::json manifest(const ReplicaExchangePlan& plan) {
+  return {{"kairos_replica_exchange", 1},
+          {"config", fs::absolute(plan.settings.config).lexically_normal().string()},
+          {"config_text", plan.config_text},
+          {"set", plan.settings.overrides},
+          {"temperatures", plan.temperatures},
+          {"interval", plan.settings.interval}};
+}
+
+// ----- the exchange state in a checkpoint
+
+nlohmann::json to_json(const ExchangeState& s, std::uint64_t rows) {
+  std::ostringstream rng;
+  rng << s.rng;
+  return {{"round", s.round},       {"replica_at", s.replica_at}, {"attempts", s.attempts},
+          {"accepted", s.accepted}, {"last_end", s.last_end},     {"round_trips", s.round_trips},
+          {"rng", rng.str()},       {"exchange_rows", rows}};
+}
+
+ExchangeState exchange_state_from(const nlohmann::json& j, std::size_t rungs,
+                                  const fs::path& file) {
+  ExchangeState s;
+  try {
+    s.round = j.at("round").get<std::uint64_t>();
+    s.replica_at = j.at("replica_at").get<std::vector<std::uint32_t>>();
+    s.attempts = j.at("attempts").get<std::vector<std::uint64_t>>();
+    s.accepted = j.at("accepted").get<std::vector<std::uint64_t>>();
+    s.last_end = j.at("last_end").get<std::vector<std::int8_t>>();
+    s.round_trips = j.at("round_trips").get<std::vector<std::uint64_t>>();
+    std::istringstream rng(j.at("rng").get<std::string>());
+    rng >> s.rng;
+    if (!rng) throw InputError("the random stream's state is unreadable");
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not an ensemble checkpoint: {}", file.string(), e.what()));
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", file.string(), e.what()));
+  }
+  std::vector<std::uint32_t> sorted = s.replica_at;
+  std::sort(sorted.begin(), sorted.end());
+  bool permutation = sorted.size() == rungs;
+  for (std::size_t k = 0; permutation && k < rungs; ++k) permutation = sorted[k] == k;
+  if (!permutation || s.attempts.size() + 1 != rungs || s.accepted.size() + 1 != rungs ||
+      s.last_end.size() != rungs || s.round_trips.size() != rungs) {
+    throw InputError(
+        fmt::format("{}: the checkpoint is not one of {} replicas", file.string(), rungs));
+  }
+  return s;
+}
+
+struct Checkpoint {
+  fs::path directory;
+  ExchangeState state;
+  std::uint64_t rows = 0;
+};
+
+// checkpoint/, or checkpoint.old/ when an interrupted checkpoint left only that complete.
+std::optional<Checkpoint> find_checkpoint(const fs::path& directory, std::size_t rungs) {
+  for (const char* name : {kCheckpoint, kCheckpointOld}) {
+    const fs::path file = directory / name / kEnsembleFile;
+    std::error_code ec;
+    if (!fs::exists(file, ec)) continue;
+    std::ifstream in(file);
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded()) throw InputError(fmt::format("{}: unreadable JSON", file.string()));
+    Checkpoint c{directory / name, exchange_state_from(j, rungs, file), 0};
+    c.rows = j.value("exchange_rows", std::uint64_t{0});
+    return c;
+  }
+  return std::nullopt;
+}
+
+void sync_directory(const fs::path& directory) {
+  // The renames below are what makes a checkpoint current: they must reach the disk in order.
+  if (std::FILE* f = std::fopen(directory.c_str(), "r")) {
+    (void)::fsync(::fileno(f));
+    std::fclose(f);
+  }
+}
+
+// ----- the replicas of this process
+
+template <int D>
+class LocalReplicas {
+ public:
+  LocalReplicas(const ReplicaExchangePlan& plan, const ReplicaComm& comm,
+                const std::optional<Checkpoint>& checkpoint, const ExchangeState& state)
+      : plan_(plan), comm_(comm) {
+    const std::vector<std::uint32_t> rung = state.rung_of();
+    for (std::size_t r = static_cast<std::size_t>(comm.rank()); r < state.rungs();
+         r += static_cast<std::size_t>(comm.size())) {
+      const Config c = replica_config(r, rung[r]);
+      std::optional<fs::path> restart;
+      if (checkpoint) restart = checkpoint->directory / replica_file(r);
+      try {
+        replicas_.push_back({r, std::make_unique<Simulation<D>>(c, restart)});
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("replica {}: {}", r, e.what()));
+      }
+    }
+  }
+
+  // Every replica of this process to time t, `workers` at a time; InputError naming the first
+  // replica that failed.
+  void advance_to(double t, int workers) {
+    std::atomic<std::size_t> next{0};
+    std::vector<std::exception_ptr> errors(replicas_.size());
+    auto work = [&] {
+      for (std::size_t i; (i = next.fetch_add(1)) < replicas_.size();) {
+        try {
+          replicas_[i].sim->advance_to_time(t);
+        } catch (...) {
+          errors[i] = std::current_exception();
+        }
+      }
+    };
+    const auto threads = static_cast<std::size_t>(
+        std::clamp<int>(workers, 1, static_cast<int>(std::max<std::size_t>(1, replicas_.size()))));
+    std::vector<std::thread> pool;
+    for (std::size_t w = 1; w < threads; ++w) pool.emplace_back(work);
+    work();
+    for (std::thread& th : pool) th.join();
+    for (std::size_t i = 0; i < replicas_.size(); ++i) {
+      if (!errors[i]) continue;
+      try {
+        std::rethrow_exception(errors[i]);
+      } catch (const std::exception& e) {
+        throw InputError(fmt::format("replica {} at time {}: {}", replicas_[i].index, t, e.what()));
+      }
+    }
+  }
+
+  // Each replica's configurational energy, summed over the processes: every rank gets all.
+  std::vector<double> energies(std::size_t count) const {
+    std::vector<double> u(count, 0.0);
+    for (const Replica& rep : replicas_) u[rep.index] = rep.sim->potential_energy();
+    comm_.sum(u);
+    return u;
+  }
+
+  // A replica that changed rungs takes the new rung's thermostat and has its velocities scaled.
+  void move(const std::vector<std::uint32_t>& rung_before,
+            const std::vector<std::uint32_t>& rung_after) {
+    const std::vector<double>& t = plan_.temperatures;
+    for (Replica& rep : replicas_) {
+      const std::uint32_t from = rung_before[rep.index], to = rung_after[rep.index];
+      if (from == to) continue;
+      const double scale = std::sqrt(t[to] / t[from]);
+      std::vector<Vec<D>> v = rep.sim->velocities();
+      for (Vec<D>& vi : v) vi = scale * vi;
+      rep.sim->set_velocities(v);
+      rep.sim->set_thermostat_temperature(t[to]);
+    }
+  }
+
+  void save(const fs::path& directory) const {
+    for (const Replica& rep : replicas_) rep.sim->save(directory / replica_file(rep.index));
+  }
+
+  std::size_t particles() const { return replicas_.empty() ? 0 : replicas_.front().sim->size(); }
+
+ private:
+  Config replica_config(std::size_t r, std::size_t rung) const {
+    return parse_config(plan_.config_text, plan_.settings.config.string(),
+                        plan_.replica_overrides(r, rung));
+  }
+
+  struct Replica {
+    std::size_t index;
+    std::unique_ptr<Simulation<D>> sim;
+  };
+  const ReplicaExchangePlan& plan_;
+  const ReplicaComm& comm_;
+  std::vector<Replica> replicas_;
+};
+
+// ----- the loop
+
+std::string exchange_header(std::size_t rungs) {
+  std::string h = "round\ttime";
+  for (std::size_t k = 0; k < rungs; ++k) h += fmt::format("\tU_{}", k);
+  for (std::size_t k = 0; k < rungs; ++k) h += fmt::format("\treplica_{}", k);
+  return h + "\tswaps\n";
+}
+
+std::string exchange_row(std::uint64_t round, double time, const std::vector<double>& energy_at,
+                         const std::vector<std::uint32_t>& replica_at, const std::string& swaps) {
+  std::string row = fmt::format("{}\t{}", round, number(time));
+  for (const double u : energy_at) {
+    row += '\t';
+    row += number(u);
+  }
+  for (const std::uint32_t r : replica_at) row += fmt::format("\t{}", r);
+  row += '\t';
+  row += swaps;
+  row += '\n';
+  return row;
+}
+
+// Every process saves its replicas into checkpoint.new/, then rank 0 adds ensemble.json and
+// makes it the checkpoint: a reader finds either the previous checkpoint or this one whole.
+template <int D>
+void write_checkpoint(const fs::path& directory, const LocalReplicas<D>& replicas,
+                      const ExchangeState& state, std::uint64_t rows, const ReplicaComm& comm) {
+  const fs::path fresh = directory / kCheckpointNew;
+  const fs::path current = directory / kCheckpoint;
+  const fs::path old = directory / kCheckpointOld;
+  std::string error;
+  if (comm.rank() == 0) {
+    std::error_code ec;
+    fs::remove_all(fresh, ec);
+    fs::create_directories(fresh, ec);
+    if (ec) error = fmt::format("{}: cannot create: {}", fresh.string(), ec.message());
+  }
+  if (comm.any(!error.empty())) {
+    throw InputError(error.empty() ? "the checkpoint directory could not be made" : error);
+  }
+  try {
+    replicas.save(fresh);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  if (comm.any(!error.empty())) {
+    throw InputError(error.empty() ? "another rank could not write its replicas" : error);
+  }
+  if (comm.rank() == 0) {
+    write_text_atomically(fresh / kEnsembleFile, to_json(state, rows).dump(1) + "\n");
+    sync_directory(fresh);
+    std::error_code ec;
+    fs::remove_all(old, ec);
+    if (fs::exists(current, ec)) fs::rename(current, old, ec);
+    if (!ec) fs::rename(fresh, current, ec);
+    if (ec)
+      throw InputError(
+          fmt::format("{}: cannot make it the checkpoint: {}", fresh.string(), ec.message()));
+    sync_directory(directory);
+    fs::remove_all(old, ec);
+  }
+  (void)comm.any(false);  // the checkpoint is in place before any process goes on
+}
+
+std::string acceptance_text(const ExchangeState& s) {
+  std::string out;
+  for (std::size_t k = 0; k < s.attempts.size(); ++k) {
+    out += k == 0 ? "" : " ";
+    out += s.attempts[k] == 0 ? "-"
+                              : fmt::format("{:.2f}", static_cast<double>(s.accepted[k]) /
+                                                          static_cast<double>(s.attempts[k]));
+  }
+  return out;
+}
+
+template <int D>
+ReplicaExchangeOutcome run_ensemble(const ReplicaExchangePlan& plan, const ReplicaComm& comm) {
+  const ReplicaExchangeSettings& settings = plan.settings;
+  const std::size_t rungs = plan.temperatures.size();
+  const bool root = comm.rank() == 0;
+  const std::optional<Checkpoint> checkpoint = find_checkpoint(settings.directory, rungs);
+  ExchangeState state = checkpoint ? checkpoint->state : ExchangeState::start(rungs, plan.seed);
+  if (state.round > settings.exchanges) {
+    throw InputError(fmt::format(
+        "--exchanges {}: the ensemble in {} has done {} rounds already; give at least that many",
+        settings.exchanges, settings.directory.string(), state.round));
+  }
+  LocalReplicas<D> replicas(plan, comm, checkpoint, state);
+  std::optional<LineFile> table;
+  if (root) {
+    const fs::path path = settings.directory / kExchangeTable;
+    table.emplace(path, exchange_header(rungs), checkpoint ? checkpoint->rows : 0);
+    if (table->rows() != (checkpoint ? checkpoint->rows : 0)) {
+      throw InputError(fmt::format(
+          "{}: holds {} rows, fewer than the {} of the checkpoint it continues (edited or "
+          "cut?); start the ensemble afresh in another directory",
+          path.string(), table->rows(), checkpoint->rows));
+    }
+    fmt::print(
+        "kairos replica-exchange: {} replicas of {} particles ({}D) at T = {} .. {}, "
+        "{}{} rounds of {} time units, in {}/\n",
+        rungs, replicas.particles(), D, number(plan.temperatures.front()),
+        number(plan.temperatures.back()),
+        checkpoint ? fmt::format("continuing at round {} of ", state.round) : "",
+        settings.exchanges, number(settings.interval), settings.directory.string());
+    std::fflush(stdout);
+  }
+
+  ReplicaExchangeOutcome outcome;
+  const auto start = Clock::now();
+  auto last_checkpoint = start, last_line = start;
+  const std::uint64_t first_round = state.round;
+  auto seconds_since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  while (state.round < settings.exchanges) {
+    const double t = static_cast<double>(state.round + 1) * settings.interval;
+    replicas.advance_to(t, settings.workers);
+    const std::vector<double> u = replicas.energies(rungs);
+    std::vector<double> energy_at(rungs);
+    for (std::size_t k = 0; k < rungs; ++k) energy_at[k] = u[state.replica_at[k]];
+    const std::vector<std::uint32_t> replica_at = state.replica_at, before = state.rung_of();
+    const std::string swaps = attempt_exchanges(state, plan.temperatures, energy_at);
+    if (table) table->append(exchange_row(state.round, t, energy_at, replica_at, swaps));
+    replicas.move(before, state.rung_of());
+
+    const bool wall = plan.max_wall_seconds > 0.0 && seconds_since(start) >= plan.max_wall_seconds;
+    const bool stop = comm.any(stop_requested() || wall);
+    if (stop) {
+      outcome.wall_limit = comm.any(wall);
+      outcome.stopped = !outcome.wall_limit;
+    }
+    const bool due = seconds_since(last_checkpoint) >= settings.checkpoint_seconds;
+    if (stop || state.round == settings.exchanges || comm.any(due)) {
+      write_checkpoint(settings.directory, replicas, state, state.round, comm);
+      last_checkpoint = Clock::now();
+    }
+    if (root && (seconds_since(last_line) >= 10.0 || state.round == settings.exchanges)) {
+      const double rate =
+          static_cast<double>(state.round - first_round) / std::max(1e-9, seconds_since(start));
+      fmt::print("kairos replica-exchange: round {}/{}, t = {}, {:.3g} rounds/s, acceptance {}\n",
+                 state.round, settings.exchanges, number(t), rate, acceptance_text(state));
+      std::fflush(stdout);
+      last_line = Clock::now();
+    }
+    if (stop) break;
+  }
+  outcome.rounds = state.round;
+  if (root && state.round == settings.exchanges && state.round > 0) {
+    ExchangeResults results = read_exchange_table(settings.directory / kExchangeTable, rungs);
+    outcome.summary =
+        write_exchange_results(plan, state, results, static_cast<double>(D * replicas.particles()),
+                               provenance_now(settings.command_line, std::nullopt));
+  }
+  return outcome;
+}
+
+}  // namespace
+
+std::vector<std::string> ReplicaExchangePlan::replica_overrides(std::size_t r,
+                                                                std::size_t rung) const {
+  std::vector<std::string> o = settings.overrides;
+  o.push_back(fmt::format("system.seed={}", seed + r));
+  o.push_back("system.temperature=" + number(temperatures[r]));
+  o.push_back("driving.temperature=" + number(temperatures[rung]));
+  return o;
+}
+
+ReplicaExchangePlan plan_replica_exchange(const ReplicaExchangeSettings& settings) {
+  if (settings.directory.empty()) throw InputError("-o/--output: the directory must not be empty");
+  if (!std::isfinite(settings.interval) || !(settings.interval > 0.0)) {
+    throw InputError(
+        fmt::format("--interval: must be a finite time > 0, got {}", number(settings.interval)));
+  }
+  if (settings.exchanges < 1) throw InputError("--exchanges: must be at least 1");
+  if (settings.equilibration >= settings.exchanges) {
+    throw InputError(fmt::format(
+        "--equilibration {}: must be fewer than --exchanges {} (the rounds left for statistics)",
+        settings.equilibration, settings.exchanges));
+  }
+  if (settings.workers < 1 || settings.workers > 4096) {
+    throw InputError(fmt::format("--workers: must be in [1, 4096], got {}", settings.workers));
+  }
+  if (!std::isfinite(settings.checkpoint_seconds) || !(settings.checkpoint_seconds >= 0.0)) {
+    throw InputError("--checkpoint-seconds: must be a finite number >= 0");
+  }
+  for (const std::string& s : settings.overrides) {
+    const std::string key = s.substr(0, s.find('='));
+    for (const char* own : {"system.temperature", "driving.temperature"}) {
+      if (key == own) {
+        throw InputError(fmt::format(
+            "--set {}: replica exchange sets {} for each replica from the ladder; give the "
+            "temperatures by --temperatures",
+            s, own));
+      }
+    }
+  }
+  ReplicaExchangePlan plan;
+  plan.settings = settings;
+  plan.temperatures = parse_temperature_ladder(settings.temperatures, "--temperatures");
+  if (plan.temperatures.size() > 4096) {
+    throw InputError("--temperatures: more than 4096 replicas");
+  }
+  plan.config_text = read_config_text(settings.config);
+  const Config base = parse_config(plan.config_text, settings.config.string(), settings.overrides);
+  if (integrators().at(base.run.integrator) != IntegratorKind::kEvent) {
+    throw InputError(
+        fmt::format("run.integrator = \"{}\": replica exchange runs the event integrator",
+                    base.run.integrator));
+  }
+  if (!driving_kinds().is(base.driving.kind, DrivingKind::kAndersen)) {
+    throw InputError(fmt::format(
+        "driving.kind = \"{}\": replica exchange holds each replica at its rung's temperature "
+        "with the Andersen thermostat; add [driving] kind = \"andersen\" (and its rate) to the "
+        "config",
+        base.driving.kind));
+  }
+  plan.seed = base.system.seed;
+  plan.dimension = base.system.dimension;
+  plan.max_wall_seconds = base.run.max_wall_seconds;
+  for (std::size_t r = 0; r < plan.temperatures.size(); ++r) {
+    try {
+      (void)parse_config(plan.config_text, settings.config.string(), plan.replica_overrides(r, r));
+    } catch (const InputError& e) {
+      throw InputError(
+          fmt::format("replica {} (T = {}): {}", r, number(plan.temperatures[r]), e.what()));
+    }
+  }
+  return plan;
+}
+
+void claim_replica_directory(const ReplicaExchangePlan& plan) {
+  const fs::path& dir = plan.settings.directory;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) {
+    throw InputError(fmt::format("{}: cannot create the directory: {}", dir.string(),
+                                 ec ? ec.message() : "not a directory"));
+  }
+  const fs::path path = dir / kManifest;
+  const nlohmann::json want = manifest(plan);
+  if (!fs::exists(path, ec)) {
+    if (fs::exists(dir / kCheckpoint, ec) || fs::exists(dir / kExchangeTable, ec)) {
+      throw InputError(
+          fmt::format("{}: holds an exchange table or checkpoint but no {}; give another directory",
+                      dir.string(), kManifest));
+    }
+    write_text_atomically(dir / kConfigCopy, plan.config_text);
+    write_text_atomically(path, want.dump(2) + "\n");
+    return;
+  }
+  std::ifstream in(path);
+  const nlohmann::json have = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (have.is_discarded() || !have.is_object() || !have.contains("kairos_replica_exchange")) {
+    throw InputError(fmt::format("{}: not a replica-exchange manifest", path.string()));
+  }
+  for (const char* key : {"config_text", "set", "temperatures", "interval"}) {
+    if (have.value(key, nlohmann::json()) != want[key]) {
+      throw InputError(fmt::format(
+          "{} holds another ensemble: its {} differs ({}); continue it with the command that "
+          "began it, or give another directory",
+          dir.string(), key == std::string("config_text") ? "config text" : key,
+          key == std::string("config_text") ? have.value("config", std::string("?"))
+                                            : have.value(key, nlohmann::json()).dump()));
+    }
+  }
+}
+
+ReplicaExchangeOutcome run_replica_exchange(const ReplicaExchangePlan& plan,
+                                            const ReplicaComm& comm) {
+  return plan.dimension == 2 ? run_ensemble<2>(plan, comm) : run_ensemble<3>(plan, comm);
+}
+
+}  // namespace kairos
