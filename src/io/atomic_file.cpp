@@ -11,15 +11,21 @@
 
 namespace kairos {
 
-namespace {
-void fsync_path(const std::filesystem::path& p, int flags) {
-  const int fd = ::open(p.c_str(), flags);
-  if (fd >= 0) {
-    ::fsync(fd);
-    ::close(fd);
+void sync_to_disk(const std::filesystem::path& p) {
+  std::error_code ec;
+  const bool directory = std::filesystem::is_directory(p, ec);
+  const int fd = ::open(p.c_str(), directory ? O_RDONLY | O_DIRECTORY : O_RDONLY);
+  if (fd < 0) {
+    throw InputError("cannot open '" + p.string() + "' to sync it: " + std::strerror(errno));
+  }
+  const int status = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  // EINVAL: a file system that cannot sync this kind of file (some do not sync directories).
+  if (status != 0 && error != EINVAL) {
+    throw InputError("cannot sync '" + p.string() + "' to disk: " + std::strerror(error));
   }
 }
-}  // namespace
 
 void replace_file_atomically(const std::filesystem::path& target,
                              const std::function<void(const std::filesystem::path&)>& write) {
@@ -32,7 +38,13 @@ void replace_file_atomically(const std::filesystem::path& target,
     std::filesystem::remove(tmp, ignored);
     throw;
   }
-  fsync_path(tmp, O_RDONLY);
+  try {
+    sync_to_disk(tmp);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw;
+  }
   std::error_code ec;
   std::filesystem::rename(tmp, target, ec);
   if (ec) {
@@ -41,7 +53,7 @@ void replace_file_atomically(const std::filesystem::path& target,
     throw InputError("cannot replace '" + target.string() + "': " + ec.message());
   }
   const auto dir = target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
-  fsync_path(dir, O_RDONLY | O_DIRECTORY);
+  sync_to_disk(dir);
 }
 
 void write_text_atomically(const std::filesystem::path& target, std::string_view text) {

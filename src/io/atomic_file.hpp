@@ -15,4 +15,8 @@ void replace_file_atomically(const std::filesystem::path& target,
 
 void write_text_atomically(const std::filesystem::path& target, std::string_view text);
 
+// fsync of a file or a directory (its entries: renames in it); InputError naming it if the
+// disk reports an error (a file system that cannot sync that kind of file is not one).
+void sync_to_disk(const std::filesystem::path& path);
+
 }  // namespace kairos

@@ -83,4 +83,58 @@ std::optional<TransportObstacle> transport_obstacle(const Config& c) {
   return std::nullopt;
 }
 
+std::optional<TransportObstacle> replica_exchange_obstacle(const Config& c) {
+  const auto refuse = [](std::string key, std::string why) {
+    return TransportObstacle{std::move(key), std::move(why)};
+  };
+  // A conservative system in the transport sense is canonical under the thermostat, but for
+  // its static walls (allowed here) and the driving (the thermostat itself).
+  Config conservative = c;
+  conservative.driving = DrivingConfig{};
+  conservative.boundary.walls.clear();
+  conservative.boundary.planes.clear();
+  conservative.boundary.cylinders.clear();
+  conservative.boundary.spheres.clear();
+  if (std::optional<TransportObstacle> o = transport_obstacle(conservative)) return o;
+  if (c.soft.enabled())
+    return refuse("soft", "soft contacts in progress cannot have their velocities scaled");
+  if (c.analysis.transport)
+    return refuse("analysis.transport", "the Helfand moments cannot follow a velocity scaling");
+  if (!c.boundary.container.axis.empty())
+    return refuse("boundary.container", "a driven container is not an equilibrium state");
+  if (!c.boundary.outlet.normal.empty())
+    return refuse("boundary.outlet", "an outlet moves particles: not an equilibrium state");
+  const auto still = [&](const WallConfig& w,
+                         const std::string& key) -> std::optional<TransportObstacle> {
+    bool sliding = false;
+    for (double v : w.velocity) sliding = sliding || v != 0.0;
+    if (sliding || w.amplitude != 0.0 || w.mass != 0.0)
+      return refuse(key, "a moving wall is not an equilibrium state");
+    Config probe;
+    probe.interactions.contact = w.contact;
+    if (transport_obstacle(probe))
+      return refuse(key + ".restitution", "the wall dissipates energy");
+    return std::nullopt;
+  };
+  for (std::size_t k = 0; k < c.boundary.walls.size(); ++k)
+    if (auto o = still(c.boundary.walls[k], fmt::format("boundary.wall[{}]", k))) return o;
+  for (std::size_t k = 0; k < c.boundary.planes.size(); ++k)
+    if (auto o = still(c.boundary.planes[k].wall, fmt::format("boundary.plane[{}]", k))) return o;
+  const auto round = [&](const std::vector<CylinderConfig>& list,
+                         const char* name) -> std::optional<TransportObstacle> {
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const std::string key = fmt::format("boundary.{}[{}]", name, k);
+      if (list[k].angular_velocity != 0.0)
+        return refuse(key + ".angular_velocity", "a rotating wall is not an equilibrium state");
+      WallConfig w;
+      w.contact = list[k].contact;
+      if (auto o = still(w, key)) return o;
+    }
+    return std::nullopt;
+  };
+  if (auto o = round(c.boundary.cylinders, "cylinder")) return o;
+  if (auto o = round(c.boundary.spheres, "sphere")) return o;
+  return std::nullopt;
+}
+
 }  // namespace kairos

@@ -24,4 +24,10 @@ std::optional<TransportObstacle> transport_obstacle(const Config& config);
 // of hard cores): the first obstacle by its key and why; nothing when it can be.
 std::optional<TransportObstacle> compression_obstacle(const Config& config);
 
+// What keeps replica exchange (replica/replica_exchange.hpp) from a system: each replica must
+// sample the canonical distribution of its rung with the engine's potential energy as U (no
+// field, no dissipation, no driven or moving boundary, no shear), and have its velocities
+// scaled on a swap (no soft spheres, fixed grains or Helfand moments). Nothing when it can.
+std::optional<TransportObstacle> replica_exchange_obstacle(const Config& config);
+
 }  // namespace kairos

@@ -125,4 +125,11 @@ void LineFile::write_all(std::string_view text) {
   size_ += done;
 }
 
+void LineFile::sync() {
+  if (::fsync(fd_) != 0 && errno != EINVAL) {
+    throw InputError(
+        fmt::format("{}: cannot sync to disk: {}", path_.string(), std::strerror(errno)));
+  }
+}
+
 }  // namespace kairos

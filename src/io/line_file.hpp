@@ -34,6 +34,9 @@ class LineFile {
 
   // Appends one line (with its newline); InputError, the file unchanged, if it cannot.
   void append(std::string_view line);
+  // Flushes the file to disk (fsync): what a checkpoint that counts its rows relies on.
+  // InputError naming the file if the disk reports an error.
+  void sync();
   // Data lines in the file (after the header).
   std::uint64_t rows() const { return rows_; }
   const std::filesystem::path& path() const { return path_; }

@@ -467,13 +467,67 @@ class PySimulation {
     return f();
   }
 
+  // callback(self) at each multiple of `every` (in the target's unit: time after the present,
+  // or events / collisions counted from now) up to the target, with the GIL and the object free
+  // (it may read or change the state, e.g. set_velocities); False from it stops the advance.
+  struct CallbackStop {};
+  bool advance_with_callback(std::optional<double> time, std::optional<std::uint64_t> events,
+                             std::optional<std::uint64_t> collisions, const py::object& every,
+                             const py::object& callback) {
+    if (!PyCallable_Check(callback.ptr()))
+      throw py::type_error("advance: callback must be callable, not " + type_name(callback));
+    const double step = number_from(every, "every");
+    if (!time && (!(step >= 1.0) || step != std::floor(step) || step > 0x1p62)) {
+      throw InputError(
+          fmt::format("advance: every = {} must be a whole number >= 1 of {} for an advance by {}",
+                      step, events ? "events" : "collisions", events ? "events" : "collisions"));
+    }
+    const py::object self = py::cast(this, py::return_value_policy::reference);
+    const auto call = [&] {
+      in_callback_ = true;
+      busy_ = false;
+      struct Back {
+        PySimulation& sim;
+        ~Back() {
+          sim.busy_ = true;
+          sim.in_callback_ = false;
+        }
+      } back{*this};
+      py::gil_scoped_acquire gil;
+      const py::object answer = callback(self);
+      if (!answer.is_none() && !answer.cast<bool>()) throw CallbackStop{};
+    };
+    return visit([&](auto& s) {
+      try {
+        return advancing([&] {
+          if (time) {
+            if (!(*time >= s.time()) || !std::isfinite(*time))
+              return s.advance_to_time(*time, python_keeps_going);  // its error
+            return s.sample_every(step, *time - s.time(), call, python_keeps_going);
+          }
+          const auto n = static_cast<std::uint64_t>(step);
+          if (events) return s.sample_every_events(n, *events, call, python_keeps_going);
+          return s.sample_every_collisions(n, *collisions, call, python_keeps_going);
+        });
+      } catch (const CallbackStop&) {
+        return false;
+      }
+    });
+  }
+
   int dimension() const {
     return visit([](const auto& s) { return dimension_of(s); });
   }
   bool advance(std::optional<double> time, std::optional<std::uint64_t> events,
-               std::optional<std::uint64_t> collisions) {
+               std::optional<std::uint64_t> collisions, const py::object& every,
+               const py::object& callback) {
     const int given = (time ? 1 : 0) + (events ? 1 : 0) + (collisions ? 1 : 0);
     if (given != 1) throw InputError("advance: give exactly one of time=, events= or collisions=");
+    if (in_callback_) throw InputError("advance: not from inside an advance's callback");
+    if (every.is_none() != callback.is_none())
+      throw InputError("advance: give every= and callback= together");
+    if (!callback.is_none())
+      return advance_with_callback(time, events, collisions, every, callback);
     return visit([&](auto& s) {
       return advancing([&] {
         if (time) return s.advance_to_time(*time, python_keeps_going);
@@ -905,6 +959,7 @@ class PySimulation {
   }
   std::variant<std::unique_ptr<Simulation<2>>, std::unique_ptr<Simulation<3>>> sim_;
   std::atomic<bool> busy_{false};
+  bool in_callback_ = false;  // an advance's callback is running (no nested advance)
 };
 
 // kairos.Correlator: analysis/msd.hpp's multiple-tau correlator fed by the user, with 1, 2 or
@@ -1352,9 +1407,13 @@ PYBIND11_MODULE(kairos, m) {
            "for helfand_moments() and transport() (a conservative periodic system).")
       .def("advance", &PySimulation::advance, py::arg("time") = py::none(),
            py::arg("events") = py::none(), py::arg("collisions") = py::none(),
+           py::arg("every") = py::none(), py::arg("callback") = py::none(),
            "Advances to simulated time `time` (exactly; no event needs to happen then), or by "
-           "`events` events, or by `collisions` collisions (one of the three). Returns False if "
-           "no event was left before the target.")
+           "`events` events, or by `collisions` collisions (one of the three). With every= and "
+           "callback=, calls callback(sim) at each multiple of `every` on the way (in the "
+           "target's unit: simulated time, or events / collisions from now); the callback may "
+           "read or change the state, and returning False stops the advance there. Returns False "
+           "if no event was left before the target or the callback stopped it.")
       .def("positions", &PySimulation::positions,
            "Positions at the present time, an (N, D) array, wrapped into the periodic box.")
       .def("velocities", &PySimulation::velocities, "Velocities at the present time, (N, D).")

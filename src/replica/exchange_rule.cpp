@@ -23,6 +23,7 @@ ExchangeState ExchangeState::start(std::size_t rungs, std::uint64_t seed) {
   s.attempts.assign(rungs > 0 ? rungs - 1 : 0, 0);
   s.accepted.assign(s.attempts.size(), 0);
   s.last_end.assign(rungs, -1);
+  if (rungs > 0) s.last_end[0] = 0;  // replica 0 starts on the coldest rung
   s.round_trips.assign(rungs, 0);
   // Its own stream, apart from the replicas' (seeded from system.seed + r).
   std::seed_seq seq{seed, std::uint64_t{0x7265706c696361}};  // "replica"
@@ -54,12 +55,13 @@ std::string attempt_exchanges(ExchangeState& state, const std::vector<double>& t
       std::swap(state.replica_at[k], state.replica_at[k + 1]);
     }
   }
-  // Round trips: a replica that reaches the coldest rung having last touched the hottest.
+  // Round trips: a replica that reaches the coldest rung having gone from it to the hottest
+  // (a replica that starts hot has been nowhere yet).
   if (rungs >= 2) {
     const std::uint32_t cold = state.replica_at.front(), hot = state.replica_at.back();
     if (state.last_end[cold] == 1) ++state.round_trips[cold];
     state.last_end[cold] = 0;
-    state.last_end[hot] = 1;
+    if (state.last_end[hot] == 0) state.last_end[hot] = 1;
   }
   ++state.round;
   return outcome;

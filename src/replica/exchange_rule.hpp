@@ -27,8 +27,9 @@ struct ExchangeState {
   std::vector<std::uint32_t> replica_at;  // per rung: the replica on it
   std::vector<std::uint64_t> attempts;    // per neighbour pair (k, k + 1)
   std::vector<std::uint64_t> accepted;    // likewise
-  // Per replica: the end of the ladder it last touched (-1 none yet, 0 the coldest rung, 1 the
-  // hottest) and its round trips (coldest -> hottest -> coldest) so far.
+  // Per replica: where it is on its way (-1 not yet on the coldest rung, 0 on it or on its way
+  // up from it, 1 reached the hottest rung since) and its round trips (coldest -> hottest ->
+  // coldest) so far.
   std::vector<std::int8_t> last_end;
   std::vector<std::uint64_t> round_trips;
   std::mt19937_64 rng;

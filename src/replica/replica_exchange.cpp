@@ -21,6 +21,7 @@
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
 #include "io/config_choices.hpp"
+#include "io/config_obstacles.hpp"
 #include "io/line_file.hpp"
 #include "replica/exchange_rule.hpp"
 #include "replica/exchange_statistics.hpp"
@@ -105,28 +106,63 @@ struct Checkpoint {
   std::uint64_t rows = 0;
 };
 
-// checkpoint/, or checkpoint.old/ when an interrupted checkpoint left only that complete.
+// checkpoint/ (settle_checkpoint has made it the newest complete one), or nothing.
 std::optional<Checkpoint> find_checkpoint(const fs::path& directory, std::size_t rungs) {
-  for (const char* name : {kCheckpoint, kCheckpointOld}) {
-    const fs::path file = directory / name / kEnsembleFile;
-    std::error_code ec;
-    if (!fs::exists(file, ec)) continue;
-    std::ifstream in(file);
-    const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    if (j.is_discarded()) throw InputError(fmt::format("{}: unreadable JSON", file.string()));
-    Checkpoint c{directory / name, exchange_state_from(j, rungs, file), 0};
-    c.rows = j.value("exchange_rows", std::uint64_t{0});
-    return c;
+  const fs::path file = directory / kCheckpoint / kEnsembleFile;
+  std::error_code ec;
+  if (!fs::exists(file, ec)) return std::nullopt;
+  std::ifstream in(file);
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) throw InputError(fmt::format("{}: unreadable JSON", file.string()));
+  Checkpoint c{directory / kCheckpoint, exchange_state_from(j, rungs, file), 0};
+  try {
+    c.rows = j.at("exchange_rows").get<std::uint64_t>();
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not an ensemble checkpoint: {}", file.string(), e.what()));
   }
-  return std::nullopt;
+  if (c.rows != c.state.round) {
+    throw InputError(
+        fmt::format("{}: {} exchange rows for {} rounds", file.string(), c.rows, c.state.round));
+  }
+  return c;
 }
 
-void sync_directory(const fs::path& directory) {
-  // The renames below are what makes a checkpoint current: they must reach the disk in order.
-  if (std::FILE* f = std::fopen(directory.c_str(), "r")) {
-    (void)::fsync(::fileno(f));
-    std::fclose(f);
+// After a kill while a checkpoint was being made: makes checkpoint/ the newest complete one.
+// checkpoint.new/ is complete when it holds ensemble.json (written last, after every replica's
+// file); checkpoint.old/ is the previous one, kept until the new one is in place.
+void settle_checkpoint(const fs::path& directory) {
+  const fs::path fresh = directory / kCheckpointNew;
+  const fs::path current = directory / kCheckpoint;
+  const fs::path old = directory / kCheckpointOld;
+  std::error_code ec;
+  const auto fail = [&](const fs::path& what) {
+    throw InputError(
+        fmt::format("{}: cannot settle the checkpoint: {}", what.string(), ec.message()));
+  };
+  if (fs::exists(fresh / kEnsembleFile, ec)) {
+    if (fs::exists(current, ec)) {
+      fs::remove_all(old, ec);
+      fs::rename(current, old, ec);
+      if (ec) fail(current);
+    }
+    fs::rename(fresh, current, ec);
+    if (ec) fail(fresh);
+    sync_to_disk(directory);
+  } else if (!fs::exists(current, ec) && fs::exists(old / kEnsembleFile, ec)) {
+    fs::rename(old, current, ec);
+    if (ec) fail(old);
+    sync_to_disk(directory);
   }
+  fs::remove_all(fresh, ec);
+  if (fs::exists(current, ec)) fs::remove_all(old, ec);
+}
+
+// The data rows of a table written by LineFile (a torn last line not counted).
+std::uint64_t complete_rows(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::uint64_t lines = 0;
+  for (std::string line; std::getline(in, line);) lines += in.eof() ? 0 : 1;
+  return lines > 0 ? lines - 1 : 0;
 }
 
 // ----- the replicas of this process
@@ -191,7 +227,7 @@ class LocalReplicas {
 
   // A replica that changed rungs takes the new rung's thermostat and has its velocities scaled.
   void move(const std::vector<std::uint32_t>& rung_before,
-            const std::vector<std::uint32_t>& rung_after) {
+            const std::vector<std::uint32_t>& rung_after, std::uint64_t round) {
     const std::vector<double>& t = plan_.temperatures;
     for (Replica& rep : replicas_) {
       const std::uint32_t from = rung_before[rep.index], to = rung_after[rep.index];
@@ -199,8 +235,13 @@ class LocalReplicas {
       const double scale = std::sqrt(t[to] / t[from]);
       std::vector<Vec<D>> v = rep.sim->velocities();
       for (Vec<D>& vi : v) vi = scale * vi;
-      rep.sim->set_velocities(v);
-      rep.sim->set_thermostat_temperature(t[to]);
+      try {
+        rep.sim->set_velocities(v);
+        rep.sim->set_thermostat_temperature(t[to]);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("replica {} moving to T = {} in round {}: {}", rep.index,
+                                     number(t[to]), round, e.what()));
+      }
     }
   }
 
@@ -248,11 +289,13 @@ std::string exchange_row(std::uint64_t round, double time, const std::vector<dou
   return row;
 }
 
-// Every process saves its replicas into checkpoint.new/, then rank 0 adds ensemble.json and
-// makes it the checkpoint: a reader finds either the previous checkpoint or this one whole.
+// Every process saves its replicas into checkpoint.new/, then rank 0 adds ensemble.json (the
+// exchange table synced first: the rows it counts are on disk) and makes it the checkpoint,
+// removing the previous one only once the new one is in place: a kill at any moment leaves a
+// complete checkpoint that settle_checkpoint finds.
 template <int D>
 void write_checkpoint(const fs::path& directory, const LocalReplicas<D>& replicas,
-                      const ExchangeState& state, std::uint64_t rows, const ReplicaComm& comm) {
+                      const ExchangeState& state, LineFile* table, const ReplicaComm& comm) {
   const fs::path fresh = directory / kCheckpointNew;
   const fs::path current = directory / kCheckpoint;
   const fs::path old = directory / kCheckpointOld;
@@ -275,16 +318,18 @@ void write_checkpoint(const fs::path& directory, const LocalReplicas<D>& replica
     throw InputError(error.empty() ? "another rank could not write its replicas" : error);
   }
   if (comm.rank() == 0) {
-    write_text_atomically(fresh / kEnsembleFile, to_json(state, rows).dump(1) + "\n");
-    sync_directory(fresh);
+    table->sync();
+    write_text_atomically(fresh / kEnsembleFile, to_json(state, table->rows()).dump(1) + "\n");
+    sync_to_disk(fresh);
     std::error_code ec;
     fs::remove_all(old, ec);
     if (fs::exists(current, ec)) fs::rename(current, old, ec);
     if (!ec) fs::rename(fresh, current, ec);
-    if (ec)
+    if (ec) {
       throw InputError(
           fmt::format("{}: cannot make it the checkpoint: {}", fresh.string(), ec.message()));
-    sync_directory(directory);
+    }
+    sync_to_disk(directory);
     fs::remove_all(old, ec);
   }
   (void)comm.any(false);  // the checkpoint is in place before any process goes on
@@ -350,7 +395,7 @@ ReplicaExchangeOutcome run_ensemble(const ReplicaExchangePlan& plan, const Repli
     const std::vector<std::uint32_t> replica_at = state.replica_at, before = state.rung_of();
     const std::string swaps = attempt_exchanges(state, plan.temperatures, energy_at);
     if (table) table->append(exchange_row(state.round, t, energy_at, replica_at, swaps));
-    replicas.move(before, state.rung_of());
+    replicas.move(before, state.rung_of(), state.round);
 
     const bool wall = plan.max_wall_seconds > 0.0 && seconds_since(start) >= plan.max_wall_seconds;
     const bool stop = comm.any(stop_requested() || wall);
@@ -360,7 +405,7 @@ ReplicaExchangeOutcome run_ensemble(const ReplicaExchangePlan& plan, const Repli
     }
     const bool due = seconds_since(last_checkpoint) >= settings.checkpoint_seconds;
     if (stop || state.round == settings.exchanges || comm.any(due)) {
-      write_checkpoint(settings.directory, replicas, state, state.round, comm);
+      write_checkpoint(settings.directory, replicas, state, table ? &*table : nullptr, comm);
       last_checkpoint = Clock::now();
     }
     if (root && (seconds_since(last_line) >= 10.0 || state.round == settings.exchanges)) {
@@ -443,6 +488,12 @@ ReplicaExchangePlan plan_replica_exchange(const ReplicaExchangeSettings& setting
         "config",
         base.driving.kind));
   }
+  if (const std::optional<TransportObstacle> o = replica_exchange_obstacle(base)) {
+    throw InputError(
+        fmt::format("{}: replica exchange needs each replica to sample the canonical "
+                    "distribution of its temperature: {}",
+                    o->key, o->why));
+  }
   plan.seed = base.system.seed;
   plan.dimension = base.system.dimension;
   plan.max_wall_seconds = base.run.max_wall_seconds;
@@ -455,6 +506,26 @@ ReplicaExchangePlan plan_replica_exchange(const ReplicaExchangeSettings& setting
     }
   }
   return plan;
+}
+
+// InputError unless the manifest `have` (read from path) describes this ensemble.
+static void check_manifest(const ReplicaExchangePlan& plan, const nlohmann::json& have,
+                           const fs::path& path) {
+  const fs::path& dir = plan.settings.directory;
+  const nlohmann::json want = manifest(plan);
+  if (have.is_discarded() || !have.is_object() || !have.contains("kairos_replica_exchange")) {
+    throw InputError(fmt::format("{}: not a replica-exchange manifest", path.string()));
+  }
+  for (const char* key : {"config_text", "set", "temperatures", "interval"}) {
+    if (have.value(key, nlohmann::json()) != want[key]) {
+      throw InputError(fmt::format(
+          "{} holds another ensemble: its {} differs ({}); continue it with the command that "
+          "began it, or give another directory",
+          dir.string(), key == std::string("config_text") ? "config text" : key,
+          key == std::string("config_text") ? have.value("config", std::string("?"))
+                                            : have.value(key, nlohmann::json()).dump()));
+    }
+  }
 }
 
 void claim_replica_directory(const ReplicaExchangePlan& plan) {
@@ -479,17 +550,15 @@ void claim_replica_directory(const ReplicaExchangePlan& plan) {
   }
   std::ifstream in(path);
   const nlohmann::json have = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (have.is_discarded() || !have.is_object() || !have.contains("kairos_replica_exchange")) {
-    throw InputError(fmt::format("{}: not a replica-exchange manifest", path.string()));
-  }
-  for (const char* key : {"config_text", "set", "temperatures", "interval"}) {
-    if (have.value(key, nlohmann::json()) != want[key]) {
+  check_manifest(plan, have, path);
+  settle_checkpoint(dir);
+  if (const std::optional<Checkpoint> c = find_checkpoint(dir, plan.temperatures.size())) {
+    const fs::path table = dir / kExchangeTable;
+    if (complete_rows(table) < c->rows) {
       throw InputError(fmt::format(
-          "{} holds another ensemble: its {} differs ({}); continue it with the command that "
-          "began it, or give another directory",
-          dir.string(), key == std::string("config_text") ? "config text" : key,
-          key == std::string("config_text") ? have.value("config", std::string("?"))
-                                            : have.value(key, nlohmann::json()).dump()));
+          "{}: holds {} rows, fewer than the {} of the checkpoint it continues (edited or cut?); "
+          "start the ensemble afresh in another directory",
+          table.string(), complete_rows(table), c->rows));
     }
   }
 }

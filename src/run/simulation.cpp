@@ -153,21 +153,41 @@ bool Simulation<D>::sample_every(double interval, double duration,
 }
 
 template <int D>
+bool Simulation<D>::sample_every_count(std::uint64_t step, std::uint64_t count,
+                                       const std::function<std::uint64_t()>& now,
+                                       const std::function<bool(std::uint64_t)>& advance,
+                                       const std::function<void()>& sample) {
+  const std::uint64_t end = target_after(now(), count);
+  // As the run driver's loop with one trigger in collisions (every step from the start).
+  CollisionTrigger trigger;
+  trigger.step = step;
+  trigger.next = target_after(now(), step);
+  while (now() < end) {
+    const std::uint64_t stop = std::min(trigger.next, end);
+    if (!advance(stop - now())) return false;
+    if (trigger.due(now())) sample();
+  }
+  return true;
+}
+
+template <int D>
 bool Simulation<D>::sample_every_collisions(std::uint64_t step, std::uint64_t count,
                                             const std::function<void()>& sample,
                                             const KeepGoing& keep_going) {
   if (step == 0) throw InputError("sampling every 0 collisions: the step must be at least 1");
-  const std::uint64_t end = target_after(collisions(), count);
-  // As the run driver's loop with one trigger in collisions (every step from the start).
-  CollisionTrigger trigger;
-  trigger.step = step;
-  trigger.next = target_after(collisions(), step);
-  while (collisions() < end) {
-    const std::uint64_t stop = std::min(trigger.next, end);
-    if (!advance_collisions(stop - collisions(), keep_going)) return false;
-    if (trigger.due(collisions())) sample();
-  }
-  return true;
+  return sample_every_count(
+      step, count, [&] { return collisions(); },
+      [&](std::uint64_t n) { return advance_collisions(n, keep_going); }, sample);
+}
+
+template <int D>
+bool Simulation<D>::sample_every_events(std::uint64_t step, std::uint64_t count,
+                                        const std::function<void()>& sample,
+                                        const KeepGoing& keep_going) {
+  if (step == 0) throw InputError("sampling every 0 events: the step must be at least 1");
+  return sample_every_count(
+      step, count, [&] { return events(); },
+      [&](std::uint64_t n) { return advance_events(n, keep_going); }, sample);
 }
 
 template <int D>

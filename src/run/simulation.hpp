@@ -66,6 +66,10 @@ class Simulation {
   bool sample_every_collisions(std::uint64_t step, std::uint64_t count,
                                const std::function<void()>& sample,
                                const KeepGoing& keep_going = {});
+  // The same on the event count: sample() each `step` events after events(), and ends `count`
+  // events on (false if no event was left before).
+  bool sample_every_events(std::uint64_t step, std::uint64_t count,
+                           const std::function<void()>& sample, const KeepGoing& keep_going = {});
 
   double time() const;
   std::uint64_t events() const;
@@ -132,6 +136,12 @@ class Simulation {
   // keep_going said stop.
   bool advance_within(const AdvanceLimits& limits, const std::function<bool()>& done,
                       const KeepGoing& keep_going);
+  // sample() every `step` of a count (collisions or events: `now`) for `count` more, each
+  // stretch advanced by advance(n).
+  bool sample_every_count(std::uint64_t step, std::uint64_t count,
+                          const std::function<std::uint64_t()>& now,
+                          const std::function<bool(std::uint64_t)>& advance,
+                          const std::function<void()>& sample);
 
   Config config_;
   std::unique_ptr<EventEngineAdapter<D, CalendarQueue>> engine_;

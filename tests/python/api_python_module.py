@@ -137,6 +137,67 @@ class Module(kt.KairosTestCase):
             sim.set_thermostat_temperature(-1.0)
         self.assertIn("driving.temperature", str(caught.exception))
 
+    def test_callbacks_every_interval_and_custom_stopping_rules(self):
+        cfg = self.write_config(hard_config())
+        plain = kairos.Simulation(cfg)
+        plain.advance(time=1.0)
+        seen = []
+        sim = kairos.Simulation(cfg)
+        self.assertTrue(sim.advance(time=1.0, every=0.25,
+                                    callback=lambda s: seen.append((s.time, s.collisions))))
+        # At each multiple of the interval, exactly; reading the state changes no bit of it.
+        self.assertEqual([t for t, _ in seen], [0.25, 0.5, 0.75, 1.0])
+        self.assertTrue(np.array_equal(sim.positions(), plain.positions()))
+        self.assertEqual(seen[-1][1], plain.collisions)
+        # On the event and the collision counts, from now on.
+        start = sim.events
+        counts = []
+        self.assertTrue(sim.advance(events=1000, every=250,
+                                    callback=lambda s: counts.append(s.events - start)))
+        self.assertEqual(counts, [250, 500, 750, 1000])
+        start = sim.collisions
+        counts = []
+        sim.advance(collisions=300, every=100,
+                    callback=lambda s: counts.append(s.collisions - start))
+        self.assertEqual(counts, [100, 200, 300])
+        # A stopping rule: False stops the advance there, and the simulation goes on later.
+        stopped_at = []
+
+        def until_hot(s):
+            stopped_at.append(s.time)
+            return s.time < 1.7
+
+        self.assertFalse(sim.advance(time=5.0, every=0.1, callback=until_hot))
+        self.assertAlmostEqual(sim.time, 1.7, delta=1e-9)
+        self.assertLess(len(stopped_at), 8)
+        self.assertTrue(sim.advance(time=2.0))
+        # The callback may change the state: a velocity rescale every 0.2 holds kT at 1.
+        def rescale(s):
+            s.set_velocities(s.velocities() * np.sqrt(1.0 / s.temperature()))
+        sim.advance(time=3.0, every=0.2, callback=rescale)
+        self.assertAlmostEqual(sim.temperature(), 1.0, delta=1e-12)
+        cases = [
+            (lambda: sim.advance(time=4.0, every=0.5), kairos.InputError, "together"),
+            (lambda: sim.advance(events=10, every=0, callback=print), kairos.InputError,
+             "every = 0"),
+            (lambda: sim.advance(events=10, every=2.5, callback=print), kairos.InputError,
+             "whole number"),
+            (lambda: sim.advance(time=4.0, every=0.5, callback=3), TypeError, "callable"),
+            (lambda: sim.advance(time=4.0, every=0.5,
+                                 callback=lambda s: s.advance(time=5.0)), kairos.InputError,
+             "inside an advance's callback"),
+        ]
+        for call, error, needle in cases:
+            with self.assertRaises(error) as caught:
+                call()
+            self.assertIn(needle, str(caught.exception))
+        # An error in the callback propagates, the state stays usable.
+        def broken(s):
+            raise ZeroDivisionError("from the callback")
+        with self.assertRaises(ZeroDivisionError):
+            sim.advance(time=sim.time + 1.0, every=0.1, callback=broken)
+        self.assertTrue(sim.advance(time=sim.time + 0.5))
+
     def test_the_cli_continues_a_saved_simulation_exactly(self):
         cfg = self.write_config(hard_config(time=1.0))
         sim = kairos.Simulation(cfg)

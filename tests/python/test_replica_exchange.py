@@ -13,6 +13,7 @@
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import time
@@ -179,6 +180,43 @@ class ReplicaExchange(kt.KairosTestCase):
         self.exchange_ok(config, split, *common, "--exchanges", "120")
         self.assert_same_ensemble(split, whole)
 
+    def test_a_checkpoint_interrupted_at_any_step_is_settled(self):
+        # The directories a kill leaves in each step of making a checkpoint, built from two real
+        # checkpoints (rounds 30 and 60); each continues to round 90 as the uninterrupted run.
+        config = self.write_config(chain_config(12))
+        common = ["--temperatures", LADDER, "--interval", "2"]
+        whole = self.path("whole")
+        self.exchange_ok(config, whole, *common, "--exchanges", "90")
+        base = self.path("base")
+        self.exchange_ok(config, base, *common, "--exchanges", "30")
+        at30 = self.path("at30")
+        shutil.copytree(os.path.join(base, "checkpoint"), at30)
+        self.exchange_ok(config, base, *common, "--exchanges", "60")
+        at60 = os.path.join(base, "checkpoint")
+        partial = self.path("partial")  # replica files written, ensemble.json not yet
+        shutil.copytree(at60, partial)
+        os.remove(os.path.join(partial, "ensemble.json"))
+        cases = {  # the layout, and the round it continues from
+            "new complete, before the renames": ({"checkpoint.new": at60, "checkpoint": at30}, 60),
+            "between the renames": ({"checkpoint.new": at60, "checkpoint.old": at30}, 60),
+            "before the old one is removed": ({"checkpoint": at60, "checkpoint.old": at30}, 60),
+            "new incomplete": ({"checkpoint.new": partial, "checkpoint": at30}, 30),
+            "only the old one": ({"checkpoint.old": at30}, 30),
+        }
+        for k, (name, (layout, newest)) in enumerate(cases.items()):
+            with self.subTest(case=name):
+                out = self.path("case%d" % k)
+                os.makedirs(out)
+                for f in ("replica.json", "replica-config.toml", "exchange.tsv"):
+                    shutil.copy(os.path.join(base, f), out)
+                for directory, source in layout.items():
+                    shutil.copytree(source, os.path.join(out, directory))
+                result = self.exchange_ok(config, out, *common, "--exchanges", "90")
+                self.assertIn("continuing at round %d of 90" % newest, result.stdout)
+                self.assertEqual(sorted(d for d in os.listdir(out) if d.startswith("checkpoint")),
+                                 ["checkpoint"])
+                self.assert_same_ensemble(out, whole)
+
     def test_a_stopped_ensemble_continues_bit_for_bit(self):
         # About 2 s of rounds (several under the sanitizers): stopped by SIGTERM after the first
         # progress, continued by the same command.
@@ -267,6 +305,11 @@ class ReplicaExchange(kt.KairosTestCase):
                                                                     "--temperatures"]),
             ([good] + ladder + ["--set", "system.packing_fraction=2"],
              ["system.packing_fraction"]),
+            # Not canonical with the engine's potential energy: refused, naming the key.
+            ([good] + ladder + ["--set", "field.gravity=[0,0,-1]"],
+             ["field.gravity", "canonical"]),
+            ([good] + ladder + ["--set", "contact.restitution=0.9"],
+             ["contact.restitution", "canonical"]),
         ]
         for k, (args, needles) in enumerate(cases):
             with self.subTest(case=k):

@@ -85,6 +85,22 @@ TEST(ExchangeRule, CountsRoundTripsThroughTheLadder) {
   EXPECT_EQ(s.round_trips[1], 1u);
 }
 
+TEST(ExchangeRule, ARoundTripStartsOnTheColdestRung) {
+  // Three rungs, every attempt accepted: the replicas cycle through the ladder. Replica 2 starts
+  // on the hottest rung: its first way down is no round trip.
+  ExchangeState s = ExchangeState::start(3, 1);
+  const std::vector<double> t = {1.0, 2.0, 3.0}, u = {0.0, 0.0, 0.0};
+  const std::vector<std::vector<std::uint32_t>> expected = {
+      {1, 0, 2}, {1, 2, 0}, {2, 1, 0}, {2, 0, 1}, {0, 2, 1}, {0, 1, 2}, {1, 0, 2}};
+  for (const auto& after : expected) {
+    attempt_exchanges(s, t, u);
+    ASSERT_EQ(s.replica_at, after);
+  }
+  // Replica 0: cold (start) -> hot (round 1) -> cold (round 4); replica 1: cold (round 0) ->
+  // hot (round 3) -> cold (round 6); replica 2: hot, then cold (round 2), not hot again yet.
+  EXPECT_EQ(s.round_trips, (std::vector<std::uint64_t>{1, 1, 0}));
+}
+
 TEST(ExchangeRule, ParsesLadders) {
   const std::vector<double> geometric = parse_temperature_ladder("1:8:4:log", "--temperatures");
   ASSERT_EQ(geometric.size(), 4u);
