@@ -106,14 +106,7 @@ class ReplicaExchange final : public ReplicaCommand {
     } catch (const std::exception& e) {
       error = e.what();
     }
-    const MpiSession::Agreement agreement = session.agree(error.empty());
-    if (!agreement.all_ok) {
-      if (!error.empty() && (root || agreement.root_ok)) {
-        std::fprintf(stderr, "kairos: error: %s%s\n",
-                     root ? "" : fmt::format("rank {}: ", session.rank()).c_str(), error.c_str());
-      }
-      return 2;
-    }
+    if (!session.all_ready(error)) return 2;
     // From here on the ranks depend on each other: an error on one ends the whole job.
     try {
       const ReplicaExchangeOutcome outcome = run_replica_exchange(*plan, MpiReplicaComm(session));

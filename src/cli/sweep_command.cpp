@@ -106,14 +106,7 @@ class Sweep final : public SweepCommand {
     }
     // Every rank's outcome counts (a config a node cannot read); rank 0's error is printed
     // once, another rank's with its rank.
-    const MpiSession::Agreement agreement = session.agree(error.empty());
-    if (!agreement.all_ok) {
-      if (!error.empty() && (root || agreement.root_ok)) {
-        std::fprintf(stderr, "kairos: error: %s%s\n",
-                     root ? "" : fmt::format("rank {}: ", session.rank()).c_str(), error.c_str());
-      }
-      return 2;
-    }
+    if (!session.all_ready(error)) return 2;
     // From here on the ranks depend on each other: an error on one ends the whole job
     // (MPI_Abort) instead of leaving the others waiting for it.
     try {

@@ -1,6 +1,7 @@
 #include "cli/sweep_mpi.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <thread>
@@ -20,6 +21,16 @@ int launcher_ranks() {
   }
   if (std::getenv("PMIX_RANK") != nullptr) return 1;
   return 0;
+}
+
+bool MpiSession::all_ready(const std::string& error) const {
+  const Agreement agreement = agree(error.empty());
+  if (agreement.all_ok) return true;
+  if (!error.empty() && (rank() == 0 || agreement.root_ok)) {
+    const std::string who = rank() == 0 ? "" : "rank " + std::to_string(rank()) + ": ";
+    std::fprintf(stderr, "kairos: error: %s%s\n", who.c_str(), error.c_str());
+  }
+  return false;
 }
 
 #ifdef KAIROS_HAVE_MPI

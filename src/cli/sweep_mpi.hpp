@@ -7,6 +7,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "sweep/sweep_runner.hpp"
@@ -35,6 +36,9 @@ class MpiSession {
     bool root_ok = true;
   };
   Agreement agree(bool ok) const;
+  // agree(error.empty()); when some rank failed, prints rank 0's error (or, when rank 0 is
+  // ready, each failing rank's, prefixed with its rank) and returns false.
+  bool all_ready(const std::string& error) const;
   // Ends every rank of the job with this status (an error after the agreement).
   [[noreturn]] void abort(int status) const;
   // Waits for every rank without spinning: a rank whose runs have ended would otherwise take a

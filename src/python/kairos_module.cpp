@@ -544,18 +544,46 @@ class PySimulation {
   }
   void set_velocities(const py::object& values) {
     visit([&]<int D>(Simulation<D>& s) {
-      const auto array =
-          py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
-      if (!array || array.ndim() != 2 || array.shape(1) != D) {
-        throw py::type_error(
-            fmt::format("set_velocities: velocities must be an (N, {}) array of numbers, not {}", D,
-                        type_name(values)));
+      s.set_velocities(vectors_from<D>(values, "set_velocities", "velocities"));
+    });
+  }
+  void set_positions(const py::object& values) {
+    visit([&]<int D>(Simulation<D>& s) {
+      s.set_positions(vectors_from<D>(values, "set_positions", "positions"));
+    });
+  }
+  // An (N, D) array of numbers; TypeError naming the call and what was given otherwise.
+  template <int D>
+  static std::vector<Vec<D>> vectors_from(const py::object& values, const char* call,
+                                          const char* what) {
+    const auto array =
+        py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
+    if (!array || array.ndim() != 2 || array.shape(1) != D) {
+      throw py::type_error(fmt::format("{}: {} must be an (N, {}) array of numbers, not {}", call,
+                                       what, D, type_name(values)));
+    }
+    const auto view = array.template unchecked<2>();
+    std::vector<Vec<D>> out(static_cast<std::size_t>(array.shape(0)));
+    for (std::size_t i = 0; i < out.size(); ++i)
+      for (int a = 0; a < D; ++a) out[i][a] = view(static_cast<py::ssize_t>(i), a);
+    return out;
+  }
+  void set_species(const py::object& values) {
+    visit([&](auto& s) {
+      const auto array = py::array_t<long long, py::array::c_style>::ensure(values);
+      if (!array || array.ndim() != 1 || py::isinstance<py::str>(values)) {
+        throw py::type_error("set_species: species must be a 1-d array of integers, not " +
+                             type_name(values));
       }
-      const auto view = array.template unchecked<2>();
-      std::vector<Vec<D>> v(static_cast<std::size_t>(array.shape(0)));
-      for (std::size_t i = 0; i < v.size(); ++i)
-        for (int a = 0; a < D; ++a) v[i][a] = view(static_cast<py::ssize_t>(i), a);
-      s.set_velocities(v);
+      const auto view = array.template unchecked<1>();
+      std::vector<std::uint32_t> k(static_cast<std::size_t>(array.shape(0)));
+      for (std::size_t i = 0; i < k.size(); ++i) {
+        const long long v = view(static_cast<py::ssize_t>(i));
+        if (v < 0 || v > 0xffffffffLL)
+          throw InputError(fmt::format("set_species: particle {}: species {} out of range", i, v));
+        k[i] = static_cast<std::uint32_t>(v);
+      }
+      s.set_species(k);
     });
   }
   void set_thermostat_temperature(double temperature) {
@@ -1421,6 +1449,16 @@ PYBIND11_MODULE(kairos, m) {
            "Gives every particle a new velocity now ((N, D), the numbering of positions()): the "
            "run goes on as one started with them. Refused (InputError) for a fixed grain given "
            "a velocity, soft spheres, sleeping particles or helfand=True.")
+      .def("set_positions", &PySimulation::set_positions, py::arg("positions"),
+           "Moves every particle to a new place now ((N, D), the numbering of positions(); "
+           "wrapped into the periodic box). Velocities and the clock stay; every event is "
+           "predicted anew. InputError naming the pair for an overlap, or the engine's message "
+           "for a wall or a bond the new places break.")
+      .def("set_species", &PySimulation::set_species, py::arg("species"),
+           "Gives particles new species now ((N,) indices into species_names; the radius and "
+           "mass of the configuration's species of that name). InputError for an overlap the "
+           "new sizes make, a species the configuration lacks, or a change to or from a fixed "
+           "species.")
       .def("set_thermostat_temperature", &PySimulation::set_thermostat_temperature,
            py::arg("temperature"),
            "[driving] kind = \"andersen\": the thermostat's temperature from now on (what save() "

@@ -166,6 +166,8 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   EventEngine<D, Queue>& engine() { return engine_; }
   const EventEngine<D, Queue>& engine() const { return engine_; }
   FrozenClockWatch& clock_watch() { return watch_; }
+  // The driving's random stream (a new engine built from this one's state takes it over).
+  const std::mt19937_64& rng() const { return rng_; }
   // The Andersen thermostat's temperature from now on (the kicks drawn after this call;
   // logic_error unless [driving] is andersen). Replica exchange moves a replica to another rung.
   void set_driving_temperature(double temperature);

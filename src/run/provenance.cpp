@@ -5,9 +5,7 @@
 #include <array>
 #include <ctime>
 
-#ifndef KAIROS_GIT_COMMIT
-#define KAIROS_GIT_COMMIT "unknown"
-#endif
+#include "kairos_git_commit.hpp"  // generated into the build tree (CMakeLists.txt)
 
 namespace kairos {
 

@@ -11,6 +11,7 @@
 #include "core/periodic.hpp"
 #include "core/state_blocks.hpp"
 #include "core/stop_flag.hpp"
+#include "init/initial_state.hpp"
 #include "io/config_choices.hpp"
 #include "io/config_obstacles.hpp"
 #include "run/event_adapter.hpp"
@@ -25,7 +26,7 @@ template <int D>
 Simulation<D>::Simulation(const Config& config,
                           const std::optional<std::filesystem::path>& restart_file,
                           const EngineTracking& tracking)
-    : config_(config) {
+    : config_(config), tracking_(tracking) {
   if (integrators().at(config.run.integrator) != IntegratorKind::kEvent) {
     throw InputError(fmt::format(
         "run.integrator = \"{}\": an in-memory simulation drives the event integrator; run the "
@@ -234,12 +235,125 @@ void Simulation<D>::set_velocities(const std::vector<Vec<D>>& velocities) {
           species[species_[i]].name));
     }
   }
+  check_state_can_change("set_velocities");
+  engine.set_velocities(engine.time(), velocities);
+}
+
+template <int D>
+void Simulation<D>::check_state_can_change(const char* what) const {
+  const EventEngine<D, CalendarQueue>& engine = engine_->engine();
   if (engine.soft() || engine.sleeping() > 0 || engine.tracks_helfand()) {
     throw InputError(
-        "set_velocities: not with soft spheres, sleeping particles or the Helfand moments kept "
-        "(helfand=True): their state follows the velocities");
+        fmt::format("{}: not with soft spheres, sleeping particles or the Helfand moments kept "
+                    "(helfand=True): their state follows the particles'",
+                    what));
   }
-  engine.set_velocities(engine.time(), velocities);
+}
+
+template <int D>
+void Simulation<D>::rebuild(const char* what,
+                            const std::function<void(ParticleSystem<D>&)>& change) {
+  check_state_can_change(what);
+  const EventEngine<D, CalendarQueue>& engine = engine_->engine();
+  const double now = engine.time();
+  ParticleSystem<D> s = engine.export_state(/*with_zones=*/false);
+  // Every particle at the present time; the scheduler's state is predicted anew.
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    Kinematics<D>& k = s.kinematics[i];
+    const Vec<D> v = s.velocity(i, now);
+    k.pos = s.position(i, now);
+    k.vel = v;
+    k.time = now;
+  }
+  s.events.clear();
+  s.cell.clear();
+  s.order.clear();
+  s.zones.reset();
+  change(s);
+  std::vector<Vec<D>> position(s.size());
+  std::vector<double> diameter(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    position[i] = s.kinematics[i].pos;
+    diameter[i] = 2.0 * s.kinematics[i].radius;
+  }
+  std::uint32_t i = 0, j = 0;
+  const double overlap = max_overlap<D>(s.box, s.periodic, position, diameter, &i, &j);
+  if (overlap > 1e-12 * *std::min_element(diameter.begin(), diameter.end())) {
+    throw InputError(fmt::format("{}: particles {} and {} overlap by {:.6g}", what, i, j, overlap));
+  }
+  RunStart<D> start;
+  start.config = config_;
+  start.rng = engine_->rng();
+  start.resumed = progress_;
+  start.state = std::move(s);
+  try {
+    auto fresh = start_event_engine<D, CalendarQueue>(std::move(start), {}, tracking_);
+    engine_ = std::move(fresh);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", what, e.what()));
+  }
+  const ParticleSystem<D>& now_state = engine_->engine().export_state(false);
+  mass_ = now_state.mass;
+  for (std::size_t k = 0; k < n_; ++k) radius_[k] = now_state.kinematics[k].radius;
+  species_ = now_state.species;
+}
+
+template <int D>
+void Simulation<D>::set_positions(const std::vector<Vec<D>>& positions) {
+  if (positions.size() != n_) {
+    throw InputError(
+        fmt::format("set_positions: {} positions for {} particles", positions.size(), n_));
+  }
+  for (std::size_t i = 0; i < n_; ++i) {
+    for (int a = 0; a < D; ++a) {
+      if (!std::isfinite(positions[i][a])) {
+        throw InputError(fmt::format("set_positions: particle {}: position not finite", i));
+      }
+    }
+  }
+  rebuild("set_positions", [&](ParticleSystem<D>& s) {
+    for (std::size_t i = 0; i < n_; ++i) {
+      Vec<D> x = positions[i];
+      for (int a = 0; a < D; ++a)
+        if (s.periodic[a]) x[a] = wrap_into_box(x[a], s.box[a]);
+      s.kinematics[i].pos = x;
+    }
+  });
+}
+
+template <int D>
+void Simulation<D>::set_species(const std::vector<std::uint32_t>& species) {
+  if (species.size() != n_) {
+    throw InputError(fmt::format("set_species: {} species for {} particles", species.size(), n_));
+  }
+  // The configuration's entry of each of the state's species names (nullptr: none).
+  std::vector<const SpeciesConfig*> entry(species_names_.size(), nullptr);
+  for (std::size_t k = 0; k < species_names_.size(); ++k)
+    for (const SpeciesConfig& c : config_.system.species)
+      if (c.name == species_names_[k]) entry[k] = &c;
+  for (std::size_t i = 0; i < n_; ++i) {
+    const std::uint32_t k = species[i];
+    if (k >= species_names_.size() || entry[k] == nullptr) {
+      throw InputError(fmt::format(
+          "set_species: particle {}: species {} is not one of the configuration's species", i, k));
+    }
+    const std::uint32_t now = species_.empty() ? 0 : species_[i];
+    const SpeciesConfig* was = now < entry.size() ? entry[now] : nullptr;
+    if (entry[k]->fixed != (was != nullptr && was->fixed)) {
+      throw InputError(fmt::format(
+          "set_species: particle {}: from species {} to {}: a particle cannot become or stop "
+          "being a fixed grain",
+          i, now < species_names_.size() ? species_names_[now] : "?", species_names_[k]));
+    }
+  }
+  rebuild("set_species", [&](ParticleSystem<D>& s) {
+    if (s.species.empty()) s.species.assign(n_, 0);
+    for (std::size_t i = 0; i < n_; ++i) {
+      s.species[i] = species[i];
+      s.kinematics[i].radius = 0.5 * entry[species[i]]->diameter;
+      s.mass[i] = entry[species[i]]->mass;
+    }
+  });
 }
 
 template <int D>

@@ -457,6 +457,102 @@ class Module(kt.KairosTestCase):
         sim = kairos.Simulation(cfg, set=("system.particles=100", "system.seed=3"))
         self.assertEqual(len(sim), 100)
 
+    def test_set_positions_and_species_go_on_from_them(self):
+        cfg = self.write_config(kt.base_config(particles=200, packing_fraction=0.2,
+                                               lattice="random", seed=5))
+        sim = kairos.Simulation(cfg)
+        sim.advance(time=0.3)
+        # The whole system translated (and wrapped): the same dynamics, up to round-off, as the
+        # untranslated one (0.5 time units, a few hundred collisions).
+        moved = kairos.Simulation(cfg)
+        moved.advance(time=0.3)
+        shift = np.array([0.37, -1.25, 2.5]) * sim.box
+        moved.set_positions(sim.positions() + shift)
+        self.assertEqual(moved.time, sim.time)
+        d = moved.positions() - sim.positions() - shift
+        self.assertLess(np.abs(d - sim.box * np.round(d / sim.box)).max(), 1e-12)
+        self.assertTrue(np.all((moved.positions() >= 0) & (moved.positions() < sim.box)))
+        sim.advance(time=0.8)
+        moved.advance(time=0.8)
+        d = moved.positions() - sim.positions() - shift
+        self.assertLess(np.abs(d - sim.box * np.round(d / sim.box)).max(), 1e-8)
+        self.assertEqual(moved.collisions, sim.collisions)
+        # The new engine runs the dynamics backwards to the start, as hard spheres must.
+        x0 = moved.positions()
+        moved.set_velocities(-moved.velocities())
+        moved.advance(time=1.3)
+        moved.set_positions(moved.positions())
+        moved.set_velocities(-moved.velocities())
+        moved.advance(time=1.8)
+        d = moved.positions() - x0
+        self.assertLess(np.abs(d - sim.box * np.round(d / sim.box)).max(), 1e-8)
+        # Particle 1 put onto particle 0: refused, naming the pair; the state is unchanged.
+        x = moved.positions()
+        x[1] = x[0] + [0.5, 0.0, 0.0]
+        with self.assertRaises(kairos.InputError) as caught:
+            moved.set_positions(x)
+        self.assertIn("particles 0 and 1 overlap", str(caught.exception))
+        self.assertTrue(moved.advance(time=2.0))
+        self.assertGreater(min_gap(moved.positions(), moved.radii(), moved.box), -1e-9)
+
+        # A bond or a wall the new places break: the engine's refusal, the state unchanged.
+        chain = kairos.Simulation(
+            "[system]\nparticles = 8\nchain_length = 8\nchain_spacing = 1.1\n"
+            "packing_fraction = 0.001\n\n[[bond]]\ntype = \"backbone\"\nkind = \"tether\"\n"
+            "max_length = 1.25\n")
+        x = chain.positions()
+        x[4] += 0.5 * chain.box  # far from every bead, and from its bonded neighbours
+        with self.assertRaises(kairos.InputError) as caught:
+            chain.set_positions(x)
+        self.assertIn("stretched", str(caught.exception))
+        walled = kairos.Simulation(self.write_config(kt.base_config(
+            particles=50, packing_fraction=0.05, lattice="random",
+            boundary={"wall": [{"face": "z-"}, {"face": "z+"}]}), "walled.toml"))
+        x = walled.positions()
+        x[3, 2] = 0.2
+        with self.assertRaises(kairos.InputError) as caught:
+            walled.set_positions(x)
+        self.assertIn("particle 3 overlaps the wall", str(caught.exception))
+        self.assertTrue(walled.advance(time=0.5))
+
+        # Species: a mixture's big particles made small (always room), then every particle big,
+        # which these random places do not leave room for: refused, naming a pair.
+        mix = self.write_config(kt.base_config(
+            particles=100, packing_fraction=0.05, lattice="random", seed=3,
+            system={"species": [{"name": "small", "diameter": 1.0, "fraction": 0.5},
+                                {"name": "big", "diameter": 1.5, "mass": 3.0,
+                                 "fraction": 0.5}]}))
+        sim = kairos.Simulation(mix)
+        names = list(sim.species_names)
+        species = sim.species().copy()
+        self.assertGreater(np.count_nonzero(species == names.index("big")), 20)
+        shrunk = np.full_like(species, names.index("small"))
+        ke = sim.kinetic_energy()
+        sim.set_species(shrunk)
+        np.testing.assert_array_equal(sim.species(), shrunk)
+        self.assertTrue(np.all(sim.radii() == 0.5) and np.all(sim.masses() == 1.0))
+        # The velocities stay: the kinetic energy follows the new masses.
+        v = sim.velocities()
+        self.assertAlmostEqual(sim.kinetic_energy(), 0.5 * (v ** 2).sum(), delta=1e-12 * ke)
+        sim.advance(time=2.0)
+        self.assertGreater(min_gap(sim.positions(), sim.radii(), sim.box), -1e-9)
+        with self.assertRaises(kairos.InputError) as caught:
+            sim.set_species(np.full_like(species, names.index("big")))
+        self.assertRegex(str(caught.exception), r"set_species: particles \d+ and \d+ overlap")
+        np.testing.assert_array_equal(sim.species(), shrunk)
+        cases = [
+            (lambda: sim.set_positions(x[:10]), kairos.InputError, "10 positions for 100"),
+            (lambda: sim.set_species([0] * 99), kairos.InputError, "99 species for 100"),
+            (lambda: sim.set_species([7] * 100), kairos.InputError, "species 7"),
+            (lambda: sim.set_species("big"), TypeError, "array of integers"),
+            (lambda: (lambda h: h.set_positions(h.positions()))(kairos.Simulation(
+                cfg, helfand=True)), kairos.InputError, "Helfand"),
+        ]
+        for call, error, needle in cases:
+            with self.assertRaises(error) as caught:
+                call()
+            self.assertIn(needle, str(caught.exception))
+
     def test_set_velocities_goes_on_from_them_exactly(self):
         cfg = self.write_config(kt.base_config(particles=200, packing_fraction=0.2,
                                                lattice="random", seed=5))
