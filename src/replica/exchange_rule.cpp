@@ -68,7 +68,17 @@ std::string attempt_exchanges(ExchangeState& state, const std::vector<double>& t
 }
 
 std::vector<double> parse_temperature_ladder(const std::string& spec, const std::string& what) {
-  const SweepAxis axis = parse_sweep_axis("temperature=" + spec, what);
+  // The sweep's value forms; its messages name the argument as `what KEY=VALUES`.
+  const SweepAxis axis = [&] {
+    try {
+      return parse_sweep_axis("temperature=" + spec, what);
+    } catch (const InputError& e) {
+      std::string message = e.what();
+      const std::string key = what + " temperature=";
+      if (message.starts_with(key)) message.replace(0, key.size(), what + " ");
+      throw InputError(message);
+    }
+  }();
   std::vector<double> ladder;
   for (const std::string& v : axis.values) {
     double t = 0.0;
