@@ -96,6 +96,16 @@ std::optional<TransportObstacle> replica_exchange_obstacle(const Config& c) {
   conservative.boundary.cylinders.clear();
   conservative.boundary.spheres.clear();
   if (std::optional<TransportObstacle> o = transport_obstacle(conservative)) return o;
+  // Elastic rough contacts conserve energy but exchange it with the spins, which neither the
+  // thermostat nor a swap's scaling touches.
+  const auto rough = [](const ContactConfig& k) {
+    return k.tangential_restitution != -1.0 && k.friction != 0.0;
+  };
+  if (rough(c.interactions.contact))
+    return refuse("contact.tangential_restitution", "rough particles' spins are not thermalised");
+  for (const PairContactConfig& p : c.interactions.pairs)
+    if (rough(p.contact))
+      return refuse("contact.pair", "rough particles' spins are not thermalised");
   if (c.soft.enabled())
     return refuse("soft", "soft contacts in progress cannot have their velocities scaled");
   if (c.analysis.transport)
@@ -114,6 +124,8 @@ std::optional<TransportObstacle> replica_exchange_obstacle(const Config& c) {
     probe.interactions.contact = w.contact;
     if (transport_obstacle(probe))
       return refuse(key + ".restitution", "the wall dissipates energy");
+    if (rough(w.contact))
+      return refuse(key + ".tangential_restitution", "a rough wall spins the particles");
     return std::nullopt;
   };
   for (std::size_t k = 0; k < c.boundary.walls.size(); ++k)

@@ -126,9 +126,11 @@ void LineFile::write_all(std::string_view text) {
 }
 
 void LineFile::sync() {
-  if (::fsync(fd_) != 0 && errno != EINVAL) {
+  if (::fsync(fd_) == 0) return;
+  const int error = errno;
+  if (error != EINVAL) {
     throw InputError(
-        fmt::format("{}: cannot sync to disk: {}", path_.string(), std::strerror(errno)));
+        fmt::format("{}: cannot sync to disk: {}", path_.string(), std::strerror(error)));
   }
 }
 

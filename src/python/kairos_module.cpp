@@ -458,6 +458,7 @@ class PySimulation {
   // other use of this Simulation from them is refused until it returns).
   template <class F>
   auto advancing(F&& f) {
+    if (in_callback_) throw InputError("not from inside an advance's callback");
     busy_ = true;
     struct Idle {
       std::atomic<bool>& busy;
@@ -484,18 +485,24 @@ class PySimulation {
     }
     const py::object self = py::cast(this, py::return_value_policy::reference);
     const auto call = [&] {
-      in_callback_ = true;
-      busy_ = false;
+      // The flags change only while this thread holds the GIL: no other Python thread can
+      // find the object free while the advance goes on.
+      py::gil_scoped_acquire gil;
       struct Back {
         PySimulation& sim;
         ~Back() {
           sim.busy_ = true;
           sim.in_callback_ = false;
         }
-      } back{*this};
-      py::gil_scoped_acquire gil;
+      };
+      in_callback_ = true;
+      busy_ = false;
+      const Back back{*this};
       const py::object answer = callback(self);
-      if (!answer.is_none() && !answer.cast<bool>()) throw CallbackStop{};
+      if (answer.is_none()) return;
+      const int truth = PyObject_IsTrue(answer.ptr());
+      if (truth < 0) throw py::error_already_set();
+      if (truth == 0) throw CallbackStop{};
     };
     return visit([&](auto& s) {
       try {
@@ -523,7 +530,6 @@ class PySimulation {
                const py::object& callback) {
     const int given = (time ? 1 : 0) + (events ? 1 : 0) + (collisions ? 1 : 0);
     if (given != 1) throw InputError("advance: give exactly one of time=, events= or collisions=");
-    if (in_callback_) throw InputError("advance: not from inside an advance's callback");
     if (every.is_none() != callback.is_none())
       throw InputError("advance: give every= and callback= together");
     if (!callback.is_none())
@@ -987,7 +993,7 @@ class PySimulation {
   }
   std::variant<std::unique_ptr<Simulation<2>>, std::unique_ptr<Simulation<3>>> sim_;
   std::atomic<bool> busy_{false};
-  bool in_callback_ = false;  // an advance's callback is running (no nested advance)
+  std::atomic<bool> in_callback_{false};  // an advance's callback runs (no nested advance)
 };
 
 // kairos.Correlator: analysis/msd.hpp's multiple-tau correlator fed by the user, with 1, 2 or

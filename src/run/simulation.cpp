@@ -165,7 +165,7 @@ bool Simulation<D>::sample_every_count(std::uint64_t step, std::uint64_t count,
   trigger.next = target_after(now(), step);
   while (now() < end) {
     const std::uint64_t stop = std::min(trigger.next, end);
-    if (!advance(stop - now())) return false;
+    if (now() < stop && !advance(stop - now())) return false;
     if (trigger.due(now())) sample();
   }
   return true;
@@ -222,21 +222,32 @@ void Simulation<D>::set_velocities(const std::vector<Vec<D>>& velocities) {
     throw InputError(
         fmt::format("set_velocities: {} velocities for {} particles", velocities.size(), n_));
   }
-  const auto& species = config_.system.species;
+  const std::vector<const SpeciesConfig*> entry = config_species();
   for (std::size_t i = 0; i < n_; ++i) {
     for (int a = 0; a < D; ++a) {
       if (!std::isfinite(velocities[i][a])) {
         throw InputError(fmt::format("set_velocities: particle {}: velocity not finite", i));
       }
     }
-    if (species[species_[i]].fixed && !(velocities[i] == Vec<D>{})) {
+    const std::uint32_t k = species_.empty() ? 0 : species_[i];
+    const SpeciesConfig* own = k < entry.size() ? entry[k] : nullptr;
+    if (own != nullptr && own->fixed && !(velocities[i] == Vec<D>{})) {
       throw InputError(fmt::format(
           "set_velocities: particle {} is a fixed grain (species {}): its velocity stays 0", i,
-          species[species_[i]].name));
+          own->name));
     }
   }
   check_state_can_change("set_velocities");
   engine.set_velocities(engine.time(), velocities);
+}
+
+template <int D>
+std::vector<const SpeciesConfig*> Simulation<D>::config_species() const {
+  std::vector<const SpeciesConfig*> entry(species_names_.size(), nullptr);
+  for (std::size_t k = 0; k < species_names_.size(); ++k)
+    for (const SpeciesConfig& c : config_.system.species)
+      if (c.name == species_names_[k]) entry[k] = &c;
+  return entry;
 }
 
 template <int D>
@@ -254,6 +265,12 @@ template <int D>
 void Simulation<D>::rebuild(const char* what,
                             const std::function<void(ParticleSystem<D>&)>& change) {
   check_state_can_change(what);
+  if (engine_->kind().sheared) {
+    throw InputError(fmt::format(
+        "{}: not under Lees-Edwards shear (the images slide: a new place needs the flow's "
+        "offset and velocity)",
+        what));
+  }
   const EventEngine<D, CalendarQueue>& engine = engine_->engine();
   const double now = engine.time();
   ParticleSystem<D> s = engine.export_state(/*with_zones=*/false);
@@ -326,11 +343,7 @@ void Simulation<D>::set_species(const std::vector<std::uint32_t>& species) {
   if (species.size() != n_) {
     throw InputError(fmt::format("set_species: {} species for {} particles", species.size(), n_));
   }
-  // The configuration's entry of each of the state's species names (nullptr: none).
-  std::vector<const SpeciesConfig*> entry(species_names_.size(), nullptr);
-  for (std::size_t k = 0; k < species_names_.size(); ++k)
-    for (const SpeciesConfig& c : config_.system.species)
-      if (c.name == species_names_[k]) entry[k] = &c;
+  const std::vector<const SpeciesConfig*> entry = config_species();
   for (std::size_t i = 0; i < n_; ++i) {
     const std::uint32_t k = species[i];
     if (k >= species_names_.size() || entry[k] == nullptr) {
@@ -349,6 +362,7 @@ void Simulation<D>::set_species(const std::vector<std::uint32_t>& species) {
   rebuild("set_species", [&](ParticleSystem<D>& s) {
     if (s.species.empty()) s.species.assign(n_, 0);
     for (std::size_t i = 0; i < n_; ++i) {
+      if (s.species[i] == species[i]) continue;  // its own size and mass stay
       s.species[i] = species[i];
       s.kinematics[i].radius = 0.5 * entry[species[i]]->diameter;
       s.mass[i] = entry[species[i]]->mass;

@@ -87,14 +87,15 @@ class Simulation {
   // moments kept (their state follows the velocities), InputError saying so.
   void set_velocities(const std::vector<Vec<D>>& velocities);
   // Moves every particle to a new place now (the numbering of positions(); wrapped into the
-  // box along periodic axes), or gives particles new species (indices into species_names(): the
-  // radius and mass of the configuration's species of that name). Velocities, spins, counters,
+  // box along periodic axes), or gives particles new species (indices into species_names(): a
+  // particle whose species changes takes the radius and mass of the configuration's species of
+  // that name; the others keep theirs). Velocities, spins, counters,
   // image counters and the clock stay; every event is predicted anew from the new state, as a
   // run started from it would (the driving's next kick is drawn anew from its stream).
   // InputError naming the particle for a count that differs, a value that is not finite, a
   // species that is not in the configuration or a change to or from a fixed species; naming
   // the pair for an overlap; the engine's message for a wall or a bond the new state breaks.
-  // Refused with soft contacts in progress, sleeping particles or the Helfand moments kept.
+  // Refused with soft spheres, sleeping particles, the Helfand moments kept, or under shear.
   void set_positions(const std::vector<Vec<D>>& positions);
   void set_species(const std::vector<std::uint32_t>& species);
   // [driving] kind "andersen": the thermostat's temperature from now on (the configuration's
@@ -156,6 +157,8 @@ class Simulation {
 
   // A new engine from the present state changed by `change` (set_positions, set_species).
   void rebuild(const char* what, const std::function<void(ParticleSystem<D>&)>& change);
+  // The configuration's entry of each of the state's species names (nullptr: none).
+  std::vector<const SpeciesConfig*> config_species() const;
   // The refusals set_velocities shares with rebuild.
   void check_state_can_change(const char* what) const;
 

@@ -171,11 +171,22 @@ class Module(kt.KairosTestCase):
         self.assertAlmostEqual(sim.time, 1.7, delta=1e-9)
         self.assertLess(len(stopped_at), 8)
         self.assertTrue(sim.advance(time=2.0))
-        # The callback may change the state: a velocity rescale every 0.2 holds kT at 1.
+        # The callback may change the state: heated to kT = 2, a rescale every 0.2 brings it
+        # back to 1 (5 calls).
+        sim.set_velocities(sim.velocities() * np.sqrt(2.0))
+        self.assertAlmostEqual(sim.temperature(), 2.0, delta=1e-9)
+        calls = []
+
         def rescale(s):
+            calls.append(s.time)
             s.set_velocities(s.velocities() * np.sqrt(1.0 / s.temperature()))
         sim.advance(time=3.0, every=0.2, callback=rescale)
+        self.assertEqual(len(calls), 5)
         self.assertAlmostEqual(sim.temperature(), 1.0, delta=1e-12)
+        # Any truthy or falsy answer counts, as in an `if`.
+        answers = iter([[1], 0])
+        self.assertFalse(sim.advance(time=4.0, every=0.1, callback=lambda s: next(answers)))
+        self.assertAlmostEqual(sim.time, 3.2, delta=1e-9)
         cases = [
             (lambda: sim.advance(time=4.0, every=0.5), kairos.InputError, "together"),
             (lambda: sim.advance(events=10, every=0, callback=print), kairos.InputError,
@@ -185,6 +196,9 @@ class Module(kt.KairosTestCase):
             (lambda: sim.advance(time=4.0, every=0.5, callback=3), TypeError, "callable"),
             (lambda: sim.advance(time=4.0, every=0.5,
                                  callback=lambda s: s.advance(time=5.0)), kairos.InputError,
+             "inside an advance's callback"),
+            (lambda: sim.advance(events=100, every=10,
+                                 callback=lambda s: s.advance(events=5)), kairos.InputError,
              "inside an advance's callback"),
         ]
         for call, error, needle in cases:
@@ -540,6 +554,14 @@ class Module(kt.KairosTestCase):
             sim.set_species(np.full_like(species, names.index("big")))
         self.assertRegex(str(caught.exception), r"set_species: particles \d+ and \d+ overlap")
         np.testing.assert_array_equal(sim.species(), shrunk)
+        # A polydisperse system: particles whose species does not change keep their own sizes.
+        poly = kairos.Simulation(self.write_config(kt.base_config(
+            particles=100, packing_fraction=0.1, lattice="random", seed=4,
+            system={"size_distribution": "uniform", "polydispersity": 0.1}), "poly.toml"))
+        radii = poly.radii().copy()
+        self.assertGreater(radii.std(), 0.01)
+        poly.set_species(poly.species())
+        np.testing.assert_array_equal(poly.radii(), radii)
         cases = [
             (lambda: sim.set_positions(x[:10]), kairos.InputError, "10 positions for 100"),
             (lambda: sim.set_species([0] * 99), kairos.InputError, "99 species for 100"),

@@ -312,6 +312,8 @@ class ReplicaExchange(kt.KairosTestCase):
              ["field.gravity", "canonical"]),
             ([good] + ladder + ["--set", "contact.restitution=0.9"],
              ["contact.restitution", "canonical"]),
+            ([good] + ladder + ["--set", "contact.tangential_restitution=1.0"],
+             ["contact.tangential_restitution", "spins"]),
         ]
         for k, (args, needles) in enumerate(cases):
             with self.subTest(case=k):
