@@ -33,12 +33,6 @@ void replace_file_atomically(const std::filesystem::path& target,
   tmp += ".tmp";
   try {
     write(tmp);
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    throw;
-  }
-  try {
     sync_to_disk(tmp);
   } catch (...) {
     std::error_code ignored;
