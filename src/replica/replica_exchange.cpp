@@ -62,12 +62,12 @@ nlohmann::json manifest(const ReplicaExchangePlan& plan) {
 
 // ----- the exchange state in a checkpoint
 
-nlohmann::json to_json(const ExchangeState& s, std::uint64_t rows) {
+nlohmann::json to_json(const ExchangeState& s) {
   std::ostringstream rng;
   rng << s.rng;
   return {{"round", s.round},       {"replica_at", s.replica_at}, {"attempts", s.attempts},
           {"accepted", s.accepted}, {"last_end", s.last_end},     {"round_trips", s.round_trips},
-          {"rng", rng.str()},       {"exchange_rows", rows}};
+          {"rng", rng.str()}};
 }
 
 ExchangeState exchange_state_from(const nlohmann::json& j, std::size_t rungs,
@@ -100,10 +100,10 @@ ExchangeState exchange_state_from(const nlohmann::json& j, std::size_t rungs,
   return s;
 }
 
+// exchange.tsv has one row per round: the checkpoint's rows are its rounds.
 struct Checkpoint {
   fs::path directory;
   ExchangeState state;
-  std::uint64_t rows = 0;
 };
 
 // checkpoint/ (settle_checkpoint has made it the newest complete one), or nothing.
@@ -114,17 +114,7 @@ std::optional<Checkpoint> find_checkpoint(const fs::path& directory, std::size_t
   std::ifstream in(file);
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) throw InputError(fmt::format("{}: unreadable JSON", file.string()));
-  Checkpoint c{directory / kCheckpoint, exchange_state_from(j, rungs, file), 0};
-  try {
-    c.rows = j.at("exchange_rows").get<std::uint64_t>();
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: not an ensemble checkpoint: {}", file.string(), e.what()));
-  }
-  if (c.rows != c.state.round) {
-    throw InputError(
-        fmt::format("{}: {} exchange rows for {} rounds", file.string(), c.rows, c.state.round));
-  }
-  return c;
+  return Checkpoint{directory / kCheckpoint, exchange_state_from(j, rungs, file)};
 }
 
 // After a kill while a checkpoint was being made: makes checkpoint/ the newest complete one.
@@ -290,9 +280,9 @@ std::string exchange_row(std::uint64_t round, double time, const std::vector<dou
 }
 
 // Every process saves its replicas into checkpoint.new/, then rank 0 adds ensemble.json (the
-// exchange table synced first: the rows it counts are on disk) and makes it the checkpoint,
-// removing the previous one only once the new one is in place: a kill at any moment leaves a
-// complete checkpoint that settle_checkpoint finds.
+// exchange table synced first: its row of every round up to this one is on disk) and makes it the
+// checkpoint, removing the previous one only once the new one is in place: a kill at any moment
+// leaves a complete checkpoint that settle_checkpoint finds.
 template <int D>
 void write_checkpoint(const fs::path& directory, const LocalReplicas<D>& replicas,
                       const ExchangeState& state, LineFile* table, const ReplicaComm& comm) {
@@ -319,7 +309,7 @@ void write_checkpoint(const fs::path& directory, const LocalReplicas<D>& replica
   }
   if (comm.rank() == 0) {
     table->sync();
-    write_text_atomically(fresh / kEnsembleFile, to_json(state, table->rows()).dump(1) + "\n");
+    write_text_atomically(fresh / kEnsembleFile, to_json(state).dump(1) + "\n");
     sync_to_disk(fresh);
     std::error_code ec;
     fs::remove_all(old, ec);
@@ -362,13 +352,8 @@ ReplicaExchangeOutcome run_ensemble(const ReplicaExchangePlan& plan, const Repli
   std::optional<LineFile> table;
   if (root) {
     const fs::path path = settings.directory / kExchangeTable;
-    table.emplace(path, exchange_header(rungs), checkpoint ? checkpoint->rows : 0);
-    if (table->rows() != (checkpoint ? checkpoint->rows : 0)) {
-      throw InputError(fmt::format(
-          "{}: holds {} rows, fewer than the {} of the checkpoint it continues (edited or "
-          "cut?); start the ensemble afresh in another directory",
-          path.string(), table->rows(), checkpoint->rows));
-    }
+    // Cut back to the checkpoint's rounds (claim_replica_directory refused a table with fewer).
+    table.emplace(path, exchange_header(rungs), state.round);
     fmt::print(
         "kairos replica-exchange: {} replicas of {} particles ({}D) at T = {} .. {}, "
         "{}{} rounds of {} time units, in {}/\n",
@@ -554,11 +539,11 @@ void claim_replica_directory(const ReplicaExchangePlan& plan) {
   settle_checkpoint(dir);
   if (const std::optional<Checkpoint> c = find_checkpoint(dir, plan.temperatures.size())) {
     const fs::path table = dir / kExchangeTable;
-    if (complete_rows(table) < c->rows) {
+    if (complete_rows(table) < c->state.round) {
       throw InputError(fmt::format(
           "{}: holds {} rows, fewer than the {} of the checkpoint it continues (edited or cut?); "
           "start the ensemble afresh in another directory",
-          table.string(), complete_rows(table), c->rows));
+          table.string(), complete_rows(table), c->state.round));
     }
   }
 }
