@@ -357,7 +357,7 @@ nlohmann::json RunDriver<D>::outputs_present() const {
     for (const std::string& more : o->more_files())
       if (fs::exists(directory() / more, ec)) list.push_back(more);
   }
-  if (fs::exists(directory() / "run.log", ec)) list.push_back("run.log");
+  if (fs::exists(directory() / RunLog::kFile, ec)) list.push_back(RunLog::kFile);
   if (fs::exists(directory() / "config.toml", ec)) list.push_back("config.toml");
   return list;
 }
@@ -373,7 +373,7 @@ void RunDriver<D>::open_log() {
   if (!provenance_.restart_file.empty())
     header.push_back(
         fmt::format("continues {} at t = {:.10g}", provenance_.restart_file, integrator_->time()));
-  log_->open(directory() / "run.log", header,
+  log_->open(directory() / RunLog::kFile, header,
              {fmt::format("setup: {} particles in {}D, {:.3g} s of wall time",
                           integrator_->mobile(), D, setup_wall_seconds_)});
 }

@@ -14,6 +14,7 @@
 #include <ctime>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "io/progress.hpp"
@@ -22,6 +23,8 @@ namespace kairos {
 
 class RunLog {
  public:
+  static constexpr std::string_view kFile = "run.log";
+
   // interval_seconds 0: no log (every call does nothing); echo: progress lines on stdout too.
   RunLog(double interval_seconds, bool echo);
   RunLog(const RunLog&) = delete;

@@ -12,6 +12,7 @@
 """
 
 import os
+import shutil
 import resource
 import signal
 import subprocess
@@ -301,23 +302,32 @@ class OutputDirectories(kt.KairosTestCase):
     def test_an_earlier_runs_analysis_files_are_outputs_too(self):
         # An analysis file alone (msd.tsv) is an earlier run's output: kept unless --overwrite,
         # which removes it with the rest, so that no stale helfand.tsv or msd.tsv lies beside
-        # a new run's files (the guard used to know the five files of the first outputs only).
+        # a new run's files. The guard twice knew too few files (the five of the first
+        # outputs; later not mutual_diffusion.tsv): each output now declares its files once.
         config = kt.base_config(production=20.0)
-        config["analysis"] = {"msd": True, "transport": True}
+        config["system"]["species"] = [{"name": "A", "fraction": 0.5},
+                                       {"name": "B", "fraction": 0.5}]
+        config["analysis"] = {"msd": True, "transport": True, "vacf": True,
+                              "mutual_diffusion": True}
         out = self.path("out")
         self.run_ok("run", self.write_config(config), "-o", out)
+        stale = ("msd.tsv", "helfand.tsv", "green_kubo.tsv", "vacf.tsv", "mutual_diffusion.tsv")
         for name in os.listdir(out):
-            if name not in ("msd.tsv", "helfand.tsv", ".kairos.lock"):
+            if name not in stale + (".kairos.lock",):
                 os.remove(os.path.join(out, name))
         del config["analysis"]
         plain = self.write_config(config, "plain.toml")
-        result = self.kairos("run", plain, "-o", out)
-        self.assert_user_error(result, "holds the outputs of an earlier run", "msd.tsv",
-                               "--overwrite")
+        for name in stale:
+            # Each file alone is enough for the guard.
+            alone = self.path("alone_" + name)
+            os.makedirs(alone)
+            shutil.copy(os.path.join(out, name), alone)
+            result = self.kairos("run", plain, "-o", alone)
+            self.assert_user_error(result, "holds the outputs of an earlier run", name,
+                                   "--overwrite")
         self.run_ok("run", plain, "-o", out, "--overwrite")
-        self.assertFalse(os.path.exists(os.path.join(out, "msd.tsv")))
-        self.assertFalse(os.path.exists(os.path.join(out, "helfand.tsv")))
-
+        for name in stale:
+            self.assertFalse(os.path.exists(os.path.join(out, name)), name)
 
 if __name__ == "__main__":
     kt.main()

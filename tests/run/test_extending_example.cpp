@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "core/stop_flag.hpp"
 #include "io/config.hpp"
@@ -24,7 +26,8 @@ namespace {
 template <int D>
 class EnergyLog final : public Observer<D> {
  public:
-  std::string name() const override { return "energy.tsv"; }
+  static constexpr std::array<std::string_view, 1> kFiles{"energy.tsv"};
+  std::string name() const override { return std::string(kFiles[0]); }
   // The thermo interval (a key of its own would be declared in io/config).
   double interval(const Config& config, double production) const override {
     return config.output.thermo_interval > 0 ? config.output.thermo_interval : production / 100.0;

@@ -25,11 +25,12 @@ TEST(OutputFiles, EveryFileARunWritesIsListed) {
   fs::remove_all(dir);
   const std::string text =
       "[system]\nparticles = 500\npacking_fraction = 0.3\nseed = 4\n"
+      "species = [{name = \"A\", fraction = 0.5}, {name = \"B\", fraction = 0.5}]\n"
       "[run]\nequilibration_collisions_per_particle = 1.0\ncollisions_per_particle = 20.0\n"
       "[output]\nprogress = \"never\"\nprofile_axis = \"z\"\ndirectory = \"" +
       dir.string() +
       "\"\n"
-      "[analysis]\nmsd = true\nvacf = true\ntransport = true\nrdf = true\n"
+      "[analysis]\nmsd = true\nvacf = true\nmutual_diffusion = true\ntransport = true\nrdf = true\n"
       "structure_factor = true\nbond_order = true\nvelocity_distribution = true\n"
       "[compress]\npacking_fraction = 0.31\n";
   const RunOutcome outcome = run_simulation(parse_config(text, "<test>"));

@@ -4,9 +4,11 @@
 // mean local values with their blocked errors. docs/outputs.md.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "analysis/structure.hpp"
 #include "run/outputs/analysis_output.hpp"
@@ -25,7 +27,8 @@ class BondOrderOutput final : public AnalysisOutput<D> {
  public:
   explicit BondOrderOutput(std::shared_ptr<StructureSnapshot<D>> snapshot)
       : snapshot_(std::move(snapshot)) {}
-  std::string name() const override { return "bond_order.tsv"; }
+  static constexpr std::array<std::string_view, 1> kFiles{"bond_order.tsv"};
+  std::string name() const override { return std::string(kFiles[0]); }
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 
  protected:

@@ -22,11 +22,11 @@ void CompressionOutput<D>::open(const RunContext<D>& run) {
                         row.packing_fraction, row.pressure, row.temperature, row.collisions,
                         row.collision_rate);
   }
-  write_text_atomically(run.directory() / "compress.tsv", rows);
+  write_text_atomically(run.directory() / kRowsFile, rows);
 
   const ContactNetwork& net = report_->network;
   if (!report_->has_network) {
-    write_text_atomically(run.directory() / "contacts.tsv",
+    write_text_atomically(run.directory() / kContactsFile,
                           "# no contact network: the packing is not near jamming (reduced pressure "
                           "below 1e6) and compress.contact_gap is 0\n");
   }
@@ -44,11 +44,11 @@ void CompressionOutput<D>::open(const RunContext<D>& run) {
     contacts += fmt::format("{}\t{}{}\t{:.6g}\t{}\t0\n", c.i, "xyz"[c.face / 2],
                             c.face % 2 == 0 ? '-' : '+', c.gap, int{net.rattler[c.i]});
   }
-  if (report_->has_network) write_text_atomically(run.directory() / "contacts.tsv", contacts);
+  if (report_->has_network) write_text_atomically(run.directory() / kContactsFile, contacts);
 
   TrajectoryLayout layout;
   layout.double_precision = true;
-  replace_file_atomically(run.directory() / "packing.gsd", [&](const std::filesystem::path& tmp) {
+  replace_file_atomically(run.directory() / kPackingFile, [&](const std::filesystem::path& tmp) {
     auto w = gsd::Writer::create(tmp, "kairos " KAIROS_VERSION);
     append_trajectory_frame(w, *packing_, layout);
     w.close();

@@ -5,8 +5,10 @@
 // `compression`. Written when the run opens: the compression happened in its setup.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/particle_system.hpp"
@@ -26,8 +28,15 @@ class CompressionOutput final : public Observer<D> {
   CompressionOutput(std::shared_ptr<const CompressionReport> report,
                     std::shared_ptr<const ParticleSystem<D>> packing)
       : report_(std::move(report)), packing_(std::move(packing)) {}
-  std::string name() const override { return "compress.tsv"; }
-  std::vector<std::string> more_files() const override { return {"packing.gsd", "contacts.tsv"}; }
+  // The compression's rows, the packing it left, and that packing's contact network.
+  static constexpr std::string_view kRowsFile = "compress.tsv";
+  static constexpr std::string_view kPackingFile = "packing.gsd";
+  static constexpr std::string_view kContactsFile = "contacts.tsv";
+  static constexpr std::array<std::string_view, 3> kFiles{kRowsFile, kPackingFile, kContactsFile};
+  std::string name() const override { return std::string(kRowsFile); }
+  std::vector<std::string> more_files() const override {
+    return {std::string(kPackingFile), std::string(kContactsFile)};
+  }
   void open(const RunContext<D>& run) override;
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 

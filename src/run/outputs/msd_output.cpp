@@ -166,8 +166,8 @@ std::string MsdOutput<D>::theory_does_not_apply(const Config& config) const {
 template <int D>
 std::vector<std::string> MsdOutput<D>::more_files() const {
   std::vector<std::string> files;
-  if (config_.vacf) files.push_back("vacf.tsv");
-  if (config_.mutual_diffusion) files.push_back("mutual_diffusion.tsv");
+  if (config_.vacf) files.emplace_back(kVacfFile);
+  if (config_.mutual_diffusion) files.emplace_back(kMutualFile);
   return files;
 }
 
@@ -267,7 +267,7 @@ void MsdOutput<D>::close(const RunContext<D>& run, bool) {
       for (const double m : lag.mean) text += fmt::format("\t{:.10g}", m);
       text += "\n";
     }
-    write_text_atomically(run.directory() / "mutual_diffusion.tsv", text);
+    write_text_atomically(run.directory() / kMutualFile, text);
   }
   if (!vacf_) return;
   // The velocity autocorrelation and its running Green-Kubo integral (1/d) int_0^lag.
@@ -287,7 +287,7 @@ void MsdOutput<D>::close(const RunContext<D>& run, bool) {
     }
     text += "\n";
   }
-  write_text_atomically(run.directory() / "vacf.tsv", text);
+  write_text_atomically(run.directory() / kVacfFile, text);
 }
 
 template <int D>

@@ -8,9 +8,11 @@
 // species' collective Helfand moments (docs/outputs.md).
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "analysis/granular_theory.hpp"
@@ -50,7 +52,11 @@ template <int D>
 class MsdOutput final : public Observer<D> {
  public:
   MsdOutput(const Config& config, const EventIntegrator<D>& engine);
-  std::string name() const override { return "msd.tsv"; }
+  static constexpr std::string_view kMsdFile = "msd.tsv";
+  static constexpr std::string_view kVacfFile = "vacf.tsv";                // analysis.vacf
+  static constexpr std::string_view kMutualFile = "mutual_diffusion.tsv";  // .mutual_diffusion
+  static constexpr std::array<std::string_view, 3> kFiles{kMsdFile, kVacfFile, kMutualFile};
+  std::string name() const override { return std::string(kMsdFile); }
   std::vector<std::string> more_files() const override;
   bool samples_in_time() const override { return !in_collisions_; }
   bool samples_in_collisions() const override { return in_collisions_; }

@@ -18,6 +18,11 @@
 // InputError thrown there (a full disk) stops the run, and the observer is not called for
 // writing again, while the others still are. An InputError from open (a file there that is not
 // this run's to continue) ends the run before its first event.
+//
+// An output that writes files into the output directory declares all it may write once, as
+// `static constexpr std::array<std::string_view, N> kFiles`, and names them from there (name(),
+// more_files(), its writes): registry.cpp collects them for the directory's guard and
+// --overwrite (output_file_names()).
 #pragma once
 
 #include <cstdint>

@@ -4,8 +4,10 @@
 // lineage left in the directory).
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "analysis/profile.hpp"
 #include "run/outputs/observer.hpp"
@@ -15,7 +17,8 @@ namespace kairos {
 template <int D>
 class ProfileOutput final : public Observer<D> {
  public:
-  std::string name() const override { return "profile.tsv"; }
+  static constexpr std::array<std::string_view, 1> kFiles{"profile.tsv"};
+  std::string name() const override { return std::string(kFiles[0]); }
   void open(const RunContext<D>& run) override;
   void sample(const RunContext<D>& run) override;
   void close(const RunContext<D>& run, bool) override {

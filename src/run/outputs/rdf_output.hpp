@@ -5,9 +5,11 @@
 // measured (summary.json's `compressibility`). docs/outputs.md.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "analysis/structure.hpp"
@@ -37,7 +39,8 @@ class RdfOutput final : public AnalysisOutput<D> {
   // `thermo`: for the measured Z.
   RdfOutput(std::shared_ptr<StructureSnapshot<D>> snapshot, const ThermoOutput<D>& thermo)
       : snapshot_(std::move(snapshot)), thermo_(thermo) {}
-  std::string name() const override { return "rdf.tsv"; }
+  static constexpr std::array<std::string_view, 1> kFiles{"rdf.tsv"};
+  std::string name() const override { return std::string(kFiles[0]); }
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 
  protected:

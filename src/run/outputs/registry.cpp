@@ -1,5 +1,7 @@
 #include "run/outputs/registry.hpp"
 
+#include <algorithm>
+#include <stdexcept>
 #include <utility>
 
 #include "run/dem_adapter.hpp"
@@ -24,6 +26,7 @@
 #include "run/outputs/transport_output.hpp"
 #include "run/outputs/velocity_distribution_output.hpp"
 #include "run/outputs/walls_with_mass_summary.hpp"
+#include "run/run_log.hpp"
 
 namespace kairos {
 
@@ -35,6 +38,38 @@ T& add(ObserverList<D>& list, Args&&... args) {
   T& added = *observer;
   list.push_back(std::move(observer));
   return added;
+}
+
+// Every output and analysis make_observers may create: the files they declare (their kFiles)
+// are output_file_names(). A new output is added here and in make_observers; make_observers
+// refuses one whose files this list misses (require_files_listed), so a run of it fails its tests.
+template <class... Outputs>
+struct OutputKinds {
+  static std::vector<std::string> files() {
+    std::vector<std::string> names;
+    (names.insert(names.end(), Outputs::kFiles.begin(), Outputs::kFiles.end()), ...);
+    return names;
+  }
+};
+using AllOutputs = OutputKinds<RunSummary<3>, ThermoOutput<3>, TrajectoryOutput<3>,
+                               RestartOutput<3>, ProfileOutput<3>, TransportOutput<3>, MsdOutput<3>,
+                               RdfOutput<3>, StructureFactorOutput<3>, BondOrderOutput<3>,
+                               VelocityDistributionOutput<3>, CompressionOutput<3>>;
+
+template <int D>
+void require_files_listed(const ObserverList<D>& list) {
+  const auto& listed = output_file_names();
+  const auto require = [&](const std::string& file) {
+    if (std::find(listed.begin(), listed.end(), file) == listed.end()) {
+      throw std::logic_error("output file '" + file +
+                             "' is not in output_file_names(): add its output to AllOutputs "
+                             "(run/outputs/registry.cpp)");
+    }
+  };
+  for (const auto& observer : list) {
+    if (observer->writes_file()) require(observer->name());
+    for (const std::string& more : observer->more_files()) require(more);
+  }
 }
 
 }  // namespace
@@ -77,27 +112,16 @@ ObserverList<D> make_observers(const Config& config, const Integrator<D>& integr
   }
   if (const DemAdapter<D>* dem = integrator.as_dem()) add<DemSummary<D>>(list, *dem);
   if (!integrator.walls_with_mass().empty()) add<WallsWithMassSummary<D>>(list);
+  require_files_listed(list);
   return list;
 }
 
 const std::vector<std::string>& output_file_names() {
-  static const std::vector<std::string> names = {"summary.json",
-                                                 "thermo.tsv",
-                                                 "trajectory.gsd",
-                                                 "restart.gsd",
-                                                 "profile.tsv",
-                                                 "helfand.tsv",
-                                                 "green_kubo.tsv",
-                                                 "msd.tsv",
-                                                 "vacf.tsv",
-                                                 "rdf.tsv",
-                                                 "sk.tsv",
-                                                 "bond_order.tsv",
-                                                 "velocity_distribution.tsv",
-                                                 "compress.tsv",
-                                                 "packing.gsd",
-                                                 "contacts.tsv",
-                                                 "run.log"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> all = AllOutputs::files();
+    all.emplace_back(RunLog::kFile);
+    return all;
+  }();
   return names;
 }
 

@@ -1,6 +1,7 @@
 // The one list of a run's outputs and analyses (HOOMD's operations list): the run driver calls
 // them in this order at every moment of the run (outputs/observer.hpp). A new output is one
-// file pair in src/run/outputs/ and one line in make_observers (docs/extending.md).
+// file pair in src/run/outputs/, one line in make_observers and its type in AllOutputs
+// (registry.cpp; docs/extending.md).
 #pragma once
 
 #include <memory>
@@ -31,8 +32,8 @@ ObserverList<D> make_observers(const Config& config, const Integrator<D>& integr
 
 // Every file an output or analysis of make_observers may write into the output directory,
 // whatever the configuration (an earlier run's may have had others): the files the
-// directory's guard refuses to clobber and --overwrite removes (run/output_directory.cpp). A
-// new output adds its file here (a test checks the list against a run with every output on).
+// directory's guard refuses to clobber and --overwrite removes (run/output_directory.cpp). Each
+// output declares its files once, as its kFiles; this is their union, with run.log.
 const std::vector<std::string>& output_file_names();
 
 }  // namespace kairos

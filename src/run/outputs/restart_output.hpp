@@ -3,7 +3,9 @@
 // whose records it keeps (thermo rows, trajectory frames), so that it records them written.
 #pragma once
 
+#include <array>
 #include <string>
+#include <string_view>
 
 #include "run/outputs/observer.hpp"
 
@@ -12,7 +14,8 @@ namespace kairos {
 template <int D>
 class RestartOutput final : public Observer<D> {
  public:
-  std::string name() const override { return "restart.gsd"; }
+  static constexpr std::array<std::string_view, 1> kFiles{"restart.gsd"};
+  std::string name() const override { return std::string(kFiles[0]); }
   // Default 0: at the end only.
   double interval(const Config& config, double) const override {
     return config.output.restart_interval;

@@ -3,7 +3,9 @@
 // checks of the final state (momentum drift, max overlap). docs/outputs.md has every key.
 #pragma once
 
+#include <array>
 #include <string>
+#include <string_view>
 
 #include "run/outputs/observer.hpp"
 
@@ -12,7 +14,9 @@ namespace kairos {
 template <int D>
 class RunSummary final : public Observer<D> {
  public:
-  std::string name() const override { return "summary.json"; }
+  // summary.json, which the run driver writes from every observer's summarize().
+  static constexpr std::array<std::string_view, 1> kFiles{"summary.json"};
+  std::string name() const override { return std::string(kFiles[0]); }
   bool writes_file() const override { return false; }
   void open(const RunContext<D>& run) override { momentum_start_ = run.integrator().momentum(); }
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;

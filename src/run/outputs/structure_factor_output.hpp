@@ -5,9 +5,11 @@
 // docs/outputs.md.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "analysis/structure.hpp"
 #include "run/outputs/analysis_output.hpp"
@@ -34,7 +36,8 @@ class StructureFactorOutput final : public AnalysisOutput<D> {
  public:
   explicit StructureFactorOutput(std::shared_ptr<StructureSnapshot<D>> snapshot)
       : snapshot_(std::move(snapshot)) {}
-  std::string name() const override { return "sk.tsv"; }
+  static constexpr std::array<std::string_view, 1> kFiles{"sk.tsv"};
+  std::string name() const override { return std::string(kFiles[0]); }
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 
  protected:

@@ -9,9 +9,11 @@
 // moments analyses sample at (RunContext::sample_production_row).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "analysis/thermodynamics.hpp"
@@ -28,7 +30,8 @@ class ThermoOutput final : public Observer<D> {
       "compressibility\tkinetic_energy\tmean_free_time\trotational_temperature\t"
       "dissipated_energy\twall_work\tpotential_energy\n";
 
-  std::string name() const override { return "thermo.tsv"; }
+  static constexpr std::array<std::string_view, 1> kFiles{"thermo.tsv"};
+  std::string name() const override { return std::string(kFiles[0]); }
   // Default: 100 rows per production length.
   double interval(const Config& config, double production) const override {
     return config.output.thermo_interval > 0 ? config.output.thermo_interval : production / 100.0;

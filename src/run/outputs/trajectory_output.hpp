@@ -11,9 +11,11 @@
 // log-spaced frames, the origin of their sequence (the driver's part).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "io/gsd_file.hpp"
 #include "io/gsd_snapshot.hpp"
@@ -24,7 +26,8 @@ namespace kairos {
 template <int D>
 class TrajectoryOutput final : public Observer<D> {
  public:
-  std::string name() const override { return "trajectory.gsd"; }
+  static constexpr std::array<std::string_view, 1> kFiles{"trajectory.gsd"};
+  std::string name() const override { return std::string(kFiles[0]); }
   // Default: 10 frames per production length. Log-spaced: the first lag (given).
   double interval(const Config& config, double production) const override {
     return config.output.trajectory_interval > 0 ? config.output.trajectory_interval

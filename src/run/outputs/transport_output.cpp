@@ -178,7 +178,7 @@ void TransportOutput<D>::close(const RunContext<D>& run, bool) {
       "lag\torigins\tshear_flux_acf\tbulk_flux_acf\theat_flux_acf\tshear_viscosity\t"
       "bulk_viscosity\tthermal_conductivity\n";
   for (const auto& r : transport_->green_kubo_rows(from, to)) text += row(r);
-  write_text_atomically(run.directory() / "green_kubo.tsv", text);
+  write_text_atomically(run.directory() / kGreenKuboFile, text);
 }
 
 template <int D>

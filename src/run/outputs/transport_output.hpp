@@ -9,6 +9,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "analysis/helfand_transport.hpp"
@@ -65,8 +66,12 @@ template <int D>
 class TransportOutput final : public Observer<D> {
  public:
   TransportOutput(const Config& config, const EventIntegrator<D>& engine);
-  std::string name() const override { return "helfand.tsv"; }
-  std::vector<std::string> more_files() const override { return {"green_kubo.tsv"}; }
+  // The Einstein-Helfand moments and the Green-Kubo flux autocorrelations.
+  static constexpr std::string_view kHelfandFile = "helfand.tsv";
+  static constexpr std::string_view kGreenKuboFile = "green_kubo.tsv";
+  static constexpr std::array<std::string_view, 2> kFiles{kHelfandFile, kGreenKuboFile};
+  std::string name() const override { return std::string(kHelfandFile); }
+  std::vector<std::string> more_files() const override { return {std::string(kGreenKuboFile)}; }
   bool samples_in_time() const override { return true; }
   double interval(const Config&, double) const override { return interval_; }
   void production_starts(const RunContext<D>& run) override;

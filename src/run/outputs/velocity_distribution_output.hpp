@@ -6,7 +6,9 @@
 // docs/outputs.md.
 #pragma once
 
+#include <array>
 #include <string>
+#include <string_view>
 
 #include "analysis/structure.hpp"
 #include "run/integrator.hpp"
@@ -24,7 +26,8 @@ bool sample_velocity_distribution(const Integrator<D>& integrator,
 template <int D>
 class VelocityDistributionOutput final : public AnalysisOutput<D> {
  public:
-  std::string name() const override { return "velocity_distribution.tsv"; }
+  static constexpr std::array<std::string_view, 1> kFiles{"velocity_distribution.tsv"};
+  std::string name() const override { return std::string(kFiles[0]); }
   void summarize(nlohmann::json& summary, const RunContext<D>& run) const override;
 
  protected:
