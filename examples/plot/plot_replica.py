@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Plots a replica-exchange run (docs/replica_exchange.md): the heat capacity and the mean
-potential energy against temperature (temperatures.tsv, with their jackknife errors), the
+potential energy against temperature (temperatures.tsv, with their errors), the
 acceptance of each pair of rungs beside the one the energy distributions predict, and the walk
 of a few replicas through the ladder (exchange.tsv).
 

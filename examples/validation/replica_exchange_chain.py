@@ -14,13 +14,14 @@ box far wider than it. The same chain is simulated
    every time unit (thermo.tsv).
 
 At every temperature the mean energy <U> and the heat capacity C = D B / 2 + var(U) / T^2 of the
-two must agree within their errors (jackknife over 20 blocks of the rounds, or of the rows).
+two must agree within their errors: the exchange run's own (docs/replica_exchange.md "Results"),
+and for the independent runs a jackknife over 20 blocks of their rows.
 The acceptance of each pair of rungs is printed beside the one the two rungs' energy
 distributions predict (summary.json's predicted_rate).
 
     python3 examples/validation/replica_exchange_chain.py build/kairos [beads] [rounds]
 
-About 6 minutes on two cores for 32 beads and 20 000 rounds.
+About 4 minutes on two cores for 32 beads and 20 000 rounds.
 """
 
 import json

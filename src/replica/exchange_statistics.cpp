@@ -1,5 +1,6 @@
 #include "replica/exchange_statistics.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "analysis/block_average.hpp"
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "replica/replica_exchange.hpp"
@@ -109,6 +111,34 @@ Estimate jackknife(const std::vector<double>& samples,
   return e;
 }
 
+namespace {
+
+// Jackknife blocks for the heat capacity: its error is uncertain by about 1/sqrt(2 B).
+constexpr std::size_t kMostJackknifeBlocks = 64;
+
+// The error bars of one rung's energies. <U>'s is the blocking estimate with its automatically
+// chosen level (analysis/block_average.hpp); the heat capacity's is a jackknife over blocks at
+// least as long as the blocks that level found sufficient both for U and for (U - <U>)^2, the
+// fluctuation the heat capacity averages (which may stay correlated longer than U).
+struct RungErrors {
+  BlockAverage energy, fluctuation;
+  std::size_t cv_blocks = 0;
+};
+
+RungErrors rung_errors(const std::vector<double>& u) {
+  RungErrors e;
+  e.energy = block_average(u);
+  std::vector<double> squares(u.size());
+  for (std::size_t i = 0; i < u.size(); ++i)
+    squares[i] = (u[i] - e.energy.mean) * (u[i] - e.energy.mean);
+  e.fluctuation = block_average(squares);
+  const std::size_t length = std::size_t{1} << std::max(e.energy.level, e.fluctuation.level);
+  e.cv_blocks = std::min(kMostJackknifeBlocks, u.size() / length);
+  return e;
+}
+
+}  // namespace
+
 double heat_capacity(const std::vector<double>& u, double temperature, double kinetic_dof) {
   return 0.5 * kinetic_dof + variance(u) / (temperature * temperature);
 }
@@ -154,17 +184,27 @@ fs::path write_exchange_results(const ReplicaExchangePlan& plan, const ExchangeS
   }
   for (std::size_t k = 0; k < rungs; ++k) {
     const double t = temps[k];
-    const Estimate energy = jackknife(u[k], mean);
+    const RungErrors errors = rung_errors(u[k]);
     const Estimate cv = jackknife(
-        u[k], [&](const std::vector<double>& x) { return heat_capacity(x, t, kinetic_dof); });
+        u[k], [&](const std::vector<double>& x) { return heat_capacity(x, t, kinetic_dof); },
+        errors.cv_blocks);
+    const Estimate energy{u[k].empty() ? kNaN : errors.energy.mean,
+                          u[k].size() >= 2 ? errors.energy.stderr_ : kNaN};
+    const bool reliable = errors.energy.reliable && errors.fluctuation.reliable;
     rung_list.push_back(
         {{"rung", k},
          {"temperature", t},
          {"samples", u[k].size()},
          {"potential_energy",
-          {{"mean", finite_or_null(energy.value)}, {"stderr", finite_or_null(energy.error)}}},
+          {{"mean", finite_or_null(energy.value)},
+           {"stderr", finite_or_null(energy.error)},
+           {"correlation_rounds", finite_or_null(errors.energy.correlation_time)}}},
          {"heat_capacity",
-          {{"mean", finite_or_null(cv.value)}, {"stderr", finite_or_null(cv.error)}}}});
+          {{"mean", finite_or_null(cv.value)},
+           {"stderr", finite_or_null(cv.error)},
+           {"blocks", errors.cv_blocks},
+           {"correlation_rounds", finite_or_null(errors.fluctuation.correlation_time)}}},
+         {"errors_reliable", reliable}});
     table += fmt::format("{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\n", k, t, u[k].size(),
                          tsv_number(energy.value), tsv_number(energy.error), tsv_number(cv.value),
                          tsv_number(cv.error), tsv_number(rate[k]), tsv_number(predicted[k]));

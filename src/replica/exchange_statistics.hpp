@@ -3,9 +3,12 @@
 // neighbouring rungs the acceptance measured and the one the two energy distributions predict,
 // per replica its round trips through the ladder. Written as temperatures.tsv and summary.json.
 //
-// Errors are jackknife errors over contiguous blocks of the rounds after the equilibration
-// (at most 20 blocks; Efron and Stein, Ann. Stat. 9, 586 (1981); the blocks absorb the
-// correlation between successive rounds when each is longer than it).
+// Errors come from the rounds after the equilibration. <U>'s is the blocking estimate
+// (analysis/block_average.hpp: Flyvbjerg and Petersen, J. Chem. Phys. 91, 461 (1989), the
+// level chosen by Jonsson's test), which finds how many rounds the energies stay correlated.
+// The heat capacity's is a jackknife (Efron and Stein, Ann. Stat. 9, 586 (1981)) over at most
+// 64 contiguous blocks, each at least as long as the blocks that test found independent for U
+// and for its fluctuation (U - <U>)^2. summary.json says whether both tests found a plateau.
 #pragma once
 
 #include <cstdint>

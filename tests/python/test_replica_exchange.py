@@ -117,6 +117,10 @@ class ReplicaExchange(kt.KairosTestCase):
                 u = rung["potential_energy"]
                 cv = rung["heat_capacity"]
                 self.assertEqual(rung["samples"], rounds - 200)
+                # The errors account for the rounds' correlation, and the run is long enough
+                # for the blocking to find it.
+                self.assertTrue(rung["errors_reliable"], rung)
+                self.assertGreaterEqual(u["correlation_rounds"], 1.0)
                 u_tol = 4.0 * np.hypot(u["stderr"], u_ref_error)
                 self.assertLess(abs(u["mean"] - u_exact), u_tol,
                                 "<U> = %s +- %s against %s" % (u["mean"], u["stderr"], u_exact))
