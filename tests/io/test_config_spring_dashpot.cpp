@@ -16,8 +16,12 @@ packing_fraction = 0.05
 )";
 
 std::string with(std::string_view potential) {
-  return std::string(kGas) + "[[potential]]\nkind = \"spring_dashpot\"\n" + std::string(potential) +
-         "\n";
+  // Appended in place: GCC 12's -Warray-bounds misreads `std::string(kGas) + "..."` at -O1.
+  std::string text(kGas);
+  text += "[[potential]]\nkind = \"spring_dashpot\"\n";
+  text += potential;
+  text += "\n";
+  return text;
 }
 
 std::string error_of(const std::string& text) {
