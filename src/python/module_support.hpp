@@ -79,7 +79,9 @@ inline double number_from(const py::object& value, const std::string& name) {
 // SIGINT during kairos.run: the run stops cleanly after the current event (request_stop(), as
 // in the CLI) and writes every output; Python's handler is back afterwards. During the setup of
 // kairos.run or kairos.Simulation (a table build) it unwinds with Interrupted, which the module
-// turns into KeyboardInterrupt.
+// turns into KeyboardInterrupt. A second SIGINT before that kills the process at once, as in
+// the CLI (docs/guarantees.md): the way out of a stop that does not come (a sweep's point that
+// does not end; its runs get SIGTERM when the sweep dies).
 extern "C" inline void stop_on_sigint(int) {
   request_stop();
 }
@@ -89,6 +91,7 @@ class SigintStopsRun {
     clear_stop_request();
     struct sigaction sa {};
     sa.sa_handler = stop_on_sigint;
+    sa.sa_flags = SA_RESETHAND;  // the second one: the default action
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, &previous_);
   }

@@ -13,6 +13,8 @@ import json
 import os
 import pathlib
 import signal
+import subprocess
+import sys
 import threading
 import time
 
@@ -688,6 +690,47 @@ class Runners(kt.KairosTestCase):
         again = kairos.sweep(cfg, output=self.path("py"), vary=vary)
         self.assertEqual([r["summary"]["run_id"] for r in again],
                          [r["summary"]["run_id"] for r in runs])
+
+    def test_a_second_ctrl_c_ends_a_sweep_whose_runs_do_not_stop(self):
+        # The first SIGINT asks the sweep to stop: it sends its runs SIGTERM and waits for them.
+        # A run that does not stop (here a stand-in program that ignores SIGTERM) would keep it
+        # waiting; the second SIGINT kills the process at once, as it kills the CLI.
+        cfg = self.write_config(kt.base_config(particles=30, production=2.0))
+        pid_file = self.path("child.pid")
+        stubborn = self.path("stubborn")
+        with open(stubborn, "w") as f:
+            f.write("#!/bin/sh\ntrap '' TERM\necho $$ > %s\nexec sleep 60\n" % pid_file)
+        os.chmod(stubborn, 0o755)
+        script = ("import kairos\n"
+                  "kairos.sweep(%r, output=%r, vary={'system.seed': [1, 2]}, workers=1, "
+                  "kairos=%r)\n" % (cfg, self.path("s"), stubborn))
+        proc = subprocess.Popen([sys.executable, "-c", script], env=os.environ.copy(),
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        try:
+            deadline = time.monotonic() + 30.0
+            while not os.path.exists(pid_file) and time.monotonic() < deadline:
+                time.sleep(0.05)
+            self.assertTrue(os.path.exists(pid_file), "the sweep did not start its run")
+            time.sleep(0.2)
+            proc.send_signal(signal.SIGINT)
+            with self.assertRaises(subprocess.TimeoutExpired):
+                proc.wait(timeout=1.0)  # waiting for the run, which ignores SIGTERM
+            proc.send_signal(signal.SIGINT)
+            proc.wait(timeout=10.0)
+            self.assertEqual(proc.returncode, -signal.SIGINT)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+            if os.path.exists(pid_file):
+                with open(pid_file) as f:
+                    child = int(f.read())
+                try:
+                    os.kill(child, signal.SIGKILL)
+                except ProcessLookupError:
+                    pass
+            proc.stdout.close()
+            proc.stderr.close()
 
     def test_failures_warn_and_mistakes_raise(self):
         cfg = self.write_config(kt.base_config(particles=30, production=2.0,
