@@ -79,19 +79,22 @@ inline double number_from(const py::object& value, const std::string& name) {
 // SIGINT during kairos.run: the run stops cleanly after the current event (request_stop(), as
 // in the CLI) and writes every output; Python's handler is back afterwards. During the setup of
 // kairos.run or kairos.Simulation (a table build) it unwinds with Interrupted, which the module
-// turns into KeyboardInterrupt. A second SIGINT before that kills the process at once, as in
-// the CLI (docs/guarantees.md): the way out of a stop that does not come (a sweep's point that
-// does not end; its runs get SIGTERM when the sweep dies).
+// turns into KeyboardInterrupt. For the runners (kairos.sweep, kairos.replica_exchange),
+// `second_kills`: a second SIGINT before the first is answered kills the process at once, as in
+// the CLI (docs/guarantees.md), the way out of a stop that may not come (a sweep's run that
+// does not end, a long round; a sweep's runs get SIGTERM when it dies). A single run stops
+// within an event and its outputs' writing, so there a second Ctrl-C (Jupyter's interrupt
+// pressed twice) does not kill the session.
 extern "C" inline void stop_on_sigint(int) {
   request_stop();
 }
 class SigintStopsRun {
  public:
-  SigintStopsRun() {
+  explicit SigintStopsRun(bool second_kills = false) {
     clear_stop_request();
     struct sigaction sa {};
     sa.sa_handler = stop_on_sigint;
-    sa.sa_flags = SA_RESETHAND;  // the second one: the default action
+    sa.sa_flags = second_kills ? SA_RESETHAND : 0;  // the second one: the default action
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, &previous_);
   }

@@ -140,7 +140,7 @@ void bind_runners(py::module_& m) {
                                           output.value_or("kairos-sweep"));
         const fs::path executable = sweep_program(program);
         const LocalSweepOutcome outcome = [&] {
-          SigintStopsRun sigint;
+          SigintStopsRun sigint(/*second_kills=*/true);
           py::gil_scoped_release release;
           return run_local_sweep(plan, {executable, workers, ""});
         }();
@@ -217,7 +217,7 @@ void bind_runners(py::module_& m) {
         const SweepDirectoryLock lock(plan.settings.directory);
         claim_replica_directory(plan);
         const ReplicaExchangeOutcome outcome = [&] {
-          SigintStopsRun sigint;
+          SigintStopsRun sigint(/*second_kills=*/true);
           py::gil_scoped_release release;
           return run_replica_exchange(plan, ReplicaComm{});
         }();

@@ -133,7 +133,14 @@ RungErrors rung_errors(const std::vector<double>& u) {
     squares[i] = (u[i] - e.energy.mean) * (u[i] - e.energy.mean);
   e.fluctuation = block_average(squares);
   const std::size_t length = std::size_t{1} << std::max(e.energy.level, e.fluctuation.level);
-  e.cv_blocks = std::min(kMostJackknifeBlocks, u.size() / length);
+  // The blocks jackknife() will use (it takes at most half the samples as blocks); 0: too few
+  // samples for an error.
+  e.cv_blocks = std::min({kMostJackknifeBlocks, u.size() / length, u.size() / 2});
+  if (e.cv_blocks < 2) e.cv_blocks = 0;
+  if (u.size() < 2) {  // no fluctuation measured: no correlation time either
+    e.energy.correlation_time = kNaN;
+    e.fluctuation.correlation_time = kNaN;
+  }
   return e;
 }
 

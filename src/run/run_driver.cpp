@@ -14,11 +14,15 @@
 #include "io/atomic_file.hpp"
 #include "io/config_choices.hpp"
 #include "run/outputs/msd_output.hpp"
+#include "run/outputs/run_summary.hpp"
 #include "run/setup_chain.hpp"
 
 namespace kairos {
 
 namespace {
+
+// The file the driver writes from every observer's summarize() (run_summary.hpp names it).
+const std::string kSummaryFile(RunSummary<3>::kFiles[0]);
 
 namespace fs = std::filesystem;
 
@@ -162,8 +166,8 @@ RunOutcome RunDriver<D>::run() {
   for (const auto& o : observers_) o->summarize(outcome.summary, *this);
   outcome.summary["peak_rss_bytes"] = peak_rss_bytes();
   outcome.summary["outputs"] = outputs_present();
-  failures_.attempt("summary.json", [&] {
-    write_text_atomically(directory_->path() / "summary.json", outcome.summary.dump(2) + "\n");
+  failures_.attempt(kSummaryFile, [&] {
+    write_text_atomically(directory_->path() / kSummaryFile, outcome.summary.dump(2) + "\n");
   });
   const std::string run_failed = failures_.any() ? with_outputs() : error_;
   log_->line(fmt::format("end: {} after {} of wall time; {} events, {} collisions, t = {:.10g}{}",
@@ -171,11 +175,11 @@ RunOutcome RunDriver<D>::run() {
                          integrator_->collisions(), integrator_->time(),
                          run_failed.empty() ? "" : "; error: " + run_failed));
   // failures_.error now ends with the summary's failure (error_ holds the earlier ones).
-  if (failures_.failed_file("summary.json")) {
+  if (failures_.failed_file(kSummaryFile)) {
     outcome.error = with_outputs();
     // What the console lists is what the directory holds: the summary is not among it.
     nlohmann::json& listed = outcome.summary["outputs"];
-    listed.erase(std::remove(listed.begin(), listed.end(), nlohmann::json("summary.json")),
+    listed.erase(std::remove(listed.begin(), listed.end(), nlohmann::json(kSummaryFile)),
                  listed.end());
   }
   return outcome;
@@ -350,7 +354,7 @@ bool RunDriver<D>::write_due(const std::vector<std::size_t>& due) {
 // config.toml last (summary.json's "outputs").
 template <int D>
 nlohmann::json RunDriver<D>::outputs_present() const {
-  nlohmann::json list = nlohmann::json::array({"summary.json"});
+  nlohmann::json list = nlohmann::json::array({kSummaryFile});
   std::error_code ec;
   for (const auto& o : observers_) {
     if (o->writes_file() && fs::exists(directory() / o->name(), ec)) list.push_back(o->name());

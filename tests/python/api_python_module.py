@@ -12,6 +12,7 @@ Run by ctest with the module's directory on PYTHONPATH (tests/CMakeLists.txt).
 import json
 import os
 import pathlib
+import shlex
 import signal
 import subprocess
 import sys
@@ -699,7 +700,8 @@ class Runners(kt.KairosTestCase):
         pid_file = self.path("child.pid")
         stubborn = self.path("stubborn")
         with open(stubborn, "w") as f:
-            f.write("#!/bin/sh\ntrap '' TERM\necho $$ > %s\nexec sleep 60\n" % pid_file)
+            f.write("#!/bin/sh\ntrap '' TERM\necho $$ > %s\nexec sleep 60\n"
+                    % shlex.quote(pid_file))
         os.chmod(stubborn, 0o755)
         script = ("import kairos\n"
                   "kairos.sweep(%r, output=%r, vary={'system.seed': [1, 2]}, workers=1, "

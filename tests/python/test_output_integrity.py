@@ -329,5 +329,6 @@ class OutputDirectories(kt.KairosTestCase):
         for name in stale:
             self.assertFalse(os.path.exists(os.path.join(out, name)), name)
 
+
 if __name__ == "__main__":
     kt.main()
