@@ -698,14 +698,14 @@ class Runners(kt.KairosTestCase):
         # waiting; the second SIGINT kills the process at once, as it kills the CLI.
         cfg = self.write_config(kt.base_config(particles=30, production=2.0))
         pid_file = self.path("child.pid")
-        stubborn = self.path("stubborn")
-        with open(stubborn, "w") as f:
+        ignores_sigterm = self.path("ignores_sigterm.sh")
+        with open(ignores_sigterm, "w") as f:
             f.write("#!/bin/sh\ntrap '' TERM\necho $$ > %s\nexec sleep 60\n"
                     % shlex.quote(pid_file))
-        os.chmod(stubborn, 0o755)
+        os.chmod(ignores_sigterm, 0o755)
         script = ("import kairos\n"
                   "kairos.sweep(%r, output=%r, vary={'system.seed': [1, 2]}, workers=1, "
-                  "kairos=%r)\n" % (cfg, self.path("s"), stubborn))
+                  "kairos=%r)\n" % (cfg, self.path("s"), ignores_sigterm))
         proc = subprocess.Popen([sys.executable, "-c", script], env=os.environ.copy(),
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE)
         try:
