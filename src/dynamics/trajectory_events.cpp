@@ -225,11 +225,19 @@ double expand_until(double from, Pred done) {
   return kNever;
 }
 
+// The sign of f' as t grows without bound: that of its leading coefficient (0 for a constant f).
+double slope_at_infinity(const Quartic& q) {
+  for (int k = 4; k >= 1; --k)
+    if (q.c[k] != 0.0) return q.c[k];
+  return 0.0;
+}
+
 // The root of f' in (lo, hi), where f' is monotone (hi may be infinite); NaN if f' keeps its
 // sign there. At infinity f' takes the sign of its leading coefficient.
 double slope_root(const Quartic& q, double lo, double hi) {
   const double d_lo = q.df(lo);
   if (d_lo == 0.0) return kNaN;  // lo itself is the critical point, and a split point already
+  if (std::isinf(hi) && (d_lo > 0.0) == (slope_at_infinity(q) > 0.0)) return kNaN;  // no flip
   const auto flipped = [&](double t) { return q.df(t) * d_lo <= 0.0; };
   const double end = std::isinf(hi) ? expand_until(lo, flipped) : hi;
   if (std::isinf(end) || !flipped(end)) return kNaN;
@@ -276,40 +284,54 @@ double oscillating_plane_event_time(const NormalMotion& m, const OscillatingPlan
       m, bounds, [&](double t) { return oscillating_gap(m, p, p0, transient, w0, t); }, t_max);
 }
 
+namespace {
+
+// The event on the monotone piece [s, e] of f (e may be infinite), if f falls through zero
+// there: its time, else NaN.
+double event_on_piece(const Quartic& q, double s, double e) {
+  if (!(e > s)) return kNaN;
+  const double probe = std::isinf(e) ? 2.0 * s + 1.0 : s + 0.5 * (e - s);
+  if (!(q.df(probe) < 0.0)) return kNaN;  // only a falling piece can hold the event
+  if (q.f(s) <= 0.0) return s;            // overlapping when f' turns negative (or at t = 0)
+  const auto below = [&](double t) { return q.f(t) < 0.0 || (q.f(t) == 0.0 && q.df(t) < 0.0); };
+  const double end = std::isinf(e) ? expand_until(s, below) : e;
+  if (std::isinf(end) || !below(end)) return kNaN;  // stays positive, or only touches at e
+  return polish_root([&](double t) { return std::pair{q.f(t), q.df(t)}; }, s, end);
+}
+
+}  // namespace
+
 double quartic_event_time(const std::array<double, 5>& c, double t_max) {
   if (c[4] == 0.0 && c[3] == 0.0) {
     return within_horizon(quadratic_event_time(c[0], c[1], c[2]), t_max);
   }
   if (c[0] <= 0.0 && c[1] < 0.0) return within_horizon(0.0, t_max);  // overlapping, approaching
   const Quartic q{c};
-  // Split [0, t_max] where f'' vanishes (f' is monotone between), then where f' vanishes, so
-  // that f is monotone on every piece. Extra split points are harmless.
-  SplitPoints pts;
-  pts.insert(0.0);
+  // Split the half-line where f'' vanishes (f' is monotone between), then each such segment
+  // where f' vanishes, so that f is monotone on every piece, and walk the pieces in time order.
+  // The pieces are never cut at the horizon, which only ends the walk: the brackets, and so
+  // the polished root to its last bit, do not depend on it. A candidate loop passes its running
+  // best as the horizon, which depends on the order of its candidates (and that order on the
+  // CPU's gather): cut pieces gave runs that differed in the last bits from one CPU to another.
+  SplitPoints mono;
+  mono.insert(0.0);
   double r2[2];
   const int n2 = real_quadratic_roots(12.0 * c[4], 6.0 * c[3], 2.0 * c[2], r2);
   for (int i = 0; i < n2; ++i) {
-    if (r2[i] > 0.0 && r2[i] < t_max) pts.insert(r2[i]);
+    if (r2[i] > 0.0 && std::isfinite(r2[i])) mono.insert(r2[i]);
   }
-  const SplitPoints mono = pts;
   for (int i = 0; i < mono.n; ++i) {
-    const double r = slope_root(q, mono[i], i + 1 < mono.n ? mono[i + 1] : t_max);
-    if (r == r) pts.insert(r);  // not NaN
-  }
-  pts.insert(t_max);
-
-  // Walk the monotone pieces in time order; only a falling piece can hold the event.
-  for (int i = 0; i + 1 < pts.n; ++i) {
-    const double s = pts[i];
-    const double e = pts[i + 1];
-    if (!(e > s)) continue;
-    const double probe = std::isinf(e) ? 2.0 * s + 1.0 : s + 0.5 * (e - s);
-    if (!(q.df(probe) < 0.0)) continue;
-    if (q.f(s) <= 0.0) return s;  // overlapping when f' turns negative (or at t = 0)
-    const auto below = [&](double t) { return q.f(t) < 0.0 || (q.f(t) == 0.0 && q.df(t) < 0.0); };
-    const double end = std::isinf(e) ? expand_until(s, below) : e;
-    if (std::isinf(end) || !below(end)) continue;  // stays positive, or only touches at e
-    return polish_root([&](double t) { return std::pair{q.f(t), q.df(t)}; }, s, end);
+    const double lo = mono[i];
+    const double hi = i + 1 < mono.n ? mono[i + 1] : kNever;
+    if (lo > t_max) return kNever;
+    const double r = slope_root(q, lo, hi);
+    const bool split = r == r && r > lo && r < hi;  // not NaN, inside
+    double t = event_on_piece(q, lo, split ? r : hi);
+    if (t != t && split) {
+      if (r > t_max) return kNever;
+      t = event_on_piece(q, r, hi);
+    }
+    if (t == t) return within_horizon(t, t_max);
   }
   return kNever;
 }

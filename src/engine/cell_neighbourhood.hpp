@@ -60,7 +60,7 @@ class CellNeighbourhood {
 
   CellNeighbourhood() = default;
   // vector_gather: gather the lists' heads sixteen at a time with AVX-512 (gather_lists_avx512)
-  // instead of walking them one by one; the same candidates, in another order.
+  // instead of walking them one by one; the same candidates in the same order (walk_lists).
   CellNeighbourhood(const CellGrid<D>& grid, bool vector_gather)
       : grid_(grid), vector_gather_(vector_gather) {
     for (CandidateList<D>& list : lists_) size_list(list);
@@ -260,10 +260,14 @@ inline void CellNeighbourhood<D>::gather_cells(CellCode cell, const std::uint8_t
   }
 }
 
-// The members of the lists of cells[0 .. count), in list order, as candidates (with their
-// cells' shift numbers tags[] when kTagged). The first three links of every list are loaded in
-// three waves of independent loads (heads, second members, third links), not in a chain per
-// cell, so that each wave's cache misses overlap; only crowded cells follow links further.
+// The members of the lists of cells[0 .. count) as candidates (with their cells' shift numbers
+// tags[] when kTagged): every list's head, then every list's second member, then the rest list
+// by list, which is the order gather_lists_avx512 writes. Both walks must list the candidates in
+// one order: the candidate loops give a tie between two event times (two contacts due at once,
+// common in dense granular matter) to the one listed first, so a different order made runs
+// differ between CPUs. The first three links of every list are loaded in three waves of
+// independent loads (heads, second members, third links), not in a chain per cell, so that each
+// wave's cache misses overlap; only crowded cells follow links further.
 template <int D>
 template <bool kTagged>
 void CellNeighbourhood<D>::walk_lists(const std::uint32_t* cells, const std::uint32_t* tags,
@@ -290,23 +294,25 @@ void CellNeighbourhood<D>::walk_lists(const std::uint32_t* cells, const std::uin
       cand = grow(list);
       cap = static_cast<std::uint32_t>(list.ids.size());
     }
+  for (const std::uint32_t* wave : {first, second}) {
+    for (int c = 0; c < count; ++c) {
+      __builtin_prefetch(links.hot + wave[c]);
+      cand[n] = wave[c];
+      if constexpr (kTagged) list.shift[n] = tags[c];
+      n += wave[c] != end ? 1u : 0u;
+    }
+  }
   for (int c = 0; c < count; ++c) {
-    const std::uint32_t from = n;
-    __builtin_prefetch(links.hot + first[c]);
-    cand[n] = first[c];
-    n += first[c] != end ? 1u : 0u;
-    __builtin_prefetch(links.hot + second[c]);
-    cand[n] = second[c];
-    n += second[c] != end ? 1u : 0u;
     if (third[c] != end) [[unlikely]] {  // a crowded cell: the rest by links
-      append_members(third[c], links, list, n, cand, cap);
-      while (cap - n < room(count - c - 1)) {
+      while (cap - n < room(1)) {
         cand = grow(list);
         cap = static_cast<std::uint32_t>(list.ids.size());
       }
-    }
-    if constexpr (kTagged) {
-      for (std::uint32_t k = from; k < n; ++k) list.shift[k] = tags[c];
+      const std::uint32_t from = n;
+      append_members(third[c], links, list, n, cand, cap);
+      if constexpr (kTagged) {
+        for (std::uint32_t k = from; k < n; ++k) list.shift[k] = tags[c];
+      }
     }
   }
   list.count = n;

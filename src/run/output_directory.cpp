@@ -42,7 +42,7 @@ struct RecordedId {
 std::vector<RecordedId> recorded_run_ids(const fs::path& dir, const fs::path& restart_file) {
   std::vector<RecordedId> out;
   std::error_code ec;
-  const fs::path restart = dir / "restart.gsd";
+  const fs::path restart = dir / kRestartFileName;
   // The restart file continued is no evidence of what the directory holds (it may have been
   // copied there).
   if (fs::exists(restart, ec) && !fs::equivalent(restart, restart_file, ec)) {
@@ -57,9 +57,9 @@ std::vector<RecordedId> recorded_run_ids(const fs::path& dir, const fs::path& re
     } catch (const std::exception&) {
       id.clear();  // unreadable: no evidence either way
     }
-    out.push_back({"restart.gsd", id});
+    out.push_back({std::string(kRestartFileName), id});
   }
-  const fs::path summary = dir / "summary.json";
+  const fs::path summary = dir / kSummaryFileName;
   if (fs::exists(summary, ec)) {
     std::string id;
     try {
@@ -69,7 +69,7 @@ std::vector<RecordedId> recorded_run_ids(const fs::path& dir, const fs::path& re
     } catch (const std::exception&) {
       id.clear();
     }
-    out.push_back({"summary.json", id});
+    out.push_back({std::string(kSummaryFileName), id});
   }
   return out;
 }
@@ -165,14 +165,15 @@ OutputDirectory::OutputDirectory(const fs::path& dir,
     return;
   }
   if (!overwrite) {
-    const bool restartable = fs::exists(dir / "restart.gsd", ec);
+    const bool restartable = fs::exists(dir / kRestartFileName, ec);
     release();
     throw InputError(fmt::format(
         "output.directory '{}' holds the outputs of an earlier run ({}): {}write this run to "
         "another directory (-o), or pass --overwrite to replace them",
         dir.string(), found,
-        restartable ? fmt::format("continue it with --restart {}, ", (dir / "restart.gsd").string())
-                    : ""));
+        restartable
+            ? fmt::format("continue it with --restart {}, ", (dir / kRestartFileName).string())
+            : ""));
   }
   remove_outputs();
 }

@@ -14,10 +14,18 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "run/run_progress.hpp"
 
 namespace kairos {
+
+// The two files of a run directory that are read by more than their writers: the directory's
+// guard reads the lineage from them, the sweep reads them to tell a finished run from one to
+// continue. Their writers (run/outputs/restart_output.hpp, run/outputs/run_summary.hpp) declare
+// them from here.
+inline constexpr std::string_view kRestartFileName = "restart.gsd";
+inline constexpr std::string_view kSummaryFileName = "summary.json";
 
 // A run continued from a restart file (--restart).
 struct RestartLineage {

@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "run/output_directory.hpp"
 
 namespace kairos {
 namespace {
@@ -103,8 +104,8 @@ const char* state_name(SweepRunState state) {
 SweepRunRecord read_sweep_run(const fs::path& dir) {
   SweepRunRecord r;
   std::error_code ec;
-  r.has_restart = fs::is_regular_file(dir / "restart.gsd", ec);
-  const fs::path summary = dir / "summary.json";
+  r.has_restart = fs::is_regular_file(dir / kRestartFileName, ec);
+  const fs::path summary = dir / kSummaryFileName;
   if (fs::is_regular_file(summary, ec)) {
     std::ifstream in(summary);
     r.summary = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);

@@ -18,6 +18,7 @@
 #include "core/error.hpp"
 #include "core/stop_flag.hpp"
 #include "io/progress.hpp"
+#include "run/output_directory.hpp"
 #include "run/provenance.hpp"
 #include "sweep/sweep_results.hpp"
 
@@ -152,7 +153,7 @@ SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOp
     const bool resume = record.has_restart && record.state == SweepRunState::kStopped;
     if (resume) {
       args.push_back("--restart");
-      args.push_back((dir / "restart.gsd").string());
+      args.push_back((dir / kRestartFileName).string());
     } else if (holds_outputs(dir)) {
       args.push_back("--overwrite");  // a failed or killed attempt's outputs
     }

@@ -4,6 +4,7 @@
 // moving between cells, and the component's own check.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -130,6 +131,34 @@ void expect_same(const std::map<std::uint32_t, Vec<D>>& got,
   }
 }
 
+// The one order both walks list candidates in (engine/cell_neighbourhood.hpp, walk_lists):
+// the head of each cell's list (cells in `which` order), then each list's second member, then
+// the rest list by list. Candidate loops give a tie to the candidate listed first, so an order
+// of its own in one walk would make runs differ between CPUs.
+template <int D>
+std::vector<std::uint32_t> walk_order(const CellGrid<D>& grid, CellCode cell,
+                                      const std::uint8_t* which, int count) {
+  std::vector<std::vector<std::uint32_t>> members(static_cast<std::size_t>(count));
+  for (int c = 0; c < count; ++c)
+    for (std::uint32_t p = grid.first(grid.neighbour(cell, which[c]).cell); p != grid.end();
+         p = grid.next(p))
+      members[c].push_back(p);
+  std::vector<std::uint32_t> order;
+  for (const std::size_t rank : {0u, 1u})
+    for (const auto& m : members)
+      if (m.size() > rank) order.push_back(m[rank]);
+  for (const auto& m : members)
+    order.insert(order.end(), m.begin() + std::min<std::size_t>(2, m.size()), m.end());
+  return order;
+}
+
+template <int D>
+void expect_walk_order(const CandidateList<D>& list, const std::vector<std::uint32_t>& order,
+                       CellCode cell) {
+  const std::vector<std::uint32_t> got(list.ids.begin(), list.ids.begin() + list.count);
+  EXPECT_EQ(got, order) << "cell " << cell;
+}
+
 // Every cell of a grid (interior, faces, edges, corners) gathers by brute force's rule.
 template <int D>
 void every_cell_gathers_by_brute_force(const Vec<D>& box, const std::array<bool, D>& periodic,
@@ -154,6 +183,10 @@ void every_cell_gathers_by_brute_force(const Vec<D>& box, const std::array<bool,
     cells.gather(cell, list, hot.data());
     const auto want = expected_candidates(grid, box, hot, cell, all);
     expect_same<D>(listed(list), want, cell);
+    expect_walk_order<D>(list,
+                         walk_order(cells.grid(), cell, CellNeighbourhood<D>::kAllNeighbours.data(),
+                                    CellGrid<D>::kNeighbourCells),
+                         cell);
     for (const auto& [j, shift] : want)
       for (int a = 0; a < D; ++a) shifted += shift[a] != 0.0;
   }
@@ -202,6 +235,10 @@ TEST(CellNeighbourhood, ALayerGathersOnlyTheCellsOneStepAlongAnAxis) {
           const auto want = expected_candidates(
               grid, box, hot, cell, [&](const std::array<int, 3>& d) { return d[axis] == sign; });
           expect_same<3>(listed(list), want, cell);
+          expect_walk_order<3>(
+              list,
+              walk_order(cells.grid(), cell, grid.layer(axis, sign), CellGrid<3>::kLayerCells),
+              cell);
         }
       }
     }

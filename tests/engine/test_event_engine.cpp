@@ -95,8 +95,8 @@ TEST(EventEngine, VectorAndScalarCandidateLoopsGiveBitIdenticalRuns) {
   expect_vector_and_scalar_loops_agree(testing::lattice_system<3>(3, 0.45, 23), 50000);
 }
 
-// The AVX-512 list gather lists the same candidates as the scalar walk, in another order
-// (which could only decide exact ties): the runs agree bit for bit.
+// The AVX-512 list gather lists the same candidates as the scalar walk, in the same order (an
+// order that differed decided exact ties differently): the lists and the runs agree bit for bit.
 template <int D>
 void expect_list_walks_agree(const ParticleSystem<D>& start, int events) {
   EngineOptions scalar, vector;

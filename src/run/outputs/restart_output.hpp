@@ -7,6 +7,7 @@
 #include <string>
 #include <string_view>
 
+#include "run/output_directory.hpp"
 #include "run/outputs/observer.hpp"
 
 namespace kairos {
@@ -14,7 +15,7 @@ namespace kairos {
 template <int D>
 class RestartOutput final : public Observer<D> {
  public:
-  static constexpr std::array<std::string_view, 1> kFiles{"restart.gsd"};
+  static constexpr std::array<std::string_view, 1> kFiles{kRestartFileName};
   std::string name() const override { return std::string(kFiles[0]); }
   // Default 0: at the end only.
   double interval(const Config& config, double) const override {

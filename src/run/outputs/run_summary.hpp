@@ -7,6 +7,7 @@
 #include <string>
 #include <string_view>
 
+#include "run/output_directory.hpp"
 #include "run/outputs/observer.hpp"
 
 namespace kairos {
@@ -15,7 +16,7 @@ template <int D>
 class RunSummary final : public Observer<D> {
  public:
   // summary.json, which the run driver writes from every observer's summarize().
-  static constexpr std::array<std::string_view, 1> kFiles{"summary.json"};
+  static constexpr std::array<std::string_view, 1> kFiles{kSummaryFileName};
   std::string name() const override { return std::string(kFiles[0]); }
   bool writes_file() const override { return false; }
   void open(const RunContext<D>& run) override { momentum_start_ = run.integrator().momentum(); }
