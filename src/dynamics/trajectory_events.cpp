@@ -178,15 +178,18 @@ int real_quadratic_roots(double a, double b, double c, double roots[2]) {
 
 // First point where g, decreasing through zero on [lo, hi] (g(lo) > 0 >= g(hi)), reaches zero:
 // Newton steps, with bisection whenever Newton leaves the bracket or stops halving its step.
-// Fn returns {g(x), g'(x)}.
+// Fn returns {g(x), g'(x)}. The result always lies above the bracket's lower end, which only
+// rises: once that end passes `beyond`, so will the result, and kNever is returned at once
+// (the same iterates up to there, so a result at or before `beyond` is the one without it).
 template <class Fn>
-double polish_root(Fn g, double lo, double hi) {
+double polish_root(Fn g, double lo, double hi, double beyond = kNever) {
   double x = lo + 0.5 * (hi - lo);
   double step = hi - lo;
   for (int i = 0; i < 256; ++i) {
     const auto [gx, dgx] = g(x);
     if (gx == 0.0) return x;
     (gx > 0.0 ? lo : hi) = x;
+    if (lo > beyond) return kNever;
     const double prev_step = step;
     step = gx / dgx;
     double next = x - step;
@@ -287,8 +290,8 @@ double oscillating_plane_event_time(const NormalMotion& m, const OscillatingPlan
 namespace {
 
 // The event on the monotone piece [s, e] of f (e may be infinite), if f falls through zero
-// there: its time, else NaN.
-double event_on_piece(const Quartic& q, double s, double e) {
+// there: its time (kNever once it is known to come after t_max), else NaN.
+double event_on_piece(const Quartic& q, double s, double e, double t_max) {
   if (!(e > s)) return kNaN;
   const double probe = std::isinf(e) ? 2.0 * s + 1.0 : s + 0.5 * (e - s);
   if (!(q.df(probe) < 0.0)) return kNaN;  // only a falling piece can hold the event
@@ -296,7 +299,7 @@ double event_on_piece(const Quartic& q, double s, double e) {
   const auto below = [&](double t) { return q.f(t) < 0.0 || (q.f(t) == 0.0 && q.df(t) < 0.0); };
   const double end = std::isinf(e) ? expand_until(s, below) : e;
   if (std::isinf(end) || !below(end)) return kNaN;  // stays positive, or only touches at e
-  return polish_root([&](double t) { return std::pair{q.f(t), q.df(t)}; }, s, end);
+  return polish_root([&](double t) { return std::pair{q.f(t), q.df(t)}; }, s, end, t_max);
 }
 
 }  // namespace
@@ -324,12 +327,16 @@ double quartic_event_time(const std::array<double, 5>& c, double t_max) {
     const double lo = mono[i];
     const double hi = i + 1 < mono.n ? mono[i + 1] : kNever;
     if (lo > t_max) return kNever;
+    // f rising up to the horizon on this segment (f' >= 0 at its start and > 0 at the horizon,
+    // f' monotone): no event before the horizon, the same answer as the walk, without the search
+    // for f''s root beyond it.
+    if (t_max < hi && q.df(lo) >= 0.0 && q.df(t_max) > 0.0) return kNever;
     const double r = slope_root(q, lo, hi);
     const bool split = r == r && r > lo && r < hi;  // not NaN, inside
-    double t = event_on_piece(q, lo, split ? r : hi);
+    double t = event_on_piece(q, lo, split ? r : hi, t_max);
     if (t != t && split) {
       if (r > t_max) return kNever;
-      t = event_on_piece(q, r, hi);
+      t = event_on_piece(q, r, hi, t_max);
     }
     if (t == t) return within_horizon(t, t_max);
   }

@@ -247,13 +247,12 @@ class Sweep(kt.KairosTestCase):
     def test_runs_cut_by_a_wall_time_limit_finish_over_several_invocations(self):
         # run.max_wall_seconds cuts each run (a cluster job's time slice); each invocation of the
         # same command continues them, and the last leaves what one uninterrupted run leaves.
-        # Each run takes several slices of 0.3 s even on a fast machine (about 2.4 million
-        # collisions: 1.5 s at 1.6 million a second; with 300 per particle a fast machine
-        # finished in two slices).
-        config = self.config(particles=2000, production=1200.0)
+        # Slices of 0.1 s: each run (0.6 million collisions) takes several even on a fast
+        # machine (slices of 0.3 s let one finish in two).
+        config = self.config(particles=2000, production=300.0)
         sweep = self.path("sweep")
         args = [config, "-o", sweep, "--vary", "system.seed=3..4", "--workers", "2",
-                "--set", "run.max_wall_seconds=%g" % (0.3 * kt.SLOWDOWN)]
+                "--set", "run.max_wall_seconds=%g" % (0.1 * kt.SLOWDOWN)]
         invocations = 0
         while True:
             invocations += 1
