@@ -23,9 +23,9 @@
 
 #include <fmt/format.h>
 
-#include "model/environment.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
+#include "model/environment.hpp"
 #include "scheduler/calendar_queue.hpp"
 
 namespace kairos::bench {

@@ -41,13 +41,13 @@
 #include <fmt/format.h>
 
 #include "analysis/granular_theory.hpp"
-#include "model/environment.hpp"
 #include "core/periodic.hpp"
 #include "dem/dem_integrator.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
 #include "interactions/soft_contact.hpp"
 #include "io/atomic_file.hpp"
+#include "model/environment.hpp"
 #include "run/soft_tables_setup.hpp"
 #include "scheduler/calendar_queue.hpp"
 

@@ -30,11 +30,11 @@
 #include <fmt/format.h>
 
 #include "analysis/granular_theory.hpp"
-#include "model/environment.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
 #include "interactions/potential_spec.hpp"
 #include "interactions/soft_contact.hpp"
+#include "model/environment.hpp"
 #include "run/soft_tables_setup.hpp"
 #include "scheduler/calendar_queue.hpp"
 

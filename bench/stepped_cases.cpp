@@ -31,10 +31,10 @@
 
 #include <fmt/format.h>
 
-#include "model/environment.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
 #include "interactions/potential_spec.hpp"
+#include "model/environment.hpp"
 #include "scheduler/calendar_queue.hpp"
 
 namespace kairos::bench {

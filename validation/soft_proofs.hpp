@@ -26,13 +26,13 @@
 #include <stdexcept>
 #include <vector>
 
-#include "model/environment.hpp"
 #include "core/particle_system.hpp"
 #include "dem/dem_integrator.hpp"
 #include "engine/event_engine.hpp"
 #include "init/initial_state.hpp"
 #include "interactions/soft_contact.hpp"
 #include "io/config.hpp"
+#include "model/environment.hpp"
 #include "run/soft_tables_setup.hpp"
 #include "scheduler/calendar_queue.hpp"
 
