@@ -206,7 +206,7 @@ double polish_root(Fn g, double lo, double hi, double beyond = kNever) {
 
 // A short sorted list of split points in time.
 struct SplitPoints {
-  std::array<double, 8> t{};  // 0, two roots of f'', three of f', the horizon
+  std::array<double, 3> t{};  // 0 and the two roots of f
   int n = 0;
   void insert(double x) {
     int k = n++;

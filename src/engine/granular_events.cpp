@@ -469,11 +469,11 @@ namespace {
 // against the rounding of both sides) rules out a contact before the horizon. Exact for the
 // scan: a rejected pair's quartic would have found no event before the horizon either, so the
 // scan picks the same partner and time (and stays independent of its candidates' order).
+// `accel`: |a|, the same for every pair of a scan (|g| or 0), taken once by the caller.
 template <int D>
-bool out_of_reach(const Vec<D>& r, const Vec<D>& g, const Vec<D>& a, double sigma, double horizon) {
+bool out_of_reach(const Vec<D>& r, const Vec<D>& g, double accel, double sigma, double horizon) {
   if (!(horizon < kNever)) return false;
-  const double reach =
-      sigma + horizon * (std::sqrt(dot(g, g)) + 0.5 * horizon * std::sqrt(dot(a, a)));
+  const double reach = sigma + horizon * (std::sqrt(dot(g, g)) + 0.5 * horizon * accel);
   return dot(r, r) > reach * reach * (1.0 + 1e-9);
 }
 
@@ -487,6 +487,7 @@ std::uint32_t EventEngine<D, Queue>::scan_with_sleepers(const CandidateList& lis
                                                         double t, double& best) const {
   const Vec<D> xi = position(i, t), vi = velocity(i, t);
   const bool si = is_asleep(i);
+  const double gravity = std::sqrt(dot(env_.gravity, env_.gravity));
   std::uint32_t found = kNoPartner;
   for (std::uint32_t k = 0; k < list.count; ++k) {
     const std::uint32_t j = list.ids[k];
@@ -498,7 +499,7 @@ std::uint32_t EventEngine<D, Queue>::scan_with_sleepers(const CandidateList& lis
     // Relative acceleration: gravity acts on the awake one of a mixed pair.
     const Vec<D> accel = sj ? env_.gravity : (si ? -1.0 * env_.gravity : Vec<D>{});
     const double sigma = radius_of(i) + radius_of(j);
-    if (out_of_reach<D>(r, g, accel, sigma, best)) continue;
+    if (out_of_reach<D>(r, g, sj || si ? gravity : 0.0, sigma, best)) continue;
     const double dt =
         pair_contact_time_accelerated<D>(r.data(), g.data(), accel.data(), sigma, best);
     if (dt < best) {

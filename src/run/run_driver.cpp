@@ -13,16 +13,16 @@
 #include "core/stop_flag.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config_choices.hpp"
+#include "run/output_directory.hpp"
 #include "run/outputs/msd_output.hpp"
-#include "run/outputs/run_summary.hpp"
 #include "run/setup_chain.hpp"
 
 namespace kairos {
 
 namespace {
 
-// The file the driver writes from every observer's summarize() (run_summary.hpp names it).
-const std::string kSummaryFile(RunSummary<3>::kFiles[0]);
+// The file the driver writes from every observer's summarize().
+const std::string kSummaryFile(kSummaryFileName);
 
 namespace fs = std::filesystem;
 
