@@ -781,10 +781,52 @@ class PySimulation {
     });
   }
 
+  // Z and P over `duration` of simulated time from now, rows every `interval` (None: a 64th
+  // of the duration) for the blocked error, as summary.json's compressibility and pressure.
+  py::dict pressure(const py::object& duration_arg, const py::object& interval_arg) {
+    CorrelationRequest request;
+    request.duration = positive_from(duration_arg, "pressure: duration");
+    request.interval = interval_arg.is_none() ? request.duration / 64.0
+                                              : positive_from(interval_arg, "pressure: interval");
+    if (request.interval > request.duration) {
+      throw InputError(fmt::format(
+          "pressure: interval ({}) must not exceed the duration ({}): the error needs rows",
+          request.interval, request.duration));
+    }
+    return visit([&](auto& s) {
+      const PressureMeasurement m =
+          advancing([&] { return measure_pressure(s, request, python_keeps_going); });
+      py::dict out;
+      out["Z"] = m.compressibility.mean;
+      out["Z_stderr"] = m.compressibility.stderr_;
+      out["Z_stderr_reliable"] = m.undefined.empty() && m.compressibility.reliable;
+      out["pressure"] = m.pressure;
+      out["pressure_stderr"] = m.pressure_stderr;
+      out["temperature"] = m.temperature;
+      out["rows"] = m.compressibility.samples;
+      out["interval"] = request.interval;
+      out["start_time"] = m.span.start_time;
+      out["end_time"] = m.span.end_time;
+      out["collisions"] = m.span.collisions;
+      out["mean_free_time"] = m.span.mean_free_time;
+      out["completed"] = m.span.completed;
+      out["why"] = m.undefined.empty() ? py::object(py::none()) : py::object(py::str(m.undefined));
+      return out;
+    });
+  }
+
+  double virial() const {
+    return visit([](const auto& s) { return s.virial(); });
+  }
+  std::string integrator() const {
+    return visit([](const auto& s) { return std::string(s.integrator().name()); });
+  }
+
   std::string repr() const {
     return visit([](const auto& s) {
-      return fmt::format("<kairos.Simulation: {} particles in {}D, t = {:.6g}, {} collisions>",
-                         s.size(), dimension_of(s), s.time(), s.collisions());
+      return fmt::format("<kairos.Simulation ({}): {} particles in {}D, t = {:.6g}, {} collisions>",
+                         s.integrator().name(), s.size(), dimension_of(s), s.time(),
+                         s.collisions());
     });
   }
   void save(const fs::path& path) const {
@@ -1175,6 +1217,14 @@ PYBIND11_MODULE(kairos, m) {
       .def_property_readonly("time", &PySimulation::time)
       .def_property_readonly("events", &PySimulation::events)
       .def_property_readonly("collisions", &PySimulation::collisions)
+      .def_property_readonly("virial", &PySimulation::virial,
+                             "The collisional virial W = sum r_ij . J_ij since the state's start "
+                             "(the DEM: the time integral of sum r_ij . F_ij).")
+      .def_property_readonly("integrator", &PySimulation::integrator, "\"event\" or \"dem\".")
+      .def("pressure", &PySimulation::pressure, py::arg("duration"),
+           py::arg("interval") = py::none(),
+           "Advances by duration; Z and the pressure over it as summary.json gives them, with "
+           "the blocked error over rows interval apart (None: a 64th of the duration).")
       .def("__len__", &PySimulation::size)
       .def("kinetic_energy", &PySimulation::kinetic_energy)
       .def("temperature", &PySimulation::temperature,

@@ -67,6 +67,12 @@ Advance DemAdapter<D>::advance(const AdvanceLimits& limits) {
   long n = chunk_;
   if (limits.phase_in_time) n = std::min(n, steps_to(limits.phase_end_time));
   n = std::min(n, steps_to(limits.next_output_time));
+  // A count of events (an in-memory Simulation advancing by time steps): up to it, and never
+  // stopped for rest (steps always happen). The run driver never sets it.
+  const bool by_events = limits.events != AdvanceLimits{}.events;
+  if (by_events && limits.events > events())
+    n = std::min<long>(n, static_cast<long>(std::min<std::uint64_t>(
+                              limits.events - events(), static_cast<std::uint64_t>(chunk_))));
   const std::uint64_t before = dem_.collisions(), wall_before = dem_.wall_collisions();
   // A step the DEM cannot take (a pair overlapping by more than half its smaller radius: the
   // time step far too large) throws InputError out of the run: its state is no longer one to
@@ -78,14 +84,15 @@ Advance DemAdapter<D>::advance(const AdvanceLimits& limits) {
   Advance result;
   // A length in collisions would never end once nothing moves or meets any more; a length in
   // time does.
-  if (!limits.phase_in_time && c == before && dem_.contact_count() == 0 && ke == 0.0) {
+  const bool counts_collisions = !limits.phase_in_time && !by_events;
+  if (counts_collisions && c == before && dem_.contact_count() == 0 && ke == 0.0) {
     result.stop = AdvanceStop::kNoMoreEvents;  // everything at rest and apart
     return result;
   }
   // A settled packing (under gravity, between walls) meets no new contacts: the collision
   // target would never come. At rest: no contact began in this chunk and the kinetic energy
   // fell below 1e-12 of its peak.
-  if (!limits.phase_in_time && c == before && dem_.wall_collisions() == wall_before &&
+  if (counts_collisions && c == before && dem_.wall_collisions() == wall_before &&
       ke <= 1e-12 * ke_peak_) {
     result.stop = AdvanceStop::kAtRest;
     return result;

@@ -32,8 +32,8 @@ struct AdvanceLimits {
   // Return once the collision count has reached this (the phase's target, the next output due
   // in collisions).
   std::uint64_t collisions = ~std::uint64_t{0};
-  // Return once the event count has reached this (the event integrator: an in-memory
-  // Simulation advancing by events; the DEM has no events and ignores it).
+  // Return once the event count has reached this (an in-memory Simulation advancing by events;
+  // the DEM's events are its time steps).
   std::uint64_t events = ~std::uint64_t{0};
   // The soonest output due in simulated time (infinity: none).
   double next_output_time = kNoTime;

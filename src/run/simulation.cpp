@@ -14,6 +14,7 @@
 #include "init/initial_state.hpp"
 #include "io/config_choices.hpp"
 #include "io/config_obstacles.hpp"
+#include "run/dem_adapter.hpp"
 #include "run/event_adapter.hpp"
 #include "run/output_directory.hpp"
 #include "run/setup_chain.hpp"
@@ -27,13 +28,13 @@ Simulation<D>::Simulation(const Config& config,
                           const std::optional<std::filesystem::path>& restart_file,
                           const EngineTracking& tracking)
     : config_(config), tracking_(tracking) {
-  if (integrators().at(config.run.integrator) != IntegratorKind::kEvent) {
-    throw InputError(fmt::format(
-        "run.integrator = \"{}\": an in-memory simulation drives the event integrator; run the "
-        "DEM with `kairos run` (kairos.run in Python)",
-        config.run.integrator));
+  const bool dem = integrators().at(config.run.integrator) == IntegratorKind::kDem;
+  if (dem && tracking.helfand) {
+    throw InputError(
+        "the Helfand moments (helfand=True): the event integrator only, not run.integrator = "
+        "\"dem\" (as analysis.transport)");
   }
-  RunStart<D> start = start_run<D>(config, restart_file, "event");
+  RunStart<D> start = start_run<D>(config, restart_file, dem ? "dem" : "event");
   config_ = start.config;
   if (tracking.helfand) {
     if (const std::optional<TransportObstacle> obstacle = transport_obstacle(config_)) {
@@ -51,10 +52,17 @@ Simulation<D>::Simulation(const Config& config,
   for (std::size_t i = 0; i < n_; ++i) radius_[i] = start.state.kinematics[i].radius;
   species_ = start.state.species;
   species_names_ = start.state.species_names;
-  // The tables `kairos run` would use (the same speeds covered: the same maps, bit for bit).
-  engine_ = start_event_engine<D, CalendarQueue>(std::move(start), {}, tracking);
-  const std::vector<SoftTableUse>& tables = engine_->tables();
-  if (!tables.empty()) progress_.soft_table_max_speed = tables.front().spec.max_normal_speed;
+  if (dem) {
+    integrator_ = start_integrator<D>(std::move(start));
+    dem_ = integrator_->as_dem();
+  } else {
+    // The tables `kairos run` would use (the same speeds covered: the same maps, bit for bit).
+    auto engine = start_event_engine<D, CalendarQueue>(std::move(start), {}, tracking);
+    engine_ = engine.get();
+    integrator_ = std::move(engine);
+    const std::vector<SoftTableUse>& tables = engine_->tables();
+    if (!tables.empty()) progress_.soft_table_max_speed = tables.front().spec.max_normal_speed;
+  }
   progress_.config = to_toml(config_);
   progress_.run_id = lineage_run_id(restart_file, progress_);
   if (plan) print_restart_note(*plan, restart_file->string());
@@ -66,6 +74,20 @@ Simulation<D>::Simulation(const Config& config,
 template <int D>
 Simulation<D>::~Simulation() = default;
 
+template <int D>
+EventEngineAdapter<D, CalendarQueue>& Simulation<D>::event_engine(const char* what) const {
+  if (engine_ == nullptr) {
+    throw InputError(fmt::format(
+        "{}: the event integrator only, not run.integrator = \"dem\" (docs/python.md)", what));
+  }
+  return *engine_;
+}
+
+template <int D>
+const EventIntegrator<D>& Simulation<D>::event_integrator(const char* what) const {
+  return event_engine(what);
+}
+
 // The run driver's loop (EventEngineAdapter::advance, as `kairos run` advances), with the
 // Simulation's stop rules: an event, a state or a frozen clock that cannot go on is the
 // caller's InputError; keep_going is asked at the adapter's polls (every 16 384 events).
@@ -73,7 +95,7 @@ template <int D>
 bool Simulation<D>::advance_within(const AdvanceLimits& limits, const std::function<bool()>& done,
                                    const KeepGoing& keep_going) {
   while (!done()) {
-    const Advance a = engine_->advance(limits);
+    const Advance a = integrator_->advance(limits);
     switch (a.stop) {
       case AdvanceStop::kNone:
         break;
@@ -91,12 +113,11 @@ bool Simulation<D>::advance_within(const AdvanceLimits& limits, const std::funct
 
 template <int D>
 bool Simulation<D>::advance_to_time(double t, const KeepGoing& keep_going) {
-  EventEngine<D, CalendarQueue>& engine = engine_->engine();
-  if (!(t >= engine.time()) || !std::isfinite(t)) {
+  if (!(t >= time()) || !std::isfinite(t)) {
     throw InputError(
         fmt::format("advance to time {}: the simulation is at time {} already (or "
                     "the time is not finite)",
-                    t, engine.time()));
+                    t, time()));
   }
   // The clock stops at t, as at the end of a phase measured in time.
   AdvanceLimits limits;
@@ -104,6 +125,10 @@ bool Simulation<D>::advance_to_time(double t, const KeepGoing& keep_going) {
   limits.phase_end_time = t;
   limits.phase_in_time = true;
   limits.clock_stops = true;
+  if (engine_ == nullptr)
+    return advance_within(
+        limits, [&] { return integrator_->reached(t); }, keep_going);
+  EventEngine<D, CalendarQueue>& engine = engine_->engine();
   return advance_within(
       limits, [&] { return engine.time() == t && !(engine.next_event_time() <= t); }, keep_going);
 }
@@ -143,12 +168,14 @@ bool Simulation<D>::sample_every(double interval, double duration,
   // As the run driver's loop (run_driver.cpp run_phase) with one trigger in time.
   TimeTrigger trigger;
   trigger.step = interval;
-  trigger.next = trigger.after(time());
-  while (time() < end) {
+  // The clock triggers compare with (the DEM's within round-off of its step).
+  const auto now = [&] { return integrator_->trigger_time(); };
+  trigger.next = trigger.after(now());
+  while (!integrator_->reached(end)) {
     double stop = std::min(trigger.next, end);
     if (stop >= end - TimeTrigger::slack(end)) stop = end;
-    if (!advance_to_time(stop, keep_going)) return false;
-    if (trigger.due(time())) sample();
+    if (!advance_to_time(std::max(stop, time()), keep_going)) return false;
+    if (trigger.due(now())) sample();
   }
   return true;
 }
@@ -193,31 +220,37 @@ bool Simulation<D>::sample_every_events(std::uint64_t step, std::uint64_t count,
 
 template <int D>
 double Simulation<D>::time() const {
-  return engine_->engine().time();
+  return integrator_->time();
 }
 template <int D>
 std::uint64_t Simulation<D>::events() const {
-  return engine_->engine().counters().events;
+  return integrator_->events();
 }
 template <int D>
 std::uint64_t Simulation<D>::collisions() const {
-  return engine_->engine().counters().collisions;
+  return integrator_->collisions();
+}
+template <int D>
+double Simulation<D>::virial() const {
+  return integrator_->virial();
 }
 template <int D>
 const Vec<D>& Simulation<D>::box() const {
-  return engine_->engine().box();
+  return integrator_->box();
 }
 template <int D>
 std::vector<Vec<D>> Simulation<D>::positions() const {
+  if (engine_ == nullptr) return integrator_->particles().position;
   return engine_->engine().current_positions();
 }
 template <int D>
 std::vector<Vec<D>> Simulation<D>::velocities() const {
+  if (engine_ == nullptr) return integrator_->particles().velocity;
   return engine_->engine().current_velocities();
 }
 template <int D>
 void Simulation<D>::set_velocities(const std::vector<Vec<D>>& velocities) {
-  EventEngine<D, CalendarQueue>& engine = engine_->engine();
+  EventEngine<D, CalendarQueue>& engine = event_engine("set_velocities").engine();
   if (velocities.size() != n_) {
     throw InputError(
         fmt::format("set_velocities: {} velocities for {} particles", velocities.size(), n_));
@@ -252,7 +285,7 @@ std::vector<const SpeciesConfig*> Simulation<D>::config_species() const {
 
 template <int D>
 void Simulation<D>::check_state_can_change(const char* what) const {
-  const EventEngine<D, CalendarQueue>& engine = engine_->engine();
+  const EventEngine<D, CalendarQueue>& engine = event_engine(what).engine();
   if (engine.soft() || engine.sleeping() > 0 || engine.tracks_helfand()) {
     throw InputError(
         fmt::format("{}: not with soft spheres, sleeping particles or the Helfand moments kept "
@@ -305,7 +338,8 @@ void Simulation<D>::rebuild(const char* what,
   start.state = std::move(s);
   try {
     auto fresh = start_event_engine<D, CalendarQueue>(std::move(start), {}, tracking_);
-    engine_ = std::move(fresh);
+    engine_ = fresh.get();
+    integrator_ = std::move(fresh);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", what, e.what()));
   }
@@ -372,39 +406,41 @@ void Simulation<D>::set_species(const std::vector<std::uint32_t>& species) {
 
 template <int D>
 std::vector<WallReading> Simulation<D>::walls_with_mass() const {
-  return engine_->walls_with_mass();
+  return integrator_->walls_with_mass();
 }
 
 template <int D>
 double Simulation<D>::kinetic_energy() const {
-  return engine_->engine().kinetic_energy();
+  return integrator_->kinetic_energy();
 }
 template <int D>
 double Simulation<D>::temperature() const {
   // kT as thermo.tsv gives it (under shear: of the velocities relative to the flow).
-  const std::size_t moving = engine_->mobile();
-  return Thermodynamics(D, moving, engine_->volume(), moving < n_)
-      .temperature(engine_->thermal_energy(), engine_->held_degrees_of_freedom());
+  const std::size_t moving = integrator_->mobile();
+  return Thermodynamics(D, moving, integrator_->volume(), moving < n_)
+      .temperature(integrator_->thermal_energy(), integrator_->held_degrees_of_freedom());
 }
 template <int D>
 double Simulation<D>::potential_energy() const {
-  return engine_->engine().potential_energy();
+  return integrator_->potential_energy();
 }
 template <int D>
 ParticleSystem<D> Simulation<D>::state() const {
+  if (dem_ != nullptr) return dem_->dem().export_state();
   return engine_->engine().export_state();
 }
 template <int D>
 bool Simulation<D>::tracks_images() const {
-  return engine_->engine().tracks_images();
+  return engine_ != nullptr && engine_->engine().tracks_images();
 }
 template <int D>
 bool Simulation<D>::tracks_helfand() const {
-  return engine_->engine().tracks_helfand();
+  return engine_ != nullptr && engine_->engine().tracks_helfand();
 }
 
 template <int D>
 std::vector<Vec<D>> Simulation<D>::unwrapped_positions() const {
+  event_engine("unwrapped positions");
   if (!tracks_images()) {
     throw InputError(
         "unwrapped positions need image counters: this Simulation keeps none (created with "
@@ -424,6 +460,7 @@ std::vector<Vec<D>> Simulation<D>::unwrapped_positions() const {
 
 template <int D>
 std::vector<std::array<std::int32_t, D>> Simulation<D>::images() const {
+  event_engine("images");
   if (!tracks_images()) {
     throw InputError("images: this Simulation keeps no image counters (created with images=False)");
   }
@@ -451,6 +488,7 @@ std::vector<std::array<std::int32_t, D>> Simulation<D>::images() const {
 
 template <int D>
 typename HelfandMoments<D>::Moments Simulation<D>::helfand_moments() const {
+  event_engine("the Helfand moments");
   if (!tracks_helfand()) {
     throw InputError(
         "the Helfand moments are not kept: create the Simulation with helfand=True (a "
@@ -460,11 +498,7 @@ typename HelfandMoments<D>::Moments Simulation<D>::helfand_moments() const {
 }
 template <int D>
 const std::array<double, 9>& Simulation<D>::virial_tensor() const {
-  return engine_->engine().counters().virial_tensor;
-}
-template <int D>
-const EventIntegrator<D>& Simulation<D>::integrator() const {
-  return *engine_;
+  return event_engine("the virial tensor").engine().counters().virial_tensor;
 }
 
 template <int D>
@@ -483,17 +517,19 @@ void Simulation<D>::set_thermostat_temperature(double temperature) {
         "times system.temperature = {}",
         temperature, kT));
   }
-  engine_->set_driving_temperature(temperature);
+  event_engine("set_thermostat_temperature").set_driving_temperature(temperature);
   config_.driving.temperature = temperature;
   progress_.config = to_toml(config_);  // what save() stores: a restart continues at it
 }
 
 template <int D>
 void Simulation<D>::save(const std::filesystem::path& path) const {
-  // The driving's next kick time, as `kairos run` records it before its restart file.
+  // The driving's next kick time, as `kairos run` records it before its restart file; the
+  // DEM's time step and marks where it stands (no phase target: a saved state continues with
+  // production from here).
   RunProgress progress = progress_;
-  engine_->record(progress, 0, 0.0);
-  engine_->write_restart(path, progress);
+  integrator_->record(progress, ~std::uint64_t{0}, std::numeric_limits<double>::infinity());
+  integrator_->write_restart(path, progress);
 }
 
 template class Simulation<2>;

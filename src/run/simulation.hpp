@@ -1,8 +1,13 @@
-// An event-driven simulation held in memory and advanced on request: the engine of `kairos run`
-// without its output files, for scripts (the Python module, python/kairos_module.cpp) and
-// tests. It starts through the same setup chain as `kairos run` (run/setup_chain.hpp: the same
-// start state, contact laws, soft-sphere tables and engine), so its trajectory is the CLI's bit
-// for bit, and save() writes a restart file that `kairos run --restart` continues.
+// A simulation held in memory and advanced on request: the integrator of `kairos run` (the
+// event engine, or the DEM with run.integrator = "dem") without its output files, for scripts
+// (the Python module, python/kairos_module.cpp) and tests. It starts through the same setup
+// chain as `kairos run` (run/setup_chain.hpp: the same start state, contact laws, soft-sphere
+// tables and integrator), so its trajectory is the CLI's bit for bit, and save() writes a
+// restart file that `kairos run --restart` continues.
+//
+// What only the event engine has (changing the state, image counters, the Helfand moments, the
+// virial tensor, the time correlations) is refused under the DEM with an InputError naming the
+// call (event_integrator).
 #pragma once
 
 #include <array>
@@ -28,16 +33,19 @@ template <int D, class Queue>
 class EventEngineAdapter;
 template <int D>
 class EventIntegrator;
+template <int D>
+class DemAdapter;
 class CalendarQueue;
 
 template <int D>
 class Simulation {
  public:
-  // From a configuration (run.integrator "event"; [driving] kicks as `kairos run` draws them,
-  // their random stream and next kick time kept by save()), or from a restart file with it.
-  // InputError for anything the user must fix.
-  // `tracking`: image counters and Helfand moments kept beyond what the configuration asks for
-  // (the moments: InputError for a system transport_obstacle() names, as analysis.transport).
+  // From a configuration (run.integrator "event": [driving] kicks as `kairos run` draws them,
+  // their random stream and next kick time kept by save(); or "dem"), or from a restart file
+  // with it. InputError for anything the user must fix.
+  // `tracking`: image counters and Helfand moments the event engine keeps beyond what the
+  // configuration asks for (the moments: InputError for a system transport_obstacle() names, as
+  // analysis.transport, and under the DEM; the DEM keeps no image counters).
   explicit Simulation(const Config& config,
                       const std::optional<std::filesystem::path>& restart_file = {},
                       const EngineTracking& tracking = {});
@@ -46,12 +54,17 @@ class Simulation {
   Simulation& operator=(const Simulation&) = delete;
 
   // Events until the clock reaches t (>= time()), which it then shows exactly (no event needs
-  // to happen at t). Returns false if stopped early by `keep_going` returning false (asked
-  // every 16 384 events, e.g. to let Python handle Ctrl-C). A frozen clock (run/frozen_clock.hpp)
-  // throws InputError saying who collides and what to change; the state stays readable.
+  // to happen at t); the DEM: time steps until the first step at or after t (reached(t): its
+  // steps are dt apart, so the clock may stand up to a step past t). Returns false if stopped early
+  // by `keep_going` returning false (asked every 16 384 events, e.g. to let Python handle Ctrl-C).
+  // A frozen clock (run/frozen_clock.hpp) throws InputError saying who collides and what to change;
+  // the state stays readable.
   using KeepGoing = std::function<bool()>;
   bool advance_to_time(double t, const KeepGoing& keep_going = {});
   // Until `count` more events / collisions have happened (or no event is left: then false).
+  // The DEM: events are time steps, and collisions pairs entering contact (several may in one
+  // step: the count may pass the target); a DEM at rest whose contacts no longer begin returns
+  // false from advance_collisions, as the engine with no event left.
   bool advance_events(std::uint64_t count, const KeepGoing& keep_going = {});
   bool advance_collisions(std::uint64_t count, const KeepGoing& keep_going = {});
   // Calls sample() at each multiple of `interval` in simulated time after time() up to
@@ -74,12 +87,17 @@ class Simulation {
   double time() const;
   std::uint64_t events() const;
   std::uint64_t collisions() const;
+  // The collisional virial W = sum r_ij . J_ij over the collisions since the state's start (a
+  // restart's included; the DEM: the time integral of sum r_ij . F_ij), what thermo.tsv's Z is
+  // made of (analysis/thermodynamics.hpp).
+  double virial() const;
   std::size_t size() const { return n_; }
   const Vec<D>& box() const;
   // Per particle, in the numbering of the configuration (or the start file), at time():
   // positions wrapped into the periodic box, velocities.
   std::vector<Vec<D>> positions() const;
   std::vector<Vec<D>> velocities() const;
+  // The DEM: set_velocities, set_positions and set_species are refused (InputError).
   // Gives every particle a new velocity now (in the numbering of positions()); the events are
   // predicted anew, so the run goes on from the new velocities exactly as one started with them.
   // InputError naming the particle for a count that differs, a velocity that is not finite or
@@ -133,8 +151,12 @@ class Simulation {
   // since the state's start: a restart's included).
   typename HelfandMoments<D>::Moments helfand_moments() const;
   const std::array<double, 9>& virial_tensor() const;
-  // The engine under the run driver's interface, for the analyses (run/simulation_analyses.hpp).
-  const EventIntegrator<D>& integrator() const;
+  // The integrator under the run driver's interface, for the analyses
+  // (run/simulation_analyses.hpp).
+  const Integrator<D>& integrator() const { return *integrator_; }
+  // The event engine's; InputError naming `what` under the DEM.
+  const EventIntegrator<D>& event_integrator(const char* what) const;
+  bool dem() const { return dem_ != nullptr; }
   // The compression that made the start state ([compress], or a random start denser than
   // insertion reaches): what it did and the packing's contact network; null if none.
   const CompressionReport* compression() const { return compression_ ? &*compression_ : nullptr; }
@@ -162,9 +184,15 @@ class Simulation {
   // The refusals set_velocities shares with rebuild.
   void check_state_can_change(const char* what) const;
 
+  // The event engine's adapter, the non-owning view of integrator_ that the event-only calls
+  // use (the refusal under the DEM).
+  EventEngineAdapter<D, CalendarQueue>& event_engine(const char* what) const;
+
   Config config_;
   EngineTracking tracking_;
-  std::unique_ptr<EventEngineAdapter<D, CalendarQueue>> engine_;
+  std::unique_ptr<Integrator<D>> integrator_;
+  EventEngineAdapter<D, CalendarQueue>* engine_ = nullptr;  // null under the DEM
+  const DemAdapter<D>* dem_ = nullptr;                      // null under the event engine
   RunProgress progress_;
   std::optional<CompressionReport> compression_;
   std::size_t n_ = 0;

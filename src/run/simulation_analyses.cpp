@@ -16,6 +16,7 @@
 #include "run/outputs/sampling_interval.hpp"
 #include "run/outputs/structure_factor_output.hpp"
 #include "run/outputs/structure_snapshot.hpp"
+#include "run/outputs/summary_values.hpp"
 #include "run/outputs/transport_output.hpp"
 #include "run/outputs/velocity_distribution_output.hpp"
 
@@ -32,7 +33,8 @@ SampledSpan begin_span(const Simulation<D>& sim, const CorrelationRequest& reque
   span.interval = request.interval;
   if (span.interval == 0.0) {
     span.interval_automatic = true;
-    span.interval = half_enskog_mean_free_time(sim.integrator(), request.interval_name);
+    span.interval = half_enskog_mean_free_time(sim.event_integrator("the automatic interval"),
+                                               request.interval_name);
   }
   span.start_time = sim.time();
   span.collisions = sim.collisions();
@@ -141,18 +143,19 @@ template <int D>
 MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& request, bool vacf,
                               const typename Simulation<D>::KeepGoing& keep_going,
                               std::size_t particles, MsdTime clock, bool mutual) {
+  const EventIntegrator<D>& engine = sim.event_integrator("msd");  // as analysis.msd
   if (!sim.tracks_images()) {
     throw InputError(
         "msd: the mean-square displacement needs image counters: this Simulation keeps none "
         "(created with images=False)");
   }
-  if (sim.integrator().kind().sheared) {
+  if (engine.kind().sheared) {
     throw InputError(
         "msd: the mean-square displacement under Lees-Edwards shear is not measured yet (the "
         "streaming displacement would need subtracting), as analysis.msd");
   }
   MsdMeasurement<D> m;
-  const auto& kind = sim.integrator().kind();
+  const auto& kind = engine.kind();
   const bool cooling = freely_cooling<D>(kind);
   m.in_collisions = msd_on_collision_clock<D>(clock, kind);
   if (m.in_collisions && vacf) {
@@ -166,7 +169,6 @@ MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& requ
   m.species = sim.species_names();
   if (m.species.empty()) m.species = {"A"};
   const std::size_t n = sim.size();
-  const EventIntegrator<D>& engine = sim.integrator();
   const auto species_of = [&](std::size_t i) {
     return i < sim.species().size() ? sim.species()[i] : 0u;
   };
@@ -273,6 +275,7 @@ MsdMeasurement<D> measure_msd(Simulation<D>& sim, const CorrelationRequest& requ
 template <int D>
 TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationRequest& request,
                                           const typename Simulation<D>::KeepGoing& keep_going) {
+  const EventIntegrator<D>& engine = sim.event_integrator("transport");  // as analysis.transport
   if (!sim.tracks_helfand()) {
     throw InputError(
         "transport: the Helfand moments are not kept: create the Simulation with helfand=True "
@@ -280,7 +283,6 @@ TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationR
   }
   TransportMeasurement<D> m;
   m.span = begin_span(sim, request);
-  const EventIntegrator<D>& engine = sim.integrator();
   MassMoments<D> mass(engine);  // a mixture's (the Simulation keeps images for them)
   m.transport.emplace(m.span.interval, sim.size(), engine.volume(), mass.count(), mass.scale());
   m.span.completed = sim.sample_every(
@@ -301,6 +303,55 @@ TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationR
   return m;
 }
 
+template <int D>
+PressureMeasurement measure_pressure(Simulation<D>& sim, const CorrelationRequest& request,
+                                     const typename Simulation<D>::KeepGoing& keep_going) {
+  const Integrator<D>& integrator = sim.integrator();
+  PressureMeasurement m;
+  m.span.interval = request.interval;
+  m.span.start_time = sim.time();
+  m.span.collisions = sim.collisions();
+  const std::size_t moving = integrator.mobile();
+  Thermodynamics stats(D, moving, integrator.volume(), moving < sim.size());
+  const ThermoPoint start = integrator.point();
+  stats.mark(start);
+  const double start_ke = integrator.thermal_energy();
+  const double start_held = integrator.held_degrees_of_freedom();
+  std::vector<double> temperatures;
+  m.span.completed = sim.sample_every(
+      request.interval, request.duration,
+      [&] {
+        const ThermoRow r = stats.row(integrator.point(), integrator.thermal_energy(), true,
+                                      integrator.held_degrees_of_freedom());
+        temperatures.push_back(r.temperature);
+      },
+      keep_going);
+  const double duration = sim.time() - m.span.start_time;
+  m.span.end_time = sim.time();
+  m.span.collisions = sim.collisions() - m.span.collisions;
+  m.span.mean_free_time = stats.mean_free_time(duration, m.span.collisions);
+  m.temperature = integrator.temperature_from_rows() && !temperatures.empty()
+                      ? block_average(temperatures).mean
+                      : stats.temperature(start_ke, start_held);
+  m.compressibility = stats.compressibility_blocks();
+  m.compressibility.mean =
+      stats.compressibility(integrator.virial() - start.virial, m.temperature, duration);
+  if (!integrator.bulk())
+    m.undefined = not_bulk_reason(moving < sim.size(), true);
+  else if (!(duration > 0.0))
+    m.undefined = "no time elapsed";
+  else if (!(m.temperature > 0.0))
+    m.undefined = "the particles are at rest (kT = 0)";
+  if (!m.undefined.empty()) {
+    m.compressibility.mean = m.compressibility.stderr_ = kNaN;
+    m.pressure = m.pressure_stderr = kNaN;
+    return m;
+  }
+  m.pressure = stats.pressure(m.compressibility.mean, m.temperature);
+  m.pressure_stderr = stats.pressure(m.compressibility.stderr_, m.temperature);
+  return m;
+}
+
 #define KAIROS_SIMULATION_ANALYSES(D)                                                              \
   template RdfNow<D> rdf_now<D>(const Simulation<D>&, int, double);                                \
   template StructureFactorNow structure_factor_now<D>(const Simulation<D>&, double);               \
@@ -310,7 +361,9 @@ TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationR
                                             const typename Simulation<D>::KeepGoing&, std::size_t, \
                                             MsdTime, bool);                                        \
   template TransportMeasurement<D> measure_transport<D>(Simulation<D>&, const CorrelationRequest&, \
-                                                        const typename Simulation<D>::KeepGoing&);
+                                                        const typename Simulation<D>::KeepGoing&); \
+  template PressureMeasurement measure_pressure<D>(Simulation<D>&, const CorrelationRequest&,      \
+                                                   const typename Simulation<D>::KeepGoing&);
 KAIROS_SIMULATION_ANALYSES(2)
 KAIROS_SIMULATION_ANALYSES(3)
 #undef KAIROS_SIMULATION_ANALYSES

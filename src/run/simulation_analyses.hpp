@@ -9,6 +9,7 @@
 //   time correlations                measure_msd, measure_transport: they advance the
 //                                    simulation, sampling at the multiples of an interval in
 //                                    simulated time as `kairos run` does
+//   pressure over a span              measure_pressure: Z and P as summary.json gives them
 #pragma once
 
 #include <array>
@@ -19,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "analysis/block_average.hpp"
 #include "analysis/helfand_transport.hpp"
 #include "analysis/interdiffusion.hpp"
 #include "analysis/msd.hpp"
@@ -143,5 +145,24 @@ struct TransportMeasurement {
 template <int D>
 TransportMeasurement<D> measure_transport(Simulation<D>& sim, const CorrelationRequest& request,
                                           const typename Simulation<D>::KeepGoing& keep_going = {});
+
+// The compressibility factor Z = PV / (N kT) and the pressure over a span of simulated time, as
+// summary.json gives them for a production (run/outputs/thermo_output.cpp): Z from the virial
+// over the whole span at the production temperature (the kinetic one at the span's start, or
+// the rows' mean where kinetic energy is exchanged or dissipated: temperature_from_rows), and
+// its blocked error over rows `interval` apart (thermo.tsv's rows: Flyvbjerg-Petersen with
+// Jonsson's level). Bulk values only: `undefined` says why not (walls, open faces, a field,
+// fixed grains; no time elapsed; particles at rest) and leaves them NaN.
+struct PressureMeasurement {
+  SampledSpan span;
+  BlockAverage compressibility;  // mean over the span; stderr_ over the rows
+  double pressure = 0.0, pressure_stderr = 0.0;
+  double temperature = 0.0;  // the production temperature the Z is made with
+  std::string undefined;
+};
+// Advances `sim` by request.duration with rows every request.interval (> 0) in simulated time.
+template <int D>
+PressureMeasurement measure_pressure(Simulation<D>& sim, const CorrelationRequest& request,
+                                     const typename Simulation<D>::KeepGoing& keep_going = {});
 
 }  // namespace kairos

@@ -10,6 +10,7 @@ Run by ctest with the module's directory on PYTHONPATH (tests/CMakeLists.txt).
 """
 
 import json
+import math
 import os
 import pathlib
 import shlex
@@ -414,6 +415,116 @@ class Module(kt.KairosTestCase):
         again = kairos.run(cfg, output=out, overwrite=True)
         self.assertEqual(again["collisions"], done[0]["collisions"])
 
+    def test_the_dem_runs_as_the_cli_runs_it(self):
+        # run.integrator = "dem": the same steps as `kairos run` (the first step at or after the
+        # time asked for), the same restart file, a saved state continued bit for bit.
+        config = hard_config(time=0.6, soft={"model": "hertz", "young": 1e5, "poisson": 0.3,
+                                             "restitution": 0.7, "restitution_speed": 1.0,
+                                             "friction": 0.3})
+        config["system"]["packing_fraction"] = 0.1
+        config["run"]["integrator"] = "dem"
+        cfg = self.write_config(config)
+        self.run_ok("run", cfg, "-o", self.path("cli"))
+        summary = self.summary(self.path("cli"))
+        dt = summary["dem"]["time_step"]
+        sim = kairos.Simulation(cfg)
+        self.assertEqual(sim.integrator, "dem")
+        self.assertIn("(dem)", repr(sim))
+        self.assertTrue(sim.advance(time=0.6))
+        self.assertTrue(0.6 - 1e-9 * dt <= sim.time < 0.6 + dt, sim.time)
+        self.assertEqual(sim.collisions, summary["collisions"])  # a new run: all of them
+        self.assertAlmostEqual(sim.temperature(), summary["temperature"],
+                               delta=1e-12 * summary["temperature"])
+        sim.save(self.path("module.gsd"))
+        a = kt.read_exact_state(self.path("cli", "restart.gsd"))
+        b = kt.read_exact_state(self.path("module.gsd"))
+        for name in kt.EXACT_CHUNKS:
+            self.assertTrue(np.array_equal(a[name], b[name]), name)
+        springs = [kt.restart_chunk(p, "kairos/dem/springs")
+                   for p in (self.path("cli", "restart.gsd"), self.path("module.gsd"))]
+        self.assertTrue(np.array_equal(springs[0], springs[1]))
+        # Events are time steps: exactly as many as asked; a saved state goes on bit for bit.
+        steps = sim.events
+        self.assertTrue(sim.advance(events=37))
+        self.assertEqual(sim.events, steps + 37)
+        self.assertAlmostEqual(sim.time, 0.0 + sim.events * dt, delta=1e-9)
+        again = kairos.Simulation(cfg, restart=self.path("module.gsd"))
+        self.assertEqual(again.events, steps)
+        self.assertTrue(again.advance(events=37))
+        self.assertTrue(np.array_equal(again.positions(), sim.positions()))
+        self.assertTrue(np.array_equal(again.velocities(), sim.velocities()))
+        # Collisions: at least as many more as asked (several pairs may meet in one step).
+        c = sim.collisions
+        self.assertTrue(sim.advance(collisions=20))
+        self.assertGreaterEqual(sim.collisions, c + 20)
+        x = sim.positions()
+        self.assertEqual(x.shape, (200, 3))
+        self.assertTrue(((x >= 0) & (x < sim.box)).all())
+        # What only the event engine has is refused, naming the call.
+        for call, needle in [
+                (lambda: sim.set_velocities(sim.velocities()), "set_velocities"),
+                (lambda: sim.set_positions(sim.positions()), "set_positions"),
+                (lambda: sim.images(), "images"),
+                (lambda: sim.msd(0.1, 1.0), "msd"),
+                (lambda: kairos.Simulation(cfg, helfand=True), "helfand")]:
+            with self.assertRaises(kairos.InputError) as caught:
+                call()
+            self.assertIn(needle, str(caught.exception))
+            self.assertIn("dem", str(caught.exception))
+
+    def test_pressure_is_the_summarys_and_the_equation_of_states(self):
+        # Z and P over a span as summary.json gives them for a production of that length with
+        # thermo rows at the same times (bit for bit), for both integrators.
+        for integrator in ("event", "dem"):
+            with self.subTest(integrator=integrator):
+                config = hard_config(time=4.0, output={"thermo_interval": 0.25,
+                                                       "interval_unit": "time",
+                                                       "trajectory": False})
+                if integrator == "dem":
+                    config["system"]["packing_fraction"] = 0.1
+                    config["soft"] = {"model": "dashpot", "stiffness": 1e4}
+                    config["run"]["integrator"] = "dem"
+                cfg = self.write_config(config, integrator + ".toml")
+                out = self.path(integrator)
+                self.run_ok("run", cfg, "-o", out)
+                z = self.summary(out)["compressibility"]
+                p = kairos.Simulation(cfg).pressure(4.0, interval=0.25)
+                self.assertEqual(p["Z"], z["mean"])
+                self.assertEqual(p["Z_stderr"], z["stderr"])
+                self.assertEqual(p["rows"], z["blocks"])
+                self.assertEqual(p["pressure"], self.summary(out)["pressure"])
+                self.assertIsNone(p["why"])
+        # Hard spheres at packing fraction 0.3: the Kolafa-Labik-Malijevsky equation of state
+        # (Pieprzyk et al. coefficients, docs/physics.md#equations-of-state), Z = 3.9840; 500
+        # spheres over 50 time units give Z to about 0.01 (measured 2026-12-07: 3.977 +- 0.014
+        # over 20). Tolerance: 4 standard errors and 0.01 for the finite system.
+        sim = kairos.Simulation(self.write_config(hard_config(time=1.0, system={
+            "particles": 500, "lattice": "fcc", "packing_fraction": 0.3}), "eos.toml"))
+        sim.advance(time=3.0)
+        p = sim.pressure(50.0)
+        self.assertEqual(sim.time, 53.0)
+        self.assertEqual(p["rows"], 64)
+        self.assertLess(abs(p["Z"] - 3.9840), 4 * p["Z_stderr"] + 0.01, p)
+        self.assertLess(p["Z_stderr"], 0.02)
+        n, volume = len(sim), np.prod(sim.box)
+        self.assertAlmostEqual(p["pressure"], p["Z"] * n * p["temperature"] / volume, delta=1e-12)
+        # The virial it is made of: Z - 1 = W / (D N kT t) over the span.
+        w = sim.virial
+        q = sim.pressure(5.0)
+        self.assertAlmostEqual(q["Z"], 1 + (sim.virial - w) / (3 * n * q["temperature"] * 5.0),
+                               delta=1e-12 * q["Z"])
+        # Not a bulk value under gravity and walls: NaN with the reason.
+        with open(kt.example("vibrated_bed_2d.toml")) as f:
+            bed = kairos.Simulation(f.read())
+        r = bed.pressure(0.5)
+        self.assertTrue(math.isnan(r["Z"]) and math.isnan(r["pressure"]))
+        self.assertIn("walls", r["why"])
+        for call, needle in [(lambda: sim.pressure(0.0), "duration"),
+                             (lambda: sim.pressure(1.0, interval=2.0), "interval")]:
+            with self.assertRaises(kairos.InputError) as caught:
+                call()
+            self.assertIn(needle, str(caught.exception))
+
     def test_mistakes_raise_input_errors_naming_the_problem(self):
         cfg = self.write_config(hard_config())
         sim = kairos.Simulation(cfg)
@@ -421,7 +532,7 @@ class Module(kt.KairosTestCase):
             (lambda: sim.advance(), "exactly one"),
             (lambda: sim.advance(time=1.0, events=3), "exactly one"),
             (lambda: (sim.advance(time=1.0), sim.advance(time=0.5)), "at time 1"),
-            (lambda: kairos.Simulation(cfg, set=["run.integrator=dem"]), "integrator"),
+            (lambda: kairos.Simulation(cfg, set=["run.integrator=dem"]), "[soft]"),
             (lambda: sim.set_thermostat_temperature(2.0), "no Andersen thermostat"),
             (lambda: kairos.Simulation(cfg, set=["system.packing_fraction=1.5"]),
              "packing_fraction"),

@@ -66,14 +66,14 @@ TEST(SimulationAnalyses, MassMomentsAreTheComponentsMassSumsAboutTheCentreOfMass
   const std::vector<std::uint32_t>& species = sim.species();
   ASSERT_EQ(std::count(species.begin(), species.end(), 3u), 0);  // E: none
   ASSERT_TRUE(sim.advance_to_time(2.0));
-  MassMoments<3> mass(sim.integrator());
+  MassMoments<3> mass(sim.event_integrator("mass moments"));
   ASSERT_EQ(mass.count(), 2u);  // A and B; C is the last present
   EXPECT_EQ(mass.name(0), "A");
   EXPECT_EQ(mass.name(1), "B");
   EXPECT_TRUE(mass.why().empty());
   for (int round = 0; round < 2; ++round) {
     std::vector<Vec<3>> moments;
-    mass.sample(sim.integrator(), moments);
+    mass.sample(sim.event_integrator("mass moments"), moments);
     const std::vector<Vec<3>> x = sim.unwrapped_positions();
     const std::vector<double>& m = sim.masses();
     Vec<3> all{};
