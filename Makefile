@@ -3,12 +3,13 @@
 #   make test    install missing Debian packages, build the tests and the CLI, run the whole test suite
 #   make bench   build and run the benchmark driver (see bench/README.md)
 #   make asan    build and test with AddressSanitizer + UBSan
+#   make wheel   build the Python module and the CLI into a wheel in build/dist (docs/install.md)
 
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build demo test bench asan format clean
+.PHONY: all deps configure build demo test bench asan wheel format clean
 
 all: build
 
@@ -34,6 +35,9 @@ test: configure
 bench: configure
 	cmake --build $(BUILD) -j $(JOBS) --target kairos_bench
 	$(BUILD)/bench/kairos_bench
+
+wheel: configure
+	cmake --build $(BUILD) -j $(JOBS) --target wheel
 
 # -Og with line tables: file:line in every report, and under the sanitizers each file outside
 # the hot directories compiles in 45 % less time than at -O1, for the same test time (measured

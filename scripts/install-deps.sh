@@ -8,7 +8,7 @@ packages=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev
   zlib1g-dev
-  python3 python3-gsd python3-numpy
+  python3 python3-gsd python3-numpy python3-wheel python3-venv
   python3-dev pybind11-dev
   libopenmpi-dev openmpi-bin
 )

@@ -119,6 +119,63 @@ class Install(kt.KairosTestCase):
         for key in ("sim_time", "events", "kinetic_energy", "compressibility"):
             self.assertEqual(own[key], cli[key], key)
 
+    def test_a_wheel_installs_into_a_virtual_environment(self):
+        # scripts/make_wheel.py (the `wheel` target) packs the built module and CLI; pip installs
+        # the wheel into a virtual environment, whose python imports the module from its own
+        # site-packages and whose bin/ holds the CLI (where kairos.sweep finds it).
+        if not self.module_built:
+            self.skipTest("the Python module is not built")
+        for needed in ("wheel", "venv", "ensurepip"):
+            if run([PYTHON, "-c", "import " + needed]).returncode != 0:
+                self.skipTest("python3-%s is not installed (scripts/install-deps.sh)" %
+                              ("venv" if needed == "ensurepip" else needed))
+        module = [f for f in os.listdir(os.path.join(self.build, "python"))
+                  if f.startswith("kairos.") and f.endswith(".so")][0]
+        result = run([PYTHON, os.path.join(kt.SOURCE_DIR, "scripts", "make_wheel.py"), "--module",
+                      os.path.join(self.build, "python", module), "--cli", kt.KAIROS,
+                      "--version", "0.1.0", "--out", self.path("dist")])
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        wheel = result.stdout.strip()
+        self.assertEqual(os.path.basename(wheel),
+                         "kairos-0.1.0-cp3%d-cp3%d-linux_x86_64.whl" % ((sys.version_info.minor,) * 2))
+        # With the system's packages (numpy from Debian): pip resolves the dependency offline.
+        venv = self.path("venv")
+        result = run([PYTHON, "-m", "venv", "--system-site-packages", venv])
+        self.assertEqual(result.returncode, 0, result.stderr)
+        result = run([os.path.join(venv, "bin", "pip"), "install", "--no-index", wheel])
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        example = os.path.join(kt.SOURCE_DIR, "examples", "hard_spheres_3d.toml")
+        code = ("import kairos, sys\n"
+                "assert kairos.__file__.startswith(sys.prefix), kairos.__file__\n"
+                "sim = kairos.Simulation(sys.argv[1], set=['system.particles=256'])\n"
+                "sim.advance(time=0.5)\n"
+                "print(sim.positions().shape, sim.time)\n"
+                "s = kairos.sweep(sys.argv[1], output=sys.argv[2], workers=1,\n"
+                "                 vary={'system.seed': [1]}, set=%r)\n"
+                "print(len(s), s[0]['summary']['stop_reason'])\n" % SHORT[1::2])
+        result = run([os.path.join(venv, "bin", "python"), "-c", code, example,
+                      self.path("venv-sweep")], cwd=self.tmp, env={"PATH": "/usr/bin:/bin"})
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertIn("(256, 3) 0.5", result.stdout)
+        self.assertIn("1 completed", result.stdout)
+        result = run([os.path.join(venv, "bin", "kairos"), "run", example, "-o",
+                      self.path("venv-run")] + SHORT, cwd=self.tmp)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        # A plain environment: the module imports and runs without numpy (its arrays need it).
+        plain = self.path("plain")
+        result = run([PYTHON, "-m", "venv", plain])
+        self.assertEqual(result.returncode, 0, result.stderr)
+        result = run([os.path.join(plain, "bin", "pip"), "install", "--no-index", "--no-deps",
+                      wheel])
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        code = ("import kairos, sys\n"
+                "s = kairos.run(sys.argv[1], output=sys.argv[2], set=%r)\n"
+                "print(s['stop_reason'])\n" % SHORT[1::2])
+        result = run([os.path.join(plain, "bin", "python"), "-c", code, example,
+                      self.path("plain-run")], cwd=self.tmp, env={"PATH": "/usr/bin:/bin"})
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertIn("completed", result.stdout)
+
     def test_the_debian_package_holds_a_working_tree(self):
         if not os.path.isfile(os.path.join(self.build, "CPackConfig.cmake")):
             self.skipTest("no CPack configuration in this build")
