@@ -22,6 +22,7 @@
 #include "io/config.hpp"
 #include "io/config_choices.hpp"
 #include "io/config_obstacles.hpp"
+#include "io/directory_manifest.hpp"
 #include "io/line_file.hpp"
 #include "replica/exchange_rule.hpp"
 #include "replica/exchange_statistics.hpp"
@@ -493,26 +494,6 @@ ReplicaExchangePlan plan_replica_exchange(const ReplicaExchangeSettings& setting
   return plan;
 }
 
-// InputError unless the manifest `have` (read from path) describes this ensemble.
-static void check_manifest(const ReplicaExchangePlan& plan, const nlohmann::json& have,
-                           const fs::path& path) {
-  const fs::path& dir = plan.settings.directory;
-  const nlohmann::json want = manifest(plan);
-  if (have.is_discarded() || !have.is_object() || !have.contains("kairos_replica_exchange")) {
-    throw InputError(fmt::format("{}: not a replica-exchange manifest", path.string()));
-  }
-  for (const char* key : {"config_text", "set", "temperatures", "interval"}) {
-    if (have.value(key, nlohmann::json()) != want[key]) {
-      throw InputError(fmt::format(
-          "{} holds another ensemble: its {} differs ({}); continue it with the command that "
-          "began it, or give another directory",
-          dir.string(), key == std::string("config_text") ? "config text" : key,
-          key == std::string("config_text") ? have.value("config", std::string("?"))
-                                            : have.value(key, nlohmann::json()).dump()));
-    }
-  }
-}
-
 void claim_replica_directory(const ReplicaExchangePlan& plan) {
   const fs::path& dir = plan.settings.directory;
   std::error_code ec;
@@ -533,9 +514,15 @@ void claim_replica_directory(const ReplicaExchangePlan& plan) {
     write_text_atomically(path, want.dump(2) + "\n");
     return;
   }
-  std::ifstream in(path);
-  const nlohmann::json have = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  check_manifest(plan, have, path);
+  const nlohmann::json have = read_manifest(path, "replica-exchange", "kairos_replica_exchange");
+  require_same_manifest(
+      have, want,
+      {{"config_text", "config text",
+        [](const nlohmann::json& had) { return had.value("config", std::string("?")); }, nullptr},
+       {"set", "set", {}, nullptr},
+       {"temperatures", "temperatures", {}, nullptr},
+       {"interval", "interval", {}, nullptr}},
+      dir, "ensemble");
   settle_checkpoint(dir);
   if (const std::optional<Checkpoint> c = find_checkpoint(dir, plan.temperatures.size())) {
     const fs::path table = dir / kExchangeTable;

@@ -16,6 +16,7 @@
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
+#include "io/directory_manifest.hpp"
 
 namespace kairos {
 namespace {
@@ -133,32 +134,22 @@ void claim_sweep_directory(const SweepPlan& plan) {
     write_text_atomically(path, want.dump(2) + "\n");
     return;
   }
-  std::ifstream in(path);
-  const nlohmann::json have = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (have.is_discarded() || !have.is_object()) {
-    throw InputError(fmt::format("{}: not a sweep manifest (unreadable JSON)", path.string()));
-  }
-  auto refuse = [&](const std::string& what) {
-    throw InputError(fmt::format(
-        "{} holds another sweep: {} (see its sweep.json); continue it with the command that "
-        "began it, or give another directory",
-        plan.directory.string(), what));
-  };
-  if (have.value("config_text", std::string()) != plan.config_text) {
-    refuse(fmt::format("the config text differs from that of {}",
-                       have.value("config", std::string("its config"))));
-  }
-  if (have.value("set", nlohmann::json::array()) != want["set"]) {
-    refuse(fmt::format("its --set list was {}", have.value("set", nlohmann::json()).dump()));
-  }
-  if (have.value("vary", nlohmann::json::array()) != want["vary"]) {
+  const nlohmann::json have = read_manifest(path, "sweep");
+  const auto vary_flags = [](const nlohmann::json& had) {
     std::string was;
-    for (const auto& a : have.value("vary", nlohmann::json::array())) {
-      was += fmt::format(" --vary {}={}", a.value("key", std::string("?")),
+    for (const auto& a : had.value("vary", nlohmann::json::array())) {
+      was += fmt::format("{}--vary {}={}", was.empty() ? "" : " ", a.value("key", std::string("?")),
                          a.value("spec", std::string("?")));
     }
-    refuse(fmt::format("its grid was{}", was));
-  }
+    return was;
+  };
+  require_same_manifest(
+      have, want,
+      {{"config_text", "config text",
+        [](const nlohmann::json& had) { return had.value("config", std::string("?")); }, ""},
+       {"set", "--set list", {}, nlohmann::json::array()},
+       {"vary", "grid", vary_flags, nlohmann::json::array()}},
+      plan.directory, "sweep");
   write_copy();
 }
 
