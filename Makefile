@@ -4,12 +4,13 @@
 #   make bench   build and run the benchmark driver (see bench/README.md)
 #   make asan    build and test with AddressSanitizer + UBSan
 #   make wheel   build the Python module and the CLI into a wheel in build/dist (docs/install.md)
+#   make install build, then install into PREFIX (default /usr/local; docs/install.md)
 
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build demo test bench asan wheel format clean
+.PHONY: all deps configure build demo test bench asan wheel install format clean
 
 all: build
 
@@ -38,6 +39,10 @@ bench: configure
 
 wheel: configure
 	cmake --build $(BUILD) -j $(JOBS) --target wheel
+
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX)
 
 # -Og with line tables: file:line in every report, and under the sanitizers each file outside
 # the hot directories compiles in 45 % less time than at -O1, for the same test time (measured

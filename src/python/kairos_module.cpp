@@ -818,6 +818,28 @@ class PySimulation {
   double virial() const {
     return visit([](const auto& s) { return s.virial(); });
   }
+  py::dict energies() const {
+    return visit([](const auto& s) {
+      const auto e = s.energies();
+      py::dict out;
+      out["kinetic"] = e.kinetic;
+      out["rotational"] = e.rotational;
+      out["potential"] = e.potential;
+      out["field"] = e.field;
+      out["dissipated"] = e.dissipated;
+      out["work_by_walls"] = e.work_by_walls;
+      return out;
+    });
+  }
+  py::array_t<double> momentum() const {
+    return visit([](const auto& s) {
+      const auto p = s.momentum();
+      return py::array_t<double>(static_cast<py::ssize_t>(p.size()), p.data());
+    });
+  }
+  double max_overlap() const {
+    return visit([](const auto& s) { return s.max_overlap(); });
+  }
   std::string integrator() const {
     return visit([](const auto& s) { return std::string(s.integrator().name()); });
   }
@@ -1221,6 +1243,12 @@ PYBIND11_MODULE(kairos, m) {
                              "The collisional virial W = sum r_ij . J_ij since the state's start "
                              "(the DEM: the time integral of sum r_ij . F_ij).")
       .def_property_readonly("integrator", &PySimulation::integrator, "\"event\" or \"dem\".")
+      .def("energies", &PySimulation::energies,
+           "The energies now and the work and dissipation since the state's start: kinetic, "
+           "rotational, potential, field (gravity), dissipated, work_by_walls (docs/python.md).")
+      .def("momentum", &PySimulation::momentum, "The total momentum, (D,).")
+      .def("max_overlap", &PySimulation::max_overlap,
+           "The largest overlap of any pair now (0 for hard particles up to round-off).")
       .def("pressure", &PySimulation::pressure, py::arg("duration"),
            py::arg("interval") = py::none(),
            "Advances by duration; Z and the pressure over it as summary.json gives them, with "

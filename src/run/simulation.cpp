@@ -327,7 +327,7 @@ void Simulation<D>::rebuild(const char* what,
     diameter[i] = 2.0 * s.kinematics[i].radius;
   }
   std::uint32_t i = 0, j = 0;
-  const double overlap = max_overlap<D>(s.box, s.periodic, position, diameter, &i, &j);
+  const double overlap = kairos::max_overlap<D>(s.box, s.periodic, position, diameter, &i, &j);
   if (overlap > 1e-12 * *std::min_element(diameter.begin(), diameter.end())) {
     throw InputError(fmt::format("{}: particles {} and {} overlap by {:.6g}", what, i, j, overlap));
   }
@@ -407,6 +407,29 @@ void Simulation<D>::set_species(const std::vector<std::uint32_t>& species) {
 template <int D>
 std::vector<WallReading> Simulation<D>::walls_with_mass() const {
   return integrator_->walls_with_mass();
+}
+
+template <int D>
+typename Simulation<D>::Energies Simulation<D>::energies() const {
+  Energies e;
+  const Integrator<D>& in = *integrator_;
+  e.kinetic = in.kinetic_energy();
+  e.rotational = in.rotational_energy();
+  e.potential = in.potential_energy();
+  e.field = dem_ != nullptr ? dem_->dem().field_energy()
+                            : engine_->total_energy() - e.kinetic - e.rotational - e.potential;
+  if (engine_ != nullptr && !engine_->environment().has_gravity()) e.field = 0.0;
+  e.dissipated = in.dissipated_energy();
+  e.work_by_walls = in.work_by_walls();
+  return e;
+}
+template <int D>
+Vec<D> Simulation<D>::momentum() const {
+  return integrator_->momentum();
+}
+template <int D>
+double Simulation<D>::max_overlap() const {
+  return integrator_->max_overlap();
 }
 
 template <int D>

@@ -130,6 +130,22 @@ class Simulation {
   double temperature() const;
   // Of the stepped potentials, or the elastic energy of soft contacts in progress.
   double potential_energy() const;
+  // The energies now and the work and dissipation since the state's start (a restart's
+  // included), as summary.json's energy budget adds them up: kinetic (translational) and
+  // rotational; potential (the stepped potentials', or the elastic energy of soft contacts);
+  // field (in gravity, -sum m g.x over the particles that move; NaN along a periodic axis, 0
+  // without); dissipated (in collisions and at walls; the DEM: the damping's and friction's
+  // work); work_by_walls (what moving walls gave the particles). Without driving, shear or an
+  // outlet, kinetic + rotational + potential + field + dissipated - work_by_walls is constant
+  // (to round-off for the event engine, to O(dt^2) for the DEM).
+  struct Energies {
+    double kinetic = 0.0, rotational = 0.0, potential = 0.0, field = 0.0;
+    double dissipated = 0.0, work_by_walls = 0.0;
+  };
+  Energies energies() const;
+  Vec<D> momentum() const;
+  // The largest overlap of any pair now (0 for hard particles up to round-off).
+  double max_overlap() const;
   // The walls with mass now (boundaries/wall_body.hpp): face, position, speed, energy.
   std::vector<WallReading> walls_with_mass() const;
   // The complete state (what a restart file holds).
