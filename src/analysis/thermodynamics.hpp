@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "analysis/block_average.hpp"
@@ -53,6 +54,13 @@ class Thermodynamics {
   const ThermoPoint& last() const { return last_; }
   // The row for the interval from the last mark to `now`; starts the next interval at `now`.
   ThermoRow row(const ThermoPoint& now, double kinetic_energy, bool production, double held = 0.0);
+
+  // The production rows' Z and mean free time of an earlier invocation of the same run (read
+  // back from its thermo.tsv), before this one's: as if this object had made those rows.
+  void restore_production_rows(std::vector<double> z, std::vector<double> mean_free_times) {
+    z_samples_ = std::move(z);
+    mft_samples_ = std::move(mean_free_times);
+  }
 
   BlockAverage compressibility_blocks() const { return block_average(z_samples_); }
   BlockAverage mean_free_time_blocks() const { return block_average(mft_samples_); }

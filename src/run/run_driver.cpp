@@ -410,6 +410,8 @@ RunProgress RunDriver<D>::progress_now() const {
       p.production_end_time = phase_end_time_;
     else
       p.production_target = phase_target_;
+  } else {
+    p.has_production_start = false;  // only an unfinished production is continued
   }
   // Equilibration still owed if the run stops now, in the unit of the config's length.
   const std::uint64_t c = integrator_->collisions();

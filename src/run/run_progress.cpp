@@ -68,6 +68,15 @@ void write_progress(gsd::Writer& w, const RunProgress& progress) {
     w.write_chunk("kairos/run/production_target", 1, 1, &progress.production_target);
   if (std::isfinite(progress.production_end_time))
     w.write_chunk("kairos/run/production_end_time", 1, 1, &progress.production_end_time);
+  if (progress.has_production_start) {
+    const double start[4] = {progress.production_start_time, progress.production_start_virial,
+                             progress.production_start_thermal_energy,
+                             progress.production_start_held};
+    const std::uint64_t counts[2] = {progress.production_start_events,
+                                     progress.production_start_collisions};
+    w.write_chunk("kairos/run/production_start", 4, 1, start);
+    w.write_chunk("kairos/run/production_start_counts", 2, 1, counts);
+  }
   if (progress.integrator != "event") {
     const std::vector<std::int8_t> name(progress.integrator.begin(), progress.integrator.end());
     w.write_chunk("kairos/run/integrator", name.size(), 1, name.data());
@@ -178,6 +187,21 @@ void read_progress(const gsd::Reader& r, std::uint64_t f, const std::filesystem:
         require<double>(r, f, "kairos/run/production_end_time", path, 1)[0];
     if (!std::isfinite(progress.production_end_time))
       throw InputError(file + ": kairos/run/production_end_time is not finite");
+  }
+  if (r.find(f, "kairos/run/production_start")) {
+    const auto start = require<double>(r, f, "kairos/run/production_start", path, 4);
+    const auto counts = require<std::uint64_t>(r, f, "kairos/run/production_start_counts", path, 2);
+    for (const double x : start)
+      if (!std::isfinite(x)) throw InputError(file + ": kairos/run/production_start is not finite");
+    if (start[0] > s.time || counts[1] > s.counters.collisions)
+      throw InputError(file + ": kairos/run/production_start lies after the state");
+    progress.has_production_start = true;
+    progress.production_start_time = start[0];
+    progress.production_start_virial = start[1];
+    progress.production_start_thermal_energy = start[2];
+    progress.production_start_held = start[3];
+    progress.production_start_events = counts[0];
+    progress.production_start_collisions = counts[1];
   }
   if (r.find(f, "kairos/run/integrator")) {
     const auto name = r.read<std::int8_t>(f, "kairos/run/integrator");

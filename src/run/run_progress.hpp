@@ -76,6 +76,14 @@ struct RunProgress {
   // the time (NaN: none) it was to end at; a continued run completes it.
   std::uint64_t production_target = 0;
   double production_end_time = std::numeric_limits<double>::quiet_NaN();
+  // Where that unfinished production began (kairos/run/production_start and _counts: its
+  // time, virial, thermal energy and the degrees of freedom held still then, its event and
+  // collision counts), so that a run completing it in the same directory averages over the
+  // whole production, as one uninterrupted run (outputs/thermo_output.hpp).
+  bool has_production_start = false;
+  double production_start_time = 0.0, production_start_virial = 0.0;
+  double production_start_thermal_energy = 0.0, production_start_held = 0.0;
+  std::uint64_t production_start_events = 0, production_start_collisions = 0;
 };
 
 // The restart file of a run: the state (io/gsd_snapshot.hpp) and the run's progress, atomically.

@@ -272,6 +272,17 @@ class Sweep(kt.KairosTestCase):
         with open(os.path.join(directory, "thermo.tsv"), "rb") as a, \
                 open(os.path.join(whole, "thermo.tsv"), "rb") as b:
             self.assertEqual(a.read(), b.read())
+        # The table's averages over the production are the uninterrupted run's, bit for bit:
+        # each continuation completed the production and averaged it whole.
+        reference = self.summary(whole)
+        row = rows[1]
+        for key, value in (("compressibility.mean", reference["compressibility"]["mean"]),
+                           ("compressibility.stderr", reference["compressibility"]["stderr"]),
+                           ("pressure", reference["pressure"]),
+                           ("production_time", reference["production_time"]),
+                           ("mean_free_time", reference["mean_free_time"])):
+            self.assertEqual(float(row[key]), value, key)
+        self.assertIn("whole production", row["production_covers"])
 
     def test_a_failing_run_is_reported_and_the_others_finish(self):
         # 30 particles at packing fraction 0.66 from a random start: the config is valid, but

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <random>
 #include <string>
@@ -221,6 +222,94 @@ TEST_F(RunDriverTest, AFailedWriteStopsTheEventRunWithEveryOtherOutputWritten) {
 TEST_F(RunDriverTest, AFailedWriteStopsTheDemRunWithEveryOtherOutputWritten) {
   expect_a_failed_write_stops_the_run<3>(config("dem", "collisions_per_particle = 20.0", "", "dem"),
                                          dir_ / "dem");
+}
+
+// Stops the run (as a signal would) at its k-th call.
+template <int D>
+class StopAt final : public Observer<D> {
+ public:
+  explicit StopAt(int k) : k_(k) {}
+  std::string name() const override { return "stop.tsv"; }
+  bool writes_file() const override { return false; }
+  double interval(const Config&, double) const override { return 0.75; }
+  void write(const RunContext<D>&) override {
+    if (++calls_ == k_) request_stop();
+  }
+
+ private:
+  int k_, calls_ = 0;
+};
+
+std::string text_of(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// A production stopped part-way and completed from its restart file in the same directory ends
+// with summary.json's production averages of one uninterrupted run, bit for bit: Z with its
+// blocked error, the pressure, the production time and temperature, the mean free time, the
+// stepped energy per particle and a free lid's height (the thermo.tsv rows of the earlier
+// invocation read back, its start from the restart file); `extra` gives the system.
+void expect_stopped_production_averages_as_whole(const fs::path& dir, const std::string& extra) {
+  const auto config = [&](const std::string& name) {
+    return parse_config(
+        "[system]\nparticles = 200\npacking_fraction = 0.2\nlattice = \"random\"\nseed = 3\n"
+        "[run]\nequilibration_time = 0.0\ntime = 6.0\n[output]\nprogress = \"never\"\n"
+        "interval_unit = \"time\"\nthermo_interval = 0.25\ntrajectory = false\ndirectory = \"" +
+            (dir / name).string() + "\"\n" + extra,
+        "<test>");
+  };
+  const Config split = config("split"), whole = config("whole");
+  {
+    RunDriver<3> first(split, std::nullopt, {});
+    first.add_observer(std::make_unique<StopAt<3>>(3));
+    const RunOutcome outcome = first.run();
+    ASSERT_EQ(outcome.summary["stop_reason"], "signal");
+    ASSERT_LT(outcome.summary["production_time"].get<double>(), 3.0);
+  }
+  clear_stop_request();
+  RunDriver<3> second(split, dir / "split" / "restart.gsd", {});
+  const RunOutcome continued = second.run();
+  ASSERT_EQ(continued.summary["stop_reason"], "completed") << continued.error;
+  RunDriver<3> uninterrupted(whole, std::nullopt, {});
+  const RunOutcome reference = uninterrupted.run();
+  ASSERT_EQ(text_of(dir / "split" / "thermo.tsv"), text_of(dir / "whole" / "thermo.tsv"));
+  const nlohmann::json& a = continued.summary;
+  const nlohmann::json& b = reference.summary;
+  EXPECT_NE(a["production_covers"].get<std::string>().find("whole production"), std::string::npos);
+  for (const char* key :
+       {"production_time", "production_collisions_per_particle", "production_temperature"})
+    EXPECT_EQ(a[key], b[key]) << key;
+  for (const char* key : {"mean", "stderr", "stderr_blocks"})
+    EXPECT_EQ(a["compressibility"][key], b["compressibility"][key]) << key;
+  EXPECT_EQ(a["compressibility"]["blocks"], b["compressibility"]["blocks"]);
+  EXPECT_EQ(a["mean_free_time"], b["mean_free_time"]);
+  EXPECT_EQ(a.value("pressure", nlohmann::json()), b.value("pressure", nlohmann::json()));
+  if (b.contains("stepped")) {
+    for (const char* key : {"potential_energy_per_particle_mean",
+                            "potential_energy_per_particle_stderr", "potential_energy_rows"})
+      EXPECT_EQ(a["stepped"][key], b["stepped"][key]) << key;
+  }
+  if (b.contains("walls_with_mass")) {
+    for (const char* key : {"position_mean", "position_stderr", "speed_rms", "samples"})
+      EXPECT_EQ(a["walls_with_mass"][0][key], b["walls_with_mass"][0][key]) << key;
+  }
+  // Without the restored rows the continued run would have averaged its own rows only.
+  EXPECT_GT(a["compressibility"]["blocks"].get<int>(), 20);
+}
+
+TEST_F(RunDriverTest, AStoppedProductionCompletedInItsDirectoryAveragesAsOneUninterruptedRun) {
+  expect_stopped_production_averages_as_whole(
+      dir_,
+      "[[potential]]\nkind = \"square_well\"\nlambda = 1.5\ndepth = 0.5\n"
+      "[driving]\nkind = \"andersen\"\nrate = 1.0\ntemperature = 1.0\n");
+}
+
+TEST_F(RunDriverTest, AStoppedProductionUnderAFreeLidAveragesItsHeightAsOneUninterruptedRun) {
+  expect_stopped_production_averages_as_whole(
+      dir_,
+      "[[boundary.wall]]\nface = \"z-\"\n[[boundary.wall]]\nface = \"z+\"\n"
+      "mass = 50.0\nforce = 20.0\n");
 }
 
 // What a write that failed leaves owed is recorded in the restart file, and a run continued

@@ -106,12 +106,12 @@ ObserverList<D> make_observers(const Config& config, const Integrator<D>& integr
   if (const EventIntegrator<D>* engine = integrator.as_event()) {
     add<EventSummary<D>>(list, *engine);
     add<PressureTensor<D>>(list, *engine, thermo);
-    if (engine->stepped()) add<SteppedSummary<D>>(list, *engine);
+    if (engine->stepped()) add<SteppedSummary<D>>(list, *engine, thermo);
     if (engine->soft()) add<SoftSummary<D>>(list, *engine);
     if (engine->kind().granular) add<GranularSummary<D>>(list, *engine);
   }
   if (const DemAdapter<D>* dem = integrator.as_dem()) add<DemSummary<D>>(list, *dem);
-  if (!integrator.walls_with_mass().empty()) add<WallsWithMassSummary<D>>(list);
+  if (!integrator.walls_with_mass().empty()) add<WallsWithMassSummary<D>>(list, thermo);
   require_files_listed(list);
   return list;
 }

@@ -8,16 +8,23 @@
 
 #include "run/event_adapter.hpp"
 #include "run/outputs/observer.hpp"
+#include "run/outputs/thermo_output.hpp"
 
 namespace kairos {
 
 template <int D>
 class SteppedSummary final : public Observer<D> {
  public:
-  explicit SteppedSummary(const EventIntegrator<D>& engine) : engine_(engine) {}
+  SteppedSummary(const EventIntegrator<D>& engine, const ThermoOutput<D>& thermo)
+      : engine_(engine), thermo_(thermo) {}
   std::string name() const override { return "summary.json (stepped)"; }
   bool writes_file() const override { return false; }
-  void open(const RunContext<D>&) override { start_ = engine_.counters(); }
+  // A continued production: the earlier invocations' rows, from thermo.tsv's potential_energy.
+  void open(const RunContext<D>&) override {
+    start_ = engine_.counters();
+    if (const auto* rows = thermo_.earlier_production_column("potential_energy"))
+      potential_rows_ = *rows;
+  }
   void sample(const RunContext<D>&) override {
     potential_rows_.push_back(engine_.potential_energy());
   }
@@ -25,6 +32,7 @@ class SteppedSummary final : public Observer<D> {
 
  private:
   const EventIntegrator<D>& engine_;
+  const ThermoOutput<D>& thermo_;
   EventCounters start_;
   std::vector<double> potential_rows_;  // U at each production thermo row
 };

@@ -2,10 +2,89 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+
 #include "analysis/block_average.hpp"
+#include "core/error.hpp"
 #include "run/outputs/summary_values.hpp"
+#include "run/phase_length.hpp"
 
 namespace kairos {
+
+template <int D>
+bool completes_production(const RunContext<D>& run) {
+  const RunProgress& r = run.resumed();
+  const std::optional<RestartPlan>& plan = run.plan();
+  return run.restarted() && run.continuation().same_directory && r.has_production_start &&
+         (r.production_target > 0 || std::isfinite(r.production_end_time)) && plan &&
+         !plan->repredict && !length_given_anew(plan);
+}
+
+namespace {
+
+std::vector<std::string> split_tabs(const std::string& line) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t tab = line.find('\t', start);
+    out.push_back(line.substr(start, tab - start));
+    if (tab == std::string::npos) return out;
+    start = tab + 1;
+  }
+}
+
+}  // namespace
+
+template <int D>
+void ThermoOutput<D>::continue_production(const RunContext<D>& run) {
+  const RunProgress& r = run.resumed();
+  production_start_ = {r.production_start_time, r.production_start_virial,
+                       r.production_start_events, r.production_start_collisions};
+  production_ke_ = r.production_start_thermal_energy;
+  production_held_ = r.production_start_held;
+  production_started_ = production_continued_ = true;
+  // The kept rows (the file was cut to them): every value as written, %.17g, read back exactly.
+  const std::filesystem::path path = run.directory() / name();
+  std::ifstream in(path);
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(path.string() + ": cannot read its header");
+  earlier_columns_ = split_tabs(line);
+  earlier_rows_.assign(earlier_columns_.size(), {});
+  while (std::getline(in, line)) {
+    const std::vector<std::string> fields = split_tabs(line);
+    if (fields.empty() || fields[0] != "production") continue;
+    if (fields.size() != earlier_columns_.size()) {
+      throw InputError(fmt::format("{}: a production row with {} columns, not the header's {}",
+                                   path.string(), fields.size(), earlier_columns_.size()));
+    }
+    for (std::size_t k = 1; k < fields.size(); ++k)
+      earlier_rows_[k].push_back(std::strtod(fields[k].c_str(), nullptr));
+  }
+  // As Thermodynamics::row and write_row keep them.
+  std::vector<double> z, mft;
+  if (const auto* column = earlier_production_column("compressibility"))
+    for (const double x : *column)
+      if (std::isfinite(x)) z.push_back(x);
+  if (const auto* column = earlier_production_column("mean_free_time"))
+    for (const double x : *column)
+      if (std::isfinite(x)) mft.push_back(x);
+  stats_->restore_production_rows(std::move(z), std::move(mft));
+  if (const auto* column = earlier_production_column("temperature"))
+    production_temperatures_ = *column;
+  if (const auto* column = earlier_production_column("potential_energy"))
+    production_potential_energies_ = *column;
+}
+
+template <int D>
+const std::vector<double>* ThermoOutput<D>::earlier_production_column(
+    const std::string& column) const {
+  if (!production_continued_) return nullptr;
+  for (std::size_t k = 1; k < earlier_columns_.size(); ++k)
+    if (earlier_columns_[k] == column) return &earlier_rows_[k];
+  return nullptr;
+}
 
 template <int D>
 void ThermoOutput<D>::open(const RunContext<D>& run) {
@@ -38,6 +117,7 @@ void ThermoOutput<D>::open(const RunContext<D>& run) {
                                  resumed.mark_collisions}
                    : integrator.point();
   stats_->mark(kept_mark_);
+  if (completes_production(run)) continue_production(run);
 }
 
 template <int D>
@@ -99,6 +179,8 @@ void ThermoOutput<D>::equilibration_ends(const RunContext<D>& run, bool stopped)
 
 template <int D>
 void ThermoOutput<D>::production_starts(const RunContext<D>& run) {
+  if (production_continued_) return;  // an earlier invocation's, restored
+  production_started_ = true;
   production_start_ = run.integrator().point();
   production_ke_ = run.integrator().thermal_energy();
   production_held_ = run.integrator().held_degrees_of_freedom();
@@ -117,6 +199,14 @@ void ThermoOutput<D>::record(RunProgress& progress) const {
   progress.mark_virial = kept_mark_.virial;
   progress.mark_events = kept_mark_.events;
   progress.mark_collisions = kept_mark_.collisions;
+  // Kept by the driver only for an unfinished production (RunDriver::progress_now).
+  progress.has_production_start = production_started_;
+  progress.production_start_time = production_start_.time;
+  progress.production_start_virial = production_start_.virial;
+  progress.production_start_events = production_start_.events;
+  progress.production_start_collisions = production_start_.collisions;
+  progress.production_start_thermal_energy = production_ke_;
+  progress.production_start_held = production_held_;
 }
 
 template <int D>
@@ -190,6 +280,14 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
   j["compressibility"] = z;
   set_or_explain(j, j, "pressure", th.pressure(z_mean, kT_production), why, "pressure");
   j["production_temperature"] = kT_production;
+  // A continued run says what its production averages cover (a new run: its production).
+  if (run.restarted()) {
+    j["production_covers"] =
+        production_continued_
+            ? "the whole production, begun by an earlier invocation of this run in this "
+              "directory (completed from its restart file)"
+            : "the production of this invocation";
+  }
   const std::string no_collision =
       production_collisions == 0 ? "no collision in the production" : "";
   set_or_explain(j, j, "mean_free_time", th.mean_free_time(production_time, production_collisions),
@@ -205,6 +303,8 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
   j["mean_free_time_stderr_reliable"] = mft_stderr_why.empty() && mft_blocks.reliable && u_steady;
 }
 
+template bool completes_production<2>(const RunContext<2>&);
+template bool completes_production<3>(const RunContext<3>&);
 template class ThermoOutput<2>;
 template class ThermoOutput<3>;
 

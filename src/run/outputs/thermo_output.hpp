@@ -58,6 +58,12 @@ class ThermoOutput final : public Observer<D> {
   // production rows' values (NaN mean without production time or at kT = 0).
   BlockAverage production_compressibility(const Integrator<D>& integrator) const;
   const Thermodynamics& statistics() const { return *stats_; }
+  // A run completing the production an earlier invocation of it left unfinished, in the same
+  // directory with the same physics (completes_production): the kept production rows' column
+  // `name` of thermo.tsv as that invocation wrote them (every digit: %.17g), for the observers
+  // that sample at the rows (the stepped energy, the walls with mass); null otherwise or for a
+  // column the file lacks.
+  const std::vector<double>* earlier_production_column(const std::string& name) const;
 
  private:
   // A row not yet written for the present: new collisions, or (timed) time gone by.
@@ -80,6 +86,21 @@ class ThermoOutput final : public Observer<D> {
   // under their fast noise, so their error bars are reliable only when its own is.
   std::vector<double> production_potential_energies_;
   std::uint64_t events_start_ = 0, collisions_start_ = 0;  // of this invocation
+  bool production_started_ = false;
+  // The production is an earlier invocation's, continued: its start and rows restored.
+  bool production_continued_ = false;
+  std::vector<std::string> earlier_columns_;
+  std::vector<std::vector<double>> earlier_rows_;  // per column, the kept production rows
+
+  // Restores the production's start from the restart file and its rows from thermo.tsv.
+  void continue_production(const RunContext<D>& run);
 };
+
+// Whether a continued run completes the production its restart file left unfinished, in the
+// same directory (its thermo.tsv holds that production's kept rows) and with the same physics
+// (a bit-identical continuation, the run length not given anew): then summary.json's averages
+// over the production rows cover the whole production, as one uninterrupted run's.
+template <int D>
+bool completes_production(const RunContext<D>& run);
 
 }  // namespace kairos

@@ -9,6 +9,18 @@
 namespace kairos {
 
 template <int D>
+void WallsWithMassSummary<D>::open(const RunContext<D>& run) {
+  const std::vector<WallReading> walls = run.integrator().walls_with_mass();
+  for (const WallReading& w : walls) {
+    const auto* position = thermo_.earlier_production_column("wall_" + w.face + "_position");
+    const auto* speed = thermo_.earlier_production_column("wall_" + w.face + "_speed");
+    if (position == nullptr || speed == nullptr) return;  // a new production
+    positions_.push_back(*position);
+    speeds_.push_back(*speed);
+  }
+}
+
+template <int D>
 void WallsWithMassSummary<D>::sample(const RunContext<D>& run) {
   const std::vector<WallReading> walls = run.integrator().walls_with_mass();
   if (positions_.empty()) {
