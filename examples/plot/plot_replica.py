@@ -34,7 +34,11 @@ def main():
     count = len(rungs)
     replica_at = np.array([table["replica_%d" % k] for k in range(count)])  # [rung][round]
 
-    import matplotlib
+    try:
+        import matplotlib
+    except ModuleNotFoundError:
+        sys.exit("%s: drawing needs matplotlib: sudo apt-get install python3-matplotlib"
+                 % os.path.basename(sys.argv[0]))
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 

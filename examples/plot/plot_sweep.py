@@ -99,8 +99,11 @@ def main():
                 f.write("%r\t%s\t%r\t%r\t%d\n" % (xv, g, mean, error, n))
     if not args.output:
         return
-    import matplotlib
-
+    try:
+        import matplotlib
+    except ModuleNotFoundError:
+        sys.exit("%s: drawing needs matplotlib: sudo apt-get install python3-matplotlib"
+                 % os.path.basename(sys.argv[0]))
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 

@@ -1,5 +1,6 @@
 // The Python module `kairos` (pybind11): kairos.run, the CLI's `kairos run` as a function,
-// kairos.Simulation, an event-driven simulation held in memory (run/simulation.hpp) whose state
+// kairos.Simulation, a simulation held in memory (run/simulation.hpp: the event engine or the
+// DEM) whose state
 // and analyses (run/simulation_analyses.hpp) come back as NumPy arrays, and kairos.Correlator,
 // the multiple-tau correlator of analysis.msd (analysis/msd.hpp) fed by the user.
 // kairos.sweep and kairos.replica_exchange are in runner_bindings.cpp, the helpers both files
@@ -828,6 +829,9 @@ class PySimulation {
       out["field"] = e.field;
       out["dissipated"] = e.dissipated;
       out["work_by_walls"] = e.work_by_walls;
+      out["work_by_driving"] = e.work_by_driving;
+      out["work_by_shear"] = e.work_by_shear;
+      out["taken_out"] = e.taken_out;
       return out;
     });
   }
@@ -1129,8 +1133,10 @@ PYBIND11_MODULE(kairos, m) {
   using kairos::PyCorrelator;
   using kairos::PySimulation;
   m.doc() =
-      "Kairos, event-driven particle dynamics: kairos.run (the `kairos run` command) and "
-      "kairos.Simulation (a simulation in memory, its state as NumPy arrays). docs/python.md.";
+      "Kairos, event-driven particle dynamics: kairos.run (the `kairos run` command), "
+      "kairos.Simulation (a simulation in memory, its state as NumPy arrays, its analyses), "
+      "kairos.Correlator (the multiple-tau correlator), kairos.sweep and "
+      "kairos.replica_exchange (grids of runs and parallel tempering). docs/python.md.";
   m.attr("__version__") = KAIROS_VERSION;
   // A configuration or state the user must fix; Python's ValueError family.
   py::register_exception<kairos::InputError>(m, "InputError", PyExc_ValueError);
@@ -1160,13 +1166,28 @@ PYBIND11_MODULE(kairos, m) {
         const bool overwrite = kairos::flag_from(overwrite_arg, "overwrite");
         kairos::Config c = kairos::config_from(config, set);
         if (output) c.output.directory = output->string();
+        // The call as the provenance's command line: its arguments as Python spells them (TOML
+        // text given inline as <TOML text>).
+        const bool inline_text = py::isinstance<py::str>(config) &&
+                                 config.cast<std::string>().find('\n') != std::string::npos;
+        std::string call = "kairos.run(" + (inline_text ? std::string("<TOML text>")
+                                                        : py::repr(config).cast<std::string>());
+        for (const auto& [name, value] :
+             {std::pair<const char*, const py::object*>{"output", &output_arg},
+              {"set", &set},
+              {"restart", &restart_arg}}) {
+          if (!value->is_none())
+            call += fmt::format(", {}={}", name, py::repr(*value).cast<std::string>());
+        }
+        if (overwrite) call += ", overwrite=True";
+        call += ")";
         const kairos::RunOutcome outcome = [&] {
           kairos::SigintStopsRun sigint;
           const kairos::ScopedStopDeadline setup_limit(c.run.max_wall_seconds);
           py::gil_scoped_release release;  // the run is C++ throughout
           kairos::RunOptions options;
           options.overwrite = overwrite;
-          options.command_line = "kairos.run (the Python module)";
+          options.command_line = call;
           return kairos::run_simulation(c, restart, options);
         }();
         if (outcome.summary.value("stop_reason", "") == "signal") {
@@ -1189,9 +1210,10 @@ PYBIND11_MODULE(kairos, m) {
   kairos::bind_runners(m);  // kairos.sweep, kairos.replica_exchange (runner_bindings.cpp)
 
   py::class_<PySimulation>(m, "Simulation",
-                           "An event-driven simulation in memory: the engine of `kairos run` "
-                           "started from the same configuration (bit-identical trajectory), "
-                           "advanced on request, without output files.")
+                           "A simulation in memory: the integrator of `kairos run` (the event "
+                           "engine, or the DEM with run.integrator = \"dem\") started from the "
+                           "same configuration (bit-identical trajectory), advanced on request, "
+                           "without output files.")
       .def(py::init<const py::object&, const py::object&, const py::object&, const py::object&,
                     const py::object&>(),
            py::arg("config"), py::arg("set") = py::none(), py::arg("restart") = py::none(),
@@ -1245,7 +1267,8 @@ PYBIND11_MODULE(kairos, m) {
       .def_property_readonly("integrator", &PySimulation::integrator, "\"event\" or \"dem\".")
       .def("energies", &PySimulation::energies,
            "The energies now and the work and dissipation since the state's start: kinetic, "
-           "rotational, potential, field (gravity), dissipated, work_by_walls (docs/python.md).")
+           "rotational, potential, field (gravity), dissipated, work_by_walls, work_by_driving, "
+           "work_by_shear, taken_out (docs/python.md).")
       .def("momentum", &PySimulation::momentum, "The total momentum, (D,).")
       .def("max_overlap", &PySimulation::max_overlap,
            "The largest overlap of any pair now (0 for hard particles up to round-off).")

@@ -421,6 +421,11 @@ typename Simulation<D>::Energies Simulation<D>::energies() const {
   if (engine_ != nullptr && !engine_->environment().has_gravity()) e.field = 0.0;
   e.dissipated = in.dissipated_energy();
   e.work_by_walls = in.work_by_walls();
+  if (engine_ != nullptr) {
+    e.work_by_driving = engine_->counters().work_by_driving;
+    e.work_by_shear = engine_->counters().work_by_shear;
+  }
+  if (const auto outlet = in.outlet()) e.taken_out = outlet->energy;
   return e;
 }
 template <int D>
@@ -526,6 +531,7 @@ const std::array<double, 9>& Simulation<D>::virial_tensor() const {
 
 template <int D>
 void Simulation<D>::set_thermostat_temperature(double temperature) {
+  EventEngineAdapter<D, CalendarQueue>& engine = event_engine("set_thermostat_temperature");
   if (!driving_kinds().is(config_.driving.kind, DrivingKind::kAndersen)) {
     throw InputError(fmt::format(
         "set_thermostat_temperature: the simulation has no Andersen thermostat (driving.kind = "
@@ -540,7 +546,7 @@ void Simulation<D>::set_thermostat_temperature(double temperature) {
         "times system.temperature = {}",
         temperature, kT));
   }
-  event_engine("set_thermostat_temperature").set_driving_temperature(temperature);
+  engine.set_driving_temperature(temperature);
   config_.driving.temperature = temperature;
   progress_.config = to_toml(config_);  // what save() stores: a restart continues at it
 }

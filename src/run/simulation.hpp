@@ -135,12 +135,15 @@ class Simulation {
   // rotational; potential (the stepped potentials', or the elastic energy of soft contacts);
   // field (in gravity, -sum m g.x over the particles that move; NaN along a periodic axis, 0
   // without); dissipated (in collisions and at walls; the DEM: the damping's and friction's
-  // work); work_by_walls (what moving walls gave the particles). Without driving, shear or an
-  // outlet, kinetic + rotational + potential + field + dissipated - work_by_walls is constant
-  // (to round-off for the event engine, to O(dt^2) for the DEM).
+  // work); work_by_walls (what moving walls gave the particles), work_by_driving ([driving]
+  // kicks), work_by_shear (Lees-Edwards images), taken_out (what particles took out through an
+  // outlet). kinetic + rotational + potential + field + dissipated + taken_out - work_by_walls -
+  // work_by_driving - work_by_shear is constant (to round-off for the event engine, to O(dt^2)
+  // for the DEM; under shear with box-frame velocities).
   struct Energies {
     double kinetic = 0.0, rotational = 0.0, potential = 0.0, field = 0.0;
-    double dissipated = 0.0, work_by_walls = 0.0;
+    double dissipated = 0.0, work_by_walls = 0.0, work_by_driving = 0.0, work_by_shear = 0.0;
+    double taken_out = 0.0;
   };
   Energies energies() const;
   Vec<D> momentum() const;

@@ -64,7 +64,7 @@ class Install(kt.KairosTestCase):
         self.assertIn("kairos", result.stdout)
         for rel in ("lib/libkairos_core.a", "include/kairos/engine/event_engine.hpp",
                     "include/kairos/core/vec.hpp", "share/kairos/examples/hard_spheres_3d.toml",
-                    "share/doc/kairos/config.md", "share/doc/kairos/README.md"):
+                    "share/doc/kairos/docs/config.md", "share/doc/kairos/README.md"):
             self.assertTrue(os.path.isfile(os.path.join(prefix, rel)), rel)
         self.assertFalse(os.path.exists(os.path.join(prefix, "include/kairos/cli")))
         # An installed example runs from the installed CLI.
