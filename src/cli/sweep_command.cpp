@@ -44,6 +44,11 @@ class Sweep final : public SweepCommand {
         "--workers", workers_,
         "Runs at a time on this machine (default: its cores); under mpirun, per rank "
         "(default 1)");
+    command_
+        ->add_option("--status-interval", status_seconds_,
+                     "Wall seconds between status lines (runs done, running, waiting, ETA) on "
+                     "stdout and in sweep.log (default 60; 0: none)")
+        ->check(CLI::Range(0.0, 1e9));
     command_->add_flag("--dry-run", dry_run_,
                        "List the runs and their commands; run nothing, write nothing");
     command_->footer(
@@ -70,7 +75,8 @@ class Sweep final : public SweepCommand {
     const int workers = workers_option_->count() > 0
                             ? workers_
                             : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-    const LocalSweepOutcome outcome = run_local_sweep(plan, {this_executable(), workers, ""});
+    const LocalSweepOutcome outcome =
+        run_local_sweep(plan, {this_executable(), workers, "", status_seconds_});
     return conclude(plan, outcome.tally, outcome.states, stop_signal);
   }
 
@@ -112,13 +118,15 @@ class Sweep final : public SweepCommand {
     try {
       const int workers = workers_option_->count() > 0 ? workers_ : 1;
       if (root) {
-        fmt::print("kairos sweep: {} runs in {}/ on {} MPI ranks, {} at a time on each\n",
-                   plan->points.size(), plan->directory.string(), session.size(), workers);
-        std::fflush(stdout);
+        announce(*plan, fmt::format("kairos sweep: {} runs in {}/ on {} MPI ranks, {} at a time on "
+                                    "each",
+                                    plan->points.size(), plan->directory.string(), session.size(),
+                                    workers));
       }
       const std::unique_ptr<SweepWork> work = mpi_sweep_work(session, plan->points.size());
       const SweepTally tally = run_sweep(
-          *plan, *work, {this_executable(), workers, fmt::format("rank {}: ", session.rank())});
+          *plan, *work,
+          {this_executable(), workers, fmt::format("rank {}: ", session.rank()), status_seconds_});
       // Rank 0's runner returned once every rank was told that nothing is left (or left): the
       // runs have ended, and the table can be written while the others wait.
       if (!root) {
@@ -145,34 +153,35 @@ class Sweep final : public SweepCommand {
     auto count = [&](SweepRunState s) { return std::count(states.begin(), states.end(), s); };
     const auto failed = count(SweepRunState::kFailed);
     const auto finished = count(SweepRunState::kFinished);
-    fmt::print(
-        "kairos sweep: {} of {} runs finished, {} failed, {} stopped, {} not run; results in "
-        "{}\n",
-        finished, states.size(), failed, count(SweepRunState::kStopped),
-        count(SweepRunState::kNotRun), (plan.directory / "results.tsv").string());
-    std::fflush(stdout);
+    announce(plan,
+             fmt::format("kairos sweep: {} of {} runs finished, {} failed, {} stopped, {} "
+                         "not run; results in {}",
+                         finished, states.size(), failed, count(SweepRunState::kStopped),
+                         count(SweepRunState::kNotRun), (plan.directory / "results.tsv").string()));
     if (tally.interrupted) {
-      std::fprintf(stderr,
-                   "kairos sweep: stopped; the same command continues the sweep (stopped runs "
-                   "from their restart files)\n");
+      announce(plan,
+               "kairos sweep: stopped; the same command continues the sweep (stopped runs from "
+               "their restart files)",
+               stderr);
       return 128 + stop_signal();
     }
     if (failed > 0) {
-      std::fprintf(stderr, "kairos: error: %ld of %zu runs failed (state 'failed' in %s)\n",
-                   static_cast<long>(failed), states.size(),
-                   (plan.directory / "results.tsv").c_str());
+      announce(plan,
+               fmt::format("kairos: error: {} of {} runs failed (state 'failed' in {})", failed,
+                           states.size(), (plan.directory / "results.tsv").string()),
+               stderr);
       return 2;
     }
     if (finished < static_cast<long>(states.size())) {
       // Stopped by run.max_wall_seconds or by a signal sent to the runs themselves, or not
       // started (a process could not be made).
-      std::fprintf(stderr,
-                   "kairos: error: %zu of %zu runs did not finish (%ld stopped, %ld not run: "
-                   "%s); the same command continues them\n",
-                   states.size() - static_cast<std::size_t>(finished), states.size(),
-                   static_cast<long>(count(SweepRunState::kStopped)),
-                   static_cast<long>(count(SweepRunState::kNotRun)),
-                   (plan.directory / "results.tsv").c_str());
+      announce(plan,
+               fmt::format("kairos: error: {} of {} runs did not finish ({} stopped, {} not run: "
+                           "{}); the same command continues them",
+                           states.size() - static_cast<std::size_t>(finished), states.size(),
+                           count(SweepRunState::kStopped), count(SweepRunState::kNotRun),
+                           (plan.directory / "results.tsv").string()),
+               stderr);
       return 2;
     }
     return 0;
@@ -185,6 +194,7 @@ class Sweep final : public SweepCommand {
   std::vector<std::string> vary_;
   std::vector<std::string> overrides_;
   int workers_ = 1;
+  double status_seconds_ = 60.0;
   bool dry_run_ = false;
 };
 

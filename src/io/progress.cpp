@@ -10,7 +10,8 @@
 namespace kairos {
 
 std::string format_duration(double seconds) {
-  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
+  if (!std::isfinite(seconds) || seconds < 0 || seconds > 1e15)
+    return "--:--";  // unknown, or beyond 1e15 s (a long long holds it, with room)
   const auto s = static_cast<long long>(seconds + 0.5);
   return s >= 3600 ? fmt::format("{}:{:02}:{:02}", s / 3600, (s / 60) % 60, s % 60)
                    : fmt::format("{:02}:{:02}", s / 60, s % 60);

@@ -24,6 +24,8 @@
 #include "io/config_obstacles.hpp"
 #include "io/directory_manifest.hpp"
 #include "io/line_file.hpp"
+#include "io/log_file.hpp"
+#include "io/progress.hpp"
 #include "replica/exchange_rule.hpp"
 #include "replica/exchange_statistics.hpp"
 #include "run/provenance.hpp"
@@ -38,6 +40,7 @@ using Clock = std::chrono::steady_clock;
 constexpr const char* kManifest = "replica.json";
 constexpr const char* kConfigCopy = "replica-config.toml";
 constexpr const char* kExchangeTable = "exchange.tsv";
+constexpr const char* kLogFile = "replica-exchange.log";  // what the root printed, stamped
 constexpr const char* kCheckpoint = "checkpoint";
 constexpr const char* kCheckpointNew = "checkpoint.new";
 constexpr const char* kCheckpointOld = "checkpoint.old";
@@ -351,18 +354,25 @@ ReplicaExchangeOutcome run_ensemble(const ReplicaExchangePlan& plan, const Repli
   }
   LocalReplicas<D> replicas(plan, comm, checkpoint, state);
   std::optional<LineFile> table;
+  LogFile log;
+  // A line on stdout and in the log (the root's).
+  const auto say = [&](const std::string& line) {
+    fmt::print("{}\n", line);
+    std::fflush(stdout);
+    log.line(line);
+  };
   if (root) {
+    log.open(settings.directory / kLogFile);
     const fs::path path = settings.directory / kExchangeTable;
     // Cut back to the checkpoint's rounds (claim_replica_directory refused a table with fewer).
     table.emplace(path, exchange_header(rungs), state.round);
-    fmt::print(
-        "kairos replica-exchange: {} replicas of {} particles ({}D) at T = {} .. {}, "
-        "{}{} rounds of {} time units, in {}/\n",
-        rungs, replicas.particles(), D, number(plan.temperatures.front()),
-        number(plan.temperatures.back()),
-        checkpoint ? fmt::format("continuing at round {} of ", state.round) : "",
-        settings.exchanges, number(settings.interval), settings.directory.string());
-    std::fflush(stdout);
+    say(
+        fmt::format("kairos replica-exchange: {} replicas of {} particles ({}D) at T = {} .. {}, "
+                    "{}{} rounds of {} time units, in {}/",
+                    rungs, replicas.particles(), D, number(plan.temperatures.front()),
+                    number(plan.temperatures.back()),
+                    checkpoint ? fmt::format("continuing at round {} of ", state.round) : "",
+                    settings.exchanges, number(settings.interval), settings.directory.string()));
   }
 
   ReplicaExchangeOutcome outcome;
@@ -397,14 +407,25 @@ ReplicaExchangeOutcome run_ensemble(const ReplicaExchangePlan& plan, const Repli
     if (root && (seconds_since(last_line) >= 10.0 || state.round == settings.exchanges)) {
       const double rate =
           static_cast<double>(state.round - first_round) / std::max(1e-9, seconds_since(start));
-      fmt::print("kairos replica-exchange: round {}/{}, t = {}, {:.3g} rounds/s, acceptance {}\n",
-                 state.round, settings.exchanges, number(t), rate, acceptance_text(state));
-      std::fflush(stdout);
+      say(fmt::format(
+          "kairos replica-exchange: round {}/{}, t = {}, {:.3g} rounds/s, ETA {}, "
+          "acceptance {}",
+          state.round, settings.exchanges, number(t), rate,
+          format_duration(rate > 0.0 ? static_cast<double>(settings.exchanges - state.round) / rate
+                                     : -1.0),
+          acceptance_text(state)));
       last_line = Clock::now();
     }
     if (stop) break;
   }
   outcome.rounds = state.round;
+  if (root) {
+    log.line(fmt::format("end: {} after {} rounds of {}; {} of wall time",
+                         outcome.wall_limit ? "run.max_wall_seconds reached"
+                         : outcome.stopped  ? "stopped by a signal"
+                                            : "completed",
+                         state.round, settings.exchanges, format_duration(seconds_since(start))));
+  }
   if (root && state.round == settings.exchanges && state.round > 0) {
     ExchangeResults results = read_exchange_table(settings.directory / kExchangeTable, rungs);
     outcome.summary =

@@ -1,11 +1,6 @@
 #include "run/run_log.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
 #include <ctime>
 
 #include <fmt/format.h>
@@ -14,17 +9,8 @@ namespace kairos {
 
 namespace {
 
-// The wall-clock time of a line: UTC, ISO 8601, to the second.
-std::string utc(std::time_t at) {
-  std::tm utc{};
-  gmtime_r(&at, &utc);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return text;
-}
-
 std::string utc_now() {
-  return utc(std::time(nullptr));
+  return utc_time(std::time(nullptr));
 }
 
 }  // namespace
@@ -34,9 +20,7 @@ RunLog::RunLog(double interval_seconds, bool echo)
       echo_(echo),
       created_(std::time(nullptr)) {}
 
-RunLog::~RunLog() {
-  if (fd_ >= 0) ::close(fd_);
-}
+RunLog::~RunLog() = default;
 
 void RunLog::note(const std::string& text) {
   if (!enabled()) return;
@@ -68,16 +52,12 @@ void RunLog::setup_step(const std::string& step, const std::string& detail) {
 void RunLog::open(const std::filesystem::path& file, const std::vector<std::string>& header,
                   const std::vector<std::string>& trailer) {
   if (!enabled()) return;
-  file_ = file;
-  fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
-  if (fd_ < 0) {
-    std::fprintf(stderr, "kairos: warning: cannot open %s: %s; the run goes on without its log\n",
-                 file.c_str(), std::strerror(errno));
-    interval_ = 0.0;
+  if (!file_.open(file)) {
+    interval_ = 0.0;  // the run goes on without its log
     return;
   }
-  for (const std::string& h : header) write(utc(created_) + " " + h + "\n");
-  for (const std::string& n : noted_) write(n + "\n");
+  for (const std::string& h : header) write(utc_time(created_) + " " + h);
+  for (const std::string& n : noted_) write(n);
   noted_.clear();
   for (const std::string& t : trailer) line(t);
 }
@@ -93,21 +73,14 @@ void RunLog::progress(const ProgressInfo& info, bool force) {
 }
 
 void RunLog::line(const std::string& text) {
-  if (fd_ < 0) return;
-  write(utc_now() + " " + text + "\n");
+  if (!file_.is_open()) return;
+  write(utc_now() + " " + text);
 }
 
-// Whole lines by one write(2) each (O_APPEND: a line is never interleaved or torn by a
-// concurrent writer); a short write or an error ends the log.
-void RunLog::write(const std::string& text) {
-  if (fd_ < 0) return;
-  const ssize_t written = ::write(fd_, text.data(), text.size());
-  if (written == static_cast<ssize_t>(text.size())) return;
-  std::fprintf(stderr, "kairos: warning: cannot write %s: %s; no further log lines\n",
-               file_.c_str(), written < 0 ? std::strerror(errno) : "short write");
-  ::close(fd_);
-  fd_ = -1;
-  interval_ = 0.0;
+// A failed write ends the log (LogFile) and with it the progress lines.
+void RunLog::write(const std::string& stamped_line) {
+  file_.stamped(stamped_line);
+  if (!file_.is_open()) interval_ = 0.0;
 }
 
 }  // namespace kairos

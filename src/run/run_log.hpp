@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "io/log_file.hpp"
 #include "io/progress.hpp"
 
 namespace kairos {
@@ -51,13 +52,12 @@ class RunLog {
 
  private:
   using Clock = PhaseClock::Clock;
-  void write(const std::string& text);
+  void write(const std::string& stamped_line);
   void echo(const std::string& text) const;  // on stdout in a batch job
 
   double interval_ = 0.0;
   bool echo_ = false;
-  int fd_ = -1;
-  std::filesystem::path file_;
+  LogFile file_;
   std::time_t created_;
   std::vector<std::string> noted_;
   std::string step_;

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -17,6 +18,7 @@
 
 #include "core/error.hpp"
 #include "core/stop_flag.hpp"
+#include "io/log_file.hpp"
 #include "io/progress.hpp"
 #include "run/output_directory.hpp"
 #include "run/provenance.hpp"
@@ -125,6 +127,13 @@ fs::path this_executable() {
   return exe;
 }
 
+void announce(const SweepPlan& plan, const std::string& line, std::FILE* stream) {
+  std::fprintf(stream, "%s\n", line.c_str());
+  std::fflush(stream);
+  LogFile log;
+  if (log.open(plan.directory / kSweepLogFile)) log.line(line);
+}
+
 SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOptions& options) {
   SweepTally tally;
   std::vector<Child> running;
@@ -132,9 +141,38 @@ SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOp
   bool stopping = false;
   bool start_failed = false;
   const std::size_t workers = static_cast<std::size_t>(std::max(1, options.workers));
+  LogFile log;
+  log.open(plan.directory / kSweepLogFile);
   auto say = [&](const std::string& line) {
     fmt::print("{}{}\n", options.label, line);
     std::fflush(stdout);
+    log.line(options.label + line);
+  };
+  const auto began = Clock::now();
+  auto last_status = began;
+  double finished_seconds = 0.0;  // wall time of the runs that ended in this invocation
+  std::size_t ended = 0;
+  // Runs finished, failed, skipped, running and waiting, the time so far and the ETA: the mean
+  // wall time of the runs ended so far for each run left, shared among the workers.
+  auto print_status = [&] {
+    const std::optional<std::size_t> waiting = work.waiting();
+    std::string eta = "ETA unknown (no run ended yet)";
+    if (ended > 0 && waiting) {
+      // A running run has the mean less its time so far left (at least nothing), a waiting
+      // one the mean.
+      const double mean = finished_seconds / static_cast<double>(ended);
+      double left = mean * static_cast<double>(*waiting);
+      for (const Child& c : running) left += std::max(0.0, mean - seconds_since(c.start));
+      eta = "ETA " + format_duration(left / static_cast<double>(workers));
+    } else if (!waiting) {
+      eta = "ETA: see rank 0's share of the runs";
+    }
+    say(
+        fmt::format("status: {} finished, {} failed, {} skipped as done, {} running{}; {} so "
+                    "far, {}",
+                    tally.finished, tally.failed, tally.skipped, running.size(),
+                    waiting ? fmt::format(", {} waiting", *waiting) : std::string(),
+                    format_duration(seconds_since(began)), eta));
   };
 
   auto start = [&](std::size_t index) {
@@ -174,6 +212,8 @@ SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOp
   };
 
   auto finish = [&](const Child& child, int status) {
+    finished_seconds += seconds_since(child.start);
+    ++ended;
     const SweepPoint& point = plan.points[child.index];
     const fs::path dir = plan.run_directory(point);
     const fs::path console = dir / kSweepConsoleFile;
@@ -247,6 +287,11 @@ SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOp
       finish(child, status);
     }
     if (running.empty() && (exhausted || stopping || start_failed) && !work.serving()) break;
+    if (options.status_seconds > 0.0 && !running.empty() &&
+        seconds_since(last_status) >= options.status_seconds) {
+      print_status();
+      last_status = Clock::now();
+    }
     work.serve();
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
@@ -257,9 +302,8 @@ LocalSweepOutcome run_local_sweep(const SweepPlan& plan, const SweepRunnerOption
   make_sweep_directory(plan);
   const SweepDirectoryLock lock(plan.directory);
   claim_sweep_directory(plan);
-  fmt::print("kairos sweep: {} runs in {}/, {} at a time\n", plan.points.size(),
-             plan.directory.string(), options.workers);
-  std::fflush(stdout);
+  announce(plan, fmt::format("kairos sweep: {} runs in {}/, {} at a time", plan.points.size(),
+                             plan.directory.string(), options.workers));
   LocalSweepWork work(plan.points.size());
   LocalSweepOutcome outcome;
   outcome.tally = run_sweep(plan, work, options);

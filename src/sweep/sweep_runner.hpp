@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -33,6 +34,8 @@ class SweepWork {
   virtual bool serving() const { return false; }
   // No new work is to be handed out (a stop was requested).
   virtual void stop() {}
+  // Points not handed out yet, when this process knows (for the ETA of the status lines).
+  virtual std::optional<std::size_t> waiting() const { return std::nullopt; }
 };
 
 // Every point, in order: a sweep on this machine only.
@@ -44,6 +47,7 @@ class LocalSweepWork final : public SweepWork {
     return next_++;
   }
   void stop() override { stopped_ = true; }
+  std::optional<std::size_t> waiting() const override { return stopped_ ? 0 : count_ - next_; }
 
  private:
   std::size_t count_;
@@ -64,10 +68,18 @@ struct SweepRunnerOptions {
   std::filesystem::path executable;  // the kairos binary the children run
   int workers = 1;                   // children at a time
   std::string label;                 // prefix of the progress lines ("" or "rank 3: ")
+  // Wall seconds between status lines (runs finished, running, waiting, elapsed, ETA); 0: none.
+  double status_seconds = 60.0;
 };
 
+// The sweep's log in its directory: every line the sweep prints, stamped with the UTC time,
+// appended by every invocation and every MPI rank (io/log_file.hpp).
+inline constexpr const char* kSweepLogFile = "sweep.log";
+// A line of the sweep's own (its banner, its last line, its errors) on `stream` and in the log.
+void announce(const SweepPlan& plan, const std::string& line, std::FILE* stream = stdout);
+
 // Runs the points `work` hands out until it has none left (or a stop is requested), printing one
-// line per run to stdout.
+// line per run to stdout and to sweep.log, and a status line every options.status_seconds.
 SweepTally run_sweep(const SweepPlan& plan, SweepWork& work, const SweepRunnerOptions& options);
 
 // A sweep on this machine from start to end: claims the directory (sweep.json, the lock), runs

@@ -13,6 +13,7 @@
 
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -270,6 +271,18 @@ class ReplicaExchange(kt.KairosTestCase):
         with open(os.path.join(out, "exchange.tsv"), "rb") as f, \
                 open(os.path.join(whole, "exchange.tsv"), "rb") as g:
             self.assertEqual(f.read(), g.read())
+        # replica-exchange.log keeps every invocation's lines, stamped: a banner and an end each
+        # (the last one completed), and the progress lines with their ETA.
+        with open(os.path.join(out, "replica-exchange.log")) as f:
+            lines = f.read().splitlines()
+        self.assertTrue(all(re.match(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ ", l) for l in lines))
+        banners = [l for l in lines if "replicas of 32 particles" in l]
+        ends = [l for l in lines if " end: " in l]
+        self.assertGreater(len(banners), 1)
+        self.assertEqual(len(banners), len(ends))
+        self.assertIn("run.max_wall_seconds reached", ends[0])
+        self.assertIn("completed after", ends[-1])
+        self.assertTrue(any("rounds/s, ETA " in l for l in lines))
 
     def test_mpi_ranks_give_the_same_ensemble(self):
         reason = kt.mpi_unavailable()

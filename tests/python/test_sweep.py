@@ -15,6 +15,7 @@ import hashlib
 import importlib.util
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -283,6 +284,33 @@ class Sweep(kt.KairosTestCase):
                            ("mean_free_time", reference["mean_free_time"])):
             self.assertEqual(float(row[key]), value, key)
         self.assertIn("whole production", row["production_covers"])
+
+    def test_status_lines_and_the_log(self):
+        # A status line every --status-interval (runs finished, running, waiting, the time so
+        # far, the ETA once a run has ended) on stdout; every line of stdout also in sweep.log,
+        # stamped, and a continued sweep appends to it.
+        config = self.config(particles=2000, production=100.0)
+        sweep = self.path("sweep")
+        result = self.sweep(config, "-o", sweep, "--vary", "system.seed=1..3", "--workers", "1",
+                            "--status-interval", "0.02")
+        self.assertEqual(result.returncode, 0, kt.describe(result))
+        status = [l for l in result.stdout.splitlines() if l.startswith("status: ")]
+        self.assertTrue(status, result.stdout)
+        self.assertRegex(status[0], r"status: 0 finished, 0 failed, 0 skipped as done, 1 running, "
+                                    r"2 waiting; \d\d:\d\d so far, ETA unknown")
+        self.assertTrue(any(re.search(r"1 finished.*, ETA \d\d:\d\d$", l) for l in status),
+                        status)
+        with open(os.path.join(sweep, "sweep.log")) as f:
+            logged = f.read().splitlines()
+        stamp = re.compile(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ ")
+        self.assertTrue(all(stamp.match(l) for l in logged), logged)
+        self.assertEqual([l[21:] for l in logged], result.stdout.splitlines())
+        again = self.sweep(config, "-o", sweep, "--vary", "system.seed=1..3")
+        self.assertEqual(again.returncode, 0, kt.describe(again))
+        with open(os.path.join(sweep, "sweep.log")) as f:
+            appended = f.read().splitlines()
+        self.assertEqual(appended[:len(logged)], logged)
+        self.assertEqual([l[21:] for l in appended[len(logged):]], again.stdout.splitlines())
 
     def test_a_failing_run_is_reported_and_the_others_finish(self):
         # 30 particles at packing fraction 0.66 from a random start: the config is valid, but
