@@ -812,6 +812,22 @@ class PySimulation {
       out["mean_free_time"] = m.span.mean_free_time;
       out["completed"] = m.span.completed;
       out["why"] = m.undefined.empty() ? py::object(py::none()) : py::object(py::str(m.undefined));
+      const auto d = static_cast<std::size_t>(dimension_of(s));
+      out["pressure_tensor"] =
+          m.tensor
+              ? py::object(matrix_of(
+                    d, d, [&](std::size_t a, std::size_t b) { return (*m.tensor)[a * d + b]; }))
+              : py::object(py::none());
+      if (m.shear_stress) {
+        py::dict shear;
+        shear["shear_rate"] = m.shear_rate;
+        shear["shear_stress"] = m.shear_stress->mean;
+        shear["shear_stress_stderr"] = m.shear_stress->stderr_;
+        shear["viscosity"] = -m.shear_stress->mean / m.shear_rate;
+        shear["viscosity_stderr"] = m.shear_stress->stderr_ / std::abs(m.shear_rate);
+        shear["samples"] = m.shear_stress->samples;
+        out["shear"] = shear;
+      }
       return out;
     });
   }

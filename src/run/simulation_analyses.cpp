@@ -12,6 +12,7 @@
 #include "run/event_adapter.hpp"
 #include "run/outputs/bond_order_output.hpp"
 #include "run/outputs/msd_output.hpp"
+#include "run/outputs/pressure_tensor.hpp"
 #include "run/outputs/rdf_output.hpp"
 #include "run/outputs/sampling_interval.hpp"
 #include "run/outputs/structure_factor_output.hpp"
@@ -318,12 +319,30 @@ PressureMeasurement measure_pressure(Simulation<D>& sim, const CorrelationReques
   const double start_ke = integrator.thermal_energy();
   const double start_held = integrator.held_degrees_of_freedom();
   std::vector<double> temperatures;
+  // The event engine's pressure tensor and shear stress, as outputs/pressure_tensor.cpp.
+  const EventIntegrator<D>* engine = integrator.as_event();
+  std::array<double, 9> kinetic_sum{}, virial_start{};
+  if (engine != nullptr) virial_start = engine->counters().virial_tensor;
+  double row_start = sim.time(), row_virial_xy = virial_start[1];
+  std::vector<double> shear_rows;
+  int rows = 0;
   m.span.completed = sim.sample_every(
       request.interval, request.duration,
       [&] {
         const ThermoRow r = stats.row(integrator.point(), integrator.thermal_energy(), true,
                                       integrator.held_degrees_of_freedom());
         temperatures.push_back(r.temperature);
+        if (engine == nullptr) return;
+        const std::array<double, 9> kinetic = engine->peculiar_kinetic_tensor();
+        for (int k = 0; k < D * D; ++k) kinetic_sum[k] += kinetic[k];
+        ++rows;
+        if (engine->kind().sheared && sim.time() > row_start) {
+          const double virial_xy = engine->counters().virial_tensor[1];
+          shear_rows.push_back(shear_stress_row(kinetic[1], virial_xy - row_virial_xy,
+                                                sim.time() - row_start, engine->volume()));
+          row_start = sim.time();
+          row_virial_xy = virial_xy;
+        }
       },
       keep_going);
   const double duration = sim.time() - m.span.start_time;
@@ -333,6 +352,19 @@ PressureMeasurement measure_pressure(Simulation<D>& sim, const CorrelationReques
   m.temperature = integrator.temperature_from_rows() && !temperatures.empty()
                       ? block_average(temperatures).mean
                       : stats.temperature(start_ke, start_held);
+  if (engine != nullptr && rows > 0 && duration > 0.0) {
+    std::array<double, 9> tensor{};
+    for (int k = 0; k < D * D; ++k) {
+      tensor[k] = pressure_tensor_element(kinetic_sum[k], rows,
+                                          engine->counters().virial_tensor[k] - virial_start[k],
+                                          duration, engine->volume());
+    }
+    m.tensor = tensor;
+  }
+  if (engine != nullptr && engine->kind().sheared) {
+    m.shear_stress = block_average(shear_rows);
+    m.shear_rate = engine->environment().shear_rate;
+  }
   m.compressibility = stats.compressibility_blocks();
   m.compressibility.mean =
       stats.compressibility(integrator.virial() - start.virial, m.temperature, duration);

@@ -159,6 +159,12 @@ struct PressureMeasurement {
   double pressure = 0.0, pressure_stderr = 0.0;
   double temperature = 0.0;  // the production temperature the Z is made with
   std::string undefined;
+  // The event engine: the pressure tensor over the span (row-major D x D, as summary.json's
+  // pressure_tensor: the kinetic part averaged over the rows plus the collisional part), and
+  // under Lees-Edwards shear the shear stress P_xy over the rows (blocked) and the rate.
+  std::optional<std::array<double, 9>> tensor;
+  std::optional<BlockAverage> shear_stress;
+  double shear_rate = 0.0;
 };
 // Advances `sim` by request.duration with rows every request.interval (> 0) in simulated time.
 template <int D>

@@ -503,6 +503,26 @@ class Module(kt.KairosTestCase):
                 self.assertEqual(p["rows"], z["blocks"])
                 self.assertEqual(p["pressure"], self.summary(out)["pressure"])
                 self.assertIsNone(p["why"])
+                if integrator == "event":  # the tensor too, as summary.json's
+                    np.testing.assert_array_equal(p["pressure_tensor"],
+                                                  self.summary(out)["pressure_tensor"])
+                    self.assertAlmostEqual(np.trace(p["pressure_tensor"]) / 3, p["pressure"],
+                                           delta=0.02 * p["pressure"])
+                else:
+                    self.assertIsNone(p["pressure_tensor"])
+        # Under Lees-Edwards shear: the shear stress and the viscosity, as summary.json's.
+        with open(kt.example("shear_flow_2d.toml")) as f:
+            cfg = self.write_config(f.read(), "shear.toml")
+        out = self.path("shear")
+        self.run_ok("run", cfg, "-o", out, "--set", "run.time=2.0", "--set",
+                    "run.equilibration_time=0", "--set", 'output.interval_unit="time"', "--set",
+                    "output.thermo_interval=0.25", "--set", "output.trajectory=false")
+        shear = self.summary(out)["shear"]
+        p = kairos.Simulation(cfg).pressure(2.0, interval=0.25)["shear"]
+        for key in ("shear_rate", "shear_stress", "shear_stress_stderr", "viscosity",
+                    "viscosity_stderr", "samples"):
+            self.assertEqual(p[key], shear[key], key)
+        self.assertGreater(p["viscosity"], 0.0)
         # Hard spheres at packing fraction 0.3: the Kolafa-Labik-Malijevsky equation of state
         # (Pieprzyk et al. coefficients, docs/physics.md#equations-of-state), Z = 3.9840; 500
         # spheres over 50 time units give Z to about 0.01 (measured 2026-12-07: 3.977 +- 0.014

@@ -21,9 +21,8 @@ void PressureTensor<D>::sample(const RunContext<D>&) {
   const double time = engine_.time();
   if (engine_.kind().sheared && time > shear_row_start_.time) {
     const double virial_xy = engine_.counters().virial_tensor[1];  // row x, column y
-    shear_stress_rows_.push_back(
-        (sample[1] + (virial_xy - shear_row_start_.virial_xy) / (time - shear_row_start_.time)) /
-        engine_.volume());
+    shear_stress_rows_.push_back(shear_stress_row(sample[1], virial_xy - shear_row_start_.virial_xy,
+                                                  time - shear_row_start_.time, engine_.volume()));
     shear_row_start_ = {time, virial_xy};
   }
 }
@@ -41,9 +40,9 @@ void PressureTensor<D>::summarize(nlohmann::json& j, const RunContext<D>&) const
       nlohmann::json row = nlohmann::json::array();
       for (int b = 0; b < D; ++b) {
         const int k = a * D + b;
-        row.push_back((kinetic_sum_[k] / samples_ +
-                       (c.virial_tensor[k] - virial_start_[k]) / production_time) /
-                      volume);
+        row.push_back(pressure_tensor_element(kinetic_sum_[k], samples_,
+                                              c.virial_tensor[k] - virial_start_[k],
+                                              production_time, volume));
       }
       tensor.push_back(row);
     }

@@ -16,6 +16,21 @@
 
 namespace kairos {
 
+// Element k (row-major, D x D) of the pressure tensor over a span: the kinetic part averaged
+// over `samples` rows (its sum `kinetic_sum`) plus the collisional part, the virial tensor's
+// change over the span's `duration`, over the volume.
+inline double pressure_tensor_element(double kinetic_sum, int samples, double virial_change,
+                                      double duration, double volume) {
+  return (kinetic_sum / samples + virial_change / duration) / volume;
+}
+
+// One row's shear stress P_xy: its kinetic xy part and the collisional xy virial since the
+// previous row, over the volume.
+inline double shear_stress_row(double kinetic_xy, double virial_xy_change, double row_duration,
+                               double volume) {
+  return (kinetic_xy + virial_xy_change / row_duration) / volume;
+}
+
 template <int D>
 class PressureTensor final : public Observer<D> {
  public:
