@@ -249,13 +249,17 @@ std::string text_of(const fs::path& path) {
 // with summary.json's production averages of one uninterrupted run, bit for bit: Z with its
 // blocked error, the pressure, the production time and temperature, the mean free time, the
 // stepped energy per particle and a free lid's height (the thermo.tsv rows of the earlier
-// invocation read back, its start from the restart file); `extra` gives the system.
-void expect_stopped_production_averages_as_whole(const fs::path& dir, const std::string& extra) {
+// invocation read back, its start from the restart file); `extra` gives the system, `run` more
+// [run] keys.
+void expect_stopped_production_averages_as_whole(const fs::path& dir, const std::string& extra,
+                                                 const std::string& run = "") {
   const auto config = [&](const std::string& name) {
     return parse_config(
         "[system]\nparticles = 200\npacking_fraction = 0.2\nlattice = \"random\"\nseed = 3\n"
-        "[run]\nequilibration_time = 0.0\ntime = 6.0\n[output]\nprogress = \"never\"\n"
-        "interval_unit = \"time\"\nthermo_interval = 0.25\ntrajectory = false\ndirectory = \"" +
+        "[run]\nequilibration_time = 0.0\ntime = 6.0\n" +
+            run +
+            "[output]\nprogress = \"never\"\n"
+            "interval_unit = \"time\"\nthermo_interval = 0.25\ntrajectory = false\ndirectory = \"" +
             (dir / name).string() + "\"\n" + extra,
         "<test>");
   };
@@ -303,6 +307,12 @@ TEST_F(RunDriverTest, AStoppedProductionCompletedInItsDirectoryAveragesAsOneUnin
       dir_,
       "[[potential]]\nkind = \"square_well\"\nlambda = 1.5\ndepth = 0.5\n"
       "[driving]\nkind = \"andersen\"\nrate = 1.0\ntemperature = 1.0\n");
+}
+
+TEST_F(RunDriverTest, AStoppedDemProductionAveragesAsOneUninterruptedRun) {
+  expect_stopped_production_averages_as_whole(
+      dir_, "[soft]\nmodel = \"dashpot\"\nstiffness = 10000.0\nrestitution = 0.9\n",
+      "integrator = \"dem\"\n");
 }
 
 TEST_F(RunDriverTest, AStoppedProductionUnderAFreeLidAveragesItsHeightAsOneUninterruptedRun) {
