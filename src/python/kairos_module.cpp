@@ -495,9 +495,32 @@ class PySimulation {
       d["position"] = w.position;
       d["speed"] = w.speed;
       d["energy"] = w.energy;
+      d["mass"] = w.mass;
+      d["container"] = w.container;
+      if (!w.container) {
+        d["force"] = w.force;
+        d["pressure"] = w.pressure;
+      }
+      if (w.sprung) {
+        d["drive_work"] = w.drive_work;
+        d["dashpot_dissipated"] = w.dashpot;
+      }
       out.append(d);
     }
     return out;
+  }
+  // An outlet's tally since the start of the simulation (None without [boundary.outlet]).
+  py::object outlet() const {
+    return visit([](const auto& s) -> py::object {
+      const auto o = s.integrator().outlet();
+      if (!o) return py::none();
+      py::dict d;
+      d["passes"] = o->passes;
+      d["mass"] = o->mass;
+      d["energy_taken"] = o->energy;
+      d["waiting"] = o->waiting >= 0 ? py::object(py::int_(o->waiting)) : py::object(py::none());
+      return d;
+    });
   }
   bool tracks_images() const {
     return visit([](const auto& s) { return s.tracks_images(); });
@@ -1305,7 +1328,12 @@ PYBIND11_MODULE(kairos, m) {
            "`history`: compress.tsv's columns as arrays. None if the start was not compressed.")
       .def("walls_with_mass", &PySimulation::walls_with_mass,
            "The walls with mass now (boundary.wall.mass): one dict each, face, position (of its "
-           "plane along its axis), speed and energy, as thermo.tsv's columns.")
+           "plane along its axis), speed and energy, as thermo.tsv's columns, and mass, force "
+           "and pressure (summary.json's), a container's spring work.")
+      .def("outlet", &PySimulation::outlet,
+           "An outlet's tally since the start ([boundary.outlet]): passes, mass, energy_taken, "
+           "waiting (the DEM's particles waiting to pass; None for the event engine); None "
+           "without an outlet.")
       .def("__repr__", &PySimulation::repr)
       .def("save", &PySimulation::save, py::arg("path"),
            "Writes a restart file (atomically) that `kairos run --restart` continues.")

@@ -249,8 +249,36 @@ class Module(kt.KairosTestCase):
         for key in ("position", "speed", "energy"):
             self.assertEqual(walls[0][key], rows[-1][header.index("wall_z+_" + key)], key)
         self.assertLess(walls[0]["position"], sim.box[2] - 0.5)
-        self.assertEqual(kairos.Simulation(self.write_config(hard_config(), "plain.toml"))
-                         .walls_with_mass(), [])
+        # Its pressure: its force over its area (the box's x-y face), as summary.json's.
+        self.assertEqual((walls[0]["mass"], walls[0]["force"]), (10.0, 200.0))
+        self.assertAlmostEqual(walls[0]["pressure"], 200.0 / (sim.box[0] * sim.box[1]),
+                               delta=1e-12)
+        self.assertEqual(walls[0]["pressure"],
+                         self.summary(out)["walls_with_mass"][0]["pressure"])
+        plain = kairos.Simulation(self.write_config(hard_config(), "plain.toml"))
+        self.assertEqual(plain.walls_with_mass(), [])
+        self.assertIsNone(plain.outlet())
+
+    def test_an_outlets_tally_as_the_cli_has_it(self):
+        # The silo (examples/silo_2d.toml): the grains that passed its outlet, their mass and
+        # energy, as summary.json's total and thermo.tsv's last row.
+        with open(kt.example("silo_2d.toml")) as f:
+            cfg = self.write_config(f.read(), "silo.toml")
+        out = self.path("silo")
+        self.run_ok("run", cfg, "-o", out, "--set", "run.time=20.0", "--set",
+                    "run.equilibration_time=0", "--set", 'output.interval_unit="time"',
+                    "--set", "output.thermo_interval=20.0", "--set", "output.trajectory=false")
+        sim = kairos.Simulation(cfg)
+        sim.advance(time=20.0)
+        tally = sim.outlet()
+        header, rows, _ = kt.read_thermo(os.path.join(out, "thermo.tsv"))
+        self.assertGreater(tally["passes"], 0)
+        self.assertEqual(tally["passes"], rows[-1][header.index("outlet_passes")])
+        self.assertEqual(tally["mass"], rows[-1][header.index("outlet_mass")])
+        self.assertEqual(tally["energy_taken"], rows[-1][header.index("outlet_energy")])
+        self.assertIsNone(tally["waiting"])
+        self.assertEqual(tally["passes"],
+                         self.summary(out)["granular"]["outlet"]["total_passes_since_start"])
 
     def test_arrays_obey_the_physics(self):
         sim = kairos.Simulation(self.write_config(hard_config()))
