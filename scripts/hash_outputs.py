@@ -57,6 +57,9 @@ SMALLER = {"granular_clustering_2d.toml": ["system.particles=20000"],
            "silo_2d.toml": ["run.equilibration_time=5", "run.time=7"],
            # Measured in time; the first spheres pass after about 7 time units.
            "silo_3d.toml": ["run.equilibration_time=6", "run.time=3"],
+           # The same, through a round orifice (its ring met by the spheres that pass).
+           "silo_round_3d.toml": ["system.particles=1000", "run.equilibration_time=6",
+                                  "run.time=3"],
            # The compression examples: fewer particles, jammed at Z = 1e6.
            "jammed_spheres_3d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],
            "jammed_disks_2d.toml": ["system.particles=300", "compress.jammed_pressure=1e6"],

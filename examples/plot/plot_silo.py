@@ -26,16 +26,20 @@ import kairos_output as ko
 
 
 def draw_boundaries(ax, config, width, up):
-    """The strips of [[boundary.plane]] (horizontal ones) and the outlet's plane; `up` is the
-    vertical axis (the last)."""
+    """The strips of [[boundary.plane]] (horizontal ones; a plane with a round hole cut through
+    the hole's centre) and the outlet's plane; `up` is the vertical axis (the last)."""
     for plane in config["boundary"].get("plane", []):
         y = plane["point"][up]
-        lo = plane.get("span_min", 0.0)
-        hi = plane.get("span_max", width)
-        ax.plot([max(lo, 0.0), min(hi, width)], [y, y], color="k", lw=2)
-        for end in (lo, hi):
-            if 0.0 < end < width:
-                ax.plot([end], [y], "ko", ms=3)
+        if "hole_radius" in plane:  # a round orifice, cut through its centre
+            cx = plane.get("hole_center", plane["point"])[0]
+            pieces = [(0.0, cx - plane["hole_radius"]), (cx + plane["hole_radius"], width)]
+        else:
+            pieces = [(plane.get("span_min", 0.0), plane.get("span_max", width))]
+        for lo, hi in pieces:
+            ax.plot([max(lo, 0.0), min(hi, width)], [y, y], color="k", lw=2)
+            for end in (lo, hi):
+                if 0.0 < end < width:
+                    ax.plot([end], [y], "ko", ms=3)
     outlet = config["boundary"].get("outlet")
     if outlet:
         ax.axhline(outlet["point"][up], color="C3", ls="--", lw=1, label="outlet")

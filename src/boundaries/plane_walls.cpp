@@ -36,11 +36,24 @@ PlaneWalls<D>::PlaneWalls(std::vector<PlaneWall<D>> planes, const Vec<D>& box,
     }
   }
   edges_ = CylinderWalls<D>(std::move(edges), gravity);
+  std::vector<RingEdge<D>> rings;
+  for (std::size_t k = 0; k < planes_.size(); ++k) {
+    const PlaneWall<D>& p = planes_[k];
+    if (!p.holed()) continue;
+    rings.push_back({p.hole_center, p.normal, p.hole_radius, p.wall.contact});
+    ring_planes_.push_back(static_cast<int>(k));
+  }
+  rings_ = RingEdges<D>(std::move(rings), gravity);
 }
 
 template <int D>
 std::string PlaneWalls<D>::name(int s) const {
   if (s < planes()) return "boundary.plane[" + std::to_string(s) + "]";
+  if (is_ring(s)) {
+    return "boundary.plane[" +
+           std::to_string(ring_planes_[static_cast<std::size_t>(s - first_ring())]) +
+           "] hole's edge";
+  }
   return edge_names_[static_cast<std::size_t>(s - planes())];
 }
 
@@ -84,9 +97,10 @@ double PlaneWalls<D>::strip_event_time(const PlaneWall<D>& p, const Vec<D>& x, c
 template <int D>
 double PlaneWalls<D>::event_time(int s, const Vec<D>& x, const Vec<D>& v, double radius, double t,
                                  double horizon) const {
+  if (is_ring(s)) return rings_.event_time(s - first_ring(), x, v, radius, horizon);
   if (s >= planes()) return edges_.event_time(s - planes(), x, v, radius, t, horizon);
   const PlaneWall<D>& p = plane(s);
-  if (p.spanned()) return strip_event_time(p, x, v, radius, horizon);
+  if (p.plate()) return strip_event_time(p, x, v, radius, horizon);
   const NormalMotion m{dot(p.normal, x) - radius, dot(p.normal, v), dot(p.normal, gravity_)};
   const double u = p.normal_speed();
   const double d = p.offset + (u != 0.0 ? u * t : 0.0);
@@ -103,6 +117,7 @@ double PlaneWalls<D>::event_time(int s, const Vec<D>& x, const Vec<D>& v, double
 // The lowest n.x over the cell (its outer layers along a bounded axis reach to infinity).
 template <int D>
 bool PlaneWalls<D>::reaches(int s, CellCode cell, const CellGrid<D>& grid) const {
+  if (is_ring(s)) return rings_.reaches(s - first_ring(), cell, grid, rmax_);
   if (s >= planes()) return edges_.reaches(s - planes(), cell, grid);
   const PlaneWall<D>& p = plane(s);
   if (p.normal_speed() != 0.0) return true;
@@ -113,11 +128,14 @@ template <int D>
 ContactResult<D> PlaneWalls<D>::resolve(int s, const Vec<D>& x, double t, double mass,
                                         double radius, double inertia_factor, bool force_elastic,
                                         Vec<D>& v, Spin<D>& w) const {
+  if (is_ring(s)) {
+    return rings_.resolve(s - first_ring(), x, mass, radius, inertia_factor, force_elastic, v, w);
+  }
   if (s >= planes()) {
     return edges_.resolve(s - planes(), x, t, mass, radius, inertia_factor, force_elastic, v, w);
   }
   const PlaneWall<D>& p = plane(s);
-  if (p.spanned()) {  // a still plate, met on either face
+  if (p.plate()) {  // a still plate, met on either face
     return resolve_surface_contact<D>(p.wall.contact, normal(s, x, t), Vec<D>{}, mass, radius,
                                       inertia_factor, force_elastic, v, w);
   }
@@ -128,6 +146,14 @@ ContactResult<D> PlaneWalls<D>::resolve(int s, const Vec<D>& x, double t, double
 template <int D>
 void PlaneWalls<D>::check_start(const Vec<D>& x, double radius, double t, std::uint64_t id) const {
   edges_.check_start(x, radius, t, id);
+  for (int s = first_ring(); s < surfaces(); ++s) {
+    const double g = gap(s, x, t);
+    if (g < radius * (1.0 - 1e-12)) {
+      throw InputError(fmt::format(
+          "particle {} overlaps the wall {} (centre {:.6g} from the edge, radius {:.6g})", id,
+          name(s), g, radius));
+    }
+  }
   for (int s = 0; s < planes(); ++s) {
     const double g = gap(s, x, t);
     if (g < radius * (1.0 - 1e-12)) {
@@ -153,6 +179,29 @@ void PlaneWalls<D>::prepare(const CellGrid<D>& grid, double rmax, double particl
                             bool uniform) {
   edges_.prepare(grid, rmax, particle_volume, uniform);
   rmax_ = rmax;
+  // A ring's contact needs R > a (ring_contact_time); a narrower hole passes nothing anyway.
+  for (const int k : ring_planes_) {
+    const PlaneWall<D>& p = plane(k);
+    if (!(p.hole_radius > rmax)) {
+      throw InputError(fmt::format(
+          "boundary.plane[{}].hole_radius: {:.6g} is not larger than the largest particle "
+          "radius {:.6g}: no particle could pass the hole",
+          k, p.hole_radius, rmax));
+    }
+    // Along a periodic axis the ring and the particles touching it stay inside the box: its
+    // images are not followed.
+    for (int a = 0; a < D; ++a) {
+      if (faces_[static_cast<std::size_t>(2 * a)].kind != FaceKind::kPeriodic) continue;
+      const double half = p.hole_radius * std::sqrt(std::max(0.0, 1.0 - p.normal[a] * p.normal[a]));
+      if (p.hole_center[a] - half - rmax < 0.0 || p.hole_center[a] + half + rmax > box_[a]) {
+        throw InputError(fmt::format(
+            "boundary.plane[{}].hole_center: the hole's edge comes within a particle radius of "
+            "the periodic faces along {} (its images are not followed); move it inside or make "
+            "it smaller",
+            k, "xyz"[a]));
+      }
+    }
+  }
   squeeze_time_ = kNever;
   squeeze_plane_ = -1;
   for (int s = 0; s < planes(); ++s) {

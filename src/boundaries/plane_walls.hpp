@@ -18,6 +18,11 @@
 // points in 2D), surfaces of their own: a zero-radius outside cylinder each (RoundWalls), after
 // all the planes in this component's numbering. A strip is a thin plate, met on both faces, and
 // nothing beside it (docs/physics.md#outlets-and-strips).
+//
+// A still plane in 3D may have a circular hole instead (hole_radius, hole_center: a silo's or a
+// hopper's round orifice): a plate met on both faces wherever the foot lies outside the hole,
+// whose edge is a ring (boundaries/ring_edges.hpp), numbered after the strips' edges
+// (docs/physics.md#circular-holes).
 #pragma once
 
 #include <array>
@@ -29,6 +34,7 @@
 
 #include "boundaries/cylinder_walls.hpp"
 #include "boundaries/face_wall.hpp"
+#include "boundaries/ring_edges.hpp"
 #include "core/vec.hpp"
 #include "dynamics/collision_time.hpp"
 #include "interactions/granular_contact.hpp"
@@ -46,8 +52,14 @@ struct PlaneWall {
   // A strip: where the plane is, along a box axis (-1: everywhere).
   int span_axis = -1;
   double span_min = -kNever, span_max = kNever;
+  // A circular hole (3D, a still plane): its radius (0: none) and centre, a point of the plane.
+  double hole_radius = 0.0;
+  Vec<D> hole_center{};
 
   bool spanned() const { return span_axis >= 0; }
+  bool holed() const { return hole_radius > 0.0; }
+  // A thin plate, met on both faces where it is: a strip, or a plane with a hole.
+  bool plate() const { return spanned() || holed(); }
   // The axis a strip's edges run along (3D: the one besides the span axis the normal has no
   // component along; 2D: out of the plane, D - 1 by the cylinders' convention) and the axis
   // across it in the plane of the normal; -1 for either when there is none (Environment::check
@@ -67,6 +79,10 @@ struct PlaneWall {
   }
   // Whether the foot of x on the plane (x less its distance along n) lies within the strip.
   bool covers(const Vec<D>& x, double distance) const {
+    if (holed()) {
+      const Vec<D> foot = x - distance * normal;
+      return norm2(foot - hole_center) >= hole_radius * hole_radius;
+    }
     if (span_axis < 0) return true;
     const double u = x[span_axis] - distance * normal[span_axis];
     return u >= span_min && u <= span_max;
@@ -100,15 +116,20 @@ class PlaneWalls {
   PlaneWalls(std::vector<PlaneWall<D>> planes, const Vec<D>& box,
              const std::array<Face<D>, 2 * D>& faces, const Vec<D>& gravity);
 
-  // The boundary interface (model/boundaries.hpp): surface s < planes() is plane s, the rest
-  // the strips' edges (edges_, in the order of their planes, low end first).
+  // The boundary interface (model/boundaries.hpp): surface s < planes() is plane s, then the
+  // strips' edges (edges_, in the order of their planes, low end first), then the holes' rings
+  // (rings_, in the order of their planes).
   bool any() const { return !planes_.empty(); }
-  int surfaces() const { return planes() + edges_.surfaces(); }
+  int surfaces() const { return planes() + edges_.surfaces() + rings_.surfaces(); }
   int planes() const { return static_cast<int>(planes_.size()); }
+  // Surface s is a hole's ring (ring number s - first_ring()).
+  int first_ring() const { return planes() + edges_.surfaces(); }
+  bool is_ring(int s) const { return s >= first_ring(); }
   bool is_surface(int /*s*/) const { return true; }
   const PlaneWall<D>& plane(int s) const { return planes_[static_cast<std::size_t>(s)]; }
   std::string name(int s) const;
   const ContactModel& contact(int s) const {
+    if (is_ring(s)) return rings_.contact(s - first_ring());
     return s < planes() ? plane(s).wall.contact : edges_.contact(s - planes());
   }
   double approach_speed(int s) const { return s < planes() ? plane(s).normal_speed() : 0.0; }
@@ -116,16 +137,18 @@ class PlaneWalls {
   // A strip is a plate with two faces: the distance from it on either side, and none beside it
   // (its foot outside it).
   double gap(int s, const Vec<D>& x, double t) const {
+    if (is_ring(s)) return rings_.gap(s - first_ring(), x);
     if (s >= planes()) return edges_.gap(s - planes(), x, t);
     const double g = dot(plane(s).normal, x) - plane(s).position(t);
-    if (!plane(s).spanned()) return g;
+    if (!plane(s).plate()) return g;
     return plane(s).covers(x, g) ? std::abs(g) : kNever;
   }
-  // A strip's normal points to the side x is on.
+  // A plate's normal points to the side x is on.
   Vec<D> normal(int s, const Vec<D>& x, double t) const {
+    if (is_ring(s)) return rings_.normal(s - first_ring(), x);
     if (s >= planes()) return edges_.normal(s - planes(), x, t);
     const PlaneWall<D>& p = plane(s);
-    return p.spanned() && dot(p.normal, x) < p.offset ? -1.0 * p.normal : p.normal;
+    return p.plate() && dot(p.normal, x) < p.offset ? -1.0 * p.normal : p.normal;
   }
   Vec<D> velocity(int s, const Vec<D>& /*x*/, double t) const {
     return s < planes() ? plane(s).surface_velocity(t) : Vec<D>{};
@@ -173,6 +196,8 @@ class PlaneWalls {
   std::vector<PlaneWall<D>> planes_;
   CylinderWalls<D> edges_;  // the strips' ends: outside cylinders of radius 0
   std::vector<std::string> edge_names_;
+  RingEdges<D> rings_;            // the holes' edges
+  std::vector<int> ring_planes_;  // the plane of each ring
   Vec<D> box_{};
   std::array<Face<D>, 2 * D> faces_{};
   Vec<D> gravity_{};

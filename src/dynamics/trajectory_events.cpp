@@ -2,6 +2,9 @@
 // contact (docs/physics.md#quartic-pair-contact). See trajectory_events.hpp for the contracts.
 #include "dynamics/trajectory_events.hpp"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <limits>
 #include <utility>
 
@@ -302,7 +305,140 @@ double event_on_piece(const Quartic& q, double s, double e, double t_max) {
   return polish_root([&](double t) { return std::pair{q.f(t), q.df(t)}; }, s, end, t_max);
 }
 
+// A polynomial of degree <= kMaxPolynomialDegree: c[0] + c[1] t + ... (degree: its highest
+// nonzero coefficient).
+struct Polynomial {
+  std::array<double, kMaxPolynomialDegree + 1> c{};
+  int degree = 0;
+  double f(double t) const {
+    double y = c[static_cast<std::size_t>(degree)];
+    for (int k = degree - 1; k >= 0; --k) y = y * t + c[static_cast<std::size_t>(k)];
+    return y;
+  }
+  Polynomial derivative() const {
+    Polynomial d;
+    d.degree = std::max(0, degree - 1);
+    for (int k = 1; k <= degree; ++k)
+      d.c[static_cast<std::size_t>(k - 1)] = k * c[static_cast<std::size_t>(k)];
+    return d;
+  }
+  // The sign of p as t grows without bound.
+  double sign_at_infinity() const {
+    for (int k = degree; k >= 0; --k)
+      if (c[static_cast<std::size_t>(k)] != 0.0)
+        return c[static_cast<std::size_t>(k)] > 0.0 ? 1 : -1;
+    return 0.0;
+  }
+};
+
+// The roots of p in (0, infinity), sorted: each isolated on a piece where p is monotone, between
+// consecutive roots of p' (found the same way, down to a quadratic in closed form), and
+// polished there. The pieces never depend on a horizon (quartic_event_time says why).
+int positive_roots(const Polynomial& p, std::array<double, kMaxPolynomialDegree>& out) {
+  int n = 0;
+  if (p.degree <= 2) {
+    double r[2];
+    const int k = real_quadratic_roots(p.c[2], p.c[1], p.c[0], r);
+    for (int i = 0; i < k; ++i)
+      if (r[i] > 0.0 && std::isfinite(r[i])) out[static_cast<std::size_t>(n++)] = r[i];
+    if (n == 2 && out[0] > out[1]) std::swap(out[0], out[1]);
+    return n;
+  }
+  const Polynomial dp = p.derivative();
+  std::array<double, kMaxPolynomialDegree> crit{};
+  const int m = positive_roots(dp, crit);
+  for (int i = 0; i <= m; ++i) {
+    const double lo = i == 0 ? 0.0 : crit[static_cast<std::size_t>(i - 1)];
+    const double hi = i < m ? crit[static_cast<std::size_t>(i)] : kNever;
+    const double p_lo = p.f(lo);
+    if (p_lo == 0.0) {
+      if (lo > 0.0 && (n == 0 || out[static_cast<std::size_t>(n - 1)] < lo))
+        out[static_cast<std::size_t>(n++)] = lo;
+      continue;
+    }
+    const double sign = p_lo > 0.0 ? 1.0 : -1.0;  // p monotone on the piece: falls if positive
+    const auto crossed = [&](double t) { return sign * p.f(t) <= 0.0; };
+    double end = hi;
+    if (std::isinf(hi)) {
+      if (p.sign_at_infinity() * sign > 0.0) continue;
+      end = expand_until(lo, crossed);
+    }
+    if (std::isinf(end) || !crossed(end)) continue;
+    const Polynomial dq = dp;
+    const double r = polish_root(
+        [&](double t) {
+          return std::pair{sign * p.f(t), sign * dq.f(t)};
+        },
+        lo, end);
+    if (r > 0.0 && (n == 0 || out[static_cast<std::size_t>(n - 1)] < r))
+      out[static_cast<std::size_t>(n++)] = r;
+  }
+  return n;
+}
+
 }  // namespace
+
+double polynomial_event_time(const double* coefficients, int degree, double t_max) {
+  Polynomial p;
+  p.degree = std::clamp(degree, 0, kMaxPolynomialDegree);
+  for (int k = 0; k <= p.degree; ++k) p.c[static_cast<std::size_t>(k)] = coefficients[k];
+  while (p.degree > 0 && p.c[static_cast<std::size_t>(p.degree)] == 0.0) --p.degree;
+  if (p.degree <= 2) return within_horizon(quadratic_event_time(p.c[0], p.c[1], p.c[2]), t_max);
+  const Polynomial dp = p.derivative();
+  if (p.c[0] <= 0.0 && p.c[1] < 0.0) return within_horizon(0.0, t_max);  // overlapping, closing
+  // The monotone pieces of f, between the roots of f', walked in time order: the first that
+  // falls through zero holds the event.
+  std::array<double, kMaxPolynomialDegree> crit{};
+  const int m = positive_roots(dp, crit);
+  for (int i = 0; i <= m; ++i) {
+    const double lo = i == 0 ? 0.0 : crit[static_cast<std::size_t>(i - 1)];
+    const double hi = i < m ? crit[static_cast<std::size_t>(i)] : kNever;
+    if (lo > t_max) return kNever;
+    const double probe = std::isinf(hi) ? 2.0 * lo + 1.0 : lo + 0.5 * (hi - lo);
+    if (!(dp.f(probe) < 0.0)) continue;  // only a falling piece can hold the event
+    if (p.f(lo) <= 0.0) return within_horizon(lo, t_max);
+    const auto below = [&](double t) { return p.f(t) < 0.0 || (p.f(t) == 0.0 && dp.f(t) < 0.0); };
+    const double end = std::isinf(hi) ? expand_until(lo, below) : hi;
+    if (std::isinf(end) || !below(end)) continue;
+    return within_horizon(polish_root(
+                              [&](double t) {
+                                return std::pair{p.f(t), dp.f(t)};
+                              },
+                              lo, end, t_max),
+                          t_max);
+  }
+  return kNever;
+}
+
+double ring_contact_time(const double* r, const double* v, const double* g, const double* n,
+                         double ring_radius, double radius, double t_max) {
+  double rr = 0.0, rv = 0.0, vv = 0.0, rg = 0.0, vg = 0.0, gg = 0.0;
+  double nr = 0.0, nv = 0.0, ng = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    rr += r[k] * r[k];
+    rv += r[k] * v[k];
+    vv += v[k] * v[k];
+    rg += r[k] * g[k];
+    vg += v[k] * g[k];
+    gg += g[k] * g[k];
+    nr += n[k] * r[k];
+    nv += n[k] * v[k];
+    ng += n[k] * g[k];
+  }
+  const double R2 = ring_radius * ring_radius;
+  // q(t) = |r + v t + g t^2 / 2|^2 and z(t) = n . (the same), as coefficients in t.
+  const std::array<double, 5> q{rr, 2.0 * rv, vv + rg, vg, 0.25 * gg};
+  const std::array<double, 3> z{nr, nv, 0.5 * ng};
+  std::array<double, 5> s = q, w = q;  // s = q + R^2 - a^2, w = q - z^2
+  s[0] += R2 - radius * radius;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) w[static_cast<std::size_t>(i + j)] -= z[i] * z[j];
+  std::array<double, 9> f{};
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) f[static_cast<std::size_t>(i + j)] += s[i] * s[j];
+  for (int i = 0; i < 5; ++i) f[static_cast<std::size_t>(i)] -= 4.0 * R2 * w[i];
+  return polynomial_event_time(f.data(), 8, t_max);
+}
 
 double quartic_event_time(const std::array<double, 5>& c, double t_max) {
   if (c[4] == 0.0 && c[3] == 0.0) {

@@ -178,6 +178,27 @@ double oscillating_plane_event_time(const NormalMotion& m, const OscillatingPlan
 // Degree 2 or less is quadratic_event_time.
 double quartic_event_time(const std::array<double, 5>& c, double t_max = kNever);
 
+// The same for a polynomial of degree up to kMaxPolynomialDegree (a sphere falling towards a
+// ring, a circular edge, is of degree 8: docs/physics.md#circular-holes): f(t) = c[0] + c[1] t +
+// ... + c[degree] t^degree, f >= 0 the allowed side. Its monotone pieces are those between the
+// real roots of f', found the same way recursively (f'', ..., down to a quadratic in closed
+// form), each isolated on a monotone piece of its own and polished; the pieces are walked in
+// time order and never cut at the horizon. The first time f falls through zero, kNever if none
+// before t_max.
+inline constexpr int kMaxPolynomialDegree = 8;
+double polynomial_event_time(const double* c, int degree, double t_max = kNever);
+
+// Contact time of a sphere of radius a with a ring: a circle of radius R > a about the unit axis
+// n through the ring's centre (a circular hole's edge). The sphere's centre is at r from the
+// ring's centre with velocity v and constant acceleration g (3D). With q = |r(t)|^2 and
+// z = n . r(t), its distance from the circle obeys dist^2 = q - 2 R rho + R^2 (rho = sqrt(q -
+// z^2), the distance from the axis), and f(t) = (q + R^2 - a^2)^2 - 4 R^2 (q - z^2) =
+// (dist^2 - a^2) ((rho + R)^2 + z^2 - a^2) has the sign of dist^2 - a^2, the second factor being
+// at least R^2 - a^2 > 0: a polynomial of degree 8 under a field, 4 without
+// (docs/physics.md#circular-holes).
+double ring_contact_time(const double* r, const double* v, const double* g, const double* n,
+                         double ring_radius, double radius, double t_max = kNever);
+
 // Contact time of a pair at relative position r, velocity v and constant relative acceleration
 // a (gravity on one body only, e.g. a falling sphere against a resting one), contact distance
 // sigma: f(t) = |r + v t + a t^2/2|^2 - sigma^2. With a = 0 this is pair_contact_time exactly.

@@ -403,6 +403,28 @@ class Reader : public KeyReader {
            fmt::format("{}.span_axis: give span_min, span_max or both (where the strip ends)",
                        prefix));
     }
+    // A circular hole: in 3D, in a whole plane, its centre only with it.
+    if (plane.hole_radius > 0.0) {
+      if (dimension != 3) {
+        fail(pt.get("hole_radius"), prefix + ".hole_radius",
+             fmt::format("{}.hole_radius: a hole is for planes in 3D (in 2D cut the line into two "
+                         "strips: span_axis)",
+                         prefix));
+      }
+      if (!plane.span_axis.empty()) {
+        fail(pt.get("hole_radius"), prefix + ".hole_radius",
+             fmt::format("{}.hole_radius: a strip (span_axis) cannot also have a hole", prefix));
+      }
+    } else if (pt.get("hole_center") != nullptr) {
+      fail(pt.get("hole_center"), prefix + ".hole_center",
+           fmt::format("{}.hole_center: give the hole's radius too ({}.hole_radius)", prefix,
+                       prefix));
+    }
+    for (const double c : plane.hole_center) {
+      if (!std::isfinite(c))
+        fail(pt.get("hole_center"), prefix + ".hole_center",
+             prefix + ".hole_center: must be finite");
+    }
     return plane;
   }
 

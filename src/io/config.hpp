@@ -122,6 +122,9 @@ struct PlaneConfig {
   std::string span_axis;
   double span_min = -std::numeric_limits<double>::infinity();
   double span_max = std::numeric_limits<double>::infinity();
+  // A circular hole (3D; 0: none) and its centre (empty: `point`), projected onto the plane.
+  double hole_radius = 0.0;
+  std::vector<double> hole_center;
 
   bool operator==(const PlaneConfig&) const = default;
 };

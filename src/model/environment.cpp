@@ -110,6 +110,26 @@ void Environment<D>::check_strip(const PlaneWall<D>& p, const std::string& name)
   }
 }
 
+// A plane with a circular hole: 3D, still, not a strip; the hole's size and centre finite.
+template <int D>
+void Environment<D>::check_hole(const PlaneWall<D>& p, const std::string& name) const {
+  if (D != 3) {
+    throw InputError(name +
+                     ".hole_radius: a hole is for planes in 3D (in 2D cut the line into "
+                     "two strips: span_axis)");
+  }
+  if (p.spanned())
+    throw InputError(name + ".hole_radius: a strip (span_axis) cannot also have a hole");
+  if (!std::isfinite(p.hole_radius)) throw InputError(name + ".hole_radius: must be finite");
+  for (int a = 0; a < D; ++a)
+    if (!std::isfinite(p.hole_center[a])) throw InputError(name + ".hole_center: must be finite");
+  if (p.plane_moves() || norm2(p.wall.velocity) != 0.0) {
+    throw InputError(name +
+                     ".hole_radius: a plane with a hole must hold still: no velocity or "
+                     "vibration (its edge does not move)");
+  }
+}
+
 // An outlet's plane, like a plane wall's, must not cut a periodic axis; its insertion region is
 // a box on the particles' side of it (a particle put back behind it would pass again at once).
 template <int D>
@@ -159,10 +179,11 @@ void Environment<D>::check() const {
     check_wall_motion(p.wall, name);
     check_plane(p.normal, p.offset, name);
     if (p.spanned()) check_strip(p, name);
+    if (p.holed()) check_hole(p, name);
   }
   check_outlets();
-  const std::size_t surfaces =
-      2 * D + planes.size() + cylinders.size() + spheres.size() + outlets.size() + 2 * strips();
+  const std::size_t surfaces = 2 * D + planes.size() + cylinders.size() + spheres.size() +
+                               outlets.size() + 2 * strips() + holes();
   if (surfaces > static_cast<std::size_t>(EventCode<D>::kWallCodes)) {
     throw InputError("boundary: " + std::to_string(surfaces - 2 * D) +
                      " plane, cylinder and sphere walls; at most " +

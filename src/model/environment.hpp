@@ -154,9 +154,15 @@ struct Environment {
   void check_outlets() const;
   void check_plane(const Vec<D>& normal, double offset, const std::string& name) const;
   void check_strip(const PlaneWall<D>& p, const std::string& name) const;
+  void check_hole(const PlaneWall<D>& p, const std::string& name) const;
   std::size_t strips() const {
     std::size_t n = 0;
     for (const PlaneWall<D>& p : planes) n += p.spanned() ? 1 : 0;
+    return n;
+  }
+  std::size_t holes() const {
+    std::size_t n = 0;
+    for (const PlaneWall<D>& p : planes) n += p.holed() ? 1 : 0;
     return n;
   }
 };

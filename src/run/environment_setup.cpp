@@ -404,6 +404,13 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
       plane.span_min = pc.span_min;
       plane.span_max = pc.span_max;
     }
+    if (pc.hole_radius > 0.0) {
+      plane.hole_radius = pc.hole_radius;
+      const std::vector<double>& c = pc.hole_center.empty() ? pc.point : pc.hole_center;
+      Vec<D> center{};
+      for (int a = 0; a < D && a < static_cast<int>(c.size()); ++a) center[a] = c[a];
+      plane.hole_center = center - (dot(plane.normal, center) - plane.offset) * plane.normal;
+    }
     env.planes.push_back(plane);
   }
   for (const bool sphere : {false, true}) {

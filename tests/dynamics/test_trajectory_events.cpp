@@ -4,9 +4,11 @@
 // and at its time the stable-rule condition must hold).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "dynamics/collision_time.hpp"
 #include "dynamics/trajectory_events.hpp"
@@ -562,6 +564,150 @@ TEST(QuarticContact, RandomAgainstSampling) {
     }
   }
   EXPECT_GT(events, 300);
+}
+
+// polynomial_event_time of degree 8, built from known roots: the first root where f falls
+// (through zero from above), against the roots themselves and dense sampling; it agrees with
+// quartic_event_time on quartics to round-off; the horizon never changes its bits.
+TEST(PolynomialEvent, RandomRootsAgainstTheFirstFallingRoot) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 3.0);
+  int events = 0;
+  for (int i = 0; i < 3000; ++i) {
+    // f(t) = s * prod (t - t_k) over 8 real roots, or 6 with a positive quadratic factor.
+    std::vector<double> roots;
+    const int real = i % 2 == 0 ? 8 : 6;
+    for (int k = 0; k < real; ++k) roots.push_back(u(rng));
+    std::vector<double> c{i % 4 < 2 ? 1.0 : -1.0};
+    const auto times = [&](double a0, double a1, double a2) {  // c *= a0 + a1 t + a2 t^2
+      std::vector<double> out(c.size() + 2, 0.0);
+      for (std::size_t k = 0; k < c.size(); ++k) {
+        out[k] += a0 * c[k];
+        out[k + 1] += a1 * c[k];
+        out[k + 2] += a2 * c[k];
+      }
+      c = out;
+    };
+    for (const double t : roots) times(-t, 1.0, 0.0);
+    if (real == 6) {
+      const double x = u(rng), a0 = 0.3 + x * x, a1 = 0.3 * u(rng);  // a1^2 < 0.81 < 4 a0
+      times(a0, a1, 1.0);
+    }
+    c.resize(9, 0.0);
+    const auto f = [&](double t) {
+      double y = 0.0;
+      for (int k = 8; k >= 0; --k) y = y * t + c[static_cast<std::size_t>(k)];
+      return y;
+    };
+    const auto df = [&](double t) {
+      double y = 0.0;
+      for (int k = 8; k >= 1; --k) y = y * t + k * c[static_cast<std::size_t>(k)];
+      return y;
+    };
+    const double t = polynomial_event_time(c.data(), 8, 10.0);
+    ASSERT_TRUE(t >= 0.0) << i;
+    // The expected event: t = 0 when f(0) <= 0 and falling, else the first root > 0 at which f
+    // changes sign from + to - (cases with roots closer than 1e-3 are left out: the expanded
+    // coefficients move such near-double roots by up to sqrt(eps) of their spacing's scale).
+    std::sort(roots.begin(), roots.end());
+    bool crowded = false;
+    for (std::size_t k = 1; k < roots.size(); ++k) crowded |= roots[k] - roots[k - 1] < 1e-3;
+    if (crowded) continue;
+    double expected = kNever;
+    if (f(0.0) <= 0.0 && df(0.0) < 0.0) {
+      expected = 0.0;
+    } else {
+      for (const double r : roots) {
+        if (r > 0.0 && df(r) < 0.0) {
+          expected = r;
+          break;
+        }
+      }
+    }
+    if (expected == kNever) {
+      ASSERT_EQ(t, kNever) << i;
+      continue;
+    }
+    ++events;
+    // The root of the product form, moved by the expanded coefficients' round-off (eight roots
+    // within a few units are ill-conditioned: up to ~1e-8); at t the given polynomial vanishes
+    // to round-off of its terms, and dense sampling finds no earlier falling crossing.
+    ASSERT_NEAR(t, expected, 1e-6 * (1.0 + expected)) << i;
+    if (expected > 0.0) {  // a crossing (t = 0: overlapping and closing at the start)
+      double terms = 0.0, power = 1.0;
+      for (int k = 0; k <= 8; ++k, power *= t)
+        terms += std::abs(c[static_cast<std::size_t>(k)]) * power;
+      ASSERT_LE(std::abs(f(t)), 1e-13 * terms) << i;
+    }
+    const auto gap = [&](double x) { return GapSample{f(x), df(x)}; };
+    ASSERT_LE(t, first_sampled_event(gap, 10.0, 20000, 1e-9) + 1e-12) << i;
+    // The horizon decides whether it is reported, never its bits.
+    ASSERT_EQ(polynomial_event_time(c.data(), 8, t + 1.0), t) << i;
+    if (t > 0.0) {
+      ASSERT_EQ(polynomial_event_time(c.data(), 8, std::nextafter(t, 0.0)), kNever) << i;
+    }
+  }
+  EXPECT_GT(events, 1000);
+  // A quartic: as quartic_event_time.
+  std::uniform_real_distribution<double> w(-1.0, 1.0);
+  for (int i = 0; i < 2000; ++i) {
+    const std::array<double, 5> q{0.1 + w(rng) * w(rng), w(rng), w(rng), w(rng), w(rng)};
+    const double a = quartic_event_time(q, 50.0), b = polynomial_event_time(q.data(), 4, 50.0);
+    if (a == kNever) {
+      ASSERT_EQ(b, kNever) << i;
+    } else {
+      ASSERT_NEAR(a, b, 1e-12 * (1.0 + a)) << i;
+    }
+  }
+}
+
+// A sphere against a ring (a circular hole's edge): the degree-8 contact time against dense
+// sampling of the distance from the circle itself, falling under gravity at random, from every
+// side; never a missed contact, and at the event the distance is the radius.
+TEST(RingContact, FallingSpheresAgainstDenseSampling) {
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double R = 1.5, a = 0.5;
+  int events = 0;
+  for (int i = 0; i < 3000; ++i) {
+    std::array<double, 3> n{u(rng), u(rng), u(rng)};
+    const double nn = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (double& x : n) x /= nn;
+    const std::array<double, 3> r{3 * u(rng), 3 * u(rng), 3 * u(rng)};
+    const std::array<double, 3> v{2 * u(rng), 2 * u(rng), 2 * u(rng)};
+    std::array<double, 3> g{0.0, 0.0, i % 3 == 0 ? 0.0 : -1.0};
+    if (i % 5 == 0) g = {0.3 * u(rng), 0.3 * u(rng), -1.0};
+    const auto distance2 = [&](double t) {  // from the circle, and its rate
+      std::array<double, 3> x{}, xv{};
+      double z = 0.0, zv = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        x[k] = r[k] + v[k] * t + 0.5 * g[k] * t * t;
+        xv[k] = v[k] + g[k] * t;
+        z += n[k] * x[k];
+        zv += n[k] * xv[k];
+      }
+      double rho2 = 0.0, rhov = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double p = x[k] - z * n[k], pv = xv[k] - zv * n[k];
+        rho2 += p * p;
+        rhov += p * pv;
+      }
+      const double rho = std::sqrt(rho2);
+      return GapSample{(rho - R) * (rho - R) + z * z - a * a,
+                       2.0 * (rho - R) * (rho > 0.0 ? rhov / rho : 0.0) + 2.0 * z * zv};
+    };
+    if (distance2(0.0).f < 0.0) continue;  // starts overlapping the ring: not a case
+    const double horizon = 4.0;
+    const double t = ring_contact_time(r.data(), v.data(), g.data(), n.data(), R, a, horizon);
+    ASSERT_TRUE(t >= 0.0) << i;
+    ASSERT_LE(t, first_sampled_event(distance2, horizon, 20000, 1e-9) + 1e-12) << i;
+    if (t == kNever) continue;
+    ++events;
+    const GapSample at = distance2(t);
+    ASSERT_NEAR(at.f, 0.0, 1e-9) << i;
+    ASSERT_LE(at.df, 1e-9) << i;
+  }
+  EXPECT_GT(events, 100);
 }
 
 }  // namespace

@@ -166,6 +166,33 @@ class PlaneWalls(kt.KairosTestCase):
         soft["boundary"]["plane"][0].update({"amplitude": 0.01, "frequency": 2.0})
         self.refused(soft, "vibrating wall boundary.plane[0]")
 
+    def test_bad_holes_are_refused_naming_the_key(self):
+        # A circular hole: 3D only, not in a strip, its centre only with its radius, wider than
+        # the grains, clear of the periodic faces, in a still plane.
+        floor = {"normal": [0.0, 1.0], "point": [0.0, 4.0], "hole_radius": 3.0}
+        self.refused(small_config(plane=[floor]), "boundary.plane[0].hole_radius", "3D")
+        strip = dict(floor, span_axis="x", span_max=5.0)
+        self.refused(small_config(plane=[strip]), "boundary.plane[0].hole_radius", "strip")
+        centre = {"normal": [0.0, 1.0], "point": [0.0, 4.0], "hole_center": [1.0, 4.0]}
+        self.refused(small_config(plane=[centre]), "boundary.plane[0].hole_center",
+                     "hole_radius")
+        with open(kt.example("silo_round_3d.toml")) as f:
+            text = f.read()
+        for override, needle in (
+                ("boundary.plane[0].hole_radius=0.4", "not larger than the largest particle"),
+                ("boundary.plane[0].velocity=[0.0, 0.0, 0.1]", "hold still")):
+            with self.subTest(override=override):
+                result = self.kairos("run", self.write_config(text, "silo.toml"), "-o",
+                                     self.path("out"), "--set", override, "--overwrite")
+                self.assert_user_error(result, "boundary.plane[0]", needle)
+        # Along a periodic axis the ring must stay inside the box.
+        periodic = self.write_config(text.replace('[[boundary.wall]]\nface = "y-"\n', "")
+                                     .replace('[[boundary.wall]]\nface = "y+"\n', ""),
+                                     "periodic.toml")
+        result = self.kairos("run", periodic, "-o", self.path("p"), "--set",
+                             "boundary.plane[0].point=[9.2, 1.0, 6.0]")
+        self.assert_user_error(result, "boundary.plane[0].hole_center", "periodic")
+
 
 if __name__ == "__main__":
     kt.main()

@@ -176,6 +176,12 @@ bool span_min_given(const void* p) {
 bool span_max_given(const void* p) {
   return std::isfinite(static_cast<const PlaneConfig*>(p)->span_max);
 }
+bool hole_given(const void* p) {
+  return static_cast<const PlaneConfig*>(p)->hole_radius > 0.0;
+}
+bool hole_center_given(const void* p) {
+  return !static_cast<const PlaneConfig*>(p)->hole_center.empty();
+}
 
 const PlaneConfig kPlaneDefaults{};
 constexpr KeyDecl kPlane[] = {
@@ -216,6 +222,24 @@ constexpr KeyDecl kPlane[] = {
      .unit = "length",
      .doc = "the strip's high end along span_axis",
      .written = &span_max_given},
+    {.name = "hole_radius",
+     .type = KeyType::kFloat,
+     .member = field<&PlaneConfig::hole_radius>,
+     .range = {.lo = 0.0, .hi = 1e6, .scale = Scale::kLength},
+     .default_text = "no hole",
+     .unit = "length",
+     .doc = "3D: a circular hole in the plane (a silo's or hopper's round orifice), larger "
+            "than the particles; the plane is then a plate met on both faces, the hole's edge "
+            "a ring (a still plane, not a strip)",
+     .written = &hole_given},
+    {.name = "hole_center",
+     .type = KeyType::kVector,
+     .member = field<&PlaneConfig::hole_center>,
+     .range = {.by_rule = true},  // finite; with hole_radius
+     .default_text = "`point`",
+     .unit = "length",
+     .doc = "the hole's centre (projected onto the plane)",
+     .written = &hole_center_given},
 };
 
 const CylinderConfig kCylinderDefaults{};
