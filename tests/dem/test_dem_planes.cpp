@@ -3,8 +3,9 @@
 // interface. An axis-aligned plane gives the face wall's trajectory (to round-off: the plane is
 // one unit higher); a sphere on a frictionless slope slides at g sin(theta), and with friction
 // rolls without slipping at (5/7) g sin(theta) (the textbook result for I = 2/5 m R^2 when
-// mu > (2/7) tan(theta)); a piston plane's work closes the energy budget; a deep overlap names
-// the plane.
+// mu > (2/7) tan(theta)); a round hole's rim (a ring) pushes a sphere falling on it through
+// the hole with the energy budget closed; a piston plane's work closes the energy budget; a
+// deep overlap names the plane.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -63,6 +64,47 @@ TEST(DemPlanes, AnAxisAlignedPlaneBouncesAsTheFloorFace) {
   EXPECT_GE(on_face.wall_collisions(), 1u);  // it did bounce
   EXPECT_NEAR(on_plane.dissipated_at_walls(), on_face.dissipated_at_walls(),
               1e-9 * on_face.dissipated_at_walls());
+}
+
+// A sphere falling onto the rim of a round hole (a plane with hole_radius: its edge a ring,
+// boundaries/ring_edges) feels the ring's force along the normal from the circle's nearest
+// point: falling just inside the rim it is pushed towards the axis and through the hole, its
+// overlap with the circle small, the elastic energy budget closed to the Verlet accuracy; one
+// on the hole's axis falls through untouched.
+TEST(DemPlanes, ASphereOnARoundHolesRimIsPushedThroughItAndOneOnTheAxisFallsUntouched) {
+  const double g = 1.0;
+  Environment<3> env = closed_box(g);
+  env.soft = {SoftContactLaw::linear_dashpot(1e5, 0.0)};  // elastic: the budget is exact
+  env.soft_wall = env.soft;
+  PlaneWall<3> floor = plane_through({0.0, 0.0, 1.0}, {10.0, 10.0, 5.0});
+  floor.hole_radius = 1.0;
+  floor.hole_center = {10.0, 10.0, 5.0};
+  env.planes = {floor};
+  // Its centre 0.2 inside the rim: it meets the ring (at height 0.458), not the plate.
+  DemIntegrator<3> rim(one_sphere({10.8, 10.0, 7.0}, {}), env);
+  const auto energy = [&](const DemIntegrator<3>& d) {
+    return d.kinetic_energy() + d.potential_energy() + d.field_energy() + d.dissipated_energy() +
+           d.dissipated_at_walls();
+  };
+  const double e0 = energy(rim);
+  double closest = kNever, rho_through = kNever;
+  while (rim.position(0)[2] > 4.0) {
+    rim.step(10);
+    const Vec<3> x = rim.position(0);
+    const double rho = std::hypot(x[0] - 10.0, x[1] - 10.0);
+    closest = std::min(closest, std::hypot(rho - 1.0, x[2] - 5.0));
+    if (x[2] < 5.0 && rho_through == kNever) rho_through = rho;
+    ASSERT_LT(rim.time(), 20.0) << "it never passed the hole";
+  }
+  EXPECT_GE(rim.wall_collisions(), 1u);  // the ring (then maybe the far side of the rim)
+  EXPECT_LT(closest, 0.5);               // it touched the ring
+  EXPECT_GT(closest, 0.5 - 0.01);        // with a small overlap
+  EXPECT_LT(rho_through, 0.8);           // pushed towards the axis, through the hole
+  EXPECT_NEAR(energy(rim), e0, 1e-4 * std::abs(e0));
+  // On the axis: a radius of 0.5 passes a hole of radius 1 without a contact.
+  DemIntegrator<3> axis(one_sphere({10.0, 10.0, 7.0}, {}), env);
+  while (axis.position(0)[2] > 3.0) axis.step(10);
+  EXPECT_EQ(axis.wall_collisions(), 0u);
 }
 
 struct Slope {

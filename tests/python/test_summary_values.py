@@ -198,8 +198,8 @@ class SummaryValues(kt.KairosTestCase):
                     args += ["--set", "system.particles=8300", "--set", "run.time=100"]
                 if name == "rotating_drum_3d.toml":  # in time, a dense bed: a short one
                     args += ["--set", "run.time=2"]
-                if name in ("free_piston_3d.toml", "spring_damper_3d.toml",
-                            "silo_2d.toml", "silo_3d.toml"):  # lengths in time
+                if name in ("free_piston_3d.toml", "spring_damper_3d.toml", "silo_2d.toml",
+                            "silo_3d.toml", "silo_round_3d.toml"):  # lengths in time
                     args += ["--set", "run.equilibration_time=1", "--set", "run.time=3",
                              "--set", "output.thermo_interval=0.5"]
                 if name in ("jammed_spheres_3d.toml", "jammed_disks_2d.toml",
