@@ -1,4 +1,5 @@
-// The check every boundary component's event times pass against dense sampling.
+// The check every boundary component's event times pass against dense sampling, and the
+// energy budget of a silo test.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -18,6 +19,17 @@ inline bool agrees_with_sampling(double predicted, double sampled, double h, int
   EXPECT_LE(predicted, sampled + 1e-12) << k;
   EXPECT_GT(predicted, sampled - h - 1e-12) << k;
   return true;
+}
+
+// A silo's energy budget, unit masses under g = 1 along the last axis: kinetic + rotational +
+// potential energy, plus what collisions dissipated less the walls' work plus what the outlet
+// took out: constant.
+template <class Engine>
+double silo_budget(const Engine& engine) {
+  double e = engine.kinetic_energy() + engine.rotational_energy();
+  for (const auto& p : engine.current_positions()) e += p[p.size() - 1];  // m g h
+  const auto& c = engine.counters();
+  return e + c.dissipated_in_collisions + c.dissipated_at_walls - c.work_by_walls + c.outlet_energy;
 }
 
 }  // namespace kairos::testing

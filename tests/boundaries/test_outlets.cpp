@@ -231,13 +231,8 @@ ParticleSystem<D> grains_above_the_floor(std::uint64_t seed) {
   return s;
 }
 
-// Kinetic + rotational + potential energy, plus what collisions dissipated less the walls'
-// work plus what the outlet took out: constant.
 double budget(const Engine& engine) {
-  double e = engine.kinetic_energy() + engine.rotational_energy();
-  for (const Vec<D>& p : engine.current_positions()) e += p[1];  // m g y, m = g = 1
-  const EventCounters& c = engine.counters();
-  return e + c.dissipated_in_collisions + c.dissipated_at_walls - c.work_by_walls + c.outlet_energy;
+  return testing::silo_budget(engine);
 }
 
 TEST(OutletsInTheEngine, GrainsDrainThroughTheOrificeAndComeBackAtTheTop) {

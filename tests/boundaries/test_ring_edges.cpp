@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "../release_suite_only.hpp"
 #include "boundaries/outlets.hpp"
 #include "boundaries/plane_walls.hpp"
 #include "core/error.hpp"
@@ -39,6 +40,7 @@ PlaneWall<D> holed_floor(double level, double hole, double cx, double cy) {
 }
 
 TEST(RingEdges, TheHoledPlateAndItsRingAgreeWithDenseSampling) {
+  KAIROS_RELEASE_SUITE_ONLY();  // 10^8 sampled distances; the engine test below runs the ring
   const Vec<D> box{10.0, 10.0, 10.0}, g{0.0, 0.0, -1.0};
   PlaneWalls<D> planes({holed_floor(4.0, 1.5, 5.0, 5.0)}, box, walls_all_round(), g);
   ASSERT_EQ(planes.surfaces(), 2);  // the plate and its ring
@@ -136,10 +138,7 @@ ParticleSystem<D> grains(std::uint64_t seed) {
 }
 
 double budget(const Engine& engine) {
-  double e = engine.kinetic_energy() + engine.rotational_energy();
-  for (const Vec<D>& p : engine.current_positions()) e += p[2];  // m g z, m = g = 1
-  const EventCounters& c = engine.counters();
-  return e + c.dissipated_in_collisions + c.dissipated_at_walls - c.work_by_walls + c.outlet_energy;
+  return testing::silo_budget(engine);
 }
 
 TEST(RingEdgesInTheEngine, GrainsDrainThroughARoundOrificeAndMeetItsRim) {
@@ -156,7 +155,8 @@ TEST(RingEdgesInTheEngine, GrainsDrainThroughARoundOrificeAndMeetItsRim) {
         rim_hits += std::abs(std::hypot(rho - 2.0, p[2] - 4.0) - 0.5) < 1e-9 ? 1 : 0;
       }
     }
-    if (k % 199 == 0) engine.validate();  // every surface's prediction, by brute force
+    // Every surface's prediction, by brute force.
+    if (k % testing::validation_stride(199) == 0) engine.validate();
   }
   engine.validate();
   EXPECT_GT(engine.counters().outlet_passes, 20u);
