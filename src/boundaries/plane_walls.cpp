@@ -182,6 +182,11 @@ void PlaneWalls<D>::prepare(const CellGrid<D>& grid, double rmax, double particl
   // A ring's contact needs R > a (ring_contact_time); a narrower hole passes nothing anyway.
   for (const int k : ring_planes_) {
     const PlaneWall<D>& p = plane(k);
+    if (!(p.hole_radius <= 2e6 * rmax)) {
+      throw InputError(
+          fmt::format("boundary.plane[{}].hole_radius: {:.6g} is beyond 10^6 particle diameters", k,
+                      p.hole_radius));
+    }
     if (!(p.hole_radius > rmax)) {
       throw InputError(fmt::format(
           "boundary.plane[{}].hole_radius: {:.6g} is not larger than the largest particle "

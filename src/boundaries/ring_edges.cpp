@@ -21,13 +21,19 @@ void split(const RingEdge<D>& r, const Vec<D>& x, double& z, Vec<D>& across) {
 
 }  // namespace
 
+// Only over the hole (the foot within it): beside it the plate's face is the nearer surface
+// (its distance |z| is below the ring's), and a soft contact (the DEM) must meet one of the two,
+// not both; at the rim the two distances agree, so the contact passes from one to the other
+// without a jump.
 template <int D>
 double RingEdges<D>::gap(int s, const Vec<D>& x) const {
   const RingEdge<D>& r = ring(s);
   double z = 0.0;
   Vec<D> across{};
   split(r, x, z, across);
-  return std::hypot(std::sqrt(norm2(across)) - r.radius, z);
+  const double rho = std::sqrt(norm2(across));
+  if (rho > r.radius) return kNever;
+  return std::hypot(rho - r.radius, z);
 }
 
 // From the circle's point nearest to x (on the axis every point of the circle is as near: any

@@ -39,7 +39,9 @@ class RingEdges {
   int surfaces() const { return static_cast<int>(rings_.size()); }
   const RingEdge<D>& ring(int s) const { return rings_[static_cast<std::size_t>(s)]; }
   const ContactModel& contact(int s) const { return ring(s).contact; }
-  // The distance of x from the circle, and the unit vector from its nearest point to x.
+  // The distance of x from the circle where x lies over the hole (its distance from the axis
+  // at most R; beside the hole the plate's face is nearer: kNever), and the unit vector from the
+  // circle's nearest point to x.
   double gap(int s, const Vec<D>& x) const;
   Vec<D> normal(int s, const Vec<D>& x) const;
   // Relative time of the contact of a particle (at x, velocity v, under the field) of this

@@ -437,6 +437,26 @@ double ring_contact_time(const double* r, const double* v, const double* g, cons
   for (int i = 0; i < 5; ++i)
     for (int j = 0; j < 5; ++j) f[static_cast<std::size_t>(i + j)] += s[i] * s[j];
   for (int i = 0; i < 5; ++i) f[static_cast<std::size_t>(i)] -= 4.0 * R2 * w[i];
+  // f(0) and f'(0) from the product form (dist^2 - a^2) ((rho + R)^2 + z^2 - a^2): the expanded
+  // coefficients carry round-off of the size of (2 R^2)^2, which for a wide ring (R >> a) swamps
+  // a grazing particle's f(0) and f'(0), and the solver's "overlapping and closing" at t = 0
+  // fired on noise (a clock frozen on a grain sliding over the rim).
+  double px = 0.0, pv = 0.0;  // r and v across the axis: |r_perp|^2, r_perp . v_perp
+  for (int k = 0; k < 3; ++k) {
+    const double rp = r[k] - nr * n[k], vp = v[k] - nv * n[k];
+    px += rp * rp;
+    pv += rp * vp;
+  }
+  if (px > 0.0) {
+    const double rho = std::sqrt(px), drho = pv / rho;
+    const double a2 = radius * radius;
+    const double A = (rho - ring_radius) * (rho - ring_radius) + nr * nr - a2;
+    const double B = (rho + ring_radius) * (rho + ring_radius) + nr * nr - a2;
+    const double dA = 2.0 * (rho - ring_radius) * drho + 2.0 * nr * nv;
+    const double dB = 2.0 * (rho + ring_radius) * drho + 2.0 * nr * nv;
+    f[0] = A * B;
+    f[1] = dA * B + A * dB;
+  }
   return polynomial_event_time(f.data(), 8, t_max);
 }
 

@@ -81,12 +81,20 @@ TEST(RingEdges, TheHoledPlateAndItsRingAgreeWithDenseSampling) {
   EXPECT_GT(met[0], 100);
   EXPECT_GT(met[1], 20);      // the ring
   EXPECT_GT(from_below, 20);  // the plate's underside
-  // The ring's normal points from its nearest point to the centre; its gap is that distance.
-  const Vec<D> on_rim{5.0 + 1.5 + 0.3, 5.0, 4.0 + 0.4};
-  EXPECT_NEAR(planes.gap(1, on_rim, 0.0), 0.5, 1e-15);
-  const Vec<D> n = planes.normal(1, on_rim, 0.0);
-  EXPECT_NEAR(n[0], 0.6, 1e-15);
+  // Over the hole the ring's normal points from its nearest point to the centre and its gap is
+  // that distance; beside the hole the plate is the nearer surface (its gap |z|), the ring's none
+  // (a soft contact meets one of the two, and the distances agree at the rim).
+  const Vec<D> over{5.0 + 1.5 - 0.3, 5.0, 4.0 + 0.4};
+  EXPECT_NEAR(planes.gap(1, over, 0.0), 0.5, 1e-15);
+  EXPECT_EQ(planes.gap(0, over, 0.0), kNever);
+  const Vec<D> n = planes.normal(1, over, 0.0);
+  EXPECT_NEAR(n[0], -0.6, 1e-15);
   EXPECT_NEAR(n[2], 0.8, 1e-15);
+  const Vec<D> beside{5.0 + 1.5 + 0.3, 5.0, 4.0 + 0.4};
+  EXPECT_EQ(planes.gap(1, beside, 0.0), kNever);
+  EXPECT_NEAR(planes.gap(0, beside, 0.0), 0.4, 1e-15);
+  const Vec<D> at_rim{5.0 + 1.5, 5.0, 4.0 + 0.4};
+  EXPECT_NEAR(planes.gap(0, at_rim, 0.0), planes.gap(1, at_rim, 0.0), 1e-15);
 }
 
 using Engine = EventEngine<D, CalendarQueue>;

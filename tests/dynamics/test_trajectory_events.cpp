@@ -710,5 +710,39 @@ TEST(RingContact, FallingSpheresAgainstDenseSampling) {
   EXPECT_GT(events, 100);
 }
 
+// A wide ring (R = 200 a): a sphere just touching it (to round-off) and leaving or sliding past
+// it has no contact at t = 0, though the expanded polynomial's terms are (2 R^2)^2 and their
+// round-off larger than its f(0) and f'(0) (which ring_contact_time takes from the product form:
+// a review found the clock frozen on a grain sliding over such a rim); one closing in is met at
+// at once (within round-off).
+TEST(RingContact, AWideRingsGrazingSphereIsNotMetOnRoundOff) {
+  const double R = 100.0, a = 0.5;
+  const std::array<double, 3> n{0.0, 0.0, 1.0}, none{0.0, 0.0, 0.0};
+  int checked = 0;
+  for (const double angle : {0.3, 0.9, 1.2}) {
+    for (const double slack : {0.0, 1e-13, 1e-12, -1e-13}) {
+      // On the circle of centres at distance a (1 + slack) from the rim, above the plate.
+      const double d = a * (1.0 + slack);
+      const double rho = R + d * std::cos(angle), z = d * std::sin(angle);
+      const std::array<double, 3> r{rho, 0.0, z};
+      // Leaving along the normal, sliding along the rim (tangent), and both.
+      for (const std::array<double, 3>& v :
+           {std::array<double, 3>{std::cos(angle), 0.0, std::sin(angle)},
+            std::array<double, 3>{0.0, 0.66, 0.0},
+            std::array<double, 3>{0.1 * std::cos(angle), 0.66, 0.1 * std::sin(angle)}}) {
+        const double t = ring_contact_time(r.data(), v.data(), none.data(), n.data(), R, a);
+        EXPECT_TRUE(t == kNever || t > 1e-3) << angle << " " << slack << " " << t;
+        ++checked;
+      }
+      // Closing in along the normal: met now.
+      const std::array<double, 3> in{-std::cos(angle), 0.0, -std::sin(angle)};
+      if (slack <= 0.0) {
+        EXPECT_LT(ring_contact_time(r.data(), in.data(), none.data(), n.data(), R, a), 1e-12);
+      }
+    }
+  }
+  EXPECT_EQ(checked, 36);
+}
+
 }  // namespace
 }  // namespace kairos

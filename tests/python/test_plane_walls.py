@@ -180,6 +180,7 @@ class PlaneWalls(kt.KairosTestCase):
             text = f.read()
         for override, needle in (
                 ("boundary.plane[0].hole_radius=0.4", "not larger than the largest particle"),
+                ("boundary.plane[0].hole_radius=1e300", "beyond 10^6 particle diameters"),
                 ("boundary.plane[0].velocity=[0.0, 0.0, 0.1]", "hold still")):
             with self.subTest(override=override):
                 result = self.kairos("run", self.write_config(text, "silo.toml"), "-o",
