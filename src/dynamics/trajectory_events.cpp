@@ -364,10 +364,9 @@ int positive_roots(const Polynomial& p, std::array<double, kMaxPolynomialDegree>
       end = expand_until(lo, crossed);
     }
     if (std::isinf(end) || !crossed(end)) continue;
-    const Polynomial dq = dp;
     const double r = polish_root(
         [&](double t) {
-          return std::pair{sign * p.f(t), sign * dq.f(t)};
+          return std::pair{sign * p.f(t), sign * dp.f(t)};
         },
         lo, end);
     if (r > 0.0 && (n == 0 || out[static_cast<std::size_t>(n - 1)] < r))
