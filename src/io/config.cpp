@@ -369,98 +369,47 @@ class Reader : public KeyReader {
     return face_number(valid.at(face));
   }
 
-  // [[boundary.plane]] number i: its normal (not zero; kept as written, normalised by
-  // make_environment) and point, then the contact law and the motion keys of a face wall. Whether
-  // it cuts a periodic axis is checked with the box (Environment::check).
-  PlaneConfig read_plane(const toml::table& pt, std::size_t i, int dimension,
-                         const ContactConfig& contact) const {
-    const std::string prefix = fmt::format("boundary.plane[{}]", i);
-    PlaneConfig plane;
-    plane.wall.contact = contact;
-    read_group(pt, prefix, plane_keys(), &plane, &dimension);
-    require_vectors(pt, prefix, {"normal", "point"}, dimension);
-    require_nonzero(pt, prefix, "normal", plane.normal, "it points into the domain");
-    read_contact(pt, prefix, plane.wall.contact);
-    read_group(pt, prefix, wall_keys(), &plane.wall, &dimension);
-    // A strip: an axis of the box, and at least one end below the other.
-    if (plane.span_axis.empty()) {
-      for (const char* key : {"span_min", "span_max"}) {
-        if (pt.get(key) != nullptr) {
-          fail(pt.get(key), prefix + "." + key,
-               fmt::format("{}.{}: a span needs its axis ({}.span_axis)", prefix, key, prefix));
-        }
-      }
-    } else if (!axes(dimension).contains(plane.span_axis)) {
-      fail(pt.get("span_axis"), prefix + ".span_axis",
-           fmt::format("{}.span_axis: '{}' is not an axis of the box ({})", prefix, plane.span_axis,
-                       axes(dimension).names(", ", " or ")));
-    } else if (!(plane.span_min < plane.span_max)) {
-      fail(pt.get("span_max"), prefix + ".span_max",
-           fmt::format("{}.span_max: must be above span_min ({} <= {})", prefix, plane.span_max,
-                       plane.span_min));
-    } else if (std::isinf(plane.span_min) && std::isinf(plane.span_max)) {
-      fail(pt.get("span_axis"), prefix + ".span_axis",
-           fmt::format("{}.span_axis: give span_min, span_max or both (where the strip ends)",
-                       prefix));
+  // One entry of a surface table (io/surface_table.hpp) as the table's rules see it: its
+  // table, path and dimension, and [contact]'s law that its own contact law starts from.
+  class EntryReading final : public TableReading {
+   public:
+    EntryReading(const Reader& reader, const toml::table& table, std::string prefix, int dimension,
+                 const ContactConfig& contact)
+        : reader_(reader),
+          table_(table),
+          prefix_(std::move(prefix)),
+          dimension_(dimension),
+          contact_(contact) {}
+    const std::string& prefix() const override { return prefix_; }
+    int dimension() const override { return dimension_; }
+    bool has(std::string_view key) const override { return table_.get(key) != nullptr; }
+    [[noreturn]] void fail(std::string_view key, const std::string& message) const override {
+      const toml::node* node = key.empty() ? nullptr : table_.get(key);
+      reader_.fail(node != nullptr ? node : &table_,
+                   key.empty() ? prefix_ : prefix_ + "." + std::string(key), message);
     }
-    // A circular hole: in 3D, in a whole plane, its centre only with it.
-    if (plane.hole_radius > 0.0) {
-      if (dimension != 3) {
-        fail(pt.get("hole_radius"), prefix + ".hole_radius",
-             fmt::format("{}.hole_radius: a hole is for planes in 3D (in 2D cut the line into two "
-                         "strips: span_axis)",
-                         prefix));
-      }
-      if (!plane.span_axis.empty()) {
-        fail(pt.get("hole_radius"), prefix + ".hole_radius",
-             fmt::format("{}.hole_radius: a strip (span_axis) cannot also have a hole", prefix));
-      }
-    } else if (pt.get("hole_center") != nullptr) {
-      fail(pt.get("hole_center"), prefix + ".hole_center",
-           fmt::format("{}.hole_center: give the hole's radius too ({}.hole_radius)", prefix,
-                       prefix));
+    void read_group(const KeyGroup& group, void* object) const override {
+      reader_.read_group(table_, prefix_, group, object, &dimension_);
     }
-    for (const double c : plane.hole_center) {
-      if (!std::isfinite(c))
-        fail(pt.get("hole_center"), prefix + ".hole_center",
-             prefix + ".hole_center: must be finite");
+    void read_contact(ContactConfig& law) const override {
+      law = contact_;
+      reader_.read_contact(table_, prefix_, law);
     }
-    return plane;
-  }
+    void require_vectors(std::initializer_list<const char*> keys) const override {
+      reader_.require_vectors(table_, prefix_, keys, dimension_);
+    }
+    void require_nonzero(const char* key, const std::vector<double>& v,
+                         std::string_view meaning) const override {
+      reader_.require_nonzero(table_, prefix_, key, v, meaning);
+    }
 
-  // [[boundary.cylinder]] number i: its axis (2D: z), center and radius (required), the side
-  // the particles are on and its rotation, then its contact law. Whether it crosses a periodic
-  // face is checked with the box (Environment::check).
-  CylinderConfig read_cylinder(const toml::table& ct, std::string_view table, std::size_t i,
-                               int dimension, const ContactConfig& contact) const {
-    const std::string prefix = fmt::format("boundary.{}[{}]", table, i);
-    CylinderConfig cylinder;
-    cylinder.contact = contact;
-    read_group(ct, prefix, cylinder_keys(), &cylinder, &dimension);
-    for (const char* key : {"center", "radius"}) {
-      if (ct.get(key) == nullptr) {
-        fail(&ct, prefix + "." + key,
-             fmt::format("missing required key '{}.{}'{}", prefix, key,
-                         std::string_view(key) == "center" ? fmt::format(" ({} numbers)", dimension)
-                                                           : std::string(" (> 0)")));
-      }
-    }
-    if (!axes(3).contains(cylinder.axis)) {
-      fail(ct.get("axis"), prefix + ".axis",
-           fmt::format("{}.axis: '{}' is not an axis (x, y or z)", prefix, cylinder.axis));
-    }
-    if (dimension == 2 && cylinder.axis != "z") {
-      fail(ct.get("axis"), prefix + ".axis",
-           fmt::format("{}.axis: '{}': in 2D a {} is a circle in the plane, its axis is z", prefix,
-                       cylinder.axis, table));
-    }
-    for (const double c : cylinder.center) {
-      if (!std::isfinite(c))
-        fail(ct.get("center"), prefix + ".center", prefix + ".center: must be finite");
-    }
-    read_contact(ct, prefix, cylinder.contact);
-    return cylinder;
-  }
+   private:
+    const Reader& reader_;
+    const toml::table& table_;
+    std::string prefix_;
+    int dimension_;
+    const ContactConfig& contact_;
+  };
 
   // Vector keys a table must have (a plane's normal and point, an outlet's region): an error
   // naming the first one missing.
@@ -553,15 +502,16 @@ class Reader : public KeyReader {
       b.walls.push_back(std::move(w));
     }
 
-    const std::vector<const toml::table*> plane_tables = table_array(t, p, "plane");
-    for (std::size_t i = 0; i < plane_tables.size(); ++i)
-      b.planes.push_back(read_plane(*plane_tables[i], i, dimension, contact));
-    const std::vector<const toml::table*> cylinder_tables = table_array(t, p, "cylinder");
-    for (std::size_t i = 0; i < cylinder_tables.size(); ++i)
-      b.cylinders.push_back(read_cylinder(*cylinder_tables[i], "cylinder", i, dimension, contact));
-    const std::vector<const toml::table*> sphere_tables = table_array(t, p, "sphere");
-    for (std::size_t i = 0; i < sphere_tables.size(); ++i)
-      b.spheres.push_back(read_cylinder(*sphere_tables[i], "sphere", i, dimension, contact));
+    for_each_surface_table(b.surfaces, [&](auto table, auto& entries) {
+      const std::vector<const toml::table*> given = table_array(t, p, table.key);
+      for (std::size_t i = 0; i < given.size(); ++i) {
+        const EntryReading entry(*this, *given[i], fmt::format("boundary.{}[{}]", table.key, i),
+                                 dimension, contact);
+        typename decltype(table)::Config config;
+        table.read(entry, config);
+        entries.push_back(std::move(config));
+      }
+    });
 
     read_group(t, std::string(p), boundary_keys(), &b, &dimension);
     const toml::table none;
@@ -883,8 +833,9 @@ class Reader : public KeyReader {
     };
     for (std::size_t w = 0; w < c.boundary.walls.size(); ++w)
       moves(c.boundary.walls[w], fmt::format("boundary.wall[{}]", w), true);
-    for (std::size_t p = 0; p < c.boundary.planes.size(); ++p) {
-      const PlaneConfig& plane = c.boundary.planes[p];
+    const std::vector<PlaneConfig>& planes = c.boundary.surfaces.of<PlaneTable>();
+    for (std::size_t p = 0; p < planes.size(); ++p) {
+      const PlaneConfig& plane = planes[p];
       const std::string prefix = fmt::format("boundary.plane[{}]", p);
       moves(plane.wall, prefix, false);
       double along = 0.0;
@@ -960,17 +911,6 @@ class Reader : public KeyReader {
   // Walls with mass (boundaries/wall_body.hpp): face walls of the event engine whose motion
   // is their own; what that cannot be combined with (yet) is refused.
   void check_wall_masses(const toml::table& root, const Config& c) const {
-    for (std::size_t p = 0; p < c.boundary.planes.size(); ++p) {
-      const WallConfig& w = c.boundary.planes[p].wall;
-      for (const char* key : {"mass", "force"}) {
-        if ((key[0] == 'm' ? w.mass : w.force) == 0.0) continue;
-        const std::string name = fmt::format("boundary.plane[{}].{}", p, key);
-        fail(node_at(root, name), name,
-             fmt::format("{}: only the walls on the box's faces ([[boundary.wall]]) can have "
-                         "mass yet",
-                         name));
-      }
-    }
     for (std::size_t k = 0; k < c.boundary.walls.size(); ++k) {
       const WallConfig& w = c.boundary.walls[k];
       const std::string prefix = fmt::format("boundary.wall[{}]", k);

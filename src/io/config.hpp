@@ -16,6 +16,8 @@
 #include <vector>
 
 #include "interactions/potential_spec.hpp"
+#include "io/surface_tables.hpp"
+#include "io/wall_config.hpp"
 
 namespace kairos {
 
@@ -66,20 +68,6 @@ struct SystemConfig {
   bool operator==(const SystemConfig&) const = default;
 };
 
-// A contact law (particle-particle for a species pair, or particle-wall):
-// docs/physics.md#granular-contacts.
-struct ContactConfig {
-  double restitution = 1.0;                    // e_n (constant), or e at restitution_speed
-  std::string restitution_model = "constant";  // constant | viscoelastic | table
-  double restitution_speed = 1.0;              // viscoelastic: e(restitution_speed) = restitution
-  std::vector<std::array<double, 2>> restitution_table;       // table: (impact speed, e) pairs
-  double tangential_restitution = -1.0;                       // beta in [-1, 1]; -1 smooth
-  double friction = std::numeric_limits<double>::infinity();  // Coulomb mu (Walton); inf = no limit
-  double elastic_below_speed = 0.0;                           // |g_n| below this: elastic (0 = off)
-
-  bool operator==(const ContactConfig&) const = default;
-};
-
 struct PairContactConfig {
   std::array<std::string, 2> species;  // names
   ContactConfig contact;
@@ -96,49 +84,6 @@ struct InteractionConfig {
   double sleep_speed = -1.0;
 
   bool operator==(const InteractionConfig&) const = default;
-};
-
-struct WallConfig {
-  std::string face;              // x- x+ y- y+ z- z+
-  ContactConfig contact;         // restitution etc. of particle-wall collisions
-  std::vector<double> velocity;  // in-plane sliding velocity (D components), empty = at rest
-  double amplitude = 0.0;        // vibration along the normal: A sin(2 pi f t + phase)
-  double frequency = 0.0;        // f, cycles per unit time
-  double phase = 0.0;            // radians
-  double mass = 0.0;             // > 0: a wall with mass (a free piston; 0: infinite mass)
-  double force = 0.0;            // on a wall with mass, along its normal (into the box)
-
-  bool operator==(const WallConfig&) const = default;
-};
-
-// A plane wall anywhere ([[boundary.plane]], boundaries/plane_walls.hpp).
-struct PlaneConfig {
-  std::vector<double> normal;  // D components, into the domain (not normalised)
-  std::vector<double> point;   // D components: a point of the plane at t = 0
-  WallConfig wall;             // its contact law and motion: the keys of [[boundary.wall]]
-                               // but face
-  // A strip: the plane only where its points' coordinate along span_axis lies in
-  // [span_min, span_max] ("": everywhere; an end left out is unbounded).
-  std::string span_axis;
-  double span_min = -std::numeric_limits<double>::infinity();
-  double span_max = std::numeric_limits<double>::infinity();
-  // A circular hole (3D; 0: none) and its centre (empty: `point`), projected onto the plane.
-  double hole_radius = 0.0;
-  std::vector<double> hole_center;
-
-  bool operator==(const PlaneConfig&) const = default;
-};
-
-// A cylinder wall ([[boundary.cylinder]], boundaries/cylinder_walls.hpp).
-struct CylinderConfig {
-  std::string axis = "z";      // its axis's direction (2D: "z", the circle in the plane)
-  std::vector<double> center;  // D components: a point of the axis
-  double radius = 0.0;         // required
-  bool inside = true;          // the particles are inside it (a drum), else outside (an obstacle)
-  double angular_velocity = 0.0;  // about the axis, right-handed
-  ContactConfig contact;          // its contact law: the keys of [contact]
-
-  bool operator==(const CylinderConfig&) const = default;
 };
 
 // The walls of one axis joined as a container of finite mass on a spring to a moving anchor
@@ -169,14 +114,14 @@ struct OutletConfig {
 };
 
 struct BoundaryConfig {
-  std::vector<WallConfig> walls;          // [[boundary.wall]]
-  ContainerConfig container;              // [boundary.container]
-  OutletConfig outlet;                    // [boundary.outlet]
-  std::vector<PlaneConfig> planes;        // [[boundary.plane]]
-  std::vector<CylinderConfig> cylinders;  // [[boundary.cylinder]]
-  std::vector<CylinderConfig> spheres;    // [[boundary.sphere]]: axis is the rotation's
-  std::vector<std::string> open;          // boundary.open: faces with no wall (e.g. "z+")
-  double shear_rate = 0.0;                // Lees-Edwards: flow along x, gradient along y; 0: none
+  std::vector<WallConfig> walls;  // [[boundary.wall]]
+  ContainerConfig container;      // [boundary.container]
+  OutletConfig outlet;            // [boundary.outlet]
+  // [[boundary.plane]], [[boundary.cylinder]], ...: one list per table of io/surface_tables.hpp
+  // (surfaces.of<PlaneTable>()).
+  SurfaceConfigs surfaces;
+  std::vector<std::string> open;  // boundary.open: faces with no wall (e.g. "z+")
+  double shear_rate = 0.0;        // Lees-Edwards: flow along x, gradient along y; 0: none
 
   bool operator==(const BoundaryConfig&) const = default;
 };

@@ -12,6 +12,7 @@
 #include "io/config.hpp"
 #include "io/config_choices.hpp"
 #include "io/keys/key_tables.hpp"
+#include "io/surface_tables.hpp"
 
 namespace kairos {
 
@@ -19,21 +20,17 @@ namespace {
 
 using namespace key_tables;
 
-// Where each group appears: tables and their keys, in the order of the suggestions.
-struct Placed {
-  const KeyGroup* group;
-  std::string_view shared_from = {};  // documented in that table
-  bool last = false;  // suggested after every other key (an unknown 'restitution' elsewhere is
-                      // offered contact.* and soft.* first)
-};
+// Where each group appears: tables and their keys, in the order of the suggestions. A group
+// placed `last` is suggested after every other key (an unknown 'restitution' elsewhere is
+// offered contact.* and soft.* first).
 struct Placement {
-  std::string_view path;  // of the table
-  KeyType type;           // kTable or kTableArray
-  std::vector<Placed> groups;
+  std::string path;  // of the table
+  KeyType type;      // kTable or kTableArray
+  std::vector<PlacedGroup> groups;
 };
 
 std::vector<DeclaredKey> build() {
-  const std::vector<Placement> placements = {
+  std::vector<Placement> placements = {
       {"system", KeyType::kTable, {{&kSystemGroup}}},
       {"system.species", KeyType::kTableArray, {{&kSpeciesGroup}}},
       {"potential",
@@ -50,15 +47,6 @@ std::vector<DeclaredKey> build() {
        {{&kWallFaceGroup}, {&kContactLawGroup, "contact"}, {&kWallGroup}}},
       {"boundary.container", KeyType::kTable, {{&kContainerGroup}}},
       {"boundary.outlet", KeyType::kTable, {{&kOutletGroup}}},
-      {"boundary.plane",
-       KeyType::kTableArray,
-       {{&kPlaneGroup}, {&kContactLawGroup, "contact"}, {&kWallGroup, "boundary.wall"}}},
-      {"boundary.cylinder",
-       KeyType::kTableArray,
-       {{&kCylinderGroup}, {&kContactLawGroup, "contact"}}},
-      {"boundary.sphere",
-       KeyType::kTableArray,
-       {{&kCylinderGroup, "boundary.cylinder"}, {&kContactLawGroup, "contact"}}},
       {"driving", KeyType::kTable, {{&kDrivingGroup}}},
       {"field", KeyType::kTable, {{&kFieldGroup}}},
       {"run", KeyType::kTable, {{&kRunGroup}}},
@@ -68,6 +56,15 @@ std::vector<DeclaredKey> build() {
       {"analysis", KeyType::kTable, {{&kAnalysisGroup}}},
       {"compress", KeyType::kTable, {{&kCompressGroup}}},
   };
+  // The surface tables (io/surface_tables.hpp) after [boundary.outlet].
+  auto after = std::find_if(placements.begin(), placements.end(),
+                            [](const Placement& p) { return p.path == "boundary.outlet"; }) +
+               1;
+  SurfaceTables::each([&](auto table) {
+    after = placements.insert(after, {fmt::format("boundary.{}", table.key), KeyType::kTableArray,
+                                      table.placement()}) +
+            1;
+  });
   std::vector<DeclaredKey> out, last;
   for (const Placement& p : placements) {
     out.push_back({std::string(p.path), p.type, nullptr, nullptr, {}});
@@ -75,7 +72,7 @@ std::vector<DeclaredKey> build() {
         p.type == KeyType::kTableArray ? std::string(p.path) + "[]" : std::string(p.path);
     if (p.type == KeyType::kTableArray)
       out.push_back({prefix, KeyType::kTable, nullptr, nullptr, {}});
-    for (const Placed& g : p.groups) {
+    for (const PlacedGroup& g : p.groups) {
       for (const KeyDecl& d : g.group->keys) {
         (g.last ? last : out)
             .push_back(
@@ -192,17 +189,11 @@ const KeyGroup& boundary_keys() {
 const KeyGroup& wall_keys() {
   return kWallGroup;
 }
-const KeyGroup& plane_keys() {
-  return kPlaneGroup;
-}
 const KeyGroup& container_keys() {
   return kContainerGroup;
 }
 const KeyGroup& outlet_keys() {
   return kOutletGroup;
-}
-const KeyGroup& cylinder_keys() {
-  return kCylinderGroup;
 }
 const KeyGroup& field_keys() {
   return kFieldGroup;

@@ -13,7 +13,9 @@
 // Adding a key: a member in io/config.hpp (its initialiser is the default), one KeyDecl in the
 // group of its struct in io/keys/ (one file per part of the config; io/config_keys.cpp places
 // the groups into tables), one row in the table of docs/config.md. The reader
-// and the writer then handle it; a rule that involves other keys goes into the reader.
+// and the writer then handle it; a rule that involves other keys goes into the reader. A key of
+// a boundary geometry's table goes into its table file pair instead (io/surface_table.hpp),
+// which declares, reads and writes its own groups.
 #pragma once
 
 #include <array>
@@ -175,6 +177,11 @@ struct DeclaredKey {
   std::string_view shared_from = {};
 };
 const std::vector<DeclaredKey>& declared_keys();
+// The keys of `group` that `object` (the group's struct) has, one per line "key = value", in
+// declaration order (to_toml, io/config_writer.cpp); a vector left empty (the default) is
+// written with its effective value, `dimension` components of its fill.
+std::string group_toml(const KeyGroup& group, const void* object, std::string_view prefix,
+                       std::size_t dimension);
 // The declaration of a path ("system.species[2].name" or "system.species[].name"), or nullptr.
 const DeclaredKey* find_declared(std::string_view path);
 
@@ -186,10 +193,8 @@ const KeyGroup& contact_keys();         // [contact] alone: tc, sleep_speed
 const KeyGroup& boundary_keys();        // [boundary]
 const KeyGroup& wall_keys();            // [[boundary.wall]] (after face and the contact law)
                                         // and [[boundary.plane]] (after its own keys)
-const KeyGroup& plane_keys();           // [[boundary.plane]]: normal, point
 const KeyGroup& container_keys();       // [boundary.container]
 const KeyGroup& outlet_keys();          // [boundary.outlet]
-const KeyGroup& cylinder_keys();        // [[boundary.cylinder]]: axis, center, radius, ...
 const KeyGroup& field_keys();           // [field]
 const KeyGroup& driving_keys();         // [driving]
 const KeyGroup& run_keys();             // [run]

@@ -15,9 +15,11 @@ std::optional<TransportObstacle> compression_obstacle(const Config& c) {
     return TransportObstacle{std::move(key), std::move(why)};
   };
   const char* box = "the particles grow in a periodic box or between walls on its faces";
-  if (!c.boundary.planes.empty()) return refuse("boundary.plane", box);
-  if (!c.boundary.cylinders.empty()) return refuse("boundary.cylinder", box);
-  if (!c.boundary.spheres.empty()) return refuse("boundary.sphere", box);
+  std::optional<TransportObstacle> surface;
+  for_each_surface_table(c.boundary.surfaces, [&](auto table, const auto& entries) {
+    if (!surface && !entries.empty()) surface = refuse(fmt::format("boundary.{}", table.key), box);
+  });
+  if (surface) return surface;
   if (!c.boundary.open.empty()) return refuse("boundary.open", box);
   if (c.boundary.shear_rate != 0.0) return refuse("boundary.shear_rate", box);
   if (std::any_of(c.field.gravity.begin(), c.field.gravity.end(),
@@ -92,9 +94,7 @@ std::optional<TransportObstacle> replica_exchange_obstacle(const Config& c) {
   Config conservative = c;
   conservative.driving = DrivingConfig{};
   conservative.boundary.walls.clear();
-  conservative.boundary.planes.clear();
-  conservative.boundary.cylinders.clear();
-  conservative.boundary.spheres.clear();
+  conservative.boundary.surfaces = SurfaceConfigs{};
   if (std::optional<TransportObstacle> o = transport_obstacle(conservative)) return o;
   // Elastic rough contacts conserve energy but exchange it with the spins, which neither the
   // thermostat nor a swap's scaling touches.
@@ -130,23 +130,20 @@ std::optional<TransportObstacle> replica_exchange_obstacle(const Config& c) {
   };
   for (std::size_t k = 0; k < c.boundary.walls.size(); ++k)
     if (auto o = still(c.boundary.walls[k], fmt::format("boundary.wall[{}]", k))) return o;
-  for (std::size_t k = 0; k < c.boundary.planes.size(); ++k)
-    if (auto o = still(c.boundary.planes[k].wall, fmt::format("boundary.plane[{}]", k))) return o;
-  const auto round = [&](const std::vector<CylinderConfig>& list,
-                         const char* name) -> std::optional<TransportObstacle> {
-    for (std::size_t k = 0; k < list.size(); ++k) {
-      const std::string key = fmt::format("boundary.{}[{}]", name, k);
-      if (list[k].angular_velocity != 0.0)
-        return refuse(key + ".angular_velocity", "a rotating wall is not an equilibrium state");
-      WallConfig w;
-      w.contact = list[k].contact;
-      if (auto o = still(w, key)) return o;
+  std::optional<TransportObstacle> surface;
+  for_each_surface_table(c.boundary.surfaces, [&](auto table, const auto& entries) {
+    for (std::size_t k = 0; k < entries.size() && !surface; ++k) {
+      const std::string key = fmt::format("boundary.{}[{}]", table.key, k);
+      if (const std::optional<TableObstacle> moving = table.motion(entries[k])) {
+        surface = refuse(key + moving->key, moving->why);
+      } else {
+        WallConfig w;
+        w.contact = table.contact_law(entries[k]);
+        surface = still(w, key);
+      }
     }
-    return std::nullopt;
-  };
-  if (auto o = round(c.boundary.cylinders, "cylinder")) return o;
-  if (auto o = round(c.boundary.spheres, "sphere")) return o;
-  return std::nullopt;
+  });
+  return surface;
 }
 
 }  // namespace kairos

@@ -15,13 +15,8 @@
 
 namespace kairos {
 
-namespace {
-
 using namespace config_detail;
 
-// The keys of `group` that `object` (the group's struct) has, one per line "key = value", in
-// declaration order; a vector left empty (the default) is written with its effective value,
-// `dimension` components of its fill.
 std::string group_toml(const KeyGroup& group, const void* object, std::string_view prefix,
                        std::size_t dimension) {
   std::string out;
@@ -73,6 +68,8 @@ std::string group_toml(const KeyGroup& group, const void* object, std::string_vi
   }
   return out;
 }
+
+namespace {
 
 std::string species_pair_toml(const std::string& a, const std::string& b) {
   return fmt::format("species = [{}, {}]\n", toml_string(a), toml_string(b));
@@ -139,12 +136,10 @@ std::string to_toml(const Config& config) {
     out += group_toml(contact_law_keys(), &w.contact, "boundary.wall", dimension);
     out += group_toml(wall_keys(), &w, "boundary.wall", dimension);
   }
-  for (const PlaneConfig& p : config.boundary.planes) {
-    out += "\n[[boundary.plane]]\n";
-    out += group_toml(plane_keys(), &p, "boundary.plane", dimension);
-    out += group_toml(contact_law_keys(), &p.wall.contact, "boundary.plane", dimension);
-    out += group_toml(wall_keys(), &p.wall, "boundary.plane", dimension);
-  }
+  for_each_surface_table(config.boundary.surfaces, [&](auto surface, const auto& entries) {
+    for (const auto& entry : entries)
+      out += fmt::format("\n[[boundary.{}]]\n{}", surface.key, surface.toml(entry, dimension));
+  });
   if (!config.boundary.container.axis.empty()) {
     out += "\n[boundary.container]\n";
     out +=
@@ -153,14 +148,6 @@ std::string to_toml(const Config& config) {
   if (!config.boundary.outlet.normal.empty()) {
     out += "\n[boundary.outlet]\n";
     out += group_toml(outlet_keys(), &config.boundary.outlet, "boundary.outlet", dimension);
-  }
-  for (const bool sphere : {false, true}) {
-    const std::string name = sphere ? "boundary.sphere" : "boundary.cylinder";
-    for (const CylinderConfig& c : sphere ? config.boundary.spheres : config.boundary.cylinders) {
-      out += "\n[[" + name + "]]\n";
-      out += group_toml(cylinder_keys(), &c, name, dimension);
-      out += group_toml(contact_law_keys(), &c.contact, name, dimension);
-    }
   }
   out += table("driving", driving_keys(), &config.driving);
   out += table("field", field_keys(), &config.field);

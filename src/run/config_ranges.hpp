@@ -19,23 +19,9 @@
 #include "core/particle_system.hpp"
 #include "interactions/potential_spec.hpp"
 #include "io/config.hpp"
+#include "io/range_checks.hpp"
 
 namespace kairos {
-
-struct RangeScales {
-  int dimension = 3;
-  double d_min = 1.0, d_max = 1.0;  // smallest and largest diameter
-  double mass = 1.0;                // smallest mass
-  double kT = 1.0;                  // system.temperature
-  std::vector<double> box;          // edges; empty when there is no state (kairos steps)
-  double number_density = 0.0;      // N / V; 0 when there is no state
-
-  double speed() const;  // v = sqrt(kT / m)
-  double time() const;   // tau = d_min / v
-  // The collision rate per particle of a dilute gas at this density and temperature
-  // (Enskog's with g(sigma) = 1, largest diameter): a lower bound of the true one.
-  double dilute_collision_rate() const;
-};
 
 // The scales of a start state, or of the config alone (its species; no box).
 template <int D>

@@ -275,63 +275,7 @@ void add_soft_laws(const Config& config, const ParticleSystem<D>& s, Environment
 
 }  // namespace
 
-ContactModel make_contact_model(const ContactConfig& c, const std::string& where) {
-  ContactModel m;
-  try {
-    switch (restitution_models().at(c.restitution_model)) {
-      case RestitutionModel::kViscoelastic:
-        m.normal = NormalRestitution::viscoelastic_at(c.restitution, c.restitution_speed);
-        break;
-      case RestitutionModel::kTable: {
-        std::vector<double> speeds, values;
-        for (const auto& row : c.restitution_table) {
-          speeds.push_back(row[0]);
-          values.push_back(row[1]);
-        }
-        m.normal = NormalRestitution::table(std::move(speeds), std::move(values));
-        break;
-      }
-      case RestitutionModel::kConstant:
-        m.normal = NormalRestitution::constant(c.restitution);
-        break;
-    }
-    m.tangential = std::isfinite(c.friction)
-                       ? TangentialModel::walton(c.friction, c.tangential_restitution)
-                       : TangentialModel::constant(c.tangential_restitution);
-  } catch (const InputError& e) {
-    throw InputError(fmt::format("{}: {}", where, e.what()));
-  }
-  m.elastic_below_speed = c.elastic_below_speed;
-  return m;
-}
-
 namespace {
-// A vector key (the reader made sure it has D components, or none: then zero).
-template <int D>
-Vec<D> to_vec(const std::vector<double>& v) {
-  Vec<D> out{};
-  for (int a = 0; a < D && a < static_cast<int>(v.size()); ++a) out[a] = v[a];
-  return out;
-}
-
-// The plane through `point` with the given normal (not 0: the reader), as (unit normal, offset)
-// of n . x = offset: a plane wall's or an outlet's.
-template <int D>
-std::pair<Vec<D>, double> plane_through(const std::vector<double>& normal,
-                                        const std::vector<double>& point) {
-  Vec<D> n = to_vec<D>(normal);
-  n = (1.0 / std::sqrt(norm2(n))) * n;
-  return {n, dot(n, to_vec<D>(point))};
-}
-
-// A wall's contact law and motion from its keys (a face wall's or a plane's).
-template <int D>
-Wall<D> make_wall(const WallConfig& wc, const std::string& where) {
-  Wall<D> wall = wall_motion<D>(wc);
-  wall.contact = make_contact_model(wc.contact, where);
-  return wall;
-}
-
 // An outlet from its keys: the plane through `point` with the unit normal, and the insertion
 // region (the reader made sure every vector has its D components; the velocity may be empty).
 template <int D>
@@ -394,41 +338,10 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
     face.kind = FaceKind::kWall;
     face.wall = make_wall<D>(wc, fmt::format("boundary.wall[{}]", w));
   }
-  for (std::size_t k = 0; k < config.boundary.planes.size(); ++k) {
-    const PlaneConfig& pc = config.boundary.planes[k];
-    PlaneWall<D> plane;
-    std::tie(plane.normal, plane.offset) = plane_through<D>(pc.normal, pc.point);
-    plane.wall = make_wall<D>(pc.wall, fmt::format("boundary.plane[{}]", k));
-    if (!pc.span_axis.empty()) {
-      plane.span_axis = static_cast<int>(axes(D).at(pc.span_axis));
-      plane.span_min = pc.span_min;
-      plane.span_max = pc.span_max;
-    }
-    if (pc.hole_radius > 0.0) {
-      plane.hole_radius = pc.hole_radius;
-      const std::vector<double>& c = pc.hole_center.empty() ? pc.point : pc.hole_center;
-      Vec<D> center{};
-      for (int a = 0; a < D && a < static_cast<int>(c.size()); ++a) center[a] = c[a];
-      plane.hole_center = center - (dot(plane.normal, center) - plane.offset) * plane.normal;
-    }
-    env.planes.push_back(plane);
-  }
-  for (const bool sphere : {false, true}) {
-    const std::vector<CylinderConfig>& given =
-        sphere ? config.boundary.spheres : config.boundary.cylinders;
-    for (std::size_t k = 0; k < given.size(); ++k) {
-      const CylinderConfig& cc = given[k];
-      CylinderWall<D> round;
-      round.axis = D == 2 ? D - 1 : static_cast<int>(axes(3).at(cc.axis));
-      round.center = to_vec<D>(cc.center);
-      round.radius = cc.radius;
-      round.inside = cc.inside;
-      round.angular_velocity = cc.angular_velocity;
-      round.contact = make_contact_model(
-          cc.contact, fmt::format("boundary.{}[{}]", sphere ? "sphere" : "cylinder", k));
-      (sphere ? env.spheres : env.cylinders).push_back(round);
-    }
-  }
+  for_each_surface_table(config.boundary.surfaces, [&](auto table, const auto& entries) {
+    for (std::size_t k = 0; k < entries.size(); ++k)
+      table.add(entries[k], fmt::format("boundary.{}[{}]", table.key, k), env);
+  });
   for (const std::string& open : config.boundary.open)
     env.faces[face_index(open, D)].kind = FaceKind::kOpen;
   if (const OutletConfig& oc = config.boundary.outlet; !oc.normal.empty())
@@ -452,18 +365,6 @@ Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s
   return env;
 }
 
-template <int D>
-Wall<D> wall_motion(const WallConfig& wc) {
-  Wall<D> wall;
-  wall.velocity = to_vec<D>(wc.velocity);
-  wall.amplitude = wc.amplitude;
-  wall.angular_frequency = 2.0 * std::numbers::pi * wc.frequency;
-  wall.phase = wc.phase;
-  wall.mass = wc.mass;
-  wall.force = wc.force;
-  return wall;
-}
-
 double face_wall_offset(const WallConfig& wc, int dimension, double t) {
   const auto offset = [&]<int D>() {
     return wall_motion<D>(wc).plane_position(face_index(wc.face, D), Vec<D>{}, t);
@@ -471,8 +372,6 @@ double face_wall_offset(const WallConfig& wc, int dimension, double t) {
   return dimension == 2 ? offset.template operator()<2>() : offset.template operator()<3>();
 }
 
-template Wall<2> wall_motion<2>(const WallConfig&);
-template Wall<3> wall_motion<3>(const WallConfig&);
 template Environment<2> make_environment<2>(const Config&, const ParticleSystem<2>&);
 template Environment<3> make_environment<3>(const Config&, const ParticleSystem<3>&);
 

@@ -7,12 +7,10 @@
 
 #include "core/particle_system.hpp"
 #include "io/config.hpp"
+#include "io/config_models.hpp"
 #include "model/environment.hpp"
 
 namespace kairos {
-
-// The contact law a [contact]-style table describes. Throws InputError naming `where`.
-ContactModel make_contact_model(const ContactConfig& c, const std::string& where);
 
 // For the state `s`: its species names (index = species number) are what pair overrides and
 // potentials name (a name the state does not have is an InputError); species missing from
@@ -22,10 +20,6 @@ ContactModel make_contact_model(const ContactConfig& c, const std::string& where
 // do the bonds of one type.
 template <int D>
 Environment<D> make_environment(const Config& config, const ParticleSystem<D>& s);
-
-// A wall's motion from its keys (velocity, vibration, mass and force), without its contact law.
-template <int D>
-Wall<D> wall_motion(const WallConfig& wc);
 
 // Where the plane of the face wall `wc` lies at time t, less its face's rest position (0 or L):
 // Wall::plane_position from the keys alone, for comparing two configurations before any

@@ -90,10 +90,12 @@ Effect effect_of(const std::string& key) {
     return Effect::kResume;
   if (k == "contact.sleep_speed") return Effect::kRepredict;  // sleepers predict nothing
   if (starts_with(k, "contact.")) return Effect::kResume;
-  // A wall's, a plane's or a cylinder's contact law resumes; its place and motion re-predict (a
+  // A wall's or a surface table's contact law resumes; its place and motion re-predict (a
   // plane moved into the particles is refused by the start checks, naming the particle).
-  for (const std::string_view table :
-       {"boundary.wall.", "boundary.plane.", "boundary.cylinder.", "boundary.sphere."}) {
+  std::vector<std::string> tables = {"boundary.wall."};
+  SurfaceTables::each(
+      [&](auto table) { tables.push_back(fmt::format("boundary.{}.", table.key)); });
+  for (const std::string_view table : tables) {
     if (!starts_with(k, table)) continue;
     const std::string_view leaf = std::string_view(k).substr(table.size());
     if (std::find(kWallLaw.begin(), kWallLaw.end(), leaf) != kWallLaw.end()) return Effect::kResume;

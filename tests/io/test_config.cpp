@@ -1180,6 +1180,70 @@ TEST(ConfigToToml, RoundTripWithEveryGranularKey) {
   EXPECT_EQ(parse_config(to_toml(d_back), "config.toml"), d_back);
 }
 
+// Every surface table (io/surface_tables.hpp) writes its entries and reads them back exactly,
+// each entry's contact law starting from [contact]'s.
+TEST(ConfigToToml, RoundTripWithEverySurfaceTable) {
+  Config c = parse_config(R"([system]
+particles = 200
+packing_fraction = 0.2
+box_scale = [1.0, 1.0, 3.0]
+[contact]
+restitution = 0.7
+[[boundary.wall]]
+face = "z-"
+[[boundary.wall]]
+face = "z+"
+[[boundary.wall]]
+face = "x-"
+[[boundary.wall]]
+face = "x+"
+[[boundary.wall]]
+face = "y-"
+[[boundary.wall]]
+face = "y+"
+[[boundary.plane]]
+normal = [0.0, 0.0, 1.0]
+point = [0.0, 0.0, 0.5]
+hole_radius = 1.5
+restitution = 0.5
+[[boundary.plane]]
+normal = [0.0, 1.0, 1.0]
+point = [0.0, 0.0, 3.0]
+span_axis = "y"
+span_max = 2.0
+[[boundary.cylinder]]
+axis = "x"
+center = [0.0, 3.0, 3.0]
+radius = 2.5
+angular_velocity = 0.125
+friction = 0.5
+tangential_restitution = 0.2
+[[boundary.sphere]]
+center = [3.0, 3.0, 6.0]
+radius = 0.75
+inside = false
+)",
+                          "surfaces.toml");
+  const auto& planes = c.boundary.surfaces.of<PlaneTable>();
+  const auto& cylinders = c.boundary.surfaces.of<CylinderTable>();
+  const auto& spheres = c.boundary.surfaces.of<SphereTable>();
+  ASSERT_EQ(planes.size(), 2u);
+  ASSERT_EQ(cylinders.size(), 1u);
+  ASSERT_EQ(spheres.size(), 1u);
+  EXPECT_EQ(planes[0].wall.contact.restitution, 0.5);
+  EXPECT_EQ(planes[1].wall.contact.restitution, 0.7);  // [contact]'s
+  EXPECT_EQ(planes[1].span_max, 2.0);
+  EXPECT_EQ(cylinders[0].contact.friction, 0.5);
+  EXPECT_EQ(cylinders[0].contact.restitution, 0.7);
+  EXPECT_FALSE(spheres[0].inside);
+  const std::string text = to_toml(c);
+  for (const char* table : {"[[boundary.plane]]", "[[boundary.cylinder]]", "[[boundary.sphere]]"})
+    EXPECT_NE(text.find(table), std::string::npos) << text;
+  const Config back = parse_config(text, "config.toml");
+  EXPECT_EQ(back, c) << text;
+  EXPECT_EQ(to_toml(back), text);
+}
+
 TEST(ConfigToToml, MinimalConfigWritesEveryKeyWithResolvedDefaults) {
   const Config c = parse_config(kMinimal, "t.toml");
   const std::string text = to_toml(c);

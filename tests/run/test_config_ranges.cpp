@@ -83,6 +83,32 @@ TEST(ConfigRanges, KeysOutOfRangeNameKeyValueAndRange) {
   expect_range_error("[contact]\ntc = 1e300\n", {"contact.tc", "tau"});
 }
 
+// Each surface table (io/surface_tables.hpp) checks its own keys, named by its entry: a plane's
+// point and wall motion, a cylinder's or sphere's place, rotation and contact law.
+TEST(ConfigRanges, SurfaceTablesCheckTheirOwnKeys) {
+  const std::string walls =
+      "[[boundary.wall]]\nface = \"z-\"\n[[boundary.wall]]\nface = \"z+\"\n"
+      "[[boundary.wall]]\nface = \"x-\"\n[[boundary.wall]]\nface = \"x+\"\n"
+      "[[boundary.wall]]\nface = \"y-\"\n[[boundary.wall]]\nface = \"y+\"\n";
+  const std::string plane = "[[boundary.plane]]\nnormal = [0.0, 0.0, 1.0]\n";
+  EXPECT_EQ(range_error(walls + plane + "point = [5.0, 5.0, 1.0]\n"), "");
+  expect_range_error(walls + plane + "point = [5.0, 5.0, 1e300]\n",
+                     {"boundary.plane[0].point[2] = 1e+300", "1e6 times the longest box edge"});
+  expect_range_error(walls + plane + "point = [5.0, 5.0, 1.0]\nfrequency = 1e300\n",
+                     {"boundary.plane[0].frequency", "up to 1e9 / tau"});
+  const std::string drum = "[[boundary.cylinder]]\ncenter = [5.0, 5.0, 5.0]\nradius = 4.0\n";
+  EXPECT_EQ(range_error(walls + drum), "");
+  expect_range_error(walls + drum + "angular_velocity = 1e300\n",
+                     {"boundary.cylinder[0].angular_velocity", "1e6 / tau"});
+  // The round walls' contact law is checked in the run's units as a face wall's is.
+  expect_range_error(walls + drum +
+                         "restitution = 0.8\nrestitution_model = \"viscoelastic\"\n"
+                         "restitution_speed = 1e-300\n",
+                     {"boundary.cylinder[0].restitution_speed = 1e-300", "thermal speed"});
+  expect_range_error(walls + "[[boundary.sphere]]\ncenter = [5.0, 5.0, 5.0]\nradius = 1e300\n",
+                     {"boundary.sphere[0].radius = 1e+300", "1e6 times the longest box edge"});
+}
+
 TEST(ConfigRanges, OpenFacesNeedGravityPullingBack) {
   const std::string open = "[[boundary.wall]]\nface = \"z-\"\n[boundary]\nopen = [\"z+\"]\n";
   EXPECT_EQ(range_error(open + "[field]\ngravity = [0, 0, -1]\n"), "");

@@ -1,4 +1,5 @@
-// The [boundary] keys: walls, the container, outlets, planes, cylinders and spheres.
+// The [boundary] keys: walls, the container and outlets (the surface tables, planes, cylinders
+// and spheres, declare theirs in io/tables/).
 //
 // Each key's name, type, default, range and doc line (io/config_keys.hpp); io/config_keys.cpp
 // places the groups into their tables.
@@ -167,115 +168,6 @@ constexpr KeyDecl kOutlet[] = {
      .doc = "seeds the places drawn in the insertion region"},
 };
 
-bool span_given(const void* p) {
-  return !static_cast<const PlaneConfig*>(p)->span_axis.empty();
-}
-bool span_min_given(const void* p) {
-  return std::isfinite(static_cast<const PlaneConfig*>(p)->span_min);
-}
-bool span_max_given(const void* p) {
-  return std::isfinite(static_cast<const PlaneConfig*>(p)->span_max);
-}
-bool hole_given(const void* p) {
-  return static_cast<const PlaneConfig*>(p)->hole_radius > 0.0;
-}
-bool hole_center_given(const void* p) {
-  return !static_cast<const PlaneConfig*>(p)->hole_center.empty();
-}
-
-const PlaneConfig kPlaneDefaults{};
-constexpr KeyDecl kPlane[] = {
-    {.name = "normal",
-     .type = KeyType::kVector,
-     .member = field<&PlaneConfig::normal>,
-     .range = {.by_rule = true},  // not zero, no component along a periodic axis
-     .default_text = "**required**",
-     .doc = "the plane's normal, pointing into the domain (normalised)"},
-    {.name = "point",
-     .type = KeyType::kVector,
-     .member = field<&PlaneConfig::point>,
-     .range = {.by_rule = true},  // finite
-     .default_text = "**required**",
-     .unit = "length",
-     .doc = "a point of the plane at t = 0"},
-    {.name = "span_axis",
-     .type = KeyType::kString,
-     .member = field<&PlaneConfig::span_axis>,
-     .range = {.by_rule = true},  // a bounded axis the plane runs along; a still plane
-     .choices = &choices_in<&axes>,
-     .doc = "cut the plane to a strip along this axis, with edges at its ends (a silo's floor "
-            "beside its orifice, a hopper's side); \"\": the whole plane",
-     .written = &span_given},
-    {.name = "span_min",
-     .type = KeyType::kFloat,
-     .member = field<&PlaneConfig::span_min>,
-     .range = {.by_rule = true},  // below span_max
-     .default_text = "unbounded",
-     .unit = "length",
-     .doc = "the strip's low end along span_axis (of the plane's points)",
-     .written = &span_min_given},
-    {.name = "span_max",
-     .type = KeyType::kFloat,
-     .member = field<&PlaneConfig::span_max>,
-     .range = {.by_rule = true},  // above span_min
-     .default_text = "unbounded",
-     .unit = "length",
-     .doc = "the strip's high end along span_axis",
-     .written = &span_max_given},
-    {.name = "hole_radius",
-     .type = KeyType::kFloat,
-     .member = field<&PlaneConfig::hole_radius>,
-     .range = {.lo = 0.0, .hi = 1e6, .scale = Scale::kLength},
-     .default_text = "no hole",
-     .unit = "length",
-     .doc = "3D: a circular hole in the plane (a silo's or hopper's round orifice), larger "
-            "than the particles; the plane is then a plate met on both faces, the hole's edge "
-            "a ring (a still plane, not a strip)",
-     .written = &hole_given},
-    {.name = "hole_center",
-     .type = KeyType::kVector,
-     .member = field<&PlaneConfig::hole_center>,
-     .range = {.by_rule = true},  // finite; with hole_radius
-     .default_text = "`point`",
-     .unit = "length",
-     .doc = "the hole's centre (projected onto the plane)",
-     .written = &hole_center_given},
-};
-
-const CylinderConfig kCylinderDefaults{};
-constexpr KeyDecl kCylinder[] = {
-    {.name = "axis",
-     .type = KeyType::kString,
-     .member = field<&CylinderConfig::axis>,
-     .range = {.by_rule = true},  // x, y or z; 2D: z only
-     .default_text = "`\"z\"`",
-     .doc = "the direction of its axis: x, y or z (2D: z, the circle in the plane)"},
-    {.name = "center",
-     .type = KeyType::kVector,
-     .member = field<&CylinderConfig::center>,
-     .range = {.by_rule = true},  // finite
-     .default_text = "**required**",
-     .unit = "length",
-     .doc = "a point of its axis"},
-    {.name = "radius",
-     .type = KeyType::kFloat,
-     .member = field<&CylinderConfig::radius>,
-     .range = {.lo = 0.0, .lo_open = true},
-     .default_text = "**required**",
-     .unit = "length",
-     .doc = "its radius"},
-    {.name = "inside",
-     .type = KeyType::kBoolean,
-     .member = field<&CylinderConfig::inside>,
-     .doc = "the particles are inside it (a drum, a silo); false: outside (an obstacle)"},
-    {.name = "angular_velocity",
-     .type = KeyType::kFloat,
-     .member = field<&CylinderConfig::angular_velocity>,
-     .range = {.lo = -1e6, .hi = 1e6, .scale = Scale::kRate},
-     .unit = "radians / time",
-     .doc = "its rotation about the axis, right-handed (a rotating drum)"},
-};
-
 constexpr KeyDecl kWallFace[] = {
     {.name = "face",
      .type = KeyType::kString,
@@ -288,10 +180,8 @@ constexpr KeyDecl kWallFace[] = {
 
 constexpr KeyGroup kBoundaryGroup{"boundary", kBoundary, &kBoundaryDefaults};
 constexpr KeyGroup kWallGroup{"wall", kWall, &kWallDefaults};
-constexpr KeyGroup kPlaneGroup{"plane", kPlane, &kPlaneDefaults};
 constexpr KeyGroup kContainerGroup{"container", kContainer, &kContainerDefaults};
 constexpr KeyGroup kOutletGroup{"outlet", kOutlet, &kOutletDefaults};
-constexpr KeyGroup kCylinderGroup{"cylinder", kCylinder, &kCylinderDefaults};
 constexpr KeyGroup kWallFaceGroup{"wall face", kWallFace, nullptr};
 
 }  // namespace kairos::key_tables
