@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "dynamics/collision_time.hpp"
 #include "dynamics/trajectory_events.hpp"
+#include "interactions/parameter_domain.hpp"
 
 namespace kairos {
 
@@ -130,6 +131,31 @@ void RoundWalls<D, S>::check_start(const Vec<D>& x, double radius, double t,
 template <int D, RoundShape S>
 void RoundWalls<D, S>::throw_squeezed(double /*t*/, double /*dmax*/, bool /*uniform*/) const {
   throw std::logic_error("RoundWalls::throw_squeezed: a round wall never squeezes");
+}
+
+template <int D, RoundShape Shape>
+void RoundWalls<D, Shape>::check_specs(const std::vector<CylinderWall<D>>& walls,
+                                       const std::array<bool, D>& periodic) {
+  constexpr bool sphere = Shape == RoundShape::kSphere;
+  for (std::size_t s = 0; s < walls.size(); ++s) {
+    const CylinderWall<D>& c = walls[s];
+    const std::string name =
+        std::string(sphere ? "boundary.sphere[" : "boundary.cylinder[") + std::to_string(s) + "]";
+    if (c.axis < 0 || c.axis >= D) throw InputError(name + ": axis must be a box axis");
+    require_positive(c.radius, "radius", name + ": ");
+    if (!std::isfinite(c.angular_velocity))
+      throw InputError(name + ": angular_velocity must be finite");
+    for (int a = 0; a < D; ++a) {
+      if (!std::isfinite(c.center[a])) throw InputError(name + ": center must be finite");
+      if ((sphere || D == 2 || a != c.axis) && periodic[a]) {
+        throw InputError(
+            name + ": the axis " + std::string(1, "xyz"[a]) +
+            (sphere ? " is periodic: a sphere" : " across the cylinder is periodic: a cylinder") +
+            " must not cross a periodic face (it would not meet its own periodic "
+            "image); make that axis bounded (walls or open faces)");
+      }
+    }
+  }
 }
 
 template class RoundWalls<2, RoundShape::kCylinder>;

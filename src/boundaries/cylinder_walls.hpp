@@ -15,6 +15,7 @@
 // matter. Like the planes they are functions of the time alone: nothing in restart files.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -61,6 +62,20 @@ class RoundWalls {
       : cylinders_(std::move(walls)), gravity_(gravity) {
     for (CylinderWall<D>& c : cylinders_) c.shape = Shape;
   }
+  // As every geometry of the registry is built (model/boundaries.hpp): the box's faces bound
+  // nothing a round wall needs.
+  RoundWalls(std::vector<CylinderWall<D>> walls, const Vec<D>& /*box*/,
+             const std::array<Face<D>, 2 * D>& /*faces*/, const Vec<D>& gravity)
+      : RoundWalls(std::move(walls), gravity) {}
+
+  // The model's side (model/environment.hpp): one wall's specification, the checks against the
+  // box (a box axis, a radius > 0, finite; no periodic axis across it: periodic[a]), one event
+  // code each, its contact law.
+  using Spec = CylinderWall<D>;
+  static void check_specs(const std::vector<CylinderWall<D>>& walls,
+                          const std::array<bool, D>& periodic);
+  static std::size_t codes(const std::vector<CylinderWall<D>>& walls) { return walls.size(); }
+  static const ContactModel& contact_of(const CylinderWall<D>& c) { return c.contact; }
 
   // The boundary interface (model/boundaries.hpp): surface s is cylinder (sphere) s.
   bool any() const { return !cylinders_.empty(); }

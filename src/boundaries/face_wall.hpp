@@ -11,8 +11,10 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "boundaries/wall_spring.hpp"
+#include "core/error.hpp"
 #include "core/vec.hpp"
 #include "interactions/granular_contact.hpp"
 
@@ -111,6 +113,31 @@ Vec<D> face_normal(int face) {
 // positive inside the box.
 inline double face_gap(int face, double x, double plane) {
   return face % 2 == 0 ? x - plane : plane - x;
+}
+
+// A wall's motion keys as the model takes them (a face wall's or a plane's, `name` in
+// messages): finite, a vibration's amplitude and frequency not negative, a force only on a wall
+// with mass and no motion of its own on one. Throws InputError.
+template <int D>
+void check_wall_motion(const Wall<D>& w, const std::string& name) {
+  for (int a = 0; a < D; ++a) {
+    if (!std::isfinite(w.velocity[a])) throw InputError(name + ": velocity must be finite");
+  }
+  if (!(w.amplitude >= 0.0) || !std::isfinite(w.amplitude)) {
+    throw InputError(name + ": amplitude must be finite and >= 0");
+  }
+  if (!(w.angular_frequency >= 0.0) || !std::isfinite(w.angular_frequency) ||
+      !std::isfinite(w.phase)) {
+    throw InputError(name + ": frequency must be finite and >= 0 and the phase finite");
+  }
+  if (!(w.mass >= 0.0) || !std::isfinite(w.mass) || !std::isfinite(w.force))
+    throw InputError(name + ": mass must be finite and >= 0 and the force finite");
+  if (w.mass == 0.0 && w.force != 0.0)
+    throw InputError(name + ": a force moves only a wall with mass");
+  if (w.mass > 0.0 && (w.vibrates() || norm2(w.velocity) != 0.0))
+    throw InputError(name +
+                     ": a wall with mass moves as the impulses it takes say (no velocity "
+                     "or vibration of its own)");
 }
 
 }  // namespace kairos

@@ -244,6 +244,108 @@ void PlaneWalls<D>::throw_squeezed(double t, double dmax, bool /*uniform*/) cons
       t, name(squeeze_plane_), p.normal_speed(), dmax, squeeze_time_));
 }
 
+// The plane n.x = offset of a wall or an outlet (`name`): a finite unit normal, a finite point,
+// and not across a periodic axis (it would not meet its own periodic image).
+template <int D>
+void check_plane_placement(const Vec<D>& normal, double offset, const std::string& name,
+                           const std::array<bool, D>& periodic) {
+  double n2 = 0.0;
+  for (int a = 0; a < D; ++a) {
+    if (!std::isfinite(normal[a])) throw InputError(name + ".normal must be finite");
+    n2 += normal[a] * normal[a];
+  }
+  if (!(std::abs(n2 - 1.0) <= 1e-12)) throw InputError(name + ".normal must be a unit vector");
+  if (!std::isfinite(offset)) throw InputError(name + ".point must be finite");
+  for (int a = 0; a < D; ++a) {
+    if (normal[a] != 0.0 && periodic[a]) {
+      throw InputError(name + ".normal has a component along the periodic axis " +
+                       std::string(1, "xyz"[a]) +
+                       ": a plane must not cut a periodic axis (it would not meet its own "
+                       "periodic image); make that axis bounded (walls or open faces) or the "
+                       "normal perpendicular to it");
+    }
+  }
+}
+
+namespace {
+
+// A plane cut to a strip (span_axis): still, across a bounded axis, with edges along a box axis.
+template <int D>
+void check_strip(const PlaneWall<D>& p, const std::string& name,
+                 const std::array<bool, D>& periodic) {
+  if (p.span_axis >= D) throw InputError(name + ".span_axis: not an axis of the box");
+  const std::string axis(1, "xyz"[p.span_axis]);
+  if (periodic[p.span_axis]) {
+    throw InputError(name + ".span_axis: " + axis +
+                     " is periodic; a strip must end across a bounded axis (walls or open faces)");
+  }
+  if (!(p.span_min < p.span_max) || std::isnan(p.span_min) || std::isnan(p.span_max))
+    throw InputError(name + ": span_min must be below span_max");
+  if (p.plane_moves() || norm2(p.wall.velocity) != 0.0) {
+    throw InputError(name +
+                     ": a strip (span_axis) must hold still: no velocity or vibration (its "
+                     "edges do not move)");
+  }
+  const auto [along, across] = p.edge_axes();
+  if (across < 0) {
+    throw InputError(name + ".span_axis: the plane is perpendicular to " + axis +
+                     ", so it cannot be cut along it; choose an axis the plane runs along");
+  }
+  if (along < 0) {
+    throw InputError(name +
+                     ".span_axis: in 3D a strip's edges run along a box axis, so the normal "
+                     "must have no component along one of the two axes besides " +
+                     axis);
+  }
+}
+
+// A plane with a circular hole: 3D, still, not a strip; the hole's size and centre finite.
+template <int D>
+void check_hole(const PlaneWall<D>& p, const std::string& name) {
+  if (D != 3) {
+    throw InputError(name +
+                     ".hole_radius: a hole is for planes in 3D (in 2D cut the line into "
+                     "two strips: span_axis)");
+  }
+  if (p.spanned())
+    throw InputError(name + ".hole_radius: a strip (span_axis) cannot also have a hole");
+  if (!std::isfinite(p.hole_radius)) throw InputError(name + ".hole_radius: must be finite");
+  for (int a = 0; a < D; ++a)
+    if (!std::isfinite(p.hole_center[a])) throw InputError(name + ".hole_center: must be finite");
+  if (p.plane_moves() || norm2(p.wall.velocity) != 0.0) {
+    throw InputError(name +
+                     ".hole_radius: a plane with a hole must hold still: no velocity or "
+                     "vibration (its edge does not move)");
+  }
+}
+
+}  // namespace
+
+template <int D>
+void PlaneWalls<D>::check_specs(const std::vector<PlaneWall<D>>& planes,
+                                const std::array<bool, D>& periodic) {
+  for (std::size_t s = 0; s < planes.size(); ++s) {
+    const PlaneWall<D>& p = planes[s];
+    const std::string name = "boundary.plane[" + std::to_string(s) + "]";
+    check_wall_motion(p.wall, name);
+    check_plane_placement<D>(p.normal, p.offset, name, periodic);
+    if (p.spanned()) check_strip<D>(p, name, periodic);
+    if (p.holed()) check_hole(p, name);
+  }
+}
+
+template <int D>
+std::size_t PlaneWalls<D>::codes(const std::vector<PlaneWall<D>>& planes) {
+  std::size_t n = planes.size();
+  for (const PlaneWall<D>& p : planes) n += (p.spanned() ? 2 : 0) + (p.holed() ? 1 : 0);
+  return n;
+}
+
+template void check_plane_placement<2>(const Vec<2>&, double, const std::string&,
+                                       const std::array<bool, 2>&);
+template void check_plane_placement<3>(const Vec<3>&, double, const std::string&,
+                                       const std::array<bool, 3>&);
+
 template class PlaneWalls<2>;
 template class PlaneWalls<3>;
 

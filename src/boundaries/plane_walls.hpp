@@ -107,6 +107,12 @@ struct PlaneWall {
   bool plane_moves() const { return normal_speed() != 0.0 || wall.vibrates(); }
 };
 
+// A plane n.x = offset of a wall or an outlet (`name` in messages): a finite unit normal, a
+// finite point, and not across a periodic axis. Throws InputError.
+template <int D>
+void check_plane_placement(const Vec<D>& normal, double offset, const std::string& name,
+                           const std::array<bool, D>& periodic);
+
 template <int D>
 class PlaneWalls {
  public:
@@ -115,6 +121,15 @@ class PlaneWalls {
   // (particles may leave through them), the uniform acceleration particles feel.
   PlaneWalls(std::vector<PlaneWall<D>> planes, const Vec<D>& box,
              const std::array<Face<D>, 2 * D>& faces, const Vec<D>& gravity);
+
+  // The model's side (model/environment.hpp): one plane's specification, the checks of the
+  // planes against the box (periodic[a]: axis a is periodic), the event codes their surfaces
+  // take (a strip's two edges and a hole's ring beside its plane), a plane's contact law.
+  using Spec = PlaneWall<D>;
+  static void check_specs(const std::vector<PlaneWall<D>>& planes,
+                          const std::array<bool, D>& periodic);
+  static std::size_t codes(const std::vector<PlaneWall<D>>& planes);
+  static const ContactModel& contact_of(const PlaneWall<D>& p) { return p.wall.contact; }
 
   // The boundary interface (model/boundaries.hpp): surface s < planes() is plane s, then the
   // strips' edges (edges_, in the order of their planes, low end first), then the holes' rings

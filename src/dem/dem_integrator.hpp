@@ -127,13 +127,12 @@ class DemIntegrator {
   DemIntegrator(const ParticleSystem<D>& system, const std::vector<SoftContactLaw>& laws,
                 std::uint32_t species, const DemOptions& options = {});
   // Laws, walls and gravity from an environment: env.soft and env.species as above, a wall at
-  // every face of kind kWall and every plane of env.planes with the law env.soft_wall[s] for
-  // particles of species s, and
-  // env.gravity. The system's periodic axes and gravity must be the environment's. InputError
-  // for what the DEM does not integrate: open faces, shear, stepped potentials, no soft laws.
-  // The default time step also covers the wall contacts (reduced mass m_min, with a wall's mass
-  // M: m_min M / (m_min + M)) and, under gravity or a wall's force, impacts at the speed of a
-  // fall (or a wall's push) across the box.
+  // every face of kind kWall and every surface of env.surfaces (planes, cylinders, spheres) with
+  // the law env.soft_wall[s] for particles of species s, and env.gravity. The system's periodic
+  // axes and gravity must be the environment's. InputError for what the DEM does not integrate:
+  // open faces, shear, stepped potentials, no soft laws. The default time step also covers the wall
+  // contacts (reduced mass m_min, with a wall's mass M: m_min M / (m_min + M)) and, under gravity
+  // or a wall's force, impacts at the speed of a fall (or a wall's push) across the box.
   DemIntegrator(const ParticleSystem<D>& system, const Environment<D>& env,
                 const DemOptions& options = {});
 

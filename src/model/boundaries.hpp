@@ -478,20 +478,22 @@ requires(BoundaryComponent<C, D>&&...) class BoundarySet {
   int surfaces_ = 0;
 };
 
-// The registry of the run's boundary geometries: one entry per geometry, in the base's list and
-// in the constructor, which makes each from the run's model (its specification lives in the
-// Environment).
-template <int D>
-class Boundaries : public BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>,
-                                      SphereWalls<D>, Outlets<D>> {
+// The run's boundaries: the box's faces, the geometries of SurfaceGeometries (the registry,
+// model/environment.hpp: each made from its specifications in the Environment, the box, its
+// faces and the field) and the outlets, numbered in that order.
+template <int D, class Geometries = SurfaceGeometries<D>>
+class Boundaries;
+
+template <int D, class... Geometry>
+class Boundaries<D, GeometryList<Geometry...>>
+    : public BoundarySet<D, FaceWalls<D>, Geometry..., Outlets<D>> {
  public:
   Boundaries() = default;
   Boundaries(const Environment<D>& environment, const Vec<D>& box)
-      : BoundarySet<D, FaceWalls<D>, PlaneWalls<D>, CylinderWalls<D>, SphereWalls<D>, Outlets<D>>(
+      : BoundarySet<D, FaceWalls<D>, Geometry..., Outlets<D>>(
             FaceWalls<D>(environment.faces, box, environment.gravity),
-            PlaneWalls<D>(environment.planes, box, environment.faces, environment.gravity),
-            CylinderWalls<D>(environment.cylinders, environment.gravity),
-            SphereWalls<D>(environment.spheres, environment.gravity),
+            Geometry(surface_specs<Geometry>(environment), box, environment.faces,
+                     environment.gravity)...,
             Outlets<D>(environment.outlets, environment.gravity)) {}
 
   const FaceWalls<D>& faces() const { return this->template get<FaceWalls<D>>(); }

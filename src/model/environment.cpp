@@ -16,27 +16,6 @@ const char* face_name(int face) {
   return names[face];
 }
 
-template <int D>
-void check_wall_motion(const Wall<D>& w, const std::string& name) {
-  for (int a = 0; a < D; ++a) {
-    if (!std::isfinite(w.velocity[a])) throw InputError(name + ": velocity must be finite");
-  }
-  if (!(w.amplitude >= 0.0) || !std::isfinite(w.amplitude)) {
-    throw InputError(name + ": amplitude must be finite and >= 0");
-  }
-  if (!(w.angular_frequency >= 0.0) || !std::isfinite(w.angular_frequency) ||
-      !std::isfinite(w.phase)) {
-    throw InputError(name + ": frequency must be finite and >= 0 and the phase finite");
-  }
-  if (!(w.mass >= 0.0) || !std::isfinite(w.mass) || !std::isfinite(w.force))
-    throw InputError(name + ": mass must be finite and >= 0 and the force finite");
-  if (w.mass == 0.0 && w.force != 0.0)
-    throw InputError(name + ": a force moves only a wall with mass");
-  if (w.mass > 0.0 && (w.vibrates() || norm2(w.velocity) != 0.0))
-    throw InputError(name +
-                     ": a wall with mass moves as the impulses it takes say (no velocity "
-                     "or vibration of its own)");
-}
 }  // namespace
 
 template <int D>
@@ -45,89 +24,18 @@ bool Environment<D>::rotates() const {
     if (!c.tangential.is_smooth()) return true;
   for (const Face<D>& f : faces)
     if (f.kind == FaceKind::kWall && !f.wall.contact.tangential.is_smooth()) return true;
-  for (const PlaneWall<D>& p : planes)
-    if (!p.wall.contact.tangential.is_smooth()) return true;
-  for (const auto* round : {&cylinders, &spheres})
-    for (const CylinderWall<D>& c : *round)
-      if (!c.contact.tangential.is_smooth()) return true;
-  return false;
+  bool rough = false;
+  SurfaceGeometries<D>::each([&](auto geometry) {
+    using G = typename decltype(geometry)::type;
+    for (const typename G::Spec& spec : surfaces.template of<G>())
+      rough = rough || !G::contact_of(spec).tangential.is_smooth();
+  });
+  return rough;
 }
 
 template <int D>
 bool Environment<D>::plain() const {
   return contact.empty();
-}
-
-// The plane n.x = offset of a wall or an outlet (`name`): a finite unit normal, a finite point,
-// and not across a periodic axis (it would not meet its own periodic image).
-template <int D>
-void Environment<D>::check_plane(const Vec<D>& normal, double offset,
-                                 const std::string& name) const {
-  double n2 = 0.0;
-  for (int a = 0; a < D; ++a) {
-    if (!std::isfinite(normal[a])) throw InputError(name + ".normal must be finite");
-    n2 += normal[a] * normal[a];
-  }
-  if (!(std::abs(n2 - 1.0) <= 1e-12)) throw InputError(name + ".normal must be a unit vector");
-  if (!std::isfinite(offset)) throw InputError(name + ".point must be finite");
-  for (int a = 0; a < D; ++a) {
-    if (normal[a] != 0.0 && periodic(a)) {
-      throw InputError(name + ".normal has a component along the periodic axis " +
-                       std::string(1, "xyz"[a]) +
-                       ": a plane must not cut a periodic axis (it would not meet its own "
-                       "periodic image); make that axis bounded (walls or open faces) or the "
-                       "normal perpendicular to it");
-    }
-  }
-}
-
-// A plane cut to a strip (span_axis): still, across a bounded axis, with edges along a box axis.
-template <int D>
-void Environment<D>::check_strip(const PlaneWall<D>& p, const std::string& name) const {
-  if (p.span_axis >= D) throw InputError(name + ".span_axis: not an axis of the box");
-  const std::string axis(1, "xyz"[p.span_axis]);
-  if (periodic(p.span_axis)) {
-    throw InputError(name + ".span_axis: " + axis +
-                     " is periodic; a strip must end across a bounded axis (walls or open faces)");
-  }
-  if (!(p.span_min < p.span_max) || std::isnan(p.span_min) || std::isnan(p.span_max))
-    throw InputError(name + ": span_min must be below span_max");
-  if (p.plane_moves() || norm2(p.wall.velocity) != 0.0) {
-    throw InputError(name +
-                     ": a strip (span_axis) must hold still: no velocity or vibration (its "
-                     "edges do not move)");
-  }
-  const auto [along, across] = p.edge_axes();
-  if (across < 0) {
-    throw InputError(name + ".span_axis: the plane is perpendicular to " + axis +
-                     ", so it cannot be cut along it; choose an axis the plane runs along");
-  }
-  if (along < 0) {
-    throw InputError(name +
-                     ".span_axis: in 3D a strip's edges run along a box axis, so the normal "
-                     "must have no component along one of the two axes besides " +
-                     axis);
-  }
-}
-
-// A plane with a circular hole: 3D, still, not a strip; the hole's size and centre finite.
-template <int D>
-void Environment<D>::check_hole(const PlaneWall<D>& p, const std::string& name) const {
-  if (D != 3) {
-    throw InputError(name +
-                     ".hole_radius: a hole is for planes in 3D (in 2D cut the line into "
-                     "two strips: span_axis)");
-  }
-  if (p.spanned())
-    throw InputError(name + ".hole_radius: a strip (span_axis) cannot also have a hole");
-  if (!std::isfinite(p.hole_radius)) throw InputError(name + ".hole_radius: must be finite");
-  for (int a = 0; a < D; ++a)
-    if (!std::isfinite(p.hole_center[a])) throw InputError(name + ".hole_center: must be finite");
-  if (p.plane_moves() || norm2(p.wall.velocity) != 0.0) {
-    throw InputError(name +
-                     ".hole_radius: a plane with a hole must hold still: no velocity or "
-                     "vibration (its edge does not move)");
-  }
 }
 
 // An outlet's plane, like a plane wall's, must not cut a periodic axis; its insertion region is
@@ -136,7 +44,7 @@ template <int D>
 void Environment<D>::check_outlets() const {
   for (const Outlet<D>& o : outlets) {
     const std::string name = "boundary.outlet";
-    check_plane(o.normal, o.offset, name);
+    check_plane_placement<D>(o.normal, o.offset, name, periodic_axes());
     for (int a = 0; a < D; ++a) {
       if (!std::isfinite(o.insert_lower[a]) || !std::isfinite(o.insert_upper[a]) ||
           !std::isfinite(o.insert_velocity[a]))
@@ -173,44 +81,19 @@ void Environment<D>::check() const {
   for (int f = 0; f < 2 * D; ++f)
     if (faces[f].kind == FaceKind::kWall)
       check_wall_motion(faces[f].wall, std::string("wall ") + face_name(f));
-  for (std::size_t s = 0; s < planes.size(); ++s) {
-    const PlaneWall<D>& p = planes[s];
-    const std::string name = "boundary.plane[" + std::to_string(s) + "]";
-    check_wall_motion(p.wall, name);
-    check_plane(p.normal, p.offset, name);
-    if (p.spanned()) check_strip(p, name);
-    if (p.holed()) check_hole(p, name);
-  }
+  // Each geometry checks its surfaces against the box and counts the event codes they take.
+  std::size_t surface_codes = 2 * D + outlets.size();
+  SurfaceGeometries<D>::each([&](auto geometry) {
+    using G = typename decltype(geometry)::type;
+    G::check_specs(surfaces.template of<G>(), periodic_axes());
+    surface_codes += G::codes(surfaces.template of<G>());
+  });
   check_outlets();
-  const std::size_t surfaces = 2 * D + planes.size() + cylinders.size() + spheres.size() +
-                               outlets.size() + 2 * strips() + holes();
-  if (surfaces > static_cast<std::size_t>(EventCode<D>::kWallCodes)) {
-    throw InputError("boundary: " + std::to_string(surfaces - 2 * D) +
+  if (surface_codes > static_cast<std::size_t>(EventCode<D>::kWallCodes)) {
+    throw InputError("boundary: " + std::to_string(surface_codes - 2 * D) +
                      " plane, cylinder and sphere walls; at most " +
                      std::to_string(EventCode<D>::kWallCodes - 2 * D) +
                      " fit the event codes (build a rough floor of grains instead)");
-  }
-  for (const bool sphere : {false, true}) {
-    const std::vector<CylinderWall<D>>& round = sphere ? spheres : cylinders;
-    for (std::size_t s = 0; s < round.size(); ++s) {
-      const CylinderWall<D>& c = round[s];
-      const std::string name =
-          std::string(sphere ? "boundary.sphere[" : "boundary.cylinder[") + std::to_string(s) + "]";
-      if (c.axis < 0 || c.axis >= D) throw InputError(name + ": axis must be a box axis");
-      require_positive(c.radius, "radius", name + ": ");
-      if (!std::isfinite(c.angular_velocity))
-        throw InputError(name + ": angular_velocity must be finite");
-      for (int a = 0; a < D; ++a) {
-        if (!std::isfinite(c.center[a])) throw InputError(name + ": center must be finite");
-        if ((sphere || D == 2 || a != c.axis) && periodic(a)) {
-          throw InputError(
-              name + ": the axis " + std::string(1, "xyz"[a]) +
-              (sphere ? " is periodic: a sphere" : " across the cylinder is periodic: a cylinder") +
-              " must not cross a periodic face (it would not meet its own periodic "
-              "image); make that axis bounded (walls or open faces)");
-        }
-      }
-    }
   }
   for (int a = 0; a < D; ++a) {
     if (!std::isfinite(gravity[a])) throw InputError("gravity must be finite");

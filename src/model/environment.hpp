@@ -26,6 +26,7 @@
 #include "interactions/soft_contact.hpp"
 #include "interactions/soft_map_table.hpp"
 #include "interactions/step_potential.hpp"
+#include "model/geometry_list.hpp"
 
 namespace kairos {
 
@@ -36,16 +37,21 @@ namespace kairos {
 // e(v_n) = -eps_rdot (the model the mapping improves on, kept for comparisons).
 enum class SoftCollisions { kMapped, kInstantaneous };
 
+// The boundary geometries beyond the box's faces, each a component of boundaries/ that keeps
+// its surfaces' specifications here: the one line a new geometry adds on the model side
+// (docs/extending.md). Their order numbers the surfaces: after the faces, before the outlets.
+template <int D>
+using SurfaceGeometries = GeometryList<PlaneWalls<D>, CylinderWalls<D>, SphereWalls<D>>;
+
 template <int D>
 struct Environment {
   Vec<D> gravity{};
   // Face 2k is the low face of axis k, 2k + 1 the high face. An axis is periodic iff both of
   // its faces are.
   std::array<Face<D>, 2 * D> faces{};
-  // Plane walls at any position and orientation (boundaries/plane_walls.hpp), after the faces.
-  std::vector<PlaneWall<D>> planes;
-  std::vector<CylinderWall<D>> cylinders;  // boundaries/cylinder_walls.hpp
-  std::vector<CylinderWall<D>> spheres;    // the same, round in every direction
+  // The surfaces of every geometry of SurfaceGeometries after the faces (plane walls at any
+  // position and orientation, cylinders, spheres): surface_specs<PlaneWalls<D>>(env).
+  typename SurfaceGeometries<D>::Specs surfaces;
   // Outlets particles pass through, to be put back in an insertion region
   // (boundaries/outlets.hpp); not walls.
   std::vector<Outlet<D>> outlets;
@@ -113,6 +119,11 @@ struct Environment {
     return false;
   }
   bool periodic(int axis) const { return faces[2 * axis].kind == FaceKind::kPeriodic; }
+  std::array<bool, D> periodic_axes() const {
+    std::array<bool, D> out{};
+    for (int a = 0; a < D; ++a) out[a] = periodic(a);
+    return out;
+  }
   bool has_gravity() const {
     for (int a = 0; a < D; ++a)
       if (gravity[a] != 0.0) return true;
@@ -134,7 +145,7 @@ struct Environment {
   bool has_walls() const {
     for (const Face<D>& f : faces)
       if (f.kind == FaceKind::kWall) return true;
-    return !planes.empty() || !cylinders.empty() || !spheres.empty();
+    return !surfaces.empty();
   }
   const ContactModel* contact_of(std::uint32_t a, std::uint32_t b) const {
     return contact.empty() ? nullptr : &contact[a * species + b];
@@ -152,19 +163,16 @@ struct Environment {
 
  private:
   void check_outlets() const;
-  void check_plane(const Vec<D>& normal, double offset, const std::string& name) const;
-  void check_strip(const PlaneWall<D>& p, const std::string& name) const;
-  void check_hole(const PlaneWall<D>& p, const std::string& name) const;
-  std::size_t strips() const {
-    std::size_t n = 0;
-    for (const PlaneWall<D>& p : planes) n += p.spanned() ? 1 : 0;
-    return n;
-  }
-  std::size_t holes() const {
-    std::size_t n = 0;
-    for (const PlaneWall<D>& p : planes) n += p.holed() ? 1 : 0;
-    return n;
-  }
 };
+
+// The specifications of geometry G's surfaces in `env` (G one of SurfaceGeometries<D>).
+template <class G, int D>
+std::vector<typename G::Spec>& surface_specs(Environment<D>& env) {
+  return env.surfaces.template of<G>();
+}
+template <class G, int D>
+const std::vector<typename G::Spec>& surface_specs(const Environment<D>& env) {
+  return env.surfaces.template of<G>();
+}
 
 }  // namespace kairos

@@ -202,7 +202,7 @@ TEST(CylinderWallsInTheEngine, ARotatingDrumKeepsEveryPredictionAndClosesTheBudg
   env.gravity = {0.0, -1.0};
   CylinderWall<2> c = drum<2>({10.0, 10.0}, 9.5, 0.2);
   c.contact = rough_law();
-  env.cylinders = {c};
+  surface_specs<CylinderWalls<2>>(env) = {c};
   env.species = 1;
   env.contact = {rough_law()};
   env.tc = 1e-3;
@@ -259,7 +259,7 @@ TEST(SphereWallsInTheEngine, AnElasticGasInASphericalContainerConservesEnergy) {
   for (int f = 0; f < 6; ++f) env.faces[static_cast<std::size_t>(f)].kind = FaceKind::kWall;
   env.gravity = {0.0, 0.0, -1.0};
   env.sleep_speed = 0.0;
-  env.spheres = {drum<3>({6.0, 6.0, 6.0}, 5.5)};
+  surface_specs<SphereWalls<3>>(env) = {drum<3>({6.0, 6.0, 6.0}, 5.5)};
   EventEngine<3, CalendarQueue> engine(s, StartMode::kPredict, {}, env);
   const auto energy = [&] {
     double e = engine.kinetic_energy();
@@ -289,7 +289,7 @@ TEST(CylinderWallsInTheDem, ADiskRestsAtTheBottomOfTheDrum) {
   env.soft_wall = {law};
   for (int f = 0; f < 4; ++f) env.faces[static_cast<std::size_t>(f)].kind = FaceKind::kWall;
   env.gravity = {0.0, -1.0};
-  env.cylinders = {drum<2>({10.0, 10.0}, 9.0)};
+  surface_specs<CylinderWalls<2>>(env) = {drum<2>({10.0, 10.0}, 9.0)};
   ParticleSystem<2> s;
   s.box = {20.0, 20.0};
   s.periodic = {false, false};
@@ -309,9 +309,10 @@ TEST(CylinderWallsInTheDem, ADiskRestsAtTheBottomOfTheDrum) {
 TEST(CylinderWalls, MoreSurfacesThanEventCodesAreAnInputError) {
   Environment<2> env;
   for (int f = 0; f < 4; ++f) env.faces[static_cast<std::size_t>(f)].kind = FaceKind::kWall;
-  env.cylinders.assign(EventCode<2>::kWallCodes - 4, drum<2>({10.0, 10.0}, 9.0));
+  surface_specs<CylinderWalls<2>>(env).assign(EventCode<2>::kWallCodes - 4,
+                                              drum<2>({10.0, 10.0}, 9.0));
   EXPECT_NO_THROW(env.check());
-  env.spheres = {drum<2>({10.0, 10.0}, 9.0)};
+  surface_specs<SphereWalls<2>>(env) = {drum<2>({10.0, 10.0}, 9.0)};
   try {
     env.check();
     FAIL() << "no error";
@@ -326,7 +327,7 @@ TEST(CylinderWallsInTheEngine, SoftSpheresUnderTheEventIntegratorAreRefusedNamin
   env.soft = {SoftContactLaw::linear_dashpot(1e4, 5.0)};
   env.soft_wall = env.soft;
   for (int f = 0; f < 4; ++f) env.faces[static_cast<std::size_t>(f)].kind = FaceKind::kWall;
-  env.cylinders = {drum<2>({10.0, 10.0}, 9.0)};
+  surface_specs<CylinderWalls<2>>(env) = {drum<2>({10.0, 10.0}, 9.0)};
   ParticleSystem<2> s;
   s.box = {20.0, 20.0};
   s.periodic = {false, false};

@@ -204,7 +204,7 @@ Environment<D> silo(double e, double width = 5.0) {
   for (PlaneWall<D> p : {floor_strip<D>(4.0, -kNever, c - 0.5 * width),
                          floor_strip<D>(4.0, c + 0.5 * width, kNever)}) {
     p.wall.contact = law;
-    env.planes.push_back(p);
+    surface_specs<PlaneWalls<D>>(env).push_back(p);
   }
   Outlet<D> o;
   o.normal = {0.0, 1.0};

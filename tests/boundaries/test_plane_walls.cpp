@@ -223,8 +223,8 @@ Environment<D> trough(double gravity) {
   env.gravity = {0.0, 0.0, -gravity};
   for (const int f : {0, 1, 4, 5}) env.faces[static_cast<std::size_t>(f)].kind = FaceKind::kWall;
   // The two sides meet at (4, ., 1), 45 degrees each.
-  env.planes = {make_plane<D>({1.0, 0.0, 1.0}, {4.0, 0.0, 1.0}),
-                make_plane<D>({-1.0, 0.0, 1.0}, {4.0, 0.0, 1.0})};
+  surface_specs<PlaneWalls<D>>(env) = {make_plane<D>({1.0, 0.0, 1.0}, {4.0, 0.0, 1.0}),
+                                       make_plane<D>({-1.0, 0.0, 1.0}, {4.0, 0.0, 1.0})};
   return env;
 }
 
@@ -233,7 +233,7 @@ int plane_contact(const Engine& engine, const Environment<D>& env) {
   const std::vector<Vec<D>> x = engine.current_positions();
   int touching = 0;
   for (const Vec<D>& p : x)
-    for (const PlaneWall<D>& plane : env.planes)
+    for (const PlaneWall<D>& plane : surface_specs<PlaneWalls<D>>(env))
       touching += std::abs(dot(plane.normal, p) - plane.offset - 0.5) < 1e-9 ? 1 : 0;
   return touching;
 }
@@ -263,7 +263,7 @@ TEST(PlaneWallsInTheEngine, ElasticGasInATroughConservesEnergyAndEveryPrediction
   EXPECT_NEAR(energy(), e0, 1e-10 * e0);
   EXPECT_LT(engine.max_overlap_now(), 1e-10);
   for (const Vec<D>& p : engine.current_positions())
-    for (const PlaneWall<D>& plane : env.planes)
+    for (const PlaneWall<D>& plane : surface_specs<PlaneWalls<D>>(env))
       ASSERT_GT(dot(plane.normal, p) - plane.offset, 0.5 - 1e-9);
 }
 
@@ -276,10 +276,10 @@ TEST(PlaneWallsInTheEngine, AResumedRunContinuesBitForBit) {
   law.tangential = TangentialModel::constant(0.4);
   env.species = 1;
   env.contact = {law};
-  env.planes[0].wall.contact = law;
-  env.planes[1].wall.amplitude = 0.2;
-  env.planes[1].wall.angular_frequency = 5.0;
-  env.planes[1].wall.velocity = {0.0, 0.3, 0.0};  // sliding along the trough
+  surface_specs<PlaneWalls<D>>(env)[0].wall.contact = law;
+  surface_specs<PlaneWalls<D>>(env)[1].wall.amplitude = 0.2;
+  surface_specs<PlaneWalls<D>>(env)[1].wall.angular_frequency = 5.0;
+  surface_specs<PlaneWalls<D>>(env)[1].wall.velocity = {0.0, 0.3, 0.0};  // sliding along the trough
   Engine a(balls_above_a_trough(7), StartMode::kPredict, EngineOptions{}, env);
   for (int k = 0; k < 5000; ++k) ASSERT_NE(a.step(), EventKind::kNone);
   a.validate();
@@ -296,7 +296,7 @@ TEST(PlaneWallsInTheEngine, GrainsComeToRestOnTheSlopesAndSleep) {
   law.normal = NormalRestitution::constant(0.5);
   env.species = 1;
   env.contact = {law};
-  for (PlaneWall<D>& p : env.planes) p.wall.contact = law;
+  for (PlaneWall<D>& p : surface_specs<PlaneWalls<D>>(env)) p.wall.contact = law;
   for (const int f : {0, 1, 4, 5}) env.faces[static_cast<std::size_t>(f)].wall.contact = law;
   env.tc = 1e-4;
   Engine engine(balls_above_a_trough(11), StartMode::kPredict, EngineOptions{}, env);
@@ -311,7 +311,7 @@ TEST(PlaneWallsInTheEngine, GrainsComeToRestOnTheSlopesAndSleep) {
   EXPECT_LT(engine.max_overlap_now(), 1e-9);
   int on_a_plane = 0;
   for (const Vec<D>& p : engine.current_positions())
-    for (const PlaneWall<D>& plane : env.planes) {
+    for (const PlaneWall<D>& plane : surface_specs<PlaneWalls<D>>(env)) {
       const double gap = dot(plane.normal, p) - plane.offset - 0.5;
       EXPECT_GT(gap, -1e-9);
       on_a_plane += gap < 1e-6 ? 1 : 0;

@@ -117,7 +117,7 @@ Environment<D> round_silo() {
   env.faces[5].kind = FaceKind::kOpen;
   PlaneWall<D> floor = holed_floor(4.0, 2.0, 5.0, 5.0);
   floor.wall.contact = law;
-  env.planes = {floor};
+  surface_specs<PlaneWalls<D>>(env) = {floor};
   Outlet<D> o;
   o.normal = {0.0, 0.0, 1.0};
   o.offset = 3.5;
@@ -184,7 +184,7 @@ TEST(RingEdgesInTheEngine, GrainsDrainThroughARoundOrificeAndMeetItsRim) {
 
 TEST(RingEdgesInTheEngine, AHoleTooNarrowForTheGrainsIsRefusedNamingIt) {
   Environment<D> env = round_silo();
-  env.planes[0].hole_radius = 0.4;
+  surface_specs<PlaneWalls<D>>(env)[0].hole_radius = 0.4;
   try {
     Engine engine(grains(2), StartMode::kPredict, EngineOptions{}, env);
     FAIL() << "a hole narrower than the grains was taken";
@@ -193,7 +193,7 @@ TEST(RingEdgesInTheEngine, AHoleTooNarrowForTheGrainsIsRefusedNamingIt) {
         << e.what();
   }
   env = round_silo();
-  env.planes[0].wall.velocity = {0.0, 0.0, 0.1};
+  surface_specs<PlaneWalls<D>>(env)[0].wall.velocity = {0.0, 0.0, 0.1};
   EXPECT_THROW(env.check(), InputError);
 }
 

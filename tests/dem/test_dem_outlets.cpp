@@ -52,7 +52,7 @@ Environment<D> silo(double width, bool rough) {
     p.span_axis = 0;
     p.span_min = lo;
     p.span_max = hi;
-    env.planes.push_back(p);
+    surface_specs<PlaneWalls<D>>(env).push_back(p);
   }
   Outlet<D> o;
   o.normal = {0.0, 1.0};
@@ -229,11 +229,11 @@ TEST(DemOutlets, ADiskBeyondThePlaneThatStillTouchesWaits) {
     v.push_back({0.0, 0.0});
   }
   Environment<D> env = silo(5.0, false);
-  env.planes.clear();
+  surface_specs<PlaneWalls<D>>(env).clear();
   PlaneWall<D> floor;
   floor.normal = {0.0, 1.0};
   floor.offset = 4.0;
-  env.planes.push_back(floor);
+  surface_specs<PlaneWalls<D>>(env).push_back(floor);
   env.outlets[0].offset = 4.49999;
   DemIntegrator<D> dem(disks(at, v), env);
   dem.step(20000);

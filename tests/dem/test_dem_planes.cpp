@@ -49,7 +49,7 @@ TEST(DemPlanes, AnAxisAlignedPlaneBouncesAsTheFloorFace) {
   const double g = 1.0;
   DemIntegrator<3> on_face(one_sphere({10.0, 10.0, 2.0}, {0.3, 0.0, -1.0}), closed_box(g));
   Environment<3> env = closed_box(g);
-  env.planes = {plane_through({0.0, 0.0, 1.0}, {0.0, 0.0, 1.0})};
+  surface_specs<PlaneWalls<3>>(env) = {plane_through({0.0, 0.0, 1.0}, {0.0, 0.0, 1.0})};
   DemIntegrator<3> on_plane(one_sphere({10.0, 10.0, 3.0}, {0.3, 0.0, -1.0}), env);
   ASSERT_EQ(on_face.dt(), on_plane.dt());
   for (int k = 0; k < 200; ++k) {
@@ -79,7 +79,7 @@ TEST(DemPlanes, ASphereOnARoundHolesRimIsPushedThroughItAndOneOnTheAxisFallsUnto
   PlaneWall<3> floor = plane_through({0.0, 0.0, 1.0}, {10.0, 10.0, 5.0});
   floor.hole_radius = 1.0;
   floor.hole_center = {10.0, 10.0, 5.0};
-  env.planes = {floor};
+  surface_specs<PlaneWalls<3>>(env) = {floor};
   // Its centre 0.2 inside the rim: it meets the ring (at height 0.458), not the plate.
   DemIntegrator<3> rim(one_sphere({10.8, 10.0, 7.0}, {}), env);
   const auto energy = [&](const DemIntegrator<3>& d) {
@@ -124,7 +124,7 @@ TEST(DemPlanes, AFrictionlessSphereSlidesDownASlopeAtGSinTheta) {
   const double g = 1.0;
   const Slope slope;
   Environment<3> env = closed_box(g);
-  env.planes = {plane_through(slope.normal(), {10.0, 10.0, 5.0})};
+  surface_specs<PlaneWalls<3>>(env) = {plane_through(slope.normal(), {10.0, 10.0, 5.0})};
   const ParticleSystem<3> s = on_slope(slope, g);
   DemIntegrator<3> dem(s, env);
   const double t = 2.0;
@@ -147,7 +147,7 @@ TEST(DemPlanes, ARoughSphereRollsDownASlopeAtFiveSeventhsOfGSinTheta) {
   const double g = 1.0, mu = 0.5;  // mu > (2/7) tan 30 = 0.165: rolling, no slip
   const Slope slope;
   Environment<3> env = closed_box(g);
-  env.planes = {plane_through(slope.normal(), {10.0, 10.0, 5.0})};
+  surface_specs<PlaneWalls<3>>(env) = {plane_through(slope.normal(), {10.0, 10.0, 5.0})};
   env.soft_friction = {SoftFriction{mu, 2.0 / 7.0, 0.5}};
   env.soft_wall_friction = env.soft_friction;
   const ParticleSystem<3> s = on_slope(slope, g);
@@ -182,7 +182,7 @@ double piston_budget_error(double steps_per_contact) {
   const Vec<3> n{-std::sqrt(0.5), 0.0, std::sqrt(0.5)};
   PlaneWall<3> piston = plane_through(n, {10.0, 10.0, 5.0});
   piston.wall.velocity = 0.2 * n;  // into the domain
-  env.planes = {piston};
+  surface_specs<PlaneWalls<3>>(env) = {piston};
   DemOptions options;
   options.steps_per_contact = steps_per_contact;
   DemIntegrator<3> dem(one_sphere(Vec<3>{10.0, 10.0, 5.0} + 2.0 * n, -0.1 * n), env, options);
@@ -205,7 +205,7 @@ TEST(DemPlanes, APistonPlanesWorkClosesTheEnergyBudget) {
 
 TEST(DemPlanes, ADeepOverlapNamesThePlane) {
   Environment<3> env = closed_box(0.0);
-  env.planes = {plane_through({0.0, 0.0, 1.0}, {0.0, 0.0, 5.0})};
+  surface_specs<PlaneWalls<3>>(env) = {plane_through({0.0, 0.0, 1.0}, {0.0, 0.0, 5.0})};
   try {
     DemIntegrator<3> dem(one_sphere({10.0, 10.0, 5.1}, {}), env);
     dem.step(1);

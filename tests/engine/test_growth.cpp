@@ -240,9 +240,9 @@ TEST(Growth, RefusesWhatItCannotGrowIn) {
   refused(open, "an open face");
   Environment<3> plane;
   plane.faces[4].kind = plane.faces[5].kind = FaceKind::kWall;
-  plane.planes.push_back(PlaneWall<3>{});
-  plane.planes.back().normal = {0.0, 0.0, 1.0};
-  plane.planes.back().offset = 0.01;
+  surface_specs<PlaneWalls<3>>(plane).push_back(PlaneWall<3>{});
+  surface_specs<PlaneWalls<3>>(plane).back().normal = {0.0, 0.0, 1.0};
+  surface_specs<PlaneWalls<3>>(plane).back().offset = 0.01;
   refused(plane, "a plane wall");
 }
 

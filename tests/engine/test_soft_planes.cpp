@@ -69,7 +69,7 @@ TEST(SoftPlanes, ATiltedPlaneContactIsTheClosedFormDashpotAlongItsNormal) {
   ASSERT_NEAR(dot(tangential, kNormal), 0.0, 1e-15);
   const Vec<3> v = tangential - vn * kNormal;
   Environment<3> env = walled(SoftContactLaw::linear_dashpot(k, gamma));
-  env.planes = {slope()};
+  surface_specs<PlaneWalls<3>>(env) = {slope()};
   Engine3 engine(towards_slope(v, 0.4, m), StartMode::kPredict, {}, env);
   EventKind kind;
   while ((kind = engine.step()) != EventKind::kSoftRelease) ASSERT_NE(kind, EventKind::kNone);
@@ -96,7 +96,7 @@ TEST(SoftPlanes, ATiltedPistonIsTheMapInTheWallsFrameAndAgreesWithTheDem) {
   Environment<3> env = walled(law);
   PlaneWall<3> piston = slope();
   piston.wall.velocity = u * kNormal;
-  env.planes = {piston};
+  surface_specs<PlaneWalls<3>>(env) = {piston};
   // Along the slope and along y, then towards it at vn relative to it.
   const Vec<3> tangential{0.1 * std::sqrt(3.0) / 2.0, 0.2, 0.1 * 0.5};
   const Vec<3> v = tangential - vn * kNormal + u * kNormal;
@@ -130,7 +130,7 @@ TEST(SoftPlanes, AGasAboveASlopeKeepsEveryInvariant) {
   PlaneWall<3> p;
   p.normal = kNormal;
   p.offset = lowest - 0.6;
-  env.planes = {p};
+  surface_specs<PlaneWalls<3>>(env) = {p};
   Engine3 engine(s, StartMode::kPredict, {}, env);
   const auto budget = [&] {
     const EventCounters& c = engine.counters();
@@ -153,7 +153,7 @@ TEST(SoftPlanes, AGasAboveASlopeKeepsEveryInvariant) {
 TEST(SoftPlanes, ARestartWithAContactAgainstAPlaneResumesBitForBit) {
   const double k = 900.0, gamma = 2.0, m = 1.5;
   Environment<3> env = walled(SoftContactLaw::linear_dashpot(k, gamma));
-  env.planes = {slope()};
+  surface_specs<PlaneWalls<3>>(env) = {slope()};
   Engine3 a(towards_slope(Vec<3>{0.1, 0.0, 0.0} - 1.3 * kNormal, 0.4, m), StartMode::kPredict, {},
             env);
   const auto against_plane = [&] {

@@ -192,7 +192,7 @@ void PlaneTable::add(const PlaneConfig& pc, const std::string& prefix, Environme
     for (int a = 0; a < D && a < static_cast<int>(c.size()); ++a) center[a] = c[a];
     plane.hole_center = center - (dot(plane.normal, center) - plane.offset) * plane.normal;
   }
-  env.planes.push_back(plane);
+  surface_specs<PlaneWalls<D>>(env).push_back(plane);
 }
 
 std::optional<TableObstacle> PlaneTable::motion(const PlaneConfig& plane) {

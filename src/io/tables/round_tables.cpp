@@ -123,7 +123,8 @@ void RoundTable<Sphere>::add(const CylinderConfig& cc, const std::string& prefix
   round.inside = cc.inside;
   round.angular_velocity = cc.angular_velocity;
   round.contact = make_contact_model(cc.contact, prefix);
-  (Sphere ? env.spheres : env.cylinders).push_back(round);
+  constexpr RoundShape shape = Sphere ? RoundShape::kSphere : RoundShape::kCylinder;
+  surface_specs<RoundWalls<D, shape>>(env).push_back(round);
 }
 
 template <bool Sphere>
