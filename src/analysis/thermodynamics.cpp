@@ -17,6 +17,12 @@ double Thermodynamics::temperature(double kinetic_energy, double held) const {
   return 2.0 * kinetic_energy / (moving > 0.0 ? moving : dimension_ * free_particles_);
 }
 
+double Thermodynamics::span_temperature(bool from_rows, const std::vector<double>& row_temperatures,
+                                        double start_kinetic_energy, double start_held) const {
+  if (from_rows && !row_temperatures.empty()) return block_average(row_temperatures).mean;
+  return temperature(start_kinetic_energy, start_held);
+}
+
 double Thermodynamics::compressibility(double virial, double kT, double duration) const {
   if (!(duration > 0.0) || !(kT > 0.0)) return std::nan("");
   return 1.0 + virial / (dimension_ * n_ * kT * duration);

@@ -44,6 +44,12 @@ class Thermodynamics {
   // `held`: degrees of freedom that contacts in progress hold still (Integrator::
   // held_degrees_of_freedom), not counted.
   double temperature(double kinetic_energy, double held = 0.0) const;
+  // The temperature a span's Z and pressure are made with: the mean of its rows' temperatures
+  // when the kinetic energy is not conserved (`from_rows`: Integrator::temperature_from_rows,
+  // a thermostat or dissipation) and there are rows, else the span's start's (its kinetic
+  // energy and held degrees of freedom then). The summary's and Simulation.pressure()'s rule.
+  double span_temperature(bool from_rows, const std::vector<double>& row_temperatures,
+                          double start_kinetic_energy, double start_held) const;
   double compressibility(double virial, double kT, double duration) const;
   double pressure(double compressibility, double kT) const;
   double mean_free_time(double duration, std::uint64_t collisions) const;

@@ -383,8 +383,20 @@ std::array<double, 9> EventEngineAdapter<D, Queue>::peculiar_kinetic_tensor() co
 
 template <int D, class Queue>
 double EventEngineAdapter<D, Queue>::total_energy() const {
+  return less_field_term(engine_.kinetic_energy() + engine_.rotational_energy() +
+                         engine_.potential_energy());
+}
+
+template <int D, class Queue>
+double EventEngineAdapter<D, Queue>::field_energy() const {
+  return less_field_term(0.0);
+}
+
+// e less m g.x over the particles that move, one at a time (the order total_energy() has always
+// summed in); NaN when the field has a component along a periodic axis.
+template <int D, class Queue>
+double EventEngineAdapter<D, Queue>::less_field_term(double e) const {
   const Environment<D>& env = engine_.environment();
-  double e = engine_.kinetic_energy() + engine_.rotational_energy() + engine_.potential_energy();
   if (!env.has_gravity()) return e;
   for (int a = 0; a < D; ++a)
     if (env.periodic(a) && env.gravity[a] != 0.0) return std::nan("");

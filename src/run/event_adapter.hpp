@@ -73,6 +73,9 @@ class EventIntegrator : public Integrator<D> {
   // potential energy in the gravity field; NaN when the field has a component along a periodic
   // axis (unbounded there).
   virtual double total_energy() const = 0;
+  // The potential energy in the gravity field alone (0 without one; NaN as above), the fixed
+  // grains' left out as in total_energy().
+  virtual double field_energy() const = 0;
 
  protected:
   using Integrator<D>::Integrator;
@@ -161,6 +164,7 @@ class EventEngineAdapter final : public EventIntegrator<D> {
     return engine_.helfand_moments();
   }
   double total_energy() const override;
+  double field_energy() const override;
 
   // The engine and its watch, for callers that step it themselves (run/simulation.hpp).
   EventEngine<D, Queue>& engine() { return engine_; }
@@ -173,6 +177,7 @@ class EventEngineAdapter final : public EventIntegrator<D> {
   void set_driving_temperature(double temperature);
 
  private:
+  double less_field_term(double e) const;
   std::vector<std::uint8_t> fixed_;  // per particle (the caller's numbering): a fixed grain
   // Stochastic driving ([driving]): Poisson events at rate N * rate, each on one random
   // particle, applied between the engine's events. The RNG and the next event's time are in

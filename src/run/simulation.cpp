@@ -416,9 +416,7 @@ typename Simulation<D>::Energies Simulation<D>::energies() const {
   e.kinetic = in.kinetic_energy();
   e.rotational = in.rotational_energy();
   e.potential = in.potential_energy();
-  e.field = dem_ != nullptr ? dem_->dem().field_energy()
-                            : engine_->total_energy() - e.kinetic - e.rotational - e.potential;
-  if (engine_ != nullptr && !engine_->environment().has_gravity()) e.field = 0.0;
+  e.field = dem_ != nullptr ? dem_->dem().field_energy() : engine_->field_energy();
   e.dissipated = in.dissipated_energy();
   e.work_by_walls = in.work_by_walls();
   if (engine_ != nullptr) {

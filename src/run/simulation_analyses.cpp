@@ -349,9 +349,8 @@ PressureMeasurement measure_pressure(Simulation<D>& sim, const CorrelationReques
   m.span.end_time = sim.time();
   m.span.collisions = sim.collisions() - m.span.collisions;
   m.span.mean_free_time = stats.mean_free_time(duration, m.span.collisions);
-  m.temperature = integrator.temperature_from_rows() && !temperatures.empty()
-                      ? block_average(temperatures).mean
-                      : stats.temperature(start_ke, start_held);
+  m.temperature = stats.span_temperature(integrator.temperature_from_rows(), temperatures, start_ke,
+                                         start_held);
   if (engine != nullptr && rows > 0 && duration > 0.0) {
     std::array<double, 9> tensor{};
     for (int k = 0; k < D * D; ++k) {
@@ -368,12 +367,8 @@ PressureMeasurement measure_pressure(Simulation<D>& sim, const CorrelationReques
   m.compressibility = stats.compressibility_blocks();
   m.compressibility.mean =
       stats.compressibility(integrator.virial() - start.virial, m.temperature, duration);
-  if (!integrator.bulk())
-    m.undefined = not_bulk_reason(moving < sim.size(), true);
-  else if (!(duration > 0.0))
-    m.undefined = "no time elapsed";
-  else if (!(m.temperature > 0.0))
-    m.undefined = "the particles are at rest (kT = 0)";
+  m.undefined = pressure_undefined_reason(integrator.bulk(), moving < sim.size(), duration,
+                                          m.temperature, "time");
   if (!m.undefined.empty()) {
     m.compressibility.mean = m.compressibility.stderr_ = kNaN;
     m.pressure = m.pressure_stderr = kNaN;

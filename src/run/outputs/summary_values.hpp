@@ -4,6 +4,9 @@
 
 #include <cmath>
 #include <string>
+#include <string_view>
+
+#include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
 
@@ -42,6 +45,17 @@ inline const char* not_bulk_reason(bool fixed_grains, bool pressure) {
   }
   return pressure ? "walls, open faces or a field: the pressure is not uniform in the box"
                   : "walls, open faces or a field: the gas is not homogeneous";
+}
+
+// Why a span's compressibility Z and pressure are undefined ("" when they are defined): not a
+// bulk system, no time elapsed over the span (`span` names it: "production time", "time"), or
+// every particle at rest. The summary's and Simulation.pressure()'s one rule.
+inline std::string pressure_undefined_reason(bool bulk, bool fixed_grains, double elapsed,
+                                             double kT, std::string_view span) {
+  if (!bulk) return not_bulk_reason(fixed_grains, true);
+  if (!(elapsed > 0.0)) return fmt::format("no {} elapsed", span);
+  if (!(kT > 0.0)) return "the particles are at rest (kT = 0)";
+  return "";
 }
 
 inline void set_sonine_a2(nlohmann::json& summary, nlohmann::json& where, double a2, bool bulk,

@@ -211,9 +211,8 @@ void ThermoOutput<D>::record(RunProgress& progress) const {
 
 template <int D>
 double ThermoOutput<D>::production_temperature(const Integrator<D>& integrator) const {
-  if (integrator.temperature_from_rows() && !production_temperatures_.empty())
-    return block_average(production_temperatures_).mean;
-  return stats_->temperature(production_ke_, production_held_);
+  return stats_->span_temperature(integrator.temperature_from_rows(), production_temperatures_,
+                                  production_ke_, production_held_);
 }
 
 template <int D>
@@ -258,13 +257,9 @@ void ThermoOutput<D>::summarize(nlohmann::json& j, const RunContext<D>& run) con
   j["collisions_per_second"] = wall > 0 ? static_cast<double>(collisions) / wall : 0.0;
   j["temperature"] = th.temperature(ke, integrator.held_degrees_of_freedom());
   j["kinetic_energy"] = ke;
-  std::string why;
-  if (!integrator.bulk())
-    why = not_bulk_reason(integrator.mobile() < integrator.size(), true);
-  else if (!(production_time > 0.0))
-    why = "no production time elapsed";
-  else if (!(kT_production > 0.0))
-    why = "the particles are at rest (kT = 0)";
+  const std::string why =
+      pressure_undefined_reason(integrator.bulk(), integrator.mobile() < integrator.size(),
+                                production_time, kT_production, "production time");
   nlohmann::json z = {
       {"blocks", z_blocks.samples},
       {"method", "blocking over thermo rows (Flyvbjerg-Petersen, level by Jonsson's test)"}};
