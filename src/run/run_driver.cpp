@@ -295,9 +295,9 @@ void RunDriver<D>::start_triggers(std::uint64_t begin, double begin_time, bool c
   triggers_.assign(observers_.size(), Trigger{});
   // Log-spaced writes count from the phase's start, or from the start a continued run's
   // restart file recorded for the phase it resumes.
-  const bool resumed_origin = continued && std::isfinite(resumed_.frame_origin_time);
-  const double origin_time = resumed_origin ? resumed_.frame_origin_time : begin_time;
-  const std::uint64_t origin = resumed_origin ? resumed_.frame_origin_collisions : begin;
+  const ProgressMark* resumed_origin = continued ? resumed_.mark("frame_origin") : nullptr;
+  const double origin_time = resumed_origin ? resumed_origin->values[0] : begin_time;
+  const std::uint64_t origin = resumed_origin ? resumed_origin->counts[0] : begin;
   log_origin_time_ = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t k = 0; k < observers_.size(); ++k) {
     const double interval = observers_[k]->interval(config_, production);
@@ -394,8 +394,8 @@ RunProgress RunDriver<D>::progress_now() const {
   RunProgress p;
   for (const auto& o : observers_) o->record(p);
   p.owed_outputs = owed_;
-  p.frame_origin_time = log_origin_time_;
-  p.frame_origin_collisions = log_origin_collisions_;
+  if (std::isfinite(log_origin_time_))
+    p.marks["frame_origin"] = {{log_origin_time_}, {log_origin_collisions_}};
   if (schedule_phase_ >= 0) {
     p.schedule_phase = schedule_phase_;
     for (std::size_t k = 0; k < observers_.size(); ++k) {
@@ -411,7 +411,7 @@ RunProgress RunDriver<D>::progress_now() const {
     else
       p.production_target = phase_target_;
   } else {
-    p.has_production_start = false;  // only an unfinished production is continued
+    p.marks.erase("production_start");  // only an unfinished production is continued
   }
   // Equilibration still owed if the run stops now, in the unit of the config's length.
   const std::uint64_t c = integrator_->collisions();

@@ -41,19 +41,12 @@ void write_progress(gsd::Writer& w, const RunProgress& progress) {
     const auto owed = static_cast<std::uint8_t>(progress.owed_outputs);
     w.write_chunk("kairos/run/owed", 1, 1, &owed);
   }
-  if (progress.has_frame_mark) {
-    w.write_chunk("kairos/run/frame_mark", 1, 1, &progress.frame_time);
-    w.write_chunk("kairos/run/frame_mark_collisions", 1, 1, &progress.frame_collisions);
-  }
-  if (std::isfinite(progress.frame_origin_time)) {
-    w.write_chunk("kairos/run/frame_origin", 1, 1, &progress.frame_origin_time);
-    w.write_chunk("kairos/run/frame_origin_collisions", 1, 1, &progress.frame_origin_collisions);
-  }
-  if (progress.has_thermo_mark) {
-    const double mark[2] = {progress.mark_time, progress.mark_virial};
-    const std::uint64_t counts[2] = {progress.mark_events, progress.mark_collisions};
-    w.write_chunk("kairos/run/thermo_mark", 2, 1, mark);
-    w.write_chunk("kairos/run/thermo_mark_counts", 2, 1, counts);
+  for (const ProgressMarkDecl& d : kProgressMarks) {
+    const ProgressMark* m = progress.mark(d.name);
+    if (m == nullptr) continue;
+    const std::string name = "kairos/run/" + std::string(d.name);
+    w.write_chunk(name, d.values, 1, m->values.data());
+    w.write_chunk(name + std::string(d.counts_suffix), d.counts, 1, m->counts.data());
   }
   if (progress.schedule_phase >= 0) {
     std::uint64_t schedule[7];
@@ -68,15 +61,6 @@ void write_progress(gsd::Writer& w, const RunProgress& progress) {
     w.write_chunk("kairos/run/production_target", 1, 1, &progress.production_target);
   if (std::isfinite(progress.production_end_time))
     w.write_chunk("kairos/run/production_end_time", 1, 1, &progress.production_end_time);
-  if (progress.has_production_start) {
-    const double start[4] = {progress.production_start_time, progress.production_start_virial,
-                             progress.production_start_thermal_energy,
-                             progress.production_start_held};
-    const std::uint64_t counts[2] = {progress.production_start_events,
-                                     progress.production_start_collisions};
-    w.write_chunk("kairos/run/production_start", 4, 1, start);
-    w.write_chunk("kairos/run/production_start_counts", 2, 1, counts);
-  }
   if (progress.integrator != "event") {
     const std::vector<std::int8_t> name(progress.integrator.begin(), progress.integrator.end());
     w.write_chunk("kairos/run/integrator", name.size(), 1, name.data());
@@ -141,34 +125,17 @@ void read_progress(const gsd::Reader& r, std::uint64_t f, const std::filesystem:
       throw InputError(file + ": kairos/run/owed is not a set of outputs");
     progress.owed_outputs = owed;
   }
-  if (r.find(f, "kairos/run/frame_mark")) {
-    const auto time = require<double>(r, f, "kairos/run/frame_mark", path, 1);
-    const auto count = require<std::uint64_t>(r, f, "kairos/run/frame_mark_collisions", path, 1);
-    if (!std::isfinite(time[0]) || time[0] > s.time || count[0] > s.counters.collisions)
-      throw InputError(file + ": kairos/run/frame_mark lies after the state");
-    progress.has_frame_mark = true;
-    progress.frame_time = time[0];
-    progress.frame_collisions = count[0];
-  }
-  if (r.find(f, "kairos/run/frame_origin")) {
-    const auto time = require<double>(r, f, "kairos/run/frame_origin", path, 1);
-    const auto count = require<std::uint64_t>(r, f, "kairos/run/frame_origin_collisions", path, 1);
-    if (!std::isfinite(time[0]) || time[0] > s.time || count[0] > s.counters.collisions)
-      throw InputError(file + ": kairos/run/frame_origin lies after the state");
-    progress.frame_origin_time = time[0];
-    progress.frame_origin_collisions = count[0];
-  }
-  if (r.find(f, "kairos/run/thermo_mark")) {
-    const auto mark = require<double>(r, f, "kairos/run/thermo_mark", path, 2);
-    const auto counts = require<std::uint64_t>(r, f, "kairos/run/thermo_mark_counts", path, 2);
-    if (!std::isfinite(mark[0]) || !std::isfinite(mark[1]) || mark[0] > s.time ||
-        counts[1] > s.counters.collisions)
-      throw InputError(file + ": kairos/run/thermo_mark lies after the state");
-    progress.has_thermo_mark = true;
-    progress.mark_time = mark[0];
-    progress.mark_virial = mark[1];
-    progress.mark_events = counts[0];
-    progress.mark_collisions = counts[1];
+  for (const ProgressMarkDecl& d : kProgressMarks) {
+    const std::string name = "kairos/run/" + std::string(d.name);
+    if (!r.find(f, name)) continue;
+    ProgressMark m;
+    m.values = require<double>(r, f, name, path, d.values);
+    m.counts = require<std::uint64_t>(r, f, name + std::string(d.counts_suffix), path, d.counts);
+    for (const double x : m.values)
+      if (!std::isfinite(x)) throw InputError(file + ": " + name + " is not finite");
+    if (m.values[0] > s.time || m.counts.back() > s.counters.collisions)
+      throw InputError(file + ": " + name + " lies after the state");
+    progress.marks.emplace(std::string(d.name), std::move(m));
   }
   if (r.find(f, "kairos/run/schedule")) {
     const auto schedule = require<std::uint64_t>(r, f, "kairos/run/schedule", path, 7);
@@ -187,21 +154,6 @@ void read_progress(const gsd::Reader& r, std::uint64_t f, const std::filesystem:
         require<double>(r, f, "kairos/run/production_end_time", path, 1)[0];
     if (!std::isfinite(progress.production_end_time))
       throw InputError(file + ": kairos/run/production_end_time is not finite");
-  }
-  if (r.find(f, "kairos/run/production_start")) {
-    const auto start = require<double>(r, f, "kairos/run/production_start", path, 4);
-    const auto counts = require<std::uint64_t>(r, f, "kairos/run/production_start_counts", path, 2);
-    for (const double x : start)
-      if (!std::isfinite(x)) throw InputError(file + ": kairos/run/production_start is not finite");
-    if (start[0] > s.time || counts[1] > s.counters.collisions)
-      throw InputError(file + ": kairos/run/production_start lies after the state");
-    progress.has_production_start = true;
-    progress.production_start_time = start[0];
-    progress.production_start_virial = start[1];
-    progress.production_start_thermal_energy = start[2];
-    progress.production_start_held = start[3];
-    progress.production_start_events = counts[0];
-    progress.production_start_collisions = counts[1];
   }
   if (r.find(f, "kairos/run/integrator")) {
     const auto name = r.read<std::int8_t>(f, "kairos/run/integrator");

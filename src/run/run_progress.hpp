@@ -9,14 +9,48 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <random>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "core/memory_budget.hpp"
 #include "core/particle_system.hpp"
 #include "core/state_blocks.hpp"
 
 namespace kairos {
+
+// A point of the run that an observer (or the driver) keeps in the restart file, so that a
+// run continued in the same directory goes on as one uninterrupted run: a time first, then
+// other values, and event or collision counts, the last a collision count. Stored as the
+// chunks kairos/run/<name> (the values) and kairos/run/<name><counts_suffix>; checked on
+// reading (finite, not after the state). Its owner fills it in Observer::record and reads it
+// from RunContext::resumed() by name.
+struct ProgressMark {
+  std::vector<double> values;
+  std::vector<std::uint64_t> counts;
+};
+
+// Every mark, declared once: its name, sizes, counts' suffix and owner. A new observer that
+// keeps a point of the run adds one line here.
+struct ProgressMarkDecl {
+  std::string_view name;
+  std::size_t values, counts;
+  std::string_view counts_suffix;
+  std::string_view meaning;
+};
+inline constexpr ProgressMarkDecl kProgressMarks[] = {
+    {"frame_mark", 1, 1, "_collisions",
+     "trajectory.gsd's last kept frame: time; collisions (a continued run writes no second)"},
+    {"frame_origin", 1, 1, "_collisions",
+     "the driver: the origin of log-spaced frames in the phase: time; collisions"},
+    {"thermo_mark", 2, 2, "_counts",
+     "thermo.tsv: the point the next row is measured from: time, virial; events, collisions"},
+    {"production_start", 4, 2, "_counts",
+     "thermo.tsv: where an unfinished production began: time, virial, thermal energy, degrees "
+     "of freedom held still; events, collisions (a continued run averages the whole of it)"},
+};
 
 // Where the run that wrote a restart file stood, beyond the physical state.
 struct RunProgress {
@@ -48,25 +82,10 @@ struct RunProgress {
   // same directory leaves them as one uninterrupted run would: rows and frames written after
   // this state (before an interruption) are dropped. -1: not recorded.
   std::int64_t thermo_rows = -1, trajectory_frames = -1;
-  // The point the next thermo row is measured from (the last kept row's; kairos/run/thermo_mark).
-  bool has_thermo_mark = false;
-  double mark_time = 0.0, mark_virial = 0.0;
-  std::uint64_t mark_events = 0, mark_collisions = 0;
   // The thermo row and trajectory frame due at this state whose writing failed
   // (kairos/run/owed, uint8): a run continued in the same directory writes them first.
   static constexpr unsigned kOwedRow = 1, kOwedFrame = 2;
   unsigned owed_outputs = 0;
-  // The last kept trajectory frame's state (kairos/run/frame_mark): a continued run writes no
-  // second frame of it.
-  bool has_frame_mark = false;
-  double frame_time = 0.0;
-  std::uint64_t frame_collisions = 0;
-  // Log-spaced trajectory frames (output.trajectory_spacing = "log"; kairos/run/frame_origin
-  // and frame_origin_collisions): the origin of the sequence of the phase in schedule_phase, its
-  // start's time and collision count, so that a continued run writes the frames an
-  // uninterrupted run would. NaN: not recorded.
-  double frame_origin_time = std::numeric_limits<double>::quiet_NaN();
-  std::uint64_t frame_origin_collisions = 0;
   // Output schedules in collisions (kairos/run/schedule) of the phase the state is in (0:
   // equilibration, 1: production, -1: not recorded): thermo, trajectory, restart; a step of 0:
   // not scheduled. A continued run in that phase with the same steps keeps them.
@@ -76,14 +95,12 @@ struct RunProgress {
   // the time (NaN: none) it was to end at; a continued run completes it.
   std::uint64_t production_target = 0;
   double production_end_time = std::numeric_limits<double>::quiet_NaN();
-  // Where that unfinished production began (kairos/run/production_start and _counts: its
-  // time, virial, thermal energy and the degrees of freedom held still then, its event and
-  // collision counts), so that a run completing it in the same directory averages over the
-  // whole production, as one uninterrupted run (outputs/thermo_output.hpp).
-  bool has_production_start = false;
-  double production_start_time = 0.0, production_start_virial = 0.0;
-  double production_start_thermal_energy = 0.0, production_start_held = 0.0;
-  std::uint64_t production_start_events = 0, production_start_collisions = 0;
+  // The points of the run that its observers and the driver keep (kProgressMarks), by name.
+  std::map<std::string, ProgressMark, std::less<>> marks;
+  const ProgressMark* mark(std::string_view name) const {
+    const auto it = marks.find(name);
+    return it != marks.end() ? &it->second : nullptr;
+  }
 };
 
 // The restart file of a run: the state (io/gsd_snapshot.hpp) and the run's progress, atomically.

@@ -97,8 +97,8 @@ TEST_P(Outputs, RestartRecordsTheRowsFramesAndSchedulesOfTheRun) {
   EXPECT_EQ(p.integrator, GetParam());
   EXPECT_EQ(p.thermo_rows, 10);
   EXPECT_EQ(p.trajectory_frames, 4);
-  EXPECT_TRUE(p.has_thermo_mark);
-  EXPECT_TRUE(p.has_frame_mark);
+  ASSERT_NE(p.mark("thermo_mark"), nullptr);
+  ASSERT_NE(p.mark("frame_mark"), nullptr);
   EXPECT_EQ(p.owed_outputs, 0u);
   // The production's schedules in collisions (256 particles: 0.5 per particle = 64): thermo,
   // trajectory, restart, as the triggers stand after the run.

@@ -17,7 +17,8 @@ template <int D>
 bool completes_production(const RunContext<D>& run) {
   const RunProgress& r = run.resumed();
   const std::optional<RestartPlan>& plan = run.plan();
-  return run.restarted() && run.continuation().same_directory && r.has_production_start &&
+  return run.restarted() && run.continuation().same_directory &&
+         r.mark("production_start") != nullptr &&
          (r.production_target > 0 || std::isfinite(r.production_end_time)) && plan &&
          !plan->repredict && !length_given_anew(plan);
 }
@@ -39,11 +40,10 @@ std::vector<std::string> split_tabs(const std::string& line) {
 
 template <int D>
 void ThermoOutput<D>::continue_production(const RunContext<D>& run) {
-  const RunProgress& r = run.resumed();
-  production_start_ = {r.production_start_time, r.production_start_virial,
-                       r.production_start_events, r.production_start_collisions};
-  production_ke_ = r.production_start_thermal_energy;
-  production_held_ = r.production_start_held;
+  const ProgressMark& m = *run.resumed().mark("production_start");
+  production_start_ = {m.values[0], m.values[1], m.counts[0], m.counts[1]};
+  production_ke_ = m.values[2];
+  production_held_ = m.values[3];
   production_started_ = production_continued_ = true;
   // The kept rows (the file was cut to them): every value as written, %.17g, read back exactly.
   const std::filesystem::path path = run.directory() / name();
@@ -111,10 +111,9 @@ void ThermoOutput<D>::open(const RunContext<D>& run) {
   events_start_ = integrator.events();
   collisions_start_ = integrator.collisions();
   // Continued in its own directory: the next row covers the interval from the last kept one.
-  const RunProgress& resumed = run.resumed();
-  kept_mark_ = run.continuation().same_directory && resumed.has_thermo_mark
-                   ? ThermoPoint{resumed.mark_time, resumed.mark_virial, resumed.mark_events,
-                                 resumed.mark_collisions}
+  const ProgressMark* mark = run.resumed().mark("thermo_mark");
+  kept_mark_ = run.continuation().same_directory && mark != nullptr
+                   ? ThermoPoint{mark->values[0], mark->values[1], mark->counts[0], mark->counts[1]}
                    : integrator.point();
   stats_->mark(kept_mark_);
   if (completes_production(run)) continue_production(run);
@@ -194,19 +193,14 @@ void ThermoOutput<D>::close(const RunContext<D>& run, bool stopped) {
 template <int D>
 void ThermoOutput<D>::record(RunProgress& progress) const {
   progress.thermo_rows = static_cast<std::int64_t>(rows_kept_);
-  progress.has_thermo_mark = true;
-  progress.mark_time = kept_mark_.time;
-  progress.mark_virial = kept_mark_.virial;
-  progress.mark_events = kept_mark_.events;
-  progress.mark_collisions = kept_mark_.collisions;
+  progress.marks["thermo_mark"] = {{kept_mark_.time, kept_mark_.virial},
+                                   {kept_mark_.events, kept_mark_.collisions}};
   // Kept by the driver only for an unfinished production (RunDriver::progress_now).
-  progress.has_production_start = production_started_;
-  progress.production_start_time = production_start_.time;
-  progress.production_start_virial = production_start_.virial;
-  progress.production_start_events = production_start_.events;
-  progress.production_start_collisions = production_start_.collisions;
-  progress.production_start_thermal_energy = production_ke_;
-  progress.production_start_held = production_held_;
+  if (production_started_) {
+    progress.marks["production_start"] = {
+        {production_start_.time, production_start_.virial, production_ke_, production_held_},
+        {production_start_.events, production_start_.collisions}};
+  }
 }
 
 template <int D>

@@ -177,10 +177,10 @@ void TrajectoryOutput<D>::open(const RunContext<D>& run) {
       frames_kept_ = writer_->frame_count();
       // The state of the last frame kept: the one the restart file recorded (its events only
       // when it is the present state: the DEM compares those).
-      const RunProgress& resumed = run.resumed();
-      if (run.continuation().same_directory && resumed.has_frame_mark) {
-        last_.collisions = resumed.frame_collisions;
-        last_.time = resumed.frame_time;
+      const ProgressMark* mark = run.resumed().mark("frame_mark");
+      if (run.continuation().same_directory && mark != nullptr) {
+        last_.collisions = mark->counts[0];
+        last_.time = mark->values[0];
         const bool present =
             last_.collisions == integrator.collisions() && last_.time == integrator.time();
         last_.events = present ? integrator.events() : ~std::uint64_t{0};
@@ -237,9 +237,7 @@ void TrajectoryOutput<D>::record(RunProgress& progress) const {
                                : enabled_ ? 0
                                           : frames_not_written_;
   if (!writer_) return;
-  progress.has_frame_mark = true;
-  progress.frame_time = kept_.time;
-  progress.frame_collisions = kept_.collisions;
+  progress.marks["frame_mark"] = {{kept_.time}, {kept_.collisions}};
 }
 
 template class TrajectoryOutput<2>;
