@@ -61,8 +61,9 @@ std::vector<DeclaredKey> build() {
                             [](const Placement& p) { return p.path == "boundary.outlet"; }) +
                1;
   SurfaceTables::each([&](auto table) {
-    after = placements.insert(after, {fmt::format("boundary.{}", table.key), KeyType::kTableArray,
-                                      table.placement()}) +
+    using Table = typename decltype(table)::type;
+    after = placements.insert(after, {fmt::format("boundary.{}", Table::key), KeyType::kTableArray,
+                                      Table::placement()}) +
             1;
   });
   std::vector<DeclaredKey> out, last;

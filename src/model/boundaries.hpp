@@ -485,7 +485,7 @@ template <int D, class Geometries = SurfaceGeometries<D>>
 class Boundaries;
 
 template <int D, class... Geometry>
-class Boundaries<D, GeometryList<Geometry...>>
+class Boundaries<D, TypeList<Geometry...>>
     : public BoundarySet<D, FaceWalls<D>, Geometry..., Outlets<D>> {
  public:
   Boundaries() = default;

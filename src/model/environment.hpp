@@ -16,6 +16,7 @@
 
 #include <memory>
 #include "core/periodic.hpp"
+#include "core/type_list.hpp"
 #include "core/vec.hpp"
 
 #include "boundaries/cylinder_walls.hpp"
@@ -26,7 +27,6 @@
 #include "interactions/soft_contact.hpp"
 #include "interactions/soft_map_table.hpp"
 #include "interactions/step_potential.hpp"
-#include "model/geometry_list.hpp"
 
 namespace kairos {
 
@@ -41,7 +41,9 @@ enum class SoftCollisions { kMapped, kInstantaneous };
 // its surfaces' specifications here: the one line a new geometry adds on the model side
 // (docs/extending.md). Their order numbers the surfaces: after the faces, before the outlets.
 template <int D>
-using SurfaceGeometries = GeometryList<PlaneWalls<D>, CylinderWalls<D>, SphereWalls<D>>;
+using SurfaceGeometries = TypeList<PlaneWalls<D>, CylinderWalls<D>, SphereWalls<D>>;
+template <class Geometry>
+using GeometrySpec = typename Geometry::Spec;
 
 template <int D>
 struct Environment {
@@ -51,7 +53,7 @@ struct Environment {
   std::array<Face<D>, 2 * D> faces{};
   // The surfaces of every geometry of SurfaceGeometries after the faces (plane walls at any
   // position and orientation, cylinders, spheres): surface_specs<PlaneWalls<D>>(env).
-  typename SurfaceGeometries<D>::Specs surfaces;
+  VectorsOf<SurfaceGeometries<D>, GeometrySpec> surfaces;
   // Outlets particles pass through, to be put back in an insertion region
   // (boundaries/outlets.hpp); not walls.
   std::vector<Outlet<D>> outlets;

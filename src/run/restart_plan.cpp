@@ -93,8 +93,9 @@ Effect effect_of(const std::string& key) {
   // A wall's or a surface table's contact law resumes; its place and motion re-predict (a
   // plane moved into the particles is refused by the start checks, naming the particle).
   std::vector<std::string> tables = {"boundary.wall."};
-  SurfaceTables::each(
-      [&](auto table) { tables.push_back(fmt::format("boundary.{}.", table.key)); });
+  SurfaceTables::each([&](auto table) {
+    tables.push_back(fmt::format("boundary.{}.", decltype(table)::type::key));
+  });
   for (const std::string_view table : tables) {
     if (!starts_with(k, table)) continue;
     const std::string_view leaf = std::string_view(k).substr(table.size());
