@@ -11,8 +11,14 @@
 
 namespace kairos {
 
+// How many of Ts are T.
+template <class T, class... Ts>
+inline constexpr std::size_t count_of = (std::size_t{0} + ... + std::size_t{std::is_same_v<T, Ts>});
+
 template <class... Types>
 struct TypeList {
+  static_assert(((count_of<Types, Types...> == 1) && ...),
+                "a TypeList holds each type once (index() finds a type by its place)");
   // f(std::type_identity<T>{}) for each type T, in order.
   template <class F>
   static void each(F&& f) {

@@ -820,30 +820,25 @@ class Reader : public KeyReader {
     }
     // A fixed grain predicts no wall contacts (as a sleeper): a wall moving along its normal
     // would reach it unseen.
-    const auto moves = [&](const WallConfig& w, std::string_view prefix, bool face) {
+    const auto moves = [&](const WallConfig& w, std::string_view prefix) {
       const char* why = "a fixed grain would not see the moving wall coming";
       if (w.amplitude > 0.0 && w.frequency > 0.0)
         conflict(fmt::format("{}.amplitude", prefix), why);
       if (w.mass > 0.0) conflict(fmt::format("{}.mass", prefix), why);
-      if (face && !w.velocity.empty()) {
+      if (!w.velocity.empty()) {
         const int axis = face_number(box_faces(c.system.dimension).at(w.face)) / 2;
         if (axis < static_cast<int>(w.velocity.size()) && w.velocity[axis] != 0.0)
           conflict(fmt::format("{}.velocity", prefix), why);
       }
     };
     for (std::size_t w = 0; w < c.boundary.walls.size(); ++w)
-      moves(c.boundary.walls[w], fmt::format("boundary.wall[{}]", w), true);
-    const std::vector<PlaneConfig>& planes = c.boundary.surfaces.of<PlaneTable>();
-    for (std::size_t p = 0; p < planes.size(); ++p) {
-      const PlaneConfig& plane = planes[p];
-      const std::string prefix = fmt::format("boundary.plane[{}]", p);
-      moves(plane.wall, prefix, false);
-      double along = 0.0;
-      for (std::size_t a = 0; a < plane.normal.size() && a < plane.wall.velocity.size(); ++a)
-        along += plane.normal[a] * plane.wall.velocity[a];
-      if (along != 0.0)
-        conflict(prefix + ".velocity", "a fixed grain would not see the moving wall coming");
-    }
+      moves(c.boundary.walls[w], fmt::format("boundary.wall[{}]", w));
+    for_each_surface_table(c.boundary.surfaces, [&](auto table, const auto& entries) {
+      for (std::size_t k = 0; k < entries.size(); ++k) {
+        if (const std::optional<TableObstacle> moving = table.normal_motion(entries[k]))
+          conflict(fmt::format("boundary.{}[{}]{}", table.key, k, moving->key), moving->why);
+      }
+    });
   }
 
   // [boundary.outlet]: what a particle that jumps back to the insertion region cannot be

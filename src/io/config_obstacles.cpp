@@ -41,6 +41,12 @@ std::optional<TransportObstacle> transport_obstacle(const Config& c) {
   if (c.boundary.shear_rate != 0.0)
     return refuse("boundary.shear_rate", "Lees-Edwards shear is a non-equilibrium state");
   if (!c.boundary.walls.empty()) return refuse("boundary.wall", "walls do not conserve momentum");
+  std::optional<TransportObstacle> surface;
+  for_each_surface_table(c.boundary.surfaces, [&](auto table, const auto& entries) {
+    if (!surface && !entries.empty())
+      surface = refuse(fmt::format("boundary.{}", table.key), "walls do not conserve momentum");
+  });
+  if (surface) return surface;
   if (!c.boundary.open.empty())
     return refuse("boundary.open", "open faces lose particles' momentum");
   for (double g : c.field.gravity)
@@ -116,10 +122,7 @@ std::optional<TransportObstacle> replica_exchange_obstacle(const Config& c) {
     return refuse("boundary.outlet", "an outlet moves particles: not an equilibrium state");
   const auto still = [&](const WallConfig& w,
                          const std::string& key) -> std::optional<TransportObstacle> {
-    bool sliding = false;
-    for (double v : w.velocity) sliding = sliding || v != 0.0;
-    if (sliding || w.amplitude != 0.0 || w.mass != 0.0)
-      return refuse(key, "a moving wall is not an equilibrium state");
+    if (wall_moves(w)) return refuse(key, "a moving wall is not an equilibrium state");
     Config probe;
     probe.interactions.contact = w.contact;
     if (transport_obstacle(probe))

@@ -136,10 +136,6 @@ std::string to_toml(const Config& config) {
     out += group_toml(contact_law_keys(), &w.contact, "boundary.wall", dimension);
     out += group_toml(wall_keys(), &w, "boundary.wall", dimension);
   }
-  for_each_surface_table(config.boundary.surfaces, [&](auto surface, const auto& entries) {
-    for (const auto& entry : entries)
-      out += fmt::format("\n[[boundary.{}]]\n{}", surface.key, surface.toml(entry, dimension));
-  });
   if (!config.boundary.container.axis.empty()) {
     out += "\n[boundary.container]\n";
     out +=
@@ -149,6 +145,11 @@ std::string to_toml(const Config& config) {
     out += "\n[boundary.outlet]\n";
     out += group_toml(outlet_keys(), &config.boundary.outlet, "boundary.outlet", dimension);
   }
+  // The surface tables after the outlet, in the order of SurfaceTables (as docs/config.md).
+  for_each_surface_table(config.boundary.surfaces, [&](auto surface, const auto& entries) {
+    for (const auto& entry : entries)
+      out += fmt::format("\n[[boundary.{}]]\n{}", surface.key, surface.toml(entry, dimension));
+  });
   out += table("driving", driving_keys(), &config.driving);
   out += table("field", field_keys(), &config.field);
   const SoftConfig& soft = config.soft;

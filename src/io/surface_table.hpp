@@ -15,6 +15,8 @@
 //   template <int D> static void add(const Config&, const std::string& prefix, Environment<D>&);
 //   static const ContactConfig& contact_law(const Config&);
 //   static std::optional<TableObstacle> motion(const Config&);  what moves it, if anything
+//   static std::optional<TableObstacle> normal_motion(const Config&);  what moves it along its
+//                                                 normal (fixed grains would not see it come)
 // `prefix` is the entry's path in messages ("boundary.plane[2]").
 #pragma once
 
@@ -68,9 +70,9 @@ class TableReading {
                                std::string_view meaning) const = 0;
 };
 
-// What keeps an entry from being still (a sliding, vibrating or rotating surface): the key
-// that moves it, after the entry's prefix ("" for the entry itself, ".angular_velocity"), and
-// why that refuses an equilibrium protocol.
+// What keeps an entry from being still (a sliding, vibrating or rotating surface), or what
+// moves it along its normal: the key that does it, after the entry's prefix ("" for the entry
+// itself, ".angular_velocity"), and why that refuses a protocol.
 struct TableObstacle {
   std::string key;
   std::string why;
@@ -79,15 +81,17 @@ struct TableObstacle {
 template <class T>
 concept SurfaceTable = requires(const typename T::Config& c, typename T::Config& m,
                                 const TableReading& r, const std::string& prefix,
-                                const RangeScales& s, Environment<3>& env3) {
+                                const RangeScales& s, Environment<2>& env2, Environment<3>& env3) {
   { T::key } -> std::convertible_to<std::string_view>;
   { T::placement() } -> std::same_as<std::vector<PlacedGroup>>;
   T::read(r, m);
   { T::toml(c, std::size_t{3}) } -> std::same_as<std::string>;
   T::check_ranges(c, prefix, s);
+  T::template add<2>(c, prefix, env2);
   T::template add<3>(c, prefix, env3);
   { T::contact_law(c) } -> std::same_as<const ContactConfig&>;
   { T::motion(c) } -> std::same_as<std::optional<TableObstacle>>;
+  { T::normal_motion(c) } -> std::same_as<std::optional<TableObstacle>>;
   requires std::equality_comparable<typename T::Config>;
 };
 

@@ -1,6 +1,6 @@
 // The registry of the boundary geometries' config tables (io/surface_table.hpp): the one line a
 // new geometry adds on the config side. Its order is the order of the tables in the written
-// config.toml and in docs/config.md.
+// config.toml and in docs/config.md (after [boundary.outlet]).
 #pragma once
 
 #include "core/type_list.hpp"

@@ -37,4 +37,12 @@ struct WallConfig {
   bool operator==(const WallConfig&) const = default;
 };
 
+// Whether a wall's keys move it (it slides, vibrates or has mass): not an equilibrium
+// boundary (replica exchange, io/config_obstacles.hpp).
+inline bool wall_moves(const WallConfig& w) {
+  bool sliding = false;
+  for (const double v : w.velocity) sliding = sliding || v != 0.0;
+  return sliding || w.amplitude != 0.0 || w.mass != 0.0;
+}
+
 }  // namespace kairos

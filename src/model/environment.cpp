@@ -85,15 +85,17 @@ void Environment<D>::check() const {
   std::size_t surface_codes = 2 * D + outlets.size();
   SurfaceGeometries<D>::each([&](auto geometry) {
     using G = typename decltype(geometry)::type;
+    static_assert(SurfaceGeometry<G, D>);
     G::check_specs(surfaces.template of<G>(), periodic_axes());
     surface_codes += G::codes(surfaces.template of<G>());
   });
   check_outlets();
   if (surface_codes > static_cast<std::size_t>(EventCode<D>::kWallCodes)) {
-    throw InputError("boundary: " + std::to_string(surface_codes - 2 * D) +
-                     " plane, cylinder and sphere walls; at most " +
-                     std::to_string(EventCode<D>::kWallCodes - 2 * D) +
-                     " fit the event codes (build a rough floor of grains instead)");
+    throw InputError(
+        "boundary: " + std::to_string(surface_codes - 2 * D) +
+        " surfaces beyond the faces (planes, cylinders, spheres, their edges, outlets); at most " +
+        std::to_string(EventCode<D>::kWallCodes - 2 * D) +
+        " fit the event codes (build a rough floor of grains instead)");
   }
   for (int a = 0; a < D; ++a) {
     if (!std::isfinite(gravity[a])) throw InputError("gravity must be finite");

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -40,6 +41,23 @@ enum class SoftCollisions { kMapped, kInstantaneous };
 // The boundary geometries beyond the box's faces, each a component of boundaries/ that keeps
 // its surfaces' specifications here: the one line a new geometry adds on the model side
 // (docs/extending.md). Their order numbers the surfaces: after the faces, before the outlets.
+//
+// A geometry is a component of the boundary registry (BoundaryComponent, model/boundaries.hpp)
+// that also has the model's side below: one surface's specification, a constructor from its
+// specifications, the box, the box's faces and the field, its checks against the box
+// (periodic[a]: axis a is periodic; InputError naming the entry), the event codes its surfaces
+// take, and a surface's contact law.
+template <class G, int D>
+concept SurfaceGeometry = requires(const std::vector<typename G::Spec>& specs,
+                                   const typename G::Spec& spec,
+                                   const std::array<bool, D>& periodic, const Vec<D>& box,
+                                   const std::array<Face<D>, 2 * D>& faces) {
+  G::check_specs(specs, periodic);
+  { G::codes(specs) } -> std::convertible_to<std::size_t>;
+  { G::contact_of(spec) } -> std::same_as<const ContactModel&>;
+  G(specs, box, faces, box);
+};
+
 template <int D>
 using SurfaceGeometries = TypeList<PlaneWalls<D>, CylinderWalls<D>, SphereWalls<D>>;
 template <class Geometry>

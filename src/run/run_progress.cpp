@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <iterator>
+#include <stdexcept>
 #include <vector>
 
 #include "core/error.hpp"
@@ -40,6 +42,14 @@ void write_progress(gsd::Writer& w, const RunProgress& progress) {
   if (progress.owed_outputs != 0) {
     const auto owed = static_cast<std::uint8_t>(progress.owed_outputs);
     w.write_chunk("kairos/run/owed", 1, 1, &owed);
+  }
+  for (const auto& [name, m] : progress.marks) {
+    const auto declared = std::find_if(std::begin(kProgressMarks), std::end(kProgressMarks),
+                                       [&](const ProgressMarkDecl& d) { return d.name == name; });
+    if (declared == std::end(kProgressMarks))
+      throw std::logic_error("restart mark '" + name + "' is not declared in kProgressMarks");
+    if (m.values.size() != declared->values || m.counts.size() != declared->counts)
+      throw std::logic_error("restart mark '" + name + "' does not have its declared sizes");
   }
   for (const ProgressMarkDecl& d : kProgressMarks) {
     const ProgressMark* m = progress.mark(d.name);

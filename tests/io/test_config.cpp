@@ -1222,6 +1222,11 @@ tangential_restitution = 0.2
 center = [3.0, 3.0, 6.0]
 radius = 0.75
 inside = false
+[boundary.outlet]
+normal = [0.0, 0.0, 1.0]
+point = [0.0, 0.0, 0.2]
+insert_lower = [1.0, 1.0, 5.0]
+insert_upper = [2.0, 2.0, 6.0]
 )",
                           "surfaces.toml");
   const auto& planes = c.boundary.surfaces.of<PlaneTable>();
@@ -1237,8 +1242,15 @@ inside = false
   EXPECT_EQ(cylinders[0].contact.restitution, 0.7);
   EXPECT_FALSE(spheres[0].inside);
   const std::string text = to_toml(c);
-  for (const char* table : {"[[boundary.plane]]", "[[boundary.cylinder]]", "[[boundary.sphere]]"})
-    EXPECT_NE(text.find(table), std::string::npos) << text;
+  // Written in the order of docs/config.md: the outlet, then the tables of SurfaceTables.
+  std::size_t at = 0;
+  for (const char* table : {"[[boundary.wall]]", "[boundary.outlet]", "[[boundary.plane]]",
+                            "[[boundary.cylinder]]", "[[boundary.sphere]]"}) {
+    const std::size_t found = text.find(table);
+    ASSERT_NE(found, std::string::npos) << table << "\n" << text;
+    EXPECT_GE(found, at) << table << "\n" << text;
+    at = found;
+  }
   const Config back = parse_config(text, "config.toml");
   EXPECT_EQ(back, c) << text;
   EXPECT_EQ(to_toml(back), text);
@@ -1491,6 +1503,24 @@ TEST(ConfigWallMass, SoftSpheresShearAndFixedGrainsAreRefused) {
   expect_error(minimal_plus("species = [{name = \"g\"}, {name = \"f\", fixed = true}]\n" +
                             std::string(kLid)),
                {"boundary.wall[1].mass", "fixed grains"});
+}
+
+// A fixed grain predicts no wall contacts: every surface table says what moves it along its
+// normal (PlaneTable::normal_motion), and only that is refused; a plane sliding in itself and a
+// rotating drum are not.
+TEST(ConfigFixedGrains, SurfacesMovingAlongTheirNormalAreRefused) {
+  const std::string fixed = "species = [{name = \"g\"}, {name = \"f\", fixed = true}]\n";
+  const std::string plane =
+      "[[boundary.plane]]\nnormal = [0.0, 0.0, 1.0]\npoint = [0.0, 0.0, 1.0]\n";
+  expect_error(minimal_plus(fixed + plane + "velocity = [0.0, 0.0, 0.5]"),
+               {"boundary.plane[0].velocity", "would not see the moving wall coming"});
+  expect_error(minimal_plus(fixed + plane + "amplitude = 0.1\nfrequency = 2.0"),
+               {"boundary.plane[0].amplitude", "would not see the moving wall coming"});
+  EXPECT_NO_THROW(parse_config(minimal_plus(fixed + plane + "velocity = [0.5, 0.0, 0.0]"), "t"));
+  EXPECT_NO_THROW(parse_config(
+      minimal_plus(fixed + "[[boundary.cylinder]]\ncenter = [5.0, 5.0, 5.0]\nradius = 4.0\n"
+                           "angular_velocity = 0.5"),
+      "t"));
 }
 
 }  // namespace

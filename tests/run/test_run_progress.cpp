@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "core/error.hpp"
@@ -106,6 +107,18 @@ TEST_F(RunProgressFile, AMarkAfterTheStateOrNotFiniteIsRefusedByName) {
                                    {0, 0}};
   EXPECT_NE(refusal(nan).find("kairos/run/production_start is not finite"), std::string::npos)
       << refusal(nan);
+}
+
+// A mark that is not declared, or not of its declared sizes, is the program's error: the
+// writer throws rather than write a chunk no reader knows, or read past the values.
+TEST_F(RunProgressFile, AnUndeclaredOrMisshapenMarkIsNotWritten) {
+  std::mt19937_64 rng(1);
+  RunProgress unknown;
+  unknown.marks["thermo_mrak"] = {{1.0, 0.0}, {0, 1}};
+  EXPECT_THROW(write_restart_file<3>(dir_ / "a.gsd", state_, rng, unknown), std::logic_error);
+  RunProgress short_one;
+  short_one.marks["thermo_mark"] = {{1.0}, {0, 1}};
+  EXPECT_THROW(write_restart_file<3>(dir_ / "b.gsd", state_, rng, short_one), std::logic_error);
 }
 
 }  // namespace

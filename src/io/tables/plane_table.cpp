@@ -173,6 +173,10 @@ void PlaneTable::check_ranges(const PlaneConfig& plane, const std::string& prefi
   for (std::size_t a = 0; a < plane.point.size(); ++a)
     range_checks::length_within_box(fmt::format("{}.point[{}]", prefix, a), plane.point[a], s);
   range_checks::check_wall(plane.wall, prefix, s.longest_edge(), s);
+  if (plane.hole_radius > 0.0) {
+    range_checks::within_declared(prefix + ".hole_radius", plane.hole_radius, s.d_max,
+                                  range_checks::length_unit(s));
+  }
 }
 
 template <int D>
@@ -196,10 +200,20 @@ void PlaneTable::add(const PlaneConfig& pc, const std::string& prefix, Environme
 }
 
 std::optional<TableObstacle> PlaneTable::motion(const PlaneConfig& plane) {
-  bool sliding = false;
-  for (const double v : plane.wall.velocity) sliding = sliding || v != 0.0;
-  if (sliding || plane.wall.amplitude != 0.0 || plane.wall.mass != 0.0)
-    return TableObstacle{"", "a moving wall is not an equilibrium state"};
+  if (wall_moves(plane.wall)) return TableObstacle{"", "a moving wall is not an equilibrium state"};
+  return std::nullopt;
+}
+
+// A vibration, a mass or a velocity along its normal (fixed grains predict no wall contacts).
+std::optional<TableObstacle> PlaneTable::normal_motion(const PlaneConfig& plane) {
+  const char* why = "a fixed grain would not see the moving wall coming";
+  if (plane.wall.amplitude > 0.0 && plane.wall.frequency > 0.0)
+    return TableObstacle{".amplitude", why};
+  if (plane.wall.mass > 0.0) return TableObstacle{".mass", why};
+  double along = 0.0;
+  for (std::size_t a = 0; a < plane.normal.size() && a < plane.wall.velocity.size(); ++a)
+    along += plane.normal[a] * plane.wall.velocity[a];
+  if (along != 0.0) return TableObstacle{".velocity", why};
   return std::nullopt;
 }
 

@@ -46,6 +46,7 @@ struct PlaneTable {
   static void add(const PlaneConfig& plane, const std::string& prefix, Environment<D>& env);
   static const ContactConfig& contact_law(const PlaneConfig& plane) { return plane.wall.contact; }
   static std::optional<TableObstacle> motion(const PlaneConfig& plane);
+  static std::optional<TableObstacle> normal_motion(const PlaneConfig& plane);
 };
 
 }  // namespace kairos

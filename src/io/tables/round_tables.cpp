@@ -134,6 +134,12 @@ std::optional<TableObstacle> RoundTable<Sphere>::motion(const CylinderConfig& ro
   return std::nullopt;
 }
 
+// Its rotation moves it within its own surface, never along its normal.
+template <bool Sphere>
+std::optional<TableObstacle> RoundTable<Sphere>::normal_motion(const CylinderConfig& /*round*/) {
+  return std::nullopt;
+}
+
 template struct RoundTable<false>;
 template struct RoundTable<true>;
 template void RoundTable<false>::add<2>(const CylinderConfig&, const std::string&, Environment<2>&);

@@ -41,6 +41,7 @@ struct RoundTable {
   static void add(const CylinderConfig& round, const std::string& prefix, Environment<D>& env);
   static const ContactConfig& contact_law(const CylinderConfig& round) { return round.contact; }
   static std::optional<TableObstacle> motion(const CylinderConfig& round);
+  static std::optional<TableObstacle> normal_motion(const CylinderConfig& round);
 };
 
 using CylinderTable = RoundTable<false>;
