@@ -1,3 +1,4 @@
+// The checks io/range_checks.hpp declares (its comments say what each does).
 #include "io/range_checks.hpp"
 
 #include <fmt/format.h>
@@ -38,7 +39,6 @@ double RangeScales::longest_edge() const {
 
 namespace range_checks {
 
-// "KEY = VALUE: out of range, must be in [LO, HI] (WHY)".
 [[noreturn]] void out_of_range(const std::string& key, double value, double lo, double hi,
                                const std::string& why) {
   throw InputError(fmt::format("{} = {}: out of range, must be in [{:.6g}, {:.6g}] ({})", key,
@@ -49,8 +49,6 @@ void within(const std::string& key, double value, double lo, double hi, const st
   if (!(value >= lo && value <= hi)) out_of_range(key, value, lo, hi, why);
 }
 
-// A bound as a message writes it: 1e9, 1e-9, 1e3 (powers of ten from 1e3 up or 1e-3 down),
-// else as {:g} does (0.5, 10).
 std::string short_number(double v) {
   const std::string e = fmt::format("{:.0e}", v);  // "1e+09", "1e-09", "5e-01"
   const int exponent = std::stoi(e.substr(e.find('e') + 1));
@@ -59,14 +57,10 @@ std::string short_number(double v) {
   return fmt::format("{:g}", v);
 }
 
-// The range declared for a key (io/keys/), by its path ("contact.pair[0].tc").
 const Range& declared(const std::string& key) {
   return find_declared(key)->decl->range;
 }
 
-// `key` against its declared range in units of `unit`, whose value and meaning `unit_text`
-// gives: "KEY = V: out of range, must be in [LO, HI] (up to 1e9 times UNIT_TEXT)". `also` (e.g.
-// ", or -1 for automatic") is added.
 void within_declared(const std::string& key, double value, double unit,
                      const std::string& unit_text, const std::string& also) {
   const Range& r = declared(key);
@@ -76,7 +70,6 @@ void within_declared(const std::string& key, double value, double unit,
   within(key, value, r.lo * unit, r.hi * unit, span + unit_text + also);
 }
 
-// The same for a magnitude (a signed value, or 0 meaning off).
 void magnitude_within(const std::string& key, double value, double hi, const std::string& why) {
   if (!(std::abs(value) <= hi)) {
     throw InputError(fmt::format("{} = {}: out of range, its magnitude must be at most {:.6g} ({})",
@@ -84,7 +77,6 @@ void magnitude_within(const std::string& key, double value, double hi, const std
   }
 }
 
-// How the scales read in a message.
 std::string energy_unit(const RangeScales& s) {
   return fmt::format("kT = {:.6g}, system.temperature", s.kT);
 }
@@ -101,8 +93,6 @@ std::string time_unit(const RangeScales& s) {
 std::string length_unit(const RangeScales& s) {
   return fmt::format("d = {:.6g}, the largest diameter", s.d_max);
 }
-
-// ----- contact laws ([contact], [[contact.pair]], walls)
 
 void check_contact(const ContactConfig& c, const std::string& prefix, const RangeScales& s) {
   const double v = s.speed();
@@ -124,8 +114,6 @@ void length_within_box(const std::string& key, double value, const RangeScales& 
                    fmt::format("1e6 times the longest box edge, {:.6g}", longest));
 }
 
-// A wall's contact law and motion ([[boundary.wall]] at a face, or a [[boundary.plane]]): its
-// amplitude is measured in box edges along its axis (`edge`: for a plane, the longest edge).
 void check_wall(const WallConfig& w, const std::string& prefix, double edge, const RangeScales& s) {
   check_contact(w.contact, prefix, s);
   const double v = s.speed();

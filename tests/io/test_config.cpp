@@ -1,6 +1,7 @@
 // Tests for the run configuration: defaults, every class of input error, overrides, round trip.
 #include "io/config.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <array>
@@ -1183,24 +1184,16 @@ TEST(ConfigToToml, RoundTripWithEveryGranularKey) {
 // Every surface table (io/surface_tables.hpp) writes its entries and reads them back exactly,
 // each entry's contact law starting from [contact]'s.
 TEST(ConfigToToml, RoundTripWithEverySurfaceTable) {
+  std::string walls;
+  for (const char* face : {"x-", "x+", "y-", "y+", "z-", "z+"})
+    walls += fmt::format("[[boundary.wall]]\nface = \"{}\"\n", face);
   Config c = parse_config(R"([system]
 particles = 200
 packing_fraction = 0.2
 box_scale = [1.0, 1.0, 3.0]
 [contact]
 restitution = 0.7
-[[boundary.wall]]
-face = "z-"
-[[boundary.wall]]
-face = "z+"
-[[boundary.wall]]
-face = "x-"
-[[boundary.wall]]
-face = "x+"
-[[boundary.wall]]
-face = "y-"
-[[boundary.wall]]
-face = "y+"
+)" + walls + R"(
 [[boundary.plane]]
 normal = [0.0, 0.0, 1.0]
 point = [0.0, 0.0, 0.5]
