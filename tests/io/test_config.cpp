@@ -1,7 +1,7 @@
-// Tests for the run configuration: defaults, every class of input error, overrides, round trip.
+// Tests for the run configuration: defaults, every class of input error, overrides, round trip
+// (the boundary geometries' tables: tests/io/test_surface_tables.cpp).
 #include "io/config.hpp"
 
-#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <array>
@@ -18,40 +18,14 @@
 #include <utility>
 #include <vector>
 
+#include "config_testing.hpp"
 #include "core/error.hpp"
 #include "special_files.hpp"
 
 namespace kairos {
 namespace {
 
-constexpr std::string_view kMinimal = R"([system]
-particles = 500
-packing_fraction = 0.3
-)";
-
-// kMinimal with extra lines appended inside [system] (or new tables after it).
-std::string minimal_plus(std::string_view extra) {
-  return std::string(kMinimal) + std::string(extra) + "\n";
-}
-
-// Parses `text` expecting an InputError; checks the message is one line and holds every fragment.
-std::string expect_error(std::string_view text, std::initializer_list<std::string_view> fragments,
-                         const std::vector<std::string>& overrides = {}) {
-  std::string message;
-  try {
-    parse_config(text, "test.toml", overrides);
-    ADD_FAILURE() << "no InputError for:\n" << text;
-    return {};
-  } catch (const InputError& e) {
-    message = e.what();
-  }
-  EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
-  for (const std::string_view fragment : fragments) {
-    EXPECT_NE(message.find(fragment), std::string::npos)
-        << "message lacks '" << fragment << "': " << message;
-  }
-  return message;
-}
+using namespace config_testing;
 
 // ----- defaults and plain parsing
 
@@ -1181,74 +1155,6 @@ TEST(ConfigToToml, RoundTripWithEveryGranularKey) {
   EXPECT_EQ(parse_config(to_toml(d_back), "config.toml"), d_back);
 }
 
-// Every surface table (io/surface_tables.hpp) writes its entries and reads them back exactly,
-// each entry's contact law starting from [contact]'s.
-TEST(ConfigToToml, RoundTripWithEverySurfaceTable) {
-  std::string walls;
-  for (const char* face : {"x-", "x+", "y-", "y+", "z-", "z+"})
-    walls += fmt::format("[[boundary.wall]]\nface = \"{}\"\n", face);
-  Config c = parse_config(R"([system]
-particles = 200
-packing_fraction = 0.2
-box_scale = [1.0, 1.0, 3.0]
-[contact]
-restitution = 0.7
-)" + walls + R"(
-[[boundary.plane]]
-normal = [0.0, 0.0, 1.0]
-point = [0.0, 0.0, 0.5]
-hole_radius = 1.5
-restitution = 0.5
-[[boundary.plane]]
-normal = [0.0, 1.0, 1.0]
-point = [0.0, 0.0, 3.0]
-span_axis = "y"
-span_max = 2.0
-[[boundary.cylinder]]
-axis = "x"
-center = [0.0, 3.0, 3.0]
-radius = 2.5
-angular_velocity = 0.125
-friction = 0.5
-tangential_restitution = 0.2
-[[boundary.sphere]]
-center = [3.0, 3.0, 6.0]
-radius = 0.75
-inside = false
-[boundary.outlet]
-normal = [0.0, 0.0, 1.0]
-point = [0.0, 0.0, 0.2]
-insert_lower = [1.0, 1.0, 5.0]
-insert_upper = [2.0, 2.0, 6.0]
-)",
-                          "surfaces.toml");
-  const auto& planes = c.boundary.surfaces.of<PlaneTable>();
-  const auto& cylinders = c.boundary.surfaces.of<CylinderTable>();
-  const auto& spheres = c.boundary.surfaces.of<SphereTable>();
-  ASSERT_EQ(planes.size(), 2u);
-  ASSERT_EQ(cylinders.size(), 1u);
-  ASSERT_EQ(spheres.size(), 1u);
-  EXPECT_EQ(planes[0].wall.contact.restitution, 0.5);
-  EXPECT_EQ(planes[1].wall.contact.restitution, 0.7);  // [contact]'s
-  EXPECT_EQ(planes[1].span_max, 2.0);
-  EXPECT_EQ(cylinders[0].contact.friction, 0.5);
-  EXPECT_EQ(cylinders[0].contact.restitution, 0.7);
-  EXPECT_FALSE(spheres[0].inside);
-  const std::string text = to_toml(c);
-  // Written in the order of docs/config.md: the outlet, then the tables of SurfaceTables.
-  std::size_t at = 0;
-  for (const char* table : {"[[boundary.wall]]", "[boundary.outlet]", "[[boundary.plane]]",
-                            "[[boundary.cylinder]]", "[[boundary.sphere]]"}) {
-    const std::size_t found = text.find(table);
-    ASSERT_NE(found, std::string::npos) << table << "\n" << text;
-    EXPECT_GE(found, at) << table << "\n" << text;
-    at = found;
-  }
-  const Config back = parse_config(text, "config.toml");
-  EXPECT_EQ(back, c) << text;
-  EXPECT_EQ(to_toml(back), text);
-}
-
 TEST(ConfigToToml, MinimalConfigWritesEveryKeyWithResolvedDefaults) {
   const Config c = parse_config(kMinimal, "t.toml");
   const std::string text = to_toml(c);
@@ -1484,36 +1390,12 @@ TEST(ConfigWallMass, NegativeMassIsAnError) {
                {"boundary.wall[1].mass", "must be in [0, 1e+09]"});
 }
 
-TEST(ConfigWallMass, APlaneWithMassIsAnError) {
-  expect_error(minimal_plus("[[boundary.plane]]\nnormal = [0.0, 0.0, 1.0]\npoint = [0.0, 0.0, "
-                            "1.0]\nmass = 5.0"),
-               {"boundary.plane[0].mass", "only the walls on the box's faces"});
-}
-
 TEST(ConfigWallMass, SoftSpheresShearAndFixedGrainsAreRefused) {
   expect_error(minimal_plus(std::string(kLid) + "[soft]\nmodel = \"dashpot\"\nstiffness = 1e4"),
                {"soft.model", "a wall with mass"});
   expect_error(minimal_plus("species = [{name = \"g\"}, {name = \"f\", fixed = true}]\n" +
                             std::string(kLid)),
                {"boundary.wall[1].mass", "fixed grains"});
-}
-
-// A fixed grain predicts no wall contacts: every surface table says what moves it along its
-// normal (PlaneTable::normal_motion), and only that is refused; a plane sliding in itself and a
-// rotating drum are not.
-TEST(ConfigFixedGrains, SurfacesMovingAlongTheirNormalAreRefused) {
-  const std::string fixed = "species = [{name = \"g\"}, {name = \"f\", fixed = true}]\n";
-  const std::string plane =
-      "[[boundary.plane]]\nnormal = [0.0, 0.0, 1.0]\npoint = [0.0, 0.0, 1.0]\n";
-  expect_error(minimal_plus(fixed + plane + "velocity = [0.0, 0.0, 0.5]"),
-               {"boundary.plane[0].velocity", "would not see the moving wall coming"});
-  expect_error(minimal_plus(fixed + plane + "amplitude = 0.1\nfrequency = 2.0"),
-               {"boundary.plane[0].amplitude", "would not see the moving wall coming"});
-  EXPECT_NO_THROW(parse_config(minimal_plus(fixed + plane + "velocity = [0.5, 0.0, 0.0]"), "t"));
-  EXPECT_NO_THROW(parse_config(
-      minimal_plus(fixed + "[[boundary.cylinder]]\ncenter = [5.0, 5.0, 5.0]\nradius = 4.0\n"
-                           "angular_velocity = 0.5"),
-      "t"));
 }
 
 }  // namespace
