@@ -10,16 +10,25 @@
 
 namespace kairos {
 
+namespace {
+
+// The first surface table with entries ("boundary.plane"; io/surface_tables.hpp), if any.
+std::optional<std::string> first_surface_table(const Config& c) {
+  std::optional<std::string> first;
+  for_each_surface_table(c.boundary.surfaces, [&](auto table, const auto& entries) {
+    if (!first && !entries.empty()) first = fmt::format("boundary.{}", table.key);
+  });
+  return first;
+}
+
+}  // namespace
+
 std::optional<TransportObstacle> compression_obstacle(const Config& c) {
   const auto refuse = [](std::string key, std::string why) {
     return TransportObstacle{std::move(key), std::move(why)};
   };
   const char* box = "the particles grow in a periodic box or between walls on its faces";
-  std::optional<TransportObstacle> surface;
-  for_each_surface_table(c.boundary.surfaces, [&](auto table, const auto& entries) {
-    if (!surface && !entries.empty()) surface = refuse(fmt::format("boundary.{}", table.key), box);
-  });
-  if (surface) return surface;
+  if (const std::optional<std::string> table = first_surface_table(c)) return refuse(*table, box);
   if (!c.boundary.open.empty()) return refuse("boundary.open", box);
   if (c.boundary.shear_rate != 0.0) return refuse("boundary.shear_rate", box);
   if (std::any_of(c.field.gravity.begin(), c.field.gravity.end(),
@@ -41,12 +50,8 @@ std::optional<TransportObstacle> transport_obstacle(const Config& c) {
   if (c.boundary.shear_rate != 0.0)
     return refuse("boundary.shear_rate", "Lees-Edwards shear is a non-equilibrium state");
   if (!c.boundary.walls.empty()) return refuse("boundary.wall", "walls do not conserve momentum");
-  std::optional<TransportObstacle> surface;
-  for_each_surface_table(c.boundary.surfaces, [&](auto table, const auto& entries) {
-    if (!surface && !entries.empty())
-      surface = refuse(fmt::format("boundary.{}", table.key), "walls do not conserve momentum");
-  });
-  if (surface) return surface;
+  if (const std::optional<std::string> table = first_surface_table(c))
+    return refuse(*table, "walls do not conserve momentum");
   if (!c.boundary.open.empty())
     return refuse("boundary.open", "open faces lose particles' momentum");
   for (double g : c.field.gravity)

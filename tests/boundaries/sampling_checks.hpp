@@ -1,10 +1,13 @@
 // The check every boundary component's event times pass against dense sampling, and the
-// energy budget of a silo test.
+// grains and energy budget of a silo test.
 #pragma once
 
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include "dynamics/collision_time.hpp"
+#include "model/environment.hpp"
 
 namespace kairos::testing {
 
@@ -19,6 +22,28 @@ inline bool agrees_with_sampling(double predicted, double sampled, double h, int
   EXPECT_LE(predicted, sampled + 1e-12) << k;
   EXPECT_GT(predicted, sampled - h - 1e-12) << k;
   return true;
+}
+
+// A silo's environment before its floor and outlet: the box's `faces`, gravity -1 along the
+// last axis, rough inelastic grains (restitution e, constant tangential restitution 0.4, the TC
+// model at 1e-4) against each other and the faces. No sleeping, as in the silo examples: a
+// draining silo with sleeping stops (the sleep rule holds grains on slopes steeper than
+// friction would), and whether it stops within a test's events is a matter of the
+// trajectory's last bits.
+template <int D>
+Environment<D> silo_grains(const std::array<Face<D>, 2 * D>& faces, double e) {
+  Environment<D> env;
+  env.gravity[D - 1] = -1.0;
+  ContactModel law;
+  law.normal = NormalRestitution::constant(e);
+  law.tangential = TangentialModel::constant(0.4);
+  env.species = 1;
+  env.contact = {law};
+  env.tc = 1e-4;
+  env.sleep_speed = 0.0;
+  env.faces = faces;
+  for (Face<D>& f : env.faces) f.wall.contact = law;
+  return env;
 }
 
 // A silo's energy budget, unit masses under g = 1 along the last axis: kinetic + rotational +

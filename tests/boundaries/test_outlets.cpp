@@ -185,25 +185,12 @@ using Engine = EventEngine<D, CalendarQueue>;
 // outlet a radius below the floor, the particles put back in the top third at rest. Rough,
 // inelastic grains (TC model) under gravity -1.
 Environment<D> silo(double e, double width = 5.0) {
-  Environment<D> env;
-  env.gravity = {0.0, -1.0};
-  ContactModel law;
-  law.normal = NormalRestitution::constant(e);
-  law.tangential = TangentialModel::constant(0.4);
-  env.species = 1;
-  env.contact = {law};
-  env.tc = 1e-4;
-  // No sleeping, as in the silo examples: a draining silo with sleeping stops (the sleep rule
-  // holds grains on slopes steeper than friction would), and whether it stops within a test's
-  // events is a matter of the trajectory's last bits.
-  env.sleep_speed = 0.0;
-  env.faces = side_walls_and_floor<D>();
-  for (Face<D>& f : env.faces) f.wall.contact = law;
+  Environment<D> env = testing::silo_grains<D>(side_walls_and_floor<D>(), e);
   env.faces[3].kind = FaceKind::kOpen;
   const double c = 8.0;
   for (PlaneWall<D> p : {floor_strip<D>(4.0, -kNever, c - 0.5 * width),
                          floor_strip<D>(4.0, c + 0.5 * width, kNever)}) {
-    p.wall.contact = law;
+    p.wall.contact = env.contact[0];
     surface_specs<PlaneWalls<D>>(env).push_back(p);
   }
   Outlet<D> o;
@@ -231,14 +218,10 @@ ParticleSystem<D> grains_above_the_floor(std::uint64_t seed) {
   return s;
 }
 
-double budget(const Engine& engine) {
-  return testing::silo_budget(engine);
-}
-
 TEST(OutletsInTheEngine, GrainsDrainThroughTheOrificeAndComeBackAtTheTop) {
   const Environment<D> env = silo(0.8);
   Engine engine(grains_above_the_floor(1), StartMode::kPredict, EngineOptions{}, env);
-  const double e0 = budget(engine);
+  const double e0 = testing::silo_budget(engine);
   const Outlet<D>& o = env.outlets[0];
   int passes = 0, edge_hits = 0;
   for (int k = 0; k < 100000; ++k) {
@@ -276,7 +259,7 @@ TEST(OutletsInTheEngine, GrainsDrainThroughTheOrificeAndComeBackAtTheTop) {
   EXPECT_GT(passes, 30);
   EXPECT_GT(edge_hits, 5);
   const EventCounters& c = engine.counters();
-  EXPECT_NEAR(budget(engine), e0,
+  EXPECT_NEAR(testing::silo_budget(engine), e0,
               1e-12 * (std::abs(e0) + std::abs(c.outlet_energy) + c.dissipated_in_collisions));
   EXPECT_LT(engine.max_overlap_now(), 1e-10);
   // No centre ever below the outlet, none inside the floor.

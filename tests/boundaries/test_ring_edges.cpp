@@ -103,20 +103,10 @@ using Engine = EventEngine<D, CalendarQueue>;
 // diameters) in its middle, an outlet a radius below the floor, the grains put back in the top
 // third at rest. Rough inelastic grains under gravity -1, no sleeping.
 Environment<D> round_silo() {
-  Environment<D> env;
-  env.gravity = {0.0, 0.0, -1.0};
-  ContactModel law;
-  law.normal = NormalRestitution::constant(0.8);
-  law.tangential = TangentialModel::constant(0.4);
-  env.species = 1;
-  env.contact = {law};
-  env.tc = 1e-4;
-  env.sleep_speed = 0.0;
-  env.faces = walls_all_round();
-  for (Face<D>& f : env.faces) f.wall.contact = law;
+  Environment<D> env = testing::silo_grains<D>(walls_all_round(), 0.8);
   env.faces[5].kind = FaceKind::kOpen;
   PlaneWall<D> floor = holed_floor(4.0, 2.0, 5.0, 5.0);
-  floor.wall.contact = law;
+  floor.wall.contact = env.contact[0];
   surface_specs<PlaneWalls<D>>(env) = {floor};
   Outlet<D> o;
   o.normal = {0.0, 0.0, 1.0};
@@ -145,14 +135,10 @@ ParticleSystem<D> grains(std::uint64_t seed) {
   return s;
 }
 
-double budget(const Engine& engine) {
-  return testing::silo_budget(engine);
-}
-
 TEST(RingEdgesInTheEngine, GrainsDrainThroughARoundOrificeAndMeetItsRim) {
   const Environment<D> env = round_silo();
   Engine engine(grains(2), StartMode::kPredict, EngineOptions{}, env);
-  const double e0 = budget(engine);
+  const double e0 = testing::silo_budget(engine);
   int rim_hits = 0;
   for (int k = 0; k < 120000; ++k) {
     const EventKind kind = engine.step();
@@ -170,7 +156,7 @@ TEST(RingEdgesInTheEngine, GrainsDrainThroughARoundOrificeAndMeetItsRim) {
   EXPECT_GT(engine.counters().outlet_passes, 20u);
   EXPECT_GT(rim_hits, 5);
   const EventCounters& c = engine.counters();
-  EXPECT_NEAR(budget(engine), e0,
+  EXPECT_NEAR(testing::silo_budget(engine), e0,
               1e-12 * (std::abs(e0) + std::abs(c.outlet_energy) + c.dissipated_in_collisions));
   EXPECT_LT(engine.max_overlap_now(), 1e-10);
   // No centre inside the plate outside the hole.
